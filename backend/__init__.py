@@ -1,0 +1,19 @@
+"""Blender-free OmniNoise engines (numpy; onnxruntime for neural models).
+
+Wave noise (Guehl et al., "Multi-Dimensional Procedural Wave Noise", TOG 2025):
+
+    >>> from backend import WaveSettings, Spectrum, compile_noise, evaluate_grid
+    >>> noise = compile_noise(WaveSettings(dim=2, spectrum=Spectrum("bandpass", 4, 8)))
+    >>> img = evaluate_grid(noise, size=256, extent=4.0)     # float32 (256, 256)
+
+Nothing here imports ``bpy`` or ``torch``.
+"""
+from .errors import SettingError
+from .spectra import Spectrum
+from .tables import WaveTable, build_table
+from .settings import WaveSettings, compile_noise
+from .grid import evaluate_grid, evaluate_points, Cancelled
+
+__all__ = ["SettingError", "Spectrum", "WaveTable", "build_table", "WaveSettings", "compile_noise",
+           "evaluate_grid", "evaluate_points", "Cancelled"]
+__version__ = "0.1.0"

@@ -1,0 +1,166 @@
+"""Plain, serialisable wave-noise settings and their compilation into evaluators.
+
+:class:`WaveSettings` holds only numbers, strings and tuples, so the CLI, job
+files and Blender properties can all build one; :func:`compile_noise` turns it
+into a :class:`~backend.wave.WaveNoise` or :class:`~backend.cellular.CellularNoise`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .byexample import PLANES, example_table
+from .cellular import CELLULAR_MODES, CellularNoise
+from .directions import DirectionSet, Domain
+from .errors import SettingError
+from .spectra import Spectrum
+from .tables import DEFAULT_SIZE, WAVEFORMS, build_axis_table, build_table, build_waveform_table
+from .wave import OUTPUTS, Transition, WaveNoise
+
+__all__ = ["WaveSettings", "compile_noise", "table_rng"]
+
+ANISOTROPY = ("none", "axes", "lobes")
+
+
+@dataclass(frozen=True)
+class WaveSettings:
+    """Everything that defines a wave noise.
+
+    dim              2, 3 or 4 (4D: the fourth coordinate is W / time)
+    spectrum         isotropic amplitude profile (cycles per unit)
+    directions       number of wave directions K
+    seed             integer in [0, 2^24): table phases and every hashed random number
+    output           real | imag | modulus | phase
+    speed            wave speed v (units per unit time, Eq. 9); animated noise when non-zero
+    slice_width      W in world units; None = 6 / (mean frequency of the table)
+    waveform         gaussian | crystal | wired | custom (with ``profile``)
+    cellular         none | polytope | code | stit
+    cell_size        cellular plane spacing (world units); None = 1 / fmin-ish
+    stit_probability, stit_depth   STIT recursion controls
+    anisotropy       none | axes (``axis_spectra``, one per axis) | lobes (``lobes``)
+    lobes            ((axis vector), weight) pairs; ``spread`` = lobe half-angle, degrees
+    example          grayscale image (H, W) for by-example noise; ``example_plane``,
+                     ``example_extent`` (world units across the image), ``sectors``
+    transition_to    a second Spectrum to blend towards along ``transition_axis``
+                     from ``transition_origin`` over ``transition_length``
+    table_size       samples per wave table (N_x)
+    table_period     world units per table period (None: (256 - 1) / fmax)
+    """
+
+    dim: int = 2
+    spectrum: Spectrum = field(default_factory=Spectrum)
+    directions: int = 16
+    seed: int = 0
+    output: str = "real"
+    speed: float = 0.0
+    slice_width: float | None = None
+    waveform: str = "gaussian"
+    profile: tuple = ()
+    cellular: str = "none"
+    cell_size: float | None = None
+    stit_probability: float = 0.5
+    stit_depth: int = 3
+    anisotropy: str = "none"
+    axis_spectra: tuple = ()
+    lobes: tuple = ()
+    spread: float = 20.0
+    example: np.ndarray | None = field(default=None, compare=False, repr=False)
+    example_plane: str = "xy"
+    example_extent: float = 1.0
+    sectors: int = 8
+    transition_to: Spectrum | None = None
+    transition_origin: tuple = ()
+    transition_axis: tuple = ()
+    transition_length: float = 1.0
+    table_size: int = DEFAULT_SIZE
+    table_period: float | None = None
+
+    def replace(self, **kw) -> "WaveSettings":
+        return replace(self, **kw)
+
+    def validate(self) -> "WaveSettings":
+        if self.dim not in (2, 3, 4):
+            raise SettingError("dim", f"must be 2, 3 or 4, got {self.dim}")
+        if int(self.directions) < 1:
+            raise SettingError("directions", f"must be at least 1, got {self.directions}")
+        if self.output not in OUTPUTS:
+            raise SettingError("output", f"unknown output {self.output!r}; choose one of {', '.join(OUTPUTS)}")
+        if self.waveform not in WAVEFORMS:
+            raise SettingError("waveform", f"unknown waveform {self.waveform!r}; choose one of {', '.join(WAVEFORMS)}")
+        if self.cellular not in CELLULAR_MODES:
+            raise SettingError("cellular", f"unknown mode {self.cellular!r}; choose one of {', '.join(CELLULAR_MODES)}")
+        if self.anisotropy not in ANISOTROPY:
+            raise SettingError("anisotropy", f"unknown mode {self.anisotropy!r}; choose one of {', '.join(ANISOTROPY)}")
+        if self.example is not None and self.example_plane not in PLANES:
+            raise SettingError("example plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")
+        if not 0.0 < self.spread <= 90.0:
+            raise SettingError("spread", f"must lie in (0, 90] degrees, got {self.spread:g}")
+        self.spectrum.validate()
+        return self
+
+    @property
+    def animated(self) -> bool:
+        return self.speed != 0.0
+
+
+def table_rng(seed: int) -> np.random.Generator:
+    """The generator behind a table's random phases: one stream per seed."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), 0x0A11E]))
+
+
+def _domains(s: WaveSettings) -> tuple[list[Domain], tuple]:
+    d = s.dim
+    last = tuple(np.eye(d)[d - 1])
+    if s.example is not None:
+        a, b, c = PLANES[s.example_plane]
+        if d == 2:
+            return [Domain("cap", 2, np.pi / 2, (0.0, 1.0), full=s.animated)], (0, 1)
+        if d == 3:
+            return [Domain("band", 3, np.radians(s.spread), (a, b, c))], (a, b)
+        raise SettingError("example", "by-example noise is 2D or 3D")
+    if s.anisotropy == "lobes":
+        if not s.lobes:
+            raise SettingError("lobes", "lobe anisotropy needs at least one (axis, weight) lobe")
+        doms = []
+        for axis, weight in s.lobes:
+            v = np.asarray(axis, dtype=np.float64)
+            if v.shape != (d,) or not np.linalg.norm(v) > 0:
+                raise SettingError("lobes", f"lobe axis {tuple(axis)} must be a non-zero {d}-vector")
+            doms.append(Domain("cap", d, np.radians(s.spread), tuple(v / np.linalg.norm(v)), weight=float(weight)))
+        return doms, (0, 1)
+    return [Domain("cap", d, np.pi / 2, last, full=s.animated)], (0, 1)
+
+
+def compile_noise(s: WaveSettings) -> WaveNoise | CellularNoise:
+    """Build tables and direction strata for settings ``s``."""
+    s.validate()
+    domains, plane = _domains(s)
+    dirs = DirectionSet.build(int(s.directions), domains)
+    if s.cellular != "none":
+        cell = s.cell_size if s.cell_size is not None else 2.0 / max(s.spectrum.fmin, s.spectrum.fmax / 4)
+        depth = s.stit_depth if s.cellular == "stit" else 0
+        return CellularNoise(dirs, s.seed, cell, s.stit_probability, depth)
+    rng = table_rng(s.seed)
+    if s.example is not None:
+        table = example_table(s.example, s.dim, rng, s.sectors, s.example_extent)
+    elif s.waveform != "gaussian":
+        table = build_waveform_table(s.waveform, rng, s.spectrum.fmax, s.dim, s.table_size,
+                                     profile=np.asarray(s.profile) if s.profile else None)
+    elif s.anisotropy == "axes":
+        table = build_axis_table(list(s.axis_spectra), s.dim, rng, s.table_size, s.table_period)
+    else:
+        table = build_table(s.spectrum, s.dim, rng, s.table_size, s.table_period)
+    transition = None
+    if s.transition_to is not None:
+        # same generator state -> identical phases (Sec. 4.3 uni-phase waves)
+        pair = build_axis_table([s.spectrum, s.transition_to], s.dim, table_rng(s.seed), s.table_size,
+                                s.table_period, mode="sectors")
+        table = type(table)(pair.values[:1], pair.period, "single", s.dim, table.meta)
+        axis = np.asarray(s.transition_axis or np.eye(s.dim)[0], np.float32)
+        origin = np.asarray(s.transition_origin or np.zeros(s.dim), np.float32)
+        if axis.shape != (s.dim,) or origin.shape != (s.dim,):
+            raise SettingError("transition", f"origin and axis must be {s.dim}-vectors")
+        transition = Transition(pair.values[1:2], origin, axis / np.linalg.norm(axis), float(s.transition_length))
+    width = s.slice_width if s.slice_width is not None else 6.0 / table.mean_frequency()
+    return WaveNoise(table, dirs, s.seed, width, s.speed, transition, plane)
