@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import fast
 from .directions import DirectionSet, map_directions
 from .errors import SettingError
 from .hashing import MAX_EXACT_ID, white_noise4
@@ -151,15 +152,20 @@ class WaveNoise:
             val = val + (vb - val) * beta
         return val
 
-    def evaluate(self, x: np.ndarray, time: float | np.ndarray = 0.0) -> np.ndarray:
+    def evaluate(self, x: np.ndarray, time: float | np.ndarray = 0.0, accelerate: bool = True) -> np.ndarray:
         """Complex noise at points x: float32 (P, dim) -> complex64 (P,).
 
         ``time`` (scalar or (P,)) shifts every wave by speed * time along its
         direction (Eq. 9).  For 4D noise the fourth coordinate is part of x.
+        ``accelerate`` uses the compiled path of :mod:`backend.fast` when it applies.
         """
         x = np.ascontiguousarray(x, dtype=_F)
         if x.ndim != 2 or x.shape[1] != self.dim:
             raise SettingError("points", f"expected shape (P, {self.dim}), got {x.shape}")
+        if accelerate:
+            z = fast.evaluate(self, x, time)
+            if z is not None:
+                return z
         shift = _F(self.speed) * np.asarray(time, _F)
         beta = self.transition.factor(x) if self.transition is not None else None
         z = np.zeros(len(x), np.complex64)

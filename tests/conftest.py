@@ -1,0 +1,28 @@
+import os
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+if ROOT not in sys.path:
+    sys.path.insert(0, ROOT)
+
+
+def radial_psd(img: np.ndarray, extent: float, nbins: int | None = None):
+    """Radially averaged power spectrum of a 2D image: (freqs cycles/unit, power)."""
+    n = img.shape[0]
+    F = np.abs(np.fft.fft2(img - img.mean())) ** 2
+    f = np.fft.fftfreq(n, d=extent / n)
+    R = np.hypot(*np.meshgrid(f, f, indexing="ij"))
+    df = 1.0 / extent
+    b = np.rint(R / df).astype(int)
+    nb = nbins or n // 2
+    tot = np.bincount(b.ravel(), F.ravel(), minlength=nb + 1)[: nb + 1]
+    cnt = np.bincount(b.ravel(), minlength=nb + 1)[: nb + 1]
+    return np.arange(nb + 1) * df, tot / np.maximum(cnt, 1), F, R, f
+
+
+@pytest.fixture
+def psd():
+    return radial_psd

@@ -1,0 +1,71 @@
+"""The `omninoise wave` command-line contract."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from backend.cli import main
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def run(capsys, *args):
+    rc = main(["wave", *args])
+    err = capsys.readouterr().err
+    return rc, err
+
+
+def test_npy_shapes(tmp_path, capsys):
+    out = str(tmp_path / "a.npy")
+    assert run(capsys, "--size", "32", "--quiet", "-o", out)[0] == 0
+    a = np.load(out)
+    assert a.shape == (32, 32) and a.dtype == np.float32
+    assert run(capsys, "--dim", "3", "--size", "16", "--quiet", "-o", out)[0] == 0
+    assert np.load(out).shape == (16, 16, 16)
+    assert run(capsys, "--dim", "4", "--time", "0.5", "--size", "12", "--quiet", "-o", out)[0] == 0
+    assert np.load(out).shape == (12, 12, 12)
+
+
+def test_png_and_exr(tmp_path, capsys):
+    png, exr = str(tmp_path / "a.png"), str(tmp_path / "a.exr")
+    assert run(capsys, "--size", "40", "--quiet", "--cellular", "stit", "-o", png)[0] == 0
+    with open(png, "rb") as fh:
+        assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
+    assert run(capsys, "--size", "40", "--quiet", "--output", "phase", "-o", exr)[0] == 0
+    from export.images import read_image
+
+    img = read_image(exr)
+    assert img.shape == (40, 40) and img.min() >= -np.pi - 1e-6 and img.max() <= np.pi + 1e-6
+
+
+@pytest.mark.parametrize("args,setting", [
+    (["--fmin", "9", "--fmax", "8"], "--fmin"),
+    (["--directions", "0"], "--directions"),
+    (["--period", "100"], "Nyquist"),
+    (["--example", "/no/such/image.png"], "--example"),
+    (["--waveform", "custom"], "--profile"),
+])
+def test_bad_settings_fail_with_one_line(tmp_path, capsys, args, setting):
+    out = tmp_path / "x.png"
+    rc, err = run(capsys, "--size", "16", "--quiet", *args, "-o", str(out))
+    lines = [l for l in err.splitlines() if l.strip()]
+    assert rc != 0 and len(lines) == 1 and setting in lines[0], err
+    assert not out.exists()
+
+
+def test_existing_output_survives_failure(tmp_path, capsys):
+    out = tmp_path / "keep.npy"
+    np.save(out, np.arange(3, dtype=np.float32))
+    rc, _ = run(capsys, "--size", "16", "--quiet", "--fmin", "9", "--fmax", "8", "-o", str(out))
+    assert rc != 0 and np.array_equal(np.load(out), np.arange(3, dtype=np.float32))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.npy"]
+
+
+def test_python_dash_m_backend(tmp_path):
+    out = str(tmp_path / "m.npy")
+    r = subprocess.run([sys.executable, "-m", "backend", "wave", "--size", "8", "--quiet", "-o", out],
+                       cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert np.load(out).shape == (8, 8)
