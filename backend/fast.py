@@ -133,5 +133,5 @@ def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
     re = np.empty(len(x), _F)
     im = np.empty(len(x), _F)
     _kernel(np.ascontiguousarray(x, _F), sd, noise.slice_offsets, noise.dirs.amp, nmin, slpos, omega, zeta,
-            noise._fast_table, _F(1.0 / noise.table.period), _F(noise.speed * float(time)), re, im)
+            noise._fast_table, _F(1.0 / noise.table.period), _F(noise.speed) * _F(time), re, im)
     return (re + 1j * im).astype(np.complex64)
