@@ -1,0 +1,191 @@
+"""Wave noise speed against the CPU peers a user would pick instead, in one run.
+
+ns per sample for 2D 1024^2 and 3D 128^3 / 256^3 grids at 8, 16, 32, 64
+directions, next to 5-octave fractal Perlin (pyfastnoisesimd, FastNoise Lite),
+opensimplex (5 octaves) and Blender's Noise (detail 5) and Gabor textures
+evaluated through bpy Geometry Nodes.  Prints ratios wave / fastest peer.
+Then streams a 512^3 grid and reports peak memory against the output's size.
+
+Run: make bench   (numbers: median of --repeat runs, wall clock, this machine)
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
+from backend import fast  # noqa: E402
+
+
+def timed(fn, repeat):
+    fn()  # warm-up (JIT compile, caches)
+    ts = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t)
+    return float(np.median(ts))
+
+
+def grid_coords(dim, n, extent):
+    g = np.arange(n, dtype=np.float32) * np.float32(extent / n)
+    return g
+
+
+def peers(dim, n, repeat):
+    out = {}
+    freq = 2.0  # features per unit, grid spans 4 units
+    try:
+        import pyfastnoisesimd as fns
+
+        p = fns.Noise(seed=1, numWorkers=os.cpu_count() or 1)
+        p.noiseType = fns.NoiseType.PerlinFractal
+        p.fractal.octaves = 5
+        p.frequency = freq * 4.0 / n
+        shape = [1, n, n] if dim == 2 else [n, n, n]
+        out["pyfastnoisesimd perlin fbm5"] = timed(lambda: p.genAsGrid(shape), repeat)
+    except ImportError:
+        pass
+    try:
+        from pyfastnoiselite.pyfastnoiselite import FastNoiseLite, FractalType, NoiseType
+
+        fnl = FastNoiseLite(1)
+        fnl.noise_type = NoiseType.NoiseType_Perlin
+        fnl.fractal_type = FractalType.FractalType_FBm
+        fnl.fractal_octaves = 5
+        fnl.frequency = freq * 4.0 / n
+        g = np.arange(n, dtype=np.float32)
+        coords = np.stack(np.meshgrid(*([g] * dim), indexing="ij"), 0).reshape(dim, -1)
+        out["FastNoise Lite perlin fbm5"] = timed(lambda: fnl.gen_from_coords(coords), repeat)
+    except ImportError:
+        pass
+    try:
+        import opensimplex
+
+        opensimplex.seed(1)
+        g = np.arange(n, dtype=np.float64) * 4.0 / n
+
+        def os5():
+            for o in range(5):
+                f = freq * 2 ** o
+                if dim == 2:
+                    opensimplex.noise2array(g * f, g * f)
+                else:
+                    opensimplex.noise3array(g * f, g * f, g * f)
+
+        out["opensimplex fbm5"] = timed(os5, repeat)
+    except ImportError:
+        pass
+    return out
+
+
+def blender_peers(dim, n, repeat):
+    try:
+        import bpy  # noqa: F401
+        from blender_addon.field_eval import evaluate_field
+    except ImportError:
+        return {}
+    g = np.arange(n, dtype=np.float32) * np.float32(4.0 / n)
+    mesh = np.stack(np.meshgrid(*([g] * dim), indexing="ij"), -1).reshape(-1, dim)
+    pts = np.zeros((len(mesh), 3), np.float32)
+    pts[:, :dim] = mesh
+
+    def noise(tree, pos):
+        t = tree.nodes.new("ShaderNodeTexNoise")
+        t.noise_dimensions = "3D" if dim == 3 else "2D"
+        t.inputs["Scale"].default_value = 2.0
+        t.inputs["Detail"].default_value = 5.0
+        tree.links.new(pos, t.inputs["Vector"])
+        return t.outputs["Fac"]
+
+    def gabor(tree, pos):
+        t = tree.nodes.new("ShaderNodeTexGabor")
+        t.gabor_type = "3D" if dim == 3 else "2D"
+        t.inputs["Scale"].default_value = 2.0
+        tree.links.new(pos, t.inputs["Vector"])
+        return t.outputs["Value"]
+
+    def white(tree, pos):  # the cost of the evaluation harness itself
+        t = tree.nodes.new("ShaderNodeTexWhiteNoise")
+        tree.links.new(pos, t.inputs["Vector"])
+        return t.outputs["Value"]
+
+    out = {}
+    for name, build in (("Blender Noise detail 5", noise), ("Blender Gabor", gabor), ("harness (White Noise)", white)):
+        out[name] = timed(lambda: evaluate_field(pts, build), repeat)
+    return out
+
+
+def wave_times(dim, n, repeat, dirs):
+    out = {}
+    for k in dirs:
+        s = WaveSettings(dim=dim, spectrum=Spectrum("fractal", 1.0, 16.0, 1.0), directions=k, seed=1)
+        noise = compile_noise(s)
+        out[f"wave {k} dirs"] = timed(lambda: evaluate_grid(noise, n, 4.0), repeat)
+    return out
+
+
+def peak_memory_512() -> dict:
+    code = (
+        "import resource, numpy as np, sys; sys.path.insert(0, %r);"
+        "from backend import *;"
+        "n = compile_noise(WaveSettings(dim=3, spectrum=Spectrum('gaussian', 2, 8), directions=8, seed=1));"
+        "base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss;"
+        "a = evaluate_grid(n, 512, 4.0);"
+        "peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss;"
+        "print(base * 1024, peak * 1024, a.nbytes)" % ROOT)
+    t = time.perf_counter()
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t
+    base, peak, nbytes = (int(v) for v in r.stdout.split())
+    return dict(output_mib=nbytes / 2**20, peak_mib=peak / 2**20, before_mib=base / 2**20,
+                extra_mib=(peak - base - nbytes) / 2**20, seconds=wall)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="smaller grids (smoke run)")
+    ap.add_argument("--json", default=os.path.join(ROOT, "out", "bench", "wave.json"))
+    a = ap.parse_args()
+    cases = [(2, 256), (3, 48)] if a.quick else [(2, 1024), (3, 128), (3, 256)]
+    dirs = (8, 16) if a.quick else (8, 16, 32, 64)
+    print(f"wave noise engine: {'numba' if fast.available() else 'numpy'} path, {os.cpu_count()} cores")
+    results = {}
+    for dim, n in cases:
+        samples = n ** dim
+        rows = wave_times(dim, n, a.repeat, dirs)
+        rows.update(peers(dim, n, a.repeat))
+        if n <= 128:
+            rows.update(blender_peers(dim, n, a.repeat))
+        ns = {k: v / samples * 1e9 for k, v in rows.items()}
+        peer_ns = {k: v for k, v in ns.items() if not k.startswith("wave") and not k.startswith("harness")}
+        fastest = min(peer_ns, key=peer_ns.get) if peer_ns else None
+        print(f"\n{dim}D {n}^{dim} ({samples:,} samples)")
+        print(f"  {'method':34s} {'ns/sample':>10s}  {'ratio vs ' + (fastest or '-'):s}")
+        for k, v in sorted(ns.items(), key=lambda kv: kv[1]):
+            ratio = v / peer_ns[fastest] if fastest else float("nan")
+            print(f"  {k:34s} {v:10.1f}  {ratio:6.2f}x")
+        results[f"{dim}D_{n}"] = ns
+    if not a.quick:
+        m = peak_memory_512()
+        print(f"\n512^3 grid, 8 dirs: output {m['output_mib']:.0f} MiB, process peak {m['peak_mib']:.0f} MiB "
+              f"({m['extra_mib']:.0f} MiB beyond start + output), {m['seconds']:.1f} s")
+        results["stream_512"] = m
+    os.makedirs(os.path.dirname(a.json), exist_ok=True)
+    with open(a.json, "w") as fh:
+        json.dump(results, fh, indent=1)
+
+
+if __name__ == "__main__":
+    main()
