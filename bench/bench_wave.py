@@ -140,6 +140,7 @@ def peak_memory_512() -> dict:
         "import resource, numpy as np, sys; sys.path.insert(0, %r);"
         "from backend import *;"
         "n = compile_noise(WaveSettings(dim=3, spectrum=Spectrum('gaussian', 2, 8), directions=8, seed=1));"
+        "evaluate_grid(n, 16, 4.0);"  # JIT-compile first, so the baseline includes it
         "base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss;"
         "a = evaluate_grid(n, 512, 4.0);"
         "peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss;"
