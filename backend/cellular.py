@@ -75,23 +75,30 @@ class CellularNoise:
         #: family normals, two per stratum (slicing, wave): float32 (2K, D)
         self.normals = np.concatenate([r, centres]).astype(_F)
 
-    def _family(self, x, normal, fam: float, level: float, spacing: float):
-        """Distance (world units) to the nearest plane and slab index for one family."""
-        off = white_noise4(_F(fam), level, _F(_STREAM_OFFSET), self.seed)
-        p = (x @ normal) * _F(1.0 / spacing) + off
+    @staticmethod
+    def _nearest_plane(p, fam, stream, key, spacing):
+        """Planes at j + slpos_j (slpos_j = 0.3 + 0.4 hash(fam, j, stream, key)) along p.
+
+        Returns the distance to the nearest plane (world units) and the slab index.
+        """
         j = np.floor(p)
         o = p - j
         j = j + _F(0.0)
 
         def pos(idx):
-            return _F(0.3) + _F(0.4) * white_noise4(_F(fam), idx, _F(_STREAM_PLANE) + level, self.seed)
+            return _F(0.3) + _F(0.4) * white_noise4(fam, idx, stream, key)
 
         here = pos(j)
         above = o >= here
         other = np.where(above, _F(1.0) + pos(j + _F(1.0)) - o, o + _F(1.0) - pos(j - _F(1.0)))
         dist = np.minimum(np.abs(o - here), other) * _F(spacing)
-        slab = np.where(above, j, j - _F(1.0))
-        return dist, slab
+        return dist, np.where(above, j, j - _F(1.0))
+
+    def _family(self, x, normal, fam: float, level: float, spacing: float):
+        """Distance (world units) to the nearest plane and slab index for one family."""
+        off = white_noise4(_F(fam), level, _F(_STREAM_OFFSET), self.seed)
+        p = (x @ normal) * _F(1.0 / spacing) + off
+        return self._nearest_plane(p, _F(fam), _F(_STREAM_PLANE) + level, self.seed, spacing)
 
     def evaluate(self, x: np.ndarray) -> CellularResult:
         """x: float32 (P, dim) -> CellularResult."""
@@ -119,16 +126,7 @@ class CellularNoise:
                 fam = _F(1000 * level + k)
                 off = white_noise4(fam, code, _F(_STREAM_OFFSET), self.seed)
                 p = np.sum(x * normal, axis=1) * _F(1.0 / spacing) + off
-                j = np.floor(p)
-                o = p - j
-                j = j + _F(0.0)
-                here = _F(0.3) + _F(0.4) * white_noise4(fam, j, _F(_STREAM_PLANE) + lv, code)
-                above = o >= here
-                nxt = _F(0.3) + _F(0.4) * white_noise4(fam, j + _F(1.0), _F(_STREAM_PLANE) + lv, code)
-                prv = _F(0.3) + _F(0.4) * white_noise4(fam, j - _F(1.0), _F(_STREAM_PLANE) + lv, code)
-                other = np.where(above, _F(1.0) + nxt - o, o + _F(1.0) - prv)
-                d = np.minimum(np.abs(o - here), other) * _F(spacing)
-                slab = np.where(above, j, j - _F(1.0))
+                d, slab = self._nearest_plane(p, fam, _F(_STREAM_PLANE) + lv, code, spacing)
                 dist = np.where(split, np.minimum(dist, d), dist)
                 new_code = np.where(split, white_noise4(slab, new_code, _F(_STREAM_CODE) + lv, self.seed), new_code)
             code = new_code
