@@ -65,13 +65,8 @@ class CellularNoise:
         self.cell_size = float(cell_size)
         self.probability = _F(probability)
         self.depth = int(depth)
-        K = directions.count
-        ks = np.arange(K, dtype=_F)
+        r = directions.hashed_normals(self.seed, _STREAM_NORMAL)
         centres = directions.centres()
-        r = np.stack([white_noise4(ks, _F(0), _F(_STREAM_NORMAL + i), self.seed) for i in range(self.dim)], 1)
-        r = _F(2.0) * r - _F(1.0)
-        r = r - np.sum(r * centres, axis=1, keepdims=True) * centres
-        r = r / np.linalg.norm(r, axis=1, keepdims=True)
         #: family normals, two per stratum (slicing, wave): float32 (2K, D)
         self.normals = np.concatenate([r, centres]).astype(_F)
 

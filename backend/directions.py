@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import SettingError
+from .hashing import white_noise4
 
 __all__ = ["Domain", "DirectionSet", "strata", "map_directions", "psi_inverse", "NEWTON_STEPS"]
 
@@ -216,6 +217,20 @@ class DirectionSet:
             amps.append(np.full(n, np.sqrt(w[i] / n)))
         return cls(list(domains), np.concatenate(los), np.concatenate(his), np.concatenate(doms),
                    np.concatenate(amps).astype(_F))
+
+    def hashed_normals(self, seed: np.float32, stream: int) -> np.ndarray:
+        """Per-stratum unit normals orthogonal to the stratum centres: float32 (K, dim).
+
+        A hashed vector r in [-1, 1]^dim (White Noise at (k, 0, stream + axis, seed))
+        with its component along the centre c removed: r - (r . c) c, normalised.
+        """
+        ks = np.arange(self.count, dtype=_F)
+        dim = self.domains[0].dim
+        centres = self.centres()
+        r = np.stack([white_noise4(ks, _F(0), _F(stream + i), seed) for i in range(dim)], 1)
+        r = _F(2.0) * r - _F(1.0)
+        r = r - np.sum(r * centres, axis=1, keepdims=True) * centres
+        return r / np.linalg.norm(r, axis=1, keepdims=True)
 
     def centres(self) -> np.ndarray:
         """Direction of each stratum's centre: float32 (K, dim)."""

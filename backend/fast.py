@@ -61,7 +61,6 @@ if numba is not None:
             zr = np.float32(0.0)
             zi = np.float32(0.0)
             for k in range(K):
-                p = soffs[k]
                 acc = np.float32(0.0)
                 for d in range(D):
                     acc += x[i, d] * sdirs[k, d]

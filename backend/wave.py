@@ -97,14 +97,10 @@ class WaveNoise:
         self.speed = float(speed)
         self.transition = transition
         self.plane = plane
-        K, D = directions.count, self.dim
-        ks = np.arange(K, dtype=_F)
-        centres = directions.centres()
-        r = np.stack([white_noise4(ks, _F(0), _F(STREAM["slice_dir"] + i), self.seed) for i in range(D)], 1)
-        r = _F(2.0) * r - _F(1.0)
-        r = r - np.sum(r * centres, axis=1, keepdims=True) * centres
+        ks = np.arange(directions.count, dtype=_F)
         #: slicing directions s_k pre-divided by W: float32 (K, D)
-        self.slice_dirs = (r / np.linalg.norm(r, axis=1, keepdims=True) / _F(self.slice_width)).astype(_F)
+        normals = directions.hashed_normals(self.seed, STREAM["slice_dir"])
+        self.slice_dirs = (normals / _F(self.slice_width)).astype(_F)
         #: slice origin offsets o_k: float32 (K,)
         self.slice_offsets = white_noise4(ks, _F(0), _F(STREAM["slice_offset"]), self.seed)
 

@@ -37,11 +37,6 @@ def timed(fn, repeat):
     return float(np.median(ts))
 
 
-def grid_coords(dim, n, extent):
-    g = np.arange(n, dtype=np.float32) * np.float32(extent / n)
-    return g
-
-
 def peers(dim, n, repeat):
     out = {}
     freq = 2.0  # features per unit, grid spans 4 units
