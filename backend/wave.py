@@ -12,9 +12,13 @@ w0 = cos(pi/2 s), w1 = sin(pi/2 s), s = smoothstep(u): w0^2 + w1^2 = 1, so the
 variance does not dip between slices.  Stratum weights a_k = sqrt(1/K) make
 E|N|^2 = 1 whatever the number of directions K.
 
-Every random number comes from :func:`backend.hashing.white_noise4` at
-``(k, slice, stream, seed)``, Blender's White Noise node; so Blender nodes can
-evaluate the same function.  Evaluation is float32 and chunked by the caller.
+Every random number comes from :func:`backend.hashing.white_noise4`,
+Blender's White Noise node; so Blender nodes can evaluate the same function.
+A slice's records use the node's Color output, whose three channels are the
+4D hash at the input permutations (x, y, z, w), (z, x, w, y), (w, z, y, x)
+(:data:`COLOR_PERMUTATIONS`): one node at (k, slice, A, seed) yields the border
+position, the wave offset and the first direction jitter; a second at
+(k, slice, B, seed) the other jitters.  Evaluation is float32 and chunked by the caller.
 """
 from __future__ import annotations
 
@@ -28,13 +32,21 @@ from .errors import SettingError
 from .hashing import MAX_EXACT_ID, white_noise4
 from .tables import WaveTable, table_lookup
 
-__all__ = ["WaveNoise", "Transition", "OUTPUTS", "select_output", "STREAM"]
+__all__ = ["WaveNoise", "Transition", "OUTPUTS", "select_output", "STREAM", "COLOR_PERMUTATIONS", "white_color4"]
 
 _F = np.float32
 OUTPUTS = ("real", "imag", "modulus", "phase")
 
 #: hash streams (third White Noise input): one per random quantity
-STREAM = dict(slice_dir=0, slice_offset=4, slice_pos=5, jitter=6, wave_offset=9)
+STREAM = dict(slice_dir=0, slice_offset=4, slice_a=5, slice_b=6)
+#: channel c of the White Noise node's Color = white_noise4 of the inputs in this order
+COLOR_PERMUTATIONS = ((0, 1, 2, 3), (2, 0, 3, 1), (3, 2, 1, 0))
+
+
+def white_color4(x, y, z, w, channel: int) -> np.ndarray:
+    """Channel ``channel`` of Blender's White Noise (4D) Color output at (x, y, z, w)."""
+    args = (x, y, z, w)
+    return white_noise4(*(args[i] for i in COLOR_PERMUTATIONS[channel]))
 
 BLEND_HALF_WIDTH = 0.3   # border ramp half-width, in slice widths
 SLPOS_MIN, SLPOS_RANGE = 0.3, 0.4
@@ -108,12 +120,16 @@ class WaveNoise:
     def slice_records(self, k: int, m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """For slice ids m (float32): border position (M,), direction (M, D), offset zeta (M,)."""
         kk, s = _F(k), self.seed
-        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * white_noise4(kk, m, _F(STREAM["slice_pos"]), s)
-        u = np.stack([white_noise4(kk, m, _F(STREAM["jitter"] + i), s) for i in range(self.dim - 1)], 1)
+        a, b = _F(STREAM["slice_a"]), _F(STREAM["slice_b"])
+        # node A = White Noise (k, m, a, seed): Color (r, g, b) = border, offset, jitter 0
+        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * white_color4(kk, m, a, s, 0)
+        zeta = white_color4(kk, m, a, s, 1)
+        # node B = White Noise (k, m, b, seed): Color (r, g) = jitters 1, 2
+        jit = [white_color4(kk, m, a, s, 2)] + [white_color4(kk, m, b, s, c) for c in range(self.dim - 2)]
+        u = np.stack(jit, 1)
         lo, hi = self.dirs.lo[k], self.dirs.hi[k]
         u = lo + (hi - lo) * u
         omega = map_directions(u, self.dirs.domains[self.dirs.domain[k]])
-        zeta = white_noise4(kk, m, _F(STREAM["wave_offset"]), s)
         return slpos, omega, zeta
 
     def _lookup(self, values: np.ndarray, omega: np.ndarray, coord: np.ndarray) -> np.ndarray:

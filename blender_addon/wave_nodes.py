@@ -1,0 +1,407 @@
+"""The Wave Noise node: a node group built from Blender's own nodes (no OSL).
+
+The group computes exactly the sum of :mod:`backend.wave` (Guehl et al. 2025,
+Eq. 6 and 9, Algorithm 1), node for node:
+
+* per stratum k: slice coordinate p = x . s_k + o_k, slice n = floor(p), f = p - n;
+* slice records of n and n+1 from Blender's White Noise Texture (4D) at
+  (k, slice, stream, seed), which :mod:`backend.hashing` reproduces bit for bit;
+* the jittered direction by the same equal-measure map as
+  :func:`backend.directions.map_directions` (2D angle; 3D arccos; 4D with five
+  Newton steps for psi), Householder-rotated onto the lobe axis;
+* the wave (x . omega - v t) / L + zeta read from the complex table, stored as a
+  float image (R = real, G = imaginary) packed into the .blend and sampled with
+  linear interpolation and Repeat extension (texel centres at (i + 1/2) / N);
+* border weights cos / sin(pi/2 smoothstep(u)), amplitude sqrt(1/K).
+
+Every per-stratum quantity the backend precomputes (s_k, o_k, stratum box,
+lobe axis) enters as a constant input of a stratum sub-group, so the main
+group reads: Vector, W, Scale, Time in; Value, Imaginary, Modulus, Phase out.
+The same builder makes shader groups (Cycles, EEVEE, any device) and
+Geometry Nodes groups (fields on geometry).
+
+Rebuilding for new settings clears the inner nodes and keeps the interface,
+so links to the group node survive.  Settings are stored as JSON on the tree
+(``tree["omninoise_wave"]``).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+
+import bpy
+import numpy as np
+
+from ._deps import backend
+
+__all__ = ["build_wave_group", "ensure_table_image", "settings_to_json", "settings_from_json",
+           "INPUTS", "OUTPUTS", "SETTINGS_KEY"]
+
+_F = np.float32
+SETTINGS_KEY = "omninoise_wave"
+#: (name, socket type, default) of the group's inputs and outputs
+INPUTS = (("Vector", "NodeSocketVector", (0.0, 0.0, 0.0)), ("W", "NodeSocketFloat", 0.0),
+          ("Scale", "NodeSocketFloat", 1.0), ("Time", "NodeSocketFloat", 0.0))
+OUTPUTS = ("Value", "Imaginary", "Modulus", "Phase")
+STREAM = backend.wave.STREAM
+
+
+# -- settings <-> JSON ----------------------------------------------------------
+
+def settings_to_json(s) -> str:
+    """WaveSettings -> JSON (the node's fields only; by-example images are bake-only)."""
+    sp = s.spectrum
+    d = dict(dim=s.dim, directions=int(s.directions), seed=int(s.seed), speed=float(s.speed),
+             spectrum=dict(kind=sp.kind, fmin=sp.fmin, fmax=sp.fmax, exponent=sp.exponent),
+             waveform=s.waveform, anisotropy=s.anisotropy, spread=float(s.spread),
+             lobes=[[list(map(float, a)), float(w)] for a, w in s.lobes],
+             axis_spectra=[dict(kind=a.kind, fmin=a.fmin, fmax=a.fmax, exponent=a.exponent) for a in s.axis_spectra],
+             slice_width=s.slice_width, table_size=int(s.table_size))
+    return json.dumps(d, sort_keys=True)
+
+
+def settings_from_json(text: str):
+    d = json.loads(text)
+    Spectrum = backend.Spectrum
+    return backend.WaveSettings(
+        dim=d["dim"], directions=d["directions"], seed=d["seed"], speed=d["speed"],
+        spectrum=Spectrum(**d["spectrum"]), waveform=d["waveform"], anisotropy=d["anisotropy"],
+        spread=d["spread"], lobes=tuple((tuple(a), w) for a, w in d["lobes"]),
+        axis_spectra=tuple(Spectrum(**a) for a in d["axis_spectra"]), slice_width=d["slice_width"],
+        table_size=d["table_size"])
+
+
+# -- the table as a packed float image ---------------------------------------------
+
+def ensure_table_image(values: np.ndarray) -> bpy.types.Image:
+    """A packed float image holding a complex table: complex64 (rows, N) -> N x rows, R = re, G = im.
+
+    Images are shared by content (the name carries a hash of the values), so
+    identical tables are stored once per .blend.
+    """
+    values = np.ascontiguousarray(values, np.complex64)
+    rows, size = values.shape
+    name = "OmniNoise table " + hashlib.sha256(values.tobytes()).hexdigest()[:12]
+    img = bpy.data.images.get(name)
+    if img is not None and tuple(img.size) == (size, rows):
+        return img
+    img = bpy.data.images.new(name, size, rows, alpha=True, float_buffer=True)
+    img.colorspace_settings.name = "Non-Color"
+    img.alpha_mode = "CHANNEL_PACKED"
+    img.use_half_precision = False  # Cycles would otherwise sample a half-float copy (5e-4 error)
+    px = np.zeros((rows, size, 4), _F)
+    px[..., 0] = values.real
+    px[..., 1] = values.imag
+    px[..., 3] = 1.0
+    img.pixels.foreach_set(px.ravel())
+    img.pack()
+    return img
+
+
+# -- a small node-building helper ---------------------------------------------
+
+class _Nodes:
+    """Adds math nodes to a shader or geometry tree; constants go into socket defaults."""
+
+    def __init__(self, tree: bpy.types.NodeTree):
+        self.tree = tree
+        self.geo = tree.bl_idname == "GeometryNodeTree"
+        self.col = 0
+        self.row = 0
+
+    def new(self, kind: str, **props):
+        n = self.tree.nodes.new(kind)
+        for k, v in props.items():
+            setattr(n, k, v)
+        n.location = (200.0 * self.col, -160.0 * self.row)
+        self.row += 1
+        if self.row > 24:
+            self.row, self.col = 0, self.col + 1
+        return n
+
+    def put(self, sock, v) -> None:
+        if isinstance(v, bpy.types.NodeSocket):
+            self.tree.links.new(v, sock)
+        elif isinstance(v, (tuple, list, np.ndarray)):
+            sock.default_value = tuple(float(c) for c in v)
+        else:
+            sock.default_value = float(v)
+
+    def math(self, op: str, a, b=0.0, c=0.0, clamp: bool = False):
+        n = self.new("ShaderNodeMath", operation=op, use_clamp=clamp)
+        for s, v in zip(n.inputs, (a, b, c)):
+            self.put(s, v)
+        return n.outputs[0]
+
+    def vmath(self, op: str, a, b=(0.0, 0.0, 0.0), scale=None):
+        n = self.new("ShaderNodeVectorMath", operation=op)
+        self.put(n.inputs[0], a)
+        self.put(n.inputs[1], b)
+        if scale is not None:
+            self.put(n.inputs["Scale"], scale)
+        return n.outputs["Value"] if op in ("DOT_PRODUCT", "LENGTH", "DISTANCE") else n.outputs["Vector"]
+
+    def combine(self, x=0.0, y=0.0, z=0.0):
+        n = self.new("ShaderNodeCombineXYZ")
+        for s, v in zip(n.inputs, (x, y, z)):
+            self.put(s, v)
+        return n.outputs[0]
+
+    def separate(self, v):
+        n = self.new("ShaderNodeSeparateXYZ")
+        self.put(n.inputs[0], v)
+        return tuple(n.outputs)
+
+    def white(self, k, n, stream: int, seed, channels: int = 3) -> list:
+        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> its Color's first channels.
+
+        The channels are backend.wave.white_color4 with channel 0, 1, 2.  Fewer
+        than three are read with exact dot products (c . e_i): Cycles keeps an
+        unlinked Separate XYZ output on its stack for the whole shader.
+        """
+        node = self.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
+        self.put(node.inputs["Vector"], self.combine(k, n, float(stream)))
+        self.put(node.inputs["W"], seed)
+        color = node.outputs["Color"]
+        if channels == 3:
+            return list(self.separate(color))
+        return [self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c])) for c in range(channels)]
+
+    def image(self, img: bpy.types.Image, vector):
+        """Linear, repeating image lookup -> colour socket (r, g, b) read as a vector."""
+        if self.geo:
+            node = self.new("GeometryNodeImageTexture", interpolation="Linear", extension="REPEAT")
+            node.inputs["Image"].default_value = img
+        else:
+            node = self.new("ShaderNodeTexImage", interpolation="Linear", extension="REPEAT", image=img)
+        self.put(node.inputs["Vector"], vector)
+        return node.outputs["Color"]
+
+
+def _new_group(name: str, tree_type: str, inputs, outputs) -> bpy.types.NodeTree:
+    tree = bpy.data.node_groups.new(name, tree_type)
+    for nm, st, default in inputs:
+        s = tree.interface.new_socket(nm, in_out="INPUT", socket_type=st)
+        if default is not None:
+            s.default_value = default
+    for nm, st in outputs:
+        tree.interface.new_socket(nm, in_out="OUTPUT", socket_type=st)
+    return tree
+
+
+# -- one stratum -----------------------------------------------------------------
+
+_STRATUM_INPUTS = (("Sum", "NodeSocketVector", None), ("Position", "NodeSocketVector", None),
+                   ("W", "NodeSocketFloat", None), ("Shift", "NodeSocketFloat", None))
+
+
+def _direction(b: _Nodes, u, dim: int, full: bool, g) -> tuple:
+    """map_directions (backend.directions) for a cap domain: u sockets (dim-1) -> (vec3, w)."""
+    u = list(u)
+    sign = None
+    if full:  # the last u coordinate picks the hemisphere
+        last = b.math("MULTIPLY", u[-1], 2.0)
+        below = b.math("LESS_THAN", last, 1.0)               # 1 when last < 1
+        flip = b.math("SUBTRACT", 1.0, below)
+        sign = b.math("MULTIPLY_ADD", below, 2.0, -1.0)      # +1 / -1
+        u[-1] = b.math("SUBTRACT", last, flip)
+    w = None
+    if dim == 2:
+        t = b.math("MULTIPLY", g["Spread"], b.math("MULTIPLY_ADD", u[0], 2.0, -1.0))
+        vec = b.combine(b.math("SINE", t), b.math("COSINE", t), 0.0)
+    elif dim == 3:
+        phi = b.math("MULTIPLY", u[0], float(_F(2.0 * np.pi)))
+        ct = b.math("SUBTRACT", 1.0, b.math("MULTIPLY", u[1], g["Cap"]))
+        st = b.math("SQRT", b.math("MAXIMUM", b.math("SUBTRACT", 1.0, b.math("MULTIPLY", ct, ct)), 0.0))
+        vec = b.combine(b.math("MULTIPLY", st, b.math("COSINE", phi)), b.math("MULTIPLY", st, b.math("SINE", phi)), ct)
+    else:
+        phi = b.math("MULTIPLY", u[0], float(_F(2.0 * np.pi)))
+        ct = b.math("MULTIPLY_ADD", u[1], 2.0, -1.0)
+        st = b.math("SQRT", b.math("MAXIMUM", b.math("SUBTRACT", 1.0, b.math("MULTIPLY", ct, ct)), 0.0))
+        # psi - sin psi cos psi = u2 (sigma - sin sigma cos sigma): safeguarded Newton (psi_inverse)
+        c = b.math("MULTIPLY", u[2], g["Cap"])
+        psi = b.math("MINIMUM", b.math("POWER", b.math("MULTIPLY", c, 1.5), float(_F(1.0 / 3.0))), g["Spread"])
+        for _ in range(backend.directions.NEWTON_STEPS):
+            sp = b.math("SINE", psi)
+            gv = b.math("SUBTRACT", b.math("SUBTRACT", psi, b.math("MULTIPLY", sp, b.math("COSINE", psi))), c)
+            dg = b.math("ADD", b.math("MULTIPLY", 2.0, b.math("MULTIPLY", sp, sp)), 1e-6)
+            psi = b.math("MINIMUM", b.math("MAXIMUM", b.math("SUBTRACT", psi, b.math("DIVIDE", gv, dg)), 0.0),
+                         g["Spread"])
+        sp = b.math("SINE", psi)
+        sst = b.math("MULTIPLY", sp, st)
+        vec = b.combine(b.math("MULTIPLY", sst, b.math("COSINE", phi)), b.math("MULTIPLY", sst, b.math("SINE", phi)),
+                        b.math("MULTIPLY", sp, ct))
+        w = b.math("COSINE", psi)
+    if g["Mirror Scale"] != 0.0:  # Householder reflection of e_last onto the cap axis
+        proj = b.vmath("DOT_PRODUCT", vec, g["Mirror"])
+        if w is not None:
+            proj = b.math("ADD", proj, b.math("MULTIPLY", w, g["Mirror W"]))
+        m = b.math("MULTIPLY", g["Mirror Scale"], proj)
+        vec = b.vmath("SUBTRACT", vec, b.vmath("SCALE", g["Mirror"], scale=m))
+        if w is not None:
+            w = b.math("SUBTRACT", w, b.math("MULTIPLY", m, g["Mirror W"]))
+    if sign is not None:
+        vec = b.vmath("SCALE", vec, scale=sign)
+        if w is not None:
+            w = b.math("MULTIPLY", w, sign)
+    return vec, w
+
+
+def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.types.Image, rows: int,
+                   mode: str, consts: dict) -> bpy.types.NodeTree:
+    """Sub-group for one stratum: Sum + amp (w0 T0 + w1 T1) as a vector (re, im, 0).
+
+    The stratum's constants (``consts``, from :func:`_stratum_constants`) are
+    written into the nodes' sockets, not passed as group inputs: Cycles' SVM
+    compiler would load every constant group input of every stratum onto its
+    255-float stack before the first wave.  The position is offset by
+    (Sum - Sum), exactly zero: that data dependency makes the compiler finish
+    stratum k before it starts stratum k+1.
+    """
+    tree = _new_group(name, tree_type, _STRATUM_INPUTS, (("Sum", "NodeSocketVector"),))
+    b = _Nodes(tree)
+    gi = b.new("NodeGroupInput")
+    go = b.new("NodeGroupOutput")
+    b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, img, rows,
+                                           mode, consts))
+    return tree
+
+
+def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, mode: str, consts: dict):
+    """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket."""
+    g = dict(consts)
+    g.update(ins)
+    x = b.vmath("ADD", g["Position"], b.vmath("SUBTRACT", g["Sum"], g["Sum"]))
+    # slice coordinate p = x . s_k + o_k (Alg. 1); s_k is pre-divided by the slice width
+    p = b.vmath("DOT_PRODUCT", x, g["Slice Dir"])
+    if dim == 4:
+        p = b.math("ADD", p, b.math("MULTIPLY", g["W"], g["Slice Dir W"]))
+    p = b.math("ADD", p, g["Slice Offset"])
+    n0 = b.math("ADD", b.math("FLOOR", p), 0.0)
+    f = b.math("SUBTRACT", p, n0)
+    n1 = b.math("ADD", n0, 1.0)
+    k, seed = g["k"], g["Seed"]
+    box_lo, box_size = g["Box Lo"], g["Box Size"]
+    waves = []
+    slpos = None
+    for side, n in enumerate((n0, n1)):
+        ha = b.white(k, n, STREAM["slice_a"], seed)  # border, offset, jitter 0
+        jit = [ha[2]] + (b.white(k, n, STREAM["slice_b"], seed, dim - 2) if dim > 2 else [])
+        u = [b.math("MULTIPLY_ADD", jit[i], box_size[i], box_lo[i]) for i in range(dim - 1)]
+        omega, om_w = _direction(b, u, dim, full, g)
+        zeta = ha[1]
+        if side == 0:
+            slpos = b.math("MULTIPLY_ADD", ha[0], backend.wave.SLPOS_RANGE, backend.wave.SLPOS_MIN)
+        dot = b.vmath("DOT_PRODUCT", x, omega)
+        if om_w is not None:
+            dot = b.math("ADD", dot, b.math("MULTIPLY", g["W"], om_w))
+        coord = b.math("MULTIPLY_ADD", b.math("SUBTRACT", dot, g["Shift"]), g["Inv Period"], zeta)
+        if mode == "single":
+            waves.append(b.image(img, b.combine(coord, 0.5, 0.0)))
+        else:  # per-axis tables, interpolated by omega_a^2 (Fig. 5 left)
+            comps = b.separate(omega)
+            acc = None
+            for a in range(rows):
+                wa = om_w if a == 3 else comps[a]
+                t = b.vmath("SCALE", b.image(img, b.combine(coord, (a + 0.5) / rows, 0.0)),
+                            scale=b.math("MULTIPLY", wa, wa))
+                acc = t if acc is None else b.vmath("ADD", acc, t)
+            waves.append(acc)
+    u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wave.BLEND_HALF_WIDTH, 0.5, clamp=True)
+    s = b.math("MULTIPLY", b.math("MULTIPLY", b.math("MULTIPLY", u, u), b.math("MULTIPLY_ADD", u, -2.0, 3.0)),
+               float(_F(np.pi / 2)))
+    w0 = b.math("MULTIPLY", b.math("COSINE", s), g["Amplitude"])
+    w1 = b.math("MULTIPLY", b.math("SINE", s), g["Amplitude"])
+    out = b.vmath("ADD", b.vmath("SCALE", waves[0], scale=w0), b.vmath("SCALE", waves[1], scale=w1))
+    return b.vmath("ADD", g["Sum"], out)
+
+
+# -- the whole group ------------------------------------------------------------------
+
+def _stratum_constants(noise, k: int) -> dict:
+    dirs = noise.dirs
+    dom = dirs.domains[dirs.domain[k]]
+    if dom.kind != "cap":
+        raise backend.SettingError("example", "by-example noise is bake-only; the node supports caps and lobes")
+    dim = noise.dim
+    s = _F(dom.spread)
+    if dim == 4:
+        cap = _F(s - np.sin(s) * np.cos(s))
+    else:
+        cap = _F(_F(1.0) - np.cos(s))
+    v = -np.asarray(dom.axis, dtype=_F)
+    v[dim - 1] += 1.0
+    vv = float(np.dot(v, v))
+    scale = float(_F(2.0 / vv)) if vv >= 1e-12 else 0.0
+    sd = noise.slice_dirs[k]
+    pad = lambda a, fill=0.0: tuple(float(c) for c in (list(a[:3]) + [fill] * (3 - len(a[:3]))))  # noqa: E731
+    return {
+        "k": float(k), "Seed": float(noise.seed),
+        "Slice Dir": pad(sd), "Slice Dir W": float(sd[3]) if dim == 4 else 0.0,
+        "Slice Offset": float(noise.slice_offsets[k]),
+        "Box Lo": pad(dirs.lo[k]), "Box Size": pad(dirs.hi[k] - dirs.lo[k]),
+        "Spread": float(s), "Cap": float(cap),
+        "Mirror": pad(v), "Mirror W": float(v[3]) if dim == 4 else 0.0, "Mirror Scale": scale,
+        "Inv Period": float(_F(1.0 / noise.table.period)), "Amplitude": float(dirs.amp[k]),
+    }
+
+
+def _clear(tree: bpy.types.NodeTree) -> None:
+    for n in list(tree.nodes):
+        if n.bl_idname == "ShaderNodeGroup" or n.bl_idname == "GeometryNodeGroup":
+            sub = n.node_tree
+            tree.nodes.remove(n)
+            if sub is not None and sub.users == 0:
+                bpy.data.node_groups.remove(sub)
+        else:
+            tree.nodes.remove(n)
+
+
+def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
+                     name: str = "Wave Noise") -> bpy.types.NodeTree:
+    """Build (or rebuild in place) the Wave Noise group for ``settings`` (a backend WaveSettings).
+
+    tree_type: 'ShaderNodeTree' or 'GeometryNodeTree'.  Returns the group tree;
+    its interface (INPUTS, OUTPUTS) is the same for every setting.
+    """
+    if settings.cellular != "none":
+        raise backend.SettingError("cellular", "use the Wave Cellular node for cellular variants")
+    if settings.example is not None or settings.transition_to is not None:
+        raise backend.SettingError("example", "by-example and transition noises are bake-only")
+    noise = backend.compile_noise(settings)
+    table = noise.table
+    if table.mode not in ("single", "axes"):
+        raise backend.SettingError("anisotropy", f"table mode {table.mode!r} has no node form")
+    if tree is None:
+        tree = _new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in OUTPUTS))
+        tree.interface.items_tree["Scale"].min_value = -1000.0
+    else:
+        _clear(tree)
+    tree[SETTINGS_KEY] = settings_to_json(settings)
+    img = ensure_table_image(table.values)
+    dim = noise.dim
+    full = any(d.full for d in noise.dirs.domains)
+    b = _Nodes(tree)
+    gi = b.new("NodeGroupInput")
+    go = b.new("NodeGroupOutput")
+    x = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
+    w = b.math("MULTIPLY", gi.outputs["W"], gi.outputs["Scale"])
+    shift = b.math("MULTIPLY", gi.outputs["Time"], float(_F(noise.speed)))
+    group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
+    acc = (0.0, 0.0, 0.0)
+    for k in range(noise.dirs.count):
+        node = b.new(group_kind)
+        node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
+                                        table.values.shape[0], table.mode, _stratum_constants(noise, k))
+        node.label = f"Direction {k + 1}"
+        b.put(node.inputs["Sum"], acc)
+        b.put(node.inputs["Position"], x)
+        b.put(node.inputs["W"], w)
+        b.put(node.inputs["Shift"], shift)
+        acc = node.outputs["Sum"]
+    re, im, _ = b.separate(acc)
+    b.put(go.inputs["Value"], re)
+    b.put(go.inputs["Imaginary"], im)
+    b.put(go.inputs["Modulus"], b.vmath("LENGTH", acc))
+    b.put(go.inputs["Phase"], b.math("ARCTAN2", im, re))
+    return tree

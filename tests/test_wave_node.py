@@ -1,0 +1,198 @@
+"""The Wave Noise node group against the engine: Geometry Nodes fields and Cycles bakes.
+
+Agreement is measured at the very points Blender evaluated: for Cycles the
+shading positions are baked too (a bake interpolates positions in float32, so
+they differ from the ideal pixel centres by ~5e-5).
+"""
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
+from backend.wave import select_output  # noqa: E402
+from blender_addon.field_eval import evaluate_field  # noqa: E402
+from blender_addon.wave_nodes import SETTINGS_KEY, build_wave_group, settings_from_json  # noqa: E402
+
+OUT = {"Value": "real", "Imaginary": "imag", "Modulus": "modulus", "Phase": "phase"}
+
+
+def _engine(s, pts, scale=1.0, time=0.0, w=0.0):
+    x = pts[:, : min(s.dim, 3)]
+    if s.dim == 4:
+        x = np.concatenate([x, np.full((len(x), 1), w, np.float32)], 1)
+    return compile_noise(s).evaluate((x * np.float32(scale)).astype(np.float32), time, accelerate=False)
+
+
+def _node_field(s, pts, output, scale=1.0, time=0.0, w=0.0):
+    grp = build_wave_group(s, "GeometryNodeTree")
+
+    def build(tree, pos):
+        g = tree.nodes.new("GeometryNodeGroup")
+        g.node_tree = grp
+        tree.links.new(pos, g.inputs["Vector"])
+        g.inputs["Scale"].default_value = scale
+        g.inputs["Time"].default_value = time
+        g.inputs["W"].default_value = w
+        return g.outputs[output]
+
+    try:
+        return evaluate_field(pts, build)
+    finally:
+        bpy.data.node_groups.remove(grp)
+
+
+CASES = {
+    "2d": (WaveSettings(dim=2, spectrum=Spectrum("bandpass", 2, 6), directions=8, seed=3), {}),
+    "3d": (WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 6), directions=8, seed=3), {"scale": 1.7}),
+    "4d": (WaveSettings(dim=4, spectrum=Spectrum("bandpass", 2, 6), directions=8, seed=3), {"w": 0.7}),
+    "3d+t": (WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2, 6), directions=8, seed=4, speed=0.8),
+             {"time": 1.3}),
+    "2d+t": (WaveSettings(dim=2, spectrum=Spectrum("gaussian", 2, 6), directions=6, seed=4, speed=0.5),
+             {"time": 2.5}),
+    "lobes": (WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2, 6), directions=12, seed=7, anisotropy="lobes",
+                           lobes=(((1.0, 0.2, 0.3), 1.0), ((0.0, 1.0, 0.0), 0.5)), spread=25.0), {}),
+    "axes": (WaveSettings(dim=3, directions=8, seed=7, anisotropy="axes",
+                          axis_spectra=(Spectrum("bandpass", 1, 3), Spectrum("bandpass", 4, 6),
+                                        Spectrum("bandpass", 2, 3))), {}),
+    "crystal": (WaveSettings(dim=2, spectrum=Spectrum("gaussian", 2, 6), directions=8, seed=7, waveform="crystal"),
+                {}),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_geometry_nodes_field_equals_engine(case):
+    s, kw = CASES[case]
+    pts = np.random.default_rng(1).uniform(-2, 3, (1500, 3)).astype(np.float32)
+    z = _engine(s, pts, **kw)
+    for output in ("Value", "Imaginary", "Modulus"):
+        got = _node_field(s, pts, output, **kw)
+        ref = select_output(z, OUT[output])
+        d = np.abs(got - ref)
+        # same hashes, same float32 maths: most points agree to ~1e-7; the float32
+        # table coordinate bounds the rest (~1e-4)
+        assert np.median(d) < 1e-6 and np.percentile(d, 99) < 3e-5 and d.max() < 2e-4, (output, d.max())
+        assert ref.std() > 0.1
+
+
+def test_phase_output_where_defined():
+    s, kw = CASES["3d"]
+    pts = np.random.default_rng(2).uniform(-2, 3, (1500, 3)).astype(np.float32)
+    z = _engine(s, pts, **kw)
+    got = _node_field(s, pts, "Phase", **kw)
+    d = np.abs(np.angle(np.exp(1j * (got - select_output(z, "phase")))))
+    strong = np.abs(z) > 0.1  # phase is ill-conditioned where the modulus vanishes
+    assert d[strong].max() < 2e-3 and np.median(d) < 1e-6
+
+
+def _plane_material(grp, kw):
+    mesh = bpy.data.meshes.new("plane")
+    mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    uv = mesh.uv_layers.new(name="UV")
+    for i, c in enumerate([(0, 0), (1, 0), (1, 1), (0, 1)]):
+        uv.data[i].uv = c
+    ob = bpy.data.objects.new("plane", mesh)
+    bpy.context.scene.collection.objects.link(ob)
+    mat = bpy.data.materials.new("wave")
+    ob.data.materials.append(mat)
+    nt = mat.node_tree
+    nt.nodes.clear()
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    g = nt.nodes.new("ShaderNodeGroup")
+    g.node_tree = grp
+    nt.links.new(tc.outputs["Object"], g.inputs["Vector"])
+    for key, val in kw.items():
+        g.inputs[{"scale": "Scale", "time": "Time", "w": "W"}[key]].default_value = val
+    comb = nt.nodes.new("ShaderNodeCombineXYZ")
+    for i, o in enumerate(("Value", "Imaginary", "Modulus")):
+        nt.links.new(g.outputs[o], comb.inputs[i])
+    em = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(comb.outputs[0], em.inputs["Color"])
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    nt.links.new(em.outputs[0], out.inputs["Surface"])
+    return ob, nt, tc, comb, em
+
+
+def _bake(ob, nt, size):
+    img = bpy.data.images.new("bake", size, size, alpha=False, float_buffer=True)
+    img.colorspace_settings.name = "Non-Color"
+    it = nt.nodes.new("ShaderNodeTexImage")
+    it.image = img
+    nt.nodes.active = it
+    bpy.context.view_layer.objects.active = ob
+    ob.select_set(True)
+    bpy.ops.object.bake(type="EMIT", margin=0)
+    px = np.array(img.pixels[:], np.float32).reshape(size, size, 4)
+    nt.nodes.remove(it)
+    bpy.data.images.remove(img)
+    return px
+
+
+@pytest.mark.parametrize("case", ["2d", "3d", "4d", "3d+t"])
+def test_cycles_bake_equals_engine(case):
+    s, kw = CASES[case]
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 1
+    grp = build_wave_group(s, "ShaderNodeTree")
+    ob, nt, tc, comb, em = _plane_material(grp, kw)
+    vals = _bake(ob, nt, 48)
+    nt.links.new(tc.outputs["Object"], em.inputs["Color"])  # bake the shading positions too
+    pos = _bake(ob, nt, 48)[..., :3].reshape(-1, 3)
+    assert np.abs(pos[:, :2]).max() > 0.9  # the plane was covered
+    z = _engine(s, np.ascontiguousarray(pos), **kw)
+    for c, o in enumerate(("real", "imag", "modulus")):
+        d = np.abs(vals[..., c].ravel() - select_output(z, o))
+        assert np.percentile(d, 99) < 5e-5 and d.max() < 2e-4, (o, d.max())
+
+
+@pytest.mark.parametrize("dim,k", [(2, 64), (3, 32), (4, 32)])
+def test_cycles_compiles_many_directions(dim, k):
+    """Cycles' SVM stack (255 floats) holds the largest direction counts the node offers."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = 1
+    grp = build_wave_group(WaveSettings(dim=dim, spectrum=Spectrum("bandpass", 2, 6), directions=k, seed=3),
+                           "ShaderNodeTree")
+    ob, nt, *_ = _plane_material(grp, {})
+    px = _bake(ob, nt, 8)
+    assert px[..., 0].std() > 0.1  # an overflowing shader bakes to a constant
+
+
+def test_rebuild_keeps_links_and_interface():
+    s, _ = CASES["3d"]
+    grp = build_wave_group(s, "ShaderNodeTree")
+    mat = bpy.data.materials.new("links")
+    nt = mat.node_tree
+    nt.nodes.clear()
+    g = nt.nodes.new("ShaderNodeGroup")
+    g.node_tree = grp
+    em = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(g.outputs["Modulus"], em.inputs["Strength"])
+    before = len(grp.nodes)
+    s2 = s.replace(directions=5, dim=2, seed=9)
+    build_wave_group(s2, tree=grp)
+    assert len(nt.links) == 1 and nt.links[0].from_socket.name == "Modulus"
+    assert settings_from_json(grp[SETTINGS_KEY]) == s2
+    assert sum(n.bl_idname == "ShaderNodeGroup" for n in grp.nodes) == 5 and len(grp.nodes) < before
+    assert before
+    assert not [t for t in bpy.data.node_groups if t.name.startswith(".") and t.users == 0]
+
+
+def test_table_image_is_float_and_survives_save(tmp_path):
+    s, _ = CASES["2d"]
+    grp = build_wave_group(s, "ShaderNodeTree")
+    grp.use_fake_user = True
+    img = next(i for i in bpy.data.images if i.name.startswith("OmniNoise table"))
+    assert img.packed_file is not None and not img.use_half_precision and img.is_float
+    ref = np.array(img.pixels[:], np.float32)
+    name = img.name
+    path = str(tmp_path / "t.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    img = bpy.data.images[name]
+    assert np.array_equal(np.array(img.pixels[:], np.float32), ref)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
