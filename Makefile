@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: all setup demo test bench clean
+.PHONY: all setup demo test bench dist clean
 
 all: test
 
@@ -32,5 +32,10 @@ $(VENV)/.bench: $(STAMP) requirements-bench.txt
 bench: $(VENV)/.bench
 	$(BIN)/python bench/bench_wave.py
 
+# installable extension zips (linux-x64, windows-x64, macos-arm64) in dist/, built and validated
+# with Blender's own extension builder from the bpy wheel
+dist: $(STAMP)
+	$(BIN)/python tools/build_dist.py --out dist
+
 clean:
-	rm -rf $(VENV) out build *.egg-info
+	rm -rf $(VENV) out build dist wheels *.egg-info

@@ -1,22 +1,22 @@
 """Blender layer of OmniNoise: the only package that imports ``bpy``.
 
-Operators, panels and node-group builders register here (later issues); for now
-the package provides :mod:`.field_eval`, which evaluates Blender texture nodes
-through Geometry Nodes for tests and benchmarks.
+Registration is cheap: classes and menu entries only.  Engines load when first
+used (building a node imports numpy and the backend, no model is read).
 """
+from __future__ import annotations
 
-_classes: list = []
+
+def _modules():
+    from . import preferences, wave_ui
+
+    return (preferences, wave_ui)
 
 
 def register():
-    import bpy
-
-    for cls in _classes:
-        bpy.utils.register_class(cls)
+    for m in _modules():
+        m.register()
 
 
 def unregister():
-    import bpy
-
-    for cls in reversed(_classes):
-        bpy.utils.unregister_class(cls)
+    for m in reversed(_modules()):
+        m.unregister()

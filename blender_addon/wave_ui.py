@@ -1,0 +1,205 @@
+"""Wave Noise in the node editors: Add-menu entry, settings panel, live rebuild.
+
+The node an artist adds is a plain group node whose tree :mod:`.wave_nodes`
+builds; its settings live on the tree (``NodeTree.omninoise_wave``).  Editing a
+setting rebuilds the inner nodes in place: the interface never changes, so
+links to the node survive.  A .blend keeps rendering without the extension,
+because the group is made of Blender's own nodes and its tables are packed.
+"""
+from __future__ import annotations
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
+    PointerProperty, StringProperty
+
+from ._deps import backend
+from .wave_nodes import build_wave_group
+
+_SPECTRA = [(k, k.capitalize(), "") for k in ("gaussian", "bandpass", "fractal", "white", "blue", "brown", "twolevel")]
+_WAVEFORMS = [("gaussian", "Gaussian", "Random-phase waves (Gaussian noise)"),
+              ("crystal", "Crystal", "Stepped waveform: faceted, crystal-like"),
+              ("wired", "Wired", "Impulse waveform: thin wires")]
+_ANISO = [("none", "Isotropic", "Directions over the whole (half) sphere"),
+          ("lobes", "Lobe", "Directions within a cone around an axis (Fig. 5 right)"),
+          ("axes", "Per Axis", "One band per axis, interpolated by direction (Fig. 5 left)")]
+#: most directions Cycles' shader stack holds, per dimension (tests/test_wave_node.py)
+MAX_DIRECTIONS = {2: 64, 3: 32, 4: 32}
+
+
+def _rebuild(self, context) -> None:
+    tree = self.id_data
+    if not self.is_wave or getattr(tree, "is_evaluated", False):
+        return
+    try:
+        build_wave_group(self.to_settings(), tree=tree)
+        self.error = ""
+    except backend.SettingError as e:
+        self.error = str(e)
+
+
+class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
+    """Settings of a Wave Noise group (stored with its node tree)."""
+
+    is_wave: BoolProperty(default=False, options={"HIDDEN"})
+    error: StringProperty(default="", options={"HIDDEN"})
+    dimensions: EnumProperty(name="Dimensions", items=[("2", "2D", ""), ("3", "3D", ""), ("4", "4D", "")],
+                             default="3", update=_rebuild)
+    directions: IntProperty(name="Directions", description="Number of wave directions (cost grows linearly)",
+                            default=16, min=1, max=64, update=_rebuild)
+    spectrum: EnumProperty(name="Spectrum", items=_SPECTRA, default="gaussian", update=_rebuild)
+    fmin: FloatProperty(name="Min Frequency", description="Lower band limit, cycles per unit (after Scale)",
+                        default=2.0, min=0.0, soft_max=64.0, update=_rebuild)
+    fmax: FloatProperty(name="Max Frequency", description="Upper band limit, cycles per unit (after Scale)",
+                        default=6.0, min=0.01, soft_max=64.0, update=_rebuild)
+    exponent: FloatProperty(name="Exponent", description="Fractal spectrum falls as 1/f^exponent",
+                            default=1.0, min=0.0, max=4.0, update=_rebuild)
+    waveform: EnumProperty(name="Waveform", items=_WAVEFORMS, default="gaussian", update=_rebuild)
+    anisotropy: EnumProperty(name="Anisotropy", items=_ANISO, default="none", update=_rebuild)
+    axis: FloatVectorProperty(name="Axis", size=3, default=(1.0, 0.0, 0.0), update=_rebuild)
+    spread: FloatProperty(name="Spread", description="Half-angle of the lobe, degrees", default=20.0,
+                          min=1.0, max=90.0, update=_rebuild)
+    axis_scale: FloatVectorProperty(name="Axis Frequency", description="Band limits scaled per axis",
+                                    size=3, default=(1.0, 2.0, 0.5), min=0.05, soft_max=8.0, update=_rebuild)
+    seed: IntProperty(name="Seed", default=0, min=0, max=(1 << 24) - 1, update=_rebuild)
+    speed: FloatProperty(name="Speed", description="Wave speed for animation with the Time input (Eq. 9); "
+                         "0 = static", default=0.0, soft_min=-10.0, soft_max=10.0, update=_rebuild)
+
+    def to_settings(self):
+        dim = int(self.dimensions)
+        if self.directions > MAX_DIRECTIONS[dim]:
+            raise backend.SettingError("directions", f"at most {MAX_DIRECTIONS[dim]} in {dim}D "
+                                       "(Cycles' shader stack); use a bake for more")
+        sp = backend.Spectrum(self.spectrum, self.fmin, self.fmax, self.exponent)
+        kw = {}
+        if self.anisotropy == "lobes":
+            axis = (tuple(self.axis) + (0.0,))[:dim]
+            kw = dict(anisotropy="lobes", lobes=((axis, 1.0),), spread=self.spread)
+        elif self.anisotropy == "axes":
+            scales = list(self.axis_scale) + [1.0]
+            kw = dict(anisotropy="axes", axis_spectra=tuple(
+                backend.Spectrum(self.spectrum, self.fmin * scales[a], self.fmax * scales[a], self.exponent)
+                for a in range(dim)))
+        return backend.WaveSettings(dim=dim, spectrum=sp, directions=self.directions, seed=self.seed,
+                                    speed=self.speed, waveform=self.waveform, **kw)
+
+
+def _wave_tree(context):
+    node = getattr(context, "active_node", None)
+    tree = getattr(node, "node_tree", None) if node is not None else None
+    if tree is not None and tree.omninoise_wave.is_wave:
+        return tree
+    return None
+
+
+class OMNINOISE_OT_add_wave_noise(bpy.types.Operator):
+    """Add a Wave Noise node (Guehl et al. 2025) built from Blender's own nodes"""
+
+    bl_idname = "node.omninoise_add_wave_noise"
+    bl_label = "Wave Noise"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        space = context.space_data
+        return (space is not None and space.type == "NODE_EDITOR" and space.edit_tree is not None
+                and space.tree_type in ("ShaderNodeTree", "GeometryNodeTree"))
+
+    def execute(self, context):
+        space = context.space_data
+        edit = space.edit_tree
+        tree = bpy.data.node_groups.new("Wave Noise", space.tree_type)
+        try:
+            _init_tree(tree)
+        except backend.SettingError as e:
+            bpy.data.node_groups.remove(tree)
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        for n in edit.nodes:
+            n.select = False
+        kind = "GeometryNodeGroup" if space.tree_type == "GeometryNodeTree" else "ShaderNodeGroup"
+        node = edit.nodes.new(kind)
+        node.node_tree = tree
+        node.location = space.cursor_location
+        node.select = True
+        edit.nodes.active = node
+        if space.tree_type == "ShaderNodeTree":  # object coordinates, like a solid texture
+            tc = edit.nodes.new("ShaderNodeTexCoord")
+            tc.location = (node.location.x - 220, node.location.y)
+            edit.links.new(tc.outputs["Object"], node.inputs["Vector"])
+        return {"FINISHED"}
+
+
+def _init_tree(tree) -> None:
+    """Give a fresh tree the group interface and build it from its default settings."""
+    from .wave_nodes import INPUTS, OUTPUTS
+    for nm, st, default in INPUTS:
+        s = tree.interface.new_socket(nm, in_out="INPUT", socket_type=st)
+        s.default_value = default
+    for nm in OUTPUTS:
+        tree.interface.new_socket(nm, in_out="OUTPUT", socket_type="NodeSocketFloat")
+    props = tree.omninoise_wave
+    build_wave_group(props.to_settings(), tree=tree)
+    props.is_wave = True
+
+
+class OMNINOISE_PT_wave_node(bpy.types.Panel):
+    bl_label = "Wave Noise"
+    bl_space_type = "NODE_EDITOR"
+    bl_region_type = "UI"
+    bl_category = "OmniNoise"
+
+    @classmethod
+    def poll(cls, context):
+        return _wave_tree(context) is not None
+
+    def draw(self, context):
+        props = _wave_tree(context).omninoise_wave
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(props, "dimensions")
+        layout.prop(props, "directions")
+        col = layout.column(heading="Spectrum")
+        col.prop(props, "spectrum", text="Spectrum")
+        col.prop(props, "fmin")
+        col.prop(props, "fmax")
+        if props.spectrum == "fractal":
+            col.prop(props, "exponent")
+        layout.prop(props, "waveform")
+        layout.prop(props, "anisotropy")
+        if props.anisotropy == "lobes":
+            layout.prop(props, "axis")
+            layout.prop(props, "spread")
+        elif props.anisotropy == "axes":
+            layout.prop(props, "axis_scale")
+        layout.prop(props, "seed")
+        layout.prop(props, "speed")
+        if props.error:
+            layout.label(text=props.error, icon="ERROR")
+
+
+def _menu(self, context):
+    self.layout.operator(OMNINOISE_OT_add_wave_noise.bl_idname, text="Wave Noise (OmniNoise)")
+
+
+MENUS = ("NODE_MT_category_shader_texture", "NODE_MT_category_GEO_TEXTURE")
+classes = (OMNINOISE_PG_wave, OMNINOISE_OT_add_wave_noise, OMNINOISE_PT_wave_node)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.NodeTree.omninoise_wave = PointerProperty(type=OMNINOISE_PG_wave)
+    for m in MENUS:
+        menu = getattr(bpy.types, m, None)
+        if menu is not None:
+            menu.append(_menu)
+
+
+def unregister():
+    for m in MENUS:
+        menu = getattr(bpy.types, m, None)
+        if menu is not None:
+            menu.remove(_menu)
+    del bpy.types.NodeTree.omninoise_wave
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,33 @@
+"""Run by tests/test_extension.py in a fresh Python with temporary Blender user folders.
+
+argv[-1]: the extension zip.  Prints one JSON line of what it observed.
+"""
+import importlib
+import json
+import sys
+
+import bpy
+
+MOD = "bl_ext.user_default.omninoise"
+out = {}
+out["install"] = sorted(bpy.ops.extensions.package_install_files(filepath=sys.argv[-1], repo="user_default",
+                                                                  enable_on_install=True))
+out["enabled"] = MOD in bpy.context.preferences.addons
+out["props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
+out["menu_op"] = hasattr(bpy.types, "NODE_OT_omninoise_add_wave_noise")
+ui = importlib.import_module(MOD + ".blender_addon.wave_ui")
+tree = bpy.data.node_groups.new("Wave Noise", "ShaderNodeTree")
+ui._init_tree(tree)
+out["directions_default"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
+tree.omninoise_wave.directions = 5
+out["directions_after_edit"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
+tree.omninoise_wave.directions = 60  # above the 3D limit: a message, the old tree stays
+out["error"] = tree.omninoise_wave.error
+out["directions_after_error"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
+out["cache_dir"] = importlib.import_module(MOD + ".blender_addon.preferences").cache_dir()
+bpy.ops.preferences.addon_disable(module=MOD)
+out["disabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
+bpy.ops.preferences.addon_enable(module=MOD)
+out["reenabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
+bpy.ops.preferences.addon_disable(module=MOD)
+print("RESULT " + json.dumps(out))

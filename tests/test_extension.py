@@ -1,0 +1,47 @@
+"""Build the extension with Blender's builder, install it into temporary user folders, enable/disable."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+pytest.importorskip("bpy")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@pytest.fixture(scope="module")
+def built_zip(tmp_path_factory):
+    out = tmp_path_factory.mktemp("dist")
+    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "build_dist.py"), "--no-wheels", "--out",
+                        str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    zips = [f for f in os.listdir(out) if f.endswith(".zip")]
+    assert len(zips) == 1 and "valid" in r.stdout
+    return os.path.join(out, zips[0])
+
+
+def test_zip_holds_runtime_files_only(built_zip):
+    import zipfile
+    names = zipfile.ZipFile(built_zip).namelist()
+    assert "blender_manifest.toml" in names and "blender_addon/wave_nodes.py" in names
+    assert "backend/wave.py" in names and "export/images.py" in names
+    assert not [n for n in names if n.startswith(("tests/", "bench/", "demo/", "tools/")) or "__pycache__" in n]
+
+
+def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
+    env = dict(os.environ)
+    for key in ("CONFIG", "SCRIPTS", "EXTENSIONS", "DATAFILES"):
+        env[f"BLENDER_USER_{key}"] = str(tmp_path / key.lower())
+    script = os.path.join(ROOT, "tests", "blender_scripts", "install_extension.py")
+    r = subprocess.run([sys.executable, script, built_zip], capture_output=True, text=True, env=env,
+                       cwd=str(tmp_path), timeout=600)
+    line = [ln for ln in r.stdout.splitlines() if ln.startswith("RESULT ")]
+    assert r.returncode == 0 and line, r.stdout[-3000:] + r.stderr[-3000:]
+    out = json.loads(line[0][7:])
+    assert out["install"] == ["FINISHED"] and out["enabled"] and out["props"] and out["menu_op"]
+    assert out["directions_default"] == 16 and out["directions_after_edit"] == 5
+    assert "at most 32" in out["error"] and out["directions_after_error"] == 5
+    assert out["cache_dir"].startswith(str(tmp_path))  # the user folder, not the extension's own
+    assert not out["disabled_props"] and out["reenabled_props"]
+    assert os.path.isdir(tmp_path / "extensions" / "user_default" / "omninoise")

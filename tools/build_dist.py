@@ -1,0 +1,111 @@
+"""Build the installable extension zips with Blender's own builder (``make dist``).
+
+1. Download the pinned wheels Blender lacks (onnxruntime, OpenEXR and their
+   dependencies, minus numpy, which Blender bundles) for Python 3.11 on
+   linux-x64, windows-x64 and macos-arm64 into ``wheels/`` (kept between runs).
+2. Stage the runtime files only (extension root, ``blender_addon``, ``backend``,
+   ``export``; no tests, bench, demo or training code) into ``build/extension``
+   and list the platforms and wheels in the staged manifest.
+3. Run ``blender_ext.py build --split-platforms`` from the ``bpy`` wheel (the
+   same as ``blender --command extension build``), then ``validate`` each zip.
+
+Usage: python tools/build_dist.py [--out dist] [--no-wheels]
+(``--no-wheels`` builds one platform-independent zip without bundled wheels,
+which the tests install; the wheels are only needed by the neural features.)
+"""
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PINS = {"onnxruntime": "1.31.1", "OpenEXR": "3.5.3"}
+PLATFORMS = {  # Blender platform -> pip platform tag
+    "linux-x64": "manylinux_2_28_x86_64",
+    "windows-x64": "win_amd64",
+    "macos-arm64": "macosx_14_0_arm64",
+}
+RUNTIME = ("__init__.py", "blender_manifest.toml", "blender_addon", "backend", "export")
+EXCLUDE_DIRS = {"__pycache__", "training"}
+
+
+def blender_ext() -> str:
+    spec = importlib.util.find_spec("bpy")
+    if spec is None or not spec.origin:
+        sys.exit("make dist: the bpy module is not installed (run make test or pip install bpy==5.0.1)")
+    base = os.path.dirname(spec.origin)
+    for d in sorted(os.listdir(base)):
+        p = os.path.join(base, d, "scripts", "addons_core", "bl_pkg", "cli", "blender_ext.py")
+        if os.path.exists(p):
+            return p
+    sys.exit(f"make dist: blender_ext.py not found under {base}")
+
+
+def download_wheels() -> list[str]:
+    out = []
+    for plat, tag in PLATFORMS.items():
+        dest = os.path.join(ROOT, "wheels", plat)
+        os.makedirs(dest, exist_ok=True)
+        have = [f for f in os.listdir(dest) if f.endswith(".whl")]
+        if not all(any(f.lower().startswith(n.lower() + "-" + v) for f in have) for n, v in PINS.items()):
+            cmd = [sys.executable, "-m", "pip", "download", "--quiet", "--only-binary=:all:", "--python-version",
+                   "3.11", "--platform", tag, "-d", dest] + [f"{n}=={v}" for n, v in PINS.items()]
+            print("downloading wheels for", plat, flush=True)
+            subprocess.run(cmd, check=True)
+        for f in sorted(os.listdir(dest)):
+            if f.endswith(".whl") and not f.startswith("numpy-"):
+                out.append(os.path.join(dest, f))
+    return out
+
+
+def stage(wheels: list[str]) -> str:
+    dst = os.path.join(ROOT, "build", "extension-nowheels" if not wheels else "extension")
+    shutil.rmtree(dst, ignore_errors=True)
+    os.makedirs(os.path.join(dst, "wheels"))
+    for item in RUNTIME:
+        src = os.path.join(ROOT, item)
+        if os.path.isdir(src):
+            shutil.copytree(src, os.path.join(dst, item),
+                            ignore=lambda d, names: [n for n in names if n in EXCLUDE_DIRS or n.endswith(".pyc")])
+        else:
+            shutil.copy2(src, dst)
+    names = []
+    for w in wheels:
+        name = os.path.basename(w)
+        if name not in names:
+            shutil.copy2(w, os.path.join(dst, "wheels", name))
+            names.append(name)
+    man = os.path.join(dst, "blender_manifest.toml")
+    text = open(man, encoding="utf-8").read()
+    extra = ""
+    if names:
+        extra = ("platforms = [" + ", ".join(f'"{p}"' for p in PLATFORMS) + "]\n"
+                 "wheels = [\n" + "".join(f'  "./wheels/{n}",\n' for n in names) + "]\n")
+    text = re.sub(r"(blender_version_min\s*=.*\n)", lambda m: m.group(1) + extra, text, count=1)
+    open(man, "w", encoding="utf-8").write(text)
+    return dst
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", default=os.path.join(ROOT, "dist"))
+    ap.add_argument("--no-wheels", action="store_true", help="one zip without bundled wheels")
+    a = ap.parse_args()
+    tool = blender_ext()
+    src = stage([] if a.no_wheels else download_wheels())
+    os.makedirs(a.out, exist_ok=True)
+    split = [] if a.no_wheels else ["--split-platforms"]
+    subprocess.run([sys.executable, tool, "build", "--source-dir", src, "--output-dir", a.out] + split, check=True)
+    zips = sorted(f for f in os.listdir(a.out) if f.endswith(".zip"))
+    for z in zips:
+        subprocess.run([sys.executable, tool, "validate", os.path.join(a.out, z)], check=True)
+        print(f"{z}: {os.path.getsize(os.path.join(a.out, z)) / 2**20:.1f} MiB, valid")
+
+
+if __name__ == "__main__":
+    main()
