@@ -1,0 +1,126 @@
+"""Cycles render time of a plane shaded by the Wave Noise node vs Blender's own textures.
+
+Headless Cycles (CPU), orthographic camera on a plane filling the frame,
+emission shader, R x R pixels, S samples; each shader is rendered once to
+compile, then timed over ``--repeat`` renders (the minimum is kept).  Prints ns
+per pixel-sample and ratios against Blender's Gabor Texture (the issue's target),
+the node count of each built tree, and writes out/bench/node.json.
+
+    python bench/bench_node.py [--res 256] [--samples 4] [--repeat 2]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+import bpy  # noqa: E402
+
+from backend import Spectrum, WaveSettings  # noqa: E402
+from blender_addon.wave_nodes import build_wave_group  # noqa: E402
+
+
+def scene(res: int, samples: int):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    sc.cycles.device = "CPU"
+    sc.cycles.samples = samples
+    sc.cycles.use_denoising = False
+    sc.render.resolution_x = sc.render.resolution_y = res
+    sc.render.resolution_percentage = 100
+    mesh = bpy.data.meshes.new("plane")
+    mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    ob = bpy.data.objects.new("plane", mesh)
+    sc.collection.objects.link(ob)
+    cam = bpy.data.cameras.new("cam")
+    cam.type = "ORTHO"
+    cam.ortho_scale = 2.0
+    co = bpy.data.objects.new("cam", cam)
+    co.location = (0, 0, 3)
+    sc.collection.objects.link(co)
+    sc.camera = co
+    mat = bpy.data.materials.new("m")
+    ob.data.materials.append(mat)
+    return sc, mat
+
+
+def shade(mat, make):
+    nt = mat.node_tree
+    nt.nodes.clear()
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    em = nt.nodes.new("ShaderNodeEmission")
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    nt.links.new(em.outputs[0], out.inputs["Surface"])
+    sock, count = make(nt)
+    nt.links.new(tc.outputs["Object"], sock[0])
+    nt.links.new(sock[1], em.inputs["Strength"])
+    return count
+
+
+def texture(kind, **props):
+    def make(nt):
+        n = nt.nodes.new(kind)
+        for k, v in props.items():
+            if k in n.inputs:
+                n.inputs[k].default_value = v
+            else:
+                setattr(n, k, v)
+        return (n.inputs["Vector"], n.outputs[0]), 1
+    return make
+
+
+def wave(k):
+    def make(nt):
+        grp = build_wave_group(WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2, 6), directions=k, seed=1))
+        n = nt.nodes.new("ShaderNodeGroup")
+        n.node_tree = grp
+        count = len(grp.nodes) + sum(len(g.node_tree.nodes) for g in grp.nodes if g.bl_idname == "ShaderNodeGroup")
+        return (n.inputs["Vector"], n.outputs["Value"]), count
+    return make
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--res", type=int, default=256)
+    ap.add_argument("--samples", type=int, default=4)
+    ap.add_argument("--repeat", type=int, default=2)
+    a = ap.parse_args()
+    cases = {
+        "Blender Noise detail 5": texture("ShaderNodeTexNoise", Detail=5.0, Scale=5.0),
+        "Blender Voronoi": texture("ShaderNodeTexVoronoi", Scale=5.0),
+        "Blender Gabor": texture("ShaderNodeTexGabor", Scale=5.0),
+        "Wave Noise 8 dirs": wave(8),
+        "Wave Noise 16 dirs": wave(16),
+        "Wave Noise 32 dirs": wave(32),
+    }
+    res = {}
+    for name, make in cases.items():
+        sc, mat = scene(a.res, a.samples)
+        nodes = shade(mat, make)
+        bpy.ops.render.render()  # compile and warm up
+        best = min(_timed() for _ in range(a.repeat))
+        res[name] = dict(ns_per_pixel_sample=best / (a.res * a.res * a.samples) * 1e9, nodes=nodes, seconds=best)
+    ref = res["Blender Gabor"]["ns_per_pixel_sample"]
+    print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} samples")
+    print(f"  {'shader':24s} {'ns/px-sample':>12s} {'vs Gabor':>9s} {'nodes':>6s}")
+    for name, r in res.items():
+        print(f"  {name:24s} {r['ns_per_pixel_sample']:12.1f} {r['ns_per_pixel_sample'] / ref:8.2f}x {r['nodes']:6d}")
+    os.makedirs(os.path.join(ROOT, "out", "bench"), exist_ok=True)
+    with open(os.path.join(ROOT, "out", "bench", "node.json"), "w") as fh:
+        json.dump(dict(res=a.res, samples=a.samples, results=res), fh, indent=1)
+
+
+def _timed() -> float:
+    t = time.perf_counter()
+    bpy.ops.render.render()
+    return time.perf_counter() - t
+
+
+if __name__ == "__main__":
+    main()
