@@ -20,6 +20,7 @@ setup: $(STAMP)
 
 demo: $(STAMP)
 	$(BIN)/python demo/showcase.py out/demo
+	$(BIN)/python demo/showcase_blend.py out/demo
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
