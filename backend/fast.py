@@ -100,19 +100,22 @@ if numba is not None:
             out_im[i] = zi
 
 
-def _padded_table(values: np.ndarray) -> np.ndarray:
-    """(size,) complex -> float32 (size + 2, 2) with one wrapped texel on each side."""
-    t = values[0]
-    pad = np.concatenate([t[-1:], t, t[:1]])
-    return np.ascontiguousarray(np.stack([pad.real, pad.imag], axis=1).astype(_F))
+def _padded_table(noise) -> np.ndarray:
+    """The single table as float32 (size + 2, 2) (re, im) with one wrapped texel on each side; cached."""
+    if not hasattr(noise, "_fast_table"):
+        t = noise.table.values[0]
+        pad = np.concatenate([t[-1:], t, t[:1]])
+        noise._fast_table = np.ascontiguousarray(np.stack([pad.real, pad.imag], axis=1).astype(_F))
+    return noise._fast_table
 
 
-def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
-    """Complex noise at x: float32 (P, dim) -> complex64 (P,), or None when not applicable."""
-    if not supports(noise) or np.ndim(time) != 0 or len(x) == 0:
-        return None
-    K = noise.dirs.count
-    lo, hi = x.min(axis=0), x.max(axis=0)
+def _slice_records(noise, lo: np.ndarray, hi: np.ndarray):
+    """Records of every slice the box [lo, hi] (float32 (dim,)) touches, per stratum.
+
+    Returns nmin float32 (K,) (id of each stratum's first slice), slpos (K, S),
+    omega (K, S, D), zeta (K, S); or None when a stratum needs more than
+    MAX_RECORDS slices.
+    """
     sd = noise.slice_dirs
     pmin = np.sum(np.minimum(sd * lo, sd * hi), axis=1) + noise.slice_offsets
     pmax = np.sum(np.maximum(sd * lo, sd * hi), axis=1) + noise.slice_offsets
@@ -120,19 +123,27 @@ def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
     span = int(np.max(np.floor(pmax) - nmin)) + 3
     if span > MAX_RECORDS:
         return None
-    D = noise.dim
+    K, D = sd.shape
     slpos = np.empty((K, span), _F)
     omega = np.empty((K, span, D), _F)
     zeta = np.empty((K, span), _F)
     for k in range(K):
         m = (nmin[k] + np.arange(span, dtype=_F)).astype(_F) + _F(0.0)
         slpos[k], omega[k], zeta[k] = noise.slice_records(k, m)
-    if not hasattr(noise, "_fast_table"):
-        noise._fast_table = _padded_table(noise.table.values)
+    return nmin, slpos, omega, zeta
+
+
+def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
+    """Complex noise at x: float32 (P, dim) -> complex64 (P,), or None when not applicable."""
+    if not supports(noise) or np.ndim(time) != 0 or len(x) == 0:
+        return None
+    rec = _slice_records(noise, x.min(axis=0), x.max(axis=0))
+    if rec is None:
+        return None
     re = np.empty(len(x), _F)
     im = np.empty(len(x), _F)
-    _kernel(np.ascontiguousarray(x, _F), sd, noise.slice_offsets, noise.dirs.amp, nmin, slpos, omega, zeta,
-            noise._fast_table, _F(1.0 / noise.table.period), _F(noise.speed) * _F(time), re, im)
+    _kernel(np.ascontiguousarray(x, _F), noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *rec,
+            _padded_table(noise), _F(1.0 / noise.table.period), _F(noise.speed) * _F(time), re, im)
     return (re + 1j * im).astype(np.complex64)
 
 
@@ -308,22 +319,12 @@ class GridPlan:
     """
 
     def __init__(self, noise, lo: np.ndarray, hi: np.ndarray, time: float):
-        sd = noise.slice_dirs
-        pmin = np.sum(np.minimum(sd * lo, sd * hi), axis=1) + noise.slice_offsets
-        pmax = np.sum(np.maximum(sd * lo, sd * hi), axis=1) + noise.slice_offsets
-        K, D = sd.shape
-        self.nmin = np.floor(pmin).astype(_F) - _F(1.0)
-        span = int(np.max(np.floor(pmax) - self.nmin)) + 3
-        self.ok = span <= MAX_RECORDS
+        rec = _slice_records(noise, lo, hi)
+        self.ok = rec is not None
         if not self.ok:
             return
-        self.slpos = np.empty((K, span), _F)
-        self.omega = np.empty((K, span, D), _F)
-        self.zeta = np.empty((K, span), _F)
-        for k in range(K):
-            m = (self.nmin[k] + np.arange(span, dtype=_F)).astype(_F) + _F(0.0)
-            self.slpos[k], self.omega[k], self.zeta[k] = noise.slice_records(k, m)
-        t = _padded_table(noise.table.values)
+        self.nmin, self.slpos, self.omega, self.zeta = rec
+        t = _padded_table(noise)
         self.tre = np.ascontiguousarray(t[:, 0])
         self.tim = np.ascontiguousarray(t[:, 1])
         self.noise = noise
