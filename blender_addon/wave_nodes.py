@@ -34,7 +34,7 @@ import numpy as np
 
 from ._deps import backend
 
-__all__ = ["build_wave_group", "ensure_table_image", "settings_to_json", "settings_from_json",
+__all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json", "settings_from_json",
            "INPUTS", "OUTPUTS", "SETTINGS_KEY"]
 
 _F = np.float32
@@ -357,6 +357,30 @@ def _clear(tree: bpy.types.NodeTree) -> None:
             tree.nodes.remove(n)
 
 
+def new_wave_tree(name: str = "Wave Noise", tree_type: str = "ShaderNodeTree") -> bpy.types.NodeTree:
+    """An empty group with the Wave Noise interface (INPUTS in, OUTPUTS out), ready for build_wave_group."""
+    tree = _new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in OUTPUTS))
+    tree.interface.items_tree["Scale"].min_value = -1000.0
+    return tree
+
+
+def add_wave_node(node_tree: bpy.types.NodeTree, group: bpy.types.NodeTree, location=(0.0, 0.0)):
+    """Add a group node using ``group`` to ``node_tree`` -> the node.
+
+    In shader trees a Texture Coordinate node's Object output feeds its Vector,
+    so the noise is a solid texture of the object's local space.
+    """
+    kind = "GeometryNodeGroup" if node_tree.bl_idname == "GeometryNodeTree" else "ShaderNodeGroup"
+    node = node_tree.nodes.new(kind)
+    node.node_tree = group
+    node.location = location
+    if kind == "ShaderNodeGroup":
+        tc = node_tree.nodes.new("ShaderNodeTexCoord")
+        tc.location = (location[0] - 220.0, location[1])
+        node_tree.links.new(tc.outputs["Object"], node.inputs["Vector"])
+    return node
+
+
 def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
                      name: str = "Wave Noise") -> bpy.types.NodeTree:
     """Build (or rebuild in place) the Wave Noise group for ``settings`` (a backend WaveSettings).
@@ -373,8 +397,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     if table.mode not in ("single", "axes"):
         raise backend.SettingError("anisotropy", f"table mode {table.mode!r} has no node form")
     if tree is None:
-        tree = _new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in OUTPUTS))
-        tree.interface.items_tree["Scale"].min_value = -1000.0
+        tree = new_wave_tree(name, tree_type)
     else:
         _clear(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)

@@ -13,7 +13,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
     PointerProperty, StringProperty
 
 from ._deps import backend
-from .wave_nodes import build_wave_group
+from .wave_nodes import add_wave_node, build_wave_group, new_wave_tree
 
 _SPECTRA = [(k, k.capitalize(), "") for k in ("gaussian", "bandpass", "fractal", "white", "blue", "brown", "twolevel")]
 _WAVEFORMS = [("gaussian", "Gaussian", "Random-phase waves (Gaussian noise)"),
@@ -107,39 +107,33 @@ class OMNINOISE_OT_add_wave_noise(bpy.types.Operator):
     def execute(self, context):
         space = context.space_data
         edit = space.edit_tree
-        tree = bpy.data.node_groups.new("Wave Noise", space.tree_type)
         try:
-            _init_tree(tree)
+            tree = new_wave_node_tree("Wave Noise", space.tree_type)
         except backend.SettingError as e:
-            bpy.data.node_groups.remove(tree)
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         for n in edit.nodes:
             n.select = False
-        kind = "GeometryNodeGroup" if space.tree_type == "GeometryNodeTree" else "ShaderNodeGroup"
-        node = edit.nodes.new(kind)
-        node.node_tree = tree
-        node.location = space.cursor_location
+        node = add_wave_node(edit, tree, tuple(space.cursor_location))
         node.select = True
         edit.nodes.active = node
-        if space.tree_type == "ShaderNodeTree":  # object coordinates, like a solid texture
-            tc = edit.nodes.new("ShaderNodeTexCoord")
-            tc.location = (node.location.x - 220, node.location.y)
-            edit.links.new(tc.outputs["Object"], node.inputs["Vector"])
         return {"FINISHED"}
 
 
-def _init_tree(tree) -> None:
-    """Give a fresh tree the group interface and build it from its default settings."""
-    from .wave_nodes import INPUTS, OUTPUTS
-    for nm, st, default in INPUTS:
-        s = tree.interface.new_socket(nm, in_out="INPUT", socket_type=st)
-        s.default_value = default
-    for nm in OUTPUTS:
-        tree.interface.new_socket(nm, in_out="OUTPUT", socket_type="NodeSocketFloat")
+def new_wave_node_tree(name: str, tree_type: str) -> bpy.types.NodeTree:
+    """A Wave Noise group built from the default panel settings, its settings stored on it.
+
+    Raises backend.SettingError (and leaves no tree behind) when the settings are invalid.
+    """
+    tree = new_wave_tree(name, tree_type)
     props = tree.omninoise_wave
-    build_wave_group(props.to_settings(), tree=tree)
+    try:
+        build_wave_group(props.to_settings(), tree=tree)
+    except backend.SettingError:
+        bpy.data.node_groups.remove(tree)
+        raise
     props.is_wave = True
+    return tree
 
 
 class OMNINOISE_PT_wave_node(bpy.types.Panel):

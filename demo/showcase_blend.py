@@ -17,7 +17,7 @@ sys.path.insert(0, ROOT)
 import bpy  # noqa: E402
 
 from backend import Spectrum, WaveSettings  # noqa: E402
-from blender_addon.wave_nodes import build_wave_group  # noqa: E402
+from blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402
 
 VARIANTS = [
     ("2D band", WaveSettings(dim=2, spectrum=Spectrum("bandpass", 3, 6), directions=16, seed=1), "Value"),
@@ -34,10 +34,7 @@ def _material(name, settings, output):
     mat = bpy.data.materials.new(name)
     nt = mat.node_tree
     nt.nodes.clear()
-    tc = nt.nodes.new("ShaderNodeTexCoord")
-    g = nt.nodes.new("ShaderNodeGroup")
-    g.node_tree = grp
-    nt.links.new(tc.outputs["Object"], g.inputs["Vector"])
+    g = add_wave_node(nt, grp)
     ramp = nt.nodes.new("ShaderNodeMapRange")
     ramp.inputs["From Min"].default_value = -2.0 if output == "Value" else 0.0
     ramp.inputs["From Max"].default_value = 2.0

@@ -12,7 +12,7 @@ bpy = pytest.importorskip("bpy")
 from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
 from backend.wave import select_output  # noqa: E402
 from blender_addon.field_eval import evaluate_field  # noqa: E402
-from blender_addon.wave_nodes import SETTINGS_KEY, build_wave_group, settings_from_json  # noqa: E402
+from blender_addon.wave_nodes import SETTINGS_KEY, add_wave_node, build_wave_group, settings_from_json  # noqa: E402,E501
 
 OUT = {"Value": "real", "Imaginary": "imag", "Modulus": "modulus", "Phase": "phase"}
 
@@ -97,10 +97,8 @@ def _plane_material(grp, kw):
     ob.data.materials.append(mat)
     nt = mat.node_tree
     nt.nodes.clear()
-    tc = nt.nodes.new("ShaderNodeTexCoord")
-    g = nt.nodes.new("ShaderNodeGroup")
-    g.node_tree = grp
-    nt.links.new(tc.outputs["Object"], g.inputs["Vector"])
+    g = add_wave_node(nt, grp)
+    tc = g.inputs["Vector"].links[0].from_node
     for key, val in kw.items():
         g.inputs[{"scale": "Scale", "time": "Time", "w": "W"}[key]].default_value = val
     comb = nt.nodes.new("ShaderNodeCombineXYZ")

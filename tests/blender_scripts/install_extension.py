@@ -16,8 +16,7 @@ out["enabled"] = MOD in bpy.context.preferences.addons
 out["props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
 out["menu_op"] = hasattr(bpy.types, "NODE_OT_omninoise_add_wave_noise")
 ui = importlib.import_module(MOD + ".blender_addon.wave_ui")
-tree = bpy.data.node_groups.new("Wave Noise", "ShaderNodeTree")
-ui._init_tree(tree)
+tree = ui.new_wave_node_tree("Wave Noise", "ShaderNodeTree")
 out["directions_default"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
 tree.omninoise_wave.directions = 5
 out["directions_after_edit"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
