@@ -152,8 +152,8 @@ class _Nodes:
         self.put(n.inputs[0], v)
         return tuple(n.outputs)
 
-    def white(self, k, n, stream: int, seed, channels: int = 3) -> list:
-        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> its Color's first channels.
+    def white(self, k, n, stream: int, seed, channels=(0, 1, 2)) -> list:
+        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> sockets of its Color's ``channels``.
 
         The channels are backend.wave.white_color4 with channel 0, 1, 2.  Fewer
         than three are read with exact dot products (c . e_i): Cycles keeps an
@@ -163,9 +163,9 @@ class _Nodes:
         self.put(node.inputs["Vector"], self.combine(k, n, float(stream)))
         self.put(node.inputs["W"], seed)
         color = node.outputs["Color"]
-        if channels == 3:
+        if tuple(channels) == (0, 1, 2):
             return list(self.separate(color))
-        return [self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c])) for c in range(channels)]
+        return [self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c])) for c in channels]
 
     def image(self, img: bpy.types.Image, vector):
         """Linear, repeating image lookup -> colour socket (r, g, b) read as a vector."""
@@ -285,11 +285,12 @@ def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, m
     waves = []
     slpos = None
     for side, n in enumerate((n0, n1)):
-        ha = b.white(k, n, STREAM["slice_a"], seed)  # border, offset, jitter 0
-        jit = [ha[2]] + (b.white(k, n, STREAM["slice_b"], seed, dim - 2) if dim > 2 else [])
+        # node A: (border, offset, jitter 0); slice n+1's border is not needed, so not read
+        ha = b.white(k, n, STREAM["slice_a"], seed, (0, 1, 2) if side == 0 else (1, 2))
+        zeta, jit0 = ha[-2], ha[-1]
+        jit = [jit0] + (b.white(k, n, STREAM["slice_b"], seed, range(dim - 2)) if dim > 2 else [])
         u = [b.math("MULTIPLY_ADD", jit[i], box_size[i], box_lo[i]) for i in range(dim - 1)]
         omega, om_w = _direction(b, u, dim, full, g)
-        zeta = ha[1]
         if side == 0:
             slpos = b.math("MULTIPLY_ADD", ha[0], backend.wave.SLPOS_RANGE, backend.wave.SLPOS_MIN)
         dot = b.vmath("DOT_PRODUCT", x, omega)
