@@ -18,6 +18,7 @@ from .spectra import SPECTRUM_KINDS, Spectrum
 from .settings import WaveSettings, compile_noise
 from .cellular import CELLULAR_MODES
 from .tables import WAVEFORMS
+from .transfer import PRESETS, load_transfer
 from .wave import OUTPUTS
 
 __all__ = ["main", "build_parser", "settings_from_args"]
@@ -79,8 +80,27 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--table-size", type=int, default=1024)
     w.add_argument("--period", type=float, help="table period in world units (default: 255 / fmax)")
     w.add_argument("--seed", type=int, default=0)
+    w.add_argument("--transfer", help="RGBA ramp: a preset (%s) or a ramp .json; colours .exr/.png, "
+                   "adds color (and temperature) grids to .vdb" % ", ".join(PRESETS))
+    w.add_argument("--range", type=float, nargs=2, metavar=("V0", "V1"),
+                   help="noise values mapped to the ramp's ends (default: the ramp's own)")
+    w.add_argument("--half", action="store_true", help=".exr: 16-bit half floats")
     w.add_argument("--quiet", action="store_true")
-    w.add_argument("-o", "--out", required=True, help="output: .npy (raw float32), .exr or .png (2D)")
+    w.add_argument("-o", "--out", required=True,
+                   help="output: .npy (raw float32), .exr or .png (2D), .vdb (3D: density [+ color])")
+
+    b = sub.add_parser("bake", help="run the bakes of a TOML job file (see backend/jobs.py or the README)")
+    b.add_argument("job", help="job file (.toml)")
+    b.add_argument("--only", action="append", metavar="NAME", help="bake only these (repeatable)")
+    b.add_argument("--force", action="store_true", help="re-bake outputs that are up to date")
+    b.add_argument("--keep-going", action="store_true", help="after a failed bake, carry on with the others")
+    b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
+    b.add_argument("--quiet", action="store_true")
+
+    t = sub.add_parser("transfer", help="print or save a transfer-function preset as an editable ramp .json")
+    t.add_argument("preset", nargs="?", choices=tuple(PRESETS))
+    t.add_argument("--list", action="store_true", help="list the presets")
+    t.add_argument("-o", "--out", help="write the ramp here (default: print it)")
     return ap
 
 
@@ -115,14 +135,16 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
 
 
 class _Bar:
-    def __init__(self, quiet: bool):
-        self.quiet, self.t0 = quiet, time.perf_counter()
+    def __init__(self, quiet: bool, label: str = ""):
+        self.quiet, self.t0, self.label, self.done = quiet, time.perf_counter(), label, False
 
     def __call__(self, frac: float) -> None:
-        if self.quiet:
+        if self.quiet or self.done:
             return
+        self.done = frac >= 1.0
         n = int(frac * 30)
-        sys.stderr.write(f"\r[{'#' * n}{'.' * (30 - n)}] {frac * 100:5.1f}%  {time.perf_counter() - self.t0:6.1f}s")
+        sys.stderr.write(f"\r{self.label}[{'#' * n}{'.' * (30 - n)}] {frac * 100:5.1f}%  "
+                         f"{time.perf_counter() - self.t0:6.1f}s")
         if frac >= 1.0:
             sys.stderr.write("\n")
         sys.stderr.flush()
@@ -132,10 +154,16 @@ def run_wave(a: argparse.Namespace) -> int:
     from export.images import write_image
 
     ext = os.path.splitext(a.out)[1].lower()
-    if ext not in (".npy", ".exr", ".png"):
-        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .npy, .exr or .png")
-    if a.dim > 2 and ext != ".npy":
-        raise SettingError("-o", f"a {a.dim}D grid is a volume; write it as .npy")
+    if ext not in (".npy", ".exr", ".png", ".vdb"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .npy, .exr, .png or .vdb")
+    if a.dim > 2 and ext not in (".npy", ".vdb"):
+        raise SettingError("-o", f"a {a.dim}D grid is a volume; write it as .vdb or .npy")
+    if a.dim == 2 and ext == ".vdb":
+        raise SettingError("-o", "a .vdb volume needs --dim 3 or 4")
+    if a.transfer and ext == ".npy":
+        raise SettingError("--transfer", ".npy holds raw values; use .vdb, .exr or .png for a ramp")
+    if a.range and not a.transfer:
+        raise SettingError("--range", "maps values onto a ramp; give --transfer too")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     folder = os.path.dirname(os.path.abspath(a.out))
@@ -146,9 +174,79 @@ def run_wave(a: argparse.Namespace) -> int:
     if a.fmax > nyq and a.cellular == "none" and not a.quiet:
         print(f"omninoise wave: warning: --fmax {a.fmax:g} is above the grid's Nyquist {nyq:g}; "
               "the image will alias", file=sys.stderr)
+    if ext == ".vdb" or a.transfer or a.half:
+        return _bake_wave(a, s, ext)
     noise = compile_noise(s)
     arr = evaluate_grid(noise, a.size, a.extent, s.output, a.time, s.cellular, progress=_Bar(a.quiet))
     write_image(a.out, arr)
+    return 0
+
+
+def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
+    """``wave`` through the bake pipeline: voxel-centred grid over [0, E)^d, ramp, atomic write."""
+    from .bake import BakeSpec, run_bake
+    from .sources import BoxGrid, WaveSource
+
+    tf = load_transfer(a.transfer) if a.transfer else None
+    if tf is not None and a.range:
+        tf = tf.with_range(*a.range)
+    rank = 3 if ext == ".vdb" or (ext == ".npy" and a.dim > 2) else 2
+    grid = BoxGrid((a.size,) * rank, ((0.0, 0.0, 0.0), (a.extent,) * 3))
+    spec = BakeSpec("wave", WaveSource(s), grid, a.out, tf, time=a.time, half=a.half)
+    run_bake(spec, _Bar(a.quiet), force=True)
+    return 0
+
+
+def run_bake_job(a: argparse.Namespace) -> int:
+    from .jobs import JobError, load_job, run_job
+
+    if a.dry_run:
+        entries = load_job(a.job)
+        bad = [s for _, s in entries if isinstance(s, JobError)]
+        for name, spec in entries:
+            if isinstance(spec, JobError):
+                print(f"  invalid  {spec}")
+            else:
+                frames = spec.frame_list()
+                fresh = sum(spec.is_up_to_date(f) for f in frames)
+                state = "up to date" if fresh == len(frames) else "to bake"
+                print(f"  {state:10s} {name}: {list(spec.grid.resolution)} -> {spec.output}"
+                      + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))
+        return 1 if bad else 0
+    bars = {}
+
+    def progress(name, i, count, frac):
+        if name not in bars:
+            bars[name] = _Bar(a.quiet, f"[{i + 1}/{count}] {name} ")
+        bars[name](frac)
+
+    outcomes = run_job(a.job, keep_going=a.keep_going, force=a.force, only=a.only, progress=progress)
+    failed = [o for o in outcomes if o.status != "baked" and o.status != "up to date"]
+    for o in outcomes:
+        if o.status in ("baked", "up to date") and not a.quiet:
+            print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
+    for o in failed:
+        print(f"omninoise bake: error: {o.message}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+def run_transfer(a: argparse.Namespace) -> int:
+    import json
+
+    from .transfer import preset
+
+    if a.list or not a.preset:
+        print("\n".join(PRESETS))
+        return 0
+    text = json.dumps(preset(a.preset).to_dict(), indent=2)
+    if not a.out:
+        print(text)
+        return 0
+    from export.atomic import atomic_path
+
+    with atomic_path(a.out) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text + "\n")
     return 0
 
 
@@ -158,7 +256,25 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if a.command == "wave":
             return run_wave(a)
+        if a.command == "bake":
+            return run_bake_job(a)
+        if a.command == "transfer":
+            return run_transfer(a)
     except (SettingError, FileNotFoundError, PermissionError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2
+    except Exception as exc:
+        from .grid import Cancelled
+        from .jobs import JobError
+
+        if isinstance(exc, JobError):
+            print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
+            return 2
+        if isinstance(exc, Cancelled):
+            print(f"omninoise {a.command}: cancelled", file=sys.stderr)
+            return 130
+        raise
+    except KeyboardInterrupt:
+        print(f"\nomninoise {a.command}: interrupted; no partial file was left", file=sys.stderr)
+        return 130
     return 1

@@ -6,7 +6,7 @@ into a :class:`~backend.wave.WaveNoise` or :class:`~backend.cellular.CellularNoi
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from .spectra import Spectrum
 from .tables import DEFAULT_SIZE, WAVEFORMS, build_axis_table, build_table, build_waveform_table
 from .wave import OUTPUTS, Transition, WaveNoise
 
-__all__ = ["WaveSettings", "compile_noise", "table_rng"]
+__all__ = ["WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict"]
 
 ANISOTROPY = ("none", "axes", "lobes")
 
@@ -102,6 +102,89 @@ class WaveSettings:
     @property
     def animated(self) -> bool:
         return self.speed != 0.0
+
+
+_SPECTRUM_KEYS = ("kind", "fmin", "fmax", "exponent", "split", "ratio", "samples")
+
+
+def _spectrum_to_dict(sp: Spectrum) -> dict:
+    d = dict(kind=sp.kind, fmin=float(sp.fmin), fmax=float(sp.fmax), exponent=float(sp.exponent))
+    if sp.kind == "twolevel":
+        d.update(split=float(sp.split), ratio=float(sp.ratio))
+    if sp.samples:
+        d["samples"] = [float(v) for v in sp.samples]
+    return d
+
+
+def _spectrum_from(value, where: str) -> Spectrum:
+    if isinstance(value, Spectrum):
+        return value
+    if not isinstance(value, dict):
+        raise SettingError(where, f"expected a table like {{kind = \"bandpass\", fmin = 2, fmax = 8}}, got {value!r}")
+    unknown = sorted(set(value) - set(_SPECTRUM_KEYS))
+    if unknown:
+        raise SettingError(where, f"unknown key {unknown[0]!r}; known: {', '.join(_SPECTRUM_KEYS)}")
+    d = dict(value)
+    if "samples" in d:
+        d["samples"] = tuple(float(v) for v in d["samples"])
+    return Spectrum(**d)
+
+
+def settings_to_dict(s: WaveSettings) -> dict:
+    """WaveSettings -> plain dict of JSON/TOML types (by-example images are left out)."""
+    out = {}
+    for f in fields(s):
+        v = getattr(s, f.name)
+        if f.name == "example":
+            continue
+        if f.name == "spectrum":
+            v = _spectrum_to_dict(v)
+        elif f.name == "transition_to":
+            v = None if v is None else _spectrum_to_dict(v)
+        elif f.name == "axis_spectra":
+            v = [_spectrum_to_dict(a) for a in v]
+        elif f.name == "lobes":
+            v = [[[float(c) for c in a], float(w)] for a, w in v]
+        elif isinstance(v, tuple):
+            v = [float(c) for c in v]
+        if v is not None:
+            out[f.name] = v
+    return out
+
+
+def settings_from_dict(d: dict, example: np.ndarray | None = None) -> WaveSettings:
+    """Plain dict (job file table, node JSON) -> WaveSettings; unknown keys fail with their name.
+
+    ``spectrum`` may also be given flat as ``spectrum = "bandpass"`` with ``fmin``,
+    ``fmax`` and ``exponent`` beside it.
+    """
+    known = {f.name for f in fields(WaveSettings)} - {"example"}
+    d = dict(d)
+    flat = {k: d.pop(k) for k in ("fmin", "fmax", "exponent") if k in d}
+    if isinstance(d.get("spectrum"), str) or (flat and "spectrum" not in d):
+        d["spectrum"] = dict(kind=d.get("spectrum", "gaussian"), **flat)
+    elif flat:
+        raise SettingError(", ".join(flat), "give band limits inside the spectrum table, or spectrum as a name")
+    unknown = sorted(set(d) - known)
+    if unknown:
+        raise SettingError(unknown[0], f"unknown wave setting; known: {', '.join(sorted(known))}")
+    kw = {}
+    for k, v in d.items():
+        if k == "spectrum":
+            v = _spectrum_from(v, "spectrum")
+        elif k == "transition_to":
+            v = None if v is None else _spectrum_from(v, "transition_to")
+        elif k == "axis_spectra":
+            v = tuple(_spectrum_from(a, "axis_spectra") for a in v)
+        elif k == "lobes":
+            v = tuple((tuple(float(c) for c in a), float(w)) for a, w in v)
+        elif k in ("profile", "transition_origin", "transition_axis"):
+            v = tuple(float(c) for c in v)
+        kw[k] = v
+    try:
+        return WaveSettings(example=example, **kw).validate()
+    except TypeError as exc:  # a value of the wrong type reaching a comparison
+        raise SettingError("wave settings", str(exc)) from None
 
 
 def table_rng(seed: int) -> np.random.Generator:

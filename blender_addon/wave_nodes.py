@@ -49,26 +49,12 @@ STREAM = backend.wave.STREAM
 # -- settings <-> JSON ----------------------------------------------------------
 
 def settings_to_json(s) -> str:
-    """WaveSettings -> JSON (the node's fields only; by-example images are bake-only)."""
-    sp = s.spectrum
-    d = dict(dim=s.dim, directions=int(s.directions), seed=int(s.seed), speed=float(s.speed),
-             spectrum=dict(kind=sp.kind, fmin=sp.fmin, fmax=sp.fmax, exponent=sp.exponent),
-             waveform=s.waveform, anisotropy=s.anisotropy, spread=float(s.spread),
-             lobes=[[list(map(float, a)), float(w)] for a, w in s.lobes],
-             axis_spectra=[dict(kind=a.kind, fmin=a.fmin, fmax=a.fmax, exponent=a.exponent) for a in s.axis_spectra],
-             slice_width=s.slice_width, table_size=int(s.table_size))
-    return json.dumps(d, sort_keys=True)
+    """WaveSettings -> JSON stored on the tree (by-example images are bake-only)."""
+    return json.dumps(backend.settings.settings_to_dict(s), sort_keys=True)
 
 
 def settings_from_json(text: str):
-    d = json.loads(text)
-    Spectrum = backend.Spectrum
-    return backend.WaveSettings(
-        dim=d["dim"], directions=d["directions"], seed=d["seed"], speed=d["speed"],
-        spectrum=Spectrum(**d["spectrum"]), waveform=d["waveform"], anisotropy=d["anisotropy"],
-        spread=d["spread"], lobes=tuple((tuple(a), w) for a, w in d["lobes"]),
-        axis_spectra=tuple(Spectrum(**a) for a in d["axis_spectra"]), slice_width=d["slice_width"],
-        table_size=d["table_size"])
+    return backend.settings.settings_from_dict(json.loads(text))
 
 
 # -- the table as a packed float image ---------------------------------------------

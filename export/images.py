@@ -13,7 +13,8 @@ import numpy as np
 
 from .atomic import atomic_path
 
-__all__ = ["write_npy", "write_png", "write_exr", "write_image", "read_image", "preview_8bit"]
+__all__ = ["write_npy", "write_png", "write_exr", "write_image", "read_image", "preview_8bit", "read_metadata",
+           "encode_srgb8"]
 
 
 def write_npy(path: str, array: np.ndarray) -> None:
@@ -33,8 +34,17 @@ def preview_8bit(array: np.ndarray, lo: float | None = None, hi: float | None = 
     return (np.clip((a - lo) * scale, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
 
 
-def write_png(path: str, array: np.ndarray) -> None:
-    """Write uint8 (H, W) or (H, W, 3|4) as PNG (zlib, no dependencies)."""
+def encode_srgb8(linear: np.ndarray) -> np.ndarray:
+    """Scene-linear float (..., C) -> sRGB-encoded uint8; a 4th (alpha) channel stays linear."""
+    a = np.clip(np.asarray(linear, np.float32), 0.0, 1.0)
+    out = a.copy()
+    c = out[..., :3] if a.ndim == 3 and a.shape[-1] >= 3 else out
+    np.copyto(c, np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055))
+    return (out * 255.0 + 0.5).astype(np.uint8)
+
+
+def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> None:
+    """Write uint8 (H, W) or (H, W, 3|4) as PNG (zlib, no dependencies); metadata -> tEXt chunks."""
     a = np.asarray(array)
     if a.dtype != np.uint8:
         raise TypeError("write_png expects uint8; use preview_8bit for floats")
@@ -48,17 +58,21 @@ def write_png(path: str, array: np.ndarray) -> None:
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
 
     png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0))
+           + b"".join(chunk(b"tEXt", f"{k}".encode("latin-1") + b"\0" + f"{v}".encode("latin-1"))
+                      for k, v in (metadata or {}).items())
            + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
             fh.write(png)
 
 
-def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | None = None) -> None:
+def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | None = None,
+              metadata: dict | None = None) -> None:
     """Write float (H, W) or (H, W, C) as a scanline EXR through OpenEXR.
 
     channels: names, default 'Y' for one channel, 'RGB' / 'RGBA' for 3 / 4.
     half: store 16-bit half floats instead of 32-bit floats.
+    metadata: extra string attributes in the header.
     """
     import OpenEXR
 
@@ -72,6 +86,7 @@ def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | 
     dtype = np.float16 if half else np.float32
     chans = {n: np.ascontiguousarray(a[:, :, i].astype(dtype)) for i, n in enumerate(names)}
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    header.update({str(k): str(v) for k, v in (metadata or {}).items()})
     with atomic_path(path) as tmp:
         with OpenEXR.File(header, chans) as f:
             f.write(tmp)
@@ -112,3 +127,44 @@ def read_image(path: str) -> np.ndarray:
     if a.ndim == 3:
         a = a[..., :3].mean(axis=2)
     return a
+
+
+def _png_text(path: str) -> dict:
+    out = {}
+    with open(path, "rb") as fh:
+        if fh.read(8) != b"\x89PNG\r\n\x1a\n":
+            return out
+        while True:
+            head = fh.read(8)
+            if len(head) < 8:
+                return out
+            n, tag = struct.unpack(">I", head[:4])[0], head[4:]
+            if tag == b"IDAT" or tag == b"IEND":
+                return out
+            data = fh.read(n)
+            fh.read(4)
+            if tag == b"tEXt" and b"\0" in data:
+                k, v = data.split(b"\0", 1)
+                out[k.decode("latin-1")] = v.decode("latin-1")
+
+
+def read_metadata(path: str) -> dict:
+    """String metadata of an output file (.vdb, .exr, .png); {} if absent or unreadable."""
+    if not os.path.isfile(path):
+        return {}
+    ext = os.path.splitext(path)[1].lower()
+    try:
+        if ext == ".vdb":
+            from .vdb import read_vdb_metadata
+
+            return read_vdb_metadata(path)
+        if ext == ".exr":
+            import OpenEXR
+
+            with OpenEXR.File(path, header_only=True) as f:
+                return {k: v for k, v in f.header().items() if isinstance(v, str)}
+        if ext == ".png":
+            return _png_text(path)
+    except Exception:  # a damaged or foreign file is simply not up to date
+        return {}
+    return {}

@@ -1,0 +1,258 @@
+"""Bakes: a source on a grid, through an optional transfer function, into files.
+
+A :class:`BakeSpec` names a source (:mod:`backend.sources`), a voxel-centred
+grid, an optional RGBA transfer function (:mod:`backend.transfer`, Guehl et
+al. 2025 Sec. 7.1), an output path and an optional frame range.  :func:`run_bake`
+evaluates it in slabs (memory stays near the output's size), reports progress,
+polls cancel between slabs and writes every file atomically through ``export``.
+
+Outputs by extension:
+
+    .vdb  3D grid.  ``density`` float grid (the raw value without a transfer
+          function; alpha x density_scale with one), ``color`` vec3 grid and,
+          where the ramp has temperature stops, ``temperature`` (Kelvin).
+          Voxels of zero density are inactive (sparse).
+    .exr  2D grid.  ``Y`` (raw value) or ``RGBA`` (through the ramp), half or float.
+    .png  2D grid.  8-bit preview: sRGB-encoded RGBA through the ramp, else grey
+          over the 0.5th..99.5th percentiles.
+    .npy  raw float32 values (2D or 3D), indexed (y, x) or (z, y, x).
+
+Image files put +y up (row 0 is the top row, y = y1).
+
+A frame range bakes a numbered sequence: ``#`` runs in the path become the
+zero-padded frame number (``clouds_####.vdb`` -> ``clouds_0001.vdb``), the
+naming Blender plays as an animation.  Frame f is evaluated at
+``time + (f - start) * time_step``.
+
+Every file carries a key (sha256 of everything that determines it) in its
+metadata; a bake skips files whose key matches unless ``force`` is set.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from .errors import SettingError
+from .grid import Cancelled
+from .sources import BoxGrid, Source, describe
+from .transfer import TransferFunction
+
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "frame_path", "FORMATS", "KEY_NAME", "Cancelled"]
+
+_F = np.float32
+FORMATS = (".vdb", ".exr", ".png", ".npy")
+KEY_NAME = "omninoise_key"
+#: voxels per slab: ~8 MiB of values plus ~32 MiB of colour at a time
+SLAB_VOXELS = 1 << 21
+_FRAME = re.compile(r"#+")
+
+
+@dataclass
+class BakeSpec:
+    """One bake.
+
+    name       label for messages and logs
+    source     a :class:`~backend.sources.Source`
+    grid       a :class:`~backend.sources.BoxGrid` (2D for images, 3D for volumes)
+    output     file path; with ``frames``, ``#`` runs are replaced by the frame number
+    transfer   RGBA ramp, or None for raw values
+    frames     (start, end) inclusive, or None for one file
+    time       time (or 4D W) of the single bake / of frame ``start``
+    time_step  time between frames
+    half       EXR: 16-bit half floats
+    """
+
+    name: str
+    source: Source
+    grid: BoxGrid
+    output: str
+    transfer: TransferFunction | None = None
+    frames: tuple | None = None
+    time: float = 0.0
+    time_step: float = 1.0 / 24.0
+    half: bool = False
+    extra: dict = field(default_factory=dict)
+
+    def validate(self) -> "BakeSpec":
+        self.grid.validate()
+        ext = os.path.splitext(self.output)[1].lower()
+        if ext not in FORMATS:
+            raise SettingError("output", f"{self.output!r}: unsupported type {ext or '(none)'}; use {', '.join(FORMATS)}")
+        rank = self.grid.rank
+        if ext == ".vdb" and rank != 3:
+            raise SettingError("output", f"{os.path.basename(self.output)}: .vdb needs a 3D grid (resolution [nx, ny, nz])")
+        if ext in (".exr", ".png") and rank != 2:
+            raise SettingError("output", f"{os.path.basename(self.output)}: {ext} needs a 2D grid; bake volumes to .vdb or .npy")
+        if rank == 3 and self.source.dim == 2:
+            raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")
+        if self.frames is not None:
+            a, b = self.frames
+            if int(a) != a or int(b) != b or b < a:
+                raise SettingError("frames", f"expected [start, end] whole numbers with end >= start, got {list(self.frames)}")
+            if not _FRAME.search(os.path.basename(self.output)):
+                raise SettingError("output", f"{os.path.basename(self.output)}: a frame range needs '#' in the file name "
+                                   "(e.g. clouds_####.vdb)")
+            if not self.source.animated:
+                raise SettingError("frames", "this source does not change over time (set speed, or dim = 4)")
+        folder = os.path.dirname(os.path.abspath(self.output))
+        if not os.path.isdir(folder):
+            raise SettingError("output", f"folder does not exist: {folder}")
+        return self
+
+    def frame_list(self) -> list:
+        if self.frames is None:
+            return [None]
+        return list(range(int(self.frames[0]), int(self.frames[1]) + 1))
+
+    def frame_time(self, frame) -> float:
+        if frame is None:
+            return float(self.time)
+        return float(self.time) + (frame - int(self.frames[0])) * float(self.time_step)
+
+    def key(self, frame) -> str:
+        """sha256 of everything that determines the file of ``frame``."""
+        from . import __version__
+
+        ext = os.path.splitext(self.output)[1].lower()
+        doc = dict(version=__version__, source=self.source.to_dict(), grid=self.grid.to_dict(),
+                   transfer=None if self.transfer is None else self.transfer.to_dict(),
+                   time=self.frame_time(frame), half=bool(self.half and ext == ".exr"), format=ext)
+        return hashlib.sha256(describe(doc).encode()).hexdigest()
+
+    def is_up_to_date(self, frame) -> bool:
+        """True when the file of ``frame`` exists and carries this spec's key (.npy never does)."""
+        path = frame_path(self.output, frame)
+        if os.path.splitext(path)[1].lower() == ".npy":
+            return False
+        from ._export import export
+
+        return export.read_metadata(path).get(KEY_NAME) == self.key(frame)
+
+
+@dataclass
+class BakeResult:
+    name: str
+    written: list = field(default_factory=list)
+    skipped: list = field(default_factory=list)
+
+
+def frame_path(pattern: str, frame) -> str:
+    """``clouds_####.vdb``, 7 -> ``clouds_0007.vdb`` (the last run of '#' in the file name)."""
+    if frame is None:
+        return pattern
+    folder, base = os.path.split(pattern)
+    runs = list(_FRAME.finditer(base))
+    m = runs[-1]
+    base = base[: m.start()] + f"{int(frame):0{len(m.group())}d}" + base[m.end():]
+    return os.path.join(folder, base)
+
+
+def _slabs(n_outer: int, per_outer: int, chunkable: bool):
+    """(start, stop) ranges of the outermost axis with about SLAB_VOXELS voxels each."""
+    step = n_outer if not chunkable else max(1, SLAB_VOXELS // max(1, per_outer))
+    for a in range(0, n_outer, step):
+        yield a, min(n_outer, a + step)
+
+
+def evaluate_slabs(source: Source, grid: BoxGrid, time: float, progress=None, cancel=None):
+    """Yield (start, values) over the grid's outermost axis; values float32 (n, ...) slabs."""
+    shape = grid.shape
+    first = grid.first
+    step = grid.voxel
+    per = int(np.prod(shape[1:]))
+    outer = grid.rank - 1  # z for volumes, y for images
+    for a, b in _slabs(shape[0], per, getattr(source, "chunkable", True)):
+        if cancel is not None and cancel():
+            raise Cancelled("cancelled")
+        start = [0] * grid.rank
+        start[outer] = a
+        sub = None if progress is None else (lambda x, a=a, b=b: progress((a + x * (b - a)) / shape[0]))
+        vals = source.evaluate((b - a,) + tuple(shape[1:]), first, step, time, sub, cancel, tuple(start))
+        yield a, np.asarray(vals, _F)
+
+
+def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:
+    from ._export import export
+
+    ext = os.path.splitext(path)[1].lower()
+    meta = {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}
+    tf = spec.transfer
+    if ext == ".vdb":
+        grids = {"density": "float"}
+        if tf is not None:
+            grids["color"] = "vec3"
+            if tf.has_temperature:
+                grids["temperature"] = "float"
+        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, grids, meta)
+        for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
+            if tf is None:
+                writer.add("density", z0, vals)
+                continue
+            rgba = tf.rgba(vals)
+            dens = tf.density(rgba)
+            empty = dens <= 0.0
+            dens[empty] = 0.0
+            col = rgba[..., :3]
+            col[empty] = 0.0
+            writer.add("density", z0, dens)
+            writer.add("color", z0, col)
+            if tf.has_temperature:
+                temp = tf.kelvin(vals)
+                temp[empty] = 0.0
+                writer.add("temperature", z0, temp)
+        if cancel is not None and cancel():
+            raise Cancelled("cancelled")
+        writer.write(path)
+        return
+    shape = spec.grid.shape
+    values = np.empty(shape, _F)
+    for a, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
+        values[a: a + vals.shape[0]] = vals
+    if cancel is not None and cancel():
+        raise Cancelled("cancelled")
+    if ext == ".npy":
+        export.write_npy(path, values)  # indexed (y, x) / (z, y, x) like the grid
+        return
+    values = values[::-1]  # row 0 of an image file is its top: +y up, as a plane shows it in Blender
+    if ext == ".exr":
+        if tf is None:
+            export.write_exr(path, values, half=spec.half, metadata=meta)
+        else:
+            export.write_exr(path, tf.rgba(values), half=spec.half, metadata=meta)
+    elif ext == ".png":
+        img = export.encode_srgb8(tf.rgba(values)) if tf is not None else export.preview_8bit(values)
+        export.write_png(path, img, metadata=meta)
+
+
+def run_bake(spec: BakeSpec, progress: Callable[[float], None] | None = None,
+             cancel: Callable[[], bool] | None = None, force: bool = False,
+             log: Callable[[str], None] | None = None) -> BakeResult:
+    """Bake every frame of ``spec``; progress gets the fraction done over all frames.
+
+    Raises :class:`~backend.grid.Cancelled` when cancel() turns True (the file in
+    progress is not written; finished frames stay) and SettingError for bad specs.
+    """
+    spec.validate()
+    frames = spec.frame_list()
+    res = BakeResult(spec.name)
+    for i, frame in enumerate(frames):
+        path = frame_path(spec.output, frame)
+        key = spec.key(frame)
+        if not force and spec.is_up_to_date(frame):
+            res.skipped.append(path)
+            if progress is not None:
+                progress((i + 1) / len(frames))
+            continue
+        sub = None if progress is None else (lambda x, i=i: progress((i + x) / len(frames)))
+        _bake_file(spec, path, spec.frame_time(frame), key, sub, cancel)
+        res.written.append(path)
+        if log is not None:
+            log(f"{spec.name}: wrote {path}")
+        if progress is not None:
+            progress((i + 1) / len(frames))
+    return res

@@ -1,0 +1,182 @@
+"""Batch bake jobs from TOML files (``omninoise bake JOB.toml``, the Blender panel, ``bpy``).
+
+A job file lists bakes; paths are relative to the job file's folder::
+
+    # optional: merged into every bake (a bake's own keys win, tables merge key by key)
+    [defaults]
+    bounds = [[-1, -1, 0], [1, 1, 1]]
+
+    [[bake]]
+    name = "clouds"                     # unique; used in messages and --only
+    output = "out/clouds_####.vdb"      # .vdb (3D), .exr / .png (2D), .npy; '#' = frame number
+    resolution = [128, 128, 64]         # [nx, ny] image or [nx, ny, nz] volume
+    bounds = [[-1, -1, 0], [1, 1, 1]]   # world box, voxel-centred samples
+    transfer = "clouds"                 # preset, ramp .json file, or a table (see backend.transfer)
+    frames = [1, 24]                    # optional inclusive range -> numbered sequence
+    time = 0.0                          # time (4D: W) of the first frame
+    time_step = 0.0417                  # time between frames
+    half = false                        # EXR half floats
+
+    [bake.source]                       # kind = "wave" + WaveSettings keys
+    kind = "wave"
+    dim = 3
+    speed = 0.5
+    spectrum = {kind = "fractal", fmin = 1, fmax = 8, exponent = 1.0}
+    seed = 7
+
+Every problem is reported as ``bake 'NAME': what is wrong``.
+"""
+from __future__ import annotations
+
+import copy
+import os
+import tomllib
+from dataclasses import dataclass
+from typing import Callable
+
+from .bake import BakeResult, BakeSpec, Cancelled, run_bake
+from .errors import SettingError
+from .sources import BoxGrid, source_from_dict
+from .transfer import load_transfer, transfer_from_dict
+
+__all__ = ["JobError", "load_job", "parse_job", "run_job", "JobOutcome", "BAKE_KEYS"]
+
+BAKE_KEYS = ("name", "output", "resolution", "bounds", "transfer", "frames", "time", "time_step", "half", "source")
+
+
+class JobError(ValueError):
+    """A job file or one of its bakes is wrong; the message names which and why."""
+
+
+@dataclass
+class JobOutcome:
+    name: str
+    status: str  # "baked" | "up to date" | "failed" | "cancelled"
+    message: str = ""
+    result: BakeResult | None = None
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = v
+    return out
+
+
+def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
+    name = d.get("name") or f"bake {index + 1}"
+    unknown = sorted(set(d) - set(BAKE_KEYS))
+    if unknown:
+        raise SettingError(unknown[0], f"unknown key; known: {', '.join(BAKE_KEYS)}")
+    for k in ("output", "resolution", "source"):
+        if k not in d:
+            raise SettingError(k, "missing")
+    if not isinstance(d["source"], dict):
+        raise SettingError("source", "expected a [bake.source] table")
+    source = source_from_dict(d["source"], base_dir)
+    res = d["resolution"]
+    if not isinstance(res, list):
+        raise SettingError("resolution", f"expected [nx, ny] or [nx, ny, nz], got {res!r}")
+    bounds = d.get("bounds", [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
+    try:
+        bounds = tuple(tuple(float(c) for c in b) for b in bounds)
+    except (TypeError, ValueError):
+        raise SettingError("bounds", f"expected [[x0, y0, z0], [x1, y1, z1]], got {bounds!r}") from None
+    grid = BoxGrid(tuple(res), bounds).validate()
+    tf = d.get("transfer")
+    if isinstance(tf, str):
+        path = os.path.join(base_dir, tf)
+        tf = load_transfer(path if os.path.isfile(path) else tf)
+    elif isinstance(tf, dict):
+        tf = transfer_from_dict(tf)
+    elif tf is not None:
+        raise SettingError("transfer", f"expected a preset name, a .json file or a table, got {tf!r}")
+    frames = d.get("frames")
+    if frames is not None:
+        if not (isinstance(frames, list) and len(frames) == 2):
+            raise SettingError("frames", f"expected [start, end], got {frames!r}")
+        frames = (frames[0], frames[1])
+    output = os.path.normpath(os.path.join(base_dir, str(d["output"])))
+    return BakeSpec(name=name, source=source, grid=grid, output=output, transfer=tf, frames=frames,
+                    time=float(d.get("time", 0.0)), time_step=float(d.get("time_step", 1.0 / 24.0)),
+                    half=bool(d.get("half", False))).validate()
+
+
+def parse_job(doc: dict, base_dir: str) -> list:
+    """Job document -> list of (name, BakeSpec or JobError)."""
+    unknown = sorted(set(doc) - {"defaults", "bake"})
+    if unknown:
+        raise JobError(f"unknown top-level key {unknown[0]!r}; a job has [defaults] and [[bake]] tables")
+    bakes = doc.get("bake")
+    if not isinstance(bakes, list) or not bakes:
+        raise JobError("no [[bake]] tables: nothing to do")
+    defaults = doc.get("defaults", {})
+    out, seen = [], set()
+    for i, b in enumerate(bakes):
+        d = _merge(defaults, b)
+        name = d.get("name") or f"bake {i + 1}"
+        if name in seen:
+            out.append((name, JobError(f"bake {name!r}: the name is used twice")))
+            continue
+        seen.add(name)
+        try:
+            out.append((name, _spec(d, base_dir, i)))
+        except (SettingError, FileNotFoundError) as exc:
+            out.append((name, JobError(f"bake {name!r}: {exc}")))
+    return out
+
+
+def load_job(path: str) -> list:
+    if not os.path.isfile(path):
+        raise JobError(f"job file not found: {path}")
+    try:
+        with open(path, "rb") as fh:
+            doc = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise JobError(f"{os.path.basename(path)}: not valid TOML ({exc})") from None
+    return parse_job(doc, os.path.dirname(os.path.abspath(path)))
+
+
+def run_job(path: str, keep_going: bool = False, force: bool = False, only: list | None = None,
+            progress: Callable[[str, int, int, float], None] | None = None,
+            cancel: Callable[[], bool] | None = None, log: Callable[[str], None] | None = None) -> list:
+    """Run every bake of a job file in order -> list of :class:`JobOutcome`.
+
+    progress(name, index, count, fraction) after each slab.  Without
+    ``keep_going`` the first failure stops the job (the returned list ends with
+    it); invalid bakes fail before anything is baked.  Outputs whose stored key
+    matches are skipped unless ``force``.
+    """
+    entries = load_job(path)
+    if only:
+        names = [n for n, _ in entries]
+        missing = [n for n in only if n not in names]
+        if missing:
+            raise JobError(f"no bake named {missing[0]!r}; the job has {', '.join(names)}")
+        entries = [(n, s) for n, s in entries if n in only]
+    outcomes = []
+    if not keep_going:
+        for name, spec in entries:
+            if isinstance(spec, JobError):
+                return [JobOutcome(name, "failed", str(spec))]
+    for i, (name, spec) in enumerate(entries):
+        if isinstance(spec, JobError):
+            outcomes.append(JobOutcome(name, "failed", str(spec)))
+            continue
+        cb = None if progress is None else (lambda f, i=i, name=name: progress(name, i, len(entries), f))
+        try:
+            res = run_bake(spec, cb, cancel, force, log)
+        except Cancelled:
+            outcomes.append(JobOutcome(name, "cancelled", f"bake {name!r}: cancelled"))
+            return outcomes
+        except (SettingError, OSError, RuntimeError, ValueError) as exc:
+            outcomes.append(JobOutcome(name, "failed", f"bake {name!r}: {exc}"))
+            if not keep_going:
+                return outcomes
+            continue
+        status = "baked" if res.written else "up to date"
+        outcomes.append(JobOutcome(name, status, f"{len(res.written)} written, {len(res.skipped)} up to date", res))
+    return outcomes

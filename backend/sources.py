@@ -1,0 +1,194 @@
+"""Bake sources: anything that fills a box grid with scalar noise values.
+
+A source answers ``evaluate(grid box) -> float32 array``; :mod:`backend.bake`
+slices the bake into slabs, maps values through a transfer function and hands
+them to writers.  Wave noise is a source here; the neural sources of later
+issues implement the same small interface.
+
+Grids are voxel-centred: a :class:`BoxGrid` with ``resolution`` (nx, ny[, nz])
+over world ``bounds`` puts sample (i, j, k) at ``lo + (i + 1/2, j + 1/2, k + 1/2) * voxel``,
+which is where OpenVDB puts voxel centres under a linear transform with that
+voxel size and translation ``lo + voxel / 2``.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from typing import Callable, Protocol
+
+import numpy as np
+
+from .errors import SettingError
+
+__all__ = ["BoxGrid", "Source", "WaveSource", "source_from_dict", "SOURCE_KINDS"]
+
+_F = np.float32
+
+
+@dataclass(frozen=True)
+class BoxGrid:
+    """A voxel-centred grid.
+
+    resolution  (nx, ny) for images or (nx, ny, nz) for volumes, x first
+    bounds      ((x0, y0, z0), (x1, y1, z1)) world box; an image lies in the plane z = z0
+    """
+
+    resolution: tuple
+    bounds: tuple = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+
+    def validate(self) -> "BoxGrid":
+        res = tuple(self.resolution)
+        if len(res) not in (2, 3) or any(int(n) != n or n < 1 for n in res):
+            raise SettingError("resolution", f"expected 2 or 3 positive whole numbers, got {list(res)}")
+        lo, hi = (np.asarray(b, np.float64) for b in self.bounds)
+        if lo.shape != (3,) or hi.shape != (3,):
+            raise SettingError("bounds", f"expected [[x0, y0, z0], [x1, y1, z1]], got {self.bounds}")
+        n = len(res)
+        if not np.all(hi[:n] > lo[:n]):
+            raise SettingError("bounds", f"max must exceed min on x, y{', z' if n == 3 else ''}: {self.bounds}")
+        if np.prod(np.asarray(res, np.float64)) > 2 ** 34:
+            raise SettingError("resolution", f"{list(res)} is more than 2^34 voxels")
+        return self
+
+    @property
+    def rank(self) -> int:
+        return len(self.resolution)
+
+    @property
+    def shape(self) -> tuple:
+        """Array shape: (ny, nx) or (nz, ny, nx)."""
+        return tuple(int(n) for n in reversed(self.resolution))
+
+    @property
+    def voxel(self) -> np.ndarray:
+        """float64 (rank,): spacing along x, y[, z]."""
+        lo, hi = (np.asarray(b, np.float64) for b in self.bounds)
+        n = np.asarray(self.resolution, np.float64)
+        return (hi[: self.rank] - lo[: self.rank]) / n
+
+    @property
+    def first(self) -> np.ndarray:
+        """float64 (3,): world position of sample 0 (the first voxel's centre)."""
+        p = np.asarray(self.bounds[0], np.float64).copy()
+        p[: self.rank] += 0.5 * self.voxel
+        return p
+
+    def to_dict(self) -> dict:
+        return dict(resolution=[int(n) for n in self.resolution],
+                    bounds=[[float(c) for c in b] for b in self.bounds])
+
+
+class Source(Protocol):
+    """What a bake needs from a noise.
+
+    kind      short name ("wave")
+    dim       coordinates the noise takes: 2, 3 or 4 (4D: W is the bake's time)
+    animated  True when the output changes with time
+    chunkable True when any sub-box may be evaluated alone (else the whole grid at once)
+    """
+
+    kind: str
+    dim: int
+    animated: bool
+    chunkable: bool
+
+    def evaluate(self, shape: tuple, first: np.ndarray, step: np.ndarray, time: float,
+                 progress: Callable[[float], None] | None = None,
+                 cancel: Callable[[], bool] | None = None, start: tuple | None = None) -> np.ndarray:
+        """float32 ``shape`` ((ny, nx) or (nz, ny, nx)) at first + (start + index) * step.
+
+        first (3,) world position of the grid's sample 0; step (rank,); start (rank,)
+        index of this box's first sample, x first (default zeros).  A slab's values
+        must equal the same samples of the whole grid.
+        """
+
+    def to_dict(self) -> dict:
+        """Everything that determines the values, as plain JSON types (for up-to-date checks)."""
+
+
+class WaveSource:
+    """Wave noise (Guehl et al. 2025) from :class:`~backend.settings.WaveSettings`.
+
+    3D grids need a 3D or 4D noise; a 2D grid of a 3D/4D noise is the plane z = z0.
+    4D noise takes W = ``w_offset`` + time; 2D+t and 3D+t noise take time directly.
+    """
+
+    kind = "wave"
+    chunkable = True
+
+    def __init__(self, settings, w_offset: float = 0.0):
+        from .settings import compile_noise
+
+        self.settings = settings.validate()
+        self.w_offset = float(w_offset)
+        self.dim = settings.dim
+        self.animated = settings.dim == 4 or settings.animated
+        self._compile = compile_noise
+        self._noise = None
+
+    @property
+    def noise(self):
+        if self._noise is None:
+            self._noise = self._compile(self.settings)
+        return self._noise
+
+    def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
+        from .grid import evaluate_box
+
+        rank = len(shape)
+        if rank == 3 and self.dim == 2:
+            raise SettingError("grid", "a 2D wave noise bakes images only; set dim = 3 or 4 for volumes")
+        lo = np.zeros(self.dim, _F)
+        k = min(self.dim, 3)
+        lo[:k] = np.asarray(first, np.float64)[:k]
+        if self.dim == 4:
+            lo[3] = _F(self.w_offset + time)
+        s = self.settings
+        return evaluate_box(self.noise, shape, lo, step, s.output, 0.0 if self.dim == 4 else float(time),
+                            s.cellular, progress=progress, cancel=cancel, start=start)
+
+    def to_dict(self) -> dict:
+        from .settings import settings_to_dict
+
+        d = dict(kind=self.kind, settings=settings_to_dict(self.settings), w_offset=self.w_offset)
+        if self.settings.example is not None:
+            ex = np.ascontiguousarray(self.settings.example, _F)
+            d["example_sha256"] = hashlib.sha256(ex.tobytes() + str(ex.shape).encode()).hexdigest()
+        return d
+
+
+SOURCE_KINDS = ("wave",)
+
+
+def source_from_dict(d: dict, base_dir: str = ".") -> Source:
+    """A source from a job-file table: ``kind = "wave"`` plus the engine's settings.
+
+    Wave: the keys of :class:`~backend.settings.WaveSettings`; ``example = "img.png"``
+    (relative to ``base_dir``) for by-example noise; ``w_offset`` for 4D.
+    """
+    import os
+
+    d = dict(d)
+    kind = d.pop("kind", "wave")
+    if kind != "wave":
+        raise SettingError("source.kind", f"unknown source {kind!r}; choose one of {', '.join(SOURCE_KINDS)}")
+    from .settings import settings_from_dict
+
+    example = None
+    if "example" in d:
+        path = os.path.join(base_dir, d.pop("example"))
+        if not os.path.isfile(path):
+            raise SettingError("source.example", f"image not found: {path}")
+        from ._export import export
+
+        example = export.read_image(path)
+    w_offset = float(d.pop("w_offset", 0.0))
+    return WaveSource(settings_from_dict(d, example), w_offset)
+
+
+def describe(obj) -> str:
+    """Canonical JSON of a to_dict()-able object or plain value (for hashing)."""
+    if hasattr(obj, "to_dict"):
+        obj = obj.to_dict()
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"))

@@ -1,0 +1,114 @@
+"""OpenVDB volumes through the ``openvdb`` module that Blender bundles.
+
+The module ships inside the ``bpy`` wheel (and Blender itself).  Blender's own
+way to reach it is ``bpy.utils.expose_bundled_modules()``; this package stays
+free of ``bpy`` and finds the same file through the import system instead.
+
+Volumes are written slab by slab, so a bake never holds a dense copy of the
+grid: :class:`VolumeWriter` takes float32 slabs (nz, ny, nx) or (nz, ny, nx, 3)
+indexed like the bake's arrays and stores them at VDB coordinates (x, y, z).
+Voxels equal to zero stay inactive (sparse), so empty space costs nothing.
+"""
+from __future__ import annotations
+
+import glob
+import importlib.util
+import os
+import sys
+
+import numpy as np
+
+from .atomic import atomic_path
+
+__all__ = ["openvdb_module", "VolumeWriter", "read_volume", "read_vdb_metadata"]
+
+_F = np.float32
+
+
+def openvdb_module():
+    """The ``openvdb`` module: importable directly (Blender), or found inside the bpy wheel."""
+    try:
+        import openvdb
+
+        return openvdb
+    except ImportError:
+        pass
+    spec = importlib.util.find_spec("bpy")
+    roots = list(spec.submodule_search_locations or []) if spec is not None else []
+    for root in roots:
+        for so in sorted(glob.glob(os.path.join(root, "*", "python", "lib", "python3*", "site-packages", "openvdb*"))):
+            folder = os.path.dirname(so)
+            if folder not in sys.path:
+                sys.path.append(folder)
+            import openvdb
+
+            return openvdb
+    raise RuntimeError("writing .vdb needs the openvdb module bundled with Blender: run inside Blender "
+                       "or install the bpy module (pip install bpy==5.0.1)")
+
+
+class VolumeWriter:
+    """Collects named grids slab by slab, then writes one .vdb atomically.
+
+    voxel  (3,) spacing along x, y, z;  first  (3,) world position of voxel (0, 0, 0)'s centre
+    grids  {name: "float" | "vec3"}
+    """
+
+    def __init__(self, voxel, first, grids: dict, metadata: dict | None = None):
+        self.vdb = openvdb_module()
+        vx, vy, vz = (float(v) for v in voxel)
+        tx, ty, tz = (float(v) for v in first)
+        matrix = [[vx, 0.0, 0.0, 0.0], [0.0, vy, 0.0, 0.0], [0.0, 0.0, vz, 0.0], [tx, ty, tz, 1.0]]
+        self.grids = {}
+        for name, kind in grids.items():
+            g = self.vdb.FloatGrid() if kind == "float" else self.vdb.Vec3SGrid()
+            g.name = name
+            g.transform = self.vdb.createLinearTransform(matrix)
+            if name == "density":
+                g.gridClass = self.vdb.GridClass.FOG_VOLUME
+            self.grids[name] = (g, kind)
+        self.metadata = {str(k): str(v) for k, v in (metadata or {}).items()}
+
+    def add(self, name: str, z0: int, slab: np.ndarray) -> None:
+        """Store ``slab`` float32 (nz, ny, nx) or (nz, ny, nx, 3) at z = z0 ... z0 + nz - 1."""
+        g, kind = self.grids[name]
+        a = np.asarray(slab, _F)
+        if kind == "float":
+            if a.ndim != 3:
+                raise ValueError(f"grid {name!r} takes (nz, ny, nx) slabs, got {a.shape}")
+            g.copyFromArray(np.ascontiguousarray(a.transpose(2, 1, 0)), ijk=(0, 0, int(z0)), tolerance=0.0)
+        else:
+            if a.ndim != 4 or a.shape[3] != 3:
+                raise ValueError(f"grid {name!r} takes (nz, ny, nx, 3) slabs, got {a.shape}")
+            g.copyFromArray(np.ascontiguousarray(a.transpose(2, 1, 0, 3)), ijk=(0, 0, int(z0)),
+                            tolerance=(0.0, 0.0, 0.0))
+
+    def active_voxels(self, name: str) -> int:
+        return int(self.grids[name][0].activeVoxelCount())
+
+    def write(self, path: str) -> None:
+        """Prune and write all grids to ``path`` (temporary file, then rename)."""
+        grids = []
+        for g, kind in self.grids.values():
+            g.prune(0.0) if kind == "float" else g.prune((0.0, 0.0, 0.0))
+            grids.append(g)
+        with atomic_path(path, suffix=".vdb") as tmp:
+            self.vdb.write(tmp, grids=grids, metadata=self.metadata)
+
+
+def read_vdb_metadata(path: str) -> dict:
+    """File-level metadata of a .vdb (cheap: no voxels are read)."""
+    return dict(openvdb_module().readMetadata(path))
+
+
+def read_volume(path: str, name: str, shape: tuple) -> np.ndarray:
+    """Grid ``name`` as a dense array indexed like the bake: float32 (nz, ny, nx[, 3])."""
+    vdb = openvdb_module()
+    g = vdb.read(path, name)
+    nz, ny, nx = shape
+    if isinstance(g, vdb.FloatGrid):
+        a = np.zeros((nx, ny, nz), _F)
+    else:
+        a = np.zeros((nx, ny, nz, 3), _F)
+    g.copyToArray(a, ijk=(0, 0, 0))
+    return np.ascontiguousarray(np.moveaxis(a, (0, 1, 2), (2, 1, 0)))

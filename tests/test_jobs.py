@@ -1,0 +1,149 @@
+"""``omninoise bake JOB.toml``: parsing, errors naming the bake, skipping, keep-going, CLI."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from backend.cli import main
+from backend.jobs import JobError, load_job, run_job
+from export import read_volume
+
+JOB = """
+[defaults]
+bounds = [[-1, -1, 0], [1, 1, 1]]
+
+[[bake]]
+name = "clouds"
+output = "out/clouds_##.vdb"
+resolution = [16, 16, 8]
+transfer = "clouds"
+frames = [1, 2]
+time_step = 0.5
+[bake.source]
+dim = 3
+speed = 1.0
+spectrum = {kind = "fractal", fmin = 1, fmax = 6}
+
+[[bake]]
+name = "marble"
+output = "out/marble.exr"
+resolution = [32, 16]
+transfer = "ramp.json"
+half = true
+[bake.source]
+dim = 3
+seed = 4
+spectrum = "bandpass"
+fmin = 2
+fmax = 4
+"""
+
+RAMP = '{"range": [-1, 1], "stops": [[0, [0, 0, 0, 1]], [1, [1, 1, 1, 1]]]}'
+
+
+@pytest.fixture
+def job(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "ramp.json").write_text(RAMP)
+    p = tmp_path / "job.toml"
+    p.write_text(JOB)
+    return p
+
+
+def test_job_bakes_then_skips(job):
+    out = run_job(str(job))
+    assert [(o.name, o.status) for o in out] == [("clouds", "baked"), ("marble", "baked")]
+    files = sorted(os.listdir(job.parent / "out"))
+    assert files == ["clouds_01.vdb", "clouds_02.vdb", "marble.exr"]
+    again = run_job(str(job))
+    assert [o.status for o in again] == ["up to date", "up to date"]
+    assert [o.status for o in run_job(str(job), force=True, only=["marble"])] == ["baked"]
+    d = read_volume(str(job.parent / "out" / "clouds_01.vdb"), "density", (8, 16, 16))
+    assert 0 < (d > 0).mean() < 1
+
+
+def test_job_paths_are_relative_to_the_job_file(job, tmp_path, monkeypatch):
+    monkeypatch.chdir("/")
+    specs = load_job(str(job))
+    assert specs[0][1].output == str(tmp_path / "out" / "clouds_##.vdb")
+
+
+@pytest.mark.parametrize("edit, match", [
+    (("fmax = 6}", "fmax = 6, bogus = 1}"), "bake 'clouds': spectrum: unknown key 'bogus'"),
+    (('resolution = [32, 16]', 'resolution = [32, 0]'), "bake 'marble': resolution"),
+    (('output = "out/marble.exr"', 'output = "out/marble.vdb"'), "bake 'marble': .*needs a 3D grid"),
+    (('transfer = "ramp.json"', 'transfer = "lava"'), "bake 'marble': .*neither a preset"),
+    (('seed = 4', 'seed = 4\nsped = 2'), "bake 'marble': sped: unknown wave setting"),
+    (('name = "marble"', 'name = "clouds"'), "bake 'clouds': the name is used twice"),
+    (('time_step = 0.5', 'time_step = 0.5\ncolour = 1'), "bake 'clouds': colour: unknown key"),
+])
+def test_bad_bakes_are_named_and_nothing_is_baked(job, edit, match):
+    job.write_text(JOB.replace(*edit))
+    out = run_job(str(job))
+    assert out[-1].status == "failed"
+    assert __import__("re").search(match, out[-1].message), out[-1].message
+    assert os.listdir(job.parent / "out") == []  # invalid bakes fail before any work
+
+
+def test_keep_going_bakes_the_others(job):
+    job.write_text(JOB.replace("fmax = 6}", "fmax = 6, bogus = 1}"))
+    out = run_job(str(job), keep_going=True)
+    assert [o.status for o in out] == ["failed", "baked"]
+    assert os.listdir(job.parent / "out") == ["marble.exr"]
+
+
+def test_whole_file_errors(tmp_path):
+    p = tmp_path / "j.toml"
+    with pytest.raises(JobError, match="not found"):
+        load_job(str(p))
+    p.write_text("[[bake]\nname=")
+    with pytest.raises(JobError, match="not valid TOML"):
+        load_job(str(p))
+    p.write_text("[defaults]\nbounds = []\n")
+    with pytest.raises(JobError, match=r"no \[\[bake\]\] tables"):
+        load_job(str(p))
+    p.write_text("[[bakes]]\nname = 'x'\n")
+    with pytest.raises(JobError, match="unknown top-level key 'bakes'"):
+        load_job(str(p))
+
+
+def test_cli_exit_codes_and_messages(job, capsys):
+    assert main(["bake", str(job), "--quiet"]) == 0
+    assert main(["bake", str(job), "--dry-run"]) == 0
+    assert "up to date clouds" in capsys.readouterr().out
+    job.write_text(JOB.replace("fmax = 6}", "fmax = 6, bogus = 1}"))
+    assert main(["bake", str(job), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "omninoise bake: error: bake 'clouds': spectrum: unknown key 'bogus'" in err
+    assert main(["bake", str(job), "--only", "nope"]) == 2
+    assert "no bake named 'nope'" in capsys.readouterr().err
+
+
+def test_console_script_bakes(job):
+    exe = os.path.join(os.path.dirname(sys.executable), "omninoise")
+    r = subprocess.run([exe, "bake", str(job)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "clouds: baked (2 written, 0 up to date)" in r.stderr
+
+
+def test_wave_cli_vdb_and_transfer(tmp_path, capsys):
+    vdb = str(tmp_path / "w.vdb")
+    assert main(["wave", "--dim", "3", "--size", "16", "--fmin", "1", "--fmax", "3", "--seed", "5", "--quiet",
+                 "-o", vdb]) == 0
+    from backend import WaveSettings, compile_noise, evaluate_points
+    from backend.spectra import Spectrum
+
+    d = read_volume(vdb, "density", (16, 16, 16))
+    c = (np.arange(16) + 0.5) * 4.0 / 16
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")
+    noise = compile_noise(WaveSettings(dim=3, spectrum=Spectrum("gaussian", 1.0, 3.0), seed=5))
+    ref = evaluate_points(noise, np.stack([x, y, z], -1).reshape(-1, 3).astype(np.float32), "real")
+    np.testing.assert_allclose(d.ravel(), ref, atol=1e-3)
+    assert main(["wave", "--dim", "3", "--size", "16", "--quiet", "--transfer", "smoke", "-o", vdb]) == 0
+    assert read_volume(vdb, "color", (16, 16, 16)).max() > 0
+    assert main(["wave", "--dim", "2", "--size", "16", "--quiet", "-o", vdb]) == 2
+    assert "needs --dim 3 or 4" in capsys.readouterr().err
+    assert main(["wave", "--size", "16", "--quiet", "--range", "0", "1", "-o", str(tmp_path / "a.png")]) == 2
+    assert "give --transfer too" in capsys.readouterr().err
