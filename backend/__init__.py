@@ -13,6 +13,7 @@ from .spectra import Spectrum
 from .tables import WaveTable, build_table
 from .settings import WaveSettings, compile_noise
 from .grid import evaluate_grid, evaluate_points, Cancelled
+from . import bake, jobs, sources, transfer  # noqa: E402  (bake pipeline: sources -> ramp -> files)
 
 __all__ = ["SettingError", "Spectrum", "WaveTable", "build_table", "WaveSettings", "compile_noise",
            "evaluate_grid", "evaluate_points", "Cancelled"]

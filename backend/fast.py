@@ -50,7 +50,7 @@ if numba is not None:
             np.float32(-1.0 / 720) + x2 * (np.float32(1.0 / 40320) + x2 * (
                 np.float32(-1.0 / 3628800) + x2 * np.float32(1.0 / 479001600))))))
 
-    @numba.njit(parallel=True, cache=True, fastmath=False)
+    @numba.njit(parallel=True, cache=True, fastmath=False, nogil=True)
     def _kernel(x, sdirs, soffs, amps, nmin, slpos, omega, zeta, tab, inv_period, shift, out_re, out_im):
         P, D = x.shape
         K = sdirs.shape[0]
@@ -222,7 +222,7 @@ if numba is not None:
         c = c - np.float64(fN) * np.floor(c / np.float64(fN))
         return np.float32(c - 0.5)
 
-    @numba.njit(parallel=True, cache=True, fastmath=False)
+    @numba.njit(parallel=True, cache=True, fastmath=False, nogil=True)
     def _rows_kernel(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tre, tim, inv_period, shift,
                      want_imag, blocks, out_re, out_im):
         R = others.shape[0]

@@ -219,7 +219,7 @@ PRESETS = {
     "fire": dict(range=(0.0, 1.8), interpolation="linear", density_scale=3.0,
                  stops=((0.0, (0.1, 0.0, 0.0, 0.0)), (0.3, (0.8, 0.1, 0.0, 0.3)),
                         (0.7, (1.0, 0.5, 0.05, 0.7)), (1.0, (1.0, 0.95, 0.7, 1.0))),
-                 temperature=((0.2, 0.0), (0.4, 900.0), (1.0, 1800.0))),
+                 temperature=((0.2, 0.0), (1.0, 1800.0))),
     # dense stone with thin dark veins at the noise's zero crossings (use the real output)
     "marble": dict(range=(-1.2, 1.2), interpolation="ease", density_scale=10.0,
                    stops=((0.0, (0.92, 0.9, 0.86, 1.0)), (0.46, (0.85, 0.83, 0.8, 1.0)),

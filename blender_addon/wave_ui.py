@@ -45,7 +45,7 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
     dimensions: EnumProperty(name="Dimensions", items=[("2", "2D", ""), ("3", "3D", ""), ("4", "4D", "")],
                              default="3", update=_rebuild)
     directions: IntProperty(name="Directions", description="Number of wave directions (cost grows linearly)",
-                            default=16, min=1, max=64, update=_rebuild)
+                            default=16, min=1, soft_max=64, max=256, update=_rebuild)
     spectrum: EnumProperty(name="Spectrum", items=_SPECTRA, default="gaussian", update=_rebuild)
     fmin: FloatProperty(name="Min Frequency", description="Lower band limit, cycles per unit (after Scale)",
                         default=2.0, min=0.0, soft_max=64.0, update=_rebuild)
@@ -64,9 +64,10 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
     speed: FloatProperty(name="Speed", description="Wave speed for animation with the Time input (Eq. 9); "
                          "0 = static", default=0.0, soft_min=-10.0, soft_max=10.0, update=_rebuild)
 
-    def to_settings(self):
+    def to_settings(self, node: bool = True):
+        """WaveSettings; ``node`` checks the live node's limits (bakes take any number of directions)."""
         dim = int(self.dimensions)
-        if self.directions > MAX_DIRECTIONS[dim]:
+        if node and self.directions > MAX_DIRECTIONS[dim]:
             raise backend.SettingError("directions", f"at most {MAX_DIRECTIONS[dim]} in {dim}D "
                                        "(Cycles' shader stack); use a bake for more")
         sp = backend.Spectrum(self.spectrum, self.fmin, self.fmax, self.exponent)
@@ -147,28 +148,31 @@ class OMNINOISE_PT_wave_node(bpy.types.Panel):
         return _wave_tree(context) is not None
 
     def draw(self, context):
-        props = _wave_tree(context).omninoise_wave
-        layout = self.layout
-        layout.use_property_split = True
-        layout.prop(props, "dimensions")
-        layout.prop(props, "directions")
-        col = layout.column(heading="Spectrum")
-        col.prop(props, "spectrum", text="Spectrum")
-        col.prop(props, "fmin")
-        col.prop(props, "fmax")
-        if props.spectrum == "fractal":
-            col.prop(props, "exponent")
-        layout.prop(props, "waveform")
-        layout.prop(props, "anisotropy")
-        if props.anisotropy == "lobes":
-            layout.prop(props, "axis")
-            layout.prop(props, "spread")
-        elif props.anisotropy == "axes":
-            layout.prop(props, "axis_scale")
-        layout.prop(props, "seed")
-        layout.prop(props, "speed")
-        if props.error:
-            layout.label(text=props.error, icon="ERROR")
+        self.layout.use_property_split = True
+        draw_wave_settings(self.layout, _wave_tree(context).omninoise_wave)
+
+
+def draw_wave_settings(layout, props) -> None:
+    """The settings of an :class:`OMNINOISE_PG_wave`, mirroring Blender's texture nodes."""
+    layout.prop(props, "dimensions")
+    layout.prop(props, "directions")
+    col = layout.column(heading="Spectrum")
+    col.prop(props, "spectrum", text="Spectrum")
+    col.prop(props, "fmin")
+    col.prop(props, "fmax")
+    if props.spectrum == "fractal":
+        col.prop(props, "exponent")
+    layout.prop(props, "waveform")
+    layout.prop(props, "anisotropy")
+    if props.anisotropy == "lobes":
+        layout.prop(props, "axis")
+        layout.prop(props, "spread")
+    elif props.anisotropy == "axes":
+        layout.prop(props, "axis_scale")
+    layout.prop(props, "seed")
+    layout.prop(props, "speed")
+    if props.error:
+        layout.label(text=props.error, icon="ERROR")
 
 
 def _menu(self, context):

@@ -24,7 +24,17 @@ tree.omninoise_wave.directions = 60  # above the 3D limit: a message, the old tr
 out["error"] = tree.omninoise_wave.error
 out["directions_after_error"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
 out["cache_dir"] = importlib.import_module(MOD + ".blender_addon.preferences").cache_dir()
+# a volume bake through the installed package (its relative backend/export imports, bundled openvdb)
+bake = bpy.context.scene.omninoise_bake
+bake.bounds_mode = "CUSTOM"
+bake.volume_resolution = (8, 8, 8)
+bake.name = "Installed"
+out["bake"] = sorted(bpy.ops.omninoise.bake_volume())
+obj = bpy.data.objects.get("Installed")
+out["bake_grids"] = sorted(g.name for g in obj.data.grids) if obj else []
+out["bake_file"] = bpy.path.abspath(obj.data.filepath) if obj else ""
 bpy.ops.preferences.addon_disable(module=MOD)
+out["disabled_bake_props"] = hasattr(bpy.types.Scene, "omninoise_bake")
 out["disabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
 bpy.ops.preferences.addon_enable(module=MOD)
 out["reenabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")

@@ -1,0 +1,502 @@
+"""Bake Noise Volume / Bake Noise Image / Run Bake Job: panels and operators.
+
+Settings live on the scene (``Scene.omninoise_bake``).  An operator builds a
+Blender-free :class:`backend.bake.BakeSpec` on the main thread, runs it as a
+:mod:`.tasks` worker (progress in the panel and the status bar, Esc or Cancel
+stops it) and, when it ends, loads the files: a Volume object with a Principled
+Volume material reading ``density`` / ``color`` / ``temperature``, or an image
+in an Image Texture node.  With ``blender -b`` and the ``bpy`` module the same
+operators run to completion before returning.
+"""
+from __future__ import annotations
+
+import os
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
+    IntVectorProperty, PointerProperty, StringProperty
+
+from . import tasks
+from ._deps import backend
+from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
+                           transfer_from_color_ramp, world_bounds)
+from .preferences import threads
+from .wave_nodes import SETTINGS_KEY, settings_from_json
+from .wave_ui import OMNINOISE_PG_wave, draw_wave_settings
+
+__all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "draw_progress", "register", "unregister"]
+
+_PRESETS = [(k, k.capitalize(), f"The {k} transfer function") for k in ("clouds", "smoke", "fire", "marble", "crystal")]
+_OUTPUTS = [("real", "Value", "Real part"), ("imag", "Imaginary", "Imaginary part"),
+            ("modulus", "Modulus", "Ridged: |noise|"), ("phase", "Phase", "Phasor: angle in radians")]
+_CELLULAR = [("none", "None", "Plain wave noise"), ("polytope", "Polytope", "Distance to random polytope borders"),
+             ("code", "Cell Code", "Random value per cell"), ("stit", "STIT", "Recursive STIT tessellation")]
+
+
+def _apply_preset(self, context) -> None:
+    node = ramp_node()
+    tf = apply_preset(node.color_ramp, self.preset)
+    self.range_min, self.range_max = tf.range
+    self.density_scale = tf.density_scale
+    self.use_temperature = tf.has_temperature
+    if tf.has_temperature:
+        self.temperature_start, self.temperature_max = tf.temperature[0][0], tf.temperature[-1][1]
+
+
+def _is_wave_group(self, tree) -> bool:
+    return bool(tree.get(SETTINGS_KEY)) and tree.omninoise_wave.is_wave
+
+
+class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
+    """Bake settings of a scene."""
+
+    source: EnumProperty(name="Source", items=[
+        ("SETTINGS", "Wave Noise", "Wave noise with the settings below"),
+        ("NODE", "Wave Noise Node", "The settings of a Wave Noise node group in this file")], default="SETTINGS")
+    wave: PointerProperty(type=OMNINOISE_PG_wave)
+    node_group: PointerProperty(name="Node Group", type=bpy.types.NodeTree, poll=_is_wave_group)
+    output: EnumProperty(name="Output", items=_OUTPUTS, default="real")
+    cellular: EnumProperty(name="Cellular", items=_CELLULAR, default="none")
+    # grid
+    bounds_mode: EnumProperty(name="Bounds", items=[
+        ("OBJECT", "Active Object", "The active object's world bounding box"),
+        ("CUSTOM", "Custom", "The box below")], default="OBJECT")
+    bounds_min: FloatVectorProperty(name="Min", size=3, default=(-1.0, -1.0, -1.0), subtype="XYZ")
+    bounds_max: FloatVectorProperty(name="Max", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ")
+    volume_resolution: IntVectorProperty(name="Resolution", size=3, default=(128, 128, 128), min=1, max=4096)
+    image_resolution: IntVectorProperty(name="Resolution", size=2, default=(1024, 1024), min=1, max=16384)
+    # time
+    animated: BoolProperty(name="Animated", description="Bake a numbered sequence over a frame range "
+                           "(needs wave speed, or 4D noise)", default=False)
+    frame_start: IntProperty(name="Start", default=1, min=0)
+    frame_end: IntProperty(name="End", default=24, min=0)
+    time: FloatProperty(name="Time", description="Time (4D: W) of the single bake, or of the first frame",
+                        default=0.0)
+    time_per_frame: FloatProperty(name="Time per Frame", default=1.0 / 24.0, min=0.0, soft_max=1.0, precision=4)
+    # transfer function
+    use_ramp: BoolProperty(name="Use Ramp", description="Map values through the ramp (off: raw values)",
+                           default=True)
+    preset: EnumProperty(name="Preset", items=_PRESETS, default="clouds", update=_apply_preset)
+    range_min: FloatProperty(name="From", description="Noise value at the ramp's left end", default=-0.2)
+    range_max: FloatProperty(name="To", description="Noise value at the ramp's right end", default=1.6)
+    density_scale: FloatProperty(name="Density", description="Density = alpha x this", default=4.0, min=0.0,
+                                 soft_max=50.0)
+    use_temperature: BoolProperty(name="Temperature", description="Write a temperature grid (blackbody)",
+                                  default=False)
+    temperature_start: FloatProperty(name="Start", description="Ramp position where temperature rises from 0",
+                                     default=0.2, min=0.0, max=1.0)
+    temperature_max: FloatProperty(name="Max", description="Kelvin at the ramp's right end", default=1800.0,
+                                   min=0.0, soft_max=6000.0)
+    # output
+    folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise/",
+                           description="Where baked files go ('//' = beside the .blend, or the cache "
+                                       "folder while the file is unsaved)")
+    name: StringProperty(name="Name", default="Noise")
+    image_format: EnumProperty(name="Format", items=[("EXR", "OpenEXR", "Float image"),
+                                                     ("PNG", "PNG", "8-bit preview")], default="EXR")
+    half: BoolProperty(name="Half Float", description="EXR: 16-bit half floats", default=False)
+    # batch
+    job_file: StringProperty(name="Job File", subtype="FILE_PATH", default="")
+    keep_going: BoolProperty(name="Keep Going", description="After a failed bake, carry on with the others")
+    force: BoolProperty(name="Force", description="Re-bake outputs that are up to date")
+
+
+# -- spec building (main thread) -------------------------------------------------------
+
+def _settings(p: OMNINOISE_PG_bake):
+    if p.source == "NODE":
+        if p.node_group is None:
+            raise backend.SettingError("node group", "pick a Wave Noise node group to bake")
+        s = settings_from_json(p.node_group[SETTINGS_KEY])
+    else:
+        s = p.wave.to_settings(node=False)
+    return s.replace(output=p.output, cellular=p.cellular)
+
+
+def _bounds(p: OMNINOISE_PG_bake, context, rank: int) -> tuple:
+    if p.bounds_mode == "OBJECT":
+        obj = context.active_object
+        if obj is None:
+            raise backend.SettingError("bounds", "no active object: select one, or use Custom bounds")
+        lo, hi = world_bounds(obj)
+    else:
+        lo, hi = tuple(p.bounds_min), tuple(p.bounds_max)
+    if rank == 2:  # an image covers x, y at the box's middle height
+        z = 0.5 * (lo[2] + hi[2])
+        lo, hi = (lo[0], lo[1], z), (hi[0], hi[1], z)
+    return lo, hi
+
+
+def transfer(p: OMNINOISE_PG_bake):
+    if not p.use_ramp:
+        return None
+    temp = ((p.temperature_start, 0.0), (1.0, p.temperature_max)) if p.use_temperature else ()
+    return transfer_from_color_ramp(ramp_node().color_ramp, (p.range_min, p.range_max), p.density_scale, temp)
+
+
+def build_spec(context, target: str):
+    """BakeSpec for the scene's settings; target 'VOLUME' or 'IMAGE'."""
+    p = context.scene.omninoise_bake
+    rank = 3 if target == "VOLUME" else 2
+    s = _settings(p)
+    if rank == 3 and s.dim == 2:
+        raise backend.SettingError("dimensions", "a volume needs 3D or 4D noise")
+    res = tuple(p.volume_resolution) if rank == 3 else tuple(p.image_resolution)
+    grid = backend.sources.BoxGrid(res, _bounds(p, context, rank))
+    ext = ".vdb" if rank == 3 else (".exr" if p.image_format == "EXR" else ".png")
+    name = bpy.path.clean_name(p.name or "Noise")
+    folder = output_folder(p.folder)
+    frames = (p.frame_start, p.frame_end) if p.animated else None
+    path = os.path.join(folder, name + ("_####" if frames else "") + ext)
+    return backend.bake.BakeSpec(name=name, source=backend.sources.WaveSource(s), grid=grid, output=path,
+                                 transfer=transfer(p), frames=frames, time=p.time,
+                                 time_step=p.time_per_frame, half=p.half).validate()
+
+
+# -- operators -------------------------------------------------------------------------
+
+def _message(text: str) -> None:
+    wm = bpy.context.window_manager
+    if wm is not None and hasattr(wm, "omninoise_message"):
+        wm.omninoise_message = text
+    print(f"OmniNoise: {text}")
+
+
+class _BakeOperator:
+    bl_options = {"REGISTER"}
+    target = "VOLUME"
+
+    blocking: BoolProperty(name="Blocking", description="Wait for the bake (scripts)", default=False,
+                           options={"SKIP_SAVE", "HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return tasks.current() is None
+
+    def _start(self, context, blocking: bool):
+        try:
+            spec = build_spec(context, self.target)
+        except (backend.SettingError, OSError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        target, obj = self.target, context.active_object
+        raw = spec.transfer is None
+        mat = None
+        if target == "IMAGE" and obj is not None and obj.active_material is not None \
+                and obj.active_material.node_tree is not None:
+            mat = obj.active_material
+
+        def work(progress, cancel):
+            return backend.bake.run_bake(spec, progress, cancel)
+
+        def done(result):
+            paths = [backend.bake.frame_path(spec.output, f) for f in spec.frame_list()]
+            if target == "VOLUME":
+                temp = spec.transfer is not None and spec.transfer.has_temperature
+                load_volume(spec.name, paths, spec.frames, temp)
+            else:
+                load_image(spec.name, paths, spec.frames, raw, mat)
+            _message(f"{spec.name}: {len(result.written)} written, {len(result.skipped)} up to date "
+                     f"({spec.output})")
+
+        def failed(msg):
+            _message(f"{spec.name} failed: {msg}")
+
+        task = tasks.Task(f"Baking {spec.name}", work, done, failed, threads=threads())
+        return tasks.start(task, blocking=blocking)
+
+    def execute(self, context):
+        task = self._start(context, blocking=True)
+        if task is None:
+            return {"CANCELLED"}
+        if task.status != "done":
+            self.report({"ERROR"} if task.status == "failed" else {"WARNING"}, task.message or task.status)
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if self.blocking or bpy.app.background:
+            return self.execute(context)
+        self._task = self._start(context, blocking=False)
+        if self._task is None:
+            return {"CANCELLED"}
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        task = self._task
+        if not task.running:
+            if task.status == "failed":
+                self.report({"ERROR"}, task.message)
+            elif task.status == "cancelled":
+                self.report({"WARNING"}, f"{task.label}: cancelled")
+            return {"FINISHED"} if task.status == "done" else {"CANCELLED"}
+        if event.type == "ESC" and event.value == "PRESS":
+            task.cancel()
+            return {"RUNNING_MODAL"}
+        return {"PASS_THROUGH"}
+
+
+class OMNINOISE_OT_bake_volume(_BakeOperator, bpy.types.Operator):
+    """Bake noise through the ramp into an OpenVDB volume and add it as a Volume object"""
+
+    bl_idname = "omninoise.bake_volume"
+    bl_label = "Bake Noise Volume"
+    target = "VOLUME"
+
+
+class OMNINOISE_OT_bake_image(_BakeOperator, bpy.types.Operator):
+    """Bake noise into an EXR or PNG image and add an Image Texture node"""
+
+    bl_idname = "omninoise.bake_image"
+    bl_label = "Bake Noise Image"
+    target = "IMAGE"
+
+
+class OMNINOISE_OT_cancel(bpy.types.Operator):
+    """Stop the running OmniNoise bake (nothing half-written is kept)"""
+
+    bl_idname = "omninoise.cancel"
+    bl_label = "Cancel Bake"
+
+    @classmethod
+    def poll(cls, context):
+        return tasks.current() is not None
+
+    def execute(self, context):
+        tasks.cancel()
+        return {"FINISHED"}
+
+
+class OMNINOISE_OT_run_job(bpy.types.Operator):
+    """Run the bakes of a TOML job file (the same as `omninoise bake JOB.toml`)"""
+
+    bl_idname = "omninoise.run_job"
+    bl_label = "Run Bake Job"
+
+    filepath: StringProperty(name="Job File", subtype="FILE_PATH", default="")
+    keep_going: BoolProperty(name="Keep Going", default=False)
+    force: BoolProperty(name="Force", default=False)
+    blocking: BoolProperty(default=False, options={"SKIP_SAVE", "HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return tasks.current() is None
+
+    def _start(self, context, blocking):
+        p = context.scene.omninoise_bake
+        path = bpy.path.abspath(self.filepath or p.job_file)
+        if not path or not os.path.isfile(path):
+            self.report({"ERROR"}, f"job file not found: {path or '(none)'}")
+            return None
+        keep_going, force = self.keep_going or p.keep_going, self.force or p.force
+
+        def work(progress, cancel):
+            def prog(name, i, count, frac):
+                progress((i + frac) / count)
+
+            return backend.jobs.run_job(path, keep_going=keep_going, force=force, progress=prog, cancel=cancel)
+
+        def done(outcomes):
+            bad = [o for o in outcomes if o.status in ("failed", "cancelled")]
+            text = "; ".join(f"{o.name}: {o.status}" for o in outcomes)
+            _message(text if not bad else "; ".join(o.message for o in bad))
+            if bad:
+                raise RuntimeError(bad[0].message)
+
+        return tasks.start(tasks.Task(f"Job {os.path.basename(path)}", work, done, _message, threads()),
+                           blocking=blocking)
+
+    def execute(self, context):
+        try:
+            task = self._start(context, blocking=True)
+        except backend.jobs.JobError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        if task is None:
+            return {"CANCELLED"}
+        if task.status != "done":
+            self.report({"ERROR"}, task.message or task.status)
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if self.blocking or bpy.app.background:
+            return self.execute(context)
+        self._task = self._start(context, blocking=False)
+        if self._task is None:
+            return {"CANCELLED"}
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    modal = _BakeOperator.modal
+
+
+# -- panels ----------------------------------------------------------------------------
+
+def draw_progress(layout) -> bool:
+    """Progress bar and Cancel button while a task runs; True if one is running."""
+    task = tasks.current()
+    if task is None:
+        msg = bpy.context.window_manager.omninoise_message
+        if msg:
+            layout.label(text=msg, icon="INFO")
+        return False
+    row = layout.row(align=True)
+    row.progress(factor=task.progress, type="BAR", text=f"{task.label}  {task.progress * 100:.0f}%")
+    row.operator(OMNINOISE_OT_cancel.bl_idname, text="", icon="CANCEL")
+    return True
+
+
+class _Panel:
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "OmniNoise"
+
+
+class OMNINOISE_PT_bake(_Panel, bpy.types.Panel):
+    bl_label = "Bake Noise"
+
+    def draw(self, context):
+        p = context.scene.omninoise_bake
+        layout = self.layout
+        layout.use_property_split = True
+        draw_progress(layout)
+        layout.prop(p, "source")
+        if p.source == "NODE":
+            layout.prop(p, "node_group")
+        else:
+            draw_wave_settings(layout, p.wave)
+        layout.prop(p, "output")
+        layout.prop(p, "cellular")
+
+
+class OMNINOISE_PT_bake_ramp(_Panel, bpy.types.Panel):
+    bl_label = "Transfer Function"
+    bl_parent_id = "OMNINOISE_PT_bake"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.omninoise_bake, "use_ramp", text="")
+
+    def draw(self, context):
+        p = context.scene.omninoise_bake
+        layout = self.layout
+        layout.active = p.use_ramp
+        layout.prop(p, "preset")
+        node = ramp_node(create=False)
+        if node is None:
+            layout.operator(OMNINOISE_OT_init_ramp.bl_idname, icon="COLOR")
+        else:
+            layout.template_color_ramp(node, "color_ramp", expand=True)
+        layout.use_property_split = True
+        col = layout.column(align=True)
+        col.prop(p, "range_min")
+        col.prop(p, "range_max")
+        layout.prop(p, "density_scale")
+        layout.prop(p, "use_temperature")
+        if p.use_temperature:
+            col = layout.column(align=True)
+            col.prop(p, "temperature_start")
+            col.prop(p, "temperature_max")
+
+
+class OMNINOISE_OT_init_ramp(bpy.types.Operator):
+    """Create the ramp the bake panel edits (from the selected preset)"""
+
+    bl_idname = "omninoise.init_ramp"
+    bl_label = "Create Ramp"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        _apply_preset(context.scene.omninoise_bake, context)
+        return {"FINISHED"}
+
+
+class OMNINOISE_PT_bake_output(_Panel, bpy.types.Panel):
+    bl_label = "Grid and Output"
+    bl_parent_id = "OMNINOISE_PT_bake"
+
+    def draw(self, context):
+        p = context.scene.omninoise_bake
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(p, "bounds_mode")
+        if p.bounds_mode == "CUSTOM":
+            layout.prop(p, "bounds_min")
+            layout.prop(p, "bounds_max")
+        layout.prop(p, "animated")
+        if p.animated:
+            col = layout.column(align=True)
+            col.prop(p, "frame_start")
+            col.prop(p, "frame_end")
+            layout.prop(p, "time_per_frame")
+        layout.prop(p, "time")
+        layout.prop(p, "folder")
+        layout.prop(p, "name")
+        busy = tasks.current() is not None
+        box = layout.box()
+        box.prop(p, "volume_resolution")
+        row = box.row()
+        row.enabled = not busy
+        row.operator(OMNINOISE_OT_bake_volume.bl_idname, icon="VOLUME_DATA")
+        box = layout.box()
+        box.prop(p, "image_resolution")
+        box.prop(p, "image_format")
+        if p.image_format == "EXR":
+            box.prop(p, "half")
+        row = box.row()
+        row.enabled = not busy
+        row.operator(OMNINOISE_OT_bake_image.bl_idname, icon="IMAGE_DATA")
+
+
+class OMNINOISE_PT_bake_job(_Panel, bpy.types.Panel):
+    bl_label = "Batch Job"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        p = context.scene.omninoise_bake
+        layout = self.layout
+        layout.prop(p, "job_file")
+        row = layout.row()
+        row.prop(p, "keep_going")
+        row.prop(p, "force")
+        row = layout.row()
+        row.enabled = tasks.current() is None and bool(p.job_file)
+        op = row.operator(OMNINOISE_OT_run_job.bl_idname, icon="PLAY")
+        op.filepath = p.job_file
+
+
+def _statusbar(self, context):
+    task = tasks.current()
+    if task is None:
+        return
+    row = self.layout.row(align=True)
+    row.progress(factor=task.progress, type="BAR", text=f"OmniNoise: {task.label} {task.progress * 100:.0f}%")
+    row.operator(OMNINOISE_OT_cancel.bl_idname, text="", icon="CANCEL")
+
+
+classes = (OMNINOISE_PG_bake, OMNINOISE_OT_bake_volume, OMNINOISE_OT_bake_image, OMNINOISE_OT_cancel,
+           OMNINOISE_OT_run_job, OMNINOISE_OT_init_ramp, OMNINOISE_PT_bake, OMNINOISE_PT_bake_ramp,
+           OMNINOISE_PT_bake_output, OMNINOISE_PT_bake_job)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.omninoise_bake = PointerProperty(type=OMNINOISE_PG_bake)
+    bpy.types.WindowManager.omninoise_progress = FloatProperty(min=0.0, max=1.0, options={"SKIP_SAVE"})
+    bpy.types.WindowManager.omninoise_task = StringProperty(options={"SKIP_SAVE"})
+    bpy.types.WindowManager.omninoise_message = StringProperty(options={"SKIP_SAVE"})
+    bpy.types.STATUSBAR_HT_header.append(_statusbar)
+
+
+def unregister():
+    tasks.cancel()
+    bpy.types.STATUSBAR_HT_header.remove(_statusbar)
+    for name in ("omninoise_progress", "omninoise_task", "omninoise_message"):
+        delattr(bpy.types.WindowManager, name)
+    del bpy.types.Scene.omninoise_bake
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
+
+

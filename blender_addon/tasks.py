@@ -1,0 +1,171 @@
+"""Background work that never freezes Blender's UI.
+
+A :class:`Task` runs a Blender-free function on a worker thread.  The worker
+never touches ``bpy``: it reports progress into plain attributes and polls a
+cancel flag.  A ``bpy.app.timers`` callback on the main thread copies progress
+into the window manager (panel and status-bar bars), redraws, and when the
+worker ends hands its result (or error) to the task's main-thread callbacks,
+which create Blender data.  One task runs at a time.
+
+In background mode (``blender -b``, the ``bpy`` module) there is no event loop
+to fire timers, so :func:`start` with ``blocking=True`` runs the work and its
+callbacks inline instead.
+"""
+from __future__ import annotations
+
+import threading
+import time
+import traceback
+from typing import Callable
+
+import bpy
+
+from ._deps import backend
+
+__all__ = ["Task", "start", "current", "cancel", "wait", "POLL_SECONDS"]
+
+POLL_SECONDS = 0.1
+_current: "Task | None" = None
+
+
+class Task:
+    """work(progress, cancel) -> result, run off the main thread.
+
+    on_done(result) and on_error(message) run on the main thread.
+    """
+
+    def __init__(self, label: str, work: Callable, on_done: Callable | None = None,
+                 on_error: Callable | None = None, threads: int = 0):
+        self.label = label
+        self.work = work
+        self.on_done = on_done
+        self.on_error = on_error
+        self.threads = threads
+        self.progress = 0.0
+        self.status = "running"  # running | done | failed | cancelled
+        self.message = ""
+        self.result = None
+        self.started = time.perf_counter()
+        self._cancel = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._finished = False
+
+    # -- worker side (no bpy) ----------------------------------------------------------
+    def _report(self, fraction: float) -> None:
+        self.progress = min(1.0, max(self.progress, float(fraction)))
+
+    def cancelled(self) -> bool:
+        return self._cancel.is_set()
+
+    def _run(self) -> None:
+        try:
+            if self.threads > 0:
+                try:
+                    import numba
+
+                    numba.set_num_threads(min(self.threads, numba.config.NUMBA_NUM_THREADS))
+                except ImportError:
+                    pass
+            self.result = self.work(self._report, self.cancelled)
+            self.status = "cancelled" if self._cancel.is_set() else "done"
+        except backend.Cancelled:
+            self.status = "cancelled"
+        except (backend.SettingError, OSError, ValueError, RuntimeError) as exc:
+            self.status, self.message = "failed", str(exc)
+        except Exception as exc:  # an engine bug: keep the trace for the console, one line for the UI
+            traceback.print_exc()
+            self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"
+
+    # -- main thread -------------------------------------------------------------------
+    def cancel(self) -> None:
+        self._cancel.set()
+
+    @property
+    def running(self) -> bool:
+        return not self._finished
+
+    def finish(self) -> None:
+        """Main thread: run the callbacks once the worker is over."""
+        global _current
+        if self._finished:
+            return
+        self._finished = True
+        if _current is self:
+            _current = None
+        _set_wm(None)
+        if self.status == "done" and self.on_done is not None:
+            try:
+                self.on_done(self.result)
+            except Exception as exc:  # turning files into Blender data failed
+                traceback.print_exc()
+                self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"
+        if self.status == "failed" and self.on_error is not None:
+            self.on_error(self.message)
+        _redraw()
+
+    def poll(self):
+        """bpy.app.timers callback: seconds until the next poll, or None when over."""
+        if self._thread is not None and self._thread.is_alive():
+            _set_wm(self)
+            _redraw()
+            return POLL_SECONDS
+        self.finish()
+        return None
+
+
+def _set_wm(task: "Task | None") -> None:
+    wm = getattr(bpy.context, "window_manager", None)
+    if wm is None or not hasattr(wm, "omninoise_progress"):
+        return
+    wm.omninoise_progress = task.progress if task is not None else 0.0
+    wm.omninoise_task = task.label if task is not None else ""
+
+
+def _redraw() -> None:
+    wm = getattr(bpy.context, "window_manager", None)
+    if wm is None:
+        return
+    for window in wm.windows:
+        for area in window.screen.areas:
+            if area.type in ("VIEW_3D", "NODE_EDITOR", "PROPERTIES", "STATUSBAR"):
+                area.tag_redraw()
+
+
+def current() -> "Task | None":
+    return _current
+
+
+def start(task: Task, blocking: bool = False) -> Task:
+    """Run ``task``: on a thread polled by a timer, or inline when ``blocking``."""
+    global _current
+    if _current is not None and _current.running:
+        raise RuntimeError(f"OmniNoise is busy with {_current.label!r}; wait or cancel it first")
+    _current = task
+    if blocking:
+        task._run()
+        task.finish()
+        return task
+    task._thread = threading.Thread(target=task._run, name=f"omninoise: {task.label}", daemon=True)
+    task._thread.start()
+    bpy.app.timers.register(task.poll, first_interval=POLL_SECONDS)
+    return task
+
+
+def cancel() -> bool:
+    """Ask the running task to stop; True if there was one."""
+    if _current is None or not _current.running:
+        return False
+    _current.cancel()
+    return True
+
+
+def wait(task: Task, timeout: float = 600.0) -> Task:
+    """Join the worker and finish on this (main) thread: for scripts and tests without an event loop."""
+    if task._thread is not None:
+        task._thread.join(timeout)
+    if task._thread is not None and task._thread.is_alive():
+        raise TimeoutError(f"{task.label} still running after {timeout:g} s")
+    if bpy.app.timers.is_registered(task.poll):
+        bpy.app.timers.unregister(task.poll)
+    task.finish()
+    return task

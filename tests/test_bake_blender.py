@@ -1,0 +1,244 @@
+"""Bake operators in background Blender: ramps, Volume objects, images, tasks, jobs."""
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+import blender_addon  # noqa: E402
+from backend.bake import BakeSpec, run_bake  # noqa: E402
+from backend.sources import BoxGrid, WaveSource  # noqa: E402
+from backend.transfer import preset  # noqa: E402
+from export import read_volume  # noqa: E402
+
+
+@pytest.fixture(scope="module", autouse=True)
+def addon():
+    blender_addon.register()
+    yield
+    blender_addon.unregister()
+
+
+@pytest.fixture
+def scene(tmp_path):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    sc = bpy.context.scene
+    p = sc.omninoise_bake
+    p.folder = str(tmp_path) + os.sep
+    p.bounds_mode = "CUSTOM"
+    p.bounds_min, p.bounds_max = (-1.0, -1.0, -0.5), (1.0, 1.0, 0.5)
+    p.volume_resolution = (24, 24, 12)
+    p.image_resolution = (32, 24)
+    p.wave.dimensions = "3"
+    p.wave.seed = 3
+    p.wave.fmin, p.wave.fmax = 1.0, 4.0
+    return sc
+
+
+def _ramp(mode, colour_mode="RGB"):
+    from blender_addon.bake_blender import ramp_node
+
+    cr = ramp_node().color_ramp
+    cr.color_mode = colour_mode
+    cr.interpolation = mode
+    while len(cr.elements) < 3:
+        cr.elements.new(0.5)
+    for e, (p, c) in zip(cr.elements, [(0.1, (1, 0, 0, 0.2)), (0.45, (0, 1, 0.5, 1)), (0.8, (0.2, 0.1, 1, 0.6))]):
+        e.position, e.color = p, c
+    return cr
+
+
+@pytest.mark.parametrize("mode", ["LINEAR", "CONSTANT", "EASE", "B_SPLINE", "CARDINAL"])
+def test_transfer_equals_blender_color_ramp(scene, mode):
+    from blender_addon.bake_blender import transfer_from_color_ramp
+
+    cr = _ramp(mode)
+    tf = transfer_from_color_ramp(cr, (0.0, 1.0))
+    t = np.linspace(0, 1, 401, dtype=np.float32)
+    t = t[np.min(np.abs(t[:, None] - np.array([0.1, 0.45, 0.8])[None]), 1) > 1e-3]  # away from hard steps
+    ours = tf.rgba(t)
+    blender = np.array([cr.evaluate(float(x)) for x in t], np.float32)
+    tol = 1e-5 if mode in ("LINEAR", "CONSTANT", "EASE") else 2e-3  # sampled at 257 positions
+    np.testing.assert_allclose(ours, blender, atol=tol)
+
+
+def test_presets_set_the_ramp(scene):
+    from blender_addon.bake_blender import ramp_node
+
+    p = scene.omninoise_bake
+    for name in ("fire", "marble", "clouds"):
+        p.preset = name
+        cr = ramp_node().color_ramp
+        ref = preset(name)
+        assert [round(e.position, 5) for e in cr.elements] == [round(x, 5) for x, _ in ref.stops]
+        np.testing.assert_allclose([tuple(e.color) for e in cr.elements], [c for _, c in ref.stops], atol=1e-6)
+        assert (p.range_min, p.range_max) == pytest.approx(ref.range)
+        assert p.use_temperature == ref.has_temperature
+
+
+def test_bake_volume_operator_makes_a_renderable_volume(scene, tmp_path):
+    p = scene.omninoise_bake
+    p.preset = "smoke"  # dark smoke: absorbs the white world where it is dense
+    p.density_scale = 20.0
+    p.name = "Clouds"
+    assert bpy.ops.omninoise.bake_volume() == {"FINISHED"}
+    path = str(tmp_path / "Clouds.vdb")
+    assert os.path.isfile(path)
+    obj = bpy.data.objects["Clouds"]
+    vol = obj.data
+    assert sorted(g.name for g in vol.grids) == ["color", "density"]
+    pv = next(n for n in vol.materials[0].node_tree.nodes if n.type == "PRINCIPLED_VOLUME")
+    assert pv.inputs["Density Attribute"].default_value == "density"
+    assert pv.inputs["Color Attribute"].default_value == "color"
+    # the same bake through the Blender-free pipeline gives the same voxels
+    from blender_addon.bake_ui import transfer
+
+    spec = BakeSpec("ref", WaveSource(p.wave.to_settings(node=False)), BoxGrid((24, 24, 12),
+                    ((-1, -1, -0.5), (1, 1, 0.5))), str(tmp_path / "ref.vdb"), transfer(p))
+    run_bake(spec)
+    np.testing.assert_array_equal(read_volume(path, "density", (12, 24, 24)),
+                                  read_volume(spec.output, "density", (12, 24, 24)))
+    # Cycles renders it: the white world shows through where the smoke is thin, not where it is dense
+    cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
+    scene.collection.objects.link(cam)
+    cam.location = (0, 0, 6)
+    cam.data.type = "ORTHO"
+    cam.data.ortho_scale = 2.0
+    scene.camera = cam
+    world = bpy.data.worlds.new("w")
+    world.color = (1, 1, 1)
+    scene.world = world
+    r = scene.render
+    r.engine = "CYCLES"
+    scene.cycles.samples = 8
+    scene.cycles.device = "CPU"
+    scene.view_settings.view_transform = "Standard"
+    r.resolution_x = r.resolution_y = 24
+    r.filepath = str(tmp_path / "render.png")
+    r.image_settings.file_format = "PNG"
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(r.filepath)
+    px = np.array(img.pixels[:], np.float32).reshape(24, 24, 4)[..., :3].mean(-1)
+    d = read_volume(path, "density", (12, 24, 24)).sum(0)  # optical depth per column (y, x)
+    thick, thin = d > np.quantile(d, 0.8), d < np.quantile(d, 0.2)
+    assert px[thin].mean() > px[thick].mean() + 0.05, (px[thin].mean(), px[thick].mean())
+
+
+def test_animated_volume_is_a_sequence(scene, tmp_path):
+    p = scene.omninoise_bake
+    p.wave.speed = 2.0
+    p.animated, p.frame_start, p.frame_end = True, 3, 5
+    p.name = "Anim"
+    p.preset = "fire"
+    assert bpy.ops.omninoise.bake_volume() == {"FINISHED"}
+    assert sorted(os.listdir(tmp_path)) == ["Anim_0003.vdb", "Anim_0004.vdb", "Anim_0005.vdb"]
+    vol = bpy.data.objects["Anim"].data
+    assert vol.is_sequence and vol.frame_duration == 3
+    for f in (3, 4, 5):
+        scene.frame_set(f)
+        vol.grids.load()
+        assert vol.grids.frame_filepath.endswith(f"Anim_{f:04d}.vdb")
+    assert "temperature" in [g.name for g in vol.grids]
+    nodes = vol.materials[0].node_tree.nodes
+    assert next(n for n in nodes if n.type == "PRINCIPLED_VOLUME").inputs["Blackbody Intensity"].default_value == 1.0
+
+
+def test_bake_image_operator(scene, tmp_path):
+    p = scene.omninoise_bake
+    p.name = "Marble"
+    p.preset = "marble"
+    assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
+    img = bpy.data.images["Marble"]
+    assert tuple(img.size) == (32, 24)
+    mat = bpy.data.materials["OmniNoise Marble"]
+    tex = next(n for n in mat.node_tree.nodes if n.type == "TEX_IMAGE")
+    assert tex.image == img and tex.outputs["Color"].is_linked
+    p.use_ramp = False
+    p.image_format = "PNG"
+    p.name = "Raw"
+    assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
+    assert bpy.data.images["Raw"].colorspace_settings.name == "Non-Color"
+
+
+def test_bad_settings_report_one_line(scene, tmp_path):
+    p = scene.omninoise_bake
+    p.wave.dimensions = "2"
+    with pytest.raises(RuntimeError, match="a volume needs 3D or 4D noise"):
+        bpy.ops.omninoise.bake_volume()
+    p.wave.dimensions = "3"
+    p.bounds_mode = "OBJECT"
+    with pytest.raises(RuntimeError, match="no active object"):
+        bpy.ops.omninoise.bake_volume()
+    assert os.listdir(tmp_path) == []
+
+
+def test_worker_keeps_main_thread_free_and_cancels(scene, tmp_path):
+    from blender_addon import tasks
+
+    src = WaveSource(scene.omninoise_bake.wave.to_settings(node=False).replace(directions=32))
+    spec = BakeSpec("big", src, BoxGrid((160, 160, 160)), str(tmp_path / "big.vdb"), preset("smoke"))
+    done = []
+    task = tasks.start(tasks.Task("big", lambda pr, c: run_bake(spec, pr, c), done.append))
+    ticks = 0
+    while task._thread.is_alive() and task.progress < 0.2:
+        time.sleep(0.01)
+        ticks += 1  # the main thread runs while the worker bakes (kernels release the GIL)
+    assert ticks > 3
+    assert tasks.start is not None and tasks.current() is task
+    with pytest.raises(RuntimeError, match="busy"):
+        tasks.start(tasks.Task("second", lambda pr, c: None))
+    task.cancel()
+    tasks.wait(task)
+    assert task.status == "cancelled" and not done and tasks.current() is None
+    assert os.listdir(tmp_path) == []
+    # and a task that finishes runs its callback on the main thread
+    small = BakeSpec("small", src, BoxGrid((16, 16, 16)), str(tmp_path / "small.vdb"))
+    main = threading.get_ident()
+    seen = []
+    t2 = tasks.start(tasks.Task("small", lambda pr, c: run_bake(small, pr, c),
+                                lambda r: seen.append((threading.get_ident(), r.written))))
+    tasks.wait(t2)
+    assert t2.status == "done" and seen == [(main, [small.output])] and t2.progress == 1.0
+
+
+JOB = """
+[[bake]]
+name = "vol"
+output = "vol.vdb"
+resolution = [16, 16, 8]
+bounds = [[-1, -1, 0], [1, 1, 1]]
+transfer = "smoke"
+[bake.source]
+dim = 3
+seed = 9
+
+[[bake]]
+name = "img"
+output = "img.exr"
+resolution = [24, 16]
+[bake.source]
+dim = 2
+"""
+
+
+def test_job_in_blender_matches_the_command_line(tmp_path):
+    from backend.cli import main
+
+    for sub in ("cli", "bpy"):
+        (tmp_path / sub).mkdir()
+        (tmp_path / sub / "job.toml").write_text(JOB)
+    assert main(["bake", str(tmp_path / "cli" / "job.toml"), "--quiet"]) == 0
+    assert bpy.ops.omninoise.run_job(filepath=str(tmp_path / "bpy" / "job.toml")) == {"FINISHED"}
+    for name in ("vol.vdb", "img.exr"):
+        a, b = tmp_path / "cli" / name, tmp_path / "bpy" / name
+        from export import read_metadata
+
+        assert read_metadata(str(a))["omninoise_key"] == read_metadata(str(b))["omninoise_key"]
+    np.testing.assert_array_equal(read_volume(str(tmp_path / "cli" / "vol.vdb"), "density", (8, 16, 16)),
+                                  read_volume(str(tmp_path / "bpy" / "vol.vdb"), "density", (8, 16, 16)))
+    (tmp_path / "bpy" / "job.toml").write_text(JOB.replace("seed = 9", "sed = 9"))
+    with pytest.raises(RuntimeError, match="bake 'vol': sed: unknown wave setting"):
+        bpy.ops.omninoise.run_job(filepath=str(tmp_path / "bpy" / "job.toml"))
