@@ -21,6 +21,8 @@ setup: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/python demo/showcase.py out/demo
 	$(BIN)/python demo/showcase_blend.py out/demo
+	$(BIN)/omninoise bake demo/volumes.toml
+	$(BIN)/python demo/showcase_volume.py out/demo
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

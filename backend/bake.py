@@ -47,8 +47,8 @@ __all__ = ["BakeSpec", "BakeResult", "run_bake", "frame_path", "FORMATS", "KEY_N
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
 KEY_NAME = "omninoise_key"
-#: voxels per slab: ~8 MiB of values plus ~32 MiB of colour at a time
-SLAB_VOXELS = 1 << 21
+#: voxels per slab: ~2 MiB of values plus ~8 MiB of colour at a time
+SLAB_VOXELS = 1 << 19
 _FRAME = re.compile(r"#+")
 
 
@@ -64,7 +64,8 @@ class BakeSpec:
     frames     (start, end) inclusive, or None for one file
     time       time (or 4D W) of the single bake / of frame ``start``
     time_step  time between frames
-    half       EXR: 16-bit half floats
+    half       EXR and VDB: store 16-bit half floats
+    make_folders  create a missing output folder when baking (job files) instead of failing
     """
 
     name: str
@@ -76,7 +77,7 @@ class BakeSpec:
     time: float = 0.0
     time_step: float = 1.0 / 24.0
     half: bool = False
-    extra: dict = field(default_factory=dict)
+    make_folders: bool = False
 
     def validate(self) -> "BakeSpec":
         self.grid.validate()
@@ -100,7 +101,7 @@ class BakeSpec:
             if not self.source.animated:
                 raise SettingError("frames", "this source does not change over time (set speed, or dim = 4)")
         folder = os.path.dirname(os.path.abspath(self.output))
-        if not os.path.isdir(folder):
+        if not self.make_folders and not os.path.isdir(folder):
             raise SettingError("output", f"folder does not exist: {folder}")
         return self
 
@@ -121,7 +122,7 @@ class BakeSpec:
         ext = os.path.splitext(self.output)[1].lower()
         doc = dict(version=__version__, source=self.source.to_dict(), grid=self.grid.to_dict(),
                    transfer=None if self.transfer is None else self.transfer.to_dict(),
-                   time=self.frame_time(frame), half=bool(self.half and ext == ".exr"), format=ext)
+                   time=self.frame_time(frame), half=bool(self.half and ext in (".exr", ".vdb")), format=ext)
         return hashlib.sha256(describe(doc).encode()).hexdigest()
 
     def is_up_to_date(self, frame) -> bool:
@@ -188,7 +189,7 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
             grids["color"] = "vec3"
             if tf.has_temperature:
                 grids["temperature"] = "float"
-        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, grids, meta)
+        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, grids, meta, half=spec.half)
         for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
             if tf is None:
                 writer.add("density", z0, vals)
@@ -238,6 +239,8 @@ def run_bake(spec: BakeSpec, progress: Callable[[float], None] | None = None,
     progress is not written; finished frames stay) and SettingError for bad specs.
     """
     spec.validate()
+    if spec.make_folders:
+        os.makedirs(os.path.dirname(os.path.abspath(spec.output)), exist_ok=True)
     frames = spec.frame_list()
     res = BakeResult(spec.name)
     for i, frame in enumerate(frames):

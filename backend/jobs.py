@@ -1,6 +1,7 @@
 """Batch bake jobs from TOML files (``omninoise bake JOB.toml``, the Blender panel, ``bpy``).
 
-A job file lists bakes; paths are relative to the job file's folder::
+A job file lists bakes; paths are relative to the job file's folder and
+missing output folders are created::
 
     # optional: merged into every bake (a bake's own keys win, tables merge key by key)
     [defaults]
@@ -15,7 +16,7 @@ A job file lists bakes; paths are relative to the job file's folder::
     frames = [1, 24]                    # optional inclusive range -> numbered sequence
     time = 0.0                          # time (4D: W) of the first frame
     time_step = 0.0417                  # time between frames
-    half = false                        # EXR half floats
+    half = false                        # EXR / VDB: 16-bit half floats
 
     [bake.source]                       # kind = "wave" + WaveSettings keys
     kind = "wave"
@@ -102,7 +103,7 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
     output = os.path.normpath(os.path.join(base_dir, str(d["output"])))
     return BakeSpec(name=name, source=source, grid=grid, output=output, transfer=tf, frames=frames,
                     time=float(d.get("time", 0.0)), time_step=float(d.get("time_step", 1.0 / 24.0)),
-                    half=bool(d.get("half", False))).validate()
+                    half=bool(d.get("half", False)), make_folders=True).validate()
 
 
 def parse_job(doc: dict, base_dir: str) -> list:

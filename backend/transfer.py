@@ -208,7 +208,7 @@ def load_transfer(spec: str) -> TransferFunction:
 #: presets for the wave noise's real output (mean 0, std ~0.7); ``range`` adapts them to others
 PRESETS = {
     # white puffs with soft edges, empty where the noise is low
-    "clouds": dict(range=(-0.2, 1.6), interpolation="ease", density_scale=4.0,
+    "clouds": dict(range=(0.1, 1.8), interpolation="ease", density_scale=3.0,
                    stops=((0.0, (1.0, 1.0, 1.0, 0.0)), (0.25, (0.95, 0.96, 1.0, 0.15)),
                           (1.0, (1.0, 1.0, 1.0, 1.0)))),
     # thin grey smoke with dark cores

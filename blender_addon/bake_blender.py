@@ -85,6 +85,7 @@ def world_bounds(obj) -> tuple:
 
 def _file_path(path: str) -> str:
     """Relative to the .blend when it is saved (files travel with the project), else absolute."""
+    path = os.path.abspath(path)
     if bpy.data.filepath:
         try:
             return bpy.path.relpath(path)
@@ -152,7 +153,7 @@ def load_image(name: str, paths: list, frames, raw: bool, target_material=None):
     img = bpy.data.images.get(name)
     path = _file_path(paths[0])
     if img is None or img.filepath != path:
-        img = bpy.data.images.load(paths[0], check_existing=False)
+        img = bpy.data.images.load(os.path.abspath(paths[0]), check_existing=False)
         img.name = name
         img.filepath = path
     else:

@@ -52,9 +52,10 @@ class VolumeWriter:
 
     voxel  (3,) spacing along x, y, z;  first  (3,) world position of voxel (0, 0, 0)'s centre
     grids  {name: "float" | "vec3"}
+    half   store voxel values as 16-bit half floats (about half the file size)
     """
 
-    def __init__(self, voxel, first, grids: dict, metadata: dict | None = None):
+    def __init__(self, voxel, first, grids: dict, metadata: dict | None = None, half: bool = False):
         self.vdb = openvdb_module()
         vx, vy, vz = (float(v) for v in voxel)
         tx, ty, tz = (float(v) for v in first)
@@ -66,6 +67,7 @@ class VolumeWriter:
             g.transform = self.vdb.createLinearTransform(matrix)
             if name == "density":
                 g.gridClass = self.vdb.GridClass.FOG_VOLUME
+            g.saveFloatAsHalf = bool(half)
             self.grids[name] = (g, kind)
         self.metadata = {str(k): str(v) for k, v in (metadata or {}).items()}
 

@@ -161,6 +161,15 @@ def test_bake_image_operator(scene, tmp_path):
     p.name = "Raw"
     assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
     assert bpy.data.images["Raw"].colorspace_settings.name == "Non-Color"
+    # an animated image bake is an EXR sequence that the Image Texture node plays
+    p.wave.speed, p.animated, p.frame_start, p.frame_end = 1.0, True, 2, 4
+    p.image_format, p.name = "EXR", "Seq"
+    assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
+    assert sorted(f for f in os.listdir(tmp_path) if f.startswith("Seq")) == \
+        ["Seq_0002.exr", "Seq_0003.exr", "Seq_0004.exr"]
+    img = bpy.data.images["Seq"]
+    tex = next(n for n in bpy.data.materials["OmniNoise Seq"].node_tree.nodes if n.type == "TEX_IMAGE")
+    assert img.source == "SEQUENCE" and tex.image_user.frame_duration == 3 and tex.image_user.frame_start == 2
 
 
 def test_bad_settings_report_one_line(scene, tmp_path):

@@ -68,6 +68,9 @@ def test_job_paths_are_relative_to_the_job_file(job, tmp_path, monkeypatch):
     monkeypatch.chdir("/")
     specs = load_job(str(job))
     assert specs[0][1].output == str(tmp_path / "out" / "clouds_##.vdb")
+    job.write_text(JOB.replace("out/marble.exr", "new/deeper/marble.exr"))
+    assert [o.status for o in run_job(str(job), only=["marble"])] == ["baked"]
+    assert os.listdir(tmp_path / "new" / "deeper") == ["marble.exr"]  # folders made for the job
 
 
 @pytest.mark.parametrize("edit, match", [
