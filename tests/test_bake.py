@@ -209,3 +209,20 @@ def test_failed_write_leaves_no_partial_file(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         run_bake(BakeSpec("f", WaveSource(S3), BoxGrid((8, 8, 8)), out))
     assert os.listdir(tmp_path) == []
+
+
+def test_4d_sequences_step_w(tmp_path):
+    """4D noise: frame f of a sequence is the volume at W = time + (f - start) * time_step."""
+    src = WaveSource(WaveSettings(dim=4, seed=13, spectrum=Spectrum("bandpass", 1.0, 3.0)), w_offset=0.1)
+    grid = BoxGrid((10, 8, 6), ((0, 0, 0), (1, 1, 1)))
+    seq = run_bake(BakeSpec("w", src, grid, str(tmp_path / "w_#.vdb"), frames=(1, 3),
+                            time=0.2, time_step=0.3))
+    last = read_volume(seq.written[-1], "density", grid.shape)
+    one = run_bake(BakeSpec("w1", src, grid, str(tmp_path / "one.vdb"), time=0.8))
+    np.testing.assert_array_equal(read_volume(one.written[0], "density", grid.shape), last)
+    noise = compile_noise(src.settings)
+    pts = np.concatenate([centres(grid), np.full((grid.shape[0] * 80, 1), 0.9)], 1).astype(np.float32)
+    np.testing.assert_allclose(last.ravel(), evaluate_points(noise, pts, "real"), atol=1e-3)
+    img = run_bake(BakeSpec("i", src, BoxGrid((12, 10)), str(tmp_path / "i_##.exr"), frames=(4, 5)))
+    assert [os.path.basename(p) for p in img.written] == ["i_04.exr", "i_05.exr"]
+    assert np.abs(read_image(img.written[0]) - read_image(img.written[1])).mean() > 1e-3
