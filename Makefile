@@ -24,7 +24,11 @@ demo: $(STAMP)
 	$(BIN)/omninoise bake demo/volumes.toml
 	$(BIN)/python demo/showcase_volume.py out/demo
 
-test: $(STAMP)
+$(VENV)/.train: $(STAMP) requirements-train.txt
+	$(BIN)/python -m pip install -q -r requirements-train.txt
+	@touch $@
+
+test: $(STAMP) $(VENV)/.train
 	$(BIN)/python -m pytest -q
 
 $(VENV)/.bench: $(STAMP) requirements-bench.txt

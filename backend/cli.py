@@ -97,6 +97,14 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
     b.add_argument("--quiet", action="store_true")
 
+    z = sub.add_parser("zoo", help="ground-truth images of the neural noise training zoo (needs torch)")
+    z.add_argument("--noise", help="class name (see --list)")
+    z.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
+    z.add_argument("--size", type=int, default=256)
+    z.add_argument("--seed", type=int, default=0)
+    z.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
+    z.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+
     t = sub.add_parser("transfer", help="print or save a transfer-function preset as an editable ramp .json")
     t.add_argument("preset", nargs="?", choices=tuple(PRESETS))
     t.add_argument("--list", action="store_true", help="list the presets")
@@ -230,6 +238,37 @@ def run_bake_job(a: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+def run_zoo(a: argparse.Namespace) -> int:
+    import json
+
+    try:
+        from .training import zoo
+    except ImportError as exc:
+        raise SettingError("zoo", f"needs torch ({exc}); pip install -r requirements-train.txt") from None
+    if a.list:
+        print(json.dumps(zoo.describe(), indent=2))
+        return 0
+    if not a.noise or not a.out:
+        raise SettingError("zoo", "give --noise CLASS and -o OUT (or --list)")
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    try:
+        params = zoo.parse_params(a.noise, a.param)
+    except ValueError as exc:
+        raise SettingError("--noise" if "class" in str(exc) else "--param", str(exc)) from None
+    from export.images import write_image
+
+    img = zoo.generate(a.noise, params, [a.seed], a.size)[0].numpy()
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext == ".png":
+        from export.images import write_png
+
+        write_png(a.out, (img * 255.0 + 0.5).astype(np.uint8))
+    else:
+        write_image(a.out, img)
+    return 0
+
+
 def run_transfer(a: argparse.Namespace) -> int:
     import json
 
@@ -260,6 +299,8 @@ def main(argv: list[str] | None = None) -> int:
             return run_bake_job(a)
         if a.command == "transfer":
             return run_transfer(a)
+        if a.command == "zoo":
+            return run_zoo(a)
     except (SettingError, FileNotFoundError, PermissionError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -26,7 +26,16 @@ def test_zip_holds_runtime_files_only(built_zip):
     names = zipfile.ZipFile(built_zip).namelist()
     assert "blender_manifest.toml" in names and "blender_addon/wave_nodes.py" in names
     assert "backend/wave.py" in names and "export/images.py" in names
-    assert not [n for n in names if n.startswith(("tests/", "bench/", "demo/", "tools/")) or "__pycache__" in n]
+    assert not [n for n in names if n.startswith(("tests/", "bench/", "demo/", "tools/", "backend/training/"))
+                or "__pycache__" in n]
+
+
+def test_runtime_never_imports_torch():
+    """What the add-on imports (backend, bakes, jobs, export) stays free of torch."""
+    code = ("import sys, backend, backend.bake, backend.jobs, backend.sources, export, export.vdb; "
+            "print('torch' in sys.modules)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0 and r.stdout.strip() == "False", r.stderr
 
 
 def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
