@@ -1,0 +1,212 @@
+"""Train the neural noise model: ``python -m backend.training.train --config CONFIG.json --out RUN``.
+
+Data is generated on the fly by :mod:`.zoo` (no files), on the CPU or the GPU.
+Every step: a zoo batch -> CutMix (p = 0.5) -> random flips -> ε-prediction loss
+with offset noise and the spherical embedding penalty -> AdamW (lr 8e-5,
+β = (0.9, 0.99), weight decay 0.01), gradient clipping at 1, EMA of the weights.
+``RUN/ckpt.pt`` is written atomically every ``checkpoint_every`` steps and a
+run resumes from it; ``RUN/log.jsonl`` has one line per ``log_every`` steps and
+``RUN/samples_STEP.png`` shows DDIM samples of the EMA model.
+
+Config keys (JSON) and defaults: see :class:`TrainConfig`.
+"""
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass, field, fields
+
+import numpy as np
+import torch
+
+from . import zoo
+from .cutmix import cutmix
+from .diffusion import Diffusion
+from .unet import UNet
+
+__all__ = ["TrainConfig", "train", "load_config", "build_model"]
+
+
+@dataclass
+class TrainConfig:
+    size: int = 64                 # training resolution (px); multiples of 8
+    batch: int = 16
+    steps: int = 100_000
+    lr: float = 8e-5
+    betas: tuple = (0.9, 0.99)
+    weight_decay: float = 0.01
+    grad_clip: float = 1.0
+    ema_decay: float = 0.999
+    cutmix_p: float = 0.5
+    offset_noise: float = 0.1
+    emb_lambda: float = 0.02
+    emb_dim: int = 32
+    widths: tuple = (32, 64, 128)
+    classes: tuple = field(default_factory=lambda: zoo.CLASS_NAMES)
+    seeds_per_set: int = 4
+    sets_per_class: int = 16384
+    seed: int = 0
+    device: str = "auto"
+    log_every: int = 50
+    checkpoint_every: int = 1000
+    sample_every: int = 5000
+    sample_steps: int = 20
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "TrainConfig":
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(d) - known)
+        if unknown:
+            raise ValueError(f"unknown config key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+        d = dict(d)
+        for k in ("betas", "widths", "classes"):
+            if k in d:
+                d[k] = tuple(d[k])
+        bad = [c for c in d.get("classes", ()) if c not in zoo.CLASSES]
+        if bad:
+            raise ValueError(f"unknown class {bad[0]!r}")
+        if d.get("size", 64) % 8:
+            raise ValueError(f"size must be a multiple of 8, got {d['size']}")
+        return cls(**d)
+
+
+def load_config(path: str) -> TrainConfig:
+    with open(path, encoding="utf-8") as fh:
+        return TrainConfig.from_dict(json.load(fh))
+
+
+def build_model(cfg: TrainConfig) -> UNet:
+    return UNet(len(zoo.CLASS_NAMES), len(zoo.PARAM_NAMES), emb_dim=cfg.emb_dim, widths=cfg.widths)
+
+
+def _device(name: str) -> torch.device:
+    if name == "auto":
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    return torch.device(name)
+
+
+def _save(path: str, obj) -> None:
+    tmp = path + ".tmp"
+    torch.save(obj, tmp)
+    os.replace(tmp, path)
+
+
+def _conditions(ids: torch.Tensor, conds: torch.Tensor, size: int):
+    """Per-sample class ids (B,) and conditions (B, P) -> uniform maps (B, S, S) and (B, P, S, S)."""
+    B = ids.shape[0]
+    return ids.view(B, 1, 1).expand(B, size, size).clone(), conds.view(B, -1, 1, 1).expand(-1, -1, size, size).clone()
+
+
+def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0) -> np.ndarray:
+    """DDIM samples of a few classes at their default parameters: float32 (n, S, S) in [0, 1]."""
+    from ..neural.sampler import ddim_sample, initial_noise
+
+    names = list(names or cfg.classes[:8])
+    S = cfg.size
+    ids = torch.tensor([zoo.CLASS_NAMES.index(n) for n in names], device=device)
+    conds = torch.cat([zoo.condition_vector(n, zoo.default_params(n)) for n in names]).to(device)
+    idm, pm = _conditions(ids, conds, S)
+    with torch.no_grad():
+        cond = model.embed(idm, pm)
+
+        def eps(x, t, c):
+            return model(torch.from_numpy(x).to(device), torch.from_numpy(t).to(device), cond).cpu().numpy()
+
+        x0 = ddim_sample(eps, initial_noise(seed, (len(names), 1, S, S)), None, steps=cfg.sample_steps)
+    return (x0[:, 0] + 1.0) * 0.5
+
+
+def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -> dict:
+    """Train (or resume) into folder ``out``; stops after ``max_steps`` more steps if given. Returns the last log."""
+    os.makedirs(out, exist_ok=True)
+    device = _device(cfg.device)
+    torch.manual_seed(cfg.seed)
+    model = build_model(cfg).to(device)
+    ema = copy.deepcopy(model).eval()
+    for p_ in ema.parameters():
+        p_.requires_grad_(False)
+    opt = torch.optim.AdamW(model.parameters(), lr=cfg.lr, betas=cfg.betas, weight_decay=cfg.weight_decay)
+    diff = Diffusion(offset_noise=cfg.offset_noise, emb_lambda=cfg.emb_lambda, device=device)
+    rng = np.random.default_rng(cfg.seed)
+    gen = torch.Generator(device=device).manual_seed(cfg.seed)
+    step = 0
+    ckpt = os.path.join(out, "ckpt.pt")
+    if os.path.isfile(ckpt):
+        state = torch.load(ckpt, map_location=device, weights_only=False)
+        model.load_state_dict(state["model"])
+        ema.load_state_dict(state["ema"])
+        opt.load_state_dict(state["opt"])
+        step = state["step"]
+        rng.bit_generator.state = state["rng"]
+        gen.set_state(state["gen"].to(gen.get_state().device) if hasattr(state["gen"], "to") else state["gen"])
+        log(f"resumed at step {step}")
+    with open(os.path.join(out, "config.json"), "w", encoding="utf-8") as fh:
+        json.dump(asdict(cfg), fh, indent=2)
+    sampler = zoo.ZooSampler(cfg.size, cfg.classes, cfg.seeds_per_set, cfg.sets_per_class, rng=rng, device=device)
+    end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
+    t0, last, losses = time.time(), {}, []
+    while step < end:
+        imgs, ids, conds = sampler.batch(cfg.batch)
+        idm, pm = _conditions(ids, conds, cfg.size)
+        imgs, idm, pm = cutmix(imgs, idm, pm, rng, p=cfg.cutmix_p)
+        if rng.random() < 0.5:
+            imgs, idm, pm = imgs.flip(-1), idm.flip(-1), pm.flip(-1)
+        if rng.random() < 0.5:
+            imgs, idm, pm = imgs.flip(-2), idm.flip(-2), pm.flip(-2)
+        x0 = (imgs * 2.0 - 1.0).to(device)
+        model.train()
+        loss, mse = diff.loss(model, x0, model.embed(idm.to(device), pm.to(device)), gen)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
+        opt.step()
+        with torch.no_grad():
+            for pe, pm_ in zip(ema.parameters(), model.parameters()):
+                pe.lerp_(pm_, 1.0 - cfg.ema_decay)
+        step += 1
+        losses.append(float(mse.detach()))
+        if step % cfg.log_every == 0 or step == end:
+            last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss), seconds=round(time.time() - t0, 2),
+                        emb_norm=float(model.class_emb.weight.norm(dim=1).mean()))
+            losses = []
+            with open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8") as fh:
+                fh.write(json.dumps(last) + "\n")
+            log(json.dumps(last))
+        if step % cfg.checkpoint_every == 0 or step == end:
+            _save(ckpt, dict(model=model.state_dict(), ema=ema.state_dict(), opt=opt.state_dict(), step=step,
+                             rng=rng.bit_generator.state, gen=gen.get_state(), config=asdict(cfg)))
+        if cfg.sample_every and step % cfg.sample_every == 0:
+            save_samples(ema, cfg, device, os.path.join(out, f"samples_{step:07d}.png"))
+    return last
+
+
+def save_samples(model: UNet, cfg: TrainConfig, device, path: str) -> None:
+    """A row of EMA samples (first 8 classes, default parameters) as a PNG."""
+    from .._export import export
+
+    imgs = sample_grid(model, cfg, device)
+    row = np.concatenate(list(imgs), axis=1)
+    export.write_png(path, (np.clip(row, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m backend.training.train", description=__doc__.split("\n")[0])
+    ap.add_argument("--config", required=True, help="JSON config (see TrainConfig)")
+    ap.add_argument("--out", required=True, help="run folder: checkpoint, log, samples")
+    ap.add_argument("--max-steps", type=int, help="stop after this many more steps (resume later)")
+    a = ap.parse_args(argv)
+    try:
+        cfg = load_config(a.config)
+    except (OSError, ValueError) as exc:
+        print(f"train: error: {exc}", file=sys.stderr)
+        return 2
+    train(cfg, a.out, a.max_steps)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,144 @@
+"""The ε-prediction U-Net of Maesumi et al. 2024 (Sec. 3.1, Appendix C), in torch.
+
+Three levels of 32 / 64 / 128 channels, two ResNet blocks per level and two in
+the bottleneck, skip concatenation on the way up.  Every ResNet block's first
+normalisation is modulated twice (Eq. 2):
+
+    h = GroupNorm(conv(x)) * (1 + γ₁(t)) + β₁(t)    diffusion time, sinusoidal encoding -> MLP
+    h = h * (1 + γ₂(F)) + β₂(F)                      SPADE: F resized (nearest) to the block,
+                                                     γ₂, β₂ = 3x3 convs of conv3x3(F)
+
+F is the conditioning feature grid: a per-pixel MLP (three layers of 128, as
+1x1 convolutions) of [class embedding, parameter vector] (B, E + P, H, W).
+The network takes that grid already embedded, so spatial blends of classes
+(slerp of embeddings) and parameters are built outside it, at any resolution.
+
+Shapes: x (B, 1, H, W) float32 with H, W multiples of 8; t (B,) float32 in [0, T);
+cond (B, E + P, H, W) float32 -> ε (B, 1, H, W).
+"""
+from __future__ import annotations
+
+import math
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+__all__ = ["UNet", "set_circular"]
+
+
+class TimeEmbedding(nn.Module):
+    def __init__(self, dim: int = 32, out: int = 128):
+        super().__init__()
+        self.dim = dim
+        self.mlp = nn.Sequential(nn.Linear(dim, out), nn.GELU(), nn.Linear(out, out))
+
+    def forward(self, t):
+        half = self.dim // 2
+        freqs = torch.exp(-math.log(10000.0) * torch.arange(half, device=t.device, dtype=torch.float32) / (half - 1))
+        a = t.float()[:, None] * freqs[None]
+        return self.mlp(torch.cat([a.sin(), a.cos()], 1))
+
+
+class SPADE(nn.Module):
+    """γ, β maps from the feature grid, nearest-resized to the block (Park et al. 2019)."""
+
+    def __init__(self, channels: int, feat: int = 128, hidden: int = 64):
+        super().__init__()
+        hid = min(channels, hidden)  # 64 hidden channels keep the network near the paper's ~5M parameters
+        self.shared = nn.Sequential(nn.Conv2d(feat, hid, 3, padding=1), nn.SiLU())
+        self.gamma = nn.Conv2d(hid, channels, 3, padding=1)
+        self.beta = nn.Conv2d(hid, channels, 3, padding=1)
+
+    def forward(self, h, feat):
+        f = F.interpolate(feat, size=h.shape[-2:], mode="nearest")
+        f = self.shared(f)
+        return h * (1.0 + self.gamma(f)) + self.beta(f)
+
+
+class ResBlock(nn.Module):
+    def __init__(self, cin: int, cout: int, tdim: int = 128, groups: int = 8):
+        super().__init__()
+        self.conv1 = nn.Conv2d(cin, cout, 3, padding=1)
+        self.norm1 = nn.GroupNorm(groups, cout)
+        self.time = nn.Linear(tdim, 2 * cout)
+        self.spade = SPADE(cout)
+        self.conv2 = nn.Conv2d(cout, cout, 3, padding=1)
+        self.norm2 = nn.GroupNorm(groups, cout)
+        self.skip = nn.Conv2d(cin, cout, 1) if cin != cout else nn.Identity()
+
+    def forward(self, x, temb, feat):
+        """block 1: conv -> GroupNorm -> x(1+γ₁)+β₁ (time) -> x(1+γ₂)+β₂ (SPADE) -> SiLU; block 2 plain."""
+        g, b = self.time(F.silu(temb)).chunk(2, dim=1)
+        h = self.norm1(self.conv1(x)) * (1.0 + g[:, :, None, None]) + b[:, :, None, None]
+        h = F.silu(self.spade(h, feat))
+        h = F.silu(self.norm2(self.conv2(h)))
+        return h + self.skip(x)
+
+
+class UNet(nn.Module):
+    """ε-network; ``embed`` turns class-id and parameter maps into its conditioning grid."""
+
+    def __init__(self, n_classes: int, n_params: int, emb_dim: int = 32, widths=(32, 64, 128), feat: int = 128):
+        super().__init__()
+        self.n_classes, self.n_params, self.emb_dim, self.widths = n_classes, n_params, emb_dim, tuple(widths)
+        self.class_emb = nn.Embedding(n_classes, emb_dim)
+        nn.init.normal_(self.class_emb.weight)  # E|e|^2 = emb_dim: the spherical penalty's target norm
+        self.cond_mlp = nn.Sequential(nn.Conv2d(emb_dim + n_params, feat, 1), nn.GELU(),
+                                      nn.Conv2d(feat, feat, 1), nn.GELU(), nn.Conv2d(feat, feat, 1))
+        self.temb = TimeEmbedding(32, 128)
+        w = self.widths
+        self.init = nn.Conv2d(1, w[0], 3, padding=1)
+        self.down = nn.ModuleList()
+        self.downsample = nn.ModuleList()
+        c = w[0]
+        skips = []
+        for i, cw in enumerate(w):
+            blocks = nn.ModuleList([ResBlock(c, cw), ResBlock(cw, cw)])
+            self.down.append(blocks)
+            skips.append(cw)
+            c = cw
+            self.downsample.append(nn.Sequential(nn.PixelUnshuffle(2), nn.Conv2d(4 * c, c, 1)))
+        self.mid = nn.ModuleList([ResBlock(c, c), ResBlock(c, c)])
+        self.up = nn.ModuleList()
+        self.upsample = nn.ModuleList()
+        for cw in reversed(w):
+            self.upsample.append(nn.Conv2d(c, c, 3, padding=1))
+            self.up.append(nn.ModuleList([ResBlock(c + skips.pop(), cw), ResBlock(cw, cw)]))
+            c = cw
+        self.final = ResBlock(c + w[0], w[0])
+        self.out = nn.Conv2d(w[0], 1, 1)
+
+    def embed(self, class_ids: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
+        """class_ids int64 (B, H, W), params float32 (B, P, H, W) -> cond float32 (B, E + P, H, W)."""
+        e = self.class_emb(class_ids).permute(0, 3, 1, 2)
+        return torch.cat([e, params], 1)
+
+    def forward(self, x, t, cond):
+        feat = self.cond_mlp(cond)
+        temb = self.temb(t)
+        h = self.init(x)
+        h0 = h
+        skips = []
+        for blocks, down in zip(self.down, self.downsample):
+            for blk in blocks:
+                h = blk(h, temb, feat)
+            skips.append(h)
+            h = down(h)
+        for blk in self.mid:
+            h = blk(h, temb, feat)
+        for blocks, up in zip(self.up, self.upsample):
+            h = up(F.interpolate(h, scale_factor=2.0, mode="nearest"))
+            h = torch.cat([h, skips.pop()], 1)
+            for blk in blocks:
+                h = blk(h, temb, feat)
+        h = self.final(torch.cat([h, h0], 1), temb, feat)
+        return self.out(h)
+
+
+def set_circular(model: nn.Module, on: bool = True) -> nn.Module:
+    """Circular padding in every padded convolution: seamless, tileable output (never for training)."""
+    for m in model.modules():
+        if isinstance(m, nn.Conv2d) and m.padding != (0, 0):
+            m.padding_mode = "circular" if on else "zeros"
+    return model

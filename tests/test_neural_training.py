@@ -1,0 +1,156 @@
+"""Neural noise training parts: U-Net, schedule, sampler, loss, CutMix, resumable training."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from backend.neural.sampler import ddim_sample, ddim_step, initial_noise  # noqa: E402
+from backend.neural.schedule import cosine_alphas_cumprod, ddim_timesteps  # noqa: E402
+from backend.training import zoo  # noqa: E402
+from backend.training.cutmix import cutmix  # noqa: E402
+from backend.training.diffusion import Diffusion  # noqa: E402
+from backend.training.train import TrainConfig, train  # noqa: E402
+from backend.training.unet import UNet, set_circular  # noqa: E402
+
+TINY = dict(size=16, batch=4, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=2, sample_every=0,
+            classes=("perlin", "spots", "cells_f1"))
+
+
+def test_unet_size_and_shapes():
+    m = UNet(len(zoo.CLASS_NAMES), len(zoo.PARAM_NAMES))
+    n = sum(p.numel() for p in m.parameters())
+    assert 4.5e6 < n < 5.6e6, n  # the paper's ~5.1M (Appendix C)
+    small = UNet(3, 2, emb_dim=4, widths=(8, 16, 16))
+    x = torch.randn(2, 1, 24, 40)
+    cond = small.embed(torch.zeros(2, 24, 40, dtype=torch.long), torch.rand(2, 2, 24, 40))
+    assert cond.shape == (2, 6, 24, 40)
+    assert small(x, torch.tensor([3.0, 900.0]), cond).shape == (2, 1, 24, 40)
+
+
+def test_circular_padding_makes_the_network_wrap():
+    torch.manual_seed(0)
+    m = set_circular(UNet(3, 2, emb_dim=4, widths=(8, 16, 16)).eval())
+    x = torch.randn(1, 1, 32, 32)
+    cond = m.embed(torch.ones(1, 32, 32, dtype=torch.long), torch.full((1, 2, 32, 32), 0.3))
+    t = torch.tensor([100.0])
+    with torch.no_grad():
+        a = m(torch.roll(x, (8, 16), (2, 3)), t, cond)
+        b = torch.roll(m(x, t, cond), (8, 16), (2, 3))
+    assert torch.allclose(a, b, atol=1e-5)  # translation-equivariant on the torus: tiles seamlessly
+    set_circular(m, False)
+    with torch.no_grad():
+        assert not torch.allclose(m(torch.roll(x, (8, 16), (2, 3)), t, cond), torch.roll(m(x, t, cond), (8, 16), (2, 3)),
+                                  atol=1e-3)
+
+
+def test_cosine_schedule_golden_values():
+    ab = cosine_alphas_cumprod(1000)
+    f = lambda t: math.cos((t / 1000 + 0.008) / 1.008 * math.pi / 2) ** 2  # noqa: E731
+    for t in (0, 1, 250, 500, 900):
+        assert ab[t] == pytest.approx(f(t + 1) / f(0), rel=1e-9)
+    assert np.all(np.diff(ab) < 0) and ab[-1] < 1e-6
+    np.testing.assert_array_equal(ddim_timesteps(5), [999, 749, 500, 250, 0])
+    assert len(ddim_timesteps(30)) == 30 and ddim_timesteps(30)[0] == 999 and ddim_timesteps(30)[-1] == 0
+    with pytest.raises(ValueError):
+        ddim_timesteps(0)
+
+
+def test_ddim_recovers_data_of_an_exact_model_and_calls_back():
+    ab = cosine_alphas_cumprod()
+    data = np.linspace(-0.8, 0.8, 64, dtype=np.float32).reshape(1, 1, 8, 8)
+
+    def model(x, t, cond):  # the exact ε for a point-mass data distribution
+        a = ab[int(t[0])]
+        return (x - np.sqrt(a) * data) / np.sqrt(1 - a)
+
+    seen = []
+    out = ddim_sample(model, initial_noise(3, (1, 1, 8, 8)), None, steps=12, callback=lambda i, n, x0: seen.append(i))
+    np.testing.assert_allclose(out, data, atol=1e-5)
+    assert seen == list(range(12))
+    np.testing.assert_array_equal(initial_noise(3, (2, 2)), initial_noise(3, (2, 2)))
+
+    class Stop(Exception):
+        pass
+
+    def cancel(i, n, x0):
+        if i == 2:
+            raise Stop
+
+    with pytest.raises(Stop):
+        ddim_sample(model, initial_noise(3, (1, 1, 8, 8)), None, steps=12, callback=cancel)
+    x, x0 = ddim_step(np.ones((1, 1, 2, 2), np.float32), np.zeros((1, 1, 2, 2), np.float32), 0.25, 1.0)
+    np.testing.assert_allclose(x0, 1.0)  # clipped x̂₀ = 1 / √0.25 = 2 -> 1
+
+
+def test_loss_parts():
+    d = Diffusion()
+    x0 = torch.zeros(64, 1, 8, 8)
+    eps = d.noise_like(x0, torch.Generator().manual_seed(0))
+    per_image = eps.mean(dim=(1, 2, 3))
+    assert 0.05 < per_image.std() < 0.2  # offset noise: a shared shift of std 0.1 per image
+    t = torch.full((64,), 999)
+    assert d.q_sample(torch.ones(64, 1, 8, 8), t, torch.zeros_like(x0)).max() < 1e-3
+    e = torch.randn(5, 32)
+    e = e / e.norm(dim=1, keepdim=True) * math.sqrt(32)
+    assert d.embedding_penalty(e) < 1e-10
+    assert d.embedding_penalty(e * 2) == pytest.approx(0.02 * 32, rel=1e-4)
+
+
+def test_cutmix_pastes_other_classes_with_their_conditions():
+    B, H = 6, 32
+    imgs = torch.arange(B, dtype=torch.float32).view(B, 1, 1, 1).expand(B, 1, H, H).clone()
+    ids = torch.tensor([0, 0, 1, 1, 2, 2]).view(B, 1, 1).expand(B, H, H).clone()
+    params = (torch.arange(B, dtype=torch.float32) * 10).view(B, 1, 1, 1).expand(B, 2, H, H).clone()
+    mi, mid, mp = cutmix(imgs, ids, params, np.random.default_rng(1), p=1.0)
+    for b in range(B):
+        donors = mi[b, 0].unique().long().tolist()
+        assert len(donors) >= 2  # something was pasted
+        for d in donors:
+            m = mi[b, 0] == d
+            assert torch.all(mid[b][m] == ids[d, 0, 0]) and torch.all(mp[b][:, m] == 10 * d)
+            assert d == b or ids[d, 0, 0] != ids[b, 0, 0]  # donors are of another class
+    same = cutmix(imgs, ids, params, np.random.default_rng(1), p=0.0)
+    assert torch.equal(same[0], imgs) and torch.equal(same[1], ids)
+
+
+def test_training_overfits_a_fixed_batch():
+    torch.manual_seed(0)
+    m = UNet(3, 2, emb_dim=4, widths=(8, 16, 16))
+    d = Diffusion()
+    x0 = zoo.generate("spots", zoo.default_params("spots"), torch.arange(4), 16).unsqueeze(1) * 2 - 1
+    opt = torch.optim.AdamW(m.parameters(), lr=3e-3)
+    losses = []
+    for _ in range(60):
+        _, mse = d.loss(m, x0, m.embed(torch.zeros(4, 16, 16, dtype=torch.long), torch.zeros(4, 2, 16, 16)),
+                        torch.Generator().manual_seed(7))
+        opt.zero_grad()
+        mse.backward()
+        opt.step()
+        losses.append(float(mse.detach()))
+    assert losses[-1] < 0.5 * losses[0], (losses[0], losses[-1])
+
+
+def test_training_runs_logs_and_resumes_identically(tmp_path):
+    cfg = TrainConfig.from_dict(dict(TINY, steps=4))
+    train(cfg, str(tmp_path / "a"), max_steps=2, log=lambda s: None)
+    train(cfg, str(tmp_path / "a"), log=lambda s: None)
+    train(cfg, str(tmp_path / "b"), log=lambda s: None)
+    a = torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)
+    b = torch.load(tmp_path / "b" / "ckpt.pt", weights_only=False)
+    assert a["step"] == b["step"] == 4
+    for k in a["model"]:
+        assert torch.allclose(a["model"][k], b["model"][k], atol=1e-6), k
+    log = [json.loads(line) for line in (tmp_path / "b" / "log.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in log] == [1, 2, 3, 4] and all(np.isfinite(r["mse"]) for r in log)
+
+
+def test_config_errors():
+    with pytest.raises(ValueError, match="unknown config key 'lr_rate'"):
+        TrainConfig.from_dict({"lr_rate": 1})
+    with pytest.raises(ValueError, match="unknown class 'lava'"):
+        TrainConfig.from_dict({"classes": ["lava"]})
+    with pytest.raises(ValueError, match="multiple of 8"):
+        TrainConfig.from_dict({"size": 30})
