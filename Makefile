@@ -25,7 +25,7 @@ demo: $(STAMP)
 	$(BIN)/python demo/showcase_volume.py out/demo
 
 $(VENV)/.train: $(STAMP) requirements-train.txt
-	$(BIN)/python -m pip install -q -r requirements-train.txt
+	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt
 	@touch $@
 
 test: $(STAMP) $(VENV)/.train

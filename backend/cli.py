@@ -97,6 +97,23 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
     b.add_argument("--quiet", action="store_true")
 
+    n = sub.add_parser("neural", help="neural noise (Maesumi et al. 2024) from the trained ONNX model")
+    n.add_argument("--noise", help="class name (see --list)")
+    n.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
+    n.add_argument("--size", type=int, default=256, help="output side in pixels")
+    n.add_argument("--steps", type=int, default=30, help="DDIM steps")
+    n.add_argument("--seed", type=int, default=0)
+    n.add_argument("--tileable", action="store_true", help="seamless tile (circular padding); size a multiple of 8")
+    n.add_argument("--blend", metavar="MASK", help="grayscale mask image: white areas take --noise2 / --param2")
+    n.add_argument("--noise2", help="class of the masked area (default: --noise)")
+    n.add_argument("--param2", action="append", default=[], metavar="NAME=VALUE")
+    n.add_argument("--width", type=float, default=32.0, help="blend transition width, px")
+    n.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1 = linear)")
+    n.add_argument("--model", help="model folder (default: models/neural_noise beside the package)")
+    n.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
+    n.add_argument("--quiet", action="store_true")
+    n.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+
     z = sub.add_parser("zoo", help="ground-truth images of the neural noise training zoo (needs torch)")
     z.add_argument("--noise", help="class name (see --list)")
     z.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
@@ -238,6 +255,72 @@ def run_bake_job(a: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+DEFAULT_MODEL = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "neural_noise")
+
+
+def _param_items(items: list, flag: str) -> dict:
+    out = {}
+    for item in items:
+        key, sep, val = item.partition("=")
+        try:
+            out[key] = float(val)
+        except ValueError:
+            raise SettingError(flag, f"expected NAME=VALUE with a number, got {item!r}") from None
+        if not sep:
+            raise SettingError(flag, f"expected NAME=VALUE, got {item!r}")
+    return out
+
+
+def run_neural(a: argparse.Namespace) -> int:
+    import json
+
+    from .neural import conditioning
+    from .neural.generate import generate
+    from .neural.model import ModelError, NeuralNoiseModel
+
+    folder = a.model or DEFAULT_MODEL
+    try:
+        model = NeuralNoiseModel(folder)
+    except ModelError as exc:
+        raise SettingError("--model", f"{exc}; train and export one (see models/README.md) or pass --model") from None
+    if a.list:
+        print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))
+        return 0
+    if not a.noise or not a.out:
+        raise SettingError("neural", "give --noise CLASS and -o OUT (or --list)")
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    spec = (a.noise, _param_items(a.param, "--param"))
+    if a.blend:
+        from export.images import read_image
+
+        if not os.path.isfile(a.blend):
+            raise SettingError("--blend", f"mask not found: {a.blend}")
+        mask = read_image(a.blend)
+        if mask.shape != (a.size, a.size):
+            raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
+        spec2 = (a.noise2 or a.noise, _param_items(a.param2, "--param2"))
+        cond = conditioning.blend(model, spec, spec2, conditioning.mask_weight(mask > 0.5, a.width, a.sharpness))
+    else:
+        if a.noise2 or a.param2:
+            raise SettingError("--noise2", "a second noise needs --blend MASK")
+        cond = conditioning.uniform(model, spec, a.size, a.size)
+    bar = _Bar(a.quiet)
+    img = generate(model, cond, a.seed, a.steps, a.tileable, callback=lambda i, n, x0: bar((i + 1) / n))
+    if ext == ".png":
+        from export.images import write_png
+
+        write_png(a.out, (img * 255.0 + 0.5).astype(np.uint8))
+    else:
+        from export.images import write_image
+
+        write_image(a.out, img)
+    return 0
+
+
 def run_zoo(a: argparse.Namespace) -> int:
     import json
 
@@ -301,6 +384,8 @@ def main(argv: list[str] | None = None) -> int:
             return run_transfer(a)
         if a.command == "zoo":
             return run_zoo(a)
+        if a.command == "neural":
+            return run_neural(a)
     except (SettingError, FileNotFoundError, PermissionError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2

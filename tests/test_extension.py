@@ -32,7 +32,8 @@ def test_zip_holds_runtime_files_only(built_zip):
 
 def test_runtime_never_imports_torch():
     """What the add-on imports (backend, bakes, jobs, export) stays free of torch."""
-    code = ("import sys, backend, backend.bake, backend.jobs, backend.sources, export, export.vdb; "
+    code = ("import sys, backend, backend.bake, backend.jobs, backend.sources, export, export.vdb, "
+            "backend.neural.model, backend.neural.conditioning, backend.neural.generate, backend.neural.sampler; "
             "print('torch' in sys.modules)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0 and r.stdout.strip() == "False", r.stderr

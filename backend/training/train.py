@@ -170,7 +170,7 @@ def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -
         step += 1
         losses.append(float(mse.detach()))
         if step % cfg.log_every == 0 or step == end:
-            last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss), seconds=round(time.time() - t0, 2),
+            last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss.detach()), seconds=round(time.time() - t0, 2),
                         emb_norm=float(model.class_emb.weight.norm(dim=1).mean()))
             losses = []
             with open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8") as fh:

@@ -1,0 +1,110 @@
+"""The exported neural noise model, run by onnxruntime (no torch).
+
+A model folder holds ``eps.onnx``, ``eps_tile.onnx`` and ``neural_noise.json``
+(see ``backend/training/export_onnx.py``).  Loading checks each .onnx file's
+sha256 against the JSON before onnxruntime sees it; sessions are created on
+first use.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+
+import numpy as np
+
+from ..errors import SettingError
+
+__all__ = ["NeuralNoiseModel", "ModelError"]
+
+_F = np.float32
+
+
+class ModelError(RuntimeError):
+    """A model folder is missing, incomplete or altered."""
+
+
+def _sha256(path: str) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+class NeuralNoiseModel:
+    """ε-network plus what the sampler and the conditioning need.
+
+    classes      class names (index = class id)
+    params       names of the shared parameter vector
+    embedding    float32 (n_classes, E) class embeddings
+    """
+
+    def __init__(self, folder: str, threads: int = 0):
+        cfg_path = os.path.join(folder, "neural_noise.json")
+        if not os.path.isfile(cfg_path):
+            raise ModelError(f"no neural_noise.json in {folder}")
+        with open(cfg_path, encoding="utf-8") as fh:
+            self.config = json.load(fh)
+        self.folder = folder
+        for name, digest in self.config["files"].items():
+            path = os.path.join(folder, name)
+            if not os.path.isfile(path):
+                raise ModelError(f"model file missing: {path}")
+            if _sha256(path) != digest:
+                raise ModelError(f"{name}: sha256 does not match neural_noise.json (altered or damaged file)")
+        self.classes = tuple(self.config["classes"])
+        self.params = tuple(self.config["params"])
+        self.class_params = self.config["class_params"]
+        self.embedding = np.asarray(self.config["class_embedding"], _F)
+        self.multiple_of = int(self.config.get("multiple_of", 8))
+        self.threads = threads
+        self._sessions = {}
+
+    def session(self, tileable: bool):
+        key = "eps_tile.onnx" if tileable else "eps.onnx"
+        if key not in self._sessions:
+            import onnxruntime as ort
+
+            opts = ort.SessionOptions()
+            if self.threads:
+                opts.intra_op_num_threads = self.threads
+            self._sessions[key] = ort.InferenceSession(os.path.join(self.folder, key), opts,
+                                                       providers=["CPUExecutionProvider"])
+        return self._sessions[key]
+
+    def eps_fn(self, tileable: bool = False):
+        """model(x, t, cond) -> ε callable for :func:`backend.neural.sampler.ddim_sample`."""
+        sess = self.session(tileable)
+
+        def eps(x, t, cond):
+            return sess.run(None, {"x": np.ascontiguousarray(x, _F), "t": np.ascontiguousarray(t, _F),
+                                   "cond": np.ascontiguousarray(cond, _F)})[0]
+
+        return eps
+
+    # -- classes and parameters -----------------------------------------------------------
+    def class_id(self, name: str) -> int:
+        if name not in self.classes:
+            raise SettingError("noise", f"unknown class {name!r}; choose one of {', '.join(self.classes)}")
+        return self.classes.index(name)
+
+    def param_vector(self, name: str, values: dict | None = None) -> np.ndarray:
+        """Physical parameter values of class ``name`` -> float32 (P,) normalised vector (zeros elsewhere).
+
+        Missing parameters take the middle of their range; unknown names or values
+        outside the range raise SettingError naming them.
+        """
+        self.class_id(name)
+        spec = {p["name"]: p for p in self.class_params[name]["params"]}
+        values = dict(values or {})
+        unknown = sorted(set(values) - set(spec))
+        if unknown:
+            raise SettingError("param", f"{name} has no parameter {unknown[0]!r}; it has {', '.join(spec)}")
+        vec = np.zeros(len(self.params), _F)
+        for pname, p in spec.items():
+            v = float(values.get(pname, 0.5 * (p["min"] + p["max"])))
+            if not p["min"] <= v <= p["max"]:
+                raise SettingError("param", f"{pname}={v:g} is outside [{p['min']:g}, {p['max']:g}] ({p['unit']})")
+            vec[self.params.index(pname)] = (v - p["min"]) / (p["max"] - p["min"])
+        return vec

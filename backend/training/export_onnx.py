@@ -1,0 +1,95 @@
+"""Export a trained ε-network to ONNX for the runtime: ``python -m backend.training.export_onnx RUN OUT_DIR``.
+
+Writes, each atomically:
+
+    OUT_DIR/eps.onnx           zero padding (inputs x, t, cond -> eps; batch, height, width dynamic)
+    OUT_DIR/eps_tile.onnx      circular padding: seamless, tileable output
+    OUT_DIR/neural_noise.json  schedule, class and parameter names and ranges, the class-embedding
+                               table, the training config and step, and the sha256 of both .onnx
+                               files (the runtime refuses files whose hash differs)
+
+The EMA weights are exported (``--raw`` for the optimiser's weights).
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import sys
+
+import torch
+
+from . import zoo
+from .train import TrainConfig, build_model
+from .unet import set_circular
+
+__all__ = ["export"]
+
+FORMAT = 1
+
+
+def _sha256(path: str) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _export_one(model, path: str, size: int) -> None:
+    C = model.emb_dim + model.n_params
+    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), torch.randn(1, C, size, size))
+    tmp = path + ".tmp"
+    torch.onnx.export(model, args, tmp, input_names=["x", "t", "cond"], output_names=["eps"],
+                      dynamic_axes={"x": {0: "batch", 2: "height", 3: "width"}, "t": {0: "batch"},
+                                    "cond": {0: "batch", 2: "height", 3: "width"}, "eps": {0: "batch", 2: "height", 3: "width"}},
+                      opset_version=17, dynamo=False)
+    os.replace(tmp, path)
+
+
+def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> dict:
+    """Export checkpoint ``run/ckpt.pt`` into folder ``out``; returns the JSON config written."""
+    state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
+    cfg = TrainConfig.from_dict(state["config"])
+    model = build_model(cfg)
+    model.load_state_dict(state["model" if raw else "ema"])
+    model.eval()
+    os.makedirs(out, exist_ok=True)
+    files = {}
+    for name, circular in (("eps.onnx", False), ("eps_tile.onnx", True)):
+        set_circular(model, circular)
+        _export_one(model, os.path.join(out, name), cfg.size)
+        files[name] = _sha256(os.path.join(out, name))
+    set_circular(model, False)
+    doc = dict(format=FORMAT, model="neural_noise", paper="Maesumi et al. 2024, One Noise to Rule Them All",
+               schedule=dict(kind="cosine", T=1000, s=0.008), prediction="epsilon",
+               classes=list(zoo.CLASS_NAMES), trained_classes=list(cfg.classes), params=list(zoo.PARAM_NAMES),
+               class_params=zoo.describe(), emb_dim=cfg.emb_dim,
+               class_embedding=model.class_emb.weight.detach().numpy().astype(float).round(7).tolist(),
+               train_size=cfg.size, step=int(state["step"]), weights="raw" if raw else "ema",
+               config=state["config"], files=files, multiple_of=8)
+    doc.update(extra or {})
+    path = os.path.join(out, "neural_noise.json")
+    with open(path + ".tmp", "w", encoding="utf-8") as fh:
+        json.dump(doc, fh, indent=1)
+    os.replace(path + ".tmp", path)
+    return doc
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m backend.training.export_onnx", description=__doc__.split("\n")[0])
+    ap.add_argument("run", help="training run folder (holds ckpt.pt)")
+    ap.add_argument("out", help="output folder for eps.onnx, eps_tile.onnx, neural_noise.json")
+    ap.add_argument("--raw", action="store_true", help="export the raw weights instead of the EMA")
+    a = ap.parse_args(argv)
+    if not os.path.isfile(os.path.join(a.run, "ckpt.pt")):
+        print(f"export: error: no checkpoint in {a.run}", file=sys.stderr)
+        return 2
+    doc = export(a.run, a.out, a.raw)
+    print(json.dumps(doc["files"], indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

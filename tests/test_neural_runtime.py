@@ -1,0 +1,182 @@
+"""Neural noise runtime: ONNX export vs torch, hash check, DDIM, conditioning grids, any size, tiling, CLI."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+pytest.importorskip("onnx")
+
+from backend.cli import main  # noqa: E402
+from backend.errors import SettingError  # noqa: E402
+from backend.neural import conditioning as C  # noqa: E402
+from backend.neural.generate import generate  # noqa: E402
+from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from backend.neural.sampler import ddim_sample, initial_noise  # noqa: E402
+from backend.training.export_onnx import export  # noqa: E402
+from backend.training.train import TrainConfig, build_model, train  # noqa: E402
+from backend.training.unet import set_circular  # noqa: E402
+
+TINY = dict(size=16, batch=4, steps=3, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=3, sample_every=0,
+            classes=("perlin", "spots", "cells_f1"))
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    run = tmp_path_factory.mktemp("run")
+    out = tmp_path_factory.mktemp("model")
+    train(TrainConfig.from_dict(TINY), str(run), log=lambda s: None)
+    export(str(run), str(out))
+    return run, out
+
+
+def _torch_model(run, circular=False):
+    state = torch.load(os.path.join(run, "ckpt.pt"), weights_only=False)
+    m = build_model(TrainConfig.from_dict(state["config"]))
+    m.load_state_dict(state["ema"])
+    return set_circular(m.eval(), circular)
+
+
+def test_onnx_matches_torch(exported):
+    run, out = exported
+    model = NeuralNoiseModel(str(out))
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal((2, 1, 24, 40)).astype(np.float32)
+    t = np.array([10.0, 700.0], np.float32)
+    cond = rng.standard_normal((2, model.embedding.shape[1] + len(model.params), 24, 40)).astype(np.float32)
+    for circular in (False, True):
+        ref = _torch_model(run, circular)(torch.from_numpy(x), torch.from_numpy(t), torch.from_numpy(cond))
+        got = model.eps_fn(circular)(x, t, cond)
+        np.testing.assert_allclose(got, ref.detach().numpy(), atol=1e-4)
+    tm = _torch_model(run)
+    np.testing.assert_allclose(model.embedding, tm.class_emb.weight.detach().numpy(), atol=1e-6)
+
+
+def test_hash_is_checked(exported, tmp_path):
+    _, out = exported
+    for f in os.listdir(out):
+        (tmp_path / f).write_bytes((out / f).read_bytes())
+    with open(tmp_path / "eps.onnx", "ab") as fh:
+        fh.write(b"\0")
+    with pytest.raises(ModelError, match="sha256 does not match"):
+        NeuralNoiseModel(str(tmp_path))
+    (tmp_path / "eps.onnx").write_bytes((out / "eps.onnx").read_bytes())
+    NeuralNoiseModel(str(tmp_path))  # restored: loads again
+    os.remove(tmp_path / "eps_tile.onnx")
+    with pytest.raises(ModelError, match="missing"):
+        NeuralNoiseModel(str(tmp_path))
+
+
+def test_generate_any_size_seeded_and_sampler_equals_torch(exported):
+    run, out = exported
+    model = NeuralNoiseModel(str(out))
+    cond = C.uniform(model, ("spots", {"coverage": 0.4}), 20, 36)
+    a = generate(model, cond, seed=5, steps=4)
+    assert a.shape == (20, 36) and a.dtype == np.float32 and 0 <= a.min() and a.max() <= 1
+    np.testing.assert_array_equal(a, generate(model, cond, seed=5, steps=4))
+    assert np.abs(a - generate(model, cond, seed=6, steps=4)).mean() > 1e-3
+    tm = _torch_model(run)
+    cond16 = C.uniform(model, ("perlin", {}), 16, 16)[None]
+
+    def torch_eps(x, t, c):
+        with torch.no_grad():
+            return tm(torch.from_numpy(x), torch.from_numpy(t), torch.from_numpy(c)).numpy()
+
+    xT = initial_noise(1, (1, 1, 16, 16))
+    np.testing.assert_allclose(ddim_sample(model.eps_fn(), xT, cond16, steps=5),
+                               ddim_sample(torch_eps, xT, cond16, steps=5), atol=1e-3)
+    with pytest.raises(SettingError, match="multiples of 8"):
+        generate(model, cond, tileable=True)
+
+
+def test_tileable_sampling_wraps(exported):
+    _, out = exported
+    model = NeuralNoiseModel(str(out))
+    cond = C.uniform(model, ("cells_f1", {}), 32, 32)[None]
+    xT = initial_noise(2, (1, 1, 32, 32))
+    a = ddim_sample(model.eps_fn(True), np.roll(xT, (8, 16), (2, 3)), cond, steps=3)
+    b = np.roll(ddim_sample(model.eps_fn(True), xT, cond, steps=3), (8, 16), (2, 3))
+    np.testing.assert_allclose(a, b, atol=1e-4)  # the image lives on a torus: it tiles without a seam
+
+
+def test_conditioning_grids(exported):
+    _, out = exported
+    model = NeuralNoiseModel(str(out))
+    E, P = model.embedding.shape[1], len(model.params)
+    a, b = ("spots", {"coverage": 0.3}), ("perlin", {"scale": 12})
+    ua, ub = C.uniform(model, a, 8, 8), C.uniform(model, b, 8, 8)
+    np.testing.assert_allclose(C.blend(model, a, b, np.zeros((8, 8))), ua, atol=1e-6)
+    np.testing.assert_allclose(C.blend(model, a, b, np.ones((8, 8))), ub, atol=1e-6)
+    mid = C.blend(model, a, b, np.full((8, 8), 0.5))[:E, 0, 0]
+    ea, eb = model.embedding[model.class_id("spots")], model.embedding[model.class_id("perlin")]
+    assert np.linalg.norm(mid) > 0.98 * np.linalg.norm(0.5 * (ea + eb))
+    same = C.slerp(ea, ea, np.array([0.3, 0.7]))
+    assert np.isfinite(same).all() and np.allclose(same, ea)  # slerp of a class with itself is safe
+    u = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    np.testing.assert_allclose(np.linalg.norm(C.slerp(*u, np.linspace(0, 1, 7)), axis=1), 1.0, atol=1e-6)
+    g4 = C.four_corner(model, [a, b, ("cells_f1", {}), a], 9, 11)
+    np.testing.assert_allclose(g4[:, 0, 0], ua[:, 0, 0], atol=1e-5)
+    np.testing.assert_allclose(g4[:, 0, -1], ub[:, 0, 0], atol=1e-5)
+    assert g4.shape == (E + P, 9, 11)
+    with pytest.raises(SettingError, match="no parameter 'size'"):
+        C.uniform(model, ("spots", {"size": 1}), 4, 4)
+    with pytest.raises(SettingError, match="unknown class 'lava'"):
+        C.uniform(model, ("lava", {}), 4, 4)
+
+
+def test_distance_transform_and_mask_weights():
+    rng = np.random.default_rng(3)
+    m = rng.random((23, 31)) < 0.03
+    d = C.distance_transform(m)
+    ys, xs = np.nonzero(m)
+    yy, xx = np.mgrid[:23, :31]
+    brute = np.sqrt(((yy[..., None] - ys) ** 2 + (xx[..., None] - xs) ** 2).min(-1))
+    np.testing.assert_allclose(d, brute, atol=1e-5)
+    half = np.zeros((16, 64), bool)
+    half[:, 32:] = True
+    soft, hard = C.mask_weight(half, 24, 1.0), C.mask_weight(half, 24, 4.0)
+    assert np.all(np.diff(soft[0]) >= -1e-7) and soft[0, 0] == 0 and soft[0, -1] == 1
+    assert abs(hard[0, 28] - 0.5) > abs(soft[0, 28] - 0.5)  # a larger exponent is a harder edge
+
+
+def test_painted_maps(exported):
+    _, out = exported
+    model = NeuralNoiseModel(str(out))
+    img = np.zeros((16, 24, 3), np.uint8)
+    img[:, 12:] = (255, 0, 0)
+    g = C.painted(model, img, {(0, 0, 0): ("spots", {}), (255, 0, 0): ("perlin", {})}, width=4)
+    np.testing.assert_allclose(g[:, 0, 0], C.uniform(model, ("spots", {}), 1, 1)[:, 0, 0], atol=1e-5)
+    np.testing.assert_allclose(g[:, 0, -1], C.uniform(model, ("perlin", {}), 1, 1)[:, 0, 0], atol=1e-5)
+    with pytest.raises(SettingError, match=r"uses \(255, 0, 0\) but no spec"):
+        C.painted(model, img, {(0, 0, 0): ("spots", {})})
+    idx = np.zeros((8, 8), int)
+    idx[4:] = 3
+    assert C.painted(model, idx, {0: ("spots", {}), 3: ("cells_f1", {})}).shape[1:] == (8, 8)
+
+
+def test_neural_cli(exported, tmp_path, capsys):
+    _, out = exported
+    png = str(tmp_path / "n.png")
+    base = ["neural", "--model", str(out), "--quiet", "--steps", "3"]
+    assert main(base + ["--noise", "spots", "--param", "coverage=0.5", "--size", "24", "-o", png]) == 0
+    assert main(base + ["--noise", "spots", "--size", "32", "--tileable", "-o", str(tmp_path / "t.npy")]) == 0
+    assert np.load(tmp_path / "t.npy").shape == (32, 32)
+    mask = np.zeros((32, 32), np.uint8)
+    mask[:, 16:] = 255
+    from export.images import write_png
+
+    write_png(str(tmp_path / "m.png"), mask)
+    assert main(base + ["--noise", "spots", "--noise2", "perlin", "--param2", "scale=10", "--blend",
+                        str(tmp_path / "m.png"), "--size", "32", "-o", png]) == 0
+    assert main(base + ["--list"]) == 0
+    assert "spots" in json.loads(capsys.readouterr().out)["classes"]
+    for args, msg in [(["--noise", "lava", "-o", png], "unknown class 'lava'"),
+                      (["--noise", "spots", "--param", "coverage=9", "-o", png], "outside [0.2, 0.8]"),
+                      (["--noise", "spots", "--blend", str(tmp_path / "m.png"), "--size", "16", "-o", png],
+                       "mask is 32x32 but --size is 16"),
+                      (["--noise", "spots", "--noise2", "perlin", "-o", png], "needs --blend")]:
+        assert main(base + args) == 2
+        assert msg in capsys.readouterr().err
+    assert main(["neural", "--model", str(tmp_path / "none"), "--noise", "spots", "-o", png]) == 2
+    assert "no neural_noise.json" in capsys.readouterr().err
