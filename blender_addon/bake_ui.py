@@ -162,11 +162,10 @@ def _message(text: str) -> None:
     print(f"OmniNoise: {text}")
 
 
-class _BakeOperator:
-    bl_options = {"REGISTER"}
-    target = "VOLUME"
+class _TaskOperator:
+    """An operator whose work is a :mod:`.tasks` Task: modal with Esc in the UI, blocking in scripts."""
 
-    blocking: BoolProperty(name="Blocking", description="Wait for the bake (scripts)", default=False,
+    blocking: BoolProperty(name="Blocking", description="Wait for the work to finish (scripts)", default=False,
                            options={"SKIP_SAVE", "HIDDEN"})
 
     @classmethod
@@ -174,36 +173,8 @@ class _BakeOperator:
         return tasks.current() is None
 
     def _start(self, context, blocking: bool):
-        try:
-            spec = build_spec(context, self.target)
-        except (backend.SettingError, OSError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
-        target, obj = self.target, context.active_object
-        raw = spec.transfer is None
-        mat = None
-        if target == "IMAGE" and obj is not None and obj.active_material is not None \
-                and obj.active_material.node_tree is not None:
-            mat = obj.active_material
-
-        def work(progress, cancel):
-            return backend.bake.run_bake(spec, progress, cancel)
-
-        def done(result):
-            paths = [backend.bake.frame_path(spec.output, f) for f in spec.frame_list()]
-            if target == "VOLUME":
-                temp = spec.transfer is not None and spec.transfer.has_temperature
-                load_volume(spec.name, paths, spec.frames, temp)
-            else:
-                load_image(spec.name, paths, spec.frames, raw, mat)
-            _message(f"{spec.name}: {len(result.written)} written, {len(result.skipped)} up to date "
-                     f"({spec.output})")
-
-        def failed(msg):
-            _message(f"{spec.name} failed: {msg}")
-
-        task = tasks.Task(f"Baking {spec.name}", work, done, failed, threads=threads())
-        return tasks.start(task, blocking=blocking)
+        """Start the task (None after reporting why it could not start)."""
+        raise NotImplementedError
 
     def execute(self, context):
         task = self._start(context, blocking=True)
@@ -237,6 +208,43 @@ class _BakeOperator:
         return {"PASS_THROUGH"}
 
 
+class _BakeOperator(_TaskOperator):
+    bl_options = {"REGISTER"}
+    target = "VOLUME"
+
+    def _start(self, context, blocking: bool):
+        try:
+            spec = build_spec(context, self.target)
+        except (backend.SettingError, OSError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        target, obj = self.target, context.active_object
+        raw = spec.transfer is None
+        mat = None
+        if target == "IMAGE" and obj is not None and obj.active_material is not None \
+                and obj.active_material.node_tree is not None:
+            mat = obj.active_material
+
+        def work(progress, cancel):
+            return backend.bake.run_bake(spec, progress, cancel)
+
+        def done(result):
+            paths = [backend.bake.frame_path(spec.output, f) for f in spec.frame_list()]
+            if target == "VOLUME":
+                temp = spec.transfer is not None and spec.transfer.has_temperature
+                load_volume(spec.name, paths, spec.frames, temp)
+            else:
+                load_image(spec.name, paths, spec.frames, raw, mat)
+            _message(f"{spec.name}: {len(result.written)} written, {len(result.skipped)} up to date "
+                     f"({spec.output})")
+
+        def failed(msg):
+            _message(f"{spec.name} failed: {msg}")
+
+        task = tasks.Task(f"Baking {spec.name}", work, done, failed, threads=threads())
+        return tasks.start(task, blocking=blocking)
+
+
 class OMNINOISE_OT_bake_volume(_BakeOperator, bpy.types.Operator):
     """Bake noise through the ramp into an OpenVDB volume and add it as a Volume object"""
 
@@ -268,7 +276,7 @@ class OMNINOISE_OT_cancel(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class OMNINOISE_OT_run_job(bpy.types.Operator):
+class OMNINOISE_OT_run_job(_TaskOperator, bpy.types.Operator):
     """Run the bakes of a TOML job file (the same as `omninoise bake JOB.toml`)"""
 
     bl_idname = "omninoise.run_job"
@@ -277,11 +285,6 @@ class OMNINOISE_OT_run_job(bpy.types.Operator):
     filepath: StringProperty(name="Job File", subtype="FILE_PATH", default="")
     keep_going: BoolProperty(name="Keep Going", default=False)
     force: BoolProperty(name="Force", default=False)
-    blocking: BoolProperty(default=False, options={"SKIP_SAVE", "HIDDEN"})
-
-    @classmethod
-    def poll(cls, context):
-        return tasks.current() is None
 
     def _start(self, context, blocking):
         p = context.scene.omninoise_bake
@@ -306,30 +309,6 @@ class OMNINOISE_OT_run_job(bpy.types.Operator):
 
         return tasks.start(tasks.Task(f"Job {os.path.basename(path)}", work, done, _message, threads()),
                            blocking=blocking)
-
-    def execute(self, context):
-        try:
-            task = self._start(context, blocking=True)
-        except backend.jobs.JobError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        if task is None:
-            return {"CANCELLED"}
-        if task.status != "done":
-            self.report({"ERROR"}, task.message or task.status)
-            return {"CANCELLED"}
-        return {"FINISHED"}
-
-    def invoke(self, context, event):
-        if self.blocking or bpy.app.background:
-            return self.execute(context)
-        self._task = self._start(context, blocking=False)
-        if self._task is None:
-            return {"CANCELLED"}
-        context.window_manager.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
-
-    modal = _BakeOperator.modal
 
 
 # -- panels ----------------------------------------------------------------------------

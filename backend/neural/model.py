@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import SettingError
 
-__all__ = ["NeuralNoiseModel", "ModelError"]
+__all__ = ["NeuralNoiseModel", "ModelError", "sha256_file"]
 
 _F = np.float32
 
@@ -24,7 +24,8 @@ class ModelError(RuntimeError):
     """A model folder is missing, incomplete or altered."""
 
 
-def _sha256(path: str) -> str:
+def sha256_file(path: str) -> str:
+    """Hex sha256 of a file, read in 1 MiB blocks."""
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -51,7 +52,7 @@ class NeuralNoiseModel:
             path = os.path.join(folder, name)
             if not os.path.isfile(path):
                 raise ModelError(f"model file missing: {path}")
-            if _sha256(path) != digest:
+            if sha256_file(path) != digest:
                 raise ModelError(f"{name}: sha256 does not match neural_noise.json (altered or damaged file)")
         self.classes = tuple(self.config["classes"])
         self.params = tuple(self.config["params"])

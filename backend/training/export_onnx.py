@@ -13,13 +13,13 @@ The EMA weights are exported (``--raw`` for the optimiser's weights).
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import os
 import sys
 
 import torch
 
+from ..neural.model import sha256_file
 from . import zoo
 from .train import TrainConfig, build_model
 from .unet import set_circular
@@ -27,14 +27,6 @@ from .unet import set_circular
 __all__ = ["export"]
 
 FORMAT = 1
-
-
-def _sha256(path: str) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _export_one(model, path: str, size: int) -> None:
@@ -60,7 +52,7 @@ def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> 
     for name, circular in (("eps.onnx", False), ("eps_tile.onnx", True)):
         set_circular(model, circular)
         _export_one(model, os.path.join(out, name), cfg.size)
-        files[name] = _sha256(os.path.join(out, name))
+        files[name] = sha256_file(os.path.join(out, name))
     set_circular(model, False)
     doc = dict(format=FORMAT, model="neural_noise", paper="Maesumi et al. 2024, One Noise to Rule Them All",
                schedule=dict(kind="cosine", T=1000, s=0.008), prediction="epsilon",
