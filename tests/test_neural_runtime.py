@@ -63,7 +63,7 @@ def test_hash_is_checked(exported, tmp_path):
         NeuralNoiseModel(str(tmp_path))
     (tmp_path / "eps.onnx").write_bytes((out / "eps.onnx").read_bytes())
     NeuralNoiseModel(str(tmp_path))  # restored: loads again
-    os.remove(tmp_path / "eps_tile.onnx")
+    os.remove(tmp_path / "eps.onnx")
     with pytest.raises(ModelError, match="missing"):
         NeuralNoiseModel(str(tmp_path))
 

@@ -1,9 +1,10 @@
 """The exported neural noise model, run by onnxruntime (no torch).
 
-A model folder holds ``eps.onnx``, ``eps_tile.onnx`` and ``neural_noise.json``
-(see ``backend/training/export_onnx.py``).  Loading checks each .onnx file's
-sha256 against the JSON before onnxruntime sees it; sessions are created on
-first use.
+A model folder holds ``eps.onnx`` and ``neural_noise.json`` (see
+``backend/training/export_onnx.py``).  Loading checks the .onnx file's sha256
+against the JSON before onnxruntime sees it; the session is created on first
+use.  The graph's ``tile`` input switches every convolution between zero and
+circular padding (seamless tiles).
 """
 from __future__ import annotations
 
@@ -62,8 +63,8 @@ class NeuralNoiseModel:
         self.threads = threads
         self._sessions = {}
 
-    def session(self, tileable: bool):
-        key = "eps_tile.onnx" if tileable else "eps.onnx"
+    def session(self):
+        key = "eps.onnx"
         if key not in self._sessions:
             import onnxruntime as ort
 
@@ -76,11 +77,12 @@ class NeuralNoiseModel:
 
     def eps_fn(self, tileable: bool = False):
         """model(x, t, cond) -> ε callable for :func:`backend.neural.sampler.ddim_sample`."""
-        sess = self.session(tileable)
+        sess = self.session()
+        tile = np.array([1.0 if tileable else 0.0], _F)
 
         def eps(x, t, cond):
             return sess.run(None, {"x": np.ascontiguousarray(x, _F), "t": np.ascontiguousarray(t, _F),
-                                   "cond": np.ascontiguousarray(cond, _F)})[0]
+                                   "cond": np.ascontiguousarray(cond, _F), "tile": tile})[0]
 
         return eps
 

@@ -2,11 +2,12 @@
 
 Writes, each atomically:
 
-    OUT_DIR/eps.onnx           zero padding (inputs x, t, cond -> eps; batch, height, width dynamic)
-    OUT_DIR/eps_tile.onnx      circular padding: seamless, tileable output
+    OUT_DIR/eps.onnx           inputs x, t, cond, tile -> eps (batch, height, width dynamic);
+                               tile = [0.0] zero padding, [1.0] circular padding (seamless tiles),
+                               one graph for both so the weights ship once
     OUT_DIR/neural_noise.json  schedule, class and parameter names and ranges, the class-embedding
-                               table, the training config and step, and the sha256 of both .onnx
-                               files (the runtime refuses files whose hash differs)
+                               table, the training config and step, and the .onnx file's sha256
+                               (the runtime refuses a file whose hash differs)
 
 The EMA weights are exported (``--raw`` for the optimiser's weights).
 """
@@ -22,7 +23,6 @@ import torch
 from ..neural.model import sha256_file
 from . import zoo
 from .train import TrainConfig, build_model
-from .unet import set_circular
 
 __all__ = ["export"]
 
@@ -31,9 +31,9 @@ FORMAT = 1
 
 def _export_one(model, path: str, size: int) -> None:
     C = model.emb_dim + model.n_params
-    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), torch.randn(1, C, size, size))
+    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), torch.randn(1, C, size, size), torch.zeros(1))
     tmp = path + ".tmp"
-    torch.onnx.export(model, args, tmp, input_names=["x", "t", "cond"], output_names=["eps"],
+    torch.onnx.export(model, args, tmp, input_names=["x", "t", "cond", "tile"], output_names=["eps"],
                       dynamic_axes={"x": {0: "batch", 2: "height", 3: "width"}, "t": {0: "batch"},
                                     "cond": {0: "batch", 2: "height", 3: "width"}, "eps": {0: "batch", 2: "height", 3: "width"}},
                       opset_version=17, dynamo=False)
@@ -48,12 +48,8 @@ def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> 
     model.load_state_dict(state["model" if raw else "ema"])
     model.eval()
     os.makedirs(out, exist_ok=True)
-    files = {}
-    for name, circular in (("eps.onnx", False), ("eps_tile.onnx", True)):
-        set_circular(model, circular)
-        _export_one(model, os.path.join(out, name), cfg.size)
-        files[name] = sha256_file(os.path.join(out, name))
-    set_circular(model, False)
+    _export_one(model, os.path.join(out, "eps.onnx"), cfg.size)
+    files = {"eps.onnx": sha256_file(os.path.join(out, "eps.onnx"))}
     doc = dict(format=FORMAT, model="neural_noise", paper="Maesumi et al. 2024, One Noise to Rule Them All",
                schedule=dict(kind="cosine", T=1000, s=0.008), prediction="epsilon",
                classes=list(zoo.CLASS_NAMES), trained_classes=list(cfg.classes), params=list(zoo.PARAM_NAMES),
@@ -72,7 +68,7 @@ def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m backend.training.export_onnx", description=__doc__.split("\n")[0])
     ap.add_argument("run", help="training run folder (holds ckpt.pt)")
-    ap.add_argument("out", help="output folder for eps.onnx, eps_tile.onnx, neural_noise.json")
+    ap.add_argument("out", help="output folder for eps.onnx and neural_noise.json")
     ap.add_argument("--raw", action="store_true", help="export the raw weights instead of the EMA")
     a = ap.parse_args(argv)
     if not os.path.isfile(os.path.join(a.run, "ckpt.pt")):

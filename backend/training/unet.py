@@ -27,6 +27,26 @@ from torch import nn
 __all__ = ["UNet", "set_circular"]
 
 
+class Conv3(nn.Conv2d):
+    """3x3 convolution with explicit one-pixel padding: zeros, or circular (wrap-around) for tiles.
+
+    ``tile`` is a float tensor, 0 or 1, shared by every Conv3 of a network during one
+    forward pass (see :meth:`UNet.forward`), so one exported ONNX graph serves both
+    plain and seamless output.  Weights are those of ``nn.Conv2d(cin, cout, 3, padding=1)``.
+    """
+
+    def __init__(self, cin: int, cout: int):
+        super().__init__(cin, cout, 3, padding=0)
+        self.tile = None  # set by UNet.forward
+
+    def forward(self, x):
+        zero = F.pad(x, (1, 1, 1, 1))
+        if self.tile is None:
+            return super().forward(zero)
+        wrap = F.pad(x, (1, 1, 1, 1), mode="circular")
+        return super().forward(zero + (wrap - zero) * self.tile)
+
+
 class TimeEmbedding(nn.Module):
     def __init__(self, dim: int = 32, out: int = 128):
         super().__init__()
@@ -46,9 +66,9 @@ class SPADE(nn.Module):
     def __init__(self, channels: int, feat: int = 128, hidden: int = 64):
         super().__init__()
         hid = min(channels, hidden)  # 64 hidden channels keep the network near the paper's ~5M parameters
-        self.shared = nn.Sequential(nn.Conv2d(feat, hid, 3, padding=1), nn.SiLU())
-        self.gamma = nn.Conv2d(hid, channels, 3, padding=1)
-        self.beta = nn.Conv2d(hid, channels, 3, padding=1)
+        self.shared = nn.Sequential(Conv3(feat, hid), nn.SiLU())
+        self.gamma = Conv3(hid, channels)
+        self.beta = Conv3(hid, channels)
 
     def forward(self, h, feat):
         f = F.interpolate(feat, size=h.shape[-2:], mode="nearest")
@@ -59,11 +79,11 @@ class SPADE(nn.Module):
 class ResBlock(nn.Module):
     def __init__(self, cin: int, cout: int, tdim: int = 128, groups: int = 8):
         super().__init__()
-        self.conv1 = nn.Conv2d(cin, cout, 3, padding=1)
+        self.conv1 = Conv3(cin, cout)
         self.norm1 = nn.GroupNorm(groups, cout)
         self.time = nn.Linear(tdim, 2 * cout)
         self.spade = SPADE(cout)
-        self.conv2 = nn.Conv2d(cout, cout, 3, padding=1)
+        self.conv2 = Conv3(cout, cout)
         self.norm2 = nn.GroupNorm(groups, cout)
         self.skip = nn.Conv2d(cin, cout, 1) if cin != cout else nn.Identity()
 
@@ -82,13 +102,14 @@ class UNet(nn.Module):
     def __init__(self, n_classes: int, n_params: int, emb_dim: int = 32, widths=(32, 64, 128), feat: int = 128):
         super().__init__()
         self.n_classes, self.n_params, self.emb_dim, self.widths = n_classes, n_params, emb_dim, tuple(widths)
+        self.circular = False
         self.class_emb = nn.Embedding(n_classes, emb_dim)
         nn.init.normal_(self.class_emb.weight)  # E|e|^2 = emb_dim: the spherical penalty's target norm
         self.cond_mlp = nn.Sequential(nn.Conv2d(emb_dim + n_params, feat, 1), nn.GELU(),
                                       nn.Conv2d(feat, feat, 1), nn.GELU(), nn.Conv2d(feat, feat, 1))
         self.temb = TimeEmbedding(32, 128)
         w = self.widths
-        self.init = nn.Conv2d(1, w[0], 3, padding=1)
+        self.init = Conv3(1, w[0])
         self.down = nn.ModuleList()
         self.downsample = nn.ModuleList()
         c = w[0]
@@ -103,7 +124,7 @@ class UNet(nn.Module):
         self.up = nn.ModuleList()
         self.upsample = nn.ModuleList()
         for cw in reversed(w):
-            self.upsample.append(nn.Conv2d(c, c, 3, padding=1))
+            self.upsample.append(Conv3(c, c))
             self.up.append(nn.ModuleList([ResBlock(c + skips.pop(), cw), ResBlock(cw, cw)]))
             c = cw
         self.final = ResBlock(c + w[0], w[0])
@@ -114,7 +135,13 @@ class UNet(nn.Module):
         e = self.class_emb(class_ids).permute(0, 3, 1, 2)
         return torch.cat([e, params], 1)
 
-    def forward(self, x, t, cond):
+    def forward(self, x, t, cond, tile=None):
+        """tile: None, or a float tensor (1,) of 0 (zero padding) or 1 (circular: seamless tiles)."""
+        if tile is None and self.circular:
+            tile = torch.ones(1, device=x.device)
+        for m in self.modules():
+            if isinstance(m, Conv3):
+                m.tile = None if tile is None else tile.reshape(()).to(x.dtype)
         feat = self.cond_mlp(cond)
         temb = self.temb(t)
         h = self.init(x)
@@ -136,9 +163,7 @@ class UNet(nn.Module):
         return self.out(h)
 
 
-def set_circular(model: nn.Module, on: bool = True) -> nn.Module:
-    """Circular padding in every padded convolution: seamless, tileable output (never for training)."""
-    for m in model.modules():
-        if isinstance(m, nn.Conv2d) and m.padding != (0, 0):
-            m.padding_mode = "circular" if on else "zeros"
+def set_circular(model: "UNet", on: bool = True) -> "UNet":
+    """Make circular padding the default of a torch model: seamless, tileable output (never for training)."""
+    model.circular = bool(on)
     return model
