@@ -1,0 +1,208 @@
+"""How good is a neural noise model?  Our stand-in for Table 2 of Maesumi et al. 2024.
+
+No pretrained Inception or VGG weights are available, so the measuring
+instrument is trained here too: a small CNN classifier on the zoo.  Per class:
+
+    fd          Fréchet distance between generated and zoo samples in the classifier's
+                penultimate features (64-D): |μ₁ - μ₂|² + tr(Σ₁ + Σ₂ - 2 (Σ₁Σ₂)^½)
+    acc         the classifier's accuracy on generated samples (zoo accuracy for reference)
+    psd         mean |log10 P_gen(f) - log10 P_zoo(f)| of radially averaged power spectra
+    response    for the class's first parameter: spectral centroid ratio hi/lo of the model
+                against the zoo's, |r_model / r_zoo - 1|
+
+and overall:
+
+    seam        tileable output: mean |I(:, 0) - I(:, -1)| across the wrap, over the mean
+                difference of neighbouring interior columns (1 = as smooth as the inside)
+    locality    a half/half mask blend of two classes: how often the classifier names the
+                right class on crops away from the border (the CutMix ablation of Fig. 13)
+
+Run: ``python bench/eval_neural.py --model models/neural_noise`` (see that script).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import torch
+from torch import nn
+import torch.nn.functional as F
+
+from . import zoo
+
+__all__ = ["Classifier", "train_classifier", "frechet", "radial_psd", "evaluate"]
+
+
+class Classifier(nn.Module):
+    def __init__(self, n: int, width: int = 32):
+        super().__init__()
+        w = width
+        self.body = nn.Sequential(
+            nn.Conv2d(1, w, 3, padding=1), nn.GELU(), nn.Conv2d(w, w, 3, padding=1, stride=2), nn.GELU(),
+            nn.Conv2d(w, 2 * w, 3, padding=1), nn.GELU(), nn.Conv2d(2 * w, 2 * w, 3, padding=1, stride=2), nn.GELU(),
+            nn.Conv2d(2 * w, 2 * w, 3, padding=1), nn.GELU())
+        self.head = nn.Linear(4 * w, n)
+
+    def features(self, x):
+        h = self.body(x * 2.0 - 1.0)
+        return torch.cat([h.mean(dim=(2, 3)), h.std(dim=(2, 3))], 1)  # (B, 4w): first and second moments
+
+    def forward(self, x):
+        return self.head(self.features(x))
+
+
+def train_classifier(classes, size: int, steps: int = 600, batch: int = 64, seed: int = 0, log=None):
+    """A classifier over ``classes`` trained on fresh zoo samples -> (model, held-out accuracy)."""
+    torch.manual_seed(seed)
+    clf = Classifier(len(classes))
+    opt = torch.optim.AdamW(clf.parameters(), lr=2e-3)
+    sampler = zoo.ZooSampler(size, classes, rng=np.random.default_rng(seed))
+    index = {zoo.CLASS_NAMES.index(c): i for i, c in enumerate(classes)}
+    for step in range(steps):
+        imgs, ids, _ = sampler.batch(batch)
+        y = torch.tensor([index[int(i)] for i in ids])
+        loss = F.cross_entropy(clf(imgs), y)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        if log and step % 100 == 0:
+            log(f"classifier step {step}: loss {float(loss.detach()):.3f}")
+    clf.eval()
+    test = zoo.ZooSampler(size, classes, rng=np.random.default_rng(seed + 999), sets_per_class=512)
+    imgs, ids, _ = test.batch(512)
+    with torch.no_grad():
+        pred = clf(imgs).argmax(1)
+    acc = float((pred == torch.tensor([index[int(i)] for i in ids])).float().mean())
+    return clf, acc
+
+
+def frechet(a: np.ndarray, b: np.ndarray) -> float:
+    """Fréchet distance of Gaussians fitted to feature sets a (n, d) and b (m, d)."""
+    mu1, mu2 = a.mean(0), b.mean(0)
+    s1, s2 = np.cov(a, rowvar=False), np.cov(b, rowvar=False)
+    # tr((s1 s2)^1/2) through the eigenvalues of s1^1/2 s2 s1^1/2 (symmetric, PSD)
+    w, v = np.linalg.eigh(s1)
+    r1 = (v * np.sqrt(np.clip(w, 0, None))) @ v.T
+    m = r1 @ s2 @ r1
+    tr = np.sqrt(np.clip(np.linalg.eigvalsh((m + m.T) / 2), 0, None)).sum()
+    return float(((mu1 - mu2) ** 2).sum() + np.trace(s1) + np.trace(s2) - 2 * tr)
+
+
+def radial_psd(imgs: np.ndarray) -> np.ndarray:
+    """Mean radially averaged power spectrum of images (n, S, S) -> (S // 2,)."""
+    S = imgs.shape[-1]
+    F_ = np.abs(np.fft.fft2(imgs - imgs.mean(axis=(1, 2), keepdims=True))) ** 2
+    f = np.fft.fftfreq(S) * S
+    r = np.rint(np.hypot(*np.meshgrid(f, f, indexing="ij"))).astype(int)
+    out = np.zeros(S // 2)
+    for k in range(1, S // 2 + 1):
+        out[k - 1] = F_[:, r == k].mean()
+    return out
+
+
+def _centroid(imgs):
+    p = radial_psd(imgs)
+    k = np.arange(1, len(p) + 1)
+    return float((p * k).sum() / p.sum())
+
+
+def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print) -> dict:
+    """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`)."""
+    from ..neural import conditioning as C
+    from ..neural.generate import generate
+    from ..neural.sampler import ddim_sample, initial_noise
+
+    S = int(model.config["train_size"])
+    clf, zoo_acc = train_classifier(classes, S, clf_steps, log=log)
+    index = {c: i for i, c in enumerate(classes)}
+    rng = np.random.default_rng(123)
+    rows = {}
+    eps_fn = model.eps_fn(False)
+
+    def sample(spec, count, seed0):
+        cond = np.repeat(C.uniform(model, spec, S, S)[None], count, 0)
+        x = ddim_sample(eps_fn, initial_noise(seed0, (count, 1, S, S)), cond, steps=steps)
+        return (x[:, 0] + 1) * 0.5
+
+    def feats(imgs):
+        with torch.no_grad():
+            t = torch.from_numpy(np.ascontiguousarray(imgs, np.float32))[:, None]
+            return clf.features(t).numpy(), clf(t).argmax(1).numpy()
+
+    for name in classes:
+        sets = rng.integers(0, 16384, size=n)
+        params = zoo.sample_params(name, sets)
+        real = zoo.generate(name, params, torch.arange(n) + 77_000, S).numpy()
+        gen = np.concatenate([sample((name, {k: float(v[i]) for k, v in params.items()}), 1, 1000 + i)
+                              for i in range(n)])
+        fr, _ = feats(real)
+        fg, pg = feats(gen)
+        p0 = zoo.CLASSES[name].params[0]
+        lo, hi = p0.lo + 0.2 * (p0.hi - p0.lo), p0.lo + 0.8 * (p0.hi - p0.lo)
+        mid = zoo.default_params(name)
+        zr = [_centroid(zoo.generate(name, dict(mid, **{p0.name: v}), torch.arange(8), S).numpy()) for v in (lo, hi)]
+        mr = [_centroid(sample((name, dict(mid, **{p0.name: v})), 8, 50)) for v in (lo, hi)]
+        rows[name] = dict(
+            fd=round(frechet(fr, fg), 3), acc=round(float((pg == index[name]).mean()), 3),
+            psd=round(float(np.abs(np.log10(radial_psd(gen) + 1e-12) - np.log10(radial_psd(real) + 1e-12)).mean()), 3),
+            response=round(abs((mr[1] / mr[0]) / (zr[1] / zr[0]) - 1.0), 3), param=p0.name)
+        log(f"{name}: {rows[name]}")
+    # tileable seams
+    tile = generate(model, C.uniform(model, (classes[0], {}), S * 2, S * 2), seed=5, steps=steps, tileable=True)
+    plain = generate(model, C.uniform(model, (classes[0], {}), S * 2, S * 2), seed=5, steps=steps, tileable=False)
+
+    def seam(img):
+        inner = np.abs(np.diff(img, axis=1)).mean()
+        return float(np.abs(img[:, 0] - img[:, -1]).mean() / inner)
+
+    # blend locality: left half class A, right half class B; classify crops away from the border
+    hits, total = 0, 0
+    for a, b in [(classes[i], classes[(i + 1) % len(classes)]) for i in range(len(classes))]:
+        w = np.zeros((S, 3 * S), np.float32)
+        w[:, int(1.5 * S):] = 1.0
+        img = generate(model, C.blend(model, (a, {}), (b, {}), C.mask_weight(w > 0.5, 8.0, 2.0)), seed=9,
+                       steps=steps)
+        _, pred = feats(np.stack([img[:, : S], img[:, -S:]]))
+        hits += int(pred[0] == index[a]) + int(pred[1] == index[b])
+        total += 2
+    return dict(classes=rows, zoo_accuracy=round(zoo_acc, 3), seam_tileable=round(seam(tile), 3),
+                seam_plain=round(seam(plain), 3), locality=round(hits / total, 3))
+
+
+def step_seconds(model_folder: str, run_folder: str, size: int = 256, reps: int = 3) -> dict:
+    """Seconds per DDIM step (one ε evaluation) at size², onnxruntime vs torch with the same weights.
+
+    The torch model loads the run's EMA weights; its output is checked against
+    onnxruntime's first (max |Δε| reported), so both time the same network.
+    """
+    import os
+
+    from ..neural.model import NeuralNoiseModel
+    from .train import TrainConfig, build_model
+
+    m = NeuralNoiseModel(model_folder)
+    C = m.embedding.shape[1] + len(m.params)
+    x = np.random.default_rng(0).standard_normal((1, 1, size, size)).astype(np.float32)
+    t = np.array([500.0], np.float32)
+    cond = np.zeros((1, C, size, size), np.float32)
+    eps = m.eps_fn(False)
+    eps(x, t, cond)
+    t0 = time.perf_counter()
+    for _ in range(reps):
+        eps(x, t, cond)
+    ort_s = (time.perf_counter() - t0) / reps
+    state = torch.load(os.path.join(run_folder, "ckpt.pt"), map_location="cpu", weights_only=False)
+    tm = build_model(TrainConfig.from_dict(state["config"])).eval()
+    tm.load_state_dict(state["ema"])
+    with torch.no_grad():
+        args = (torch.from_numpy(x), torch.from_numpy(t), torch.from_numpy(cond))
+        diff = float(np.abs(tm(*args).numpy() - eps(x, t, cond)).max())
+        if diff > 1e-3:
+            raise RuntimeError(f"{run_folder}/ckpt.pt is not the exported network (max |Δε| {diff:.2g}): "
+                               "re-export or pass the run it came from")
+        t0 = time.perf_counter()
+        for _ in range(reps):
+            tm(*args)
+    torch_s = (time.perf_counter() - t0) / reps
+    return dict(size=size, onnxruntime_s=round(ort_s, 4), torch_s=round(torch_s, 4), ratio=round(torch_s / ort_s, 2),
+                max_eps_difference=diff)

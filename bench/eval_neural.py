@@ -1,0 +1,55 @@
+"""Evaluate a neural noise model: `python bench/eval_neural.py --model models/neural_noise --run RUN`.
+
+Prints the per-class table of backend/training/evaluate.py (Fréchet distance in
+a zoo classifier's features, classifier accuracy on generated samples, power-
+spectrum error, parameter-response error), the seam ratio of tileable output,
+blend locality, and seconds per DDIM step for onnxruntime and torch with the
+same weights; writes everything to out/bench/neural_eval.json.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from backend.neural.model import NeuralNoiseModel  # noqa: E402
+from backend.training.evaluate import evaluate, step_seconds  # noqa: E402
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
+    ap.add_argument("--run", required=True, help="the training run (its checkpoint times torch with the same weights)")
+    ap.add_argument("--n", type=int, default=32, help="samples per class")
+    ap.add_argument("--steps", type=int, default=30, help="DDIM steps")
+    ap.add_argument("--clf-steps", type=int, default=600)
+    ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
+    a = ap.parse_args()
+    model = NeuralNoiseModel(a.model)
+    classes = tuple(model.config["trained_classes"])
+    res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr))
+    res["timing"] = step_seconds(a.model, a.run, a.size)
+    res["model"] = dict(step=model.config["step"], sha256=model.config["files"]["eps.onnx"], n=a.n, steps=a.steps)
+    print("| class | FD | acc | PSD err | response err (param) |")
+    print("|---|---|---|---|---|")
+    for name, r in res["classes"].items():
+        print(f"| {name} | {r['fd']} | {r['acc']} | {r['psd']} | {r['response']} ({r['param']}) |")
+    print(f"\nzoo accuracy of the classifier: {res['zoo_accuracy']}")
+    print(f"seam ratio: tileable {res['seam_tileable']}, plain {res['seam_plain']}; blend locality {res['locality']}")
+    t = res["timing"]
+    print(f"DDIM step at {t['size']}²: onnxruntime {t['onnxruntime_s']} s, torch {t['torch_s']} s "
+          f"(torch / ort = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e})")
+    os.makedirs(os.path.dirname(a.out), exist_ok=True)
+    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
+        json.dump(res, fh, indent=1)
+    os.replace(a.out + ".tmp", a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
