@@ -257,12 +257,36 @@ def _blender_voronoi(x, y, s, p, n):
 
 
 def _blender_wave(x, y, s, p, n):
-    """Blender's Wave Texture, Bands along X, Sine profile: sin(2 pi Scale x + Distortion fbm)."""
+    """Blender's Wave Texture, Bands along X, Sine profile:
+    n = 20 Scale x + Distortion (2 fbm(Scale x, Scale y) - 1), value = 1/2 + 1/2 sin(n - pi/2)."""
     sc = _u(p, "Scale")
-    ph = 2.0 * math.pi * sc * x
-    d = ops.fbm(x * sc * 2.0, y * sc * 2.0, s, 1 + int(p["Detail"].max().item()), torch.full_like(p["Scale"], 0.5),
-                salt=700)
-    return torch.sin(ph + _u(p, "Distortion") * d * 2.0)
+    octs = 1 + int(p["Detail"].max().item())
+    d = ops.fbm(x * sc, y * sc, s, octs, torch.full_like(p["Scale"], 0.5), salt=700)  # about [-0.7, 0.7]
+    return torch.sin(20.0 * sc * x + _u(p, "Distortion") * d * 2.0 - math.pi / 2)
+
+
+def _blender_gabor(x, y, s, p, n):
+    """Blender's Gabor Texture (2D), statistically: impulses of exp(-pi d^2) cos(2 pi F o.d) in
+    Scale-scaled space, orientation theta + (1 - Anisotropy) U(-pi, pi); as white noise filtered
+    by the angular average of the kernels' power spectra (the same second-order statistics)."""
+    ix = torch.floor(x * REF_PX).to(torch.int64)
+    iy = torch.floor(y * REF_PX).to(torch.int64)
+    white = ops.hash_unit(ix, iy, s.view(-1, 1, 1), 23) - 0.5
+    sc = _u(p, "Scale") / REF_PX  # scaled units per pixel
+    F0 = _u(p, "Frequency") * sc  # cycles per pixel
+    th, spread = _u(p, "Orientation"), (1.0 - _u(p, "Anisotropy")) * math.pi
+
+    def resp(fx, fy):
+        power = torch.zeros(x.shape[0], fy.shape[1], fx.shape[2], device=x.device)
+        for k in range(32):
+            phi = th + spread * ((k + 0.5) / 32 * 2.0 - 1.0)
+            cx, cy = F0 * torch.cos(phi), F0 * torch.sin(phi)
+            g = (torch.exp(-math.pi * ((fx - cx) ** 2 + (fy - cy) ** 2) / sc ** 2)
+                 + torch.exp(-math.pi * ((fx + cx) ** 2 + (fy + cy) ** 2) / sc ** 2))
+            power = power + g ** 2
+        return torch.sqrt(power / 32)
+
+    return ops.fft_filter(white, resp)
 
 
 def _wave_engine(kind: str):
@@ -335,9 +359,13 @@ _CLASSES = [
                _blender_noise, "Blender's Noise Texture (fBm, its input names)"),
     NoiseClass("voronoi_f1", "blender", (Param("Scale", 2, 16, "per 128 px"), Param("Randomness", 0.0, 1.0, "")),
                _blender_voronoi, "Blender's Voronoi Texture, F1 distance"),
-    NoiseClass("wave_bands", "blender", (Param("Scale", 1, 8, "bands per 128 px"), Param("Distortion", 0.0, 4.0, ""),
-                                         Param("Detail", 0, 4, "octaves", integer=True)),
-               _blender_wave, "Blender's Wave Texture, bands, sine profile"),
+    NoiseClass("wave_bands", "blender", (Param("Scale", 0.5, 4.0, "per 128 px (20/2pi bands each)"),
+                                         Param("Distortion", 0.0, 10.0, ""), Param("Detail", 0, 4, "octaves", integer=True)),
+               _blender_wave, "Blender's Wave Texture, bands along X, sine profile"),
+    NoiseClass("gabor_texture", "blender", (Param("Scale", 2.0, 10.0, "per 128 px"), Param("Frequency", 1.0, 4.0, ""),
+                                            Param("Anisotropy", 0.0, 1.0, ""),
+                                            Param("Orientation", 0.0, math.pi, "radians")),
+               _blender_gabor, "Blender's Gabor Texture (2D), Value output"),
     NoiseClass("wave_bandpass", "wave", (Param("frequency", 2, 12, "cycles per 128 px"),
                                          Param("bandwidth", 0.2, 1.0, "relative band width")),
                _wave_engine("bandpass"), "band-pass wave noise from backend (Guehl et al. 2025)"),
