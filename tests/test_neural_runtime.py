@@ -33,7 +33,7 @@ def exported(tmp_path_factory):
 
 def _torch_model(run, circular=False):
     state = torch.load(os.path.join(run, "ckpt.pt"), weights_only=False)
-    m = build_model(TrainConfig.from_dict(state["config"]))
+    m = build_model(TrainConfig.from_dict(state["config"]), state["ema"])
     m.load_state_dict(state["ema"])
     return set_circular(m.eval(), circular)
 

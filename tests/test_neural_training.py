@@ -154,3 +154,15 @@ def test_config_errors():
         TrainConfig.from_dict({"classes": ["lava"]})
     with pytest.raises(ValueError, match="multiple of 8"):
         TrainConfig.from_dict({"size": 30})
+
+
+def test_checkpoints_of_a_smaller_zoo_still_load():
+    """The zoo is append-only: a model made before classes were added uses the first ids and slots."""
+    from backend.training.train import build_model, model_names
+
+    cfg = TrainConfig.from_dict(dict(TINY))
+    old = UNet(len(zoo.CLASS_NAMES) - 1, len(zoo.PARAM_NAMES) - 3, emb_dim=8, widths=(8, 16, 16))
+    again = build_model(cfg, old.state_dict())
+    again.load_state_dict(old.state_dict())
+    classes, params = model_names(again)
+    assert classes == list(zoo.CLASS_NAMES[:-1]) and params == list(zoo.PARAM_NAMES[:-3])

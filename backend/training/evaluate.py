@@ -192,7 +192,7 @@ def step_seconds(model_folder: str, run_folder: str, size: int = 256, reps: int 
         eps(x, t, cond)
     ort_s = (time.perf_counter() - t0) / reps
     state = torch.load(os.path.join(run_folder, "ckpt.pt"), map_location="cpu", weights_only=False)
-    tm = build_model(TrainConfig.from_dict(state["config"])).eval()
+    tm = build_model(TrainConfig.from_dict(state["config"]), state["ema"]).eval()
     tm.load_state_dict(state["ema"])
     with torch.no_grad():
         args = (torch.from_numpy(x), torch.from_numpy(t), torch.from_numpy(cond))

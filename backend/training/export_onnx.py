@@ -22,7 +22,7 @@ import torch
 
 from ..neural.model import sha256_file
 from . import zoo
-from .train import TrainConfig, build_model
+from .train import TrainConfig, build_model, model_names
 
 __all__ = ["export"]
 
@@ -44,16 +44,17 @@ def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> 
     """Export checkpoint ``run/ckpt.pt`` into folder ``out``; returns the JSON config written."""
     state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
     cfg = TrainConfig.from_dict(state["config"])
-    model = build_model(cfg)
+    model = build_model(cfg, state["model"])
     model.load_state_dict(state["model" if raw else "ema"])
+    classes, params = model_names(model)
     model.eval()
     os.makedirs(out, exist_ok=True)
     _export_one(model, os.path.join(out, "eps.onnx"), cfg.size)
     files = {"eps.onnx": sha256_file(os.path.join(out, "eps.onnx"))}
     doc = dict(format=FORMAT, model="neural_noise", paper="Maesumi et al. 2024, One Noise to Rule Them All",
                schedule=dict(kind="cosine", T=1000, s=0.008), prediction="epsilon",
-               classes=list(zoo.CLASS_NAMES), trained_classes=list(cfg.classes), params=list(zoo.PARAM_NAMES),
-               class_params=zoo.describe(), emb_dim=cfg.emb_dim,
+               classes=classes, trained_classes=list(cfg.classes), params=params,
+               class_params={k: v for k, v in zoo.describe().items() if k in classes}, emb_dim=cfg.emb_dim,
                class_embedding=model.class_emb.weight.detach().numpy().astype(float).round(7).tolist(),
                train_size=cfg.size, step=int(state["step"]), weights="raw" if raw else "ema",
                config=state["config"], files=files, multiple_of=8)

@@ -28,7 +28,7 @@ from .cutmix import cutmix
 from .diffusion import Diffusion
 from .unet import UNet
 
-__all__ = ["TrainConfig", "train", "load_config", "build_model"]
+__all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names"]
 
 
 @dataclass
@@ -79,8 +79,22 @@ def load_config(path: str) -> TrainConfig:
         return TrainConfig.from_dict(json.load(fh))
 
 
-def build_model(cfg: TrainConfig) -> UNet:
-    return UNet(len(zoo.CLASS_NAMES), len(zoo.PARAM_NAMES), emb_dim=cfg.emb_dim, widths=cfg.widths)
+def build_model(cfg: TrainConfig, state: dict | None = None) -> UNet:
+    """A fresh UNet for the current zoo, or one shaped like a checkpoint's weights (``state``).
+
+    The zoo is append-only, so a checkpoint made with fewer classes or parameters
+    uses the first n class ids and parameter slots.
+    """
+    n_classes, n_params = len(zoo.CLASS_NAMES), len(zoo.PARAM_NAMES)
+    if state is not None:
+        n_classes = state["class_emb.weight"].shape[0]
+        n_params = state["cond_mlp.0.weight"].shape[1] - state["class_emb.weight"].shape[1]
+    return UNet(n_classes, n_params, emb_dim=cfg.emb_dim, widths=cfg.widths)
+
+
+def model_names(model: UNet) -> tuple:
+    """The zoo class names and parameter names a model was built for (prefixes of the zoo's)."""
+    return list(zoo.CLASS_NAMES[: model.n_classes]), list(zoo.PARAM_NAMES[: model.n_params])
 
 
 def _device(name: str) -> torch.device:
@@ -108,7 +122,7 @@ def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0
     names = list(names or cfg.classes[:8])
     S = cfg.size
     ids = torch.tensor([zoo.CLASS_NAMES.index(n) for n in names], device=device)
-    conds = torch.cat([zoo.condition_vector(n, zoo.default_params(n)) for n in names]).to(device)
+    conds = torch.cat([zoo.condition_vector(n, zoo.default_params(n)) for n in names])[:, : model.n_params].to(device)
     idm, pm = _conditions(ids, conds, S)
     with torch.no_grad():
         cond = model.embed(idm, pm)
@@ -125,7 +139,9 @@ def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -
     os.makedirs(out, exist_ok=True)
     device = _device(cfg.device)
     torch.manual_seed(cfg.seed)
-    model = build_model(cfg).to(device)
+    ckpt = os.path.join(out, "ckpt.pt")
+    state = torch.load(ckpt, map_location=device, weights_only=False) if os.path.isfile(ckpt) else None
+    model = build_model(cfg, state["model"] if state else None).to(device)
     ema = copy.deepcopy(model).eval()
     for p_ in ema.parameters():
         p_.requires_grad_(False)
@@ -134,9 +150,7 @@ def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -
     rng = np.random.default_rng(cfg.seed)
     gen = torch.Generator(device=device).manual_seed(cfg.seed)
     step = 0
-    ckpt = os.path.join(out, "ckpt.pt")
-    if os.path.isfile(ckpt):
-        state = torch.load(ckpt, map_location=device, weights_only=False)
+    if state is not None:
         model.load_state_dict(state["model"])
         ema.load_state_dict(state["ema"])
         opt.load_state_dict(state["opt"])
@@ -146,12 +160,13 @@ def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -
         log(f"resumed at step {step}")
     with open(os.path.join(out, "config.json"), "w", encoding="utf-8") as fh:
         json.dump(asdict(cfg), fh, indent=2)
+    del state
     sampler = zoo.ZooSampler(cfg.size, cfg.classes, cfg.seeds_per_set, cfg.sets_per_class, rng=rng, device=device)
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     t0, last, losses = time.time(), {}, []
     while step < end:
         imgs, ids, conds = sampler.batch(cfg.batch)
-        idm, pm = _conditions(ids, conds, cfg.size)
+        idm, pm = _conditions(ids, conds[:, : model.n_params], cfg.size)  # older runs: a prefix of the slots
         imgs, idm, pm = cutmix(imgs, idm, pm, rng, p=cfg.cutmix_p)
         if rng.random() < 0.5:
             imgs, idm, pm = imgs.flip(-1), idm.flip(-1), pm.flip(-1)

@@ -362,17 +362,18 @@ _CLASSES = [
     NoiseClass("wave_bands", "blender", (Param("Scale", 0.5, 4.0, "per 128 px (20/2pi bands each)"),
                                          Param("Distortion", 0.0, 10.0, ""), Param("Detail", 0, 4, "octaves", integer=True)),
                _blender_wave, "Blender's Wave Texture, bands along X, sine profile"),
-    NoiseClass("gabor_texture", "blender", (Param("Scale", 2.0, 10.0, "per 128 px"), Param("Frequency", 1.0, 4.0, ""),
-                                            Param("Anisotropy", 0.0, 1.0, ""),
-                                            Param("Orientation", 0.0, math.pi, "radians")),
-               _blender_gabor, "Blender's Gabor Texture (2D), Value output"),
     NoiseClass("wave_bandpass", "wave", (Param("frequency", 2, 12, "cycles per 128 px"),
                                          Param("bandwidth", 0.2, 1.0, "relative band width")),
                _wave_engine("bandpass"), "band-pass wave noise from backend (Guehl et al. 2025)"),
     NoiseClass("wave_cellular", "wave", (Param("scale", 3, 12, "cells per 128 px"), Param("split", 0.2, 0.8, "STIT split probability")),
                _wave_engine("stit"), "STIT cellular wave noise from backend (Alg. 2)"),
+    NoiseClass("gabor_texture", "blender", (Param("Scale", 2.0, 10.0, "per 128 px"), Param("Frequency", 1.0, 4.0, ""),
+                                            Param("Anisotropy", 0.0, 1.0, ""),
+                                            Param("Orientation", 0.0, math.pi, "radians")),
+               _blender_gabor, "Blender's Gabor Texture (2D), Value output"),
 ]
 
+#: append-only: a class's index and each parameter's slot are part of every trained model
 CLASSES = {c.name: c for c in _CLASSES}
 CLASS_NAMES = tuple(c.name for c in _CLASSES)
 PARAM_NAMES = tuple(dict.fromkeys(p.name for c in _CLASSES for p in c.params))
