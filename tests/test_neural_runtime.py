@@ -180,3 +180,19 @@ def test_neural_cli(exported, tmp_path, capsys):
         assert msg in capsys.readouterr().err
     assert main(["neural", "--model", str(tmp_path / "none"), "--noise", "spots", "-o", png]) == 2
     assert "no neural_noise.json" in capsys.readouterr().err
+
+
+def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
+    from backend.training.model_card import card, wall_seconds
+
+    run, out = exported
+    log = tmp_path / "log.jsonl"
+    log.write_text("\n".join(json.dumps(dict(step=i, seconds=s, mse=0.1)) for i, s in enumerate([5, 10, 3, 7])))
+    assert wall_seconds(str(log)) == 17  # two segments: 10 s, then a resume for 7 s
+    ev = dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param="scale")}, zoo_accuracy=0.9,
+              seam_tileable=1.1, seam_plain=3.0, locality=0.75, model=dict(n=4, steps=5),
+              timing=dict(size=64, onnxruntime_s=0.1, torch_s=0.2, ratio=2.0, max_eps_difference=1e-6))
+    text = card(str(run), str(out), ev, dict(ev, locality=0.5), "python -m backend.training.train ...", "test CPU")
+    meta = json.loads((out / "neural_noise.json").read_text())
+    assert meta["files"]["eps.onnx"] in text and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
+    assert "| without CutMix | 0.5 |" in text and "test CPU" in text

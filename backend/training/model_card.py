@@ -1,0 +1,133 @@
+"""Write a model's card from its run, export and evaluation: ``python -m backend.training.model_card ...``.
+
+    python -m backend.training.model_card --run RUN --model MODEL_DIR --eval EVAL.json \\
+        [--ablation-eval EVAL_NO_CUTMIX.json] --train-command "..." -o MODEL_DIR/MODEL_CARD.md
+
+Everything in the card is read from files the project's own commands wrote:
+the run's config and log (steps, loss, wall time), the export's JSON (sha256,
+classes) and the evaluation JSON of ``bench/eval_neural.py``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+
+__all__ = ["wall_seconds", "card"]
+
+
+def wall_seconds(log_path: str) -> float:
+    """Training wall time from log.jsonl: the sum over resumed segments (``seconds`` restarts at 0)."""
+    total, last = 0.0, 0.0
+    with open(log_path, encoding="utf-8") as fh:
+        for line in fh:
+            s = json.loads(line)["seconds"]
+            if s < last:
+                total += last
+            last = s
+    return total + last
+
+
+def _hardware() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            names = [ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")]
+        if names:
+            cpu = names[0]
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores visible, 1 training thread"
+
+
+def _table(ev: dict) -> str:
+    rows = ["| class | FD ↓ | classifier acc ↑ | PSD error ↓ | response error ↓ (parameter) |", "|---|---|---|---|---|"]
+    for name, r in ev["classes"].items():
+        rows.append(f"| {name} | {r['fd']} | {r['acc']} | {r['psd']} | {r['response']} ({r['param']}) |")
+    return "\n".join(rows)
+
+
+def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None) -> str:
+    with open(os.path.join(model, "neural_noise.json"), encoding="utf-8") as fh:
+        meta = json.load(fh)
+    log = [json.loads(line) for line in open(os.path.join(run, "log.jsonl"), encoding="utf-8")]
+    cfg = meta["config"]
+    t = ev["timing"]
+    mean = lambda key, e: round(sum(r[key] for r in e["classes"].values()) / len(e["classes"]), 3)  # noqa: E731
+    lines = [
+        "# Neural noise model card",
+        "",
+        f"One diffusion model for {len(meta['trained_classes'])} noise classes (Maesumi et al. 2024), trained by this "
+        "project's code on its procedural zoo.",
+        "",
+        "## How it was made",
+        "",
+        "```sh",
+        train_command.strip(),
+        "```",
+        "",
+        f"- **Data:** `backend/training/zoo.py`, generated on the fly. Classes: {', '.join(meta['trained_classes'])}. "
+        f"Halton parameter sets, {cfg['seeds_per_set']} seeds each, {cfg['size']}² px.",
+        f"- **Config:** size {cfg['size']}, batch {cfg['batch']}, {cfg['steps']} steps, lr {cfg['lr']}, "
+        f"EMA {cfg['ema_decay']}, CutMix p {cfg['cutmix_p']}, widths {cfg['widths']}, embedding {cfg['emb_dim']}-D.",
+        f"- **Hardware:** {hardware or _hardware()}.",
+        f"- **Steps:** {meta['step']}. **Wall time:** {wall_seconds(os.path.join(run, 'log.jsonl')) / 60:.1f} min.",
+        f"- **Final training MSE** (mean of the last log window): {log[-1]['mse']:.4f}.",
+        f"- **Weights:** {meta['weights']} (exported with `python -m backend.training.export_onnx`).",
+        f"- **sha256** of `eps.onnx`: `{meta['files']['eps.onnx']}`.",
+        "",
+        "## Evaluation (`bench/eval_neural.py`)",
+        "",
+        f"{ev['model']['n']} samples per class, {ev['model']['steps']} DDIM steps. The zoo classifier is accurate to "
+        f"{ev['zoo_accuracy']} on held-out zoo samples.",
+        "",
+        _table(ev),
+        "",
+        f"- **Means:** FD {mean('fd', ev)}, accuracy {mean('acc', ev)}, PSD error {mean('psd', ev)}, "
+        f"response error {mean('response', ev)}.",
+        f"- **Seams:** the wrap difference over the interior neighbour difference is {ev['seam_tileable']} for tileable "
+        f"output and {ev['seam_plain']} for plain output (1 means seamless).",
+        f"- **Blend locality** (half/half mask blends, crops classified as their side's class): {ev['locality']}.",
+        f"- **DDIM step at {t['size']}²:** onnxruntime {t['onnxruntime_s']} s, torch {t['torch_s']} s with the same "
+        f"weights (torch / onnxruntime = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e}).",
+    ]
+    if ablation is not None:
+        lines += ["", "## CutMix ablation (Fig. 13)", "",
+                  "The same config and steps with `cutmix_p = 0` (`configs/neural_noise_cpu_nocutmix.json`):", "",
+                  "| model | blend locality ↑ | mean FD ↓ | mean accuracy ↑ |", "|---|---|---|---|",
+                  f"| with CutMix | {ev['locality']} | {mean('fd', ev)} | {mean('acc', ev)} |",
+                  f"| without CutMix | {ablation['locality']} | {mean('fd', ablation)} | {mean('acc', ablation)} |"]
+    lines += ["", "## Limits", "",
+              "This is a small model trained on a CPU. The paper's setting (a GPU, 128² or more, all classes, far more "
+              "steps; `configs/neural_noise_gpu.json`) is needed for production quality. The numbers above are this "
+              "model's own, measured as written."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m backend.training.model_card", description=__doc__.split("\n")[0])
+    ap.add_argument("--run", required=True)
+    ap.add_argument("--model", required=True)
+    ap.add_argument("--eval", required=True)
+    ap.add_argument("--ablation-eval")
+    ap.add_argument("--train-command", required=True)
+    ap.add_argument("--hardware")
+    ap.add_argument("-o", "--out", required=True)
+    a = ap.parse_args(argv)
+    with open(a.eval, encoding="utf-8") as fh:
+        ev = json.load(fh)
+    abl = None
+    if a.ablation_eval:
+        with open(a.ablation_eval, encoding="utf-8") as fh:
+            abl = json.load(fh)
+    text = card(a.run, a.model, ev, abl, a.train_command, a.hardware)
+    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
+        fh.write(text)
+    os.replace(a.out + ".tmp", a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
