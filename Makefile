@@ -23,6 +23,7 @@ demo: $(STAMP)
 	$(BIN)/python demo/showcase_blend.py out/demo
 	$(BIN)/omninoise bake demo/volumes.toml
 	$(BIN)/python demo/showcase_volume.py out/demo
+	$(BIN)/python demo/neural.py out/demo
 
 $(VENV)/.train: $(STAMP) requirements-train.txt
 	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt

@@ -30,7 +30,7 @@ PLATFORMS = {  # Blender platform -> pip platform tag
     "windows-x64": "win_amd64",
     "macos-arm64": "macosx_14_0_arm64",
 }
-RUNTIME = ("__init__.py", "blender_manifest.toml", "blender_addon", "backend", "export")
+RUNTIME = ("__init__.py", "blender_manifest.toml", "blender_addon", "backend", "export", "models")
 EXCLUDE_DIRS = {"__pycache__", "training"}
 
 

@@ -1,0 +1,66 @@
+"""Neural noise showcase: out/demo/neural.png (and neural.json) from the shipped model.
+
+One row per kind of conditioning grid, all from the ONNX model through the
+numpy/onnxruntime sampler (no torch): every trained class at its default
+parameters; a parameter sweep; a mask-driven blend of two classes next to its
+mask; a four-corner blend; and a tileable tile repeated 2x2.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from backend.neural import conditioning as C  # noqa: E402
+from backend.neural.generate import generate  # noqa: E402
+from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from export.images import write_png  # noqa: E402
+
+STEPS = 30
+
+
+def main(out: str) -> int:
+    try:
+        model = NeuralNoiseModel(os.path.join(ROOT, "models", "neural_noise"))
+    except ModelError as exc:
+        print(f"neural demo skipped: {exc}")
+        return 0
+    S = int(model.config["train_size"]) * 2
+    names = model.config["trained_classes"]
+    t0 = time.perf_counter()
+    row1 = [generate(model, C.uniform(model, (n, {}), S, S), seed=i, steps=STEPS) for i, n in enumerate(names)]
+    first = model.class_params[names[0]]["params"][0]
+    sweep = [generate(model, C.uniform(model, (names[0], {first["name"]: v}), S, S), seed=3, steps=STEPS)
+             for v in np.linspace(first["min"], first["max"], len(names))]
+    W = S * 3
+    mask = np.zeros((S, W), bool)
+    yy, xx = np.mgrid[:S, :W]
+    mask[(xx - W * 0.6) ** 2 + (yy - S * 0.5) ** 2 < (S * 0.4) ** 2] = True
+    blend = generate(model, C.blend(model, (names[0], {}), (names[-1], {}), C.mask_weight(mask, S / 4, 2.0)),
+                     seed=4, steps=STEPS)
+    corners = generate(model, C.four_corner(model, [(n, {}) for n in (names + names)[1:5]], S, W), seed=5, steps=STEPS)
+    tile = generate(model, C.uniform(model, (names[1 % len(names)], {}), S, S), seed=6, steps=STEPS, tileable=True)
+    tiled = np.tile(tile, (1, 2))
+    wide = len(names) * S
+    pad = lambda a: np.pad(a, ((0, 0), (0, wide - a.shape[1])))  # noqa: E731
+    rows = [np.concatenate(row1, 1), np.concatenate(sweep, 1),
+            pad(np.concatenate([mask.astype(np.float32), blend], 1)), pad(np.concatenate([corners, tiled], 1))]
+    sheet = np.concatenate([pad(r) if r.shape[1] < wide else r[:, :wide] for r in rows], 0)
+    os.makedirs(out, exist_ok=True)
+    write_png(os.path.join(out, "neural.png"), (np.clip(sheet, 0, 1) * 255 + 0.5).astype(np.uint8))
+    info = dict(classes=names, sweep=dict(cls=names[0], param=first["name"]), steps=STEPS, size=S,
+                seconds=round(time.perf_counter() - t0, 1), model_sha256=model.config["files"]["eps.onnx"])
+    with open(os.path.join(out, "neural.json"), "w", encoding="utf-8") as fh:
+        json.dump(info, fh, indent=1)
+    print(f"wrote {out}/neural.png in {info['seconds']} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "out", "demo")))
