@@ -31,7 +31,12 @@ def _rebuild(self, context) -> None:
     if not self.is_wave or getattr(tree, "is_evaluated", False):
         return
     try:
-        build_wave_group(self.to_settings(), tree=tree)
+        if self.is_cellular:
+            from .cellular_nodes import build_cellular_group
+
+            build_cellular_group(self.to_settings(), tree=tree)
+        else:
+            build_wave_group(self.to_settings(), tree=tree)
         self.error = ""
     except backend.SettingError as e:
         self.error = str(e)
@@ -41,6 +46,9 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
     """Settings of a Wave Noise group (stored with its node tree)."""
 
     is_wave: BoolProperty(default=False, options={"HIDDEN"})
+    is_cellular: BoolProperty(default=False, options={"HIDDEN"})
+    cell_size: FloatProperty(name="Cell Size", description="Distance between the planes of one family (cellular)",
+                             default=0.5, min=0.001, soft_max=10.0, update=_rebuild)
     error: StringProperty(default="", options={"HIDDEN"})
     dimensions: EnumProperty(name="Dimensions", items=[("2", "2D", ""), ("3", "3D", ""), ("4", "4D", "")],
                              default="3", update=_rebuild)
@@ -80,6 +88,8 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
             kw = dict(anisotropy="axes", axis_spectra=tuple(
                 backend.Spectrum(self.spectrum, self.fmin * scales[a], self.fmax * scales[a], self.exponent)
                 for a in range(dim)))
+        if self.is_cellular:
+            kw.update(cellular="polytope", cell_size=self.cell_size)
         return backend.WaveSettings(dim=dim, spectrum=sp, directions=self.directions, seed=self.seed,
                                     speed=self.speed, waveform=self.waveform, **kw)
 
@@ -119,6 +129,40 @@ class OMNINOISE_OT_add_wave_noise(bpy.types.Operator):
         node.select = True
         edit.nodes.active = node
         return {"FINISHED"}
+
+
+class OMNINOISE_OT_add_wave_cellular(bpy.types.Operator):
+    """Add a Wave Cellular node: random-plane polytopes (Guehl et al. 2025, Alg. 2) from Blender's own nodes"""
+
+    bl_idname = "node.omninoise_add_wave_cellular"
+    bl_label = "Wave Cellular"
+    bl_options = {"REGISTER", "UNDO"}
+
+    poll = OMNINOISE_OT_add_wave_noise.poll
+
+    def execute(self, context):
+        space = context.space_data
+        edit = space.edit_tree
+        tree = new_cellular_node_tree("Wave Cellular", space.tree_type)
+        for n in edit.nodes:
+            n.select = False
+        node = add_wave_node(edit, tree, tuple(space.cursor_location))
+        node.select = True
+        edit.nodes.active = node
+        return {"FINISHED"}
+
+
+def new_cellular_node_tree(name: str, tree_type: str) -> bpy.types.NodeTree:
+    """A Wave Cellular group (outputs Cell and Distance) from the default panel settings."""
+    from .cellular_nodes import build_cellular_group, new_cellular_tree
+
+    tree = new_cellular_tree(name, tree_type)
+    props = tree.omninoise_wave
+    props.is_cellular = True
+    props.directions = 4
+    build_cellular_group(props.to_settings(), tree=tree)
+    props.is_wave = True
+    return tree
 
 
 def new_wave_node_tree(name: str, tree_type: str) -> bpy.types.NodeTree:
@@ -170,17 +214,21 @@ def draw_wave_settings(layout, props) -> None:
     elif props.anisotropy == "axes":
         layout.prop(props, "axis_scale")
     layout.prop(props, "seed")
-    layout.prop(props, "speed")
+    if props.is_cellular:
+        layout.prop(props, "cell_size")
+    else:
+        layout.prop(props, "speed")
     if props.error:
         layout.label(text=props.error, icon="ERROR")
 
 
 def _menu(self, context):
     self.layout.operator(OMNINOISE_OT_add_wave_noise.bl_idname, text="Wave Noise (OmniNoise)")
+    self.layout.operator(OMNINOISE_OT_add_wave_cellular.bl_idname, text="Wave Cellular (OmniNoise)")
 
 
 MENUS = ("NODE_MT_category_shader_texture", "NODE_MT_category_GEO_TEXTURE")
-classes = (OMNINOISE_PG_wave, OMNINOISE_OT_add_wave_noise, OMNINOISE_PT_wave_node)
+classes = (OMNINOISE_PG_wave, OMNINOISE_OT_add_wave_noise, OMNINOISE_OT_add_wave_cellular, OMNINOISE_PT_wave_node)
 
 
 def register():
