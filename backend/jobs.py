@@ -25,6 +25,22 @@ missing output folders are created::
     spectrum = {kind = "fractal", fmin = 1, fmax = 8, exponent = 1.0}
     seed = 7
 
+A neural noise image (Maesumi et al. 2024) is a 2D bake with a neural source::
+
+    [[bake]]
+    name = "mossy"
+    output = "out/mossy.exr"
+    resolution = [512, 512]             # image pixels
+    [bake.source]
+    kind = "neural"
+    noise = "cells_f1"
+    params = {scale = 8}
+    blend = "mask.png"                  # optional: white areas take noise2 / params2
+    noise2 = "liquid"
+    steps = 30
+    seed = 3
+    tileable = false
+
 Every problem is reported as ``bake 'NAME': what is wrong``.
 """
 from __future__ import annotations

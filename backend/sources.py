@@ -21,7 +21,7 @@ import numpy as np
 
 from .errors import SettingError
 
-__all__ = ["BoxGrid", "Source", "WaveSource", "source_from_dict", "SOURCE_KINDS"]
+__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "source_from_dict", "SOURCE_KINDS"]
 
 _F = np.float32
 
@@ -158,19 +158,117 @@ class WaveSource:
         return d
 
 
-SOURCE_KINDS = ("wave",)
+class NeuralSource:
+    """Neural noise (Maesumi et al. 2024) as a 2D bake source: one class, or two blended by a mask.
+
+    The whole image is denoised at once (``chunkable`` is False); progress is per
+    DDIM step and cancel is polled after each step.  Pixels are the model's
+    pixels: the grid's resolution is the image size and its bounds only place it.
+    Image rows run top to bottom like the mask's, so a mask lines up with the file
+    a bake writes.
+    """
+
+    kind = "neural"
+    dim = 2
+    animated = False
+    chunkable = False
+
+    def __init__(self, model_folder: str, noise: str, params: dict | None = None, noise2: str | None = None,
+                 params2: dict | None = None, mask: np.ndarray | None = None, width: float = 32.0,
+                 sharpness: float = 1.0, steps: int = 30, seed: int = 0, tileable: bool = False):
+        from .neural.model import ModelError, NeuralNoiseModel
+
+        try:
+            self.model = NeuralNoiseModel(model_folder)
+        except ModelError as exc:
+            raise SettingError("source.model", str(exc)) from None
+        self.spec = (noise, dict(params or {}))
+        self.spec2 = None if mask is None else (noise2 or noise, dict(params2 or {}))
+        self.mask = None if mask is None else np.asarray(mask, np.float32)
+        self.width, self.sharpness = float(width), float(sharpness)
+        self.steps, self.seed, self.tileable = int(steps), int(seed), bool(tileable)
+        self.model.param_vector(*self.spec)  # unknown classes / parameters fail now, with their names
+        if self.spec2 is not None:
+            self.model.param_vector(*self.spec2)
+
+    def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
+        from .grid import Cancelled
+        from .neural import conditioning as C
+        from .neural.generate import generate
+
+        if len(shape) != 2:
+            raise SettingError("grid", "neural noise bakes images (resolution [width, height])")
+        H, W = shape
+        if self.mask is None:
+            cond = C.uniform(self.model, self.spec, H, W)
+        else:
+            if self.mask.shape != (H, W):
+                raise SettingError("source.blend", f"mask is {self.mask.shape[1]}x{self.mask.shape[0]} but the "
+                                   f"resolution is {W}x{H}")
+            cond = C.blend(self.model, self.spec, self.spec2, C.mask_weight(self.mask > 0.5, self.width, self.sharpness))
+
+        def step_done(i, n, x0):
+            if progress is not None:
+                progress((i + 1) / n)
+            if cancel is not None and cancel():
+                raise Cancelled("cancelled")
+
+        img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done)
+        return np.ascontiguousarray(img[::-1])  # bakes index rows by +y; files put +y at the top
+
+    def to_dict(self) -> dict:
+        d = dict(kind=self.kind, model=self.model.config["files"], spec=[self.spec[0], self.spec[1]],
+                 steps=self.steps, seed=self.seed, tileable=self.tileable)
+        if self.mask is not None:
+            d.update(spec2=[self.spec2[0], self.spec2[1]], width=self.width, sharpness=self.sharpness,
+                     mask_sha256=hashlib.sha256(np.ascontiguousarray(self.mask).tobytes()).hexdigest())
+        return d
+
+
+SOURCE_KINDS = ("wave", "neural")
+_NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "steps", "seed",
+                "tileable")
+
+
+def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
+    import os
+
+    unknown = sorted(set(d) - set(_NEURAL_KEYS))
+    if unknown:
+        raise SettingError(f"source.{unknown[0]}", f"unknown neural setting; known: {', '.join(_NEURAL_KEYS)}")
+    if "noise" not in d:
+        raise SettingError("source.noise", "a neural source needs noise = CLASS")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    model = os.path.join(base_dir, d["model"]) if "model" in d else os.path.join(root, "models", "neural_noise")
+    mask = None
+    if "blend" in d:
+        path = os.path.join(base_dir, d["blend"])
+        if not os.path.isfile(path):
+            raise SettingError("source.blend", f"mask not found: {path}")
+        from ._export import export
+
+        mask = export.read_image(path)
+    elif "noise2" in d or "params2" in d:
+        raise SettingError("source.noise2", "a second noise needs blend = MASK")
+    return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
+                        d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps", 30), d.get("seed", 0),
+                        d.get("tileable", False))
 
 
 def source_from_dict(d: dict, base_dir: str = ".") -> Source:
-    """A source from a job-file table: ``kind = "wave"`` plus the engine's settings.
+    """A source from a job-file table: ``kind = "wave"`` plus the engine's settings, or ``kind = "neural"``.
 
     Wave: the keys of :class:`~backend.settings.WaveSettings`; ``example = "img.png"``
     (relative to ``base_dir``) for by-example noise; ``w_offset`` for 4D.
+    Neural: noise, params, [blend = "mask.png", noise2, params2, width, sharpness],
+    steps, seed, tileable, [model = folder] (see :class:`NeuralSource`).
     """
     import os
 
     d = dict(d)
     kind = d.pop("kind", "wave")
+    if kind == "neural":
+        return _neural_from_dict(d, base_dir)
     if kind != "wave":
         raise SettingError("source.kind", f"unknown source {kind!r}; choose one of {', '.join(SOURCE_KINDS)}")
     from .settings import settings_from_dict

@@ -196,3 +196,49 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     meta = json.loads((out / "neural_noise.json").read_text())
     assert meta["files"]["eps.onnx"] in text and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
     assert "| without CutMix | 0.5 |" in text and "test CPU" in text
+
+
+def test_neural_bake_source_in_jobs(exported, tmp_path):
+    """kind = "neural" in a job file: a mask blend baked to PNG/npy, equal to generate() on the same grid."""
+    from backend.bake import BakeSpec, Cancelled, run_bake
+    from backend.jobs import run_job
+    from backend.sources import BoxGrid, NeuralSource
+    from export.images import write_png
+
+    _, out = exported
+    mask = np.zeros((24, 40), np.uint8)
+    mask[:, 20:] = 255
+    write_png(str(tmp_path / "mask.png"), mask)
+    (tmp_path / "job.toml").write_text(f"""
+[[bake]]
+name = "blend"
+output = "n.npy"
+resolution = [40, 24]
+[bake.source]
+kind = "neural"
+model = "{out}"
+noise = "spots"
+params = {{coverage = 0.6}}
+blend = "mask.png"
+noise2 = "perlin"
+steps = 3
+seed = 4
+""")
+    assert [o.status for o in run_job(str(tmp_path / "job.toml"))] == ["baked"]
+    got = np.load(tmp_path / "n.npy")[::-1]  # .npy rows run by +y; image rows top-down
+    model = NeuralNoiseModel(str(out))
+    ref = generate(model, C.blend(model, ("spots", {"coverage": 0.6}), ("perlin", {}),
+                                  C.mask_weight(mask > 127, 32.0, 1.0)), seed=4, steps=3)
+    np.testing.assert_allclose(got, ref, atol=1e-6)
+    src = NeuralSource(str(out), "spots", steps=5)
+    calls = []
+    with pytest.raises(Cancelled):
+        run_bake(BakeSpec("c", src, BoxGrid((16, 16)), str(tmp_path / "c.png")), cancel=lambda: len(calls) > 1
+                 or calls.append(1))
+    assert not (tmp_path / "c.png").exists()
+    with pytest.raises(SettingError, match="no parameter 'size'"):
+        NeuralSource(str(out), "spots", {"size": 3})
+    (tmp_path / "job.toml").write_text((tmp_path / "job.toml").read_text().replace("resolution = [40, 24]",
+                                                                                  "resolution = [32, 24]"))
+    out2 = run_job(str(tmp_path / "job.toml"), force=True)
+    assert out2[0].status == "failed" and "mask is 40x24 but the resolution is 32x24" in out2[0].message
