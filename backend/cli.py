@@ -109,6 +109,11 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--param2", action="append", default=[], metavar="NAME=VALUE")
     n.add_argument("--width", type=float, default=32.0, help="blend transition width, px")
     n.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1 = linear)")
+    n.add_argument("--corners", nargs=4, metavar="SPEC",
+                   help="four-corner blend: top-left top-right bottom-left bottom-right, each CLASS[:NAME=V,...]")
+    n.add_argument("--map", metavar="PAINTED", help="multi-class map: an indexed/grey or colour-coded image")
+    n.add_argument("--region", action="append", default=[], metavar="KEY=SPEC",
+                   help="--map region: grey index (0-255) or #rrggbb colour = CLASS[:NAME=V,...] (repeat)")
     n.add_argument("--model", help="model folder (default: models/neural_noise beside the package)")
     n.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
     n.add_argument("--quiet", action="store_true")
@@ -271,6 +276,45 @@ def _param_items(items: list, flag: str) -> dict:
     return out
 
 
+def _spec_arg(text: str, flag: str) -> tuple:
+    """'cells_f1:scale=8,jitter=0.5' -> ('cells_f1', {'scale': 8.0, 'jitter': 0.5})."""
+    name, _, rest = text.partition(":")
+    return name, _param_items([p for p in rest.split(",") if p], flag)
+
+
+def _painted_cond(model, a: argparse.Namespace):
+    from .neural import conditioning
+
+    if not os.path.isfile(a.map):
+        raise SettingError("--map", f"map not found: {a.map}")
+    if not a.region:
+        raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
+    from PIL import Image
+
+    with Image.open(a.map) as im:
+        colour = any(r.startswith("#") for r in a.region)
+        img = np.asarray(im.convert("RGB" if colour else "L"))
+    if img.shape[:2] != (a.size, a.size):
+        raise SettingError("--map", f"map is {img.shape[1]}x{img.shape[0]} but --size is {a.size}")
+    specs = {}
+    for r in a.region:
+        key, sep, spec = r.partition("=")
+        if not sep:
+            raise SettingError("--region", f"expected KEY=SPEC, got {r!r}")
+        if key.startswith("#"):
+            try:
+                k = tuple(int(key[i: i + 2], 16) for i in (1, 3, 5))
+            except ValueError:
+                raise SettingError("--region", f"bad colour {key!r}; use #rrggbb") from None
+        else:
+            try:
+                k = int(key)
+            except ValueError:
+                raise SettingError("--region", f"bad index {key!r}; use 0-255 or #rrggbb") from None
+        specs[k] = _spec_arg(spec, "--region")
+    return conditioning.painted(model, img, specs, a.width, a.sharpness)
+
+
 def run_neural(a: argparse.Namespace) -> int:
     import json
 
@@ -286,15 +330,21 @@ def run_neural(a: argparse.Namespace) -> int:
     if a.list:
         print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))
         return 0
-    if not a.noise or not a.out:
-        raise SettingError("neural", "give --noise CLASS and -o OUT (or --list)")
+    if not (a.noise or a.corners or a.map) or not a.out:
+        raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
     ext = os.path.splitext(a.out)[1].lower()
     if ext not in (".png", ".exr", ".npy"):
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
     spec = (a.noise, _param_items(a.param, "--param"))
-    if a.blend:
+    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
+        raise SettingError("--blend", "choose one of --blend, --corners and --map")
+    if a.corners:
+        cond = conditioning.four_corner(model, [_spec_arg(c, "--corners") for c in a.corners], a.size, a.size)
+    elif a.map:
+        cond = _painted_cond(model, a)
+    elif a.blend:
         from export.images import read_image
 
         if not os.path.isfile(a.blend):

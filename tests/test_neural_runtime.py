@@ -169,6 +169,17 @@ def test_neural_cli(exported, tmp_path, capsys):
     write_png(str(tmp_path / "m.png"), mask)
     assert main(base + ["--noise", "spots", "--noise2", "perlin", "--param2", "scale=10", "--blend",
                         str(tmp_path / "m.png"), "--size", "32", "-o", png]) == 0
+    assert main(base + ["--corners", "spots:coverage=0.3", "perlin", "cells_f1:scale=10,jitter=0.5", "spots",
+                        "--size", "24", "-o", png]) == 0
+    cmap = np.zeros((32, 32, 3), np.uint8)
+    cmap[:, 16:] = (255, 0, 0)
+    write_png(str(tmp_path / "map.png"), cmap)
+    assert main(base + ["--map", str(tmp_path / "map.png"), "--region", "#000000=spots", "--region",
+                        "#ff0000=perlin:scale=9", "--size", "32", "-o", str(tmp_path / "m.npy")]) == 0
+    assert np.load(tmp_path / "m.npy").shape == (32, 32)
+    assert main(base + ["--map", str(tmp_path / "map.png"), "--region", "#000000=spots", "--size", "32",
+                        "-o", png]) == 2
+    assert "uses (255, 0, 0) but no spec" in capsys.readouterr().err
     assert main(base + ["--list"]) == 0
     assert "spots" in json.loads(capsys.readouterr().out)["classes"]
     for args, msg in [(["--noise", "lava", "-o", png], "unknown class 'lava'"),
@@ -242,3 +253,14 @@ seed = 4
                                                                                   "resolution = [32, 24]"))
     out2 = run_job(str(tmp_path / "job.toml"), force=True)
     assert out2[0].status == "failed" and "mask is 40x24 but the resolution is 32x24" in out2[0].message
+
+
+def test_the_shipped_model_loads_and_generates():
+    """models/neural_noise: the committed ONNX passes its hash check and samples every trained class."""
+    import backend.cli
+
+    model = NeuralNoiseModel(backend.cli.DEFAULT_MODEL)
+    assert set(model.config["trained_classes"]) <= set(model.classes) and model.config["step"] > 0
+    for name in model.config["trained_classes"][:2]:
+        img = generate(model, C.uniform(model, (name, {}), 32, 32), seed=1, steps=3)
+        assert img.shape == (32, 32) and img.std() > 0.01
