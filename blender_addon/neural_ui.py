@@ -1,0 +1,371 @@
+"""Neural noise in Blender (Maesumi et al. 2024): swatches, a painted blend map, a background bake.
+
+Settings live on the scene (``Scene.omninoise_neural``) and are saved with the
+.blend.  A swatch is a noise class with its parameters (shown under the class's
+own parameter names) and a colour; the blend map is an image painted in those
+colours with Blender's texture-paint tools.  The bake builds the conditioning
+grid on the main thread, denoises on a :mod:`.tasks` worker (progress per DDIM
+step, Esc / Cancel stop within one step) and stores the result as an image
+datablock, optionally wired into the active material as Non-Color data.
+"""
+from __future__ import annotations
+
+import importlib
+import os
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty, \
+    IntProperty, PointerProperty, StringProperty
+
+from . import tasks
+from ._deps import backend
+from .bake_ui import _TaskOperator, draw_progress
+from .preferences import threads
+
+__all__ = ["model", "build_conditioning", "register", "unregister"]
+
+_MODEL = {}
+N_PARAMS = 4
+
+
+def _mod(name: str):
+    """A backend submodule, imported on first use (``neural.model``, ``neural.conditioning``...)."""
+    return importlib.import_module(f"{backend.__name__}.{name}")
+
+
+def model():
+    """The shipped model, loaded on first use (never at register time)."""
+    if "m" not in _MODEL:
+        _MODEL["m"] = _mod("neural.model").NeuralNoiseModel(_model_folder())
+    return _MODEL["m"]
+
+
+def _model_folder() -> str:
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    return os.path.join(root, "models", "neural_noise")
+
+
+def _class_items(self, context):
+    try:
+        names = model().config["trained_classes"]
+    except Exception as exc:  # a missing or altered model: one item that says so
+        return [("NONE", "No model", str(exc))]
+    return [(n, n.replace("_", " ").title(), model().class_params[n]["doc"]) for n in names]
+
+
+def _reset_params(self, context) -> None:
+    try:
+        spec = model().class_params[self.noise]["params"]
+    except Exception:
+        return
+    for i, p in enumerate(spec[:N_PARAMS]):
+        setattr(self, f"p{i}", 0.5 * (p["min"] + p["max"]))
+
+
+class OMNINOISE_PG_swatch(bpy.types.PropertyGroup):
+    noise: EnumProperty(name="Noise", items=_class_items, update=_reset_params)
+    p0: FloatProperty(name="Parameter 1")
+    p1: FloatProperty(name="Parameter 2")
+    p2: FloatProperty(name="Parameter 3")
+    p3: FloatProperty(name="Parameter 4")
+    color: FloatVectorProperty(name="Colour", subtype="COLOR", size=3, min=0.0, max=1.0, default=(1.0, 0.0, 0.0),
+                               description="The colour that paints this swatch into the blend map")
+
+    def spec(self) -> tuple:
+        params = model().class_params[self.noise]["params"][:N_PARAMS]
+        return self.noise, {p["name"]: float(getattr(self, f"p{i}")) for i, p in enumerate(params)}
+
+
+_PALETTE = [(1, 0, 0), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 0, 1), (0, 1, 1), (1, 1, 1), (0, 0, 0)]
+
+
+class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
+    swatches: CollectionProperty(type=OMNINOISE_PG_swatch)
+    active: IntProperty(default=0)
+    mode: EnumProperty(name="Layout", items=[
+        ("SINGLE", "Single", "The active swatch everywhere"),
+        ("GRADIENT", "Left to Right", "The first swatch on the left blending into the second on the right"),
+        ("CORNERS", "Four Corners", "Swatches 1-4 at the corners, blended bilinearly (Fig. 4)"),
+        ("MAP", "Painted Map", "Each pixel of the blend map takes the swatch of its colour")], default="SINGLE")
+    blend_map: PointerProperty(name="Blend Map", type=bpy.types.Image)
+    width: FloatProperty(name="Transition", description="Width of painted transitions, pixels", default=32.0,
+                         min=1.0, soft_max=256.0)
+    sharpness: FloatProperty(name="Sharpness", description="Transition exponent (1 = linear)", default=1.0,
+                             min=0.1, soft_max=8.0)
+    size: IntProperty(name="Size", default=512, min=8, soft_max=4096, max=16384)
+    steps: IntProperty(name="Steps", default=30, min=1, max=1000)
+    seed: IntProperty(name="Seed", default=0, min=0)
+    tileable: BoolProperty(name="Tileable", description="Seamless tile (the size becomes a multiple of 8)")
+    depth: EnumProperty(name="Depth", items=[("8", "8-bit", ""), ("16", "16-bit half", ""), ("32", "32-bit float", "")],
+                        default="32")
+    name: StringProperty(name="Name", default="Neural Noise")
+    add_node: BoolProperty(name="Add Image Texture Node", default=True,
+                           description="Wire the result into the active material as Non-Color data")
+
+
+# -- conditioning from the settings (main thread) -----------------------------------------
+
+def build_conditioning(p: OMNINOISE_PG_neural, size: int):
+    """(E + P, H, W) float32 grid for the scene's settings; SettingError naming what is wrong."""
+    C = _mod("neural.conditioning")
+    m = model()
+    sw = list(p.swatches)
+    if not sw:
+        raise backend.SettingError("swatches", "add a swatch first")
+    H = W = size
+    if p.mode == "SINGLE":
+        return C.uniform(m, sw[min(p.active, len(sw) - 1)].spec(), H, W)
+    if p.mode == "GRADIENT":
+        if len(sw) < 2:
+            raise backend.SettingError("swatches", "a left-to-right blend needs two swatches")
+        w = np.broadcast_to(np.linspace(0.0, 1.0, W, dtype=np.float32)[None, :], (H, W))
+        return C.blend(m, sw[0].spec(), sw[1].spec(), w)
+    if p.mode == "CORNERS":
+        if len(sw) < 4:
+            raise backend.SettingError("swatches", "a four-corner blend needs four swatches")
+        return C.four_corner(m, [s.spec() for s in sw[:4]], H, W)
+    img = p.blend_map
+    if img is None:
+        raise backend.SettingError("blend map", "pick or create a blend map image")
+    iw, ih = img.size
+    if iw != ih:
+        raise backend.SettingError("blend map", f"the map is {iw}x{ih}; it must be square like the output")
+    px = np.empty(iw * ih * 4, np.float32)
+    img.pixels.foreach_get(px)
+    rgb = np.flipud(px.reshape(ih, iw, 4)[..., :3])  # Blender stores rows bottom-up
+    if (iw, ih) != (W, H):  # nearest resampling of the painted regions
+        rgb = rgb[(np.arange(H) * ih // H)[:, None], (np.arange(W) * iw // W)[None, :]]
+    cols = np.array([tuple(s.color) for s in sw], np.float32)
+    d = np.abs(rgb[:, :, None, :] - cols[None, None]).max(-1)  # (H, W, swatches)
+    nearest, err = d.argmin(-1), d.min(-1)
+    if np.mean(err > 0.2) > 0.01:
+        raise backend.SettingError("blend map", f"{np.mean(err > 0.2) * 100:.0f}% of the map matches no swatch "
+                                   "colour; paint with the swatch colours")
+    present = sorted(set(np.unique(nearest).tolist()))
+    return C.painted(m, nearest, {i: sw[i].spec() for i in present}, p.width * size / max(iw, 1), p.sharpness)
+
+
+def _store(name: str, img: np.ndarray, depth: str):
+    """A float image datablock holding ``img`` (H, W) in [0, 1] (8/16-bit quantised on request)."""
+    H, W = img.shape
+    if depth == "8":
+        img = np.round(img * 255.0) / 255.0
+    elif depth == "16":
+        img = img.astype(np.float16).astype(np.float32)
+    ima = bpy.data.images.get(name)
+    if ima is None or tuple(ima.size) != (W, H):
+        if ima is not None:
+            bpy.data.images.remove(ima)
+        ima = bpy.data.images.new(name, W, H, alpha=False, float_buffer=depth != "8")
+    ima.colorspace_settings.name = "Non-Color"  # set before the pixels (changing it regenerates the image)
+    rgba = np.ones((H, W, 4), np.float32)
+    rgba[..., :3] = np.flipud(img)[..., None]
+    ima.pixels.foreach_set(rgba.ravel())
+    ima.update()
+    ima.pack()
+    return ima
+
+
+class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
+    """Bake neural noise from the swatches and the blend layout into an image"""
+
+    bl_idname = "omninoise.neural_bake"
+    bl_label = "Bake Neural Noise"
+    bl_options = {"REGISTER"}
+
+    preview: BoolProperty(name="Preview", description="A quick 64 px, 10-step preview", default=False,
+                          options={"SKIP_SAVE"})
+
+    def _start(self, context, blocking: bool):
+        p = context.scene.omninoise_neural
+        size = 64 if self.preview else p.size
+        if p.tileable and size % 8:
+            size += 8 - size % 8
+        steps = min(p.steps, 10) if self.preview else p.steps
+        try:
+            m = model()
+            cond = build_conditioning(p, size)
+        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        gib = cond.nbytes * 12 / 2**30  # activations of the U-Net: about 12x the conditioning grid
+        if gib > 16:
+            self.report({"ERROR"}, f"{size}² needs about {gib:.0f} GiB; bake a smaller size")
+            return None
+        seed, tileable, depth = p.seed, p.tileable, p.depth
+        name = p.name + (" Preview" if self.preview else "")
+        obj, add_node = context.active_object, p.add_node and not self.preview
+
+        def work(progress, cancel):
+            def step(i, n, x0):
+                progress((i + 1) / n)
+                if cancel():
+                    raise backend.Cancelled("cancelled")
+
+            return _mod("neural.generate").generate(m, cond, seed, steps, tileable, callback=step)
+
+        def done(img):
+            ima = _store(name, img, depth)
+            if add_node and obj is not None and obj.active_material is not None \
+                    and obj.active_material.node_tree is not None:
+                nt = obj.active_material.node_tree
+                node = next((n for n in nt.nodes if n.type == "TEX_IMAGE" and n.image == ima), None)
+                if node is None:
+                    node = nt.nodes.new("ShaderNodeTexImage")
+                    node.image = ima
+                nt.nodes.active = node
+
+        return tasks.start(tasks.Task(f"Neural {name}", work, done, None, threads()), blocking=blocking)
+
+
+class OMNINOISE_OT_swatch_add(bpy.types.Operator):
+    """Add a noise swatch"""
+
+    bl_idname = "omninoise.swatch_add"
+    bl_label = "Add Swatch"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        p = context.scene.omninoise_neural
+        sw = p.swatches.add()
+        sw.color = _PALETTE[(len(p.swatches) - 1) % len(_PALETTE)]
+        items = _class_items(sw, context)
+        if items and items[0][0] != "NONE":
+            sw.noise = items[(len(p.swatches) - 1) % len(items)][0]
+            _reset_params(sw, context)
+        p.active = len(p.swatches) - 1
+        return {"FINISHED"}
+
+
+class OMNINOISE_OT_swatch_remove(bpy.types.Operator):
+    """Remove the active swatch"""
+
+    bl_idname = "omninoise.swatch_remove"
+    bl_label = "Remove Swatch"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return len(context.scene.omninoise_neural.swatches) > 0
+
+    def execute(self, context):
+        p = context.scene.omninoise_neural
+        p.swatches.remove(p.active)
+        p.active = max(0, min(p.active, len(p.swatches) - 1))
+        return {"FINISHED"}
+
+
+class OMNINOISE_OT_blend_map_new(bpy.types.Operator):
+    """Create a blend map to paint: filled with the first swatch's colour, the second's on the right half"""
+
+    bl_idname = "omninoise.blend_map_new"
+    bl_label = "New Blend Map"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        p = context.scene.omninoise_neural
+        n = min(p.size, 1024)
+        img = bpy.data.images.new(f"{p.name} Map", n, n, alpha=False)
+        img.colorspace_settings.name = "Non-Color"  # before the pixels: changing it later regenerates the image
+        cols = [tuple(s.color) for s in p.swatches] or [(1.0, 0.0, 0.0)]
+        rgba = np.ones((n, n, 4), np.float32)
+        rgba[..., :3] = cols[0]
+        if len(cols) > 1:
+            rgba[:, n // 2:, :3] = cols[1]
+        img.pixels.foreach_set(rgba.ravel())
+        img.update()
+        img.pack()  # painted maps travel inside the .blend
+        p.blend_map = img
+        p.mode = "MAP"
+        return {"FINISHED"}
+
+
+class OMNINOISE_UL_swatches(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        row = layout.row(align=True)
+        row.prop(item, "color", text="")
+        row.label(text=item.noise.replace("_", " ").title())
+
+
+def draw_neural(layout, context) -> None:
+    """The panel body (shared by the Image Editor and the Shader Editor)."""
+    p = context.scene.omninoise_neural
+    draw_progress(layout)
+    row = layout.row()
+    row.template_list("OMNINOISE_UL_swatches", "", p, "swatches", p, "active", rows=3)
+    col = row.column(align=True)
+    col.operator(OMNINOISE_OT_swatch_add.bl_idname, icon="ADD", text="")
+    col.operator(OMNINOISE_OT_swatch_remove.bl_idname, icon="REMOVE", text="")
+    if p.swatches:
+        sw = p.swatches[min(p.active, len(p.swatches) - 1)]
+        box = layout.box()
+        box.prop(sw, "noise")
+        box.prop(sw, "color")
+        try:
+            spec = model().class_params[sw.noise]["params"]
+        except Exception as exc:
+            box.label(text=str(exc), icon="ERROR")
+            spec = []
+        for i, prm in enumerate(spec[:N_PARAMS]):
+            box.prop(sw, f"p{i}", text=f"{prm['name']} [{prm['min']:g}, {prm['max']:g}]")
+    layout.prop(p, "mode")
+    if p.mode == "MAP":
+        row = layout.row(align=True)
+        row.prop(p, "blend_map", text="")
+        row.operator(OMNINOISE_OT_blend_map_new.bl_idname, icon="ADD", text="")
+        layout.prop(p, "width")
+        layout.prop(p, "sharpness")
+    col = layout.column(align=True)
+    col.prop(p, "size")
+    col.prop(p, "steps")
+    col.prop(p, "seed")
+    layout.prop(p, "tileable")
+    layout.prop(p, "depth")
+    layout.prop(p, "name")
+    layout.prop(p, "add_node")
+    row = layout.row(align=True)
+    row.enabled = tasks.current() is None
+    row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Preview", icon="HIDE_OFF").preview = True
+    row.operator(OMNINOISE_OT_neural_bake.bl_idname, icon="RENDER_STILL")
+
+
+class OMNINOISE_PT_neural_image(bpy.types.Panel):
+    bl_label = "Neural Noise"
+    bl_space_type = "IMAGE_EDITOR"
+    bl_region_type = "UI"
+    bl_category = "OmniNoise"
+
+    def draw(self, context):
+        draw_neural(self.layout, context)
+
+
+class OMNINOISE_PT_neural_shader(bpy.types.Panel):
+    bl_label = "Neural Noise"
+    bl_space_type = "NODE_EDITOR"
+    bl_region_type = "UI"
+    bl_category = "OmniNoise"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.space_data, "tree_type", "") == "ShaderNodeTree"
+
+    def draw(self, context):
+        draw_neural(self.layout, context)
+
+
+classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_swatch_add,
+           OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches,
+           OMNINOISE_PT_neural_image, OMNINOISE_PT_neural_shader)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.omninoise_neural = PointerProperty(type=OMNINOISE_PG_neural)
+
+
+def unregister():
+    del bpy.types.Scene.omninoise_neural
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
