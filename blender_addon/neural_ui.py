@@ -100,6 +100,11 @@ class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
     depth: EnumProperty(name="Depth", items=[("8", "8-bit", ""), ("16", "16-bit half", ""), ("32", "32-bit float", "")],
                         default="32")
     name: StringProperty(name="Name", default="Neural Noise")
+    save: EnumProperty(name="Save", items=[("NONE", "Pack Only", "Keep the image packed in the .blend"),
+                                           ("EXR", "OpenEXR", "Also write an EXR (half for 16-bit, float for 32-bit)"),
+                                           ("PNG", "PNG", "Also write an 8-bit PNG")], default="NONE")
+    folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise/",
+                           description="Where saved images go ('//' = beside the .blend, or the cache folder)")
     add_node: BoolProperty(name="Add Image Texture Node", default=True,
                            description="Wire the result into the active material as Non-Color data")
 
@@ -195,6 +200,15 @@ class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
             return None
         seed, tileable, depth = p.seed, p.tileable, p.depth
         name = p.name + (" Preview" if self.preview else "")
+        save_path = None
+        if p.save != "NONE" and not self.preview:
+            from .bake_blender import output_folder
+
+            try:
+                save_path = os.path.join(output_folder(p.folder), bpy.path.clean_name(name) + "." + p.save.lower())
+            except OSError as exc:
+                self.report({"ERROR"}, f"output folder: {exc}")
+                return None
         obj, add_node = context.active_object, p.add_node and not self.preview
 
         def work(progress, cancel):
@@ -203,10 +217,20 @@ class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
                 if cancel():
                     raise backend.Cancelled("cancelled")
 
-            return _mod("neural.generate").generate(m, cond, seed, steps, tileable, callback=step)
+            img = _mod("neural.generate").generate(m, cond, seed, steps, tileable, callback=step)
+            if save_path is not None:  # atomic, off the main thread
+                from ._deps import export
+
+                if save_path.endswith(".png"):
+                    export.write_png(save_path, (np.clip(img, 0, 1) * 255.0 + 0.5).astype(np.uint8))
+                else:
+                    export.write_exr(save_path, img, half=depth != "32")
+            return img
 
         def done(img):
             ima = _store(name, img, depth)
+            if save_path is not None:
+                ima["omninoise_file"] = save_path
             if add_node and obj is not None and obj.active_material is not None \
                     and obj.active_material.node_tree is not None:
                 nt = obj.active_material.node_tree
@@ -323,6 +347,9 @@ def draw_neural(layout, context) -> None:
     layout.prop(p, "tileable")
     layout.prop(p, "depth")
     layout.prop(p, "name")
+    layout.prop(p, "save")
+    if p.save != "NONE":
+        layout.prop(p, "folder")
     layout.prop(p, "add_node")
     row = layout.row(align=True)
     row.enabled = tasks.current() is None

@@ -144,3 +144,18 @@ def test_panel_draws(scene):
     want = [q["name"] for q in neural_ui.model().class_params[active.noise]["params"]]
     assert [t.split(" [")[0] for t in texts] == want  # sliders carry the class's own parameter names
     assert ("operator", None, "Preview") in [(n, None, t) for n, a, t in log if n == "operator"]
+
+
+def test_bake_also_saves_files(scene, tmp_path):
+    from export.images import read_image
+
+    p = scene.omninoise_neural
+    p.folder = str(tmp_path) + os.sep
+    p.name = "Saved"
+    p.save = "EXR"
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
+    np.testing.assert_allclose(read_image(str(tmp_path / "Saved.exr")), _pixels("Saved"), atol=1e-6)
+    p.save, p.depth = "PNG", "8"
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
+    np.testing.assert_allclose(read_image(str(tmp_path / "Saved.png")), _pixels("Saved"), atol=1 / 255 + 1e-6)
+    assert sorted(os.listdir(tmp_path)) == ["Saved.exr", "Saved.png"]
