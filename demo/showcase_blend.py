@@ -84,9 +84,63 @@ def build_scene():
     return sc
 
 
+def add_neural_plane(sc, out: str):
+    """The Neural Noise panel's workflow, headless: two swatches, a painted map, a bake on a plane.
+
+    The plane sits below the camera's view, so the still render is unchanged; the
+    map and the bake are also written side by side to neural_panel.png.
+    """
+    import numpy as np
+
+    import blender_addon
+    from blender_addon import neural_ui
+    from export.images import write_png
+
+    try:
+        neural_ui.model()
+    except Exception as exc:  # no shipped model: the rest of the showcase still stands
+        print(f"neural plane skipped: {exc}")
+        return
+    blender_addon.register()
+    p = sc.omninoise_neural
+    p.size, p.steps, p.seed, p.name = 128, 30, 11, "Neural Blend"
+    for noise, colour in (("cells_f1", (1.0, 0.0, 0.0)), ("damascus", (0.0, 0.0, 1.0))):
+        bpy.ops.omninoise.swatch_add()
+        p.swatches[-1].noise = noise
+        p.swatches[-1].color = colour
+    bpy.ops.omninoise.blend_map_new()
+    n = p.blend_map.size[0]
+    yy, xx = np.mgrid[:n, :n]
+    paint = np.ones((n, n, 4), np.float32)
+    paint[..., :3] = (1.0, 0.0, 0.0)
+    stroke = np.abs(yy - (n / 2 + n / 4 * np.sin(xx / n * 2 * np.pi))) < n / 6  # a wavy band "painted" in blue
+    paint[stroke, :3] = (0.0, 0.0, 1.0)
+    p.blend_map.pixels.foreach_set(paint.ravel())
+    p.blend_map.update()
+    p.mode = "MAP"
+    p.width = 24.0
+    bpy.ops.omninoise.neural_bake()
+    bpy.ops.mesh.primitive_plane_add(size=2.0, location=(0, 0, -3.0), rotation=(1.5708, 0, 0))
+    ob = bpy.context.active_object
+    ob.name = "Neural Blend"
+    mat = bpy.data.materials.new("Neural Blend")
+    nt = mat.node_tree
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image = bpy.data.images["Neural Blend"]
+    bsdf = next(nd for nd in nt.nodes if nd.type == "BSDF_PRINCIPLED")
+    nt.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+    ob.data.materials.append(mat)
+    baked = np.empty(128 * 128 * 4, np.float32)
+    bpy.data.images["Neural Blend"].pixels.foreach_get(baked)
+    side = np.concatenate([np.flipud(paint[..., :3]), np.repeat(np.flipud(baked.reshape(128, 128, 4))[..., :1], 3, -1)],
+                          1)
+    write_png(os.path.join(out, "neural_panel.png"), (np.clip(side, 0, 1) * 255 + 0.5).astype(np.uint8))
+
+
 def main(out: str) -> None:
     os.makedirs(out, exist_ok=True)
     sc = build_scene()
+    add_neural_plane(sc, out)
     path = os.path.join(out, "showcase.blend")
     tmp = path + ".tmp.blend"
     bpy.ops.wm.save_as_mainfile(filepath=tmp, compress=True)
