@@ -125,14 +125,14 @@ class BakeSpec:
                    time=self.frame_time(frame), half=bool(self.half and ext in (".exr", ".vdb")), format=ext)
         return hashlib.sha256(describe(doc).encode()).hexdigest()
 
-    def is_up_to_date(self, frame) -> bool:
+    def is_up_to_date(self, frame, key: str | None = None) -> bool:
         """True when the file of ``frame`` exists and carries this spec's key (.npy never does)."""
         path = frame_path(self.output, frame)
         if os.path.splitext(path)[1].lower() == ".npy":
             return False
         from ._export import export
 
-        return export.read_metadata(path).get(KEY_NAME) == self.key(frame)
+        return export.read_metadata(path).get(KEY_NAME) == (key or self.key(frame))
 
 
 @dataclass
@@ -246,7 +246,7 @@ def run_bake(spec: BakeSpec, progress: Callable[[float], None] | None = None,
     for i, frame in enumerate(frames):
         path = frame_path(spec.output, frame)
         key = spec.key(frame)
-        if not force and spec.is_up_to_date(frame):
+        if not force and spec.is_up_to_date(frame, key):
             res.skipped.append(path)
             if progress is not None:
                 progress((i + 1) / len(frames))

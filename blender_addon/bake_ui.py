@@ -463,8 +463,6 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.Scene.omninoise_bake = PointerProperty(type=OMNINOISE_PG_bake)
-    bpy.types.WindowManager.omninoise_progress = FloatProperty(min=0.0, max=1.0, options={"SKIP_SAVE"})
-    bpy.types.WindowManager.omninoise_task = StringProperty(options={"SKIP_SAVE"})
     bpy.types.WindowManager.omninoise_message = StringProperty(options={"SKIP_SAVE"})
     bpy.types.STATUSBAR_HT_header.append(_statusbar)
 
@@ -472,8 +470,7 @@ def register():
 def unregister():
     tasks.cancel()
     bpy.types.STATUSBAR_HT_header.remove(_statusbar)
-    for name in ("omninoise_progress", "omninoise_task", "omninoise_message"):
-        delattr(bpy.types.WindowManager, name)
+    del bpy.types.WindowManager.omninoise_message
     del bpy.types.Scene.omninoise_bake
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

@@ -92,7 +92,6 @@ class Task:
         self._finished = True
         if _current is self:
             _current = None
-        _set_wm(None)
         if self.status == "done" and self.on_done is not None:
             try:
                 self.on_done(self.result)
@@ -106,19 +105,10 @@ class Task:
     def poll(self):
         """bpy.app.timers callback: seconds until the next poll, or None when over."""
         if self._thread is not None and self._thread.is_alive():
-            _set_wm(self)
             _redraw()
             return POLL_SECONDS
         self.finish()
         return None
-
-
-def _set_wm(task: "Task | None") -> None:
-    wm = getattr(bpy.context, "window_manager", None)
-    if wm is None or not hasattr(wm, "omninoise_progress"):
-        return
-    wm.omninoise_progress = task.progress if task is not None else 0.0
-    wm.omninoise_task = task.label if task is not None else ""
 
 
 def _redraw() -> None:
