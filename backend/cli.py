@@ -267,12 +267,12 @@ def _param_items(items: list, flag: str) -> dict:
     out = {}
     for item in items:
         key, sep, val = item.partition("=")
+        if not sep:
+            raise SettingError(flag, f"expected NAME=VALUE, got {item!r}")
         try:
             out[key] = float(val)
         except ValueError:
             raise SettingError(flag, f"expected NAME=VALUE with a number, got {item!r}") from None
-        if not sep:
-            raise SettingError(flag, f"expected NAME=VALUE, got {item!r}")
     return out
 
 
@@ -360,13 +360,11 @@ def run_neural(a: argparse.Namespace) -> int:
         cond = conditioning.uniform(model, spec, a.size, a.size)
     bar = _Bar(a.quiet)
     img = generate(model, cond, a.seed, a.steps, a.tileable, callback=lambda i, n, x0: bar((i + 1) / n))
-    if ext == ".png":
-        from export.images import write_png
+    from export.images import preview_8bit, write_image, write_png
 
-        write_png(a.out, (img * 255.0 + 0.5).astype(np.uint8))
+    if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch
+        write_png(a.out, preview_8bit(img, 0.0, 1.0))
     else:
-        from export.images import write_image
-
         write_image(a.out, img)
     return 0
 
@@ -389,14 +387,12 @@ def run_zoo(a: argparse.Namespace) -> int:
         params = zoo.parse_params(a.noise, a.param)
     except ValueError as exc:
         raise SettingError("--noise" if "class" in str(exc) else "--param", str(exc)) from None
-    from export.images import write_image
+    from export.images import preview_8bit, write_image, write_png
 
     img = zoo.generate(a.noise, params, [a.seed], a.size)[0].numpy()
     ext = os.path.splitext(a.out)[1].lower()
-    if ext == ".png":
-        from export.images import write_png
-
-        write_png(a.out, (img * 255.0 + 0.5).astype(np.uint8))
+    if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch
+        write_png(a.out, preview_8bit(img, 0.0, 1.0))
     else:
         write_image(a.out, img)
     return 0

@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 
 from ._deps import backend
-from .wave_nodes import INPUTS, SETTINGS_KEY, _clear, _new_group, _Nodes, settings_to_json
+from .wave_nodes import INPUTS, SETTINGS_KEY, _clear, _group_io, _new_group, _Nodes, settings_to_json
 
 __all__ = ["build_cellular_group", "new_cellular_tree", "CELL_OUTPUTS"]
 
@@ -58,10 +58,7 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
     C = noise.cell_size
     inv = float(_F(1.0 / C))
     b = _Nodes(tree)
-    gi = b.new("NodeGroupInput")
-    go = b.new("NodeGroupOutput")
-    x = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
-    w = b.math("MULTIPLY", gi.outputs["W"], gi.outputs["Scale"])
+    _, go, x, w = _group_io(b)
     dim = noise.dim
     dist, code = None, 0.0
     for f, normal in enumerate(noise.normals):
@@ -73,9 +70,10 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
         p = b.math("MULTIPLY_ADD", dot, inv, off)
         j = b.math("FLOOR", p)
         o = b.math("SUBTRACT", p, j)
-        here = b.math("MULTIPLY_ADD", _value(b, float(f), j, float(_PLANE), seed), 0.4, 0.3)
-        nxt = b.math("MULTIPLY_ADD", _value(b, float(f), b.math("ADD", j, 1.0), float(_PLANE), seed), 0.4, 0.3)
-        prv = b.math("MULTIPLY_ADD", _value(b, float(f), b.math("SUBTRACT", j, 1.0), float(_PLANE), seed), 0.4, 0.3)
+        def plane(i, f=float(f)):  # s(i) = 0.3 + 0.4 h(f, i, 25, seed)
+            return b.math("MULTIPLY_ADD", _value(b, f, i, float(_PLANE), seed), 0.4, 0.3)
+
+        here, nxt, prv = plane(j), plane(b.math("ADD", j, 1.0)), plane(b.math("SUBTRACT", j, 1.0))
         below = b.math("LESS_THAN", o, here)  # 1 - above
         up = b.math("SUBTRACT", b.math("ADD", nxt, 1.0), o)        # 1 + s(j+1) - φ
         down = b.math("SUBTRACT", b.math("ADD", o, 1.0), prv)      # φ + 1 - s(j-1)

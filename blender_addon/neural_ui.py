@@ -222,7 +222,7 @@ class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
                 from ._deps import export
 
                 if save_path.endswith(".png"):
-                    export.write_png(save_path, (np.clip(img, 0, 1) * 255.0 + 0.5).astype(np.uint8))
+                    export.write_png(save_path, export.preview_8bit(img, 0.0, 1.0))
                 else:
                     export.write_exr(save_path, img, half=depth != "32")
             return img

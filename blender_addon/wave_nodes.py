@@ -368,6 +368,16 @@ def add_wave_node(node_tree: bpy.types.NodeTree, group: bpy.types.NodeTree, loca
     return node
 
 
+def _group_io(b: _Nodes) -> tuple:
+    """Group input and output nodes, and the scaled inputs every OmniNoise group starts from:
+    (group input, group output, Vector x Scale, W x Scale)."""
+    gi = b.new("NodeGroupInput")
+    go = b.new("NodeGroupOutput")
+    x = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
+    w = b.math("MULTIPLY", gi.outputs["W"], gi.outputs["Scale"])
+    return gi, go, x, w
+
+
 def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
                      name: str = "Wave Noise") -> bpy.types.NodeTree:
     """Build (or rebuild in place) the Wave Noise group for ``settings`` (a backend WaveSettings).
@@ -392,10 +402,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     dim = noise.dim
     full = any(d.full for d in noise.dirs.domains)
     b = _Nodes(tree)
-    gi = b.new("NodeGroupInput")
-    go = b.new("NodeGroupOutput")
-    x = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
-    w = b.math("MULTIPLY", gi.outputs["W"], gi.outputs["Scale"])
+    gi, go, x, w = _group_io(b)
     shift = b.math("MULTIPLY", gi.outputs["Time"], float(_F(noise.speed)))
     group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
     acc = (0.0, 0.0, 0.0)

@@ -102,11 +102,9 @@ def _wave_tree(context):
     return None
 
 
-class OMNINOISE_OT_add_wave_noise(bpy.types.Operator):
-    """Add a Wave Noise node (Guehl et al. 2025) built from Blender's own nodes"""
+class _AddGroupNode:
+    """Add-menu operator: a new group tree (``make_tree``) as a selected, active node at the cursor."""
 
-    bl_idname = "node.omninoise_add_wave_noise"
-    bl_label = "Wave Noise"
     bl_options = {"REGISTER", "UNDO"}
 
     @classmethod
@@ -119,7 +117,7 @@ class OMNINOISE_OT_add_wave_noise(bpy.types.Operator):
         space = context.space_data
         edit = space.edit_tree
         try:
-            tree = new_wave_node_tree("Wave Noise", space.tree_type)
+            tree = self.make_tree(self.bl_label, space.tree_type)
         except backend.SettingError as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
@@ -131,25 +129,26 @@ class OMNINOISE_OT_add_wave_noise(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class OMNINOISE_OT_add_wave_cellular(bpy.types.Operator):
+class OMNINOISE_OT_add_wave_noise(_AddGroupNode, bpy.types.Operator):
+    """Add a Wave Noise node (Guehl et al. 2025) built from Blender's own nodes"""
+
+    bl_idname = "node.omninoise_add_wave_noise"
+    bl_label = "Wave Noise"
+
+    @staticmethod
+    def make_tree(name, tree_type):
+        return new_wave_node_tree(name, tree_type)
+
+
+class OMNINOISE_OT_add_wave_cellular(_AddGroupNode, bpy.types.Operator):
     """Add a Wave Cellular node: random-plane polytopes (Guehl et al. 2025, Alg. 2) from Blender's own nodes"""
 
     bl_idname = "node.omninoise_add_wave_cellular"
     bl_label = "Wave Cellular"
-    bl_options = {"REGISTER", "UNDO"}
 
-    poll = OMNINOISE_OT_add_wave_noise.poll
-
-    def execute(self, context):
-        space = context.space_data
-        edit = space.edit_tree
-        tree = new_cellular_node_tree("Wave Cellular", space.tree_type)
-        for n in edit.nodes:
-            n.select = False
-        node = add_wave_node(edit, tree, tuple(space.cursor_location))
-        node.select = True
-        edit.nodes.active = node
-        return {"FINISHED"}
+    @staticmethod
+    def make_tree(name, tree_type):
+        return new_cellular_node_tree(name, tree_type)
 
 
 def new_cellular_node_tree(name: str, tree_type: str) -> bpy.types.NodeTree:

@@ -20,7 +20,7 @@ sys.path.insert(0, ROOT)
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
-from export.images import write_png  # noqa: E402
+from export.images import preview_8bit, write_png  # noqa: E402
 
 STEPS = 30
 
@@ -53,7 +53,7 @@ def main(out: str) -> int:
             pad(np.concatenate([mask.astype(np.float32), blend], 1)), pad(np.concatenate([corners, tiled], 1))]
     sheet = np.concatenate([pad(r) if r.shape[1] < wide else r[:, :wide] for r in rows], 0)
     os.makedirs(out, exist_ok=True)
-    write_png(os.path.join(out, "neural.png"), (np.clip(sheet, 0, 1) * 255 + 0.5).astype(np.uint8))
+    write_png(os.path.join(out, "neural.png"), preview_8bit(sheet, 0.0, 1.0))
     info = dict(classes=names, sweep=dict(cls=names[0], param=first["name"]), steps=STEPS, size=S,
                 seconds=round(time.perf_counter() - t0, 1), model_sha256=model.config["files"]["eps.onnx"])
     with open(os.path.join(out, "neural.json"), "w", encoding="utf-8") as fh:

@@ -94,7 +94,7 @@ def add_neural_plane(sc, out: str):
 
     import blender_addon
     from blender_addon import neural_ui
-    from export.images import write_png
+    from export.images import preview_8bit, write_png
 
     try:
         neural_ui.model()
@@ -134,7 +134,7 @@ def add_neural_plane(sc, out: str):
     bpy.data.images["Neural Blend"].pixels.foreach_get(baked)
     side = np.concatenate([np.flipud(paint[..., :3]), np.repeat(np.flipud(baked.reshape(128, 128, 4))[..., :1], 3, -1)],
                           1)
-    write_png(os.path.join(out, "neural_panel.png"), (np.clip(side, 0, 1) * 255 + 0.5).astype(np.uint8))
+    write_png(os.path.join(out, "neural_panel.png"), preview_8bit(side, 0.0, 1.0))
 
 
 def main(out: str) -> None:

@@ -205,7 +205,7 @@ def save_samples(model: UNet, cfg: TrainConfig, device, path: str) -> None:
 
     imgs = sample_grid(model, cfg, device)
     row = np.concatenate(list(imgs), axis=1)
-    export.write_png(path, (np.clip(row, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8))
+    export.write_png(path, export.preview_8bit(row, 0.0, 1.0))
 
 
 def main(argv=None) -> int:
