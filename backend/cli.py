@@ -119,6 +119,20 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--quiet", action="store_true")
     n.add_argument("-o", "--out", help="output: .png, .exr or .npy")
 
+    s = sub.add_parser("solid", help="neural solid textures (Henzler et al. 2020) from trained ONNX models")
+    s.add_argument("--exemplar", help="a shipped texture (see --list) or an image file (encoded by the space model)")
+    s.add_argument("--to", metavar="EXEMPLAR", help="interpolate towards this exemplar (space model)")
+    s.add_argument("--mix", type=float, default=0.5, help="interpolation weight of --to, 0..1 (default 0.5)")
+    s.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image (the z = 0 slice); 3: a volume")
+    s.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
+    s.add_argument("--scale", type=float, default=1.0,
+                   help="zoom: output pixels per exemplar pixel (default 1, the exemplar's own resolution)")
+    s.add_argument("--seed", type=int, default=0, help="variation: another seed gives another texture of the same kind")
+    s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
+    s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
+    s.add_argument("--quiet", action="store_true")
+    s.add_argument("-o", "--out", help="2D: .png (sRGB), .exr or .npy (linear); 3D: .vdb or .npy (linear)")
+
     z = sub.add_parser("zoo", help="ground-truth images of the neural noise training zoo (needs torch)")
     z.add_argument("--noise", help="class name (see --list)")
     z.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
@@ -369,6 +383,98 @@ def run_neural(a: argparse.Namespace) -> int:
     return 0
 
 
+SOLID_MODELS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "solid")
+
+
+def _solid_code(model, name: str, flag: str):
+    """z of a space model for a known exemplar name or an image file."""
+    from export.images import read_rgb
+
+    if name in model.codes:
+        return model.codes[name]
+    if not os.path.isfile(name):
+        raise SettingError(flag, f"{name!r} is neither an image file nor an exemplar the model knows "
+                                 f"({', '.join(model.codes) or 'none'})")
+    try:
+        return model.encode(read_rgb(name))
+    except ValueError as exc:
+        raise SettingError(flag, str(exc)) from None
+
+
+def run_solid(a: argparse.Namespace) -> int:
+    import json
+
+    from .neural.model import ModelError
+    from .solid.model import SolidTextureModel
+
+    if a.list:
+        out = {}
+        for entry in sorted(os.listdir(SOLID_MODELS)) if os.path.isdir(SOLID_MODELS) else []:
+            try:
+                m = SolidTextureModel(os.path.join(SOLID_MODELS, entry))
+            except ModelError:
+                continue
+            out[entry] = dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
+        print(json.dumps(out, indent=2))
+        return 0
+    if not a.exemplar or not a.out:
+        raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")
+    if a.size < 1:
+        raise SettingError("--size", f"must be >= 1, got {a.size}")
+    if not a.scale > 0:
+        raise SettingError("--scale", f"must be > 0, got {a.scale}")
+    if not 0.0 <= a.mix <= 1.0:
+        raise SettingError("--mix", f"must be in [0, 1], got {a.mix}")
+    ext = os.path.splitext(a.out)[1].lower()
+    allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
+    if ext not in allowed:
+        raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
+    folder = a.model
+    if folder is None:
+        named = os.path.join(SOLID_MODELS, os.path.basename(a.exemplar))
+        folder = named if os.path.isfile(os.path.join(named, "solid.json")) and not a.to else \
+            os.path.join(SOLID_MODELS, "space")
+    try:
+        model = SolidTextureModel(folder)
+    except ModelError as exc:
+        raise SettingError("--model", f"{exc}; see models/solid/MODEL_CARD.md or pass --model") from None
+    if a.dim == 3 and model.dim != 3:
+        raise SettingError("--dim", f"model {model.name!r} is 2D; it cannot fill a volume")
+    if model.mode == "single":
+        if a.to:
+            raise SettingError("--to", f"model {model.name!r} holds one texture; interpolation needs the space model")
+        code = model.default_code()
+    else:
+        z = _solid_code(model, a.exemplar, "--exemplar")
+        if a.to:
+            z = (1.0 - a.mix) * z + a.mix * _solid_code(model, a.to, "--to")
+        code = model.translate(z)
+    bar = _Bar(a.quiet)
+    from .solid.bake import bake_volume, evaluate_grid, srgb_to_linear
+    from .sources import BoxGrid
+
+    extent = a.size / (model.px_per_unit * a.scale)
+    if a.dim == 3 and ext == ".vdb":
+        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
+        bake_volume(model, code, grid, a.out, a.seed, progress=bar)
+        return 0
+    if a.dim == 3:
+        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
+        rgb = evaluate_grid(model, code, grid, a.seed, progress=bar)
+        from export.images import write_npy
+
+        write_npy(a.out, srgb_to_linear(rgb))
+        return 0
+    rgb = model.image(a.size, code, a.seed, scale=a.scale, progress=lambda d, n: bar(d / n))
+    from export.images import preview_8bit, write_image, write_png
+
+    if ext == ".png":
+        write_png(a.out, preview_8bit(rgb, 0.0, 1.0))
+    else:
+        write_image(a.out, srgb_to_linear(rgb))
+    return 0
+
+
 def run_zoo(a: argparse.Namespace) -> int:
     import json
 
@@ -432,6 +538,11 @@ def main(argv: list[str] | None = None) -> int:
             return run_zoo(a)
         if a.command == "neural":
             return run_neural(a)
+        if a.command == "solid":
+            return run_solid(a)
+    except InterruptedError:
+        print(f"omninoise {a.command}: cancelled", file=sys.stderr)
+        return 130
     except (SettingError, FileNotFoundError, PermissionError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2

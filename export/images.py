@@ -13,7 +13,7 @@ import numpy as np
 
 from .atomic import atomic_path
 
-__all__ = ["write_npy", "write_png", "write_exr", "write_image", "read_image", "preview_8bit", "read_metadata",
+__all__ = ["write_npy", "write_png", "write_exr", "write_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
            "encode_srgb8"]
 
 
@@ -127,6 +127,20 @@ def read_image(path: str) -> np.ndarray:
     if a.ndim == 3:
         a = a[..., :3].mean(axis=2)
     return a
+
+
+def read_rgb(path: str) -> np.ndarray:
+    """Read an 8/16-bit image file as float32 (H, W, 3) in [0, 1], its stored (sRGB) values;
+    greyscale is repeated, alpha dropped.  The exemplar format of the solid textures."""
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"image not found: {path}")
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            return np.asarray(im.convert("RGB"), dtype=np.float32) / 255.0
+    except UnidentifiedImageError:
+        raise ValueError(f"not an image Pillow can read: {path}") from None
 
 
 def _png_text(path: str) -> dict:

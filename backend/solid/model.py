@@ -1,0 +1,182 @@
+"""A neural solid texture at run time: onnxruntime and numpy, no torch (Henzler et al. 2020).
+
+A model folder holds ``solid.json`` and ``decoder.onnx`` (space models also
+``encoder.onnx`` and ``translator.onnx``), written by
+``backend/training/solid/export.py``.  Loading checks every file's sha256
+against the JSON; sessions are created on first use.
+
+    tex = SolidTextureModel("models/solid/gravel_3d")
+    code = tex.default_code()                        # TextureCode(e (64,), T (8, 3, 3))
+    rgb = tex.evaluate(points, code, seed=0)         # points (N, 3) in units -> float32 (N, 3) sRGB in [0, 1]
+
+Space models also map an exemplar image to a code (``encode``) and codes to
+(e, T) (``translate``); codes interpolate linearly in z (Sec. 5, Fig. 1).
+Positions are in texture units: ``px_per_unit`` exemplar pixels per unit.
+"""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SettingError
+from ..neural.model import ModelError, sha256_file
+from .lattice import lattice_noise
+
+__all__ = ["SolidTextureModel", "TextureCode", "DEFAULT_CHUNK"]
+
+_F = np.float32
+DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
+
+
+@dataclass(frozen=True)
+class TextureCode:
+    """What the sampler needs: the extended code e float32 (E,) and the octave transforms T float32 (m, D, D)."""
+    e: np.ndarray
+    T: np.ndarray
+
+
+class SolidTextureModel:
+    def __init__(self, folder: str, threads: int = 0):
+        path = os.path.join(folder, "solid.json")
+        if not os.path.isfile(path):
+            raise ModelError(f"no solid.json in {folder}")
+        with open(path, encoding="utf-8") as fh:
+            self.config = json.load(fh)
+        if self.config.get("model") != "neural_solid_texture":
+            raise ModelError(f"{path} is not a neural solid texture model")
+        for name, digest in self.config["files"].items():
+            fp = os.path.join(folder, name)
+            if not os.path.isfile(fp):
+                raise ModelError(f"model file missing: {fp}")
+            if sha256_file(fp) != digest:
+                raise ModelError(f"{name}: sha256 does not match solid.json (altered or damaged file)")
+        c = self.config
+        self.folder, self.threads = folder, threads
+        self.name, self.mode, self.dim = c["name"], c["mode"], int(c["dim"])
+        self.octaves, self.channels, self.code_dim = int(c["octaves"]), int(c["channels"]), int(c["code_dim"])
+        self.px_per_unit = float(c["px_per_unit"]) / float(c.get("exemplar_scale", 1.0))
+        self.codes = {k: np.asarray(v, _F) for k, v in c.get("codes", {}).items()}
+        self._sessions = {}
+
+    # -- onnxruntime ------------------------------------------------------------------------
+    def _session(self, name: str):
+        if name not in self._sessions:
+            import onnxruntime as ort
+
+            opts = ort.SessionOptions()
+            if self.threads:
+                opts.intra_op_num_threads = self.threads
+            self._sessions[name] = ort.InferenceSession(os.path.join(self.folder, name), opts,
+                                                        providers=["CPUExecutionProvider"])
+        return self._sessions[name]
+
+    # -- codes ----------------------------------------------------------------------------------
+    def default_code(self) -> TextureCode:
+        """The single-mode texture, or the space model's first training exemplar."""
+        if self.mode == "single":
+            return TextureCode(np.asarray(self.config["code"], _F), np.asarray(self.config["T"], _F))
+        return self.translate(next(iter(self.codes.values())))
+
+    def encode(self, image: np.ndarray) -> np.ndarray:
+        """Space mode, Sec. 3 encoder g: image float (H, W, 3) or (H, W) in [0, 1] -> z float32 (z_dim,).
+
+        The mean code of overlapping 128 px crops (the image is first resized
+        so its short side is at least 128 px, keeping pixels per unit).
+        """
+        if self.mode != "space":
+            raise SettingError("exemplar", f"model {self.name!r} was fitted to one exemplar and cannot encode images; "
+                                           "use a space model")
+        img = np.asarray(image, _F)
+        if img.ndim == 2:
+            img = np.repeat(img[..., None], 3, axis=2)
+        if img.ndim != 3 or img.shape[2] not in (3, 4):
+            raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
+        img = img[..., :3]
+        S = int(self.config.get("encoder_size", 128))
+        if min(img.shape[:2]) < S:
+            from PIL import Image
+            f = S / min(img.shape[:2])
+            h, w = max(S, round(img.shape[0] * f)), max(S, round(img.shape[1] * f))
+            img = np.stack([np.asarray(Image.fromarray(img[..., c]).resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
+        H, W, _ = img.shape
+        # crops at most S/2 apart that cover the whole image
+        ys = np.unique(np.linspace(0, H - S, -(-(H - S) // (S // 2)) + 1).round().astype(int))
+        xs = np.unique(np.linspace(0, W - S, -(-(W - S) // (S // 2)) + 1).round().astype(int))
+        crops = np.stack([img[y:y + S, x:x + S].transpose(2, 0, 1) for y in ys for x in xs]).astype(_F)
+        z = self._session("encoder.onnx").run(None, {"exemplar": np.clip(crops, 0.0, 1.0)})[0]
+        return z.mean(0).astype(_F)
+
+    def translate(self, z) -> TextureCode:
+        """Space mode, translator h(z) -> (e, T) (Sec. 3)."""
+        if self.mode != "space":
+            raise SettingError("code", f"model {self.name!r} has no translator (single-exemplar model)")
+        z = np.asarray(z, _F).reshape(1, -1)
+        e, T = self._session("translator.onnx").run(None, {"z": z})
+        return TextureCode(e[0].astype(_F), T[0].astype(_F))
+
+    def code(self, exemplar: str | None = None) -> TextureCode:
+        """A named training exemplar's code (space models), or the default code."""
+        if exemplar is None:
+            return self.default_code()
+        if exemplar not in self.codes:
+            raise SettingError("exemplar", f"model {self.name!r} knows no exemplar {exemplar!r}"
+                                           + (f"; it knows {', '.join(self.codes)}" if self.codes else ""))
+        return self.translate(self.codes[exemplar])
+
+    # -- evaluation ------------------------------------------------------------------------------
+    def decode(self, noise: np.ndarray, e: np.ndarray) -> np.ndarray:
+        """Decoder f(n | e): noise float32 (N, m*C), e (E,) or (N, E) -> sRGB float32 (N, 3)."""
+        e = np.asarray(e, _F).reshape(-1, self.code_dim)
+        return self._session("decoder.onnx").run(None, {"noise": np.ascontiguousarray(noise, _F),
+                                                        "code": np.ascontiguousarray(e)})[0]
+
+    def evaluate(self, points, code: TextureCode, seed: int = 0, chunk: int = DEFAULT_CHUNK,
+                 progress=None, cancel=None) -> np.ndarray:
+        """s(x | z) (Eq. 5) at points float (N, D) in texture units -> sRGB float32 (N, 3) in [0, 1].
+
+        Works in chunks of ``chunk`` points (memory stays flat whatever N);
+        ``progress(done, total)`` after each chunk; ``cancel()`` returning True
+        stops early with :class:`InterruptedError`.  2D points on a 3D model are
+        read on the z = 0 plane.
+        """
+        pts = np.asarray(points)
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+            raise SettingError("points", f"points must have shape (N, 2) or (N, 3), got {pts.shape}")
+        if pts.shape[1] > self.dim:
+            raise SettingError("points", f"model {self.name!r} is {self.dim}D and cannot be evaluated at 3D points")
+        if pts.shape[1] < self.dim:
+            pts = np.concatenate([pts, np.zeros((pts.shape[0], self.dim - pts.shape[1]), pts.dtype)], axis=1)
+        T = np.asarray(code.T, _F)
+        if T.shape != (self.octaves, self.dim, self.dim):
+            raise SettingError("code", f"transforms have shape {T.shape}, model needs {(self.octaves, self.dim, self.dim)}")
+        N = pts.shape[0]
+        out = np.empty((N, 3), _F)
+        for a in range(0, N, chunk):
+            if cancel is not None and cancel():
+                raise InterruptedError("cancelled")
+            b = min(N, a + chunk)
+            noise = lattice_noise(pts[a:b], T, seed, self.channels)
+            e = code.e if code.e.ndim == 1 else code.e[a:b]
+            out[a:b] = self.decode(noise, e)
+            if progress is not None:
+                progress(b, N)
+        return out
+
+    def image(self, size: int, code: TextureCode, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),
+              axis: str = "z", **kw) -> np.ndarray:
+        """A (size, size, 3) float32 image of the plane through ``offset`` normal to ``axis``,
+        at exemplar resolution times ``scale`` (pixel centres; row 0 at the top)."""
+        u = (np.arange(size, dtype=np.float64) + 0.5) / (self.px_per_unit * scale)
+        vv, uu = np.meshgrid(u, u, indexing="ij")
+        plane = np.stack([uu.ravel(), -vv.ravel()], axis=1)
+        if self.dim == 2:
+            pts = plane + np.asarray(offset[:2], np.float64)
+        else:
+            a, b = {"z": (0, 1), "y": (0, 2), "x": (1, 2)}[axis]
+            pts = np.zeros((plane.shape[0], 3))
+            pts[:, a], pts[:, b] = plane[:, 0], plane[:, 1]
+            pts += np.asarray(offset, np.float64)
+        return self.evaluate(pts, code, seed, **kw).reshape(size, size, 3)

@@ -1,0 +1,132 @@
+"""Export a trained solid texture to ONNX: ``python -m backend.training.solid.export RUN OUT_DIR``.
+
+Writes, each atomically:
+
+    OUT_DIR/decoder.onnx     inputs noise (N, m*C), code (B, E) with B = 1 or N -> rgb (N, 3);
+                             f(n | e) of Eq. 5 with its first layer split as W_n n + (W_e e + b), so
+                             one code is broadcast over all points and per-point codes still work
+    OUT_DIR/encoder.onnx     space mode: exemplar (B, 3, 128, 128) in [0, 1] -> z (B, z_dim)
+    OUT_DIR/translator.onnx  space mode: z (B, z_dim) -> e (B, E), T (B, m, D, D)
+    OUT_DIR/solid.json       dims, octaves, channels, units, the single-mode code e and
+                             transforms T (or the codes z of the training exemplars), the
+                             training config and every .onnx file's sha256
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+import torch
+from torch import nn
+
+from ...neural.model import sha256_file
+from .train import SolidConfig, build_model, training_images
+
+__all__ = ["export", "SplitDecoder", "FORMAT", "ENCODER_SIZE"]
+
+FORMAT = 1
+ENCODER_SIZE = 128
+
+
+class SplitDecoder(nn.Module):
+    """The decoder with its first layer split: same outputs as Decoder(cat(n, e)), broadcasting e."""
+
+    def __init__(self, dec, n_noise: int):
+        super().__init__()
+        first = dec.net[0]
+        self.wn = nn.Linear(n_noise, first.out_features, bias=False)
+        self.we = nn.Linear(first.in_features - n_noise, first.out_features)
+        with torch.no_grad():
+            self.wn.weight.copy_(first.weight[:, :n_noise])
+            self.we.weight.copy_(first.weight[:, n_noise:])
+            self.we.bias.copy_(first.bias)
+        self.rest = dec.net[1:]
+
+    def forward(self, noise, code):
+        return torch.sigmoid(self.rest(self.wn(noise) + self.we(code)))
+
+
+def _onnx(module, args, path, inputs, outputs, dynamic):
+    tmp = path + ".tmp"
+    torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
+                      opset_version=17, dynamo=False)
+    os.replace(tmp, path)
+
+
+class _Translator(nn.Module):
+    def __init__(self, tr):
+        super().__init__()
+        self.tr = tr
+
+    def forward(self, z):
+        return self.tr(z)
+
+
+def export(run: str, out: str, extra: dict | None = None) -> dict:
+    """Export ``run/ckpt.pt`` into folder ``out``; returns the JSON written."""
+    state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
+    cfg = SolidConfig.from_dict(state["config"])
+    model = build_model(cfg)
+    model.load_state_dict(state["model"])
+    model.eval()
+    os.makedirs(out, exist_ok=True)
+    n_noise = cfg.octaves * cfg.channels
+    files = {}
+    _onnx(SplitDecoder(model.decoder, n_noise), (torch.randn(16, n_noise), torch.randn(1, cfg.code_dim)),
+          os.path.join(out, "decoder.onnx"), ["noise", "code"], ["rgb"],
+          {"noise": {0: "points"}, "code": {0: "codes"}, "rgb": {0: "points"}})
+    files["decoder.onnx"] = sha256_file(os.path.join(out, "decoder.onnx"))
+    doc = dict(format=FORMAT, model="neural_solid_texture", name=cfg.name,
+               paper="Henzler, Mitra, Ritschel 2020, Learning a Neural 3D Texture Space from 2D Exemplars",
+               mode=cfg.mode, dim=cfg.dim, octaves=cfg.octaves, channels=cfg.channels, code_dim=cfg.code_dim,
+               z_dim=cfg.z_dim, px_per_unit=cfg.px_per_unit, exemplar_scale=cfg.exemplar_scale,
+               exemplars=list(cfg.exemplars), colour="sRGB", step=int(state["step"]),
+               train_seconds=round(float(state.get("elapsed", 0.0)), 1), n_params=int(state["n_params"]),
+               config=state["config"])
+    with torch.no_grad():
+        if cfg.mode == "single":
+            e, T = model.codes(batch=1)
+            doc["code"] = e[0].numpy().astype(float).round(7).tolist()
+            doc["T"] = T[0].numpy().astype(float).round(7).tolist()
+        else:
+            _onnx(model.encoder, (torch.rand(1, 3, ENCODER_SIZE, ENCODER_SIZE),), os.path.join(out, "encoder.onnx"),
+                  ["exemplar"], ["z"], {"exemplar": {0: "batch"}, "z": {0: "batch"}})
+            _onnx(_Translator(model.translator), (torch.randn(1, cfg.z_dim),), os.path.join(out, "translator.onnx"),
+                  ["z"], ["e", "T"], {"z": {0: "batch"}, "e": {0: "batch"}, "T": {0: "batch"}})
+            files["encoder.onnx"] = sha256_file(os.path.join(out, "encoder.onnx"))
+            files["translator.onnx"] = sha256_file(os.path.join(out, "translator.onnx"))
+            # codes of the training exemplars: mean z over a grid of 128 px crops
+            codes = {}
+            for name, img in zip(cfg.exemplars, training_images(cfg)):
+                crops = img.unfold(1, ENCODER_SIZE, ENCODER_SIZE // 2).unfold(2, ENCODER_SIZE, ENCODER_SIZE // 2)
+                crops = crops.permute(1, 2, 0, 3, 4).reshape(-1, 3, ENCODER_SIZE, ENCODER_SIZE)
+                codes[os.path.splitext(os.path.basename(name))[0]] = \
+                    model.encoder(crops).mean(0).numpy().astype(float).round(6).tolist()
+            doc["codes"] = codes
+            doc["encoder_size"] = ENCODER_SIZE
+    doc["files"] = files
+    doc.update(extra or {})
+    path = os.path.join(out, "solid.json")
+    with open(path + ".tmp", "w", encoding="utf-8") as fh:
+        json.dump(doc, fh, indent=1)
+    os.replace(path + ".tmp", path)
+    return doc
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m backend.training.solid.export", description=__doc__.split("\n")[0])
+    ap.add_argument("run", help="training run folder (holds ckpt.pt)")
+    ap.add_argument("out", help="output folder for the .onnx files and solid.json")
+    a = ap.parse_args(argv)
+    if not os.path.isfile(os.path.join(a.run, "ckpt.pt")):
+        print(f"solid export: error: no checkpoint in {a.run}", file=sys.stderr)
+        return 2
+    doc = export(a.run, a.out)
+    print(json.dumps(doc["files"], indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,212 @@
+"""Train a neural solid texture: ``python -m backend.training.solid.train --config CONFIG.json --out RUN``.
+
+Single mode (``mode: "single"``): one exemplar; the decoder f, the code e and
+the transforms T_i are optimised directly (Henzler et al. 2020, Sec. 4,
+"Spaces-of").  Space mode (``mode: "space"``): encoder g, translator h and
+decoder f trained jointly over many exemplars; each step encodes a random
+128 px patch P_e and asks the sampler's slice P_s to match its statistics.
+
+Every step (Sec. 3, Fig. 5): random crops of the exemplar(s) -> the sampler at
+pixel centres of random 2D slices of the D-dimensional domain (axis-aligned
+and, with probability ``oblique``, rotated planes in 3D), fresh seeds xi and
+a random offset per slice -> style loss (Gram matrices of fixed random
+multi-scale features + colour histogram, :mod:`.features`) -> Adam with a
+cosine learning-rate decay.
+
+``RUN/ckpt.pt`` is written atomically every ``checkpoint_every`` steps (a run
+resumes from it), ``RUN/log.jsonl`` has one line per ``log_every`` steps.
+Config keys and defaults: :class:`SolidConfig`.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+import torch
+
+from . import exemplars as ex
+from .features import RandomFeatures, style_loss
+from .lattice import octave_seeds
+from .model import SolidTexture, slice_points
+
+__all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
+
+
+@dataclass
+class SolidConfig:
+    name: str = "solid"
+    mode: str = "single"            # "single" or "space"
+    exemplars: tuple = ("gravel",)  # names (see exemplars.PHOTOS / PROCEDURAL) or image paths
+    dim: int = 3                    # 2: plane textures; 3: solid textures from 2D slices
+    octaves: int = 8
+    channels: int = 3               # noise values per octave (<= 3)
+    code_dim: int = 64              # |e|
+    z_dim: int = 8                  # |z| (space mode)
+    width: int = 128
+    layers: int = 4
+    crop: int = 128                 # training crop / slice size, px
+    batch: int = 4
+    steps: int = 2000
+    lr: float = 2e-3
+    lr_min: float = 1e-4
+    px_per_unit: float = 128.0      # exemplar pixels per unit of texture space
+    exemplar_scale: float = 1.0     # resample the exemplar by this factor before cropping
+    oblique: float = 0.5            # probability of a rotated (not axis-aligned) slice, 3D
+    augment: bool | None = None     # random rotations/flips of crops; default: on in 3D
+    extent: float = 64.0            # slice offsets drawn from [-extent, extent]^D units
+    hist_weight: float = 10.0
+    seed: int = 0
+    log_every: int = 25
+    checkpoint_every: int = 250
+    threads: int = 0                # torch CPU threads (0: torch's default)
+    device: str = "cpu"
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "SolidConfig":
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(d) - known)
+        if unknown:
+            raise ValueError(f"unknown config key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+        d = dict(d)
+        if "exemplars" in d:
+            d["exemplars"] = tuple(d["exemplars"])
+        cfg = cls(**d)
+        if cfg.mode not in ("single", "space"):
+            raise ValueError(f"mode must be 'single' or 'space', got {cfg.mode!r}")
+        if cfg.dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {cfg.dim}")
+        if cfg.mode == "single" and len(cfg.exemplars) != 1:
+            raise ValueError(f"single mode takes exactly one exemplar, got {len(cfg.exemplars)}")
+        return cfg
+
+
+def load_config(path: str) -> SolidConfig:
+    with open(path, encoding="utf-8") as fh:
+        return SolidConfig.from_dict(json.load(fh))
+
+
+def build_model(cfg: SolidConfig) -> SolidTexture:
+    return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
+                        cfg.layers, cfg.seed)
+
+
+def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
+    if factor == 1.0:
+        return img
+    return torch.nn.functional.interpolate(img.unsqueeze(0), scale_factor=factor, mode="bilinear",
+                                           antialias=factor < 1.0, align_corners=False)[0].clamp(0, 1)
+
+
+def training_images(cfg: SolidConfig) -> list:
+    """The training regions of the config's exemplars, resampled: list of (3, H, W)."""
+    return [_resample(ex.train_region(ex.exemplar(n), n), cfg.exemplar_scale) for n in cfg.exemplars]
+
+
+def render(model: SolidTexture, e: torch.Tensor, T: torch.Tensor, x: torch.Tensor, seeds, size: int) -> torch.Tensor:
+    """Sampler images at slice points x (B, size*size, D) -> (B, 3, size, size)."""
+    s = octave_seeds(seeds, model.octaves, x.device)
+    return model.sample(x, e, T, s).view(x.shape[0], size, size, 3).permute(0, 3, 1, 2)
+
+
+def _save(path: str, obj) -> None:
+    tmp = path + ".tmp"
+    torch.save(obj, tmp)
+    os.replace(tmp, path)
+
+
+def train(cfg: SolidConfig, out: str, max_steps: int | None = None, log=print) -> dict:
+    """Train (or resume) into folder ``out``; returns the final checkpoint dict."""
+    threads = torch.get_num_threads()
+    if cfg.threads:
+        torch.set_num_threads(cfg.threads)
+    try:
+        return _train(cfg, out, max_steps, log)
+    finally:
+        torch.set_num_threads(threads)
+
+
+def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
+    os.makedirs(out, exist_ok=True)
+    torch.manual_seed(cfg.seed)
+    gen = torch.Generator().manual_seed(cfg.seed + 1)
+    model = build_model(cfg)
+    feats = RandomFeatures(seed=0)
+    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+    step, elapsed = 0, 0.0
+    ckpt_path = os.path.join(out, "ckpt.pt")
+    if os.path.isfile(ckpt_path):
+        state = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+        model.load_state_dict(state["model"])
+        opt.load_state_dict(state["opt"])
+        step, elapsed = state["step"], state.get("elapsed", 0.0)
+        gen.set_state(state["gen"])
+        log(f"resumed at step {step}")
+    images = training_images(cfg)
+    augment = cfg.dim == 3 if cfg.augment is None else cfg.augment
+    end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
+    logf = open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8")
+    t0 = time.time() - elapsed
+    state = None
+    while step < end:
+        lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / cfg.steps))
+        for g in opt.param_groups:
+            g["lr"] = lr
+        if cfg.mode == "single":
+            ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
+            e, T = model.codes(batch=cfg.batch)
+        else:
+            pick = torch.randint(0, len(images), (cfg.batch,), generator=gen).tolist()
+            ref = torch.cat([ex.random_crops(images[k], 1, cfg.crop, gen, augment) for k in pick])
+            e, T = model.codes(ref)
+        x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen)
+        seeds = torch.randint(0, 2 ** 31 - 1, (cfg.batch,), generator=gen).numpy()
+        img = render(model, e, T, x, seeds, cfg.crop)
+        loss = style_loss(feats, img, ref, cfg.hist_weight, per_sample=cfg.mode == "space")
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+        opt.step()
+        step += 1
+        if step % cfg.log_every == 0 or step == end:
+            rec = dict(step=step, loss=round(loss.item(), 5), lr=lr, seconds=round(time.time() - t0, 1))
+            logf.write(json.dumps(rec) + "\n")
+            logf.flush()
+            log(f"step {step}/{cfg.steps} loss {loss.item():.4f} ({rec['seconds']:.0f} s)")
+        if step % cfg.checkpoint_every == 0 or step == end:
+            state = dict(config=asdict(cfg), model=model.state_dict(), opt=opt.state_dict(), step=step,
+                         elapsed=time.time() - t0, gen=gen.get_state(), n_params=model.n_params())
+            _save(ckpt_path, state)
+    logf.close()
+    if state is None:
+        state = torch.load(ckpt_path, map_location="cpu", weights_only=False)
+    return state
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m backend.training.solid.train", description=__doc__.split("\n")[0])
+    ap.add_argument("--config", required=True, help="JSON config (keys: SolidConfig)")
+    ap.add_argument("--out", required=True, help="run folder (ckpt.pt, log.jsonl)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=JSON", help="override a config key")
+    a = ap.parse_args(argv)
+    with open(a.config, encoding="utf-8") as fh:
+        d = json.load(fh)
+    for item in a.set:
+        k, _, v = item.partition("=")
+        d[k] = json.loads(v)
+    try:
+        cfg = SolidConfig.from_dict(d)
+    except (ValueError, TypeError) as err:
+        print(f"solid train: error: {err}", file=sys.stderr)
+        return 2
+    train(cfg, a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,192 @@
+"""Neural solid textures: training steps, ONNX export, and the torch-free runtime against torch."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from backend.errors import SettingError  # noqa: E402
+from backend.neural.model import ModelError  # noqa: E402
+from backend.solid.model import SolidTextureModel, TextureCode  # noqa: E402
+from backend.training.solid import exemplars as ex  # noqa: E402
+from backend.training.solid.export import export  # noqa: E402
+from backend.training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
+from backend.training.solid.lattice import octave_seeds  # noqa: E402
+from backend.training.solid.model import SolidTexture, random_rotations, slice_points  # noqa: E402
+from backend.training.solid.train import SolidConfig, build_model, train  # noqa: E402
+
+
+def _tiny(tmp_path, mode="single", dim=3, steps=4, **kw):
+    cfg = dict(name=f"tiny_{mode}_{dim}d", mode=mode, dim=dim, crop=32, batch=2, steps=steps, width=32,
+               log_every=2, checkpoint_every=2, threads=1, exemplars=["gravel"] if mode == "single" else ["gravel", "grass"])
+    cfg.update(kw)
+    run = tmp_path / f"run_{mode}_{dim}"
+    state = train(SolidConfig.from_dict(cfg), str(run), log=lambda *_: None)
+    return run, state
+
+
+def test_config_errors_name_the_key():
+    with pytest.raises(ValueError, match="unknown config key 'octave'"):
+        SolidConfig.from_dict({"octave": 4})
+    with pytest.raises(ValueError, match="exactly one exemplar"):
+        SolidConfig.from_dict({"exemplars": ["wood", "rust"]})
+    with pytest.raises(ValueError, match="dim must be 2 or 3"):
+        SolidConfig.from_dict({"dim": 4})
+
+
+def test_rotations_and_slices():
+    R = random_rotations(8, 3, seed=1)
+    np.testing.assert_allclose((R @ R.transpose(1, 2)).numpy(), np.broadcast_to(np.eye(3), (8, 3, 3)), atol=1e-5)
+    assert np.allclose(torch.det(R).numpy(), 1.0, atol=1e-5)
+    g = torch.Generator().manual_seed(0)
+    x = slice_points(4, 16, 16.0, 3, 0.0, 5.0, g)
+    assert x.shape == (4, 256, 3)
+    # axis-aligned slices: exactly one coordinate is constant over each slice, neighbours are 1/16 apart
+    for b in range(4):
+        assert int((x[b].std(0) < 1e-6).sum()) == 1
+        assert np.isclose(float((x[b, 1] - x[b, 0]).norm()), 1 / 16, atol=1e-6)
+    x2 = slice_points(2, 8, 8.0, 2, 0.5, 3.0, g)
+    assert x2.shape == (2, 64, 2) and float(x2.abs().max()) < 4.0
+
+
+def test_features_see_structure_and_colour():
+    f = RandomFeatures(seed=0)
+    rng = torch.Generator().manual_seed(0)
+    a = torch.rand(1, 3, 64, 64, generator=rng)
+    # same marginal colour histogram, different structure: smooth vs white noise
+    b = torch.nn.functional.avg_pool2d(torch.rand(1, 3, 72, 72, generator=rng), 9, 1)
+    b = (b - b.mean()) / b.std() * a.std() + a.mean()
+    assert float(style_loss(f, a, a)) < 1e-6
+    assert float(style_loss(f, b, a, hist_weight=0.0)) > 0.1
+    # channel-swapped colours keep each channel's histogram but not the joint one
+    c = torch.rand(1, 3, 64, 64, generator=rng)
+    c[:, 1] = 1.0 - c[:, 0]
+    d = c.clone()
+    d[:, 1] = c[:, 0]
+    assert float(histogram_loss(c, d)) > 1e-3
+
+
+def _fixed_loss(state, img):
+    """Style loss of a model on fixed slices, seeds and crops (no batch-to-batch noise)."""
+    from backend.training.solid.train import render
+    cfg = SolidConfig.from_dict(state["config"])
+    m = build_model(cfg)
+    m.load_state_dict(state["model"])
+    g = torch.Generator().manual_seed(123)
+    ref = ex.random_crops(img, 4, cfg.crop, g)
+    x = slice_points(4, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, g)
+    with torch.no_grad():
+        e, T = m.codes(batch=4)
+        return float(style_loss(RandomFeatures(0), render(m, e, T, x, [1, 2, 3, 4], cfg.crop), ref))
+
+
+def test_training_reduces_the_loss(tmp_path):
+    cfg = dict(dim=2, crop=48, batch=2, lr=0.005, width=64, exemplars=["gravel"])
+    _, s0 = _tiny(tmp_path / "a", steps=1, **cfg)
+    _, s1 = _tiny(tmp_path / "b", steps=60, **cfg)
+    img = ex.exemplar("gravel")
+    before, after = _fixed_loss(s0, img), _fixed_loss(s1, img)
+    assert after < 0.5 * before, (before, after)
+
+
+def test_resume_continues_from_checkpoint(tmp_path):
+    cfg = SolidConfig.from_dict(dict(name="r", dim=2, crop=32, batch=1, steps=6, width=16, checkpoint_every=2,
+                                     log_every=1, threads=1, exemplars=["gravel"]))
+    train(cfg, str(tmp_path / "a"), max_steps=3, log=lambda *_: None)
+    msgs = []
+    state = train(cfg, str(tmp_path / "a"), log=msgs.append)
+    assert msgs[0] == "resumed at step 3" and state["step"] == 6
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_single_export_runtime_matches_torch(tmp_path, dim):
+    run, state = _tiny(tmp_path, dim=dim)
+    out = tmp_path / "model"
+    doc = export(str(run), str(out))
+    assert doc["mode"] == "single" and set(doc["files"]) == {"decoder.onnx"}
+    rt = SolidTextureModel(str(out))
+    code = rt.default_code()
+    assert code.e.shape == (64,) and code.T.shape == (8, dim, dim)
+    m = build_model(SolidConfig.from_dict(state["config"]))
+    m.load_state_dict(state["model"])
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-3, 3, (1, 3000, dim)).astype(np.float32)
+    with torch.no_grad():
+        e, T = m.codes(batch=1)
+        ref = m.sample(torch.from_numpy(x), e, T, octave_seeds([7], 8)).numpy()[0]
+    got = rt.evaluate(x[0], code, seed=7, chunk=700)
+    assert got.dtype == np.float32 and got.shape == (3000, 3)
+    np.testing.assert_allclose(got, ref, atol=2e-4)
+    # chunking changes nothing; another seed gives another texture
+    np.testing.assert_array_equal(rt.evaluate(x[0], code, 7, chunk=4096), got)
+    assert np.abs(rt.evaluate(x[0], code, 8) - got).mean() > 1e-5
+
+
+def test_space_export_encode_translate_interpolate(tmp_path):
+    run, state = _tiny(tmp_path, mode="space", dim=3, crop=128, batch=2, steps=2)
+    out = tmp_path / "space"
+    doc = export(str(run), str(out))
+    assert set(doc["files"]) == {"decoder.onnx", "encoder.onnx", "translator.onnx"}
+    assert set(doc["codes"]) == {"gravel", "grass"}
+    rt = SolidTextureModel(str(out))
+    m = build_model(SolidConfig.from_dict(state["config"]))
+    m.load_state_dict(state["model"])
+    m.eval()
+    img = ex.procedural("wood", 3, 160).permute(1, 2, 0).numpy()
+    z = rt.encode(img)
+    with torch.no_grad():
+        crops = torch.stack([torch.from_numpy(img[a:a + 128, b:b + 128]).permute(2, 0, 1)
+                             for a in (0, 32) for b in (0, 32)])
+        zt = m.encoder(crops).mean(0).numpy()
+        e_t, T_t = m.translator(torch.from_numpy(zt)[None])
+    np.testing.assert_allclose(z, zt, atol=1e-4)
+    code = rt.translate(z)
+    np.testing.assert_allclose(code.e, e_t[0].numpy(), atol=1e-4)
+    np.testing.assert_allclose(code.T, T_t[0].numpy(), atol=1e-4)
+    # interpolation in z: the ends are the two exemplars' codes
+    z1, z2 = rt.codes["gravel"], rt.codes["grass"]
+    np.testing.assert_allclose(rt.translate(1.0 * z1 + 0.0 * z2).e, rt.code("gravel").e, atol=1e-6)
+    # a small grey image is upsampled to the encoder's size
+    assert rt.encode(np.full((40, 50), 0.5, np.float32)).shape == (8,)
+    with pytest.raises(SettingError, match="knows no exemplar 'marble'"):
+        rt.code("marble")
+
+
+def test_runtime_refuses_altered_and_bad_input(tmp_path):
+    run, _ = _tiny(tmp_path, dim=2, steps=2)
+    out = tmp_path / "m"
+    export(str(run), str(out))
+    rt = SolidTextureModel(str(out))
+    with pytest.raises(SettingError, match="2D and cannot be evaluated at 3D points"):
+        rt.evaluate(np.zeros((4, 3)), rt.default_code())
+    with pytest.raises(SettingError, match="transforms have shape"):
+        rt.evaluate(np.zeros((4, 2)), TextureCode(np.zeros(64, np.float32), np.zeros((8, 3, 3), np.float32)))
+    with pytest.raises(SettingError, match="cannot encode images"):
+        rt.encode(np.zeros((128, 128, 3)))
+    with pytest.raises(InterruptedError):
+        rt.evaluate(np.zeros((10, 2)), rt.default_code(), cancel=lambda: True)
+    with open(out / "decoder.onnx", "ab") as fh:
+        fh.write(b"x")
+    with pytest.raises(ModelError, match="sha256 does not match"):
+        SolidTextureModel(str(out))
+    with pytest.raises(ModelError, match="no solid.json"):
+        SolidTextureModel(str(tmp_path))
+
+
+def test_exemplars_split_and_crops():
+    img = ex.exemplar("gravel")
+    assert img.shape == (3, 512, 512) and float(img.min()) >= 0 and float(img.max()) <= 1
+    assert ex.train_region(img, "gravel").shape[2] == 384
+    assert ex.heldout_region("gravel").shape[2] == 128
+    for name in ex.PROCEDURAL:
+        a, b = ex.procedural(name, 0, 64), ex.procedural(name, 1, 64)
+        assert a.shape == (3, 64, 64) and float((a - b).abs().mean()) > 0.01, name
+    g = torch.Generator().manual_seed(0)
+    c = ex.random_crops(img, 3, 64, g, augment=True)
+    assert c.shape == (3, 3, 64, 64)
+    with pytest.raises(ValueError, match="smaller than the 600 px"):
+        ex.random_crops(img, 1, 600, g)
+    with pytest.raises(ValueError, match="unknown exemplar 'cork'"):
+        ex.exemplar("cork")
