@@ -1,0 +1,103 @@
+"""The `omninoise solid` command-line contract (tiny models trained for a few steps)."""
+import os
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from backend.cli import main  # noqa: E402
+from backend.training.solid.export import export  # noqa: E402
+from backend.training.solid.train import SolidConfig, train  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def models(tmp_path_factory):
+    root = tmp_path_factory.mktemp("solid_models")
+    out = {}
+    for mode, dim, ex in (("single", 3, ["gravel"]), ("single", 2, ["gravel"]), ("space", 3, ["gravel", "grass"])):
+        cfg = SolidConfig.from_dict(dict(name=f"{mode}{dim}", mode=mode, dim=dim, crop=32 if mode == "single" else 128,
+                                         batch=1, steps=2, width=16, threads=1, exemplars=ex))
+        train(cfg, str(root / f"run_{mode}{dim}"), log=lambda *_: None)
+        export(str(root / f"run_{mode}{dim}"), str(root / f"{mode}{dim}"))
+        out[f"{mode}{dim}"] = str(root / f"{mode}{dim}")
+    return out
+
+
+def run(capsys, *args):
+    rc = main(["solid", "--quiet", *args])
+    return rc, capsys.readouterr().err
+
+
+def test_image_outputs(models, tmp_path, capsys):
+    png, exr, npy = (str(tmp_path / f"a.{e}") for e in ("png", "exr", "npy"))
+    assert run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--size", "24", "-o", png)[0] == 0
+    with open(png, "rb") as fh:
+        assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
+    assert run(capsys, "--model", models["single2"], "--exemplar", "gravel", "--size", "24", "-o", npy)[0] == 0
+    a = np.load(npy)
+    assert a.shape == (24, 24, 3) and a.dtype == np.float32 and 0.0 <= a.min() and a.max() <= 1.0
+    # the .npy is scene-linear: the runtime's sRGB values, decoded
+    from backend.solid.bake import srgb_to_linear
+    from backend.solid.model import SolidTextureModel
+    m = SolidTextureModel(models["single2"])
+    np.testing.assert_allclose(a, srgb_to_linear(m.image(24, m.default_code(), 0)), atol=1e-6)
+    assert run(capsys, "--model", models["single2"], "--exemplar", "gravel", "--size", "24", "--seed", "3",
+               "-o", exr)[0] == 0
+    from export.images import read_image
+    assert read_image(exr).shape == (24, 24)
+
+
+def test_volume_outputs(models, tmp_path, capsys):
+    npy, vdb = str(tmp_path / "v.npy"), str(tmp_path / "v.vdb")
+    assert run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--dim", "3", "--size", "12",
+               "-o", npy)[0] == 0
+    a = np.load(npy)
+    assert a.shape == (12, 12, 12, 3)
+    assert run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--dim", "3", "--size", "12",
+               "-o", vdb)[0] == 0
+    from export.vdb import read_volume
+    col = read_volume(vdb, "color", (12, 12, 12))
+    np.testing.assert_allclose(col, a, atol=1e-6)
+    np.testing.assert_array_equal(read_volume(vdb, "density", (12, 12, 12)), 1.0)
+
+
+def test_space_model_encode_and_interpolate(models, tmp_path, capsys):
+    from PIL import Image
+    img = tmp_path / "ex.png"
+    Image.fromarray((np.random.default_rng(0).random((140, 150, 3)) * 255).astype(np.uint8)).save(img)
+    outs = []
+    for extra in ([], ["--to", "grass", "--mix", "0.0"], ["--to", "grass", "--mix", "1.0"]):
+        p = str(tmp_path / f"s{len(outs)}.npy")
+        assert run(capsys, "--model", models["space3"], "--exemplar", "gravel", "--size", "16", *extra, "-o", p)[0] == 0
+        outs.append(np.load(p))
+    np.testing.assert_allclose(outs[1], outs[0], atol=1e-6)      # mix 0 is the first exemplar
+    assert np.abs(outs[2] - outs[0]).max() > 0                    # mix 1 is another texture
+    p = str(tmp_path / "enc.png")
+    assert run(capsys, "--model", models["space3"], "--exemplar", str(img), "--size", "16", "-o", p)[0] == 0
+
+
+@pytest.mark.parametrize("args, msg", [
+    (["--exemplar", "gravel"], "give --exemplar"),
+    (["--exemplar", "gravel", "--size", "0", "-o", "x.png"], "--size: must be >= 1"),
+    (["--exemplar", "gravel", "--mix", "2", "-o", "x.png"], "--mix: must be in [0, 1]"),
+    (["--exemplar", "gravel", "--dim", "3", "-o", "x.png"], "a 3D result is written as .vdb, .npy"),
+    (["--exemplar", "gravel", "--to", "grass", "-o", "x.png"], "interpolation needs the space model"),
+])
+def test_errors_single(models, capsys, args, msg):
+    rc, err = run(capsys, "--model", models["single3"], *args)
+    assert rc == 2 and msg in err and err.count("\n") == 1
+
+
+def test_errors_models(models, tmp_path, capsys):
+    rc, err = run(capsys, "--model", models["single2"], "--exemplar", "g", "--dim", "3", "-o", str(tmp_path / "a.npy"))
+    assert rc == 2 and "is 2D; it cannot fill a volume" in err
+    rc, err = run(capsys, "--model", models["space3"], "--exemplar", "nothing.png", "-o", str(tmp_path / "a.png"))
+    assert rc == 2 and "neither an image file nor an exemplar the model knows (gravel, grass)" in err
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(b"not an image")
+    rc, err = run(capsys, "--model", models["space3"], "--exemplar", str(bad), "-o", str(tmp_path / "a.png"))
+    assert rc == 2 and "not an image Pillow can read" in err
+    rc, err = run(capsys, "--model", str(tmp_path), "--exemplar", "x", "-o", str(tmp_path / "a.png"))
+    assert rc == 2 and "no solid.json" in err
+    assert not os.path.exists(tmp_path / "a.png")
