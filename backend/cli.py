@@ -540,9 +540,6 @@ def main(argv: list[str] | None = None) -> int:
             return run_neural(a)
         if a.command == "solid":
             return run_solid(a)
-    except InterruptedError:
-        print(f"omninoise {a.command}: cancelled", file=sys.stderr)
-        return 130
     except (SettingError, FileNotFoundError, PermissionError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 
 def _modules():
-    from . import bake_ui, neural_ui, preferences, wave_ui
+    from . import bake_ui, neural_ui, preferences, solid_ui, wave_ui
 
-    return (preferences, wave_ui, bake_ui, neural_ui)
+    return (preferences, wave_ui, bake_ui, neural_ui, solid_ui)
 
 
 def register():

@@ -5,6 +5,8 @@ import os
 import numpy as np
 import pytest
 
+from backend.grid import Cancelled
+
 torch = pytest.importorskip("torch")
 
 from backend.errors import SettingError  # noqa: E402
@@ -165,7 +167,7 @@ def test_runtime_refuses_altered_and_bad_input(tmp_path):
         rt.evaluate(np.zeros((4, 2)), TextureCode(np.zeros(64, np.float32), np.zeros((8, 3, 3), np.float32)))
     with pytest.raises(SettingError, match="cannot encode images"):
         rt.encode(np.zeros((128, 128, 3)))
-    with pytest.raises(InterruptedError):
+    with pytest.raises(Cancelled):
         rt.evaluate(np.zeros((10, 2)), rt.default_code(), cancel=lambda: True)
     with open(out / "decoder.onnx", "ab") as fh:
         fh.write(b"x")

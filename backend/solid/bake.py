@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SettingError
+from ..grid import Cancelled
 from ..sources import BoxGrid
 from .model import SolidTextureModel, TextureCode
 
@@ -61,7 +62,7 @@ def bake_volume(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, path
     """A 3D model's colours over ``grid`` into an OpenVDB file: ``color`` (vec3, scene-linear) and
     ``density`` (constant ``density``), slab by slab, written atomically.
 
-    ``progress(fraction)``; ``cancel()`` returning True raises InterruptedError and writes nothing.
+    ``progress(fraction)``; ``cancel()`` returning True raises Cancelled and writes nothing.
     """
     from .._export import export
 
@@ -77,7 +78,7 @@ def bake_volume(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, path
     writer = export.VolumeWriter(grid.voxel, grid.first, {"density": "float", "color": "vec3"}, meta, half)
     for z0 in range(0, nz, per):
         if cancel is not None and cancel():
-            raise InterruptedError("cancelled")
+            raise Cancelled("cancelled")
         z1 = min(nz, z0 + per)
         rgb = model.evaluate(grid_points(grid, z0, z1) * float(scale), code, seed, cancel=cancel)
         writer.add("color", z0, srgb_to_linear(rgb).reshape(z1 - z0, ny, nx, 3))

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SettingError
+from ..grid import Cancelled
 from ..neural.model import ModelError, sha256_file
 from .lattice import lattice_noise
 
@@ -139,7 +140,7 @@ class SolidTextureModel:
 
         Works in chunks of ``chunk`` points (memory stays flat whatever N);
         ``progress(done, total)`` after each chunk; ``cancel()`` returning True
-        stops early with :class:`InterruptedError`.  2D points on a 3D model are
+        stops early with :class:`Cancelled`.  2D points on a 3D model are
         read on the z = 0 plane.
         """
         pts = np.asarray(points)
@@ -156,7 +157,7 @@ class SolidTextureModel:
         out = np.empty((N, 3), _F)
         for a in range(0, N, chunk):
             if cancel is not None and cancel():
-                raise InterruptedError("cancelled")
+                raise Cancelled("cancelled")
             b = min(N, a + chunk)
             noise = lattice_noise(pts[a:b], T, seed, self.channels)
             e = code.e if code.e.ndim == 1 else code.e[a:b]

@@ -1,0 +1,431 @@
+"""Solid Texture from Image (Henzler et al. 2020) in Blender: preview, and bakes onto the active object.
+
+Settings live on the scene (``Scene.omninoise_solid``).  The texture comes from
+a shipped single-exemplar model (``models/solid/<name>``), from an exemplar
+the space model was trained on, or from any image datablock, which the space
+model encodes into a texture code.  Bake targets:
+
+UV_IMAGE         each texel of the active UV map is evaluated at the 3D surface
+                 point it maps to (``backend.solid.surface``), so the UV layout
+                 adds no seams; a margin of extrapolated positions pads islands
+COLOR_ATTRIBUTE  a float colour attribute on the mesh's vertices
+VOLUME           an OpenVDB file (``color`` + ``density`` grids) over the object's
+                 bounds, loaded as a Volume object
+
+Positions are object-local by default (the texture moves with the object) or
+world.  Everything heavy (encoding, rasterising, evaluating, writing) runs on
+a :mod:`.tasks` worker with progress and cancel; Blender data is read before
+and written after on the main thread.
+"""
+from __future__ import annotations
+
+import importlib
+import os
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+
+from . import tasks
+from ._deps import backend
+from .bake_ui import _TaskOperator, draw_progress
+from .preferences import threads
+
+__all__ = ["models_dir", "load_model", "texture", "register", "unregister"]
+
+#: where the shipped models live; tests point it elsewhere
+MODELS_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "solid")
+_MODELS = {}
+
+
+def _mod(name: str):
+    return importlib.import_module(f"{backend.__name__}.{name}")
+
+
+def models_dir() -> str:
+    return MODELS_DIR
+
+
+def load_model(name: str):
+    """A model folder under :data:`MODELS_DIR`, loaded once (never at register time)."""
+    path = os.path.join(models_dir(), name)
+    if path not in _MODELS:
+        _MODELS[path] = _mod("solid.model").SolidTextureModel(path, threads())
+    return _MODELS[path]
+
+
+def _catalogue() -> list:
+    """(identifier, label, description) of every shipped texture: single 3D models, then space exemplars."""
+    items = []
+    root = models_dir()
+    names = sorted(os.listdir(root)) if os.path.isdir(root) else []
+    for name in names:
+        try:
+            m = load_model(name)
+        except Exception:  # an incomplete or altered folder is simply not offered
+            continue
+        if m.mode == "single" and m.dim == 3:
+            ex = m.config["exemplars"][0]
+            items.append((f"single:{name}", ex.replace("_", " ").title(), f"Fitted to the {ex} exemplar ({name})"))
+    for name in names:
+        try:
+            m = load_model(name)
+        except Exception:
+            continue
+        if m.mode == "space" and m.dim == 3:
+            for ex in sorted(m.codes):
+                items.append((f"space:{name}:{ex}", f"{ex.replace('_', ' ').title()} (space)",
+                              f"The {ex} exemplar's code in the texture space {name}"))
+    return items
+
+
+_ITEMS_CACHE = []
+
+
+def _texture_items(self, context):
+    _ITEMS_CACHE[:] = _catalogue() or [("NONE", "No models", f"No solid texture models in {models_dir()}")]
+    return _ITEMS_CACHE   # Blender needs the strings kept alive
+
+
+def _space_model_name():
+    root = models_dir()
+    for name in sorted(os.listdir(root)) if os.path.isdir(root) else []:
+        try:
+            if load_model(name).mode == "space":
+                return name
+        except Exception:
+            continue
+    return None
+
+
+class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
+    source: EnumProperty(name="Source", items=[
+        ("SHIPPED", "Shipped", "A texture that ships with OmniNoise"),
+        ("IMAGE", "Image", "Any image: the texture-space model encodes it into a texture code")], default="SHIPPED")
+    texture: EnumProperty(name="Texture", items=_texture_items)
+    image: PointerProperty(name="Exemplar", type=bpy.types.Image,
+                           description="A photo of the material (at least 128 px; larger is resized to crops)")
+    scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
+                         description="Texture units per Blender unit: larger means smaller features")
+    seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
+    coords: EnumProperty(name="Coordinates", items=[
+        ("OBJECT", "Object", "Object-local positions: the texture moves with the object"),
+        ("WORLD", "World", "World positions: objects share one block of material")], default="OBJECT")
+    target: EnumProperty(name="Bake To", items=[
+        ("UV_IMAGE", "UV Image", "An image over the active UV map, each texel coloured at its 3D surface point"),
+        ("COLOR_ATTRIBUTE", "Colour Attribute", "A colour attribute on the mesh vertices"),
+        ("VOLUME", "Volume", "An OpenVDB volume over the object's bounds (colour and density grids)")],
+        default="UV_IMAGE")
+    size: IntProperty(name="Image Size", default=1024, min=8, soft_max=8192)
+    margin: IntProperty(name="Margin", default=4, min=0, max=64, description="Texels padded past each UV island")
+    voxels: IntProperty(name="Voxels", default=128, min=4, soft_max=512, description="Voxels along the longest side")
+    name: StringProperty(name="Name", default="Solid Texture")
+    folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise_bakes",
+                           description="Where volumes are written ('//' = beside the .blend)")
+
+
+def _image_pixels(ima) -> np.ndarray:
+    """An image datablock's pixels as float32 (H, W, 3) sRGB-encoded values, top row first."""
+    w, h = ima.size
+    if w * h == 0:
+        raise backend.SettingError("image", f"image {ima.name!r} has no pixels (is its file missing?)")
+    px = np.empty(w * h * ima.channels, np.float32)
+    ima.pixels.foreach_get(px)
+    px = px.reshape(h, w, ima.channels)
+    rgb = px[..., :3] if ima.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
+    if ima.is_float:  # float buffers hold scene-linear values; the encoder was trained on sRGB values
+        c = np.clip(rgb, 0.0, 1.0)
+        rgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+    return np.ascontiguousarray(np.flipud(rgb), np.float32)
+
+
+def texture(p):
+    """(model, code_fn) for the panel's settings; code_fn() runs on the worker (it may encode an image)."""
+    if p.source == "IMAGE":
+        if p.image is None:
+            raise backend.SettingError("image", "pick an exemplar image (or switch Source to Shipped)")
+        name = _space_model_name()
+        if name is None:
+            raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
+        m = load_model(name)
+        pixels = _image_pixels(p.image)   # main thread: bpy data
+        return m, lambda: m.translate(m.encode(pixels))
+    ident = p.texture
+    if ident == "NONE" or ":" not in ident:
+        raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
+    parts = ident.split(":")
+    m = load_model(parts[1])
+    if parts[0] == "single":
+        return m, m.default_code
+    return m, lambda: m.code(parts[2])
+
+
+def _mesh_arrays(context, obj, world: bool, uv: bool):
+    """Triangles of the evaluated mesh: (uv (T, 3, 2) or None, positions (T, 3, 3)) float64."""
+    dg = context.evaluated_depsgraph_get()
+    eo = obj.evaluated_get(dg)
+    me = eo.to_mesh()
+    try:
+        me.calc_loop_triangles()
+        T, L = len(me.loop_triangles), len(me.loops)
+        if T == 0:
+            raise backend.SettingError("object", f"{obj.name!r} has no faces to bake onto")
+        tri = np.empty(T * 3, np.int32)
+        me.loop_triangles.foreach_get("loops", tri)
+        vidx = np.empty(L, np.int32)
+        me.loops.foreach_get("vertex_index", vidx)
+        co = np.empty(len(me.vertices) * 3, np.float32)
+        me.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3).astype(np.float64)
+        if world:
+            M = np.array(obj.matrix_world)
+            co = co @ M[:3, :3].T + M[:3, 3]
+        pos = co[vidx[tri]].reshape(T, 3, 3)
+        uvs = None
+        if uv:
+            layer = me.uv_layers.active
+            if layer is None:
+                raise backend.SettingError("uv", f"{obj.name!r} has no UV map; add one (UV > Smart UV Project) "
+                                                 "or bake to a colour attribute")
+            a = np.empty(L * 2, np.float32)
+            layer.data.foreach_get("uv", a)
+            uvs = a.reshape(L, 2)[tri].reshape(T, 3, 2).astype(np.float64)
+        return uvs, pos
+    finally:
+        eo.to_mesh_clear()
+
+
+def _store_image(name: str, rgb: np.ndarray):
+    """An 8-bit sRGB image datablock (packed into the .blend) holding rgb (H, W, 3) sRGB values, row 0 bottom."""
+    H, W, _ = rgb.shape
+    ima = bpy.data.images.get(name)
+    if ima is None or tuple(ima.size) != (W, H) or ima.is_float:
+        if ima is not None:
+            bpy.data.images.remove(ima)
+        ima = bpy.data.images.new(name, W, H, alpha=False)
+    ima.colorspace_settings.name = "sRGB"
+    rgba = np.ones((H, W, 4), np.float32)
+    rgba[..., :3] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0) / 255.0
+    ima.pixels.foreach_set(rgba.ravel())
+    ima.update()
+    ima.pack()
+    return ima
+
+
+def _material_with(obj, name: str, make_node):
+    """Wire ``make_node(node_tree)``'s Color output into Base Color: the active material's Principled
+    BSDF when it has one, else a new material ``OmniNoise <name>`` given to the object."""
+    mat = obj.active_material
+    if mat is None or mat.node_tree is None or \
+            not any(n.type == "BSDF_PRINCIPLED" for n in mat.node_tree.nodes):
+        mat = bpy.data.materials.get(f"OmniNoise {name}") or bpy.data.materials.new(f"OmniNoise {name}")
+        if mat.node_tree is None:
+            mat.use_nodes = True
+        if obj.active_material is None:
+            obj.data.materials.append(mat)
+        else:
+            obj.active_material = mat
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED") if any(
+        n.type == "BSDF_PRINCIPLED" for n in nt.nodes) else nt.nodes.new("ShaderNodeBsdfPrincipled")
+    node = make_node(nt)
+    node.location = (bsdf.location[0] - 320, bsdf.location[1])
+    nt.links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
+    nt.nodes.active = node
+    return mat
+
+
+class OMNINOISE_OT_solid_preview(_TaskOperator, bpy.types.Operator):
+    """Preview the solid texture: a 128 px slice through the texture (z = 0 plane) as an image"""
+
+    bl_idname = "omninoise.solid_preview"
+    bl_label = "Preview Solid Texture"
+    bl_options = {"REGISTER"}
+
+    def _start(self, context, blocking: bool):
+        p = context.scene.omninoise_solid
+        try:
+            m, code_fn = texture(p)
+        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        seed, name = p.seed, f"{p.name} Preview"
+
+        def work(progress, cancel):
+            code = code_fn()
+            progress(0.2)
+            return m.image(128, code, seed, progress=lambda d, n: progress(0.2 + 0.8 * d / n), cancel=cancel)
+
+        def done(img):
+            _store_image(name, np.flipud(img)).preview_ensure()
+
+        return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
+
+
+class OMNINOISE_OT_solid_bake(_TaskOperator, bpy.types.Operator):
+    """Bake the solid texture onto the active object: UV image, colour attribute or volume"""
+
+    bl_idname = "omninoise.solid_bake"
+    bl_label = "Bake Solid Texture"
+    bl_options = {"REGISTER"}
+
+    def _start(self, context, blocking: bool):
+        p = context.scene.omninoise_solid
+        obj = context.active_object
+        try:
+            if obj is None:
+                raise backend.SettingError("object", "select an object to bake onto")
+            if p.target != "VOLUME" and obj.type != "MESH":
+                raise backend.SettingError("object", f"{obj.name!r} is not a mesh; bake a mesh or choose Volume")
+            m, code_fn = texture(p)
+            if m.dim != 3:
+                raise backend.SettingError("model", f"model {m.name!r} is 2D; surfaces need a 3D solid texture")
+            return self._start_target(context, p, obj, m, code_fn, blocking)
+        except (backend.SettingError, _mod("neural.model").ModelError, OSError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+
+    def _start_target(self, context, p, obj, m, code_fn, blocking):
+        world, scale, seed, name = p.coords == "WORLD", float(p.scale), int(p.seed), p.name
+        surface = _mod("solid.surface")
+        if p.target == "UV_IMAGE":
+            uv, pos = _mesh_arrays(context, obj, world, uv=True)
+            size, margin = int(p.size), int(p.margin)
+
+            def work(progress, cancel):
+                code = code_fn()
+                mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.3 * f), cancel)
+                mask, pts = surface.dilate(mask, pts, margin)
+                rgb = np.zeros((size, size, 3), np.float32)
+                rgb[mask] = m.evaluate(pts[mask] * scale, code, seed,
+                                       progress=lambda d, n: progress(0.3 + 0.7 * d / n), cancel=cancel)
+                return rgb
+
+            def done(rgb):
+                ima = _store_image(name, rgb)
+
+                def node(nt):
+                    n = next((x for x in nt.nodes if x.type == "TEX_IMAGE" and x.image == ima), None)
+                    n = n or nt.nodes.new("ShaderNodeTexImage")
+                    n.image = ima
+                    return n
+
+                _material_with(obj, name, node)
+
+        elif p.target == "COLOR_ATTRIBUTE":
+            me = obj.data
+            co = np.empty(len(me.vertices) * 3, np.float32)
+            me.vertices.foreach_get("co", co)
+            co = co.reshape(-1, 3).astype(np.float64)
+            if world:
+                M = np.array(obj.matrix_world)
+                co = co @ M[:3, :3].T + M[:3, 3]
+            linear = _mod("solid.bake").srgb_to_linear
+
+            def work(progress, cancel):
+                code = code_fn()
+                rgb = m.evaluate(co * scale, code, seed, progress=lambda d, n: progress(d / n), cancel=cancel)
+                return linear(rgb)
+
+            def done(rgb):
+                attr = me.color_attributes.get(name)
+                if attr is not None and (attr.domain != "POINT" or attr.data_type != "FLOAT_COLOR"):
+                    me.color_attributes.remove(attr)
+                    attr = None
+                attr = attr or me.color_attributes.new(name, "FLOAT_COLOR", "POINT")
+                rgba = np.ones((len(me.vertices), 4), np.float32)
+                rgba[:, :3] = rgb
+                attr.data.foreach_set("color", rgba.ravel())
+                me.color_attributes.active_color = attr
+                me.update()
+
+                def node(nt):
+                    n = next((x for x in nt.nodes if x.type == "VERTEX_COLOR" and x.layer_name == name), None)
+                    n = n or nt.nodes.new("ShaderNodeVertexColor")
+                    n.layer_name = name
+                    return n
+
+                _material_with(obj, name, node)
+
+        else:  # VOLUME
+            from .bake_blender import load_volume, output_folder
+
+            lo = np.array([min(c[i] for c in obj.bound_box) for i in range(3)])
+            hi = np.array([max(c[i] for c in obj.bound_box) for i in range(3)])
+            if world:
+                from .bake_blender import world_bounds
+
+                lo, hi = (np.array(b) for b in world_bounds(obj))
+            ext = np.maximum(hi - lo, 1e-6)
+            vs = float(ext.max()) / int(p.voxels)
+            res = tuple(int(max(1, round(e / vs))) for e in ext)
+            grid = _mod("sources").BoxGrid(res, (tuple(lo), tuple(lo + np.array(res) * vs))).validate()
+            path = os.path.join(output_folder(p.folder), bpy.path.clean_name(name) + ".vdb")
+            bake = _mod("solid.bake")
+
+            def work(progress, cancel):
+                code = code_fn()
+                bake.bake_volume(m, code, grid, path, seed, scale, progress=progress, cancel=cancel)
+                return path
+
+            def done(path):
+                vol = load_volume(name, [path], None, False)
+                if not world:  # baked in the object's own space: place it like the object
+                    vol.matrix_world = obj.matrix_world.copy()
+
+        return tasks.start(tasks.Task(f"Solid {name}", work, done, None, threads()), blocking=blocking)
+
+
+def draw_solid(layout, context) -> None:
+    p = context.scene.omninoise_solid
+    draw_progress(layout)
+    layout.prop(p, "source", expand=True)
+    if p.source == "SHIPPED":
+        layout.prop(p, "texture")
+    else:
+        layout.template_ID(p, "image", open="image.open")
+    prev = bpy.data.images.get(f"{p.name} Preview")
+    if prev is not None and prev.preview is not None:
+        layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)
+    col = layout.column(align=True)
+    col.prop(p, "scale")
+    col.prop(p, "seed")
+    layout.prop(p, "coords")
+    layout.prop(p, "target")
+    if p.target == "UV_IMAGE":
+        col = layout.column(align=True)
+        col.prop(p, "size")
+        col.prop(p, "margin")
+    elif p.target == "VOLUME":
+        layout.prop(p, "voxels")
+        layout.prop(p, "folder")
+    layout.prop(p, "name")
+    row = layout.row(align=True)
+    row.enabled = tasks.current() is None
+    row.operator(OMNINOISE_OT_solid_preview.bl_idname, text="Preview", icon="HIDE_OFF")
+    row.operator(OMNINOISE_OT_solid_bake.bl_idname, text="Bake", icon="RENDER_STILL")
+
+
+class OMNINOISE_PT_solid(bpy.types.Panel):
+    bl_label = "Solid Texture from Image"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "OmniNoise"
+
+    def draw(self, context):
+        draw_solid(self.layout, context)
+
+
+classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_bake, OMNINOISE_PT_solid)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.omninoise_solid = PointerProperty(type=OMNINOISE_PG_solid)
+
+
+def unregister():
+    del bpy.types.Scene.omninoise_solid
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,215 @@
+"""Solid Texture from Image in background Blender: preview, UV image, colour attribute and volume bakes."""
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+torch = pytest.importorskip("torch")
+
+import blender_addon  # noqa: E402
+from blender_addon import solid_ui, tasks  # noqa: E402
+from backend.solid.bake import srgb_to_linear  # noqa: E402
+from backend.solid.model import SolidTextureModel  # noqa: E402
+
+SHIPPED = solid_ui.MODELS_DIR
+
+
+@pytest.fixture(scope="module", autouse=True)
+def addon(tmp_path_factory):
+    """A models folder with the shipped gravel model and a tiny texture-space model trained here."""
+    from backend.training.solid.export import export
+    from backend.training.solid.train import SolidConfig, train
+
+    root = tmp_path_factory.mktemp("solid_models")
+    shutil.copytree(os.path.join(SHIPPED, "gravel_3d"), root / "gravel_3d")
+    cfg = SolidConfig.from_dict(dict(name="space", mode="space", dim=3, crop=128, batch=1, steps=2, width=16,
+                                     threads=1, exemplars=["gravel", "grass"]))
+    train(cfg, str(root / "run"), log=lambda *_: None)
+    export(str(root / "run"), str(root / "space"))
+    shutil.rmtree(root / "run")
+    solid_ui.MODELS_DIR = str(root)
+    blender_addon.register()
+    yield
+    blender_addon.unregister()
+    solid_ui.MODELS_DIR = SHIPPED
+
+
+@pytest.fixture
+def scene(tmp_path):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    p = bpy.context.scene.omninoise_solid
+    p.texture = "single:gravel_3d"
+    p.size, p.margin, p.voxels, p.seed, p.scale = 32, 2, 8, 3, 2.0
+    p.folder = str(tmp_path)
+    return bpy.context.scene
+
+
+def _model(name="gravel_3d"):
+    return SolidTextureModel(os.path.join(solid_ui.MODELS_DIR, name))
+
+
+def _pixels(name):
+    ima = bpy.data.images[name]
+    w, h = ima.size
+    px = np.empty(w * h * 4, np.float32)
+    ima.pixels.foreach_get(px)
+    return px.reshape(h, w, 4)[..., :3]
+
+
+def test_catalogue_lists_single_models_and_space_exemplars(scene):
+    ids = [i[0] for i in solid_ui._catalogue()]
+    assert ids == ["single:gravel_3d", "space:space:grass", "space:space:gravel"]
+
+
+def test_uv_image_bake_is_the_texture_at_each_texels_surface_point(scene):
+    bpy.ops.mesh.primitive_plane_add(size=2.0)      # UV [0,1]^2 -> object xy [-1,1]^2
+    obj = bpy.context.active_object
+    obj.location = (5.0, 0.0, 0.0)                   # object coordinates: the location does not matter
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    got = _pixels("Solid Texture")                   # row 0 = bottom = v 0
+    j, i = np.meshgrid(np.arange(32), np.arange(32))
+    pts = np.stack([-1 + 2 * (j + 0.5) / 32, -1 + 2 * (i + 0.5) / 32, np.zeros_like(j, float)], -1).reshape(-1, 3)
+    m = _model()
+    ref = m.evaluate(pts * 2.0, m.default_code(), seed=3).reshape(32, 32, 3)
+    assert np.abs(got - ref).max() <= 0.5 / 255 + 1e-6   # 8-bit sRGB image
+    mat = obj.active_material
+    tex = next(n for n in mat.node_tree.nodes if n.type == "TEX_IMAGE")
+    bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    assert tex.image.name == "Solid Texture" and bsdf.inputs["Base Color"].links[0].from_node == tex
+    # world coordinates follow the location
+    scene.omninoise_solid.coords = "WORLD"
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    pts_w = pts + [5.0, 0.0, 0.0]
+    ref_w = m.evaluate(pts_w * 2.0, m.default_code(), seed=3).reshape(32, 32, 3)
+    assert np.abs(_pixels("Solid Texture") - ref_w).max() <= 0.5 / 255 + 1e-6
+
+
+def test_cube_seams_agree(scene):
+    """Texels on both sides of a cube edge (two UV islands) read nearly the same 3D points."""
+    bpy.ops.mesh.primitive_cube_add(size=2.0)
+    p = scene.omninoise_solid
+    p.size, p.scale = 256, 0.25
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    from blender_addon.solid_ui import _mesh_arrays
+    from backend.solid.surface import texel_positions
+    uv, pos = _mesh_arrays(bpy.context, bpy.context.active_object, False, True)
+    mask, pts = texel_positions(uv, pos, 256, 256)
+    img = _pixels("Solid Texture")
+    # texels within half a texel of the edge x = 1, y = 1 on the two faces that share it
+    near = mask & (np.abs(pts[..., 0] - 1) < 1e-9) & (pts[..., 1] > 1 - 2 / 64)
+    near2 = mask & (np.abs(pts[..., 1] - 1) < 1e-9) & (pts[..., 0] > 1 - 2 / 64)
+    assert near.sum() > 10 and near2.sum() > 10
+    za = pts[near][:, 2]
+    zb = pts[near2][:, 2]
+    ca, cb = img[near], img[near2]
+    # colours as a function of z along the edge, interpolated: the two faces agree
+    order = np.argsort(zb)
+    for c in range(3):
+        interp = np.interp(za, zb[order], cb[order, c])
+        assert np.abs(interp - ca[:, c]).mean() < 0.06
+
+
+def test_color_attribute_bake(scene):
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
+    obj = bpy.context.active_object
+    p = scene.omninoise_solid
+    p.target = "COLOR_ATTRIBUTE"
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    me = obj.data
+    attr = me.color_attributes["Solid Texture"]
+    assert attr.domain == "POINT" and attr.data_type == "FLOAT_COLOR"
+    got = np.empty(len(me.vertices) * 4, np.float32)
+    attr.data.foreach_get("color", got)
+    co = np.empty(len(me.vertices) * 3, np.float32)
+    me.vertices.foreach_get("co", co)
+    m = _model()
+    ref = srgb_to_linear(m.evaluate(co.reshape(-1, 3).astype(np.float64) * 2.0, m.default_code(), seed=3))
+    np.testing.assert_allclose(got.reshape(-1, 4)[:, :3], ref, atol=1e-5)
+    node = next(n for n in obj.active_material.node_tree.nodes if n.type == "VERTEX_COLOR")
+    assert node.layer_name == "Solid Texture"
+
+
+def test_volume_bake(scene, tmp_path):
+    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(1.0, 0.0, 0.0))
+    p = scene.omninoise_solid
+    p.target = "VOLUME"
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    path = tmp_path / "Solid_Texture.vdb"
+    assert path.is_file()
+    from export.vdb import read_volume
+    col = read_volume(str(path), "color", (8, 8, 8))
+    # voxel centres of the object's local bounds [-1, 1]^3 at 8 voxels
+    c = -1 + (np.arange(8) + 0.5) * 0.25
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")
+    m = _model()
+    ref = srgb_to_linear(m.evaluate(np.stack([x, y, z], -1).reshape(-1, 3) * 2.0, m.default_code(), 3))
+    np.testing.assert_allclose(col.reshape(-1, 3), ref, atol=1e-5)
+    vol = bpy.data.objects["Solid Texture"]
+    assert vol.type == "VOLUME" and tuple(vol.matrix_world.translation) == pytest.approx((1.0, 0.0, 0.0))
+
+
+def test_image_source_is_encoded_by_the_space_model(scene):
+    p = scene.omninoise_solid
+    ima = bpy.data.images.new("Exemplar", 160, 140, alpha=False)
+    rgba = np.ones((140, 160, 4), np.float32)
+    rgba[..., :3] = np.random.default_rng(1).random((140, 160, 3))
+    ima.pixels.foreach_set(rgba.ravel())
+    p.source, p.image = "IMAGE", ima
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    got = _pixels("Solid Texture Preview")
+    m = _model("space")
+    code = m.translate(m.encode(np.flipud(np.round(rgba[..., :3] * 255) / 255)))
+    ref = np.flipud(m.image(128, code, seed=3))
+    assert np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
+
+
+def test_errors_are_reported(scene):
+    p = scene.omninoise_solid
+    with pytest.raises(RuntimeError, match="select an object"):
+        bpy.ops.omninoise.solid_bake()
+    bpy.ops.mesh.primitive_plane_add()
+    me = bpy.context.active_object.data
+    me.uv_layers.remove(me.uv_layers[0])
+    me.update()
+    with pytest.raises(RuntimeError, match="has no UV map"):
+        bpy.ops.omninoise.solid_bake()
+    p.source = "IMAGE"
+    with pytest.raises(RuntimeError, match="pick an exemplar image"):
+        bpy.ops.omninoise.solid_preview()
+
+
+def test_worker_bake_cancels_and_leaves_nothing(scene):
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    p = scene.omninoise_solid
+    p.size = 1024
+    op = solid_ui.OMNINOISE_OT_solid_bake
+    task = op._start(type("Op", (), {"report": lambda *a: None, "_start_target": op._start_target})(),
+                     bpy.context, False)
+    while task.progress == 0 and task._thread.is_alive():
+        pass
+    task.cancel()
+    tasks.wait(task)
+    assert task.status == "cancelled" and task.progress < 0.9 and "Solid Texture" not in bpy.data.images
+    assert bpy.context.active_object.active_material is None
+
+
+class Recorder:
+    def __init__(self, log):
+        self.log = log
+        self.enabled = True
+
+    def __getattr__(self, name):
+        def call(*args, **kw):
+            self.log.append((name, args[1] if len(args) > 1 else None, kw.get("text")))
+            return Recorder(self.log) if name in ("row", "column", "box") else type("Op", (), {})()
+        return call
+
+
+def test_panel_draws(scene):
+    log = []
+    solid_ui.draw_solid(Recorder(log), bpy.context)
+    props = [a for n, a, t in log if n == "prop"]
+    assert {"source", "texture", "scale", "seed", "coords", "target", "size", "margin", "name"} <= set(props)
+    assert [t for n, a, t in log if n == "operator"] == ["Preview", "Bake"]
