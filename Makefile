@@ -24,6 +24,7 @@ demo: $(STAMP)
 	$(BIN)/omninoise bake demo/volumes.toml
 	$(BIN)/python demo/showcase_volume.py out/demo
 	$(BIN)/python demo/neural.py out/demo
+	$(BIN)/python demo/solid.py out/demo
 
 $(VENV)/.train: $(STAMP) requirements-train.txt
 	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt

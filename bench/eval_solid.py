@@ -163,6 +163,7 @@ def main() -> int:
     res = {}
     if not a.only_speed:
         res["quality"] = quality(a.n)
+        res["n"] = a.n
         print("| exemplar | method | style error ↓ | PSD error ↓ | diversity ↑ | success ↑ |")
         print("|---|---|---|---|---|---|")
         for name, rows in res["quality"].items():

@@ -1,0 +1,123 @@
+"""Write the solid-texture model card: ``python -m backend.training.solid.model_card``.
+
+    python -m backend.training.solid.model_card --models models/solid --runs runs/solid \\
+        --eval out/bench/solid_eval.json -o models/solid/MODEL_CARD.md
+
+Everything in the card is read from files the project's own commands wrote:
+each model's ``solid.json`` (config, steps, sha256), its run's ``log.jsonl``
+(wall time, final loss) and the evaluation JSON of ``bench/eval_solid.py``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+from ..model_card import _hardware, wall_seconds
+
+__all__ = ["card"]
+
+
+def _final_loss(log: str, window: int = 4) -> float:
+    with open(log, encoding="utf-8") as fh:
+        rows = [json.loads(line) for line in fh]
+    return round(sum(r["loss"] for r in rows[-window:]) / len(rows[-window:]), 4)
+
+
+def card(models: str, runs: str, eval_path: str | None) -> str:
+    docs = {}
+    for name in sorted(os.listdir(models)):
+        path = os.path.join(models, name, "solid.json")
+        if os.path.isfile(path):
+            with open(path, encoding="utf-8") as fh:
+                docs[name] = json.load(fh)
+    ev = {}
+    if eval_path and os.path.isfile(eval_path):
+        with open(eval_path, encoding="utf-8") as fh:
+            ev = json.load(fh)
+    L = ["# Neural solid texture models", "",
+         "Solid textures after Henzler, Mitra and Ritschel, \"Learning a Neural 3D Texture Space from 2D "
+         "Exemplars\" (CVPR 2020), trained by this project's code (`backend/training/solid/`) on CPU.", "",
+         "## How they were made", "", "```sh",
+         "# one model per config; configs/solid/NAME.json names its exemplar, dimension and schedule",
+         "python -m backend.training.solid.train --config configs/solid/NAME.json --out runs/solid/NAME",
+         "python -m backend.training.solid.export runs/solid/NAME models/solid/NAME",
+         "python bench/eval_solid.py --speed",
+         "python -m backend.training.solid.model_card -o models/solid/MODEL_CARD.md", "```", "",
+         "- **Exemplars:** the CC0 photographs brick, grass and gravel from scikit-image's data "
+         "(`data/exemplars/README.md`; training never crops their right quarter) and the procedural classes "
+         "wood, marble, rust and granite of `backend/training/solid/exemplars.py` (seed 0 trains, seed 1 is held out).",
+         "- **Model** (Sec. 3-4, Eq. 5): 8 octaves of lattice value noise, 3 values per lattice point, octave i "
+         "read at T_i 2^(i-1) x; decoder MLP of four 128-wide ReLU layers over [noise (24), e (64)] to RGB "
+         "(sigmoid, sRGB values). Single mode learns e, T and the decoder; the space model learns an "
+         "instance-normalised encoder (128 px patch -> z, 8-D), a translator h(z) -> (e, T) and the decoder jointly.",
+         "- **Loss:** no pretrained VGG can be downloaded here, so the Gram matrices are those of a fixed random "
+         "two-layer network (32 5x5 and 64 3x3 zero-mean filters, four pyramid levels; Ustyuzhaninov et al. 2017 "
+         "showed random multi-scale filters suffice for Gram-based synthesis), plus a sliced Wasserstein term on "
+         "the joint RGB distribution (10 colour directions), weight 10.",
+         "- **3D from 2D:** each step renders 128² slices through random points of 3D space, axis-aligned "
+         "(random axis permutation) or, half the time, randomly rotated; every slice must match the exemplar's "
+         "statistics. Exemplar crops are randomly rotated/flipped for 3D models.",
+         f"- **Hardware:** {_hardware()}; one torch thread per run, two runs sharing the two cores.", "",
+         "## Models", "",
+         "| model | mode | dim | exemplars | scale | steps | wall time | final loss | sha256 (decoder.onnx) |",
+         "|---|---|---|---|---|---|---|---|---|"]
+    for name, d in docs.items():
+        log = os.path.join(runs, name if d["mode"] == "single" else d["name"], "log.jsonl")
+        wall = f"{wall_seconds(log) / 60:.1f} min" if os.path.isfile(log) else "n/a"
+        loss = _final_loss(log) if os.path.isfile(log) else "n/a"
+        L.append(f"| {name} | {d['mode']} | {d['dim']}D | {', '.join(d['exemplars'])} | {d['exemplar_scale']} | "
+                 f"{d['step']} | {wall} | {loss} | `{d['files']['decoder.onnx'][:16]}…` |")
+    L += ["", "Full sha256 of every file: each model's `solid.json` (`files`); the runtime refuses a file whose "
+          "hash differs. Configs: `configs/solid/<model>.json` (the space model: `space_3d.json`).", ""]
+    q = ev.get("quality")
+    if q:
+        L += ["## Evaluation (`bench/eval_solid.py`)", "",
+              f"{ev.get('n', 8)} samples (seeds) per method at 64² px of the training resolution, compared with the exemplar's "
+              "held-out pixels. Style error: Gram distance of an independent random network (other seed, widths "
+              "and kernels than the loss) plus the colour term; a real 64 px crop scores about 1 on it because one "
+              "crop's statistics scatter around the held-out mean. PSD error: mean |log| ratio of luminance power "
+              "spectra. Diversity: mean pairwise relative distance of first-layer feature maps (0: every seed gives "
+              "the same image). Success = diversity × (row's worst style error − style error), as in Table 3.", "",
+              "| exemplar | method | style error ↓ | PSD error ↓ | diversity ↑ | success ↑ |", "|---|---|---|---|---|---|"]
+        for name, rows in q.items():
+            for meth, r in rows.items():
+                L.append(f"| {name} | {meth} | {r['style']} | {r['psd']} | {r['diversity']} | {r['success']} |")
+        L.append("")
+    sp = ev.get("speed")
+    if sp:
+        L += ["## Speed and memory (Table 2)", "", "Every point evaluated, in a fresh process each "
+              "(peak resident memory includes the interpreter and libraries):", "",
+              "| grid | engine | points/s | seconds | peak MiB |", "|---|---|---|---|---|"]
+        for r in sp:
+            L.append(f"| {'×'.join([str(r['size'])] * r['dim'])} | {r['engine']} | {r['points_per_s']:,} | "
+                     f"{r['seconds']} | {r['peak_mib']} |")
+        L.append("")
+    L += ["## Limits", "",
+          "- The point-wise MLP over value noise reproduces stochastic, stationary textures (granite, gravel-like "
+          "speckle, rust, marble clouds) far better than structured ones: bricks come out as blotches, not "
+          "courses, as the paper's own results and its Table 1 note for non-stochastic appearance.",
+          "- The photographs are greyscale; the models still output RGB.",
+          "- Trained on two CPU cores for minutes per model: a GPU run with more steps and a larger batch would "
+          "lower the style error further.", ""]
+    return "\n".join(L)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m backend.training.solid.model_card", description=__doc__.split("\n")[0])
+    ap.add_argument("--models", default="models/solid")
+    ap.add_argument("--runs", default="runs/solid")
+    ap.add_argument("--eval", default="out/bench/solid_eval.json")
+    ap.add_argument("-o", "--out", default="models/solid/MODEL_CARD.md")
+    a = ap.parse_args(argv)
+    text = card(a.models, a.runs, a.eval)
+    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
+        fh.write(text)
+    os.replace(a.out + ".tmp", a.out)
+    print(a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,161 @@
+"""Neural solid textures showcase: out/demo/solid.blend, solid_render.png and solid_slices.png.
+
+A cube, a UV sphere and Suzanne receive solid textures through the add-on's
+own "Solid Texture from Image" operator (headless, blocking), one per shipped
+photograph or procedural exemplar: the cube and the sphere as UV images (each
+texel evaluated at its 3D surface point, so the UV seams do not show), Suzanne
+as a colour attribute on a subdivided mesh; a texture-space model, when one
+ships, textures a fourth object from a photograph it encodes.  The scene
+renders in Cycles on the CPU.  solid_slices.png shows, per model, the
+exemplar beside slices of the 3D texture along the three axes and an oblique
+plane.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+import bpy  # noqa: E402
+
+import blender_addon  # noqa: E402
+from backend.solid.model import SolidTextureModel  # noqa: E402
+from export.images import preview_8bit, read_rgb, write_png  # noqa: E402
+
+MODELS = os.path.join(ROOT, "models", "solid")
+EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
+# object -> (model, bake target, scale); first shipped model in each list is used
+PLAN = [("Cube", ["gravel_3d", "granite_3d"], "UV_IMAGE", 1.5),
+        ("Sphere", ["marble_3d", "wood_3d"], "UV_IMAGE", 1.0),
+        ("Suzanne", ["wood_3d", "grass_3d", "gravel_3d"], "COLOR_ATTRIBUTE", 1.0)]
+
+
+def _shipped(names):
+    return next((n for n in names if os.path.isfile(os.path.join(MODELS, n, "solid.json"))), None)
+
+
+def slices_sheet(out: str, size: int = 160) -> list:
+    """Exemplar | xy | xz | yz | oblique slice per shipped 3D single model -> solid_slices.png."""
+    rows, names = [], []
+    for name in sorted(os.listdir(MODELS)):
+        if not os.path.isfile(os.path.join(MODELS, name, "solid.json")):
+            continue
+        m = SolidTextureModel(os.path.join(MODELS, name))
+        if m.mode != "single" or m.dim != 3:
+            continue
+        ex = m.config["exemplars"][0]
+        img = read_rgb(os.path.join(EXEMPLARS, f"{ex}.png"))
+        step = max(1, round(1.0 / m.config["exemplar_scale"]))
+        exemplar = img[::step, ::step][:size, :size]
+        code = m.default_code()
+        scale = m.config["exemplar_scale"]
+        cells = [exemplar] + [m.image(size, code, 0, scale=scale, axis=a, offset=(1.3, 2.1, 0.7)) for a in "zyx"]
+        u = (np.arange(size) + 0.5) / (m.px_per_unit * scale)
+        vv, uu = np.meshgrid(u, u, indexing="ij")
+        frame = np.linalg.qr(np.random.default_rng(4).normal(size=(3, 3)))[0]
+        pts = np.stack([uu.ravel(), -vv.ravel()], 1) @ frame[:, :2].T + 3.0
+        cells.append(m.evaluate(pts, code, 0).reshape(size, size, 3))
+        gap = np.ones((size, 4, 3), np.float32)
+        rows.append(np.concatenate(sum([[c, gap] for c in cells], [])[:-1], 1))
+        names.append(name)
+    if rows:
+        sheet = np.concatenate(sum([[r, np.ones((4, r.shape[1], 3), np.float32)] for r in rows], [])[:-1], 0)
+        write_png(os.path.join(out, "solid_slices.png"), preview_8bit(sheet, 0.0, 1.0))
+    return names
+
+
+def build_scene(out: str) -> dict:
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    blender_addon.register()
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    sc.cycles.device = "CPU"
+    sc.cycles.samples = 24
+    sc.render.resolution_x, sc.render.resolution_y = 640, 300
+    p = sc.omninoise_solid
+    p.folder = os.path.join(out, "bakes")
+    used = {}
+    x = -3.3
+    for obj_name, candidates, target, scale in PLAN:
+        model = _shipped(candidates)
+        if model is None:
+            continue
+        if obj_name == "Cube":
+            bpy.ops.mesh.primitive_cube_add(size=1.6, location=(x, 0, 0.8), rotation=(0, 0, 0.6))
+        elif obj_name == "Sphere":
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, segments=48, ring_count=24, location=(x, 0, 0.95))
+            bpy.ops.object.shade_smooth()
+        else:
+            bpy.ops.mesh.primitive_monkey_add(size=1.6, location=(x, 0, 0.9), rotation=(0.3, 0, 0.3))
+            mod = bpy.context.active_object.modifiers.new("Subdivision", "SUBSURF")
+            mod.levels = mod.render_levels = 2
+            bpy.ops.object.modifier_apply(modifier="Subdivision")   # vertex colours need the dense mesh
+            bpy.ops.object.shade_smooth()
+        obj = bpy.context.active_object
+        obj.name = obj_name
+        p.source, p.texture, p.target, p.scale = "SHIPPED", f"single:{model}", target, scale
+        p.name, p.size = f"{obj_name} {model}", 1024
+        t = time.perf_counter()
+        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        used[obj_name] = dict(model=model, target=target, seconds=round(time.perf_counter() - t, 2))
+        x += 2.2
+    space = os.path.join(MODELS, "space", "solid.json")
+    if os.path.isfile(space):
+        bpy.ops.mesh.primitive_cylinder_add(radius=0.8, depth=1.6, location=(x, 0, 0.8), vertices=48)
+        obj = bpy.context.active_object
+        obj.name = "Cylinder"
+        photo = bpy.data.images.load(os.path.join(EXEMPLARS, "grass.png"))
+        p.source, p.image, p.target, p.scale, p.name = "IMAGE", photo, "UV_IMAGE", 1.0, "Cylinder from photo"
+        t = time.perf_counter()
+        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        used["Cylinder"] = dict(model="space (encodes grass.png)", target="UV_IMAGE",
+                                seconds=round(time.perf_counter() - t, 2))
+    bpy.ops.mesh.primitive_plane_add(size=30.0)
+    bpy.ops.object.camera_add(location=(0.0, -8.5, 3.6), rotation=(1.2, 0.0, 0.0))
+    cam = bpy.context.active_object
+    cam.data.lens = 40
+    sc.camera = cam
+    bpy.ops.object.light_add(type="SUN", rotation=(0.8, 0.2, 0.5))
+    bpy.context.active_object.data.energy = 4.0
+    world = bpy.data.worlds.new("Sky")
+    if world.node_tree is None:
+        world.use_nodes = True
+    next(n for n in world.node_tree.nodes if n.type == "BACKGROUND").inputs["Color"].default_value = \
+        (0.35, 0.38, 0.42, 1.0)
+    sc.world = world
+    return used
+
+
+def main(out: str) -> int:
+    os.makedirs(out, exist_ok=True)
+    if not os.path.isdir(MODELS):
+        print("solid demo skipped: no models/solid")
+        return 0
+    t0 = time.perf_counter()
+    names = slices_sheet(out)
+    used = build_scene(out)
+    sc = bpy.context.scene
+    path = os.path.join(out, "solid.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path + ".tmp.blend", compress=True)
+    os.replace(path + ".tmp.blend", path)
+    sc.render.filepath = os.path.join(out, "solid_render.tmp.png")
+    sc.render.image_settings.file_format = "PNG"
+    t = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    os.replace(sc.render.filepath, os.path.join(out, "solid_render.png"))
+    info = dict(slices=names, objects=used, render_seconds=round(time.perf_counter() - t, 1),
+                seconds=round(time.perf_counter() - t0, 1))
+    with open(os.path.join(out, "solid.json"), "w", encoding="utf-8") as fh:
+        json.dump(info, fh, indent=1)
+    print(f"wrote {path}, solid_render.png, solid_slices.png ({info['seconds']} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "out", "demo")))
