@@ -62,19 +62,36 @@ class Decoder(nn.Module):
 
 
 class Encoder(nn.Module):
-    """g(y): instance-normalised strided convolutions and a global average: (B, 3, S, S) -> (B, z_dim)."""
+    """g(y): instance-normalised strided convolutions -> texture statistics -> z: (B, 3, S, S) -> (B, z_dim).
 
-    def __init__(self, z_dim: int = 8, widths=(32, 64, 128, 256, 256)):
+    Instance normalisation removes each feature map's mean and spread, so a
+    global average of the normalised maps would be the same for every
+    exemplar (a first version collapsed exactly so).  The code is therefore
+    read from the statistics the normalisation takes away: per-channel mean and
+    standard deviation of every block's convolution output (and of the input
+    colours), as style encoders do, followed by a two-layer MLP.
+    """
+
+    def __init__(self, z_dim: int = 8, widths=(32, 64, 128, 256, 256), hidden: int = 256):
         super().__init__()
-        mods, cin = [], 3
+        self.convs = nn.ModuleList()
+        self.norms = nn.ModuleList()
+        cin = 3
         for w in widths:
-            mods += [nn.Conv2d(cin, w, 4, 2, 1), nn.InstanceNorm2d(w, affine=True), nn.LeakyReLU(0.2)]
+            self.convs.append(nn.Conv2d(cin, w, 4, 2, 1))
+            self.norms.append(nn.InstanceNorm2d(w, affine=True))
             cin = w
-        self.conv = nn.Sequential(*mods)
-        self.fc = nn.Linear(cin, z_dim)
+        n_stats = 2 * (3 + sum(widths))
+        self.fc = nn.Sequential(nn.Linear(n_stats, hidden), nn.LeakyReLU(0.2), nn.Linear(hidden, z_dim))
 
     def forward(self, y: torch.Tensor) -> torch.Tensor:
-        return self.fc(self.conv(y * 2.0 - 1.0).mean(dim=(2, 3)))
+        x = y * 2.0 - 1.0
+        stats = [x.mean(dim=(2, 3)), x.std(dim=(2, 3))]
+        for conv, norm in zip(self.convs, self.norms):
+            h = conv(x)
+            stats += [h.mean(dim=(2, 3)), h.std(dim=(2, 3))]
+            x = nn.functional.leaky_relu(norm(h), 0.2)
+        return self.fc(torch.cat(stats, dim=1))
 
 
 class Translator(nn.Module):
