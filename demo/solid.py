@@ -1,11 +1,11 @@
 """Neural solid textures showcase: out/demo/solid.blend, solid_render.png and solid_slices.png.
 
-A cube, a UV sphere and Suzanne receive solid textures through the add-on's
-own "Solid Texture from Image" operator (headless, blocking), one per shipped
-photograph or procedural exemplar: the cube and the sphere as UV images (each
-texel evaluated at its 3D surface point, so the UV seams do not show), Suzanne
-as a colour attribute on a subdivided mesh; a texture-space model, when one
-ships, textures a fourth object from a photograph it encodes.  The scene
+A cube, a UV sphere and Suzanne receive solid textures from photographs
+through the add-on's own "Solid Texture from Image" operator (headless,
+blocking): the cube (gravel) and the sphere (grass) as UV images, each texel
+evaluated at its 3D surface point so the UV seams do not show; Suzanne as a
+colour attribute on a subdivided mesh, from the gravel photograph encoded by
+the texture-space model.  A cylinder shows the procedural wood.  The scene
 renders in Cycles on the CPU.  solid_slices.png shows, per model, the
 exemplar beside slices of the 3D texture along the three axes and an oblique
 plane.
@@ -30,16 +30,6 @@ from export.images import preview_8bit, read_rgb, write_png  # noqa: E402
 
 MODELS = os.path.join(ROOT, "models", "solid")
 EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
-# object -> (model, bake target, scale); first shipped model in each list is used
-PLAN = [("Cube", ["gravel_3d", "granite_3d"], "UV_IMAGE", 1.5),
-        ("Sphere", ["marble_3d", "wood_3d"], "UV_IMAGE", 1.0),
-        ("Suzanne", ["wood_3d", "grass_3d", "gravel_3d"], "COLOR_ATTRIBUTE", 1.0)]
-
-
-def _shipped(names):
-    return next((n for n in names if os.path.isfile(os.path.join(MODELS, n, "solid.json"))), None)
-
-
 def slices_sheet(out: str, size: int = 160) -> list:
     """Exemplar | xy | xz | yz | oblique slice per shipped 3D single model -> solid_slices.png."""
     rows, names = [], []
@@ -70,56 +60,60 @@ def slices_sheet(out: str, size: int = 160) -> list:
     return names
 
 
+def _add(kind: str, x: float):
+    if kind == "Cube":
+        bpy.ops.mesh.primitive_cube_add(size=1.6, location=(x, 0, 0.8), rotation=(0, 0, 0.6))
+    elif kind == "Sphere":
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, segments=64, ring_count=32, location=(x, 0, 0.95))
+        bpy.ops.object.shade_smooth()
+    elif kind == "Suzanne":
+        bpy.ops.mesh.primitive_monkey_add(size=1.7, location=(x, 0, 0.95), rotation=(0.35, 0, 0.35))
+        mod = bpy.context.active_object.modifiers.new("Subdivision", "SUBSURF")
+        mod.levels = mod.render_levels = 3
+        bpy.ops.object.modifier_apply(modifier="Subdivision")   # vertex colours need the dense mesh
+        bpy.ops.object.shade_smooth()
+    else:
+        bpy.ops.mesh.primitive_cylinder_add(radius=0.8, depth=1.7, location=(x, 0, 0.85), vertices=64)
+    obj = bpy.context.active_object
+    obj.name = kind
+    return obj
+
+
 def build_scene(out: str) -> dict:
+    """Cube, sphere and Suzanne textured from photographs, a cylinder from the procedural wood."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     blender_addon.register()
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
     sc.cycles.device = "CPU"
     sc.cycles.samples = 24
-    sc.render.resolution_x, sc.render.resolution_y = 640, 300
+    sc.render.resolution_x, sc.render.resolution_y = 720, 300
     p = sc.omninoise_solid
     p.folder = os.path.join(out, "bakes")
+    space = os.path.isfile(os.path.join(MODELS, "space", "solid.json"))
+    plan = [("Cube", "gravel_3d", None, "UV_IMAGE", 1.5), ("Sphere", "grass_3d", None, "UV_IMAGE", 1.0),
+            ("Suzanne", "space" if space else "gravel_3d", "gravel.png" if space else None, "COLOR_ATTRIBUTE", 1.0),
+            ("Cylinder", "wood_3d", None, "UV_IMAGE", 1.0)]
     used = {}
     x = -3.3
-    for obj_name, candidates, target, scale in PLAN:
-        model = _shipped(candidates)
-        if model is None:
+    for kind, model, photo, target, scale in plan:
+        if not os.path.isfile(os.path.join(MODELS, model, "solid.json")):
             continue
-        if obj_name == "Cube":
-            bpy.ops.mesh.primitive_cube_add(size=1.6, location=(x, 0, 0.8), rotation=(0, 0, 0.6))
-        elif obj_name == "Sphere":
-            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, segments=48, ring_count=24, location=(x, 0, 0.95))
-            bpy.ops.object.shade_smooth()
-        else:
-            bpy.ops.mesh.primitive_monkey_add(size=1.6, location=(x, 0, 0.9), rotation=(0.3, 0, 0.3))
-            mod = bpy.context.active_object.modifiers.new("Subdivision", "SUBSURF")
-            mod.levels = mod.render_levels = 2
-            bpy.ops.object.modifier_apply(modifier="Subdivision")   # vertex colours need the dense mesh
-            bpy.ops.object.shade_smooth()
-        obj = bpy.context.active_object
-        obj.name = obj_name
-        p.source, p.texture, p.target, p.scale = "SHIPPED", f"single:{model}", target, scale
-        p.name, p.size = f"{obj_name} {model}", 1024
-        t = time.perf_counter()
-        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
-        used[obj_name] = dict(model=model, target=target, seconds=round(time.perf_counter() - t, 2))
+        obj = _add(kind, x)
         x += 2.2
-    space = os.path.join(MODELS, "space", "solid.json")
-    if os.path.isfile(space):
-        bpy.ops.mesh.primitive_cylinder_add(radius=0.8, depth=1.6, location=(x, 0, 0.8), vertices=48)
-        obj = bpy.context.active_object
-        obj.name = "Cylinder"
-        photo = bpy.data.images.load(os.path.join(EXEMPLARS, "grass.png"))
-        p.source, p.image, p.target, p.scale, p.name = "IMAGE", photo, "UV_IMAGE", 1.0, "Cylinder from photo"
+        if photo:   # the texture-space model encodes the photograph itself
+            p.source, p.image = "IMAGE", bpy.data.images.load(os.path.join(EXEMPLARS, photo))
+        else:
+            p.source, p.texture = "SHIPPED", f"single:{model}"
+        p.target, p.scale, p.name, p.size = target, scale, f"{kind} {model}", 1024
         t = time.perf_counter()
         assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
-        used["Cylinder"] = dict(model="space (encodes grass.png)", target="UV_IMAGE",
-                                seconds=round(time.perf_counter() - t, 2))
+        used[kind] = dict(model=model, photo=photo, target=target, seconds=round(time.perf_counter() - t, 2),
+                          object=obj.name)
     bpy.ops.mesh.primitive_plane_add(size=30.0)
-    bpy.ops.object.camera_add(location=(0.0, -8.5, 3.6), rotation=(1.2, 0.0, 0.0))
+    bpy.ops.object.camera_add(location=(0.0, -9.0, 3.2), rotation=(1.27, 0.0, 0.0))
     cam = bpy.context.active_object
-    cam.data.lens = 40
+    cam.data.lens = 38
     sc.camera = cam
     bpy.ops.object.light_add(type="SUN", rotation=(0.8, 0.2, 0.5))
     bpy.context.active_object.data.energy = 4.0
