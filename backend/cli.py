@@ -128,6 +128,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--scale", type=float, default=1.0,
                    help="zoom: output pixels per exemplar pixel (default 1, the exemplar's own resolution)")
     s.add_argument("--seed", type=int, default=0, help="variation: another seed gives another texture of the same kind")
+    s.add_argument("--refine", type=int, default=0, metavar="N",
+                   help="space model: improve an encoded image's code with N search steps (no torch)")
     s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
     s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
     s.add_argument("--quiet", action="store_true")
@@ -386,7 +388,7 @@ def run_neural(a: argparse.Namespace) -> int:
 SOLID_MODELS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "solid")
 
 
-def _solid_code(model, name: str, flag: str):
+def _solid_code(model, name: str, flag: str, refine: int = 0, bar=None, quiet: bool = True):
     """z of a space model for a known exemplar name or an image file."""
     from export.images import read_rgb
 
@@ -396,9 +398,17 @@ def _solid_code(model, name: str, flag: str):
         raise SettingError(flag, f"{name!r} is neither an image file nor an exemplar the model knows "
                                  f"({', '.join(model.codes) or 'none'})")
     try:
-        return model.encode(read_rgb(name))
+        img = read_rgb(name)
     except ValueError as exc:
         raise SettingError(flag, str(exc)) from None
+    z = model.encode(img)
+    if refine > 0:
+        from .solid.refine import refine_code
+
+        z, hist = refine_code(model, z, img, steps=refine, progress=bar)
+        if not quiet:
+            print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
+    return z
 
 
 def run_solid(a: argparse.Namespace) -> int:
@@ -425,6 +435,8 @@ def run_solid(a: argparse.Namespace) -> int:
         raise SettingError("--scale", f"must be > 0, got {a.scale}")
     if not 0.0 <= a.mix <= 1.0:
         raise SettingError("--mix", f"must be in [0, 1], got {a.mix}")
+    if a.refine < 0:
+        raise SettingError("--refine", f"must be >= 0, got {a.refine}")
     ext = os.path.splitext(a.out)[1].lower()
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
     if ext not in allowed:
@@ -443,11 +455,14 @@ def run_solid(a: argparse.Namespace) -> int:
     if model.mode == "single":
         if a.to:
             raise SettingError("--to", f"model {model.name!r} holds one texture; interpolation needs the space model")
+        if a.refine:
+            raise SettingError("--refine", f"model {model.name!r} holds one texture; refining needs the space model")
         code = model.default_code()
     else:
-        z = _solid_code(model, a.exemplar, "--exemplar")
+        z = _solid_code(model, a.exemplar, "--exemplar", a.refine, _Bar(a.quiet, "refine "), a.quiet)
         if a.to:
-            z = (1.0 - a.mix) * z + a.mix * _solid_code(model, a.to, "--to")
+            z = (1.0 - a.mix) * z + a.mix * _solid_code(model, a.to, "--to", a.refine, _Bar(a.quiet, "refine "),
+                                                        a.quiet)
         code = model.translate(z)
     bar = _Bar(a.quiet)
     from .solid.bake import bake_volume, evaluate_grid, srgb_to_linear

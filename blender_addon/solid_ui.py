@@ -105,6 +105,9 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     texture: EnumProperty(name="Texture", items=_texture_items)
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
                            description="A photo of the material (at least 128 px; larger is resized to crops)")
+    refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
+                        description="Improve the encoded image's code by a search against its texture statistics "
+                                    "(about 0.1 s a step)")
     scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
                          description="Texture units per Blender unit: larger means smaller features")
     seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
@@ -149,7 +152,15 @@ def texture(p):
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
         m = load_model(name)
         pixels = _image_pixels(p.image)   # main thread: bpy data
-        return m, lambda: m.translate(m.encode(pixels))
+        steps = int(p.refine)
+
+        def code():
+            z = m.encode(pixels)
+            if steps > 0:
+                z = _mod("solid.refine").refine_code(m, z, pixels, steps)[0]
+            return m.translate(z)
+
+        return m, code
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
@@ -384,6 +395,7 @@ def draw_solid(layout, context) -> None:
         layout.prop(p, "texture")
     else:
         layout.template_ID(p, "image", open="image.open")
+        layout.prop(p, "refine")
     prev = bpy.data.images.get(f"{p.name} Preview")
     if prev is not None and prev.preview is not None:
         layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)

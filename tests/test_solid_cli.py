@@ -101,3 +101,15 @@ def test_errors_models(models, tmp_path, capsys):
     rc, err = run(capsys, "--model", str(tmp_path), "--exemplar", "x", "-o", str(tmp_path / "a.png"))
     assert rc == 2 and "no solid.json" in err
     assert not os.path.exists(tmp_path / "a.png")
+
+
+def test_refine_option(models, tmp_path, capsys):
+    from PIL import Image
+    img = tmp_path / "ex.png"
+    Image.fromarray((np.random.default_rng(1).random((130, 130, 3)) * 255).astype(np.uint8)).save(img)
+    p = str(tmp_path / "r.npy")
+    rc = main(["solid", "--model", models["space3"], "--exemplar", str(img), "--refine", "3", "--size", "8", "-o", p])
+    err = capsys.readouterr().err
+    assert rc == 0 and "texture-statistics distance" in err and np.load(p).shape == (8, 8, 3)
+    rc, err = run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--refine", "3", "-o", p)
+    assert rc == 2 and "refining needs the space model" in err

@@ -192,3 +192,30 @@ def test_exemplars_split_and_crops():
         ex.random_crops(img, 1, 600, g)
     with pytest.raises(ValueError, match="unknown exemplar 'cork'"):
         ex.exemplar("cork")
+
+
+def test_refinement_never_worsens_and_moves_a_wrong_start(tmp_path):
+    from backend.grid import Cancelled
+    from backend.solid.refine import refine_code, stats_distance, texture_stats
+    run, _ = _tiny(tmp_path, mode="space", dim=3, crop=128, batch=2, steps=2)
+    export(str(run), str(tmp_path / "space"))
+    rt = SolidTextureModel(str(tmp_path / "space"))
+    img = ex.procedural("rust", 1, 160).permute(1, 2, 0).numpy()
+    z0 = rt.codes["grass"]
+    z, hist = refine_code(rt, z0, img, steps=12, seed=1)
+    assert len(hist) == 13 and all(b <= a for a, b in zip(hist, hist[1:]))
+    assert z.dtype == np.float32 and z.shape == (8,)
+    assert (hist[-1] < hist[0]) == (not np.array_equal(z, z0))
+    z_same, h0 = refine_code(rt, z0, img, steps=0)
+    np.testing.assert_array_equal(z_same, z0)
+    assert h0 == hist[:1]
+    with pytest.raises(Cancelled):
+        refine_code(rt, z0, img, steps=3, cancel=lambda: True)
+    # the statistics see colour, scale and orientation
+    base = np.tile(np.sin(np.arange(64) * 0.8)[None, :, None] * 0.3 + 0.5, (64, 1, 3))
+    s0 = texture_stats(base)
+    assert stats_distance(s0, texture_stats(base.transpose(1, 0, 2))) > 0.1           # rotated stripes
+    assert stats_distance(s0, texture_stats(base * 0.5)) > 0.1                        # darker
+    fine = np.tile(np.sin(np.arange(64) * 2.4)[None, :, None] * 0.3 + 0.5, (64, 1, 3))
+    assert stats_distance(s0, texture_stats(fine)) > 0.1                               # finer
+    assert stats_distance(s0, texture_stats(base.copy())) == 0.0
