@@ -82,7 +82,9 @@ class Encoder(nn.Module):
             self.norms.append(nn.InstanceNorm2d(w, affine=True))
             cin = w
         n_stats = 2 * (3 + sum(widths))
-        self.fc = nn.Sequential(nn.Linear(n_stats, hidden), nn.LeakyReLU(0.2), nn.Linear(hidden, z_dim))
+        # the statistics' scales differ by orders of magnitude between layers: normalise the vector first
+        self.fc = nn.Sequential(nn.LayerNorm(n_stats), nn.Linear(n_stats, hidden), nn.LeakyReLU(0.2),
+                                nn.Linear(hidden, z_dim))
 
     def forward(self, y: torch.Tensor) -> torch.Tensor:
         x = y * 2.0 - 1.0
