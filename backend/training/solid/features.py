@@ -60,12 +60,15 @@ def gram_loss(grams_out: list, grams_ref: list, per_sample: bool = False) -> tor
     """Sum over taps of ||G_out - G_ref||^2 / ||G_ref||^2 (relative, so every scale counts).
 
     G_ref is the batch mean of the references (one exemplar: a steadier target),
-    or with ``per_sample`` each output's own reference (space mode).
+    or with ``per_sample`` each output's own reference (space mode).  The
+    denominator is the batch mean of ||G_ref||^2 (one term in single mode): a nearly flat
+    crop (small Gram) must not blow its sample's term up (a space run died of
+    a 200x loss spike from exactly that).
     """
     total = 0.0
     for go, gr in zip(grams_out, grams_ref):
         ref = gr if per_sample else gr.mean(0, keepdim=True)
-        total = total + (((go - ref) ** 2).sum(dim=(1, 2)) / (ref ** 2).sum(dim=(1, 2)).clamp_min(1e-8)).mean()
+        total = total + ((go - ref) ** 2).sum(dim=(1, 2)).mean() / (ref ** 2).sum(dim=(1, 2)).mean().clamp_min(1e-8)
     return total
 
 
