@@ -23,7 +23,7 @@ from ._deps import backend
 from .bake_ui import _TaskOperator, draw_progress
 from .preferences import threads
 
-__all__ = ["model", "build_conditioning", "register", "unregister"]
+__all__ = ["model", "build_conditioning", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
 
 _MODEL = {}
 N_PARAMS = 4
@@ -305,10 +305,178 @@ class OMNINOISE_OT_blend_map_new(bpy.types.Operator):
         return {"FINISHED"}
 
 
+# -- presets: the swatch set and layout as a shareable JSON file ---------------------------------
+
+PRESET_FORMAT = 1
+_PRESET_KEYS = ("mode", "width", "sharpness", "size", "steps", "seed", "tileable", "depth")
+
+
+def preset_dict(p) -> dict:
+    """The scene's swatches (class, named parameters, colour) and bake settings as plain JSON types."""
+    sw = []
+    for s in p.swatches:
+        name, params = s.spec()
+        sw.append(dict(noise=name, params=params, color=[round(float(c), 6) for c in s.color]))
+    d = dict(format=PRESET_FORMAT, kind="omninoise.neural_preset", swatches=sw)
+    d.update({k: getattr(p, k) for k in _PRESET_KEYS})
+    return d
+
+
+def apply_preset(p, d: dict) -> None:
+    """Replace the scene's swatches and settings by a preset; SettingError naming the first bad entry
+    (checked before anything changes)."""
+    if not isinstance(d, dict) or d.get("kind") != "omninoise.neural_preset":
+        raise backend.SettingError("preset", "not an OmniNoise neural-noise preset (no kind 'omninoise.neural_preset')")
+    if d.get("format") != PRESET_FORMAT:
+        raise backend.SettingError("preset", f"preset format {d.get('format')!r} is not {PRESET_FORMAT}")
+    m = model()
+    trained = m.config["trained_classes"]
+    checked = []
+    for i, s in enumerate(d.get("swatches", [])):
+        if s.get("noise") not in trained:
+            raise backend.SettingError("preset", f"swatch {i + 1}: class {s.get('noise')!r} is not in the shipped model "
+                                                 f"({', '.join(trained)})")
+        m.param_vector(s["noise"], s.get("params", {}))     # names and ranges, or SettingError
+        col = s.get("color", (1.0, 0.0, 0.0))
+        if len(col) != 3 or not all(0.0 <= float(c) <= 1.0 for c in col):
+            raise backend.SettingError("preset", f"swatch {i + 1}: colour must be three numbers in [0, 1]")
+        checked.append(s)
+    p.swatches.clear()
+    for s in checked:
+        sw = p.swatches.add()
+        sw.noise = s["noise"]
+        _reset_params(sw, None)
+        spec = m.class_params[s["noise"]]["params"][:N_PARAMS]
+        for j, prm in enumerate(spec):
+            if prm["name"] in s.get("params", {}):
+                setattr(sw, f"p{j}", float(s["params"][prm["name"]]))
+        sw.color = tuple(float(c) for c in s["color"])
+    p.active = 0
+    for k in _PRESET_KEYS:
+        if k in d:
+            setattr(p, k, d[k])
+
+
+class OMNINOISE_OT_neural_preset_save(bpy.types.Operator):
+    """Save the swatches and bake settings as a preset file to share"""
+
+    bl_idname = "omninoise.neural_preset_save"
+    bl_label = "Save Neural Preset"
+    filepath: StringProperty(subtype="FILE_PATH")
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def invoke(self, context, event):
+        self.filepath = bpy.path.clean_name(context.scene.omninoise_neural.name) + ".json"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        import json
+
+        from ._deps import export
+
+        path = bpy.path.ensure_ext(bpy.path.abspath(self.filepath), ".json")
+        try:
+            text = json.dumps(preset_dict(context.scene.omninoise_neural), indent=1)
+            with export.atomic_path(path) as tmp:
+                with open(tmp, "w", encoding="utf-8") as fh:
+                    fh.write(text)
+        except (OSError, backend.SettingError) as exc:
+            self.report({"ERROR"}, f"preset not saved: {exc}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"saved {path}")
+        return {"FINISHED"}
+
+
+class OMNINOISE_OT_neural_preset_load(bpy.types.Operator):
+    """Load swatches and bake settings from a preset file"""
+
+    bl_idname = "omninoise.neural_preset_load"
+    bl_label = "Load Neural Preset"
+    bl_options = {"REGISTER", "UNDO"}
+    filepath: StringProperty(subtype="FILE_PATH")
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        import json
+
+        path = bpy.path.abspath(self.filepath)
+        try:
+            with open(path, encoding="utf-8") as fh:
+                d = json.load(fh)
+            apply_preset(context.scene.omninoise_neural, d)
+        except json.JSONDecodeError as exc:
+            self.report({"ERROR"}, f"{os.path.basename(path)}: not JSON ({exc.msg}, line {exc.lineno})")
+            return {"CANCELLED"}
+        except (OSError, backend.SettingError) as exc:
+            self.report({"ERROR"}, f"{os.path.basename(path)}: {exc}")
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+# -- thumbnails: a small sample of each swatch from the model ---------------------------------
+
+THUMB_SIZE, THUMB_STEPS = 32, 10
+
+
+def thumbnail_name(index: int) -> str:
+    return f".OmniNoise Swatch {index + 1}"   # leading dot: hidden from image browsers
+
+
+class OMNINOISE_OT_swatch_thumbnails(_TaskOperator, bpy.types.Operator):
+    """Generate a small preview of every swatch with the model (32 px, 10 steps)"""
+
+    bl_idname = "omninoise.swatch_thumbnails"
+    bl_label = "Update Thumbnails"
+    bl_options = {"REGISTER"}
+
+    def _start(self, context, blocking: bool):
+        p = context.scene.omninoise_neural
+        try:
+            m = model()
+            C = _mod("neural.conditioning")
+            specs = [s.spec() for s in p.swatches]
+            conds = [C.uniform(m, spec, THUMB_SIZE, THUMB_SIZE) for spec in specs]
+        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        if not conds:
+            self.report({"ERROR"}, "add a swatch first")
+            return None
+        keys = [repr(spec) for spec in specs]
+        todo = [i for i, k in enumerate(keys) if (bpy.data.images.get(thumbnail_name(i)) is None
+                                                  or bpy.data.images[thumbnail_name(i)].get("omninoise_spec") != k)]
+        seed = p.seed
+
+        def work(progress, cancel):
+            out = {}
+            for n, i in enumerate(todo):
+                if cancel():
+                    raise backend.Cancelled("cancelled")
+                out[i] = _mod("neural.generate").generate(m, conds[i], seed, THUMB_STEPS)
+                progress((n + 1) / max(1, len(todo)))
+            return out
+
+        def done(out):
+            for i, img in out.items():
+                ima = _store(thumbnail_name(i), img, "8")
+                ima["omninoise_spec"] = keys[i]
+                ima.preview_ensure()
+
+        return tasks.start(tasks.Task("Swatch thumbnails", work, done, None, threads()), blocking=blocking)
+
+
 class OMNINOISE_UL_swatches(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         row = layout.row(align=True)
         row.prop(item, "color", text="")
+        thumb = bpy.data.images.get(thumbnail_name(index))
+        if thumb is not None and thumb.preview is not None:
+            row.label(text="", icon_value=thumb.preview.icon_id)
         row.label(text=item.noise.replace("_", " ").title())
 
 
@@ -321,6 +489,10 @@ def draw_neural(layout, context) -> None:
     col = row.column(align=True)
     col.operator(OMNINOISE_OT_swatch_add.bl_idname, icon="ADD", text="")
     col.operator(OMNINOISE_OT_swatch_remove.bl_idname, icon="REMOVE", text="")
+    col.separator()
+    col.operator(OMNINOISE_OT_swatch_thumbnails.bl_idname, icon="IMAGE_DATA", text="")
+    col.operator(OMNINOISE_OT_neural_preset_load.bl_idname, icon="IMPORT", text="")
+    col.operator(OMNINOISE_OT_neural_preset_save.bl_idname, icon="EXPORT", text="")
     if p.swatches:
         sw = p.swatches[min(p.active, len(p.swatches) - 1)]
         box = layout.box()
@@ -382,6 +554,7 @@ class OMNINOISE_PT_neural_shader(bpy.types.Panel):
 
 
 classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_swatch_add,
+           OMNINOISE_OT_neural_preset_save, OMNINOISE_OT_neural_preset_load, OMNINOISE_OT_swatch_thumbnails,
            OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches,
            OMNINOISE_PT_neural_image, OMNINOISE_PT_neural_shader)
 

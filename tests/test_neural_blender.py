@@ -159,3 +159,73 @@ def test_bake_also_saves_files(scene, tmp_path):
     assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
     np.testing.assert_allclose(read_image(str(tmp_path / "Saved.png")), _pixels("Saved"), atol=1 / 255 + 1e-6)
     assert sorted(os.listdir(tmp_path)) == ["Saved.exr", "Saved.png"]
+
+
+def test_preset_round_trip_and_errors(scene, tmp_path):
+    import json
+    p = scene.omninoise_neural
+    p.swatches[1].p0 = 7.5
+    p.swatches[1].color = (0.2, 0.4, 0.6)
+    p.mode, p.seed, p.steps = "GRADIENT", 11, 7
+    path = str(tmp_path / "set.json")
+    assert bpy.ops.omninoise.neural_preset_save(filepath=path) == {"FINISHED"}
+    saved = json.load(open(path))
+    assert [s["noise"] for s in saved["swatches"]] == ["spots", "damascus"]
+    bpy.ops.omninoise.swatch_remove()
+    p.mode, p.seed = "SINGLE", 0
+    assert bpy.ops.omninoise.neural_preset_load(filepath=path) == {"FINISHED"}
+    assert [s.noise for s in p.swatches] == ["spots", "damascus"] and p.swatches[1].p0 == pytest.approx(7.5)
+    assert tuple(p.swatches[1].color) == pytest.approx((0.2, 0.4, 0.6)) and (p.mode, p.seed, p.steps) == ("GRADIENT", 11, 7)
+    assert neural_ui.preset_dict(p) == saved
+    bad = dict(saved, swatches=[dict(saved["swatches"][0], noise="plaid")])
+    for content, msg in ((json.dumps(bad), "class 'plaid' is not in the shipped model"),
+                         ("{not json", "not JSON"),
+                         (json.dumps({"kind": "other"}), "not an OmniNoise neural-noise preset")):
+        (tmp_path / "bad.json").write_text(content)
+        with pytest.raises(RuntimeError, match=msg):
+            bpy.ops.omninoise.neural_preset_load(filepath=str(tmp_path / "bad.json"))
+    assert [s.noise for s in p.swatches] == ["spots", "damascus"]      # a bad preset changes nothing
+
+
+def test_thumbnails_come_from_the_model_and_are_cached(scene):
+    p = scene.omninoise_neural
+    assert bpy.ops.omninoise.swatch_thumbnails() == {"FINISHED"}
+    from backend.neural import conditioning as C
+    from backend.neural.generate import generate
+    for i, s in enumerate(p.swatches):
+        ima = bpy.data.images[neural_ui.thumbnail_name(i)]
+        assert tuple(ima.size) == (32, 32)
+        ref = generate(neural_ui.model(), C.uniform(neural_ui.model(), s.spec(), 32, 32), p.seed, 10)
+        assert np.abs(_pixels(neural_ui.thumbnail_name(i)) - ref).max() <= 0.5 / 255 + 1e-6
+    first = _pixels(neural_ui.thumbnail_name(0)).copy()
+    p.swatches[1].p0 = 6.0                    # only the changed swatch is regenerated
+    op = neural_ui.OMNINOISE_OT_swatch_thumbnails
+    task = op._start(type("Op", (), {"report": lambda *a: None})(), bpy.context, True)
+    assert task.status == "done" and list(task.result) == [1]
+    np.testing.assert_array_equal(_pixels(neural_ui.thumbnail_name(0)), first)
+
+
+def test_painted_regions_carry_their_swatch_spectra(scene):
+    """Left half painted with spots, right half with damascus: each half's power spectrum is nearer
+    its own class's (from uniform samples) than the other's."""
+    p = scene.omninoise_neural
+    p.mode, p.size, p.steps, p.width = "MAP", 64, 10, 4.0
+    bpy.ops.omninoise.blend_map_new()         # first colour left, second right
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
+    img = _pixels(p.name)
+    from backend.neural import conditioning as C
+    from backend.neural.generate import generate
+
+    def psd(a):
+        a = a - a.mean()
+        P = np.abs(np.fft.fft2(a)) ** 2
+        f = np.fft.fftfreq(a.shape[0])[:, None], np.fft.fftfreq(a.shape[1])[None, :]
+        r = np.minimum((np.hypot(*f) * a.shape[0]).astype(int), a.shape[0] // 2)
+        prof = np.bincount(r.ravel(), P.ravel()) / np.maximum(np.bincount(r.ravel()), 1)
+        return np.log(prof[1:16] / prof[1:16].sum())
+
+    refs = [np.mean([psd(generate(neural_ui.model(), C.uniform(neural_ui.model(), s.spec(), 64, 64), k, 10)[:, 4:28])
+                     for k in range(3)], axis=0) for s in p.swatches]
+    left, right = psd(img[:, 4:28]), psd(img[:, 36:60])
+    d = lambda a, b: float(np.abs(a - b).mean())  # noqa: E731
+    assert d(left, refs[0]) < d(left, refs[1]) and d(right, refs[1]) < d(right, refs[0])
