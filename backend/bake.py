@@ -91,6 +91,8 @@ class BakeSpec:
             raise SettingError("output", f"{os.path.basename(self.output)}: {ext} needs a 2D grid; bake volumes to .vdb or .npy")
         if rank == 3 and self.source.dim == 2:
             raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")
+        if getattr(self.source, "rgb", False) and self.transfer is not None:
+            raise SettingError("transfer", "a solid texture has its own colours; remove the transfer function")
         if self.frames is not None:
             a, b = self.frames
             if int(a) != a or int(b) != b or b < a:
@@ -183,6 +185,8 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
     ext = os.path.splitext(path)[1].lower()
     meta = {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}
     tf = spec.transfer
+    if getattr(spec.source, "rgb", False):
+        return _bake_rgb_file(spec, path, time, meta, progress, cancel)
     if ext == ".vdb":
         grids = {"density": "float"}
         if tf is not None:
@@ -228,6 +232,35 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
     elif ext == ".png":
         img = export.encode_srgb8(tf.rgba(values)) if tf is not None else export.preview_8bit(values)
         export.write_png(path, img, metadata=meta)
+
+
+def _bake_rgb_file(spec: BakeSpec, path: str, time: float, meta: dict, progress, cancel) -> None:
+    """Files of a colour source (scene-linear RGB values (..., 3)): VDB color + constant density,
+    RGB EXR, sRGB PNG, or (..., 3) .npy."""
+    from ._export import export
+
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".vdb":
+        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, {"density": "float", "color": "vec3"}, meta,
+                                     half=spec.half)
+        for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
+            writer.add("color", z0, vals)
+            writer.add("density", z0, np.full(vals.shape[:-1], spec.source.density, _F))
+        if cancel is not None and cancel():
+            raise Cancelled("cancelled")
+        writer.write(path)
+        return
+    values = np.empty(spec.grid.shape + (3,), _F)
+    for a, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
+        values[a: a + vals.shape[0]] = vals
+    if cancel is not None and cancel():
+        raise Cancelled("cancelled")
+    if ext == ".npy":
+        export.write_npy(path, values)
+    elif ext == ".exr":
+        export.write_exr(path, values[::-1], half=spec.half, metadata=meta)
+    else:
+        export.write_png(path, export.encode_srgb8(values[::-1]), metadata=meta)
 
 
 def run_bake(spec: BakeSpec, progress: Callable[[float], None] | None = None,

@@ -41,6 +41,23 @@ A neural noise image (Maesumi et al. 2024) is a 2D bake with a neural source::
     seed = 3
     tileable = false
 
+A neural solid texture (Henzler et al. 2020) bakes colours: a volume's ``color``
+grid (with a constant ``density``), an RGB EXR, an sRGB PNG or a (..., 3) .npy::
+
+    [[bake]]
+    name = "gravel_block"
+    output = "out/gravel.vdb"
+    resolution = [96, 96, 96]
+    bounds = [[-1, -1, -1], [1, 1, 1]]
+    [bake.source]
+    kind = "solid"
+    model = "gravel_3d"                 # a shipped model's name, or a model folder
+    # exemplar = "photo.png"            # space models: an image to encode (or a training exemplar's name)
+    # refine = 40                       # search steps refining the encoded code
+    seed = 0
+    scale = 1.0                         # texture units per world unit
+    density = 1.0
+
 Every problem is reported as ``bake 'NAME': what is wrong``.
 """
 from __future__ import annotations

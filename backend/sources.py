@@ -21,7 +21,7 @@ import numpy as np
 
 from .errors import SettingError
 
-__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "source_from_dict", "SOURCE_KINDS"]
+__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "source_from_dict", "SOURCE_KINDS"]
 
 _F = np.float32
 
@@ -225,7 +225,95 @@ class NeuralSource:
         return d
 
 
-SOURCE_KINDS = ("wave", "neural")
+class SolidSource:
+    """A neural solid texture (Henzler et al. 2020) as a bake source of colours (``rgb``).
+
+    evaluate() returns scene-linear RGB float32 (..., 3) at the grid's points
+    times ``scale`` (texture units per world unit); a bake writes them as the
+    ``color`` grid of a volume (with a constant ``density``), an RGB EXR, an
+    sRGB PNG or an (..., 3) .npy.  Any sub-box may be evaluated alone.  The
+    texture is the model's own (single-exemplar model), a training exemplar of a
+    space model (``exemplar = NAME``) or any image a space model encodes
+    (``exemplar = "photo.png"``, optionally ``refine`` search steps).
+    """
+
+    kind = "solid"
+    animated = False
+    chunkable = True
+    rgb = True
+
+    def __init__(self, model, exemplar: str | None = None, seed: int = 0, scale: float = 1.0,
+                 density: float = 1.0, refine: int = 0, code=None):
+        """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
+        code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds)."""
+        from .neural.model import ModelError
+        from .solid.model import SolidTextureModel
+
+        try:
+            self.model = model if isinstance(model, SolidTextureModel) else SolidTextureModel(model)
+        except ModelError as exc:
+            raise SettingError("source.model", str(exc)) from None
+        if not scale > 0:
+            raise SettingError("source.scale", f"must be > 0, got {scale}")
+        self.dim = self.model.dim
+        self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
+        self.exemplar = exemplar
+        self.image_sha256 = None
+        self.z = None
+        if code is not None:
+            self.code = code
+            self.image_sha256 = hashlib.sha256(np.concatenate([np.ravel(code.e), np.ravel(code.T)])
+                                               .astype(np.float32).tobytes()).hexdigest()
+            return
+        if self.model.mode == "single":
+            if exemplar is not None:
+                raise SettingError("source.exemplar", f"model {self.model.name!r} holds one texture; "
+                                                      "an exemplar needs a space model")
+            self.code = self.model.default_code()
+            return
+        if exemplar in self.model.codes:
+            self.z = self.model.codes[exemplar]
+        else:
+            import os
+
+            if exemplar is None or not os.path.isfile(exemplar):
+                raise SettingError("source.exemplar", f"{exemplar!r} is neither an image file nor an exemplar of "
+                                                      f"model {self.model.name!r} ({', '.join(self.model.codes)})")
+            from ._export import export
+
+            img = export.read_rgb(exemplar)
+            self.image_sha256 = hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest()
+            self.z = self.model.encode(img)
+            if self.refine > 0:
+                from .solid.refine import refine_code
+
+                self.z = refine_code(self.model, self.z, img, self.refine)[0]
+        self.code = self.model.translate(self.z)
+
+    def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
+        from .solid.bake import srgb_to_linear
+
+        n = len(shape)
+        start = np.zeros(n, int) if start is None else np.asarray(start)
+        axes = [first[k] + (start[k] + np.arange(shape[::-1][k])) * step[k] for k in range(n)]   # x, y[, z]
+        mesh = np.meshgrid(*reversed(axes), indexing="ij")                                      # (z,) y, x
+        pts = np.stack([m.ravel() for m in reversed(mesh)], axis=1)
+        if n == 2:
+            pts = np.concatenate([pts, np.full((len(pts), 1), first[2])], axis=1)
+        if self.dim == 2:
+            pts = pts[:, :2]
+        prog = None if progress is None else (lambda d, t: progress(d / t))
+        rgb = self.model.evaluate(pts * self.scale, self.code, self.seed, progress=prog, cancel=cancel)
+        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
+
+    def to_dict(self) -> dict:
+        return dict(kind=self.kind, model=self.model.config["files"], exemplar=self.exemplar,
+                    image_sha256=self.image_sha256, refine=self.refine, seed=self.seed, scale=self.scale,
+                    density=self.density)
+
+
+SOURCE_KINDS = ("wave", "neural", "solid")
+_SOLID_KEYS = ("model", "exemplar", "seed", "scale", "density", "refine")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "steps", "seed",
                 "tileable")
 
@@ -255,6 +343,25 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
                         d.get("tileable", False))
 
 
+def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
+    import os
+
+    unknown = sorted(set(d) - set(_SOLID_KEYS))
+    if unknown:
+        raise SettingError(f"source.{unknown[0]}", f"unknown solid setting; known: {', '.join(_SOLID_KEYS)}")
+    if "model" not in d:
+        raise SettingError("source.model", "a solid source needs model = FOLDER (e.g. models/solid/gravel_3d)")
+    model = d["model"]
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    folder = os.path.join(base_dir, model)
+    if not os.path.isdir(folder) and os.path.isdir(os.path.join(root, "models", "solid", model)):
+        folder = os.path.join(root, "models", "solid", model)     # a shipped model by name
+    ex = d.get("exemplar")
+    if ex is not None and os.path.isfile(os.path.join(base_dir, ex)):
+        ex = os.path.join(base_dir, ex)
+    return SolidSource(folder, ex, d.get("seed", 0), d.get("scale", 1.0), d.get("density", 1.0), d.get("refine", 0))
+
+
 def source_from_dict(d: dict, base_dir: str = ".") -> Source:
     """A source from a job-file table: ``kind = "wave"`` plus the engine's settings, or ``kind = "neural"``.
 
@@ -262,6 +369,8 @@ def source_from_dict(d: dict, base_dir: str = ".") -> Source:
     (relative to ``base_dir``) for by-example noise; ``w_offset`` for 4D.
     Neural: noise, params, [blend = "mask.png", noise2, params2, width, sharpness],
     steps, seed, tileable, [model = folder] (see :class:`NeuralSource`).
+    Solid: model (a folder, or a shipped model's name), [exemplar, refine], seed, scale, density
+    (see :class:`SolidSource`).
     """
     import os
 
@@ -269,6 +378,8 @@ def source_from_dict(d: dict, base_dir: str = ".") -> Source:
     kind = d.pop("kind", "wave")
     if kind == "neural":
         return _neural_from_dict(d, base_dir)
+    if kind == "solid":
+        return _solid_from_dict(d, base_dir)
     if kind != "wave":
         raise SettingError("source.kind", f"unknown source {kind!r}; choose one of {', '.join(SOURCE_KINDS)}")
     from .settings import settings_from_dict

@@ -7,20 +7,21 @@ the sRGB values.
 
     grid = BoxGrid((128, 128, 128), ((-1, -1, -1), (1, 1, 1)))
     bake_volume(model, code, grid, "out/gravel.vdb", seed=0, scale=1.0)   # color (vec3) + density grids
+
+Volumes go through the bake pipeline (:class:`backend.sources.SolidSource`), as
+job files do.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import SettingError
-from ..grid import Cancelled
 from ..sources import BoxGrid
 from .model import SolidTextureModel, TextureCode
 
-__all__ = ["srgb_to_linear", "grid_points", "bake_volume", "evaluate_grid", "SLAB_POINTS"]
+__all__ = ["srgb_to_linear", "grid_points", "bake_volume", "evaluate_grid"]
 
 _F = np.float32
-SLAB_POINTS = 1 << 19      #: points per volume slab
 
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
@@ -58,31 +59,20 @@ def evaluate_grid(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, se
 
 def bake_volume(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, path: str, seed: int = 0,
                 scale: float = 1.0, density: float = 1.0, half: bool = False, progress=None, cancel=None,
-                metadata: dict | None = None) -> None:
-    """A 3D model's colours over ``grid`` into an OpenVDB file: ``color`` (vec3, scene-linear) and
-    ``density`` (constant ``density``), slab by slab, written atomically.
+                name: str = "solid") -> None:
+    """A 3D model's colours over ``grid`` into an OpenVDB file through the bake pipeline
+    (:func:`backend.bake.run_bake`): ``color`` (vec3, scene-linear) and ``density`` (constant), slab by
+    slab, written atomically with the bake's key.
 
     ``progress(fraction)``; ``cancel()`` returning True raises Cancelled and writes nothing.
     """
-    from .._export import export
+    from ..bake import BakeSpec, run_bake
+    from ..sources import SolidSource
 
     grid.validate()
     if grid.rank != 3:
         raise SettingError("resolution", "a volume needs three resolutions (nx, ny, nz)")
     if model.dim != 3:
         raise SettingError("model", f"model {model.name!r} is 2D; a volume needs a 3D model")
-    nx, ny, nz = (int(n) for n in grid.resolution)
-    per = max(1, SLAB_POINTS // (nx * ny))
-    meta = dict(omninoise_source="neural_solid_texture", omninoise_model=model.name, omninoise_seed=seed,
-                omninoise_scale=scale, **(metadata or {}))
-    writer = export.VolumeWriter(grid.voxel, grid.first, {"density": "float", "color": "vec3"}, meta, half)
-    for z0 in range(0, nz, per):
-        if cancel is not None and cancel():
-            raise Cancelled("cancelled")
-        z1 = min(nz, z0 + per)
-        rgb = model.evaluate(grid_points(grid, z0, z1) * float(scale), code, seed, cancel=cancel)
-        writer.add("color", z0, srgb_to_linear(rgb).reshape(z1 - z0, ny, nx, 3))
-        writer.add("density", z0, np.full((z1 - z0, ny, nx), density, _F))
-        if progress is not None:
-            progress(z1 / nz)
-    writer.write(path)
+    src = SolidSource(model, seed=seed, scale=scale, density=density, code=code)
+    run_bake(BakeSpec(name, src, grid, path, half=half), progress, cancel, force=True)
