@@ -414,7 +414,7 @@ def _solid_code(model, name: str, flag: str, refine: int = 0, bar=None, quiet: b
 def run_solid(a: argparse.Namespace) -> int:
     import json
 
-    from .neural.model import ModelError
+    from .onnx_models import ModelError
     from .solid.model import SolidTextureModel
 
     if a.list:

@@ -246,7 +246,7 @@ class SolidSource:
                  density: float = 1.0, refine: int = 0, code=None):
         """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
         code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds)."""
-        from .neural.model import ModelError
+        from .onnx_models import ModelError
         from .solid.model import SolidTextureModel
 
         try:

@@ -257,7 +257,7 @@ class OMNINOISE_OT_solid_preview(_TaskOperator, bpy.types.Operator):
         p = context.scene.omninoise_solid
         try:
             m, code_fn = texture(p)
-        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
+        except (backend.SettingError, _mod("onnx_models").ModelError) as exc:
             self.report({"ERROR"}, str(exc))
             return None
         seed, name = p.seed, f"{p.name} Preview"
@@ -292,7 +292,7 @@ class OMNINOISE_OT_solid_bake(_TaskOperator, bpy.types.Operator):
             if m.dim != 3:
                 raise backend.SettingError("model", f"model {m.name!r} is 2D; surfaces need a 3D solid texture")
             return self._start_target(context, p, obj, m, code_fn, blocking)
-        except (backend.SettingError, _mod("neural.model").ModelError, OSError) as exc:
+        except (backend.SettingError, _mod("onnx_models").ModelError, OSError) as exc:
             self.report({"ERROR"}, str(exc))
             return None
 

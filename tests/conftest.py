@@ -26,3 +26,17 @@ def radial_psd(img: np.ndarray, extent: float, nbins: int | None = None):
 @pytest.fixture
 def psd():
     return radial_psd
+
+
+class Recorder:
+    """A UILayout stand-in that records what a panel's draw() asks for: (call, property, text) tuples."""
+
+    def __init__(self, log):
+        self.log = log
+        self.enabled = True
+
+    def __getattr__(self, name):
+        def call(*args, **kw):
+            self.log.append((name, args[1] if len(args) > 1 else None, kw.get("text")))
+            return Recorder(self.log) if name in ("row", "column", "box") else type("Op", (), {})()
+        return call

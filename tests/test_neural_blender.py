@@ -7,6 +7,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import blender_addon  # noqa: E402
+from conftest import Recorder  # noqa: E402
 from blender_addon import neural_ui, tasks  # noqa: E402
 
 
@@ -118,20 +119,6 @@ def test_worker_bake_cancels_within_a_step(scene):
     task.cancel()
     tasks.wait(task)
     assert task.status == "cancelled" and task.progress < 0.5 and p.name not in bpy.data.images
-
-
-class Recorder:
-    """A UILayout stand-in that records what draw() asks for."""
-
-    def __init__(self, log):
-        self.log = log
-        self.enabled = True
-
-    def __getattr__(self, name):
-        def call(*args, **kw):
-            self.log.append((name, args[1] if len(args) > 1 else None, kw.get("text")))
-            return Recorder(self.log) if name in ("row", "column", "box") else type("Op", (), {})()
-        return call
 
 
 def test_panel_draws(scene):

@@ -9,6 +9,7 @@ bpy = pytest.importorskip("bpy")
 torch = pytest.importorskip("torch")
 
 import blender_addon  # noqa: E402
+from conftest import Recorder  # noqa: E402
 from blender_addon import solid_ui, tasks  # noqa: E402
 from backend.solid.bake import srgb_to_linear  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
@@ -193,18 +194,6 @@ def test_worker_bake_cancels_and_leaves_nothing(scene):
     tasks.wait(task)
     assert task.status == "cancelled" and task.progress < 0.9 and "Solid Texture" not in bpy.data.images
     assert bpy.context.active_object.active_material is None
-
-
-class Recorder:
-    def __init__(self, log):
-        self.log = log
-        self.enabled = True
-
-    def __getattr__(self, name):
-        def call(*args, **kw):
-            self.log.append((name, args[1] if len(args) > 1 else None, kw.get("text")))
-            return Recorder(self.log) if name in ("row", "column", "box") else type("Op", (), {})()
-        return call
 
 
 def test_panel_draws(scene):

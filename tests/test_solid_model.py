@@ -10,7 +10,7 @@ from backend.grid import Cancelled
 torch = pytest.importorskip("torch")
 
 from backend.errors import SettingError  # noqa: E402
-from backend.neural.model import ModelError  # noqa: E402
+from backend.onnx_models import ModelError  # noqa: E402
 from backend.solid.model import SolidTextureModel, TextureCode  # noqa: E402
 from backend.training.solid import exemplars as ex  # noqa: E402
 from backend.training.solid.export import export  # noqa: E402

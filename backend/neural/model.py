@@ -8,30 +8,16 @@ circular padding (seamless tiles).
 """
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 
 import numpy as np
 
 from ..errors import SettingError
+from ..onnx_models import ModelError, SessionCache, load_model_json, sha256_file
 
 __all__ = ["NeuralNoiseModel", "ModelError", "sha256_file"]
 
 _F = np.float32
-
-
-class ModelError(RuntimeError):
-    """A model folder is missing, incomplete or altered."""
-
-
-def sha256_file(path: str) -> str:
-    """Hex sha256 of a file, read in 1 MiB blocks."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 class NeuralNoiseModel:
@@ -43,37 +29,18 @@ class NeuralNoiseModel:
     """
 
     def __init__(self, folder: str, threads: int = 0):
-        cfg_path = os.path.join(folder, "neural_noise.json")
-        if not os.path.isfile(cfg_path):
-            raise ModelError(f"no neural_noise.json in {folder}")
-        with open(cfg_path, encoding="utf-8") as fh:
-            self.config = json.load(fh)
+        self.config = load_model_json(folder, "neural_noise.json")
         self.folder = folder
-        for name, digest in self.config["files"].items():
-            path = os.path.join(folder, name)
-            if not os.path.isfile(path):
-                raise ModelError(f"model file missing: {path}")
-            if sha256_file(path) != digest:
-                raise ModelError(f"{name}: sha256 does not match neural_noise.json (altered or damaged file)")
         self.classes = tuple(self.config["classes"])
         self.params = tuple(self.config["params"])
         self.class_params = self.config["class_params"]
         self.embedding = np.asarray(self.config["class_embedding"], _F)
         self.multiple_of = int(self.config.get("multiple_of", 8))
         self.threads = threads
-        self._sessions = {}
+        self._sessions = SessionCache(folder, threads)
 
     def session(self):
-        key = "eps.onnx"
-        if key not in self._sessions:
-            import onnxruntime as ort
-
-            opts = ort.SessionOptions()
-            if self.threads:
-                opts.intra_op_num_threads = self.threads
-            self._sessions[key] = ort.InferenceSession(os.path.join(self.folder, key), opts,
-                                                       providers=["CPUExecutionProvider"])
-        return self._sessions[key]
+        return self._sessions("eps.onnx")
 
     def eps_fn(self, tileable: bool = False):
         """model(x, t, cond) -> ε callable for :func:`backend.neural.sampler.ddim_sample`."""

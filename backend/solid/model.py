@@ -15,7 +15,6 @@ Positions are in texture units: ``px_per_unit`` exemplar pixels per unit.
 """
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass
 
@@ -23,7 +22,7 @@ import numpy as np
 
 from ..errors import SettingError
 from ..grid import Cancelled
-from ..neural.model import ModelError, sha256_file
+from ..onnx_models import ModelError, SessionCache, load_model_json
 from .lattice import lattice_noise
 
 __all__ = ["SolidTextureModel", "TextureCode", "DEFAULT_CHUNK"]
@@ -41,38 +40,16 @@ class TextureCode:
 
 class SolidTextureModel:
     def __init__(self, folder: str, threads: int = 0):
-        path = os.path.join(folder, "solid.json")
-        if not os.path.isfile(path):
-            raise ModelError(f"no solid.json in {folder}")
-        with open(path, encoding="utf-8") as fh:
-            self.config = json.load(fh)
+        self.config = load_model_json(folder, "solid.json")
         if self.config.get("model") != "neural_solid_texture":
-            raise ModelError(f"{path} is not a neural solid texture model")
-        for name, digest in self.config["files"].items():
-            fp = os.path.join(folder, name)
-            if not os.path.isfile(fp):
-                raise ModelError(f"model file missing: {fp}")
-            if sha256_file(fp) != digest:
-                raise ModelError(f"{name}: sha256 does not match solid.json (altered or damaged file)")
+            raise ModelError(f"{os.path.join(folder, 'solid.json')} is not a neural solid texture model")
         c = self.config
         self.folder, self.threads = folder, threads
         self.name, self.mode, self.dim = c["name"], c["mode"], int(c["dim"])
         self.octaves, self.channels, self.code_dim = int(c["octaves"]), int(c["channels"]), int(c["code_dim"])
         self.px_per_unit = float(c["px_per_unit"]) / float(c.get("exemplar_scale", 1.0))
         self.codes = {k: np.asarray(v, _F) for k, v in c.get("codes", {}).items()}
-        self._sessions = {}
-
-    # -- onnxruntime ------------------------------------------------------------------------
-    def _session(self, name: str):
-        if name not in self._sessions:
-            import onnxruntime as ort
-
-            opts = ort.SessionOptions()
-            if self.threads:
-                opts.intra_op_num_threads = self.threads
-            self._sessions[name] = ort.InferenceSession(os.path.join(self.folder, name), opts,
-                                                        providers=["CPUExecutionProvider"])
-        return self._sessions[name]
+        self._session = SessionCache(folder, threads)
 
     # -- codes ----------------------------------------------------------------------------------
     def default_code(self) -> TextureCode:

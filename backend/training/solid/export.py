@@ -21,7 +21,7 @@ import sys
 import torch
 from torch import nn
 
-from ...neural.model import sha256_file
+from ...onnx_models import sha256_file
 from .train import SolidConfig, build_model, training_images
 
 __all__ = ["export", "SplitDecoder", "FORMAT", "ENCODER_SIZE"]
