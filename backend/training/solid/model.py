@@ -97,7 +97,7 @@ class Encoder(nn.Module):
 
 
 class Translator(nn.Module):
-    """h(z) -> (e (B, E), T (B, m, D, D)) with T_i = R_i (I + Delta_i(z))."""
+    """h(z) -> (e (B, E), T (B, m, D, D)) with T_i = R_i (I + tanh(Delta_i(z))) (entries of Delta bounded by 1)."""
 
     def __init__(self, z_dim: int, code_dim: int, octaves: int, dim: int, width: int = 128, seed: int = 0):
         super().__init__()
@@ -112,7 +112,9 @@ class Translator(nn.Module):
     def forward(self, z: torch.Tensor):
         out = self.net(z)
         e = out[:, :self.code_dim]
-        delta = out[:, self.code_dim:].view(-1, self.octaves, self.dim, self.dim)
+        # bounded: an unbounded Delta let a space run grow every T_i to ~100x (all octaves at the pixel
+        # scale: fine grain of one average colour for every exemplar)
+        delta = torch.tanh(out[:, self.code_dim:]).view(-1, self.octaves, self.dim, self.dim)
         eye = torch.eye(self.dim, device=z.device)
         return e, self.R @ (eye + delta)
 
