@@ -104,9 +104,9 @@ class Translator(nn.Module):
         self.code_dim, self.octaves, self.dim = code_dim, octaves, dim
         self.net = nn.Sequential(nn.Linear(z_dim, width), nn.ReLU(), nn.Linear(width, width), nn.ReLU(),
                                  nn.Linear(width, code_dim + octaves * dim * dim))
-        with torch.no_grad():  # start near T = R
-            self.net[-1].weight.mul_(0.1)
-            self.net[-1].bias.zero_()
+        with torch.no_grad():  # start near T = R; the code part keeps its full scale, so e varies with z
+            self.net[-1].weight[code_dim:].mul_(0.1)   # from the first step (a x0.1 code part left e nearly
+            self.net[-1].bias.zero_()                  # constant and the encoder unused: every code one texture)
         self.register_buffer("R", random_rotations(octaves, dim, seed))
 
     def forward(self, z: torch.Tensor):

@@ -161,7 +161,9 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
             e, T = model.codes(batch=cfg.batch)
         else:
-            pick = torch.randint(0, len(images), (cfg.batch,), generator=gen).tolist()
+            # distinct exemplars within a batch (while there are enough): each step contrasts textures
+            pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
+            pick = pick[:cfg.batch]
             ref = torch.cat([ex.random_crops(images[k], 1, cfg.crop, gen, augment) for k in pick])
             e, T = model.codes(ref)
         x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen)
