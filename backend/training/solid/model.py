@@ -41,7 +41,7 @@ def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
 class Decoder(nn.Module):
     """f(n | e): (..., m*C + E) -> RGB (..., 3) in (0, 1)."""
 
-    def __init__(self, n_noise: int, code_dim: int = 64, width: int = 128, layers: int = 4):
+    def __init__(self, n_noise: int, code_dim: int = 64, width: int = 128, layers: int = 4, init: str = "he"):
         super().__init__()
         mods, cin = [], n_noise + code_dim
         for _ in range(layers):
@@ -52,7 +52,9 @@ class Decoder(nn.Module):
         # He initialisation keeps the activations' variance through the ReLU stack, so the output
         # varies with the noise from the first step (torch's default shrinks it ~2.5x per layer and
         # training sat on a ~100-step plateau of near-constant colour)
-        for lin in self.net:
+        if init not in ("he", "torch"):
+            raise ValueError(f"decoder init must be 'he' or 'torch', got {init!r}")
+        for lin in self.net if init == "he" else ():
             if isinstance(lin, nn.Linear):
                 nn.init.kaiming_normal_(lin.weight, nonlinearity="relu" if lin.out_features != 3 else "linear")
                 nn.init.zeros_(lin.bias)
@@ -123,12 +125,12 @@ class SolidTexture(nn.Module):
     """Decoder plus either single-mode parameters (e, T) or an encoder and translator (space mode)."""
 
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
-                 mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0):
+                 mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he"):
         super().__init__()
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
         self.dim, self.octaves, self.channels, self.code_dim, self.mode = dim, octaves, channels, code_dim, mode
-        self.decoder = Decoder(octaves * channels, code_dim, width, layers)
+        self.decoder = Decoder(octaves * channels, code_dim, width, layers, decoder_init)
         if mode == "single":
             self.code = nn.Parameter(torch.rand(code_dim) * 2.0 - 1.0)     # U(-1, 1) as the authors' code
             self.T = nn.Parameter(random_rotations(octaves, dim, seed).clone())

@@ -50,6 +50,7 @@ class SolidConfig:
     z_dim: int = 8                  # |z| (space mode)
     width: int = 128
     layers: int = 4
+    decoder_init: str = "he"        # "he" (Kaiming normal) or "torch" (nn.Linear's default; gravel_3d)
     crop: int = 128                 # training crop / slice size, px
     batch: int = 4
     steps: int = 2000
@@ -93,7 +94,7 @@ def load_config(path: str) -> SolidConfig:
 
 def build_model(cfg: SolidConfig) -> SolidTexture:
     return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
-                        cfg.layers, cfg.seed)
+                        cfg.layers, cfg.seed, cfg.decoder_init)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
