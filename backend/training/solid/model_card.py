@@ -59,7 +59,10 @@ def card(models: str, runs: str, eval_path: str | None) -> str:
          "- **3D from 2D:** each step renders 128² slices through random points of 3D space, axis-aligned "
          "(random axis permutation) or, half the time, randomly rotated; every slice must match the exemplar's "
          "statistics. Exemplar crops are randomly rotated/flipped for 3D models.",
-         f"- **Hardware:** {_hardware()}; one torch thread per run, two runs sharing the two cores.", "",
+         f"- **Hardware:** {_hardware()}; one torch thread per run, two or three runs sharing the two cores "
+         "(wall times include that sharing).",
+         "- **gravel_3d** was trained before the decoder's He initialisation became the default; its config "
+         "names `decoder_init = \"torch\"`, which reproduces it. Every other model uses He initialisation.", "",
          "## Models", "",
          "| model | mode | dim | exemplars | scale | steps | wall time | final loss | sha256 (decoder.onnx) |",
          "|---|---|---|---|---|---|---|---|---|"]
@@ -99,6 +102,12 @@ def card(models: str, runs: str, eval_path: str | None) -> str:
           "speckle, rust, marble clouds) far better than structured ones: bricks come out as blotches, not "
           "courses, as the paper's own results and its Table 1 note for non-stochastic appearance.",
           "- The photographs are greyscale; the models still output RGB.",
+          "- The texture-space model needed three fixes before it conditioned on its input at all, each found by "
+          "looking at its output during training: its encoder first averaged instance-normalised maps (every "
+          "exemplar got the same code; it now reads the per-channel statistics the normalisation removes), its "
+          "translator's unbounded transforms grew ~100x (now bounded by tanh), and a x0.1-scaled code output left "
+          "the decoder ignoring e (now full scale, with distinct exemplars in every batch). Trained for minutes "
+          "on a CPU, it separates the exemplars' colours and coarse character far more than their structure.",
           "- Trained on two CPU cores for minutes per model: a GPU run with more steps and a larger batch would "
           "lower the style error further.", ""]
     return "\n".join(L)
