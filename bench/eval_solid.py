@@ -92,6 +92,18 @@ def _points(dim: int, size: int, ppu: float):
     return np.stack([x.ravel(), y.ravel(), z.ravel()], 1)
 
 
+def _peak_mib() -> int:
+    """This process's peak resident memory (VmHWM: unlike ru_maxrss, not inherited from the parent)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return round(int(line.split()[1]) / 1024)
+    except OSError:
+        pass
+    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+
+
 def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
     """One timing in this process: seconds for all points, peak RSS."""
     from backend.solid.model import SolidTextureModel
@@ -129,7 +141,7 @@ def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
                 out[a:a + chunk] = tm.sample(x[None, a:a + chunk], e, T, seeds)[0].numpy()
     sec = time.perf_counter() - t
     return dict(engine=engine, dim=dim, size=size, points=len(pts), seconds=round(sec, 3),
-                points_per_s=round(len(pts) / sec), peak_mib=round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
+                points_per_s=round(len(pts) / sec), peak_mib=_peak_mib(),
                 checksum=float(out[::9973].sum()))
 
 
@@ -161,6 +173,9 @@ def main() -> int:
         print(json.dumps(speed_one(a.speed_one, a.model, a.run, a.dim, a.size)))
         return 0
     res = {}
+    if a.only_speed and os.path.isfile(a.out):      # keep the quality table of an earlier run
+        with open(a.out, encoding="utf-8") as fh:
+            res = json.load(fh)
     if not a.only_speed:
         res["quality"] = quality(a.n)
         res["n"] = a.n
