@@ -9,7 +9,6 @@ same weights; writes everything to out/bench/neural_eval.json.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 
@@ -17,6 +16,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from backend.neural.model import NeuralNoiseModel  # noqa: E402
+from export.atomic import write_json  # noqa: E402
 from backend.training.evaluate import evaluate, step_seconds  # noqa: E402
 
 
@@ -45,9 +45,7 @@ def main() -> int:
     print(f"DDIM step at {t['size']}²: onnxruntime {t['onnxruntime_s']} s, torch {t['torch_s']} s "
           f"(torch / ort = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e})")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
-    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
-        json.dump(res, fh, indent=1)
-    os.replace(a.out + ".tmp", a.out)
+    write_json(a.out, res)
     return 0
 
 

@@ -28,6 +28,8 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
+from export.atomic import write_json  # noqa: E402
+
 MODELS = os.path.join(ROOT, "models", "solid")
 
 
@@ -195,9 +197,7 @@ def main() -> int:
             o, t = (next(r for r in res["speed"] if r["dim"] == dim and r["engine"] == e) for e in ("onnxruntime", "torch"))
             print(f"{dim}D: onnxruntime / torch speed = {o['points_per_s'] / t['points_per_s']:.2f}x")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
-    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
-        json.dump(res, fh, indent=1)
-    os.replace(a.out + ".tmp", a.out)
+    write_json(a.out, res)
     return 0
 
 

@@ -34,3 +34,13 @@ def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def write_json(path: str, doc, indent: int = 1) -> None:
+    """Write ``doc`` as JSON (UTF-8) atomically."""
+    import json
+
+    text = json.dumps(doc, indent=indent)
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)

@@ -20,6 +20,8 @@ import sys
 
 import torch
 
+from .._export import export as _ex
+
 from ..neural.model import sha256_file
 from . import zoo
 from .train import TrainConfig, build_model, model_names
@@ -60,9 +62,7 @@ def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> 
                config=state["config"], files=files, multiple_of=8)
     doc.update(extra or {})
     path = os.path.join(out, "neural_noise.json")
-    with open(path + ".tmp", "w", encoding="utf-8") as fh:
-        json.dump(doc, fh, indent=1)
-    os.replace(path + ".tmp", path)
+    _ex.write_json(path, doc)
     return doc
 
 

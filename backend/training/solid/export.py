@@ -19,6 +19,8 @@ import os
 import sys
 
 import torch
+
+from ..._export import export as _ex
 from torch import nn
 
 from ...onnx_models import sha256_file
@@ -109,9 +111,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
     doc["files"] = files
     doc.update(extra or {})
     path = os.path.join(out, "solid.json")
-    with open(path + ".tmp", "w", encoding="utf-8") as fh:
-        json.dump(doc, fh, indent=1)
-    os.replace(path + ".tmp", path)
+    _ex.write_json(path, doc)
     return doc
 
 
