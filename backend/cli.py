@@ -385,46 +385,15 @@ def run_neural(a: argparse.Namespace) -> int:
     return 0
 
 
-SOLID_MODELS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "solid")
-
-
-def _solid_code(model, name: str, flag: str, refine: int = 0, bar=None, quiet: bool = True):
-    """z of a space model for a known exemplar name or an image file."""
-    from export.images import read_rgb
-
-    if name in model.codes:
-        return model.codes[name]
-    if not os.path.isfile(name):
-        raise SettingError(flag, f"{name!r} is neither an image file nor an exemplar the model knows "
-                                 f"({', '.join(model.codes) or 'none'})")
-    try:
-        img = read_rgb(name)
-    except ValueError as exc:
-        raise SettingError(flag, str(exc)) from None
-    z = model.encode(img)
-    if refine > 0:
-        from .solid.refine import refine_code
-
-        z, hist = refine_code(model, z, img, steps=refine, progress=bar)
-        if not quiet:
-            print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
-    return z
-
-
 def run_solid(a: argparse.Namespace) -> int:
     import json
 
     from .onnx_models import ModelError
-    from .solid.model import SolidTextureModel
+    from .solid.model import SHIPPED_MODELS, SolidTextureModel, exemplar_z, load_models
 
     if a.list:
-        out = {}
-        for entry in sorted(os.listdir(SOLID_MODELS)) if os.path.isdir(SOLID_MODELS) else []:
-            try:
-                m = SolidTextureModel(os.path.join(SOLID_MODELS, entry))
-            except ModelError:
-                continue
-            out[entry] = dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
+        out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
+               for name, m in load_models().items()}
         print(json.dumps(out, indent=2))
         return 0
     if not a.exemplar or not a.out:
@@ -443,9 +412,9 @@ def run_solid(a: argparse.Namespace) -> int:
         raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
     folder = a.model
     if folder is None:
-        named = os.path.join(SOLID_MODELS, os.path.basename(a.exemplar))
+        named = os.path.join(SHIPPED_MODELS, os.path.basename(a.exemplar))
         folder = named if os.path.isfile(os.path.join(named, "solid.json")) and not a.to else \
-            os.path.join(SOLID_MODELS, "space")
+            os.path.join(SHIPPED_MODELS, "space")
     try:
         model = SolidTextureModel(folder)
     except ModelError as exc:
@@ -459,26 +428,26 @@ def run_solid(a: argparse.Namespace) -> int:
             raise SettingError("--refine", f"model {model.name!r} holds one texture; refining needs the space model")
         code = model.default_code()
     else:
-        z = _solid_code(model, a.exemplar, "--exemplar", a.refine, _Bar(a.quiet, "refine "), a.quiet)
+        def z_of(name, flag):
+            z, _, hist = exemplar_z(model, name, a.refine, flag, _Bar(a.quiet, "refine "))
+            if hist and not a.quiet:
+                print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
+            return z
+
+        z = z_of(a.exemplar, "--exemplar")
         if a.to:
-            z = (1.0 - a.mix) * z + a.mix * _solid_code(model, a.to, "--to", a.refine, _Bar(a.quiet, "refine "),
-                                                        a.quiet)
+            z = (1.0 - a.mix) * z + a.mix * z_of(a.to, "--to")
         code = model.translate(z)
     bar = _Bar(a.quiet)
-    from .solid.bake import bake_volume, evaluate_grid, srgb_to_linear
-    from .sources import BoxGrid
+    from .solid.bake import srgb_to_linear
 
-    extent = a.size / (model.px_per_unit * a.scale)
-    if a.dim == 3 and ext == ".vdb":
-        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
-        bake_volume(model, code, grid, a.out, a.seed, progress=bar)
-        return 0
-    if a.dim == 3:
-        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
-        rgb = evaluate_grid(model, code, grid, a.seed, progress=bar)
-        from export.images import write_npy
+    if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
+        from .bake import BakeSpec, run_bake
+        from .sources import BoxGrid, SolidSource
 
-        write_npy(a.out, srgb_to_linear(rgb))
+        extent = a.size / (model.px_per_unit * a.scale)
+        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
+        run_bake(BakeSpec("solid", SolidSource(model, seed=a.seed, code=code), grid, a.out), bar, force=True)
         return 0
     rgb = model.image(a.size, code, a.seed, scale=a.scale, progress=lambda d, n: bar(d / n))
     from export.images import preview_8bit, write_image, write_png

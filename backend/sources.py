@@ -258,11 +258,11 @@ class SolidSource:
         self.dim = self.model.dim
         self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
         self.exemplar = exemplar
-        self.image_sha256 = None
+        self.input_sha256 = None
         self.z = None
         if code is not None:
             self.code = code
-            self.image_sha256 = hashlib.sha256(np.concatenate([np.ravel(code.e), np.ravel(code.T)])
+            self.input_sha256 = hashlib.sha256(np.concatenate([np.ravel(code.e), np.ravel(code.T)])
                                                .astype(np.float32).tobytes()).hexdigest()
             return
         if self.model.mode == "single":
@@ -271,23 +271,11 @@ class SolidSource:
                                                       "an exemplar needs a space model")
             self.code = self.model.default_code()
             return
-        if exemplar in self.model.codes:
-            self.z = self.model.codes[exemplar]
-        else:
-            import os
+        from .solid.model import exemplar_z
 
-            if exemplar is None or not os.path.isfile(exemplar):
-                raise SettingError("source.exemplar", f"{exemplar!r} is neither an image file nor an exemplar of "
-                                                      f"model {self.model.name!r} ({', '.join(self.model.codes)})")
-            from ._export import export
-
-            img = export.read_rgb(exemplar)
-            self.image_sha256 = hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest()
-            self.z = self.model.encode(img)
-            if self.refine > 0:
-                from .solid.refine import refine_code
-
-                self.z = refine_code(self.model, self.z, img, self.refine)[0]
+        self.z, img, _ = exemplar_z(self.model, exemplar, self.refine, "source.exemplar")
+        if img is not None:
+            self.input_sha256 = hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest()
         self.code = self.model.translate(self.z)
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
@@ -308,7 +296,7 @@ class SolidSource:
 
     def to_dict(self) -> dict:
         return dict(kind=self.kind, model=self.model.config["files"], exemplar=self.exemplar,
-                    image_sha256=self.image_sha256, refine=self.refine, seed=self.seed, scale=self.scale,
+                    input_sha256=self.input_sha256, refine=self.refine, seed=self.seed, scale=self.scale,
                     density=self.density)
 
 
@@ -318,12 +306,16 @@ _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width
                 "tileable")
 
 
+def _check_keys(d: dict, known: tuple, kind: str) -> None:
+    unknown = sorted(set(d) - set(known))
+    if unknown:
+        raise SettingError(f"source.{unknown[0]}", f"unknown {kind} setting; known: {', '.join(known)}")
+
+
 def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     import os
 
-    unknown = sorted(set(d) - set(_NEURAL_KEYS))
-    if unknown:
-        raise SettingError(f"source.{unknown[0]}", f"unknown neural setting; known: {', '.join(_NEURAL_KEYS)}")
+    _check_keys(d, _NEURAL_KEYS, "neural")
     if "noise" not in d:
         raise SettingError("source.noise", "a neural source needs noise = CLASS")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -346,16 +338,15 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
     import os
 
-    unknown = sorted(set(d) - set(_SOLID_KEYS))
-    if unknown:
-        raise SettingError(f"source.{unknown[0]}", f"unknown solid setting; known: {', '.join(_SOLID_KEYS)}")
+    _check_keys(d, _SOLID_KEYS, "solid")
     if "model" not in d:
         raise SettingError("source.model", "a solid source needs model = FOLDER (e.g. models/solid/gravel_3d)")
+    from .solid.model import SHIPPED_MODELS
+
     model = d["model"]
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     folder = os.path.join(base_dir, model)
-    if not os.path.isdir(folder) and os.path.isdir(os.path.join(root, "models", "solid", model)):
-        folder = os.path.join(root, "models", "solid", model)     # a shipped model by name
+    if not os.path.isdir(folder) and os.path.isdir(os.path.join(SHIPPED_MODELS, model)):
+        folder = os.path.join(SHIPPED_MODELS, model)     # a shipped model by name
     ex = d.get("exemplar")
     if ex is not None and os.path.isfile(os.path.join(base_dir, ex)):
         ex = os.path.join(base_dir, ex)

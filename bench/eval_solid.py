@@ -33,23 +33,15 @@ from export.atomic import write_json  # noqa: E402
 MODELS = os.path.join(ROOT, "models", "solid")
 
 
-def _models():
-    from backend.solid.model import SolidTextureModel
-
-    out = {}
-    for name in sorted(os.listdir(MODELS)):
-        if os.path.isfile(os.path.join(MODELS, name, "solid.json")):
-            out[name] = SolidTextureModel(os.path.join(MODELS, name))
-    return out
-
-
 def quality(n: int) -> dict:
     import torch
 
     from backend.training.solid import exemplars as ex
     from backend.training.solid.evaluate import EVAL_SIZE, evaluate_exemplar, slices_3d
 
-    models = _models()
+    from backend.solid.model import load_models
+
+    models = load_models(MODELS)
     space = next((m for m in models.values() if m.mode == "space"), None)
     singles = {}
     for m in models.values():
@@ -80,9 +72,9 @@ def quality(n: int) -> dict:
 
 
 def _plane(size, ppu, i):
-    u = (np.arange(size) + 0.5) / ppu
-    vv, uu = np.meshgrid(u, u, indexing="ij")
-    return np.stack([uu.ravel(), -vv.ravel()], 1) + np.random.default_rng(i).uniform(-50, 50, 2)
+    from backend.solid.model import plane_points
+
+    return plane_points(size, ppu) + np.random.default_rng(i).uniform(-50, 50, 2)
 
 
 def _points(dim: int, size: int, ppu: float):

@@ -33,9 +33,10 @@ from .preferences import threads
 
 __all__ = ["models_dir", "load_model", "texture", "register", "unregister"]
 
-#: where the shipped models live; tests point it elsewhere
+#: where the shipped models live (``backend.solid.model.SHIPPED_MODELS``, computed here without importing the
+#: backend, so register() stays cheap); tests point it elsewhere
 MODELS_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "solid")
-_MODELS = {}
+_MODELS = {}   # folder path -> model, or the ModelError it raised (an altered folder is read once)
 
 
 def _mod(name: str):
@@ -46,36 +47,30 @@ def models_dir() -> str:
     return MODELS_DIR
 
 
+def _models() -> dict:
+    """{folder name: model} under :data:`MODELS_DIR`, each loaded once (never at register time)."""
+    return _mod("solid.model").load_models(models_dir(), threads(), _MODELS)
+
+
 def load_model(name: str):
-    """A model folder under :data:`MODELS_DIR`, loaded once (never at register time)."""
-    path = os.path.join(models_dir(), name)
-    if path not in _MODELS:
-        _MODELS[path] = _mod("solid.model").SolidTextureModel(path, threads())
-    return _MODELS[path]
+    """A model folder under :data:`MODELS_DIR` by name (ModelError if it is missing or altered)."""
+    m = _models().get(name)
+    if m is None:
+        err = _MODELS.get(os.path.join(models_dir(), name))
+        raise err if isinstance(err, Exception) else \
+            _mod("onnx_models").ModelError(f"no solid texture model {name!r} in {models_dir()}")
+    return m
 
 
 def _catalogue() -> list:
     """(identifier, label, description) of every shipped texture: single 3D models, then space exemplars."""
-    items = []
-    root = models_dir()
-    names = sorted(os.listdir(root)) if os.path.isdir(root) else []
-    for name in names:
-        try:
-            m = load_model(name)
-        except Exception:  # an incomplete or altered folder is simply not offered
-            continue
-        if m.mode == "single" and m.dim == 3:
-            ex = m.config["exemplars"][0]
-            items.append((f"single:{name}", ex.replace("_", " ").title(), f"Fitted to the {ex} exemplar ({name})"))
-    for name in names:
-        try:
-            m = load_model(name)
-        except Exception:
-            continue
-        if m.mode == "space" and m.dim == 3:
-            for ex in sorted(m.codes):
-                items.append((f"space:{name}:{ex}", f"{ex.replace('_', ' ').title()} (space)",
-                              f"The {ex} exemplar's code in the texture space {name}"))
+    models = _models()
+    items = [(f"single:{name}", m.config["exemplars"][0].replace("_", " ").title(),
+              f"Fitted to the {m.config['exemplars'][0]} exemplar ({name})")
+             for name, m in models.items() if m.mode == "single" and m.dim == 3]
+    items += [(f"space:{name}:{ex}", f"{ex.replace('_', ' ').title()} (space)",
+               f"The {ex} exemplar's code in the texture space {name}")
+              for name, m in models.items() if m.mode == "space" and m.dim == 3 for ex in sorted(m.codes)]
     return items
 
 
@@ -88,14 +83,7 @@ def _texture_items(self, context):
 
 
 def _space_model_name():
-    root = models_dir()
-    for name in sorted(os.listdir(root)) if os.path.isdir(root) else []:
-        try:
-            if load_model(name).mode == "space":
-                return name
-        except Exception:
-            continue
-    return None
+    return next((name for name, m in _models().items() if m.mode == "space"), None)
 
 
 class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
@@ -137,8 +125,9 @@ def _image_pixels(ima) -> np.ndarray:
     px = px.reshape(h, w, ima.channels)
     rgb = px[..., :3] if ima.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
     if ima.is_float:  # float buffers hold scene-linear values; the encoder was trained on sRGB values
-        c = np.clip(rgb, 0.0, 1.0)
-        rgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+        from ._deps import export
+
+        rgb = export.linear_to_srgb(rgb)
     return np.ascontiguousarray(np.flipud(rgb), np.float32)
 
 
@@ -171,6 +160,17 @@ def texture(p):
     return m, lambda: m.code(parts[2])
 
 
+def _vertex_positions(me, obj, world: bool) -> np.ndarray:
+    """A mesh's vertex positions, float64 (V, 3): object-local, or world through ``obj.matrix_world``."""
+    co = np.empty(len(me.vertices) * 3, np.float32)
+    me.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3).astype(np.float64)
+    if world:
+        M = np.array(obj.matrix_world)
+        co = co @ M[:3, :3].T + M[:3, 3]
+    return co
+
+
 def _mesh_arrays(context, obj, world: bool, uv: bool):
     """Triangles of the evaluated mesh: (uv (T, 3, 2) or None, positions (T, 3, 3)) float64."""
     dg = context.evaluated_depsgraph_get()
@@ -185,13 +185,7 @@ def _mesh_arrays(context, obj, world: bool, uv: bool):
         me.loop_triangles.foreach_get("loops", tri)
         vidx = np.empty(L, np.int32)
         me.loops.foreach_get("vertex_index", vidx)
-        co = np.empty(len(me.vertices) * 3, np.float32)
-        me.vertices.foreach_get("co", co)
-        co = co.reshape(-1, 3).astype(np.float64)
-        if world:
-            M = np.array(obj.matrix_world)
-            co = co @ M[:3, :3].T + M[:3, 3]
-        pos = co[vidx[tri]].reshape(T, 3, 3)
+        pos = _vertex_positions(me, obj, world)[vidx[tri]].reshape(T, 3, 3)
         uvs = None
         if uv:
             layer = me.uv_layers.active
@@ -325,12 +319,7 @@ class OMNINOISE_OT_solid_bake(_TaskOperator, bpy.types.Operator):
 
         elif p.target == "COLOR_ATTRIBUTE":
             me = obj.data
-            co = np.empty(len(me.vertices) * 3, np.float32)
-            me.vertices.foreach_get("co", co)
-            co = co.reshape(-1, 3).astype(np.float64)
-            if world:
-                M = np.array(obj.matrix_world)
-                co = co @ M[:3, :3].T + M[:3, 3]
+            co = _vertex_positions(me, obj, world)
             linear = _mod("solid.bake").srgb_to_linear
 
             def work(progress, cancel):

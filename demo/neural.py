@@ -7,7 +7,6 @@ mask; a four-corner blend; and a tileable tile repeated 2x2.
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
@@ -20,6 +19,7 @@ sys.path.insert(0, ROOT)
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, write_png  # noqa: E402
 
 STEPS = 30
@@ -56,8 +56,7 @@ def main(out: str) -> int:
     write_png(os.path.join(out, "neural.png"), preview_8bit(sheet, 0.0, 1.0))
     info = dict(classes=names, sweep=dict(cls=names[0], param=first["name"]), steps=STEPS, size=S,
                 seconds=round(time.perf_counter() - t0, 1), model_sha256=model.config["files"]["eps.onnx"])
-    with open(os.path.join(out, "neural.json"), "w", encoding="utf-8") as fh:
-        json.dump(info, fh, indent=1)
+    write_json(os.path.join(out, "neural.json"), info)
     print(f"wrote {out}/neural.png in {info['seconds']} s")
     return 0
 

@@ -12,7 +12,6 @@ plane.
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
@@ -25,18 +24,18 @@ sys.path.insert(0, ROOT)
 import bpy  # noqa: E402
 
 import blender_addon  # noqa: E402
-from backend.solid.model import SolidTextureModel  # noqa: E402
+from backend.solid.model import SHIPPED_MODELS, load_models, plane_points  # noqa: E402
+from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, read_rgb, write_png  # noqa: E402
 
-MODELS = os.path.join(ROOT, "models", "solid")
+MODELS = SHIPPED_MODELS
 EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
+
+
 def slices_sheet(out: str, size: int = 160) -> list:
     """Exemplar | xy | xz | yz | oblique slice per shipped 3D single model -> solid_slices.png."""
     rows, names = [], []
-    for name in sorted(os.listdir(MODELS)):
-        if not os.path.isfile(os.path.join(MODELS, name, "solid.json")):
-            continue
-        m = SolidTextureModel(os.path.join(MODELS, name))
+    for name, m in load_models(MODELS).items():
         if m.mode != "single" or m.dim != 3:
             continue
         ex = m.config["exemplars"][0]
@@ -46,10 +45,8 @@ def slices_sheet(out: str, size: int = 160) -> list:
         code = m.default_code()
         scale = m.config["exemplar_scale"]
         cells = [exemplar] + [m.image(size, code, 0, scale=scale, axis=a, offset=(1.3, 2.1, 0.7)) for a in "zyx"]
-        u = (np.arange(size) + 0.5) / (m.px_per_unit * scale)
-        vv, uu = np.meshgrid(u, u, indexing="ij")
         frame = np.linalg.qr(np.random.default_rng(4).normal(size=(3, 3)))[0]
-        pts = np.stack([uu.ravel(), -vv.ravel()], 1) @ frame[:, :2].T + 3.0
+        pts = plane_points(size, m.px_per_unit * scale) @ frame[:, :2].T + 3.0
         cells.append(m.evaluate(pts, code, 0).reshape(size, size, 3))
         gap = np.ones((size, 4, 3), np.float32)
         rows.append(np.concatenate(sum([[c, gap] for c in cells], [])[:-1], 1))
@@ -145,8 +142,7 @@ def main(out: str) -> int:
     os.replace(sc.render.filepath, os.path.join(out, "solid_render.png"))
     info = dict(slices=names, objects=used, render_seconds=round(time.perf_counter() - t, 1),
                 seconds=round(time.perf_counter() - t0, 1))
-    with open(os.path.join(out, "solid.json"), "w", encoding="utf-8") as fh:
-        json.dump(info, fh, indent=1)
+    write_json(os.path.join(out, "solid.json"), info)
     print(f"wrote {path}, solid_render.png, solid_slices.png ({info['seconds']} s)")
     return 0
 

@@ -14,7 +14,7 @@ import numpy as np
 from .atomic import atomic_path
 
 __all__ = ["write_npy", "write_png", "write_exr", "write_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
-           "encode_srgb8"]
+           "encode_srgb8", "linear_to_srgb"]
 
 
 def write_npy(path: str, array: np.ndarray) -> None:
@@ -34,12 +34,17 @@ def preview_8bit(array: np.ndarray, lo: float | None = None, hi: float | None = 
     return (np.clip((a - lo) * scale, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
 
 
+def linear_to_srgb(linear: np.ndarray) -> np.ndarray:
+    """Scene-linear values -> sRGB-encoded float32 in [0, 1] (IEC 61966-2-1; clipped to [0, 1] first)."""
+    c = np.clip(np.asarray(linear, np.float32), 0.0, 1.0)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055).astype(np.float32)
+
+
 def encode_srgb8(linear: np.ndarray) -> np.ndarray:
     """Scene-linear float (..., C) -> sRGB-encoded uint8; a 4th (alpha) channel stays linear."""
-    a = np.clip(np.asarray(linear, np.float32), 0.0, 1.0)
-    out = a.copy()
-    c = out[..., :3] if a.ndim == 3 and a.shape[-1] >= 3 else out
-    np.copyto(c, np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055))
+    out = np.clip(np.asarray(linear, np.float32), 0.0, 1.0)
+    c = out[..., :3] if out.ndim == 3 and out.shape[-1] >= 3 else out
+    c[...] = linear_to_srgb(c)
     return (out * 255.0 + 0.5).astype(np.uint8)
 
 

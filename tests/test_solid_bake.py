@@ -15,8 +15,17 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GRAVEL = os.path.join(ROOT, "models", "solid", "gravel_3d")
 
 
+def grid_points(grid: BoxGrid) -> np.ndarray:
+    """Voxel/pixel centres of ``grid``, x fastest: the reference positions (N, 3)."""
+    first, step = grid.first, grid.voxel
+    xs = first[0] + np.arange(grid.resolution[0]) * step[0]
+    ys = first[1] + np.arange(grid.resolution[1]) * step[1]
+    zs = first[2] + np.arange(grid.resolution[2]) * step[2] if grid.rank == 3 else np.array([first[2]])
+    z, y, x = np.meshgrid(zs, ys, xs, indexing="ij")
+    return np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+
+
 def _ref(grid: BoxGrid, seed=0, scale=1.0):
-    from backend.solid.bake import grid_points
     m = SolidTextureModel(GRAVEL)
     return srgb_to_linear(m.evaluate(grid_points(grid) * scale, m.default_code(), seed)).reshape(grid.shape + (3,))
 

@@ -1,6 +1,4 @@
 """Neural solid textures: training steps, ONNX export, and the torch-free runtime against torch."""
-import json
-import os
 
 import numpy as np
 import pytest
@@ -16,7 +14,7 @@ from backend.training.solid import exemplars as ex  # noqa: E402
 from backend.training.solid.export import export  # noqa: E402
 from backend.training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
 from backend.training.solid.lattice import octave_seeds  # noqa: E402
-from backend.training.solid.model import SolidTexture, random_rotations, slice_points  # noqa: E402
+from backend.training.solid.model import random_rotations, slice_points  # noqa: E402
 from backend.training.solid.train import SolidConfig, build_model, train  # noqa: E402
 
 

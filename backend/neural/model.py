@@ -8,7 +8,6 @@ circular padding (seamless tiles).
 """
 from __future__ import annotations
 
-import os
 
 import numpy as np
 

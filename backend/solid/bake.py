@@ -19,7 +19,7 @@ from ..errors import SettingError
 from ..sources import BoxGrid
 from .model import SolidTextureModel, TextureCode
 
-__all__ = ["srgb_to_linear", "grid_points", "bake_volume", "evaluate_grid"]
+__all__ = ["srgb_to_linear", "bake_volume"]
 
 _F = np.float32
 
@@ -28,33 +28,6 @@ def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     """sRGB-encoded values in [0, 1] -> scene-linear float32 (IEC 61966-2-1)."""
     c = np.clip(np.asarray(c, _F), 0.0, 1.0)
     return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4)).astype(_F)
-
-
-def grid_points(grid: BoxGrid, z0: int = 0, z1: int | None = None) -> np.ndarray:
-    """Voxel/pixel centres of ``grid`` (slices z0..z1 of a volume) as float64 (N, 3), x fastest."""
-    first, step = grid.first, grid.voxel
-    nx, ny = int(grid.resolution[0]), int(grid.resolution[1])
-    xs = first[0] + np.arange(nx) * step[0]
-    ys = first[1] + np.arange(ny) * step[1]
-    if grid.rank == 2:
-        zs = np.array([first[2]])
-    else:
-        z1 = int(grid.resolution[2]) if z1 is None else z1
-        zs = first[2] + np.arange(z0, z1) * step[2]
-    z, y, x = np.meshgrid(zs, ys, xs, indexing="ij")
-    return np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-
-
-def evaluate_grid(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, seed: int = 0, scale: float = 1.0,
-                  progress=None, cancel=None) -> np.ndarray:
-    """sRGB float32 (ny, nx, 3) or (nz, ny, nx, 3): the texture at the grid's centres times ``scale``
-    (texture units per world unit).  A 2D model reads x, y only."""
-    grid.validate()
-    pts = grid_points(grid) * float(scale)
-    if model.dim == 2:
-        pts = pts[:, :2]
-    prog = None if progress is None else (lambda d, n: progress(d / n))
-    return model.evaluate(pts, code, seed, progress=prog, cancel=cancel).reshape(grid.shape + (3,))
 
 
 def bake_volume(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, path: str, seed: int = 0,

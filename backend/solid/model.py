@@ -25,10 +25,66 @@ from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
 from .lattice import lattice_noise
 
-__all__ = ["SolidTextureModel", "TextureCode", "DEFAULT_CHUNK"]
+__all__ = ["SolidTextureModel", "TextureCode", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points",
+           "exemplar_z"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
+#: the models the extension ships (``models/solid`` beside ``backend``)
+SHIPPED_MODELS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                              "models", "solid")
+
+
+def plane_points(size: int, px_per_unit: float) -> np.ndarray:
+    """Pixel centres of a size x size image in texture units, row 0 at the top: float64 (size*size, 2) (u, -v)."""
+    u = (np.arange(size, dtype=np.float64) + 0.5) / px_per_unit
+    vv, uu = np.meshgrid(u, u, indexing="ij")
+    return np.stack([uu.ravel(), -vv.ravel()], axis=1)
+
+
+def load_models(root: str = SHIPPED_MODELS, threads: int = 0, cache: dict | None = None) -> dict:
+    """{folder name: model} of every loadable model folder under ``root`` (incomplete or altered folders
+    are left out), sorted by name.  ``cache`` (path -> model or ModelError) avoids re-reading folders."""
+    out = {}
+    for name in sorted(os.listdir(root)) if os.path.isdir(root) else []:
+        path = os.path.join(root, name)
+        if not os.path.isfile(os.path.join(path, "solid.json")):
+            continue
+        if cache is not None and path in cache:
+            m = cache[path]
+        else:
+            try:
+                m = SolidTextureModel(path, threads)
+            except ModelError as exc:
+                m = exc
+            if cache is not None:
+                cache[path] = m
+        if not isinstance(m, ModelError):
+            out[name] = m
+    return out
+
+
+def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setting: str = "exemplar",
+               progress=None):
+    """A space model's z for a training exemplar's name or an image file (encoded, then refined by ``refine``
+    search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement distances or [])."""
+    if exemplar in model.codes:
+        return model.codes[exemplar], None, []
+    if exemplar is None or not os.path.isfile(exemplar):
+        raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
+                                    f"({', '.join(model.codes) or 'none'})")
+    from .._export import export
+
+    try:
+        img = export.read_rgb(exemplar)
+    except ValueError as exc:
+        raise SettingError(setting, str(exc)) from None
+    z, hist = model.encode(img), []
+    if refine > 0:
+        from .refine import refine_code
+
+        z, hist = refine_code(model, z, img, steps=refine, progress=progress)
+    return z, img, hist
 
 
 @dataclass(frozen=True)
@@ -147,9 +203,7 @@ class SolidTextureModel:
               axis: str = "z", **kw) -> np.ndarray:
         """A (size, size, 3) float32 image of the plane through ``offset`` normal to ``axis``,
         at exemplar resolution times ``scale`` (pixel centres; row 0 at the top)."""
-        u = (np.arange(size, dtype=np.float64) + 0.5) / (self.px_per_unit * scale)
-        vv, uu = np.meshgrid(u, u, indexing="ij")
-        plane = np.stack([uu.ravel(), -vv.ravel()], axis=1)
+        plane = plane_points(size, self.px_per_unit * scale)
         if self.dim == 2:
             pts = plane + np.asarray(offset[:2], np.float64)
         else:

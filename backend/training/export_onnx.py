@@ -26,20 +26,25 @@ from ..neural.model import sha256_file
 from . import zoo
 from .train import TrainConfig, build_model, model_names
 
-__all__ = ["export"]
+__all__ = ["export", "onnx_export"]
 
 FORMAT = 1
+
+
+def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dynamic: dict) -> None:
+    """``torch.onnx.export`` (opset 17, TorchScript exporter) to a temporary file, then renamed onto ``path``."""
+    tmp = path + ".tmp"
+    torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
+                      opset_version=17, dynamo=False)
+    os.replace(tmp, path)
 
 
 def _export_one(model, path: str, size: int) -> None:
     C = model.emb_dim + model.n_params
     args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), torch.randn(1, C, size, size), torch.zeros(1))
-    tmp = path + ".tmp"
-    torch.onnx.export(model, args, tmp, input_names=["x", "t", "cond", "tile"], output_names=["eps"],
-                      dynamic_axes={"x": {0: "batch", 2: "height", 3: "width"}, "t": {0: "batch"},
-                                    "cond": {0: "batch", 2: "height", 3: "width"}, "eps": {0: "batch", 2: "height", 3: "width"}},
-                      opset_version=17, dynamo=False)
-    os.replace(tmp, path)
+    onnx_export(model, args, path, ["x", "t", "cond", "tile"], ["eps"],
+                {"x": {0: "batch", 2: "height", 3: "width"}, "t": {0: "batch"},
+                 "cond": {0: "batch", 2: "height", 3: "width"}, "eps": {0: "batch", 2: "height", 3: "width"}})
 
 
 def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> dict:

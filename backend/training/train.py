@@ -28,7 +28,15 @@ from .cutmix import cutmix
 from .diffusion import Diffusion
 from .unet import UNet
 
-__all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names"]
+__all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names", "check_config_keys"]
+
+
+def check_config_keys(cls, d: dict) -> None:
+    """ValueError naming the first key of ``d`` that is not a field of the config dataclass ``cls``."""
+    known = {f.name for f in fields(cls)}
+    unknown = sorted(set(d) - known)
+    if unknown:
+        raise ValueError(f"unknown config key {unknown[0]!r}; known: {', '.join(sorted(known))}")
 
 
 @dataclass
@@ -58,10 +66,7 @@ class TrainConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> "TrainConfig":
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(d) - known)
-        if unknown:
-            raise ValueError(f"unknown config key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+        check_config_keys(cls, d)
         d = dict(d)
         for k in ("betas", "widths", "classes"):
             if k in d:

@@ -32,6 +32,7 @@ import torch
 import torch.nn.functional as F
 
 from ...solid.lattice import lattice_noise
+from ...solid.model import plane_points
 from . import exemplars as ex
 from .features import RandomFeatures, gram_loss, histogram_loss
 
@@ -82,9 +83,7 @@ def slices_3d(evaluate, n: int, size: int, px_per_unit: float, seed: int = 0) ->
     """n slices (axis-aligned xy/xz/yz in turn, every 4th oblique) of a 3D texture through random
     points, sample i with seed i: evaluate(points (N, 3), seed) -> (N, 3).  Returns (n, size, size, 3)."""
     rng = np.random.default_rng(seed)
-    u = (np.arange(size) + 0.5) / px_per_unit
-    vv, uu = np.meshgrid(u, u, indexing="ij")
-    plane = np.stack([uu.ravel(), -vv.ravel()], 1)
+    plane = plane_points(size, px_per_unit)
     out = []
     for i in range(n):
         if i % 4 == 3:

@@ -19,11 +19,11 @@ import os
 import sys
 
 import torch
-
-from ..._export import export as _ex
 from torch import nn
 
+from ..._export import export as _ex
 from ...onnx_models import sha256_file
+from ..export_onnx import onnx_export as _onnx
 from .train import SolidConfig, build_model, training_images
 
 __all__ = ["export", "SplitDecoder", "FORMAT", "ENCODER_SIZE"]
@@ -48,13 +48,6 @@ class SplitDecoder(nn.Module):
 
     def forward(self, noise, code):
         return torch.sigmoid(self.rest(self.wn(noise) + self.we(code)))
-
-
-def _onnx(module, args, path, inputs, outputs, dynamic):
-    tmp = path + ".tmp"
-    torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
-                      opset_version=17, dynamo=False)
-    os.replace(tmp, path)
 
 
 class _Translator(nn.Module):

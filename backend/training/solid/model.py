@@ -15,7 +15,6 @@ the single-mode parameters learn T_i = R_i (I + Delta_i).
 """
 from __future__ import annotations
 
-import math
 
 import torch
 from torch import nn

@@ -25,11 +25,11 @@ import math
 import os
 import sys
 import time
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 
-import numpy as np
 import torch
 
+from ..train import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, style_loss
 from .lattice import octave_seeds
@@ -70,10 +70,7 @@ class SolidConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(d) - known)
-        if unknown:
-            raise ValueError(f"unknown config key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+        check_config_keys(cls, d)
         d = dict(d)
         if "exemplars" in d:
             d["exemplars"] = tuple(d["exemplars"])
