@@ -48,6 +48,12 @@ def white_color4(x, y, z, w, channel: int) -> np.ndarray:
     args = (x, y, z, w)
     return white_noise4(*(args[i] for i in COLOR_PERMUTATIONS[channel]))
 
+def border_fraction(zeta: np.ndarray) -> np.ndarray:
+    """fract(16 zeta), float32: the slice border's random fraction (exact in float32, as in the node)."""
+    t = np.asarray(zeta, _F) * _F(16.0)
+    return (t - np.floor(t)).astype(_F)
+
+
 BLEND_HALF_WIDTH = 0.3   # border ramp half-width, in slice widths
 SLPOS_MIN, SLPOS_RANGE = 0.3, 0.4
 
@@ -118,14 +124,21 @@ class WaveNoise:
 
     # -- random quantities of slice m in stratum k ------------------------------
     def slice_records(self, k: int, m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """For slice ids m (float32): border position (M,), direction (M, D), offset zeta (M,)."""
+        """For slice ids m (float32): border position (M,), direction (M, D), offset zeta (M,).
+
+        One White Noise node per slice carries everything a 2D or 3D slice needs:
+        A = White Noise (k, m, a, seed), Color (r, g, b) = offset zeta, jitters 0, 1.
+        The border position reuses zeta's low bits, SLPOS_MIN + SLPOS_RANGE * fract(16 zeta),
+        which are independent of zeta's coarse value (2^20 levels) and cost two math nodes
+        instead of a second hash.  4D reads jitter 2 from B = White Noise (k, m, b, seed).
+        """
         kk, s = _F(k), self.seed
         a, b = _F(STREAM["slice_a"]), _F(STREAM["slice_b"])
-        # node A = White Noise (k, m, a, seed): Color (r, g, b) = border, offset, jitter 0
-        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * white_color4(kk, m, a, s, 0)
-        zeta = white_color4(kk, m, a, s, 1)
-        # node B = White Noise (k, m, b, seed): Color (r, g) = jitters 1, 2
-        jit = [white_color4(kk, m, a, s, 2)] + [white_color4(kk, m, b, s, c) for c in range(self.dim - 2)]
+        zeta = white_color4(kk, m, a, s, 0)
+        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * border_fraction(zeta)
+        jit = [white_color4(kk, m, a, s, 1 + c) for c in range(min(self.dim - 1, 2))]
+        if self.dim == 4:
+            jit.append(white_color4(kk, m, b, s, 0))
         u = np.stack(jit, 1)
         lo, hi = self.dirs.lo[k], self.dirs.hi[k]
         u = lo + (hi - lo) * u

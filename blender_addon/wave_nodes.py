@@ -119,10 +119,12 @@ class _Nodes:
             self.put(s, v)
         return n.outputs[0]
 
-    def vmath(self, op: str, a, b=(0.0, 0.0, 0.0), scale=None):
+    def vmath(self, op: str, a, b=(0.0, 0.0, 0.0), c=None, scale=None):
         n = self.new("ShaderNodeVectorMath", operation=op)
         self.put(n.inputs[0], a)
         self.put(n.inputs[1], b)
+        if c is not None:
+            self.put(n.inputs[2], c)
         if scale is not None:
             self.put(n.inputs["Scale"], scale)
         return n.outputs["Value"] if op in ("DOT_PRODUCT", "LENGTH", "DISTANCE") else n.outputs["Vector"]
@@ -138,20 +140,24 @@ class _Nodes:
         self.put(n.inputs[0], v)
         return tuple(n.outputs)
 
-    def white(self, k, n, stream: int, seed, channels=(0, 1, 2)) -> list:
-        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> sockets of its Color's ``channels``.
+    def white(self, k: float, n, stream: int, seed) -> bpy.types.NodeSocket:
+        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> its Color socket.
 
-        The channels are backend.wave.white_color4 with channel 0, 1, 2.  Fewer
-        than three are read with exact dot products (c . e_i): Cycles keeps an
-        unlinked Separate XYZ output on its stack for the whole shader.
+        Channel c of the Color is backend.wave.white_color4(k, n, stream, seed, c).
+        The slice id n sits in the Combine XYZ, so the node depends on the stratum's chain
+        (a constant Combine could be scheduled early and crowd Cycles' SVM stack).
         """
         node = self.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
         self.put(node.inputs["Vector"], self.combine(k, n, float(stream)))
         self.put(node.inputs["W"], seed)
-        color = node.outputs["Color"]
-        if tuple(channels) == (0, 1, 2):
-            return list(self.separate(color))
-        return [self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c])) for c in channels]
+        return node.outputs["Color"]
+
+    def channel(self, color, c: int):
+        """Channel c of a colour socket, read with an exact dot product (c . e_c).
+
+        A Separate XYZ whose other outputs are unlinked would stay on Cycles' stack
+        for the whole shader."""
+        return self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c]))
 
     def image(self, img: bpy.types.Image, vector):
         """Linear, repeating image lookup -> colour socket (r, g, b) read as a vector."""
@@ -197,13 +203,13 @@ def _direction(b: _Nodes, u, dim: int, full: bool, g) -> tuple:
         vec = b.combine(b.math("SINE", t), b.math("COSINE", t), 0.0)
     elif dim == 3:
         phi = b.math("MULTIPLY", u[0], float(_F(2.0 * np.pi)))
-        ct = b.math("SUBTRACT", 1.0, b.math("MULTIPLY", u[1], g["Cap"]))
-        st = b.math("SQRT", b.math("MAXIMUM", b.math("SUBTRACT", 1.0, b.math("MULTIPLY", ct, ct)), 0.0))
+        ct = b.math("MULTIPLY_ADD", u[1], -g["Cap"], 1.0)
+        st = b.math("SQRT", b.math("SUBTRACT", 1.0, b.math("MULTIPLY", ct, ct)))  # SQRT is 0 below 0
         vec = b.combine(b.math("MULTIPLY", st, b.math("COSINE", phi)), b.math("MULTIPLY", st, b.math("SINE", phi)), ct)
     else:
         phi = b.math("MULTIPLY", u[0], float(_F(2.0 * np.pi)))
         ct = b.math("MULTIPLY_ADD", u[1], 2.0, -1.0)
-        st = b.math("SQRT", b.math("MAXIMUM", b.math("SUBTRACT", 1.0, b.math("MULTIPLY", ct, ct)), 0.0))
+        st = b.math("SQRT", b.math("SUBTRACT", 1.0, b.math("MULTIPLY", ct, ct)))
         # psi - sin psi cos psi = u2 (sigma - sin sigma cos sigma): safeguarded Newton (psi_inverse)
         c = b.math("MULTIPLY", u[2], g["Cap"])
         psi = b.math("MINIMUM", b.math("POWER", b.math("MULTIPLY", c, 1.5), float(_F(1.0 / 3.0))), g["Spread"])
@@ -254,7 +260,11 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.typ
 
 
 def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, mode: str, consts: dict):
-    """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket."""
+    """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket.
+
+    Per slice one White Noise node gives (zeta, jitter 0, jitter 1) (backend.wave
+    slice_records); one vector multiply-add maps them into the stratum's box.
+    """
     g = dict(consts)
     g.update(ins)
     x = b.vmath("ADD", g["Position"], b.vmath("SUBTRACT", g["Sum"], g["Sum"]))
@@ -268,23 +278,30 @@ def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, m
     n1 = b.math("ADD", n0, 1.0)
     k, seed = g["k"], g["Seed"]
     box_lo, box_size = g["Box Lo"], g["Box Size"]
+    lo3 = (0.0,) + tuple(box_lo[:2])
+    size3 = (1.0,) + tuple(box_size[:2])
     waves = []
-    slpos = None
-    for side, n in enumerate((n0, n1)):
-        # node A: (border, offset, jitter 0); slice n+1's border is not needed, so not read
-        ha = b.white(k, n, STREAM["slice_a"], seed, (0, 1, 2) if side == 0 else (1, 2))
-        zeta, jit0 = ha[-2], ha[-1]
-        jit = [jit0] + (b.white(k, n, STREAM["slice_b"], seed, range(dim - 2)) if dim > 2 else [])
-        u = [b.math("MULTIPLY_ADD", jit[i], box_size[i], box_lo[i]) for i in range(dim - 1)]
-        omega, om_w = _direction(b, u, dim, full, g)
-        if side == 0:
-            slpos = b.math("MULTIPLY_ADD", ha[0], backend.wave.SLPOS_RANGE, backend.wave.SLPOS_MIN)
+    u = None
+    for n in (n0, n1):
+        # (zeta, u0, u1) = (r, lo0 + size0 g, lo1 + size1 b) of node A
+        zu = b.vmath("MULTIPLY_ADD", b.white(k, n, STREAM["slice_a"], seed), size3, c=lo3)
+        # a Separate XYZ with an unlinked output would hold that float on the SVM stack for good
+        zu = b.separate(zu) if dim > 2 else [b.channel(zu, 0), b.channel(zu, 1)]
+        zeta, uu = zu[0], list(zu[1:dim] if dim < 4 else zu[1:3])
+        if u is None:  # border ramp of slice n0: slpos = SLPOS_MIN + SLPOS_RANGE fract(16 zeta_0)
+            frac = b.math("FRACT", b.math("MULTIPLY", zeta, 16.0))
+            slpos = b.math("MULTIPLY_ADD", frac, backend.wave.SLPOS_RANGE, backend.wave.SLPOS_MIN)
+            u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wave.BLEND_HALF_WIDTH, 0.5)
+        if dim == 4:
+            jb = b.channel(b.white(k, n, STREAM["slice_b"], seed), 0)
+            uu.append(b.math("MULTIPLY_ADD", jb, box_size[2], box_lo[2]))
+        omega, om_w = _direction(b, uu, dim, full, g)
         dot = b.vmath("DOT_PRODUCT", x, omega)
         if om_w is not None:
             dot = b.math("ADD", dot, b.math("MULTIPLY", g["W"], om_w))
         coord = b.math("MULTIPLY_ADD", b.math("SUBTRACT", dot, g["Shift"]), g["Inv Period"], zeta)
-        if mode == "single":
-            waves.append(b.image(img, b.combine(coord, 0.5, 0.0)))
+        if mode == "single":  # a one-row image: a float Vector (c, c, c) reads T(c)
+            waves.append(b.image(img, coord))
         else:  # per-axis tables, interpolated by omega_a^2 (Fig. 5 left)
             comps = b.separate(omega)
             acc = None
@@ -294,13 +311,17 @@ def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, m
                             scale=b.math("MULTIPLY", wa, wa))
                 acc = t if acc is None else b.vmath("ADD", acc, t)
             waves.append(acc)
-    u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wave.BLEND_HALF_WIDTH, 0.5, clamp=True)
-    s = b.math("MULTIPLY", b.math("MULTIPLY", b.math("MULTIPLY", u, u), b.math("MULTIPLY_ADD", u, -2.0, 3.0)),
-               float(_F(np.pi / 2)))
-    w0 = b.math("MULTIPLY", b.math("COSINE", s), g["Amplitude"])
-    w1 = b.math("MULTIPLY", b.math("SINE", s), g["Amplitude"])
-    out = b.vmath("ADD", b.vmath("SCALE", waves[0], scale=w0), b.vmath("SCALE", waves[1], scale=w1))
-    return b.vmath("ADD", g["Sum"], out)
+    # s = smoothstep(u) pi/2; Map Range clamps u to [0, 1]
+    mr = b.new("ShaderNodeMapRange", data_type="FLOAT", interpolation_type="SMOOTHSTEP", clamp=False)
+    b.put(mr.inputs["Value"], u)
+    for name, v in (("From Min", 0.0), ("From Max", 1.0), ("To Min", 0.0), ("To Max", float(_F(np.pi / 2)))):
+        b.put(mr.inputs[name], v)
+    s = mr.outputs["Result"]
+    w0, w1 = b.math("COSINE", s), b.math("SINE", s)
+    if g["Amplitude"] is not None:
+        w0, w1 = b.math("MULTIPLY", w0, g["Amplitude"]), b.math("MULTIPLY", w1, g["Amplitude"])
+    out = b.vmath("MULTIPLY_ADD", waves[0], w0, c=g["Sum"])
+    return b.vmath("MULTIPLY_ADD", waves[1], w1, c=out)
 
 
 # -- the whole group ------------------------------------------------------------------
@@ -406,16 +427,23 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     shift = b.math("MULTIPLY", gi.outputs["Time"], float(_F(noise.speed)))
     group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
     acc = (0.0, 0.0, 0.0)
+    amps = noise.dirs.amp
+    uniform = bool(np.all(amps == amps[0]))  # then one scale after the sum replaces 2 K multiplies
     for k in range(noise.dirs.count):
+        consts = _stratum_constants(noise, k)
+        if uniform:
+            consts["Amplitude"] = None
         node = b.new(group_kind)
         node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
-                                        table.values.shape[0], table.mode, _stratum_constants(noise, k))
+                                        table.values.shape[0], table.mode, consts)
         node.label = f"Direction {k + 1}"
         b.put(node.inputs["Sum"], acc)
         b.put(node.inputs["Position"], x)
         b.put(node.inputs["W"], w)
         b.put(node.inputs["Shift"], shift)
         acc = node.outputs["Sum"]
+    if uniform:
+        acc = b.vmath("SCALE", acc, scale=float(amps[0]))
     re, im, _ = b.separate(acc)
     b.put(go.inputs["Value"], re)
     b.put(go.inputs["Imaginary"], im)
