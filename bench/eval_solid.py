@@ -33,7 +33,7 @@ from export.atomic import write_json  # noqa: E402
 MODELS = os.path.join(ROOT, "models", "solid")
 
 
-def quality(n: int) -> dict:
+def quality(n: int, models_dir: str = MODELS) -> dict:
     import torch
 
     from backend.training.solid import exemplars as ex
@@ -41,7 +41,7 @@ def quality(n: int) -> dict:
 
     from backend.solid.model import load_models
 
-    models = load_models(MODELS)
+    models = load_models(models_dir)
     space = next((m for m in models.values() if m.mode == "space"), None)
     singles = {}
     for m in models.values():
@@ -153,6 +153,7 @@ def speed(model: str, run: str) -> list:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=8, help="samples (seeds) per method")
+    ap.add_argument("--models", default=MODELS, help="folder of model folders to evaluate (candidates before shipping)")
     ap.add_argument("--speed", action="store_true", help="also time onnxruntime against torch")
     ap.add_argument("--only-speed", action="store_true")
     ap.add_argument("--model", default="rust_3d", help="model timed by --speed")
@@ -171,7 +172,7 @@ def main() -> int:
         with open(a.out, encoding="utf-8") as fh:
             res = json.load(fh)
     if not a.only_speed:
-        res["quality"] = quality(a.n)
+        res["quality"] = quality(a.n, a.models)
         res["n"] = a.n
         print("| exemplar | method | style error ↓ | PSD error ↓ | diversity ↑ | success ↑ |")
         print("|---|---|---|---|---|---|")
