@@ -207,6 +207,9 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     meta = json.loads((out / "neural_noise.json").read_text())
     assert meta["files"]["eps.onnx"] in text and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
     assert "| without CutMix | 0.5 |" in text and "test CPU" in text
+    worse = dict(ev, classes={"spots": dict(fd=3.0, acc=0.25, psd=0.4, response=0.2, param="scale")}, locality=0.5)
+    text = card(str(run), str(out), ev, None, "train", "test CPU", previous=worse, previous_label="3000-step model")
+    assert "3000-step model" in text and "| mean FD ↓ | 3.0 | 1.5 |" in text and "| blend locality ↑ | 0.5 | 0.75 |" in text
 
 
 def test_neural_bake_source_in_jobs(exported, tmp_path):

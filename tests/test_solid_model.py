@@ -100,6 +100,34 @@ def test_resume_continues_from_checkpoint(tmp_path):
     assert msgs[0] == "resumed at step 3" and state["step"] == 6
 
 
+def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_path):
+    import json
+
+    from backend.training.solid.model_card import card
+
+    base = dict(name="c", dim=2, crop=32, batch=1, steps=4, width=16, checkpoint_every=2, log_every=1, threads=1,
+                exemplars=["gravel"])
+    first = train(SolidConfig.from_dict(base), str(tmp_path / "runs" / "c"), log=lambda *_: None)
+    long = dict(base, name="c_long", steps=7, init_from=str(tmp_path / "runs" / "c"))
+    msgs = []
+    state = train(SolidConfig.from_dict(long), str(tmp_path / "runs" / "c_long"), log=msgs.append)
+    assert msgs[:2] == [f"continuing {tmp_path / 'runs' / 'c'}", "resumed at step 4"] and state["step"] == 7
+    assert not torch.equal(state["model"]["decoder.net.0.weight"], first["model"]["decoder.net.0.weight"])
+    steps = [json.loads(line)["step"] for line in open(tmp_path / "runs" / "c_long" / "log.jsonl")]
+    assert steps == list(range(1, 8))  # the first run's log, then the continuation
+    with pytest.raises(ValueError, match="init_from: no checkpoint"):
+        train(SolidConfig.from_dict(dict(long, init_from=str(tmp_path / "none"))), str(tmp_path / "x"),
+              log=lambda *_: None)
+    # the card lists the config chain and reads the continued run's log
+    cfgs = tmp_path / "configs"
+    cfgs.mkdir()
+    (cfgs / "c.json").write_text(json.dumps(base))
+    (cfgs / "c_long.json").write_text(json.dumps(dict(long, init_from="runs/c")))
+    export(str(tmp_path / "runs" / "c_long"), str(tmp_path / "models" / "c"))
+    text = card(str(tmp_path / "models"), str(tmp_path / "runs"), None, str(cfgs))
+    assert "| c | single | 2D | gravel | 1.0 | `c.json` → `c_long.json` | 7 |" in text, text
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_single_export_runtime_matches_torch(tmp_path, dim):
     run, state = _tiny(tmp_path, dim=dim)

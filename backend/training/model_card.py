@@ -49,7 +49,8 @@ def _table(ev: dict) -> str:
     return "\n".join(rows)
 
 
-def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None) -> str:
+def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None,
+         previous: dict | None = None, previous_label: str = "previous model", ablation_label: str = "") -> str:
     with open(os.path.join(model, "neural_noise.json"), encoding="utf-8") as fh:
         meta = json.load(fh)
     log = [json.loads(line) for line in open(os.path.join(run, "log.jsonl"), encoding="utf-8")]
@@ -93,9 +94,20 @@ def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: s
         f"- **DDIM step at {t['size']}²:** onnxruntime {t['onnxruntime_s']} s, torch {t['torch_s']} s with the same "
         f"weights (torch / onnxruntime = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e}).",
     ]
+    if previous is not None:
+        lines += ["", "## Against the model it replaced", "",
+                  f"The same evaluation of the {previous_label}:", "",
+                  "| measure | previous | this model |", "|---|---|---|"]
+        for key, label in (("fd", "mean FD ↓"), ("acc", "mean classifier accuracy ↑"), ("psd", "mean PSD error ↓"),
+                           ("response", "mean response error ↓")):
+            lines.append(f"| {label} | {mean(key, previous)} | {mean(key, ev)} |")
+        lines += [f"| seam ratio, tileable ↓ | {previous['seam_tileable']} | {ev['seam_tileable']} |",
+                  f"| blend locality ↑ | {previous['locality']} | {ev['locality']} |",
+                  f"| zoo classifier accuracy (the instrument) | {previous['zoo_accuracy']} | {ev['zoo_accuracy']} |"]
     if ablation is not None:
         lines += ["", "## CutMix ablation (Fig. 13)", "",
-                  "The same config and steps with `cutmix_p = 0` (`configs/neural_noise_cpu_nocutmix.json`):", "",
+                  f"The same config and steps with `cutmix_p = 0` (`configs/neural_noise_cpu_nocutmix.json`)"
+                  f"{ablation_label}:", "",
                   "| model | blend locality ↑ | mean FD ↓ | mean accuracy ↑ |", "|---|---|---|---|",
                   f"| with CutMix | {ev['locality']} | {mean('fd', ev)} | {mean('acc', ev)} |",
                   f"| without CutMix | {ablation['locality']} | {mean('fd', ablation)} | {mean('acc', ablation)} |"]
@@ -114,6 +126,9 @@ def main(argv=None) -> int:
     ap.add_argument("--ablation-eval")
     ap.add_argument("--train-command", required=True)
     ap.add_argument("--hardware")
+    ap.add_argument("--previous-eval", help="evaluation JSON of the model this one replaces")
+    ap.add_argument("--previous-label", default="previous model")
+    ap.add_argument("--ablation-label", default="", help="text after the ablation's heading sentence")
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
     with open(a.eval, encoding="utf-8") as fh:
@@ -122,7 +137,11 @@ def main(argv=None) -> int:
     if a.ablation_eval:
         with open(a.ablation_eval, encoding="utf-8") as fh:
             abl = json.load(fh)
-    text = card(a.run, a.model, ev, abl, a.train_command, a.hardware)
+    prev = None
+    if a.previous_eval:
+        with open(a.previous_eval, encoding="utf-8") as fh:
+            prev = json.load(fh)
+    text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label)
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
         fh.write(text)
     os.replace(a.out + ".tmp", a.out)

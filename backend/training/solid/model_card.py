@@ -25,7 +25,47 @@ def _final_loss(log: str, window: int = 4) -> float:
     return round(sum(r["loss"] for r in rows[-window:]) / len(rows[-window:]), 4)
 
 
-def card(models: str, runs: str, eval_path: str | None) -> str:
+def _config_files(cfg: dict, configs: str) -> list:
+    """The config files a model was trained with, in order: its init_from chain, then its own."""
+    by_name = {}
+    if os.path.isdir(configs):
+        for fn in sorted(os.listdir(configs)):
+            if fn.endswith(".json"):
+                with open(os.path.join(configs, fn), encoding="utf-8") as fh:
+                    by_name.setdefault(json.load(fh).get("name"), fn)
+    chain, cur = [], cfg
+    while cur is not None and len(chain) < 8:
+        chain.insert(0, by_name.get(cur.get("name"), f"{cur.get('name')}.json"))
+        parent = os.path.basename(cur.get("init_from", "").rstrip("/"))
+        cur = None
+        if parent and parent in by_name:
+            with open(os.path.join(configs, by_name[parent]), encoding="utf-8") as fh:
+                cur = json.load(fh)
+    return chain
+
+
+def _compare(prev: dict, new: dict, replaced: list) -> list:
+    """Previous against new evaluation rows of the methods the replaced models feed."""
+    L = ["## Against the models they replaced", "",
+         "Each cell is style error / PSD error / success, previous → new (same evaluation, same seeds). "
+         "A retrained model replaces the shipped one only when its style error is lower and its PSD error "
+         "no more than 0.02 higher.", "",
+         "| exemplar | method | previous | new |", "|---|---|---|---|"]
+    methods = {"ours_3d"} if any(m != "space" for m in replaced) else set()
+    if "space" in replaced:
+        methods.add("space_3d")
+    for name, rows in new.items():
+        for meth in sorted(methods & set(rows)):
+            a, b = prev.get(name, {}).get(meth), rows[meth]
+            if a is None:
+                continue
+            fmt = lambda r: f"{r['style']} / {r['psd']} / {r['success']}"  # noqa: E731
+            L.append(f"| {name} | {meth} | {fmt(a)} | {fmt(b)} |")
+    return L + [""]
+
+
+def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/solid",
+         previous_eval: str | None = None) -> str:
     docs = {}
     for name in sorted(os.listdir(models)):
         path = os.path.join(models, name, "solid.json")
@@ -64,17 +104,33 @@ def card(models: str, runs: str, eval_path: str | None) -> str:
          "- **gravel_3d** was trained before the decoder's He initialisation became the default; its config "
          "names `decoder_init = \"torch\"`, which reproduces it. Every other model uses He initialisation.", "",
          "## Models", "",
-         "| model | mode | dim | exemplars | scale | steps | wall time | final loss | sha256 (decoder.onnx) |",
-         "|---|---|---|---|---|---|---|---|---|"]
+         "| model | mode | dim | exemplars | scale | configs | steps | wall time | final loss | sha256 (decoder.onnx) |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
+    continued = []
     for name, d in docs.items():
-        log = os.path.join(runs, name if d["mode"] == "single" else d["name"], "log.jsonl")
+        log = os.path.join(runs, d["name"], "log.jsonl")
         wall = f"{wall_seconds(log) / 60:.1f} min" if os.path.isfile(log) else "n/a"
         loss = _final_loss(log) if os.path.isfile(log) else "n/a"
+        chain = _config_files(d.get("config", {"name": d["name"]}), configs)
+        if len(chain) > 1:
+            continued.append(name)
         L.append(f"| {name} | {d['mode']} | {d['dim']}D | {', '.join(d['exemplars'])} | {d['exemplar_scale']} | "
-                 f"{d['step']} | {wall} | {loss} | `{d['files']['decoder.onnx'][:16]}…` |")
+                 f"{' → '.join(f'`{c}`' for c in chain)} | {d['step']} | {wall} | {loss} | "
+                 f"`{d['files']['decoder.onnx'][:16]}…` |")
+    if continued:
+        L += ["", f"{', '.join(continued)}: trained by the first config, then continued by the second "
+              "(`init_from` names the first run; a longer `steps` restarts the cosine learning-rate decay at the "
+              "step where the first run ended), each with the `train` command above. Wall time and loss cover "
+              "both stages. This is the longest CPU training the session allowed (no GPU was lent): "
+              "`python -m backend.training.solid.train --config configs/solid/NAME_long.json "
+              "--out runs/solid/NAME_long` after the first run."]
     L += ["", "Full sha256 of every file: each model's `solid.json` (`files`); the runtime refuses a file whose "
           "hash differs. Configs: `configs/solid/<model>.json` (the space model: `space_3d.json`).", ""]
     q = ev.get("quality")
+    if q and previous_eval and os.path.isfile(previous_eval) and continued:
+        with open(previous_eval, encoding="utf-8") as fh:
+            prev = json.load(fh).get("quality", {})
+        L += _compare(prev, q, [docs[n]["mode"] if docs[n]["mode"] == "space" else n for n in continued])
     if q:
         L += ["## Evaluation (`bench/eval_solid.py`)", "",
               f"{ev.get('n', 8)} samples (seeds) per method at 64² px of the training resolution, compared with the exemplar's "
@@ -118,9 +174,11 @@ def main(argv=None) -> int:
     ap.add_argument("--models", default="models/solid")
     ap.add_argument("--runs", default="runs/solid")
     ap.add_argument("--eval", default="out/bench/solid_eval.json")
+    ap.add_argument("--configs", default="configs/solid")
+    ap.add_argument("--previous-eval", help="evaluation JSON of the models that retrained ones replaced")
     ap.add_argument("-o", "--out", default="models/solid/MODEL_CARD.md")
     a = ap.parse_args(argv)
-    text = card(a.models, a.runs, a.eval)
+    text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval)
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
         fh.write(text)
     os.replace(a.out + ".tmp", a.out)

@@ -23,6 +23,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import sys
 import time
 from dataclasses import asdict, dataclass
@@ -67,6 +68,7 @@ class SolidConfig:
     checkpoint_every: int = 250
     threads: int = 0                # torch CPU threads (0: torch's default)
     device: str = "cpu"
+    init_from: str = ""             # a run folder to continue (its ckpt.pt and log.jsonl seed a new run)
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -87,6 +89,18 @@ class SolidConfig:
 def load_config(path: str) -> SolidConfig:
     with open(path, encoding="utf-8") as fh:
         return SolidConfig.from_dict(json.load(fh))
+
+
+def _seed_run(src: str, out: str) -> None:
+    """Copy a finished run's checkpoint and log into ``out``: training resumes from its last step
+    with this config's schedule (a longer ``steps`` restarts the cosine decay from that step)."""
+    ckpt = os.path.join(src, "ckpt.pt")
+    if not os.path.isfile(ckpt):
+        raise ValueError(f"init_from: no checkpoint {ckpt}")
+    for name in ("ckpt.pt", "log.jsonl"):
+        if os.path.isfile(os.path.join(src, name)):
+            shutil.copyfile(os.path.join(src, name), os.path.join(out, name + ".tmp"))
+            os.replace(os.path.join(out, name + ".tmp"), os.path.join(out, name))
 
 
 def build_model(cfg: SolidConfig) -> SolidTexture:
@@ -138,6 +152,9 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
     ckpt_path = os.path.join(out, "ckpt.pt")
+    if cfg.init_from and not os.path.isfile(ckpt_path):
+        _seed_run(cfg.init_from, out)
+        log(f"continuing {cfg.init_from}")
     if os.path.isfile(ckpt_path):
         state = torch.load(ckpt_path, map_location="cpu", weights_only=False)
         model.load_state_dict(state["model"])
