@@ -210,6 +210,8 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     worse = dict(ev, classes={"spots": dict(fd=3.0, acc=0.25, psd=0.4, response=0.2, param="scale")}, locality=0.5)
     text = card(str(run), str(out), ev, None, "train", "test CPU", previous=worse, previous_label="3000-step model")
     assert "3000-step model" in text and "| mean FD ↓ | 3.0 | 1.5 |" in text and "| blend locality ↑ | 0.5 | 0.75 |" in text
+    text = card(str(run), str(out), ev, dict(ev, locality=0.25), "train", "test CPU", ablation_reference=worse)
+    assert "| with CutMix | 0.5 | 3.0 | 0.25 |" in text and "| without CutMix | 0.25 |" in text
 
 
 def test_neural_bake_source_in_jobs(exported, tmp_path):
