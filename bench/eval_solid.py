@@ -157,7 +157,7 @@ def main() -> int:
     ap.add_argument("--speed", action="store_true", help="also time onnxruntime against torch")
     ap.add_argument("--only-speed", action="store_true")
     ap.add_argument("--model", default="rust_3d", help="model timed by --speed")
-    ap.add_argument("--run", default=os.path.join(ROOT, "runs", "solid", "rust_3d"),
+    ap.add_argument("--run", default=os.path.join(ROOT, "runs", "solid", "rust_3d_long"),
                     help="its training run (torch loads the same weights from ckpt.pt)")
     ap.add_argument("--speed-one", choices=("onnxruntime", "torch"), help=argparse.SUPPRESS)
     ap.add_argument("--dim", type=int, default=3, help=argparse.SUPPRESS)

@@ -126,6 +126,13 @@ def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_
     export(str(tmp_path / "runs" / "c_long"), str(tmp_path / "models" / "c"))
     text = card(str(tmp_path / "models"), str(tmp_path / "runs"), None, str(cfgs))
     assert "| c | single | 2D | gravel | 1.0 | `c.json` → `c_long.json` | 7 |" in text, text
+    # a continued run that lost to the shipped model is listed beside it, marked as not shipped
+    row = lambda v: {"gravel": {"ours_3d": dict(style=v, psd=0.1, diversity=1.0, success=0.5)}}  # noqa: E731
+    for name, v in (("prev", 0.4), ("cand", 0.6), ("now", 0.4)):
+        (tmp_path / f"{name}.json").write_text(json.dumps({"quality": row(v)}))
+    text = card(str(tmp_path / "models"), str(tmp_path / "runs"), str(tmp_path / "now.json"), str(cfgs),
+                str(tmp_path / "prev.json"), {"c": str(tmp_path / "cand.json")})
+    assert ("| gravel | ours_3d: c continued, **not shipped** | 0.4 / 0.1 / 0.5 | 0.6 / 0.1 / 0.5 |" in text), text
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -46,28 +46,38 @@ def _config_files(cfg: dict, configs: str) -> list:
     return chain
 
 
-def _compare(prev: dict, new: dict, replaced: list) -> list:
-    """Previous against new evaluation rows of the methods the replaced models feed."""
+def _compare(prev: dict, new: dict, replaced: list, rejected: dict | None = None) -> list:
+    """Previous against new evaluation rows of the methods the replaced models feed (replaced:
+    "space" or the exemplar of a 3D single model); ``rejected``:
+    {model name: (exemplar, evaluation rows of the candidate that did not replace it)}."""
     L = ["## Against the models they replaced", "",
          "Each cell is style error / PSD error / success, previous → new (same evaluation, same seeds). "
          "A retrained model replaces the shipped one only when its style error is lower and its PSD error "
          "no more than 0.02 higher (the space model: their means over its seven exemplars).", "",
          "| exemplar | method | previous | new |", "|---|---|---|---|"]
-    methods = {"ours_3d"} if any(m != "space" for m in replaced) else set()
-    if "space" in replaced:
-        methods.add("space_3d")
+    pairs = {("*", "space_3d")} if "space" in replaced else set()
+    pairs |= {(exemplar, "ours_3d") for exemplar in replaced if exemplar != "space"}
     for name, rows in new.items():
-        for meth in sorted(methods & set(rows)):
+        for meth in sorted(rows):
             a, b = prev.get(name, {}).get(meth), rows[meth]
-            if a is None:
+            if a is None or not ({(name, meth), ("*", meth)} & pairs):
                 continue
-            fmt = lambda r: f"{r['style']} / {r['psd']} / {r['success']}"  # noqa: E731
-            L.append(f"| {name} | {meth} | {fmt(a)} | {fmt(b)} |")
+            L.append(f"| {name} | {meth} | {_cell(a)} | {_cell(b)} |")
+    for model, (name, rows) in sorted((rejected or {}).items()):
+        meth = "space_3d" if model == "space" else "ours_3d"
+        if meth in rows and meth in prev.get(name, {}):
+            L.append(f"| {name} | {meth}: {model} continued, **not shipped** | {_cell(prev[name][meth])} | "
+                     f"{_cell(rows[meth])} |")
     return L + [""]
 
 
+def _cell(r: dict) -> str:
+    return f"{r['style']} / {r['psd']} / {r['success']}"
+
+
 def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/solid",
-         previous_eval: str | None = None) -> str:
+         previous_eval: str | None = None, rejected: dict | None = None) -> str:
+    """``rejected``: {model name: path of the evaluation JSON of its continued run}, shown, not shipped."""
     docs = {}
     for name in sorted(os.listdir(models)):
         path = os.path.join(models, name, "solid.json")
@@ -133,7 +143,13 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
     if q and previous_eval and os.path.isfile(previous_eval) and continued:
         with open(previous_eval, encoding="utf-8") as fh:
             prev = json.load(fh).get("quality", {})
-        L += _compare(prev, q, [docs[n]["mode"] if docs[n]["mode"] == "space" else n for n in continued])
+        rej = {}
+        for model, path in (rejected or {}).items():
+            exemplar = docs[model]["exemplars"][0] if model in docs else model.split("_")[0]
+            with open(path, encoding="utf-8") as fh:
+                rej[model] = (exemplar, json.load(fh)["quality"].get(exemplar, {}))
+        L += _compare(prev, q, ["space" if docs[n]["mode"] == "space" else docs[n]["exemplars"][0]
+                                for n in continued if docs[n]["mode"] == "space" or docs[n]["dim"] == 3], rej)
     if q:
         L += ["## Evaluation (`bench/eval_solid.py`)", "",
               f"{ev.get('n', 8)} samples (seeds) per method at 64² px of the training resolution, compared with the exemplar's "
@@ -179,9 +195,12 @@ def main(argv=None) -> int:
     ap.add_argument("--eval", default="out/bench/solid_eval.json")
     ap.add_argument("--configs", default="configs/solid")
     ap.add_argument("--previous-eval", help="evaluation JSON of the models that retrained ones replaced")
+    ap.add_argument("--rejected", nargs="*", default=[], metavar="MODEL=EVAL_JSON",
+                    help="continued runs that did not beat the shipped model, with their evaluation")
     ap.add_argument("-o", "--out", default="models/solid/MODEL_CARD.md")
     a = ap.parse_args(argv)
-    text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval)
+    rejected = dict(r.split("=", 1) for r in a.rejected)
+    text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected)
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
         fh.write(text)
     os.replace(a.out + ".tmp", a.out)
