@@ -9,6 +9,7 @@ same weights; writes everything to out/bench/neural_eval.json.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 
@@ -28,11 +29,21 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=30, help="DDIM steps")
     ap.add_argument("--clf-steps", type=int, default=600)
     ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
+    ap.add_argument("--timing-only", action="store_true",
+                    help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
     a = ap.parse_args()
     model = NeuralNoiseModel(a.model)
     classes = tuple(model.config["trained_classes"])
-    res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr))
+    if a.timing_only:
+        with open(a.out, encoding="utf-8") as fh:
+            res = json.load(fh)
+        if res.get("model", {}).get("sha256") != model.config["files"]["eps.onnx"]:
+            print(f"eval_neural: error: {a.out} evaluates another model than {a.model}", file=sys.stderr)
+            return 2
+        a.n, a.steps = res["model"]["n"], res["model"]["steps"]
+    else:
+        res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr))
     res["timing"] = step_seconds(a.model, a.run, a.size)
     res["model"] = dict(step=model.config["step"], sha256=model.config["files"]["eps.onnx"], n=a.n, steps=a.steps)
     print("| class | FD | acc | PSD err | response err (param) |")
