@@ -48,6 +48,7 @@ def white_color4(x, y, z, w, channel: int) -> np.ndarray:
     args = (x, y, z, w)
     return white_noise4(*(args[i] for i in COLOR_PERMUTATIONS[channel]))
 
+
 def border_fraction(zeta: np.ndarray) -> np.ndarray:
     """fract(16 zeta), float32: the slice border's random fraction (exact in float32, as in the node)."""
     t = np.asarray(zeta, _F) * _F(16.0)

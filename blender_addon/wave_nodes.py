@@ -281,14 +281,13 @@ def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, m
     lo3 = (0.0,) + tuple(box_lo[:2])
     size3 = (1.0,) + tuple(box_size[:2])
     waves = []
-    u = None
-    for n in (n0, n1):
+    for side, n in enumerate((n0, n1)):
         # (zeta, u0, u1) = (r, lo0 + size0 g, lo1 + size1 b) of node A
         zu = b.vmath("MULTIPLY_ADD", b.white(k, n, STREAM["slice_a"], seed), size3, c=lo3)
         # a Separate XYZ with an unlinked output would hold that float on the SVM stack for good
         zu = b.separate(zu) if dim > 2 else [b.channel(zu, 0), b.channel(zu, 1)]
-        zeta, uu = zu[0], list(zu[1:dim] if dim < 4 else zu[1:3])
-        if u is None:  # border ramp of slice n0: slpos = SLPOS_MIN + SLPOS_RANGE fract(16 zeta_0)
+        zeta, uu = zu[0], list(zu[1:min(dim, 3)])
+        if side == 0:  # border ramp of slice n0: slpos = SLPOS_MIN + SLPOS_RANGE fract(16 zeta_0)
             frac = b.math("FRACT", b.math("MULTIPLY", zeta, 16.0))
             slpos = b.math("MULTIPLY_ADD", frac, backend.wave.SLPOS_RANGE, backend.wave.SLPOS_MIN)
             u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wave.BLEND_HALF_WIDTH, 0.5)

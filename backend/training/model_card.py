@@ -30,6 +30,14 @@ def wall_seconds(log_path: str) -> float:
     return total + last
 
 
+def read_json(path: str | None):
+    """The JSON document at ``path``, or None when no path is given."""
+    if not path:
+        return None
+    with open(path, encoding="utf-8") as fh:
+        return json.load(fh)
+
+
 def _hardware() -> str:
     cpu = platform.processor() or platform.machine()
     try:
@@ -136,20 +144,7 @@ def main(argv=None) -> int:
     ap.add_argument("--ablation-reference", help="evaluation JSON of the CutMix model with the ablation's steps")
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
-    with open(a.eval, encoding="utf-8") as fh:
-        ev = json.load(fh)
-    abl = None
-    if a.ablation_eval:
-        with open(a.ablation_eval, encoding="utf-8") as fh:
-            abl = json.load(fh)
-    prev = None
-    if a.previous_eval:
-        with open(a.previous_eval, encoding="utf-8") as fh:
-            prev = json.load(fh)
-    ref = None
-    if a.ablation_reference:
-        with open(a.ablation_reference, encoding="utf-8") as fh:
-            ref = json.load(fh)
+    ev, abl, prev, ref = (read_json(p) for p in (a.eval, a.ablation_eval, a.previous_eval, a.ablation_reference))
     text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label, ref)
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
         fh.write(text)

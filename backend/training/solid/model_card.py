@@ -14,7 +14,7 @@ import json
 import os
 import sys
 
-from ..model_card import _hardware, wall_seconds
+from ..model_card import _hardware, read_json, wall_seconds
 
 __all__ = ["card"]
 
@@ -27,22 +27,24 @@ def _final_loss(log: str, window: int = 10) -> float:
     return round(rows[mid] if len(rows) % 2 else 0.5 * (rows[mid - 1] + rows[mid]), 4)
 
 
-def _config_files(cfg: dict, configs: str) -> list:
-    """The config files a model was trained with, in order: its init_from chain, then its own."""
-    by_name = {}
+def _config_index(configs: str) -> dict:
+    """{config name: (file name, config)} of the JSON configs in folder ``configs``."""
+    index = {}
     if os.path.isdir(configs):
         for fn in sorted(os.listdir(configs)):
             if fn.endswith(".json"):
-                with open(os.path.join(configs, fn), encoding="utf-8") as fh:
-                    by_name.setdefault(json.load(fh).get("name"), fn)
+                cfg = read_json(os.path.join(configs, fn))
+                index.setdefault(cfg.get("name"), (fn, cfg))
+    return index
+
+
+def _config_files(cfg: dict, index: dict) -> list:
+    """The config files a model was trained with, in order: its init_from chain, then its own."""
     chain, cur = [], cfg
     while cur is not None and len(chain) < 8:
-        chain.insert(0, by_name.get(cur.get("name"), f"{cur.get('name')}.json"))
+        chain.insert(0, index.get(cur.get("name"), (f"{cur.get('name')}.json", None))[0])
         parent = os.path.basename(cur.get("init_from", "").rstrip("/"))
-        cur = None
-        if parent and parent in by_name:
-            with open(os.path.join(configs, by_name[parent]), encoding="utf-8") as fh:
-                cur = json.load(fh)
+        cur = index[parent][1] if parent in index else None
     return chain
 
 
@@ -119,12 +121,12 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "Final loss: the median of the last ten logged batch losses.", "",
          "| model | mode | dim | exemplars | scale | configs | steps | wall time | final loss | sha256 (decoder.onnx) |",
          "|---|---|---|---|---|---|---|---|---|---|"]
-    continued = []
+    continued, index = [], _config_index(configs)
     for name, d in docs.items():
         log = os.path.join(runs, d["name"], "log.jsonl")
         wall = f"{wall_seconds(log) / 60:.1f} min" if os.path.isfile(log) else "n/a"
         loss = _final_loss(log) if os.path.isfile(log) else "n/a"
-        chain = _config_files(d.get("config", {"name": d["name"]}), configs)
+        chain = _config_files(d.get("config", {"name": d["name"]}), index)
         if len(chain) > 1:
             continued.append(name)
         L.append(f"| {name} | {d['mode']} | {d['dim']}D | {', '.join(d['exemplars'])} | {d['exemplar_scale']} | "
@@ -141,13 +143,13 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "hash differs. Configs: `configs/solid/<model>.json` (the space model: `space_3d.json`).", ""]
     q = ev.get("quality")
     if q and previous_eval and os.path.isfile(previous_eval) and continued:
-        with open(previous_eval, encoding="utf-8") as fh:
-            prev = json.load(fh).get("quality", {})
+        prev = read_json(previous_eval).get("quality", {})
         rej = {}
         for model, path in (rejected or {}).items():
-            exemplar = docs[model]["exemplars"][0] if model in docs else model.split("_")[0]
-            with open(path, encoding="utf-8") as fh:
-                rej[model] = (exemplar, json.load(fh)["quality"].get(exemplar, {}))
+            if model not in docs:
+                raise ValueError(f"--rejected: {model!r} is not a shipped model in {models}")
+            exemplar = docs[model]["exemplars"][0]
+            rej[model] = (exemplar, read_json(path)["quality"].get(exemplar, {}))
         L += _compare(prev, q, ["space" if docs[n]["mode"] == "space" else docs[n]["exemplars"][0]
                                 for n in continued if docs[n]["mode"] == "space" or docs[n]["dim"] == 3], rej)
     if q:
@@ -166,8 +168,8 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
     sp = ev.get("speed")
     if sp:
         L += ["## Speed and memory (Table 2)", "", "Every point evaluated, in a fresh process each "
-              "(peak resident memory includes the interpreter and libraries; measured on rust_3d's 1500-step "
-              "weights: speed depends on the architecture, not the weights):", "",
+              "(peak resident memory includes the interpreter and libraries; measured on one single-exemplar "
+              "model: speed depends on the architecture, not the weights):", "",
               "| grid | engine | points/s | seconds | peak MiB |", "|---|---|---|---|---|"]
         for r in sp:
             L.append(f"| {'×'.join([str(r['size'])] * r['dim'])} | {r['engine']} | {r['points_per_s']:,} | "

@@ -30,6 +30,7 @@ from dataclasses import asdict, dataclass
 
 import torch
 
+from ..._export import export as _ex
 from ..train import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, style_loss
@@ -99,8 +100,8 @@ def _seed_run(src: str, out: str) -> None:
         raise ValueError(f"init_from: no checkpoint {ckpt}")
     for name in ("ckpt.pt", "log.jsonl"):
         if os.path.isfile(os.path.join(src, name)):
-            shutil.copyfile(os.path.join(src, name), os.path.join(out, name + ".tmp"))
-            os.replace(os.path.join(out, name + ".tmp"), os.path.join(out, name))
+            with _ex.atomic_path(os.path.join(out, name)) as tmp:
+                shutil.copyfile(os.path.join(src, name), tmp)
 
 
 def build_model(cfg: SolidConfig) -> SolidTexture:
