@@ -9,9 +9,16 @@ Eq. 6 and 9, Algorithm 1), node for node:
 * the jittered direction by the same equal-measure map as
   :func:`backend.directions.map_directions` (2D angle; 3D arccos; 4D with five
   Newton steps for psi), Householder-rotated onto the lobe axis;
-* the wave (x . omega - v t) / L + zeta read from the complex table, stored as a
-  float image (R = real, G = imaginary) packed into the .blend and sampled with
-  linear interpolation and Repeat extension (texel centres at (i + 1/2) / N);
+* the wave (x . omega - v t) / L + zeta read from the complex table with the
+  engine's linear interpolation (texel centres at (i + 1/2) / N), done in nodes:
+  two float images packed into the .blend, T (R = real, G = imaginary) and its
+  forward difference dT[i] = T[i+1] - T[i], are read at texel j0's centre with
+  Closest interpolation and Repeat extension, and T + t dT is one vector
+  multiply-add.  A Linear Image Texture would not do: EEVEE samples it with
+  mipmaps and anisotropic filtering, and the table coordinate jumps at every
+  slice border and table wrap, where the screen-space derivative then picks a
+  blurred mip level (measured: correlation 0.81 with the engine at 48 px);
+  Closest is unfiltered on every engine;
 * border weights cos / sin(pi/2 smoothstep(u)), amplitude sqrt(1/K).
 
 Every per-stratum quantity the backend precomputes (s_k, o_k, stratum box,
@@ -59,15 +66,20 @@ def settings_from_json(text: str):
 
 # -- the table as a packed float image ---------------------------------------------
 
-def ensure_table_image(values: np.ndarray) -> bpy.types.Image:
-    """A packed float image holding a complex table: complex64 (rows, N) -> N x rows, R = re, G = im.
+def ensure_table_image(values: np.ndarray, slope: bool = False) -> bpy.types.Image:
+    """A packed float image of a complex table: complex64 (rows, N) -> N x rows image.
 
-    Images are shared by content (the name carries a hash of the values), so
-    identical tables are stored once per .blend.
+    slope False: R = re T, G = im T.  slope True: R, G = re, im of the forward
+    difference dT[i] = T[(i + 1) mod N] - T[i] (float32, as the engine's lerp
+    computes it).  Images are shared by content (the name carries a hash of the
+    values), so identical tables are stored once per .blend.
     """
     values = np.ascontiguousarray(values, np.complex64)
     rows, size = values.shape
-    name = "OmniNoise table " + hashlib.sha256(values.tobytes()).hexdigest()[:12]
+    if slope:
+        values = (np.roll(values, -1, axis=1) - values).astype(np.complex64)
+    kind = "slope" if slope else "table"
+    name = f"OmniNoise {kind} " + hashlib.sha256(values.tobytes()).hexdigest()[:12]
     img = bpy.data.images.get(name)
     if img is not None and tuple(img.size) == (size, rows):
         return img
@@ -160,14 +172,26 @@ class _Nodes:
         return self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c]))
 
     def image(self, img: bpy.types.Image, vector):
-        """Linear, repeating image lookup -> colour socket (r, g, b) read as a vector."""
+        """Unfiltered (Closest), repeating image lookup -> colour socket (r, g, b) read as a vector."""
         if self.geo:
-            node = self.new("GeometryNodeImageTexture", interpolation="Linear", extension="REPEAT")
+            node = self.new("GeometryNodeImageTexture", interpolation="Closest", extension="REPEAT")
             node.inputs["Image"].default_value = img
         else:
-            node = self.new("ShaderNodeTexImage", interpolation="Linear", extension="REPEAT", image=img)
+            node = self.new("ShaderNodeTexImage", interpolation="Closest", extension="REPEAT", image=img)
         self.put(node.inputs["Vector"], vector)
         return node.outputs["Color"]
+
+    def texel(self, coord, size: int):
+        """Texel j0 = floor(coord N) of an N-texel row, for a coordinate already shifted by -1/(2N):
+        -> (fraction t, centre (j0 + 1/2) / N).  Reading at the centre keeps a GPU's fixed-point
+        nearest-texel rounding away from texel edges."""
+        v = self.math("MULTIPLY", coord, float(size))
+        j0 = self.math("FLOOR", v)
+        return self.math("SUBTRACT", v, j0), self.math("MULTIPLY_ADD", j0, float(_F(1.0 / size)), float(_F(0.5 / size)))
+
+    def lerp(self, imgs: tuple, t, where):
+        """Linear interpolation T + t dT from the (table, slope) images read at ``where`` -> vector (re, im, 0)."""
+        return self.vmath("MULTIPLY_ADD", self.image(imgs[1], where), t, c=self.image(imgs[0], where))
 
 
 def _new_group(name: str, tree_type: str, inputs, outputs) -> bpy.types.NodeTree:
@@ -239,7 +263,7 @@ def _direction(b: _Nodes, u, dim: int, full: bool, g) -> tuple:
     return vec, w
 
 
-def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.types.Image, rows: int,
+def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: tuple, rows: int,
                    mode: str, consts: dict) -> bpy.types.NodeTree:
     """Sub-group for one stratum: Sum + amp (w0 T0 + w1 T1) as a vector (re, im, 0).
 
@@ -254,13 +278,16 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.typ
     b = _Nodes(tree)
     gi = b.new("NodeGroupInput")
     go = b.new("NodeGroupOutput")
-    b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, img, rows,
+    b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, imgs, rows,
                                            mode, consts))
     return tree
 
 
-def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, mode: str, consts: dict):
+def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, imgs: tuple, rows: int, mode: str, consts: dict):
     """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket.
+
+    imgs: the (table, slope) images of :func:`ensure_table_image`; Shift carries
+    v t + L / (2 N), so the coordinate below is already half a texel early.
 
     Per slice one White Noise node gives (zeta, jitter 0, jitter 1) (backend.wave
     slice_records); one vector multiply-add maps them into the stratum's box.
@@ -299,16 +326,17 @@ def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, img, rows: int, m
         if om_w is not None:
             dot = b.math("ADD", dot, b.math("MULTIPLY", g["W"], om_w))
         coord = b.math("MULTIPLY_ADD", b.math("SUBTRACT", dot, g["Shift"]), g["Inv Period"], zeta)
+        t, centre = b.texel(coord, g["Table Size"])
         if mode == "single":  # a one-row image: a float Vector (c, c, c) reads T(c)
-            waves.append(b.image(img, coord))
+            waves.append(b.lerp(imgs, t, centre))
         else:  # per-axis tables, interpolated by omega_a^2 (Fig. 5 left)
             comps = b.separate(omega)
             acc = None
             for a in range(rows):
                 wa = om_w if a == 3 else comps[a]
-                t = b.vmath("SCALE", b.image(img, b.combine(coord, (a + 0.5) / rows, 0.0)),
-                            scale=b.math("MULTIPLY", wa, wa))
-                acc = t if acc is None else b.vmath("ADD", acc, t)
+                ta = b.vmath("SCALE", b.lerp(imgs, t, b.combine(centre, (a + 0.5) / rows, 0.0)),
+                             scale=b.math("MULTIPLY", wa, wa))
+                acc = ta if acc is None else b.vmath("ADD", acc, ta)
             waves.append(acc)
     # s = smoothstep(u) pi/2; Map Range clamps u to [0, 1]
     mr = b.new("ShaderNodeMapRange", data_type="FLOAT", interpolation_type="SMOOTHSTEP", clamp=False)
@@ -350,6 +378,7 @@ def _stratum_constants(noise, k: int) -> dict:
         "Spread": float(s), "Cap": float(cap),
         "Mirror": pad(v), "Mirror W": float(v[3]) if dim == 4 else 0.0, "Mirror Scale": scale,
         "Inv Period": float(_F(1.0 / noise.table.period)), "Amplitude": float(dirs.amp[k]),
+        "Table Size": int(noise.table.size),
     }
 
 
@@ -418,12 +447,14 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     else:
         _clear(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
-    img = ensure_table_image(table.values)
+    imgs = (ensure_table_image(table.values), ensure_table_image(table.values, slope=True))
     dim = noise.dim
     full = any(d.full for d in noise.dirs.domains)
     b = _Nodes(tree)
     gi, go, x, w = _group_io(b)
-    shift = b.math("MULTIPLY", gi.outputs["Time"], float(_F(noise.speed)))
+    # v t (Eq. 9) plus half a texel in world units: the lookup reads texel floor(c N - 1/2)
+    shift = b.math("MULTIPLY_ADD", gi.outputs["Time"], float(_F(noise.speed)),
+                   float(_F(0.5 * noise.table.period / table.size)))
     group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
     acc = (0.0, 0.0, 0.0)
     amps = noise.dirs.amp
@@ -433,7 +464,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
         if uniform:
             consts["Amplitude"] = None
         node = b.new(group_kind)
-        node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
+        node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, imgs,
                                         table.values.shape[0], table.mode, consts)
         node.label = f"Direction {k + 1}"
         b.put(node.inputs["Sum"], acc)
