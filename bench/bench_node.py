@@ -4,7 +4,9 @@ Headless Cycles (CPU), orthographic camera on a plane filling the frame,
 emission shader, R x R pixels, S samples; each shader is rendered once to
 compile, then timed over ``--repeat`` renders (the minimum is kept).  Prints ns
 per pixel-sample and ratios against Blender's Gabor Texture (the issue's target),
-the node count of each built tree, and writes out/bench/node.json.
+the node count of each built tree, and writes out/bench/node.json.  Two "floor"
+rows time the cheapest trees any table-lookup wave node could be at 16
+directions (see :func:`lookup_floor`): what Alg. 1 costs in SVM at the least.
 
     python bench/bench_node.py [--res 256] [--samples 4] [--repeat 2]
 """
@@ -20,6 +22,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
+import numpy as np  # noqa: E402
 
 from backend import Spectrum, WaveSettings  # noqa: E402
 from blender_addon.wave_nodes import build_wave_group  # noqa: E402
@@ -85,6 +88,66 @@ def wave(k):
     return make
 
 
+def lookup_floor(k: int, sliced: bool):
+    """The cheapest table-lookup trees a wave node could be, for the floor of Alg. 1 in SVM.
+
+    Per direction: dot(x, omega) -> multiply-add -> one unfiltered image lookup -> add
+    (no slicing: 4 nodes).  ``sliced`` adds what any slicing needs at the least: one
+    White Noise hash of the slice and a second lookup (+3 nodes), still without
+    direction jitter, border position or blend weights.
+    """
+    def make(nt):
+        rng = np.random.default_rng(1)
+        img = bpy.data.images.new("floor table", 1024, 1, float_buffer=True, alpha=True)
+        img.pixels.foreach_set(rng.random(4096).astype(np.float32))
+        img.colorspace_settings.name = "Non-Color"
+        entry = nt.nodes.new("NodeReroute")
+        acc, count = None, 0
+
+        def node(kind, **props):
+            n = nt.nodes.new(kind)
+            for key, v in props.items():
+                setattr(n, key, v)
+            return n
+
+        def lookup(coord):
+            t = node("ShaderNodeTexImage", image=img, interpolation="Closest")
+            nt.links.new(coord, t.inputs["Vector"])
+            return t.outputs["Color"]
+
+        for _ in range(k):
+            d = rng.normal(size=3)
+            dot = node("ShaderNodeVectorMath", operation="DOT_PRODUCT")
+            dot.inputs[1].default_value = tuple(d / np.linalg.norm(d))
+            nt.links.new(entry.outputs[0], dot.inputs[0])
+            ma = node("ShaderNodeMath", operation="MULTIPLY_ADD")
+            ma.inputs[1].default_value, ma.inputs[2].default_value = 0.3, float(rng.random())
+            nt.links.new(dot.outputs["Value"], ma.inputs[0])
+            val = lookup(ma.outputs[0])
+            count += 3
+            if sliced:
+                wn = node("ShaderNodeTexWhiteNoise", noise_dimensions="1D")
+                nt.links.new(dot.outputs["Value"], wn.inputs["W"])
+                c2 = node("ShaderNodeMath", operation="ADD")
+                nt.links.new(ma.outputs[0], c2.inputs[0])
+                nt.links.new(wn.outputs["Value"], c2.inputs[1])
+                both = node("ShaderNodeMath", operation="ADD")
+                nt.links.new(val, both.inputs[0])
+                nt.links.new(lookup(c2.outputs[0]), both.inputs[1])
+                val = both.outputs[0]
+                count += 4
+            if acc is None:
+                acc = val
+            else:
+                add = node("ShaderNodeMath", operation="ADD")
+                nt.links.new(acc, add.inputs[0])
+                nt.links.new(val, add.inputs[1])
+                acc = add.outputs[0]
+                count += 1
+        return (entry.inputs[0], acc), count
+    return make
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--res", type=int, default=256)
@@ -98,6 +161,8 @@ def main():
         "Wave Noise 8 dirs": wave(8),
         "Wave Noise 16 dirs": wave(16),
         "Wave Noise 32 dirs": wave(32),
+        "floor 16: lookup only": lookup_floor(16, False),
+        "floor 16: 2 lookups+hash": lookup_floor(16, True),
     }
     res = {}
     for name, make in cases.items():

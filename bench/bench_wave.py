@@ -4,6 +4,10 @@ ns per sample for 2D 1024^2 and 3D 128^3 / 256^3 grids at 8, 16, 32, 64
 directions, next to 5-octave fractal Perlin (pyfastnoisesimd, FastNoise Lite),
 opensimplex (5 octaves) and Blender's Noise (detail 5) and Gabor textures
 evaluated through bpy Geometry Nodes.  Prints ratios wave / fastest peer.
+The "wave 16 floor" rows (bench/lookup_floor.c, compiled with cc) are idealised
+hand-vectorised AVX2 rows, not an engine: "pure" does one table lerp per
+direction per sample and nothing else, a lower bound for any exact kernel;
+"blend" does the border ramp's two lerps and weights everywhere.
 Then streams a 512^3 grid and reports peak memory against the output's size.
 
 Run: make bench   (numbers: median of --repeat runs, wall clock, this machine)
@@ -14,6 +18,7 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -130,6 +135,23 @@ def wave_times(dim, n, repeat, dirs):
     return out
 
 
+def lookup_floor() -> dict:
+    """ns per sample of the idealised AVX2 rows of bench/lookup_floor.c at 16 directions, all cores.
+
+    Keys '<grid> pure|blend' (grid 2D_1024, 3D_128, 3D_256); {} without a C compiler.
+    """
+    cc = shutil.which(os.environ.get("CC", "cc"))
+    if cc is None:
+        return {}
+    exe = os.path.join(ROOT, "out", "bench", "lookup_floor")
+    os.makedirs(os.path.dirname(exe), exist_ok=True)
+    subprocess.run([cc, "-O3", "-pthread", os.path.join(ROOT, "bench", "lookup_floor.c"), "-o", exe, "-lm"],
+                   check=True)
+    r = subprocess.run([exe, str(os.cpu_count() or 1)], capture_output=True, text=True, check=True)
+    res = json.loads(r.stdout)
+    return {} if "error" in res else res
+
+
 def peak_memory_512() -> dict:
     code = (
         "import resource, numpy as np, sys; sys.path.insert(0, %r);"
@@ -161,6 +183,7 @@ def main():
     dirs = (8, 16) if a.quick else (8, 16, 32, 64)
     print(f"wave noise engine: {'numba' if fast.available() else 'numpy'} path, {os.cpu_count()} cores")
     results = {}
+    floor = {} if a.quick else lookup_floor()
     for dim, n in cases:
         samples = n ** dim
         rows = wave_times(dim, n, a.repeat, dirs)
@@ -168,6 +191,9 @@ def main():
         if n <= 128:
             rows.update(blender_peers(dim, n, a.repeat))
         ns = {k: v / samples * 1e9 for k, v in rows.items()}
+        for kind in ("pure", "blend"):  # already ns per sample
+            if f"{dim}D_{n} {kind}" in floor:
+                ns[f"wave 16 floor, {kind} (AVX2 C)"] = floor[f"{dim}D_{n} {kind}"]
         peer_ns = {k: v for k, v in ns.items() if not k.startswith("wave") and not k.startswith("harness")}
         fastest = min(peer_ns, key=peer_ns.get) if peer_ns else None
         print(f"\n{dim}D {n}^{dim} ({samples:,} samples)")
