@@ -29,6 +29,8 @@ from blender_addon.wave_nodes import build_wave_group  # noqa: E402
 
 
 def scene(res: int, samples: int):
+    """A Cycles scene: a 2 x 2 plane filling an orthographic camera's R x R frame, with an empty material
+    -> (scene, material).  Also the scene of the EEVEE test (tests/blender_scripts/eevee_wave.py)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"

@@ -24,9 +24,9 @@ import pytest
 OpenEXR = pytest.importorskip("OpenEXR")
 pytest.importorskip("bpy")
 
-from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
 from backend.settings import settings_to_dict  # noqa: E402
 from backend.wave import select_output  # noqa: E402
+from test_wave_node import CASES as NODE_CASES, SOCKETS, _engine  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "tests", "blender_scripts", "eevee_wave.py")
@@ -34,13 +34,8 @@ RES = 40
 ENC = 0.1  # as in the script
 REQUIRED = os.environ.get("OMNINOISE_REQUIRE_EEVEE") == "1"
 
-CASES = {
-    "2d": (WaveSettings(dim=2, spectrum=Spectrum("bandpass", 2, 6), directions=8, seed=3), {}),
-    "3d": (WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 6), directions=8, seed=3), {"Scale": 1.7}),
-    "4d": (WaveSettings(dim=4, spectrum=Spectrum("bandpass", 2, 6), directions=8, seed=3), {"W": 0.7}),
-    "3d+t": (WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2, 6), directions=8, seed=4, speed=0.8),
-             {"Time": 1.3}),
-}
+#: the cases of the Cycles bake test (tests/test_wave_node.py)
+CASES = {name: NODE_CASES[name] for name in ("2d", "3d", "4d", "3d+t")}
 
 
 def _unavailable(reason: str):
@@ -54,7 +49,8 @@ def renders(tmp_path_factory):
     if ctypes.util.find_library("EGL") is None:
         _unavailable("no libEGL (install Mesa: libegl-mesa0 libgl1-mesa-dri)")
     d = tmp_path_factory.mktemp("eevee")
-    spec = {name: {"settings": settings_to_dict(s), "inputs": kw} for name, (s, kw) in CASES.items()}
+    spec = {name: {"settings": settings_to_dict(s), "inputs": {SOCKETS[k]: v for k, v in kw.items()}}
+            for name, (s, kw) in CASES.items()}
     with open(d / "cases.json", "w", encoding="utf-8") as fh:
         json.dump(spec, fh)
     r = subprocess.run([sys.executable, SCRIPT, str(d / "cases.json"), str(d), str(RES)],
@@ -87,10 +83,7 @@ def test_eevee_render_equals_engine(renders, case):
     pts = _centres(RES)
     # EEVEE shaded every pixel at its centre (the AOV is half float: 2^-11 steps near 1)
     assert np.abs(pos[..., :3].reshape(-1, 3) - pts).max() < 1e-3
-    x = pts[:, : min(s.dim, 3)] * np.float32(kw.get("Scale", 1.0))
-    if s.dim == 4:
-        x = np.concatenate([x, np.full((len(x), 1), kw["W"], np.float32)], 1)
-    z = compile_noise(s).evaluate(np.ascontiguousarray(x, np.float32), kw.get("Time", 0.0), accelerate=False)
+    z = _engine(s, pts, **kw)
     for c, out in enumerate(("real", "imag", "modulus")):
         ref = select_output(z, out)
         got = color[..., c].ravel()

@@ -15,6 +15,8 @@ from blender_addon.field_eval import evaluate_field  # noqa: E402
 from blender_addon.wave_nodes import SETTINGS_KEY, add_wave_node, build_wave_group, settings_from_json  # noqa: E402,E501
 
 OUT = {"Value": "real", "Imaginary": "imag", "Modulus": "modulus", "Phase": "phase"}
+#: the group's input socket of each keyword of _engine (and of CASES' keyword dicts)
+SOCKETS = {"scale": "Scale", "time": "Time", "w": "W"}
 
 
 def _engine(s, pts, scale=1.0, time=0.0, w=0.0):
@@ -100,7 +102,7 @@ def _plane_material(grp, kw):
     g = add_wave_node(nt, grp)
     tc = g.inputs["Vector"].links[0].from_node
     for key, val in kw.items():
-        g.inputs[{"scale": "Scale", "time": "Time", "w": "W"}[key]].default_value = val
+        g.inputs[SOCKETS[key]].default_value = val
     comb = nt.nodes.new("ShaderNodeCombineXYZ")
     for i, o in enumerate(("Value", "Imaginary", "Modulus")):
         nt.links.new(g.outputs[o], comb.inputs[i])

@@ -18,7 +18,9 @@ import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.join(ROOT, "bench"))
 
+from bench_node import scene  # noqa: E402  (the plane and orthographic camera of the render bench)
 from backend.settings import settings_from_dict  # noqa: E402
 from blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402
 
@@ -26,28 +28,13 @@ ENC = 0.1
 
 
 def render(name: str, spec: dict, out_dir: str, res: int) -> float:
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    sc = bpy.context.scene
+    sc, mat = scene(res, 1)
     sc.render.engine = "BLENDER_EEVEE"
     sc.eevee.taa_render_samples = 1
     sc.render.filter_size = 0.0
-    sc.render.resolution_x = sc.render.resolution_y = res
-    sc.render.resolution_percentage = 100
     sc.view_settings.view_transform = "Standard"
     aov = sc.view_layers[0].aovs.add()
     aov.name, aov.type = "P", "COLOR"
-    mesh = bpy.data.meshes.new("plane")
-    mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
-    ob = bpy.data.objects.new("plane", mesh)
-    sc.collection.objects.link(ob)
-    cam = bpy.data.cameras.new("cam")
-    cam.type, cam.ortho_scale = "ORTHO", 2.0
-    co = bpy.data.objects.new("cam", cam)
-    co.location = (0.0, 0.0, 3.0)
-    sc.collection.objects.link(co)
-    sc.camera = co
-    mat = bpy.data.materials.new("wave")
-    ob.data.materials.append(mat)
     nt = mat.node_tree
     nt.nodes.clear()
     g = add_wave_node(nt, build_wave_group(settings_from_dict(spec["settings"]), "ShaderNodeTree"))
