@@ -19,12 +19,18 @@ sys.path.insert(0, ROOT)
 from backend.neural.model import NeuralNoiseModel  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from backend.training.evaluate import evaluate, step_seconds  # noqa: E402
+from backend.training.threads import cpu_threads  # noqa: E402
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
-    ap.add_argument("--run", required=True, help="the training run (its checkpoint times torch with the same weights)")
+    ap.add_argument("--run", help="the training run (its checkpoint times torch with the same weights); "
+                                   "without it the DDIM step is not timed")
+    ap.add_argument("--classes", help="comma-separated classes to evaluate (default: the model's trained classes); "
+                                      "two models compare only on the same classes, with the same instrument")
+    ap.add_argument("--threads", type=int, default=0, help="CPU threads for torch and numba (0: their defaults); "
+                                                           "the classifier is reproducible for a fixed count")
     ap.add_argument("--n", type=int, default=32, help="samples per class")
     ap.add_argument("--steps", type=int, default=30, help="DDIM steps")
     ap.add_argument("--clf-steps", type=int, default=600)
@@ -33,8 +39,22 @@ def main() -> int:
                     help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
     a = ap.parse_args()
-    model = NeuralNoiseModel(a.model)
+    model = NeuralNoiseModel(a.model, threads=a.threads)
     classes = tuple(model.config["trained_classes"])
+    if a.classes:
+        classes = tuple(c.strip() for c in a.classes.split(","))
+        bad = [c for c in classes if c not in model.config["trained_classes"]]
+        if bad:
+            print(f"eval_neural: error: {a.model} was not trained on {bad[0]!r}", file=sys.stderr)
+            return 2
+    if a.timing_only and not a.run:
+        print("eval_neural: error: --timing-only needs --run", file=sys.stderr)
+        return 2
+    with cpu_threads(a.threads):
+        return _run(a, model, classes)
+
+
+def _run(a, model, classes) -> int:
     if a.timing_only:
         with open(a.out, encoding="utf-8") as fh:
             res = json.load(fh)
@@ -42,19 +62,23 @@ def main() -> int:
             print(f"eval_neural: error: {a.out} evaluates another model than {a.model}", file=sys.stderr)
             return 2
         a.n, a.steps = res["model"]["n"], res["model"]["steps"]
+        classes = tuple(res["model"].get("classes", classes))
     else:
         res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr))
-    res["timing"] = step_seconds(a.model, a.run, a.size)
-    res["model"] = dict(step=model.config["step"], sha256=model.config["files"]["eps.onnx"], n=a.n, steps=a.steps)
+    if a.run:
+        res["timing"] = step_seconds(a.model, a.run, a.size)
+    res["model"] = dict(step=model.config["step"], sha256=model.config["files"]["eps.onnx"], n=a.n, steps=a.steps,
+                        classes=list(classes))
     print("| class | FD | acc | PSD err | response err (param) |")
     print("|---|---|---|---|---|")
     for name, r in res["classes"].items():
         print(f"| {name} | {r['fd']} | {r['acc']} | {r['psd']} | {r['response']} ({r['param']}) |")
     print(f"\nzoo accuracy of the classifier: {res['zoo_accuracy']}")
     print(f"seam ratio: tileable {res['seam_tileable']}, plain {res['seam_plain']}; blend locality {res['locality']}")
-    t = res["timing"]
-    print(f"DDIM step at {t['size']}²: onnxruntime {t['onnxruntime_s']} s, torch {t['torch_s']} s "
-          f"(torch / ort = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e})")
+    t = res.get("timing")
+    if t:
+        print(f"DDIM step at {t['size']}²: onnxruntime {t['onnxruntime_s']} s, torch {t['torch_s']} s "
+              f"(torch / ort = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e})")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, res)
     return 0

@@ -212,6 +212,20 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     assert "3000-step model" in text and "| mean FD ↓ | 3.0 | 1.5 |" in text and "| blend locality ↑ | 0.5 | 0.75 |" in text
     text = card(str(run), str(out), ev, dict(ev, locality=0.25), "train", "test CPU", ablation_reference=worse)
     assert "| with CutMix | 0.5 | 3.0 | 0.25 |" in text and "| without CutMix | 0.25 |" in text
+    # a model with more classes compares with its predecessor on the predecessor's classes only
+    wide = dict(ev, classes=dict(ev["classes"], perlin=dict(fd=99.0, acc=0.0, psd=0.9, response=0.9, param="scale")))
+    text = card(str(run), str(out), wide, None, "train", "test CPU", previous=worse, compare=ev, kept="## Old\nkept")
+    assert "| mean FD ↓ | 3.0 | 1.5 |" in text and "| spots | 3.0 / 1.5 | 0.25 / 0.5 | 0.4 / 0.2 |" in text
+    assert "on its 1 classes (spots)" in text and "| perlin | 99.0 |" in text and "## Old\nkept\n" in text
+
+
+def test_model_card_carries_sections_of_the_earlier_card():
+    from backend.training.model_card import kept_sections
+
+    old = "# Card\n\nintro\n\n## A\n\nfirst | table\n\n## B (Fig. 13)\n\nsecond\n\n## C\n\nthird\n"
+    assert kept_sections(old, ["B (Fig. 13)", "A"]) == "## B (Fig. 13)\n\nsecond\n\n## A\n\nfirst | table"
+    with pytest.raises(ValueError, match="no section '## D'"):
+        kept_sections(old, ["D"])
 
 
 def test_neural_bake_source_in_jobs(exported, tmp_path):
@@ -269,3 +283,54 @@ def test_the_shipped_model_loads_and_generates():
     for name in model.config["trained_classes"][:2]:
         img = generate(model, C.uniform(model, (name, {}), 32, 32), seed=1, steps=3)
         assert img.shape == (32, 32) and img.std() > 0.01
+
+
+def test_warm_start_reads_an_export_back_exactly(exported, tmp_path):
+    """A run started from an export (init_onnx) begins with the exported EMA weights, GroupNorm affines included."""
+    from backend.neural.model import sha256_file
+    from backend.training.train import main as train_main
+
+    run, out = exported
+    sha = sha256_file(str(out / "eps.onnx"))
+    ref = torch.load(os.path.join(run, "ckpt.pt"), weights_only=False)["ema"]
+    assert any(".norm1.weight" in k for k in ref)
+    cfg = TrainConfig.from_dict(dict(TINY, steps=1, lr=0.0, init_onnx=str(out), init_sha256=sha))
+    train(cfg, str(tmp_path / "warm"), log=lambda s: None)
+    got = torch.load(tmp_path / "warm" / "ckpt.pt", weights_only=False)
+    for k, v in ref.items():
+        tol = 1e-6 if k == "class_emb.weight" else 0.0  # the JSON table is rounded to 7 decimals
+        assert torch.allclose(got["model"][k], v, atol=tol, rtol=0), k
+    # a pinned hash that does not match: one line, exit 2, no run folder written
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(dict(TINY, init_onnx=str(out), init_sha256="0" * 64)))
+    rc = train_main(["--config", str(bad), "--out", str(tmp_path / "never")])
+    assert rc == 2 and not (tmp_path / "never").exists()
+    with pytest.raises(ValueError, match="init_onnx needs init_sha256"):
+        TrainConfig.from_dict(dict(TINY, init_onnx=str(out)))
+
+
+def test_warm_start_grows_the_class_table_and_parameter_slots():
+    """New classes keep their fresh embeddings; new parameter slots get zero MLP input columns."""
+    from backend.training.unet import UNet
+    from backend.training.warm_start import warm_start
+
+    torch.manual_seed(0)
+    small = UNet(3, 2, emb_dim=4, widths=(8, 16, 16))
+    big = UNet(5, 4, emb_dim=4, widths=(8, 16, 16))
+    fresh = big.class_emb.weight.detach().clone()
+    warm_start(big, {k: v.numpy() for k, v in small.state_dict().items()})
+    assert torch.equal(big.class_emb.weight[:3], small.class_emb.weight)
+    assert torch.equal(big.class_emb.weight[3:], fresh[3:])
+    w_big, w_small = big.cond_mlp[0].weight, small.cond_mlp[0].weight
+    assert torch.equal(w_big[:, :6], w_small) and not w_big[:, 6:].any()
+    # same output for the old classes with the new slots at any value
+    x, t = torch.randn(1, 1, 16, 16), torch.tensor([300.0])
+    ids = torch.full((1, 16, 16), 2)
+    p_small = torch.rand(1, 2, 16, 16)
+    p_big = torch.cat([p_small, torch.rand(1, 2, 16, 16)], 1)
+    with torch.no_grad():
+        a = small(x, t, small.embed(ids, p_small))
+        b = big(x, t, big.embed(ids, p_big))
+    assert torch.allclose(a, b, atol=1e-5)
+    with pytest.raises(ValueError, match="init_onnx: init.weight has shape"):
+        warm_start(UNet(3, 2, emb_dim=4, widths=(16, 16, 16)), {k: v.numpy() for k, v in small.state_dict().items()})

@@ -1,6 +1,7 @@
 """Neural noise training parts: U-Net, schedule, sampler, loss, CutMix, resumable training."""
 import json
 import math
+import os
 
 import numpy as np
 import pytest
@@ -166,3 +167,39 @@ def test_checkpoints_of_a_smaller_zoo_still_load():
     again.load_state_dict(old.state_dict())
     classes, params = model_names(again)
     assert classes == list(zoo.CLASS_NAMES[:-1]) and params == list(zoo.PARAM_NAMES[:-3])
+
+
+def test_cpu_threads_limits_torch_and_numba_and_restores_them():
+    """One training thread must also mean one numba worker (the zoo's wave classes run numba kernels)."""
+    numba = pytest.importorskip("numba")
+    from backend.training.threads import cpu_threads
+
+    before = torch.get_num_threads(), numba.get_num_threads()
+    with cpu_threads(1):
+        assert torch.get_num_threads() == 1 and numba.get_num_threads() == 1
+    assert (torch.get_num_threads(), numba.get_num_threads()) == before
+    with cpu_threads(0):
+        assert (torch.get_num_threads(), numba.get_num_threads()) == before
+
+
+def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
+    """configs/: each file loads; the production (GPU) config runs one step at its resolution on the CPU."""
+    import glob
+
+    from backend.training.solid.train import load_config as load_solid
+    from backend.training.train import load_config
+
+    root = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "configs")
+    neural = sorted(glob.glob(os.path.join(root, "*.json")))
+    solid = sorted(glob.glob(os.path.join(root, "solid", "*.json")))
+    assert len(neural) >= 4 and len(solid) >= 14
+    for path in neural:
+        load_config(path)
+    for path in solid:
+        load_solid(path)
+    with open(os.path.join(root, "neural_noise_gpu.json"), encoding="utf-8") as fh:
+        gpu = json.load(fh)
+    assert gpu["size"] >= 128 and "classes" not in gpu  # the full zoo
+    cfg = TrainConfig.from_dict(dict(gpu, batch=2, steps=1, device="cpu", sample_every=0))
+    last = train(cfg, str(tmp_path / "gpu"), log=lambda s: None)
+    assert last["step"] == 1 and np.isfinite(last["mse"])

@@ -57,11 +57,27 @@ def _table(ev: dict) -> str:
     return "\n".join(rows)
 
 
+def kept_sections(card_text: str, headings) -> str:
+    """The ``## heading`` sections of an earlier card, verbatim, in the order asked (ValueError if one is missing)."""
+    parts = {}
+    for block in ("\n" + card_text).split("\n## ")[1:]:
+        title, _, body = block.partition("\n")
+        parts[title.strip()] = body.rstrip("\n")
+    out = []
+    for h in headings:
+        if h not in parts:
+            raise ValueError(f"the earlier card has no section '## {h}'")
+        out.append(f"## {h}\n{parts[h]}")
+    return "\n\n".join(out)
+
+
 def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None,
          previous: dict | None = None, previous_label: str = "previous model", ablation_label: str = "",
-         ablation_reference: dict | None = None) -> str:
+         ablation_reference: dict | None = None, compare: dict | None = None, kept: str = "") -> str:
     """The card's markdown.  ``ablation_reference``: the evaluation of the CutMix model trained like
-    the ablation (same steps) when this model was trained longer; default: this model."""
+    the ablation (same steps) when this model was trained longer; default: this model.
+    ``compare``: this model evaluated on ``previous``'s classes with the same instrument (when the
+    two models know different classes); ``kept``: sections carried over from the earlier card."""
     with open(os.path.join(model, "neural_noise.json"), encoding="utf-8") as fh:
         meta = json.load(fh)
     log = [json.loads(line) for line in open(os.path.join(run, "log.jsonl"), encoding="utf-8")]
@@ -106,15 +122,25 @@ def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: s
         f"weights (torch / onnxruntime = {t['ratio']}; max |Δε| {t['max_eps_difference']:.1e}).",
     ]
     if previous is not None:
+        cur = compare if compare is not None else ev
         lines += ["", "## Against the model it replaced", "",
-                  f"The same evaluation of the {previous_label}:", "",
+                  f"The same evaluation of the {previous_label}"
+                  + (f", both models on its {len(previous['classes'])} classes ({', '.join(previous['classes'])}) "
+                     "with one instrument (the same classifier, trained with the same seed and thread count)"
+                     if compare is not None else "") + ":", "",
                   "| measure | previous | this model |", "|---|---|---|"]
         for key, label in (("fd", "mean FD ↓"), ("acc", "mean classifier accuracy ↑"), ("psd", "mean PSD error ↓"),
                            ("response", "mean response error ↓")):
-            lines.append(f"| {label} | {mean(key, previous)} | {mean(key, ev)} |")
-        lines += [f"| seam ratio, tileable ↓ | {previous['seam_tileable']} | {ev['seam_tileable']} |",
-                  f"| blend locality ↑ | {previous['locality']} | {ev['locality']} |",
-                  f"| zoo classifier accuracy (the instrument) | {previous['zoo_accuracy']} | {ev['zoo_accuracy']} |"]
+            lines.append(f"| {label} | {mean(key, previous)} | {mean(key, cur)} |")
+        lines += [f"| seam ratio, tileable ↓ | {previous['seam_tileable']} | {cur['seam_tileable']} |",
+                  f"| blend locality ↑ | {previous['locality']} | {cur['locality']} |",
+                  f"| zoo classifier accuracy (the instrument) | {previous['zoo_accuracy']} | {cur['zoo_accuracy']} |"]
+        if compare is not None:
+            lines += ["", "| class | FD ↓ previous / this | accuracy ↑ previous / this | PSD error ↓ previous / this |",
+                      "|---|---|---|---|"]
+            for name, r in previous["classes"].items():
+                c = compare["classes"][name]
+                lines.append(f"| {name} | {r['fd']} / {c['fd']} | {r['acc']} / {c['acc']} | {r['psd']} / {c['psd']} |")
     if ablation is not None:
         ref = ablation_reference if ablation_reference is not None else ev
         lines += ["", "## CutMix ablation (Fig. 13)", "",
@@ -123,9 +149,11 @@ def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: s
                   "| model | blend locality ↑ | mean FD ↓ | mean accuracy ↑ |", "|---|---|---|---|",
                   f"| with CutMix | {ref['locality']} | {mean('fd', ref)} | {mean('acc', ref)} |",
                   f"| without CutMix | {ablation['locality']} | {mean('fd', ablation)} | {mean('acc', ablation)} |"]
+    if kept:
+        lines += ["", kept]
     lines += ["", "## Limits", "",
-              "This is a small model trained on a CPU. The paper's setting (a GPU, 128² or more, all classes, far more "
-              "steps; `configs/neural_noise_gpu.json`) is needed for production quality. The numbers above are this "
+              "This is a small model trained on a CPU. The paper's setting (a GPU, 128² or more, far more steps; "
+              "`configs/neural_noise_gpu.json`) is needed for production quality. The numbers above are this "
               "model's own, measured as written."]
     return "\n".join(lines) + "\n"
 
@@ -142,10 +170,25 @@ def main(argv=None) -> int:
     ap.add_argument("--previous-label", default="previous model")
     ap.add_argument("--ablation-label", default="", help="text after the ablation's heading sentence")
     ap.add_argument("--ablation-reference", help="evaluation JSON of the CutMix model with the ablation's steps")
+    ap.add_argument("--compare-eval", help="evaluation JSON of this model on the previous model's classes "
+                                           "(bench/eval_neural.py --classes ...), when their classes differ")
+    ap.add_argument("--keep-from", help="an earlier card whose --keep sections are carried over verbatim")
+    ap.add_argument("--keep", action="append", default=[], help="a '## ' heading of --keep-from (repeatable)")
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
-    ev, abl, prev, ref = (read_json(p) for p in (a.eval, a.ablation_eval, a.previous_eval, a.ablation_reference))
-    text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label, ref)
+    ev, abl, prev, ref, cmp = (read_json(p) for p in (a.eval, a.ablation_eval, a.previous_eval, a.ablation_reference,
+                                                       a.compare_eval))
+    kept = ""
+    if a.keep:
+        if not a.keep_from:
+            ap.error("--keep needs --keep-from")
+        with open(a.keep_from, encoding="utf-8") as fh:
+            try:
+                kept = kept_sections(fh.read(), a.keep)
+            except ValueError as exc:
+                ap.error(str(exc))
+    text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label, ref,
+                cmp, kept)
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
         fh.write(text)
     os.replace(a.out + ".tmp", a.out)

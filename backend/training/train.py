@@ -6,7 +6,9 @@ with offset noise and the spherical embedding penalty -> AdamW (lr 8e-5,
 β = (0.9, 0.99), weight decay 0.01), gradient clipping at 1, EMA of the weights.
 ``RUN/ckpt.pt`` is written atomically every ``checkpoint_every`` steps and a
 run resumes from it; ``RUN/log.jsonl`` has one line per ``log_every`` steps and
-``RUN/samples_STEP.png`` shows DDIM samples of the EMA model.
+``RUN/samples_STEP.png`` shows DDIM samples of the EMA model.  A fresh run may
+start from a shipped export's weights (``init_onnx`` + ``init_sha256``, see
+:mod:`.warm_start`), since checkpoints are not kept in git.
 
 Config keys (JSON) and defaults: see :class:`TrainConfig`.
 """
@@ -26,7 +28,10 @@ import torch
 from . import zoo
 from .cutmix import cutmix
 from .diffusion import Diffusion
+from .threads import cpu_threads
 from .unet import UNet
+from .warm_start import exported_weights, warm_start
+from ..onnx_models import ModelError
 
 __all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names", "check_config_keys"]
 
@@ -63,6 +68,9 @@ class TrainConfig:
     checkpoint_every: int = 1000
     sample_every: int = 5000
     sample_steps: int = 20
+    threads: int = 0               # CPU threads for torch and numba (0: their defaults), see .threads
+    init_onnx: str = ""            # a fresh run starts from this export's weights (see .warm_start) ...
+    init_sha256: str = ""          # ... which must have this eps.onnx sha256
 
     @classmethod
     def from_dict(cls, d: dict) -> "TrainConfig":
@@ -76,6 +84,8 @@ class TrainConfig:
             raise ValueError(f"unknown class {bad[0]!r}")
         if d.get("size", 64) % 8:
             raise ValueError(f"size must be a multiple of 8, got {d['size']}")
+        if d.get("init_onnx") and not d.get("init_sha256"):
+            raise ValueError("init_onnx needs init_sha256 (the eps.onnx hash the run starts from)")
         return cls(**d)
 
 
@@ -141,12 +151,21 @@ def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0
 
 def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -> dict:
     """Train (or resume) into folder ``out``; stops after ``max_steps`` more steps if given. Returns the last log."""
+    with cpu_threads(cfg.threads):
+        return _train(cfg, out, max_steps, log)
+
+
+def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
     os.makedirs(out, exist_ok=True)
     device = _device(cfg.device)
     torch.manual_seed(cfg.seed)
     ckpt = os.path.join(out, "ckpt.pt")
     state = torch.load(ckpt, map_location=device, weights_only=False) if os.path.isfile(ckpt) else None
-    model = build_model(cfg, state["model"] if state else None).to(device)
+    model = build_model(cfg, state["model"] if state else None)
+    if state is None and cfg.init_onnx:
+        warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256))
+        log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...)")
+    model = model.to(device)
     ema = copy.deepcopy(model).eval()
     for p_ in ema.parameters():
         p_.requires_grad_(False)
@@ -191,7 +210,7 @@ def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -
         losses.append(float(mse.detach()))
         if step % cfg.log_every == 0 or step == end:
             last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss.detach()), seconds=round(time.time() - t0, 2),
-                        emb_norm=float(model.class_emb.weight.norm(dim=1).mean()))
+                        emb_norm=float(model.class_emb.weight.detach().norm(dim=1).mean()))
             losses = []
             with open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8") as fh:
                 fh.write(json.dumps(last) + "\n")
@@ -221,7 +240,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     try:
         cfg = load_config(a.config)
-    except (OSError, ValueError) as exc:
+        if cfg.init_onnx and not os.path.isfile(os.path.join(a.out, "ckpt.pt")):
+            exported_weights(cfg.init_onnx, cfg.init_sha256)  # a bad start fails here, in one line
+    except (OSError, ValueError, ModelError) as exc:
         print(f"train: error: {exc}", file=sys.stderr)
         return 2
     train(cfg, a.out, a.max_steps)

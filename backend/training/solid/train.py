@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass
 import torch
 
 from ..._export import export as _ex
+from ..threads import cpu_threads
 from ..train import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, style_loss
@@ -67,7 +68,7 @@ class SolidConfig:
     seed: int = 0
     log_every: int = 25
     checkpoint_every: int = 250
-    threads: int = 0                # torch CPU threads (0: torch's default)
+    threads: int = 0                # CPU threads for torch and numba (0: their defaults)
     device: str = "cpu"
     init_from: str = ""             # a run folder to continue (its ckpt.pt and log.jsonl seed a new run)
 
@@ -135,13 +136,8 @@ def _save(path: str, obj) -> None:
 
 def train(cfg: SolidConfig, out: str, max_steps: int | None = None, log=print) -> dict:
     """Train (or resume) into folder ``out``; returns the final checkpoint dict."""
-    threads = torch.get_num_threads()
-    if cfg.threads:
-        torch.set_num_threads(cfg.threads)
-    try:
+    with cpu_threads(cfg.threads):
         return _train(cfg, out, max_steps, log)
-    finally:
-        torch.set_num_threads(threads)
 
 
 def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:

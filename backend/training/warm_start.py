@@ -1,0 +1,83 @@
+"""Start a training run from a shipped neural-noise export (``eps.onnx`` + ``neural_noise.json``).
+
+Checkpoints stay out of git, so the only durable copy of a trained model is its
+export.  This reads the exported weights back into a :class:`.unet.UNet` built
+for the current zoo, which may have more classes and parameter slots than the
+export (the zoo is append-only, see :mod:`.zoo`):
+
+- ONNX initialisers named like the module's parameters are copied as they are;
+- GroupNorm affines, which the exporter stores as anonymous ``onnx::Mul_N`` /
+  ``onnx::Add_N`` initialisers, are named by their node's scope
+  (``/down.0.0/norm1/Mul`` -> ``down.0.0.norm1.weight``);
+- the class embedding comes from the JSON's ``class_embedding`` table;
+- a grown class table keeps its fresh N(0, 1) rows (the spherical prior of
+  Sec. 3.1.1) for the new classes; a grown parameter vector gets zero input
+  columns in ``cond_mlp.0``, so the new slots start without any effect.
+
+The export's sha256 is checked twice: against its JSON (as the runtime does) and
+against the hash a training config pins, so a config names one set of weights.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import torch
+
+from ..onnx_models import load_model_json, sha256_file
+
+__all__ = ["exported_weights", "warm_start"]
+
+
+def exported_weights(folder: str, sha256: str) -> dict:
+    """{parameter name: float32 array} of the export in ``folder``, refusing an ``eps.onnx`` whose hash is not ``sha256``."""
+    import onnx
+    from onnx import numpy_helper
+
+    path = os.path.join(folder, "eps.onnx")
+    if not os.path.isfile(path):
+        raise ValueError(f"init_onnx: no eps.onnx in {folder}")
+    got = sha256_file(path)
+    if got != sha256:
+        raise ValueError(f"init_onnx: {path} has sha256 {got[:12]}..., the config pins {sha256[:12]}... "
+                         "(restore the pinned file from git history)")
+    doc = load_model_json(folder, "neural_noise.json")  # checks the JSON's own hash of eps.onnx
+    graph = onnx.load(path).graph
+    inits = {i.name: numpy_helper.to_array(i) for i in graph.initializer}
+    out = {k: v for k, v in inits.items() if not k.startswith("onnx::")}
+    affine = {"Mul": "weight", "Add": "bias"}
+    for node in graph.node:
+        scope, _, op = node.name.rpartition("/")
+        if op in affine and "/norm" in scope:
+            anon = [i for i in node.input if i in inits and i.startswith("onnx::")]
+            if len(anon) == 1:
+                out[scope.strip("/").replace("/", ".") + "." + affine[op]] = inits[anon[0]].reshape(-1)
+    out["class_emb.weight"] = np.asarray(doc["class_embedding"], np.float32)
+    return {k: np.asarray(v, np.float32) for k, v in out.items()}
+
+
+def warm_start(model: torch.nn.Module, weights: dict) -> None:
+    """Copy ``weights`` (see :func:`exported_weights`) into ``model`` in place.
+
+    Every parameter of the model must be found; only the class table and the
+    first MLP layer's input columns may be larger in the model than in the export.
+    ValueError names the first tensor that cannot be placed.
+    """
+    state = model.state_dict()
+    E = model.class_emb.weight.shape[1]
+    with torch.no_grad():
+        for name, dst in state.items():
+            if name not in weights:
+                raise ValueError(f"init_onnx: the export has no tensor for {name}")
+            src = torch.tensor(weights[name], dtype=dst.dtype)
+            if name == "class_emb.weight" and src.shape[0] <= dst.shape[0] and src.shape[1] == dst.shape[1]:
+                dst[: src.shape[0]] = src
+            elif name == "cond_mlp.0.weight" and E <= src.shape[1] <= dst.shape[1] and src.shape[0] == dst.shape[0]:
+                dst.zero_()
+                dst[:, : src.shape[1]] = src  # input columns [embedding E, old parameter slots]; new slots stay 0
+            elif tuple(src.shape) == tuple(dst.shape):
+                dst.copy_(src)
+            else:
+                raise ValueError(f"init_onnx: {name} has shape {tuple(src.shape)} in the export, "
+                                 f"{tuple(dst.shape)} in the model")
+    model.load_state_dict(state)
