@@ -1,10 +1,11 @@
-"""Evaluate a neural noise model: `python bench/eval_neural.py --model models/neural_noise --run RUN`.
+"""Evaluate a neural noise model: `python bench/eval_neural.py --model models/neural_noise`.
 
 Prints the per-class table of backend/training/evaluate.py (Fréchet distance in
 a zoo classifier's features, classifier accuracy on generated samples, power-
 spectrum error, parameter-response error), the seam ratio of tileable output,
 blend locality, and seconds per DDIM step for onnxruntime and torch with the
-same weights; writes everything to out/bench/neural_eval.json.
+same weights (torch rebuilt from the export, so no checkpoint is needed);
+writes everything to out/bench/neural_eval.json.
 """
 from __future__ import annotations
 
@@ -25,8 +26,6 @@ from backend.training.threads import cpu_threads  # noqa: E402
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
-    ap.add_argument("--run", help="the training run (its checkpoint times torch with the same weights); "
-                                   "without it the DDIM step is not timed")
     ap.add_argument("--classes", help="comma-separated classes to evaluate (default: the model's trained classes); "
                                       "two models compare only on the same classes, with the same instrument")
     ap.add_argument("--threads", type=int, default=0, help="CPU threads for torch and numba (0: their defaults); "
@@ -37,6 +36,7 @@ def main() -> int:
     ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
     ap.add_argument("--timing-only", action="store_true",
                     help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
+    ap.add_argument("--no-timing", action="store_true", help="skip the DDIM step timing (a busy machine)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
     a = ap.parse_args()
     model = NeuralNoiseModel(a.model, threads=a.threads)
@@ -47,8 +47,8 @@ def main() -> int:
         if bad:
             print(f"eval_neural: error: {a.model} was not trained on {bad[0]!r}", file=sys.stderr)
             return 2
-    if a.timing_only and not a.run:
-        print("eval_neural: error: --timing-only needs --run", file=sys.stderr)
+    if a.timing_only and a.no_timing:
+        print("eval_neural: error: --timing-only and --no-timing exclude each other", file=sys.stderr)
         return 2
     with cpu_threads(a.threads):
         return _run(a, model, classes)
@@ -65,8 +65,8 @@ def _run(a, model, classes) -> int:
         classes = tuple(res["model"].get("classes", classes))
     else:
         res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr))
-    if a.run:
-        res["timing"] = step_seconds(a.model, a.run, a.size)
+    if not a.no_timing:
+        res["timing"] = step_seconds(a.model, a.size)
     res["model"] = dict(step=model.config["step"], sha256=model.config["files"]["eps.onnx"], n=a.n, steps=a.steps,
                         classes=list(classes))
     print("| class | FD | acc | PSD err | response err (param) |")

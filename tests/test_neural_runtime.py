@@ -219,6 +219,43 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     assert "on its 1 classes (spots)" in text and "| perlin | 99.0 |" in text and "## Old\nkept\n" in text
 
 
+def test_model_card_without_the_run(exported, tmp_path):
+    """Runs are not kept: the export records the log's wall time and loss, and the card reads them from there."""
+    import shutil
+
+    from backend.training.model_card import main as card_main, run_figures, wall_seconds
+
+    run, out = exported
+    meta = json.loads((out / "neural_noise.json").read_text())
+    last = json.loads((run / "log.jsonl").read_text().splitlines()[-1])
+    rec = meta["training"]
+    assert rec["final_mse"] == round(last["mse"], 5) and rec["log_step"] == meta["step"] == last["step"]
+    assert rec["wall_seconds"] == round(wall_seconds(str(run / "log.jsonl")), 1)
+    wall, mse, source = run_figures(None, meta)
+    assert (wall, mse) == (rec["wall_seconds"] / 60, rec["final_mse"]) and "export's JSON" in source
+    # an export from before the record: the figures must be given, and the card says where they come from
+    old = tmp_path / "old"
+    shutil.copytree(out, old)
+    doc = json.loads((old / "neural_noise.json").read_text())
+    del doc["training"]
+    (old / "neural_noise.json").write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match="give --wall-minutes and --final-mse"):
+        run_figures(None, doc)
+    ev = tmp_path / "ev.json"
+    ev.write_text(json.dumps(dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param="scale")},
+                                  zoo_accuracy=0.9, seam_tileable=1.1, seam_plain=3.0, locality=0.75,
+                                  model=dict(n=4, steps=5), timing=dict(size=64, onnxruntime_s=0.1, torch_s=0.2,
+                                                                        ratio=2.0, max_eps_difference=1e-6))))
+    card_out = tmp_path / "CARD.md"
+    base = ["--model", str(old), "--eval", str(ev), "--train-command", "train", "-o", str(card_out)]
+    with pytest.raises(SystemExit):
+        card_main(base)
+    assert not card_out.exists()
+    assert card_main(base + ["--wall-minutes", "88.0", "--final-mse", "0.1011"]) == 0
+    text = card_out.read_text()
+    assert "**Wall time:** 88.0 min" in text and "0.1011" in text and "the run folder is not kept" in text
+
+
 def test_model_card_carries_sections_of_the_earlier_card():
     from backend.training.model_card import kept_sections
 
@@ -307,6 +344,21 @@ def test_warm_start_reads_an_export_back_exactly(exported, tmp_path):
     assert rc == 2 and not (tmp_path / "never").exists()
     with pytest.raises(ValueError, match="init_onnx needs init_sha256"):
         TrainConfig.from_dict(dict(TINY, init_onnx=str(out)))
+
+
+def test_torch_is_rebuilt_from_the_export_alone(exported):
+    """The step timing needs no checkpoint: torch runs the export's own weights, as onnxruntime does."""
+    from backend.training.evaluate import step_seconds
+    from backend.training.warm_start import torch_from_export
+
+    run, out = exported
+    ref = _torch_model(run).state_dict()
+    got = torch_from_export(str(out)).state_dict()
+    assert set(got) == set(ref)
+    for k, v in ref.items():
+        assert torch.allclose(got[k], v, atol=1e-6 if k == "class_emb.weight" else 0.0, rtol=0), k
+    t = step_seconds(str(out), size=16, reps=1)
+    assert t["max_eps_difference"] < 1e-4 and t["onnxruntime_s"] > 0 and t["torch_s"] > 0 and t["size"] == 16
 
 
 def test_warm_start_grows_the_class_table_and_parameter_slots():

@@ -169,16 +169,15 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
                 seam_plain=round(seam(plain), 3), locality=round(hits / total, 3))
 
 
-def step_seconds(model_folder: str, run_folder: str, size: int = 256, reps: int = 3) -> dict:
+def step_seconds(model_folder: str, size: int = 256, reps: int = 3) -> dict:
     """Seconds per DDIM step (one ε evaluation) at size², onnxruntime vs torch with the same weights.
 
-    The torch model loads the run's EMA weights; its output is checked against
-    onnxruntime's first (max |Δε| reported), so both time the same network.
+    The torch network is rebuilt from the export itself (:func:`.warm_start.torch_from_export`);
+    its output is checked against onnxruntime's first (max |Δε| reported), so both time the
+    same network.
     """
-    import os
-
     from ..neural.model import NeuralNoiseModel
-    from .train import TrainConfig, build_model
+    from .warm_start import torch_from_export
 
     m = NeuralNoiseModel(model_folder)
     C = m.embedding.shape[1] + len(m.params)
@@ -191,15 +190,12 @@ def step_seconds(model_folder: str, run_folder: str, size: int = 256, reps: int 
     for _ in range(reps):
         eps(x, t, cond)
     ort_s = (time.perf_counter() - t0) / reps
-    state = torch.load(os.path.join(run_folder, "ckpt.pt"), map_location="cpu", weights_only=False)
-    tm = build_model(TrainConfig.from_dict(state["config"]), state["ema"]).eval()
-    tm.load_state_dict(state["ema"])
+    tm = torch_from_export(model_folder)
     with torch.no_grad():
         args = (torch.from_numpy(x), torch.from_numpy(t), torch.from_numpy(cond))
         diff = float(np.abs(tm(*args).numpy() - eps(x, t, cond)).max())
         if diff > 1e-3:
-            raise RuntimeError(f"{run_folder}/ckpt.pt is not the exported network (max |Δε| {diff:.2g}): "
-                               "re-export or pass the run it came from")
+            raise RuntimeError(f"torch and onnxruntime disagree on {model_folder}/eps.onnx (max |Δε| {diff:.2g})")
         t0 = time.perf_counter()
         for _ in range(reps):
             tm(*args)

@@ -6,8 +6,9 @@ Writes, each atomically:
                                tile = [0.0] zero padding, [1.0] circular padding (seamless tiles),
                                one graph for both so the weights ship once
     OUT_DIR/neural_noise.json  schedule, class and parameter names and ranges, the class-embedding
-                               table, the training config and step, and the .onnx file's sha256
-                               (the runtime refuses a file whose hash differs)
+                               table, the training config and step, the run's record (wall time
+                               and final loss from its log.jsonl, since runs are not kept), and
+                               the .onnx file's sha256 (the runtime refuses a file whose hash differs)
 
 The EMA weights are exported (``--raw`` for the optimiser's weights).
 """
@@ -26,7 +27,7 @@ from ..neural.model import sha256_file
 from . import zoo
 from .train import TrainConfig, build_model, model_names
 
-__all__ = ["export", "onnx_export"]
+__all__ = ["export", "onnx_export", "run_record"]
 
 FORMAT = 1
 
@@ -37,6 +38,16 @@ def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dyn
     torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
                       opset_version=17, dynamo=False)
     os.replace(tmp, path)
+
+
+def run_record(log_path: str) -> dict:
+    """What a model card needs from a run's log.jsonl: wall seconds (over resumed segments) and the final MSE."""
+    from .model_card import wall_seconds
+
+    with open(log_path, encoding="utf-8") as fh:
+        last = [json.loads(line) for line in fh if line.strip()][-1]
+    return dict(wall_seconds=round(wall_seconds(log_path), 1), final_mse=round(float(last["mse"]), 5),
+                log_step=int(last["step"]))
 
 
 def _export_one(model, path: str, size: int) -> None:
@@ -65,6 +76,9 @@ def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> 
                class_embedding=model.class_emb.weight.detach().numpy().astype(float).round(7).tolist(),
                train_size=cfg.size, step=int(state["step"]), weights="raw" if raw else "ema",
                config=state["config"], files=files, multiple_of=8)
+    log = os.path.join(run, "log.jsonl")
+    if os.path.isfile(log):
+        doc["training"] = run_record(log)
     doc.update(extra or {})
     path = os.path.join(out, "neural_noise.json")
     _ex.write_json(path, doc)

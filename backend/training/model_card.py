@@ -1,11 +1,15 @@
 """Write a model's card from its run, export and evaluation: ``python -m backend.training.model_card ...``.
 
-    python -m backend.training.model_card --run RUN --model MODEL_DIR --eval EVAL.json \\
+    python -m backend.training.model_card [--run RUN] --model MODEL_DIR --eval EVAL.json \\
         [--ablation-eval EVAL_NO_CUTMIX.json] --train-command "..." -o MODEL_DIR/MODEL_CARD.md
 
 Everything in the card is read from files the project's own commands wrote:
-the run's config and log (steps, loss, wall time), the export's JSON (sha256,
-classes) and the evaluation JSON of ``bench/eval_neural.py``.
+the run's log (wall time, final loss), the export's JSON (config, steps, sha256,
+classes) and the evaluation JSON of ``bench/eval_neural.py``.  Runs are not kept,
+so the export also records the log's figures (``training`` in its JSON) and the
+card reads them there when no ``--run`` is given; an export made before that
+record existed takes them from ``--wall-minutes`` and ``--final-mse`` (figures
+written down from the run's log when it finished), and the card says so.
 """
 from __future__ import annotations
 
@@ -71,16 +75,36 @@ def kept_sections(card_text: str, headings) -> str:
     return "\n\n".join(out)
 
 
-def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None,
+def run_figures(run: str | None, meta: dict, wall_minutes: float | None = None,
+                final_mse: float | None = None) -> tuple:
+    """(wall minutes, final MSE, where they come from) of a model's training run.
+
+    From the run's log.jsonl when ``run`` is given, else the export's ``training``
+    record, else the figures given; ValueError when none of these has them.
+    """
+    if run:
+        with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
+            last = [json.loads(line) for line in fh if line.strip()][-1]
+        return wall_seconds(os.path.join(run, "log.jsonl")) / 60, last["mse"], "the run's log"
+    if "training" in meta:
+        rec = meta["training"]
+        return rec["wall_seconds"] / 60, rec["final_mse"], "the run's log, recorded in the export's JSON"
+    if wall_minutes is None or final_mse is None:
+        raise ValueError("no --run, and the export has no training record: give --wall-minutes and --final-mse")
+    return wall_minutes, final_mse, "the run's log when it finished (the run folder is not kept)"
+
+
+def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None,
          previous: dict | None = None, previous_label: str = "previous model", ablation_label: str = "",
-         ablation_reference: dict | None = None, compare: dict | None = None, kept: str = "") -> str:
+         ablation_reference: dict | None = None, compare: dict | None = None, kept: str = "",
+         wall_minutes: float | None = None, final_mse: float | None = None) -> str:
     """The card's markdown.  ``ablation_reference``: the evaluation of the CutMix model trained like
     the ablation (same steps) when this model was trained longer; default: this model.
     ``compare``: this model evaluated on ``previous``'s classes with the same instrument (when the
     two models know different classes); ``kept``: sections carried over from the earlier card."""
     with open(os.path.join(model, "neural_noise.json"), encoding="utf-8") as fh:
         meta = json.load(fh)
-    log = [json.loads(line) for line in open(os.path.join(run, "log.jsonl"), encoding="utf-8")]
+    wall, mse, source = run_figures(run, meta, wall_minutes, final_mse)
     cfg = meta["config"]
     t = ev["timing"]
     mean = lambda key, e: round(sum(r[key] for r in e["classes"].values()) / len(e["classes"]), 3)  # noqa: E731
@@ -101,8 +125,8 @@ def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: s
         f"- **Config:** size {cfg['size']}, batch {cfg['batch']}, {cfg['steps']} steps, lr {cfg['lr']}, "
         f"EMA {cfg['ema_decay']}, CutMix p {cfg['cutmix_p']}, widths {cfg['widths']}, embedding {cfg['emb_dim']}-D.",
         f"- **Hardware:** {hardware or _hardware()}.",
-        f"- **Steps:** {meta['step']}. **Wall time:** {wall_seconds(os.path.join(run, 'log.jsonl')) / 60:.1f} min.",
-        f"- **Final training MSE** (mean of the last log window): {log[-1]['mse']:.4f}.",
+        f"- **Steps:** {meta['step']}. **Wall time:** {wall:.1f} min.",
+        f"- **Final training MSE** (mean of the last log window): {mse:.4f}. Wall time and loss are from {source}.",
         f"- **Weights:** {meta['weights']} (exported with `python -m backend.training.export_onnx`).",
         f"- **sha256** of `eps.onnx`: `{meta['files']['eps.onnx']}`.",
         "",
@@ -160,7 +184,9 @@ def card(run: str, model: str, ev: dict, ablation: dict | None, train_command: s
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m backend.training.model_card", description=__doc__.split("\n")[0])
-    ap.add_argument("--run", required=True)
+    ap.add_argument("--run", help="the training run (its log.jsonl); default: the export's training record")
+    ap.add_argument("--wall-minutes", type=float, help="without --run or a training record: the run's wall time")
+    ap.add_argument("--final-mse", type=float, help="without --run or a training record: the run's final MSE")
     ap.add_argument("--model", required=True)
     ap.add_argument("--eval", required=True)
     ap.add_argument("--ablation-eval")
@@ -187,8 +213,11 @@ def main(argv=None) -> int:
                 kept = kept_sections(fh.read(), a.keep)
             except ValueError as exc:
                 ap.error(str(exc))
-    text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label, ref,
-                cmp, kept)
+    try:
+        text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label,
+                    ref, cmp, kept, a.wall_minutes, a.final_mse)
+    except ValueError as exc:
+        ap.error(str(exc))
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
         fh.write(text)
     os.replace(a.out + ".tmp", a.out)

@@ -26,7 +26,7 @@ import torch
 
 from ..onnx_models import load_model_json, sha256_file
 
-__all__ = ["exported_weights", "warm_start"]
+__all__ = ["exported_weights", "warm_start", "torch_from_export"]
 
 
 def exported_weights(folder: str, sha256: str) -> dict:
@@ -81,3 +81,20 @@ def warm_start(model: torch.nn.Module, weights: dict) -> None:
                 raise ValueError(f"init_onnx: {name} has shape {tuple(src.shape)} in the export, "
                                  f"{tuple(dst.shape)} in the model")
     model.load_state_dict(state)
+
+
+def torch_from_export(folder: str):
+    """The exported ε-network rebuilt as a torch :class:`.unet.UNet` (eval mode) from ``folder`` alone.
+
+    Shaped by the JSON (its classes, parameter slots and training config) and filled
+    by :func:`exported_weights`, so torch runs the very weights onnxruntime does
+    without the run's checkpoint (which is not kept).
+    """
+    from .train import TrainConfig
+    from .unet import UNet
+
+    doc = load_model_json(folder, "neural_noise.json")
+    cfg = TrainConfig.from_dict(doc["config"])
+    model = UNet(len(doc["classes"]), len(doc["params"]), emb_dim=cfg.emb_dim, widths=cfg.widths)
+    warm_start(model, exported_weights(folder, doc["files"]["eps.onnx"]))
+    return model.eval()
