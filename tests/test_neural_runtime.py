@@ -214,9 +214,11 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     assert "| with CutMix | 0.5 | 3.0 | 0.25 |" in text and "| without CutMix | 0.25 |" in text
     # a model with more classes compares with its predecessor on the predecessor's classes only
     wide = dict(ev, classes=dict(ev["classes"], perlin=dict(fd=99.0, acc=0.0, psd=0.9, response=0.9, param="scale")))
-    text = card(str(run), str(out), wide, None, "train", "test CPU", previous=worse, compare=ev, kept="## Old\nkept")
+    text = card(str(run), str(out), wide, None, "train", "test CPU", previous=worse, compare=ev, kept="## Old\nkept",
+                note="Why: more classes.")
     assert "| mean FD ↓ | 3.0 | 1.5 |" in text and "| spots | 3.0 / 1.5 | 0.25 / 0.5 | 0.4 / 0.2 |" in text
     assert "on its 1 classes (spots)" in text and "| perlin | 99.0 |" in text and "## Old\nkept\n" in text
+    assert "| spots | 3.0 / 1.5 | 0.25 / 0.5 | 0.4 / 0.2 |\n\nWhy: more classes.\n" in text
 
 
 def test_model_card_without_the_run(exported, tmp_path):

@@ -97,11 +97,12 @@ def run_figures(run: str | None, meta: dict, wall_minutes: float | None = None,
 def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None,
          previous: dict | None = None, previous_label: str = "previous model", ablation_label: str = "",
          ablation_reference: dict | None = None, compare: dict | None = None, kept: str = "",
-         wall_minutes: float | None = None, final_mse: float | None = None) -> str:
+         wall_minutes: float | None = None, final_mse: float | None = None, note: str = "") -> str:
     """The card's markdown.  ``ablation_reference``: the evaluation of the CutMix model trained like
     the ablation (same steps) when this model was trained longer; default: this model.
     ``compare``: this model evaluated on ``previous``'s classes with the same instrument (when the
-    two models know different classes); ``kept``: sections carried over from the earlier card."""
+    two models know different classes); ``kept``: sections carried over from the earlier card; ``note``:
+    a paragraph closing the comparison (why this model replaced the previous one)."""
     with open(os.path.join(model, "neural_noise.json"), encoding="utf-8") as fh:
         meta = json.load(fh)
     wall, mse, source = run_figures(run, meta, wall_minutes, final_mse)
@@ -165,6 +166,8 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
             for name, r in previous["classes"].items():
                 c = compare["classes"][name]
                 lines.append(f"| {name} | {r['fd']} / {c['fd']} | {r['acc']} / {c['acc']} | {r['psd']} / {c['psd']} |")
+        if note:
+            lines += ["", note.strip()]
     if ablation is not None:
         ref = ablation_reference if ablation_reference is not None else ev
         lines += ["", "## CutMix ablation (Fig. 13)", "",
@@ -198,6 +201,7 @@ def main(argv=None) -> int:
     ap.add_argument("--ablation-reference", help="evaluation JSON of the CutMix model with the ablation's steps")
     ap.add_argument("--compare-eval", help="evaluation JSON of this model on the previous model's classes "
                                            "(bench/eval_neural.py --classes ...), when their classes differ")
+    ap.add_argument("--note", default="", help="a paragraph after the comparison: why this model replaced the previous")
     ap.add_argument("--keep-from", help="an earlier card whose --keep sections are carried over verbatim")
     ap.add_argument("--keep", action="append", default=[], help="a '## ' heading of --keep-from (repeatable)")
     ap.add_argument("-o", "--out", required=True)
@@ -215,7 +219,7 @@ def main(argv=None) -> int:
                 ap.error(str(exc))
     try:
         text = card(a.run, a.model, ev, abl, a.train_command, a.hardware, prev, a.previous_label, a.ablation_label,
-                    ref, cmp, kept, a.wall_minutes, a.final_mse)
+                    ref, cmp, kept, a.wall_minutes, a.final_mse, a.note)
     except ValueError as exc:
         ap.error(str(exc))
     with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
