@@ -25,9 +25,10 @@ from .._export import export as _ex
 
 from ..neural.model import sha256_file
 from . import zoo
+from .model_card import run_record
 from .train import TrainConfig, build_model, model_names
 
-__all__ = ["export", "onnx_export", "run_record"]
+__all__ = ["export", "onnx_export"]
 
 FORMAT = 1
 
@@ -38,16 +39,6 @@ def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dyn
     torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
                       opset_version=17, dynamo=False)
     os.replace(tmp, path)
-
-
-def run_record(log_path: str) -> dict:
-    """What a model card needs from a run's log.jsonl: wall seconds (over resumed segments) and the final MSE."""
-    from .model_card import wall_seconds
-
-    with open(log_path, encoding="utf-8") as fh:
-        last = [json.loads(line) for line in fh if line.strip()][-1]
-    return dict(wall_seconds=round(wall_seconds(log_path), 1), final_mse=round(float(last["mse"]), 5),
-                log_step=int(last["step"]))
 
 
 def _export_one(model, path: str, size: int) -> None:

@@ -19,7 +19,7 @@ import os
 import platform
 import sys
 
-__all__ = ["wall_seconds", "card"]
+__all__ = ["wall_seconds", "run_record", "run_figures", "card"]
 
 
 def wall_seconds(log_path: str) -> float:
@@ -32,6 +32,15 @@ def wall_seconds(log_path: str) -> float:
                 total += last
             last = s
     return total + last
+
+
+def run_record(log_path: str) -> dict:
+    """What a card needs from a run's log.jsonl (the export keeps it): wall seconds over resumed segments,
+    the final MSE (mean of the last log window) and the step it was logged at."""
+    with open(log_path, encoding="utf-8") as fh:
+        last = [json.loads(line) for line in fh if line.strip()][-1]
+    return dict(wall_seconds=round(wall_seconds(log_path), 1), final_mse=round(float(last["mse"]), 5),
+                log_step=int(last["step"]))
 
 
 def read_json(path: str | None):
@@ -83,12 +92,13 @@ def run_figures(run: str | None, meta: dict, wall_minutes: float | None = None,
     record, else the figures given; ValueError when none of these has them.
     """
     if run:
-        with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
-            last = [json.loads(line) for line in fh if line.strip()][-1]
-        return wall_seconds(os.path.join(run, "log.jsonl")) / 60, last["mse"], "the run's log"
-    if "training" in meta:
-        rec = meta["training"]
-        return rec["wall_seconds"] / 60, rec["final_mse"], "the run's log, recorded in the export's JSON"
+        rec, source = run_record(os.path.join(run, "log.jsonl")), "the run's log"
+    elif "training" in meta:
+        rec, source = meta["training"], "the run's log, recorded in the export's JSON"
+    else:
+        rec = None
+    if rec is not None:
+        return rec["wall_seconds"] / 60, rec["final_mse"], source
     if wall_minutes is None or final_mse is None:
         raise ValueError("no --run, and the export has no training record: give --wall-minutes and --final-mse")
     return wall_minutes, final_mse, "the run's log when it finished (the run folder is not kept)"
