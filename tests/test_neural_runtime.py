@@ -193,6 +193,12 @@ def test_neural_cli(exported, tmp_path, capsys):
     assert "no neural_noise.json" in capsys.readouterr().err
 
 
+# an evaluation document as bench/eval_neural.py writes it, one class, for the card tests
+EVAL = dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param="scale")}, zoo_accuracy=0.9,
+            seam_tileable=1.1, seam_plain=3.0, locality=0.75, model=dict(n=4, steps=5),
+            timing=dict(size=64, onnxruntime_s=0.1, torch_s=0.2, ratio=2.0, max_eps_difference=1e-6))
+
+
 def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     from backend.training.model_card import card, wall_seconds
 
@@ -200,9 +206,7 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     log = tmp_path / "log.jsonl"
     log.write_text("\n".join(json.dumps(dict(step=i, seconds=s, mse=0.1)) for i, s in enumerate([5, 10, 3, 7])))
     assert wall_seconds(str(log)) == 17  # two segments: 10 s, then a resume for 7 s
-    ev = dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param="scale")}, zoo_accuracy=0.9,
-              seam_tileable=1.1, seam_plain=3.0, locality=0.75, model=dict(n=4, steps=5),
-              timing=dict(size=64, onnxruntime_s=0.1, torch_s=0.2, ratio=2.0, max_eps_difference=1e-6))
+    ev = EVAL
     text = card(str(run), str(out), ev, dict(ev, locality=0.5), "python -m backend.training.train ...", "test CPU")
     meta = json.loads((out / "neural_noise.json").read_text())
     assert meta["files"]["eps.onnx"] in text and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
@@ -244,10 +248,7 @@ def test_model_card_without_the_run(exported, tmp_path):
     with pytest.raises(ValueError, match="give --wall-minutes and --final-mse"):
         run_figures(None, doc)
     ev = tmp_path / "ev.json"
-    ev.write_text(json.dumps(dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param="scale")},
-                                  zoo_accuracy=0.9, seam_tileable=1.1, seam_plain=3.0, locality=0.75,
-                                  model=dict(n=4, steps=5), timing=dict(size=64, onnxruntime_s=0.1, torch_s=0.2,
-                                                                        ratio=2.0, max_eps_difference=1e-6))))
+    ev.write_text(json.dumps(EVAL))
     card_out = tmp_path / "CARD.md"
     base = ["--model", str(old), "--eval", str(ev), "--train-command", "train", "-o", str(card_out)]
     with pytest.raises(SystemExit):
