@@ -10,6 +10,7 @@ import bpy
 from mathutils import Vector
 
 from ._deps import backend
+from .compat import ensure_node_tree
 
 __all__ = ["ramp_node", "transfer_from_color_ramp", "apply_preset", "world_bounds", "load_volume",
            "load_image", "RAMP_GROUP"]
@@ -96,8 +97,7 @@ def _file_path(path: str) -> str:
 
 def _volume_material(name: str, temperature: bool):
     mat = bpy.data.materials.get(name) or bpy.data.materials.new(name)
-    if mat.node_tree is None:  # Blender 4.x: new materials start without nodes
-        mat.use_nodes = True
+    ensure_node_tree(mat)
     nt = mat.node_tree
     nt.nodes.clear()
     out = nt.nodes.new("ShaderNodeOutputMaterial")
@@ -165,8 +165,7 @@ def load_image(name: str, paths: list, frames, raw: bool, target_material=None):
     mat = target_material
     if mat is None:
         mat = bpy.data.materials.get(f"OmniNoise {name}") or bpy.data.materials.new(f"OmniNoise {name}")
-        if mat.node_tree is None:  # Blender 4.x: new materials start without nodes
-            mat.use_nodes = True
+        ensure_node_tree(mat)
     nt = mat.node_tree
     node = next((n for n in nt.nodes if n.type == "TEX_IMAGE" and n.image == img), None)
     if node is None:

@@ -21,7 +21,7 @@ from ._deps import backend
 from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
                            transfer_from_color_ramp, world_bounds)
 from .preferences import threads
-from .wave_nodes import SETTINGS_KEY, settings_from_json
+from .wave_nodes import settings_from_json, tree_settings_json
 from .wave_ui import OMNINOISE_PG_wave, draw_wave_settings
 
 __all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "draw_progress", "register", "unregister"]
@@ -44,7 +44,7 @@ def _apply_preset(self, context) -> None:
 
 
 def _is_wave_group(self, tree) -> bool:
-    return bool(tree.get(SETTINGS_KEY)) and tree.omninoise_wave.is_wave
+    return bool(tree_settings_json(tree)) and tree.omninoise_wave.is_wave
 
 
 class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
@@ -107,7 +107,10 @@ def _settings(p: OMNINOISE_PG_bake):
     if p.source == "NODE":
         if p.node_group is None:
             raise backend.SettingError("node group", "pick a Wave Noise node group to bake")
-        s = settings_from_json(p.node_group[SETTINGS_KEY])
+        text = tree_settings_json(p.node_group)
+        if text is None:
+            raise backend.SettingError("node group", f"{p.node_group.name!r} holds no Wave Noise settings")
+        s = settings_from_json(text)
     else:
         s = p.wave.to_settings(node=False)
     return s.replace(output=p.output, cellular=p.cellular)

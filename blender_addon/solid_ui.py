@@ -28,6 +28,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty,
 
 from . import tasks
 from ._deps import backend
+from .compat import ensure_node_tree
 from .bake_ui import _TaskOperator, draw_progress
 from .preferences import threads
 
@@ -224,8 +225,7 @@ def _material_with(obj, name: str, make_node):
     if mat is None or mat.node_tree is None or \
             not any(n.type == "BSDF_PRINCIPLED" for n in mat.node_tree.nodes):
         mat = bpy.data.materials.get(f"OmniNoise {name}") or bpy.data.materials.new(f"OmniNoise {name}")
-        if mat.node_tree is None:
-            mat.use_nodes = True
+        ensure_node_tree(mat)
         if obj.active_material is None:
             obj.data.materials.append(mat)
         else:

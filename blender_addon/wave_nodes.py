@@ -29,7 +29,9 @@ Geometry Nodes groups (fields on geometry).
 
 Rebuilding for new settings clears the inner nodes and keeps the interface,
 so links to the group node survive.  Settings are stored as JSON on the tree
-(``tree["omninoise_wave"]``).
+(``tree["omninoise_wave_settings"]``; files saved by OmniNoise 0.1 on Blender 5.0
+used ``tree["omninoise_wave"]``, the name of the ``NodeTree.omninoise_wave``
+property, which Blender before 5.0 refuses as a custom key; both are read).
 """
 from __future__ import annotations
 
@@ -40,12 +42,20 @@ import bpy
 import numpy as np
 
 from ._deps import backend
+from .compat import id_property
 
 __all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json", "settings_from_json",
-           "INPUTS", "OUTPUTS", "SETTINGS_KEY"]
+           "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json"]
 
 _F = np.float32
-SETTINGS_KEY = "omninoise_wave"
+SETTINGS_KEY = "omninoise_wave_settings"
+#: the key of OmniNoise 0.1 (Blender 5.0 only: before 5.0 it collides with the registered property)
+LEGACY_SETTINGS_KEY = "omninoise_wave"
+
+
+def tree_settings_json(tree) -> str | None:
+    """The settings JSON stored on a Wave Noise (or Wave Cellular) tree, or None if it has none."""
+    return id_property(tree, SETTINGS_KEY, LEGACY_SETTINGS_KEY)
 #: (name, socket type, default) of the group's inputs and outputs
 INPUTS = (("Vector", "NodeSocketVector", (0.0, 0.0, 0.0)), ("W", "NodeSocketFloat", 0.0),
           ("Scale", "NodeSocketFloat", 1.0), ("Time", "NodeSocketFloat", 0.0))

@@ -26,13 +26,13 @@ _F = np.float32
 
 
 def openvdb_module():
-    """The ``openvdb`` module: importable directly (Blender), or found inside the bpy wheel."""
-    try:
-        import openvdb
-
-        return openvdb
-    except ImportError:
-        pass
+    """The ``openvdb`` module: importable directly (Blender 4.4+), as ``pyopenvdb`` (Blender 4.2-4.3),
+    or found inside the bpy wheel.  The 4.2 ``bpy`` wheel has none: RuntimeError says so in one line."""
+    for name in ("openvdb", "pyopenvdb"):
+        try:
+            return importlib.import_module(name)
+        except ImportError:
+            pass
     spec = importlib.util.find_spec("bpy")
     roots = list(spec.submodule_search_locations or []) if spec is not None else []
     for root in roots:
@@ -43,8 +43,9 @@ def openvdb_module():
             import openvdb
 
             return openvdb
-    raise RuntimeError("writing .vdb needs the openvdb module bundled with Blender: run inside Blender "
-                       "or install the bpy module (pip install bpy==5.0.1)")
+    raise RuntimeError("writing .vdb needs Blender's OpenVDB Python module (openvdb, or pyopenvdb in "
+                       "Blender 4.2), which this Blender or bpy build lacks; write .npy or .exr instead, "
+                       "or use Blender 4.4+ / pip install bpy==5.0.1")
 
 
 class VolumeWriter:

@@ -1,8 +1,11 @@
 """Build the installable extension zips with Blender's own builder (``make dist``).
 
 1. Download the pinned wheels Blender lacks (onnxruntime, OpenEXR and their
-   dependencies, minus numpy, which Blender bundles) for Python 3.11 on
+   dependencies, minus numpy, which Blender bundles) for every Python the
+   supported Blenders run (3.11: Blender 4.2-5.0; 3.13: Blender 5.1+) on
    linux-x64, windows-x64 and macos-arm64 into ``wheels/`` (kept between runs).
+   One zip per platform carries both; Blender installs the wheels that match
+   its own Python and the builder lists both versions in ``python_versions``.
 2. Stage the runtime files only (extension root, ``blender_addon``, ``backend``,
    ``export``; no tests, bench, demo or training code) into ``build/extension``
    and list the platforms and wheels in the staged manifest.
@@ -25,6 +28,8 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PINS = {"onnxruntime": "1.31.1", "OpenEXR": "3.5.3"}
+#: the Pythons of the supported Blenders: 4.2 LTS-5.0 run 3.11, 5.1 and newer 3.13
+PYTHONS = ("3.11", "3.13")
 PLATFORMS = {  # Blender platform -> pip platform tag
     "linux-x64": "manylinux_2_28_x86_64",
     "windows-x64": "win_amd64",
@@ -46,17 +51,24 @@ def blender_ext() -> str:
     sys.exit(f"make dist: blender_ext.py not found under {base}")
 
 
+def _has_pins(folder: str, py: str) -> bool:
+    """Every pinned package has a wheel for Python ``py`` (cp311 ...) in ``folder``."""
+    cp = "cp" + py.replace(".", "")
+    have = [f.lower() for f in os.listdir(folder) if f.endswith(".whl")]
+    return all(any(f.startswith(n.lower() + "-" + v + "-") and f"-{cp}-" in f for f in have) for n, v in PINS.items())
+
+
 def download_wheels() -> list[str]:
     out = []
     for plat, tag in PLATFORMS.items():
         dest = os.path.join(ROOT, "wheels", plat)
         os.makedirs(dest, exist_ok=True)
-        have = [f for f in os.listdir(dest) if f.endswith(".whl")]
-        if not all(any(f.lower().startswith(n.lower() + "-" + v) for f in have) for n, v in PINS.items()):
-            cmd = [sys.executable, "-m", "pip", "download", "--quiet", "--only-binary=:all:", "--python-version",
-                   "3.11", "--platform", tag, "-d", dest] + [f"{n}=={v}" for n, v in PINS.items()]
-            print("downloading wheels for", plat, flush=True)
-            subprocess.run(cmd, check=True)
+        for py in PYTHONS:
+            if not _has_pins(dest, py):
+                cmd = [sys.executable, "-m", "pip", "download", "--quiet", "--only-binary=:all:", "--python-version",
+                       py, "--platform", tag, "-d", dest] + [f"{n}=={v}" for n, v in PINS.items()]
+                print(f"downloading wheels for {plat}, Python {py}", flush=True)
+                subprocess.run(cmd, check=True)
         for f in sorted(os.listdir(dest)):
             if f.endswith(".whl") and not f.startswith("numpy-"):
                 out.append(os.path.join(dest, f))
