@@ -47,5 +47,5 @@ class Diffusion:
         t = torch.randint(0, self.T, (B,), generator=generator, device=x0.device)
         eps = self.noise_like(x0, generator)
         pred = model(self.q_sample(x0, t, eps), t.to(torch.float32), cond)
-        mse = torch.mean((pred - eps) ** 2)
+        mse = torch.mean((pred.float() - eps) ** 2)  # fp32 even under bf16 autocast
         return mse + self.embedding_penalty(model.class_emb.weight), mse

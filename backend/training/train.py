@@ -28,6 +28,7 @@ import torch
 from . import zoo
 from .cutmix import cutmix
 from .diffusion import Diffusion
+from .precision import PRECISIONS, autocast, resolve
 from .threads import cpu_threads
 from .unet import UNet
 from .warm_start import exported_weights, warm_start
@@ -71,6 +72,8 @@ class TrainConfig:
     threads: int = 0               # CPU threads for torch and numba (0: their defaults), see .threads
     init_onnx: str = ""            # a fresh run starts from this export's weights (see .warm_start) ...
     init_sha256: str = ""          # ... which must have this eps.onnx sha256
+    precision: str = "auto"        # auto | fp32 | bf16: bf16 autocast where the CPU/GPU computes bf16 natively (.precision)
+    channels_last: bool = False    # NHWC activations and weights (faster with bf16 on oneDNN)
 
     @classmethod
     def from_dict(cls, d: dict) -> "TrainConfig":
@@ -84,6 +87,8 @@ class TrainConfig:
             raise ValueError(f"unknown class {bad[0]!r}")
         if d.get("size", 64) % 8:
             raise ValueError(f"size must be a multiple of 8, got {d['size']}")
+        if d.get("precision", "auto") not in PRECISIONS:
+            raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {d['precision']!r}")
         if d.get("init_onnx") and not d.get("init_sha256"):
             raise ValueError("init_onnx needs init_sha256 (the eps.onnx hash the run starts from)")
         return cls(**d)
@@ -166,6 +171,9 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
         warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256))
         log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...)")
     model = model.to(device)
+    precision = resolve(cfg.precision, device)
+    fmt = torch.channels_last if cfg.channels_last else torch.contiguous_format
+    model = model.to(memory_format=fmt)
     ema = copy.deepcopy(model).eval()
     for p_ in ema.parameters():
         p_.requires_grad_(False)
@@ -182,6 +190,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
         rng.bit_generator.state = state["rng"]
         gen.set_state(state["gen"].to(gen.get_state().device) if hasattr(state["gen"], "to") else state["gen"])
         log(f"resumed at step {step}")
+    log(f"precision {precision}, channels_last {cfg.channels_last}, {torch.get_num_threads()} threads")
     with open(os.path.join(out, "config.json"), "w", encoding="utf-8") as fh:
         json.dump(asdict(cfg), fh, indent=2)
     del state
@@ -196,9 +205,10 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
             imgs, idm, pm = imgs.flip(-1), idm.flip(-1), pm.flip(-1)
         if rng.random() < 0.5:
             imgs, idm, pm = imgs.flip(-2), idm.flip(-2), pm.flip(-2)
-        x0 = (imgs * 2.0 - 1.0).to(device)
+        x0 = (imgs * 2.0 - 1.0).to(device).contiguous(memory_format=fmt)
         model.train()
-        loss, mse = diff.loss(model, x0, model.embed(idm.to(device), pm.to(device)), gen)
+        with autocast(precision, device):
+            loss, mse = diff.loss(model, x0, model.embed(idm.to(device), pm.to(device)).contiguous(memory_format=fmt), gen)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
@@ -210,6 +220,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
         losses.append(float(mse.detach()))
         if step % cfg.log_every == 0 or step == end:
             last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss.detach()), seconds=round(time.time() - t0, 2),
+                        precision=precision, threads=torch.get_num_threads(),
                         emb_norm=float(model.class_emb.weight.detach().norm(dim=1).mean()))
             losses = []
             with open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8") as fh:
