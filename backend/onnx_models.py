@@ -6,7 +6,22 @@ import hashlib
 import json
 import os
 
-__all__ = ["ModelError", "sha256_file", "load_model_json", "SessionCache"]
+__all__ = ["ModelError", "sha256_file", "load_model_json", "fingerprint", "SessionCache", "set_default_threads",
+           "default_threads"]
+
+_THREADS = {"default": 0}
+
+
+def set_default_threads(n: int) -> None:
+    """onnxruntime intra-op threads for sessions created without their own count (0: onnxruntime's
+    default, one per physical core); the CLI's ``--threads`` and the add-on's preference set it."""
+    if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+        raise ValueError(f"threads must be a whole number >= 0, got {n!r}")
+    _THREADS["default"] = n
+
+
+def default_threads() -> int:
+    return _THREADS["default"]
 
 
 class ModelError(RuntimeError):
@@ -38,6 +53,15 @@ def load_model_json(folder: str, json_name: str) -> dict:
     return doc
 
 
+def fingerprint(files: dict) -> str:
+    """One sha256 naming a model's weights: the file's own hash for a lone ``eps.onnx`` (as pinned
+    before split exports), else the sha256 of its ``name=sha256`` lines, sorted."""
+    if set(files) == {"eps.onnx"}:
+        return files["eps.onnx"]
+    text = "".join(f"{k}={v}\n" for k, v in sorted(files.items()))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 class SessionCache:
     """onnxruntime sessions of a folder's .onnx files, created on first use (CPU, ``threads`` intra-op)."""
 
@@ -49,8 +73,9 @@ class SessionCache:
             import onnxruntime as ort
 
             opts = ort.SessionOptions()
-            if self.threads:
-                opts.intra_op_num_threads = self.threads
+            threads = self.threads or _THREADS["default"]
+            if threads:
+                opts.intra_op_num_threads = threads
             self._sessions[name] = ort.InferenceSession(os.path.join(self.folder, name), opts,
                                                         providers=["CPUExecutionProvider"])
         return self._sessions[name]

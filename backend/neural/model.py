@@ -1,10 +1,13 @@
 """The exported neural noise model, run by onnxruntime (no torch).
 
-A model folder holds ``eps.onnx`` and ``neural_noise.json`` (see
-``backend/training/export_onnx.py``).  Loading checks the .onnx file's sha256
-against the JSON before onnxruntime sees it; the session is created on first
-use.  The graph's ``tile`` input switches every convolution between zero and
-circular padding (seamless tiles).
+A model folder holds ``neural_noise.json`` and, by its ``form`` (see
+``backend/training/export_onnx.py``), either ``encoder.onnx`` + ``denoiser.onnx``
+(``split``: the conditioning's SPADE maps are computed once per image and only
+the denoiser runs at every step) or one ``eps.onnx`` (``one-piece``, the form of
+older exports, still loaded).  Loading checks every file's sha256 against the
+JSON before onnxruntime sees it; sessions are created on first use.  The graphs'
+``tile`` input switches every convolution between zero and circular padding
+(seamless tiles).
 """
 from __future__ import annotations
 
@@ -12,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SettingError
-from ..onnx_models import ModelError, SessionCache, load_model_json, sha256_file
+from ..onnx_models import ModelError, SessionCache, fingerprint, load_model_json, sha256_file
+from .schedule import alphas_from_config
 
 __all__ = ["NeuralNoiseModel", "ModelError", "sha256_file"]
 
@@ -35,20 +39,59 @@ class NeuralNoiseModel:
         self.class_params = self.config["class_params"]
         self.embedding = np.asarray(self.config["class_embedding"], _F)
         self.multiple_of = int(self.config.get("multiple_of", 8))
+        self.form = self.config.get("form", "one-piece")
+        need = {"split": ("encoder.onnx", "denoiser.onnx"), "one-piece": ("eps.onnx",)}.get(self.form)
+        if need is None:
+            raise ModelError(f"{folder}: unknown model form {self.form!r}")
+        missing = [n for n in need if n not in self.config.get("files", {})]
+        if missing:
+            raise ModelError(f"{folder}: neural_noise.json lists no sha256 for {missing[0]}")
+        #: one sha256 for the weights, whatever the form (see backend.onnx_models.fingerprint)
+        self.fingerprint = fingerprint(self.config["files"])
+        if self.config.get("prediction", "epsilon") != "epsilon":
+            raise ModelError(f"{folder}: prediction {self.config['prediction']!r} is not supported (epsilon only)")
+        try:
+            #: float64 (T,) ᾱ of the schedule the JSON declares
+            self.alphas_cumprod = alphas_from_config(self.config.get("schedule", {"kind": "cosine"}))
+        except ValueError as exc:
+            raise ModelError(f"{folder}: {exc}") from None
         self.threads = threads
         self._sessions = SessionCache(folder, threads)
 
-    def session(self):
-        return self._sessions("eps.onnx")
+    def session(self, name: str | None = None):
+        """The onnxruntime session of ``name`` (default: the ε-network of a one-piece export, the denoiser of a split one)."""
+        return self._sessions(name or ("denoiser.onnx" if self.form == "split" else "eps.onnx"))
+
+    def encode(self, cond: np.ndarray, tileable: bool = False) -> dict:
+        """Split form: cond float32 (B, C, H, W) -> {m00: [1 + γ, β] of ResBlock 0, ...} for the denoiser."""
+        sess = self.session("encoder.onnx")
+        tile = np.array([1.0 if tileable else 0.0], _F)
+        names = [o.name for o in sess.get_outputs()]
+        return dict(zip(names, sess.run(None, {"cond": np.ascontiguousarray(cond, _F), "tile": tile})))
 
     def eps_fn(self, tileable: bool = False):
-        """model(x, t, cond) -> ε callable for :func:`backend.neural.sampler.ddim_sample`."""
-        sess = self.session()
+        """model(x, t, cond) -> ε callable for the samplers of :mod:`backend.neural.sampler`.
+
+        With a split export the encoder runs when ``cond`` is a new array (by identity:
+        a sampler passes the same array at every step) and its maps are reused.
+        """
         tile = np.array([1.0 if tileable else 0.0], _F)
+        if self.form == "one-piece":
+            sess = self.session()
+
+            def eps(x, t, cond):
+                return sess.run(None, {"x": np.ascontiguousarray(x, _F), "t": np.ascontiguousarray(t, _F),
+                                       "cond": np.ascontiguousarray(cond, _F), "tile": tile})[0]
+
+            return eps
+        sess = self.session("denoiser.onnx")
+        cache = {"cond": None, "maps": None}
 
         def eps(x, t, cond):
-            return sess.run(None, {"x": np.ascontiguousarray(x, _F), "t": np.ascontiguousarray(t, _F),
-                                   "cond": np.ascontiguousarray(cond, _F), "tile": tile})[0]
+            if cache["cond"] is not cond:
+                cache["cond"], cache["maps"] = cond, self.encode(cond, tileable)
+            feed = dict(cache["maps"], x=np.ascontiguousarray(x, _F), t=np.ascontiguousarray(t, _F), tile=tile)
+            return sess.run(None, feed)[0]
 
         return eps
 

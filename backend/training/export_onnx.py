@@ -1,16 +1,28 @@
 """Export a trained ε-network to ONNX for the runtime: ``python -m backend.training.export_onnx RUN OUT_DIR``.
 
-Writes, each atomically:
+Two forms (``form`` in the JSON).  ``split`` (the default) is what the runtime
+wants: the SPADE branch depends on the conditioning only (see :mod:`.unet`), so it
+is a graph of its own that a sampler runs once per image:
 
-    OUT_DIR/eps.onnx           inputs x, t, cond, tile -> eps (batch, height, width dynamic);
-                               tile = [0.0] zero padding, [1.0] circular padding (seamless tiles),
-                               one graph for both so the weights ship once
+    OUT_DIR/encoder.onnx       inputs cond, tile -> m00 .. mNN: every ResBlock's [1 + γ₂, β₂]
+                               (batch, height, width dynamic; block k at H / 2^level_k)
+    OUT_DIR/denoiser.onnx      inputs x, t, tile, m00 .. mNN -> eps
+
+``one-piece`` (``--one-piece``; the form of models exported before the split):
+
+    OUT_DIR/eps.onnx           inputs x, t, cond, tile -> eps (batch, height, width dynamic)
+
+In both, tile = [0.0] means zero padding and [1.0] circular padding (seamless
+tiles): one graph for both so the weights ship once.  And:
+
     OUT_DIR/neural_noise.json  schedule, class and parameter names and ranges, the class-embedding
                                table, the training config and step, the run's record (wall time
                                and final loss from its log.jsonl, since runs are not kept), and
                                the .onnx file's sha256 (the runtime refuses a file whose hash differs)
 
-The EMA weights are exported (``--raw`` for the optimiser's weights).
+The EMA weights are exported (``--raw`` for the optimiser's weights).  An older
+export is re-exported from its own weights, without a checkpoint:
+``python -m backend.training.export_onnx --from-export OLD_DIR OUT_DIR``.
 """
 from __future__ import annotations
 
@@ -28,9 +40,9 @@ from . import zoo
 from .model_card import run_record
 from .train import TrainConfig, build_model, model_names
 
-__all__ = ["export", "onnx_export"]
+__all__ = ["export", "export_model", "reexport", "onnx_export"]
 
-FORMAT = 1
+FORMAT = 2  # 2: "form" (one-piece | split); a format-1 JSON is a one-piece export
 
 
 def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dynamic: dict) -> None:
@@ -49,43 +61,118 @@ def _export_one(model, path: str, size: int) -> None:
                  "cond": {0: "batch", 2: "height", 3: "width"}, "eps": {0: "batch", 2: "height", 3: "width"}})
 
 
-def export(run: str, out: str, raw: bool = False, extra: dict | None = None) -> dict:
+class _Encoder(torch.nn.Module):
+    def __init__(self, net):
+        super().__init__()
+        self.net = net
+
+    def forward(self, cond, tile):
+        return tuple(self.net.encode(cond, tile))
+
+
+class _Denoiser(torch.nn.Module):
+    def __init__(self, net):
+        super().__init__()
+        self.net = net
+
+    def forward(self, x, t, tile, *maps):
+        return self.net.denoise(x, t, list(maps), tile)
+
+
+def map_names(model) -> list:
+    """m00, m01, ...: one SPADE map input per ResBlock, in :meth:`UNet.blocks` order."""
+    return [f"m{k:02d}" for k in range(len(model.blocks()))]
+
+
+def _export_split(model, out: str, size: int) -> dict:
+    """encoder.onnx + denoiser.onnx in ``out``; returns the JSON's ``blocks`` description."""
+    C = model.emb_dim + model.n_params
+    cond, tile = torch.randn(1, C, size, size), torch.zeros(1)
+    names = map_names(model)
+    hw = {0: "batch", 2: "height", 3: "width"}
+    onnx_export(_Encoder(model), (cond, tile), os.path.join(out, "encoder.onnx"), ["cond", "tile"], names,
+                {"cond": hw, **{n: {0: "batch", 2: f"h{n}", 3: f"w{n}"} for n in names}})
+    with torch.no_grad():
+        maps = model.encode(cond, tile)
+    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), tile, *maps)
+    onnx_export(_Denoiser(model), args, os.path.join(out, "denoiser.onnx"), ["x", "t", "tile"] + names, ["eps"],
+                {"x": hw, "t": {0: "batch"}, "eps": hw, **{n: {0: "batch", 2: f"h{n}", 3: f"w{n}"} for n in names}})
+    return dict(names=names, channels=[int(m.shape[1]) for m in maps], levels=[lvl for _, lvl in model.blocks()])
+
+
+def export_model(model, out: str, meta: dict, one_piece: bool = False) -> dict:
+    """Write ``model`` (eval mode) into folder ``out`` in either form with a JSON of ``meta`` plus what the runtime needs."""
+    classes, params = model_names(model)
+    os.makedirs(out, exist_ok=True)
+    size = int(meta["train_size"])
+    doc = dict(format=FORMAT, model="neural_noise", paper="Maesumi et al. 2024, One Noise to Rule Them All",
+               schedule=dict(kind="cosine", T=1000, s=0.008), prediction="epsilon",
+               classes=classes, params=params,
+               class_params={k: v for k, v in zoo.describe().items() if k in classes}, emb_dim=model.emb_dim,
+               class_embedding=model.class_emb.weight.detach().numpy().astype(float).round(7).tolist(),
+               multiple_of=8)
+    doc.update(meta)
+    if one_piece:
+        _export_one(model, os.path.join(out, "eps.onnx"), size)
+        doc.update(form="one-piece", files={"eps.onnx": sha256_file(os.path.join(out, "eps.onnx"))})
+    else:
+        doc.update(form="split", blocks=_export_split(model, out, size))
+        doc["files"] = {n: sha256_file(os.path.join(out, n)) for n in ("encoder.onnx", "denoiser.onnx")}
+    _ex.write_json(os.path.join(out, "neural_noise.json"), doc)
+    return doc
+
+
+def export(run: str, out: str, raw: bool = False, extra: dict | None = None, one_piece: bool = False) -> dict:
     """Export checkpoint ``run/ckpt.pt`` into folder ``out``; returns the JSON config written."""
     state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
     cfg = TrainConfig.from_dict(state["config"])
     model = build_model(cfg, state["model"])
     model.load_state_dict(state["model" if raw else "ema"])
-    classes, params = model_names(model)
     model.eval()
-    os.makedirs(out, exist_ok=True)
-    _export_one(model, os.path.join(out, "eps.onnx"), cfg.size)
-    files = {"eps.onnx": sha256_file(os.path.join(out, "eps.onnx"))}
-    doc = dict(format=FORMAT, model="neural_noise", paper="Maesumi et al. 2024, One Noise to Rule Them All",
-               schedule=dict(kind="cosine", T=1000, s=0.008), prediction="epsilon",
-               classes=classes, trained_classes=list(cfg.classes), params=params,
-               class_params={k: v for k, v in zoo.describe().items() if k in classes}, emb_dim=cfg.emb_dim,
-               class_embedding=model.class_emb.weight.detach().numpy().astype(float).round(7).tolist(),
-               train_size=cfg.size, step=int(state["step"]), weights="raw" if raw else "ema",
-               config=state["config"], files=files, multiple_of=8)
+    meta = dict(trained_classes=list(cfg.classes), train_size=cfg.size, step=int(state["step"]),
+                weights="raw" if raw else "ema", config=state["config"])
     log = os.path.join(run, "log.jsonl")
     if os.path.isfile(log):
-        doc["training"] = run_record(log)
-    doc.update(extra or {})
-    path = os.path.join(out, "neural_noise.json")
-    _ex.write_json(path, doc)
-    return doc
+        meta["training"] = run_record(log)
+    meta.update(extra or {})
+    return export_model(model, out, meta, one_piece)
+
+
+#: what a re-export carries over from the old JSON (the rest is rebuilt from the weights)
+_CARRIED = ("trained_classes", "train_size", "step", "weights", "config", "training")
+
+
+def reexport(src: str, out: str, one_piece: bool = False) -> dict:
+    """Export folder ``src`` again, from its own weights (torch rebuilt from the export), into ``out``."""
+    from ..onnx_models import load_model_json
+    from .warm_start import torch_from_export
+
+    old = load_model_json(src, "neural_noise.json")
+    model = torch_from_export(src)
+    meta = {k: old[k] for k in _CARRIED if k in old}
+    meta["reexported_from"] = dict(form=old.get("form", "one-piece"), files=old["files"])
+    return export_model(model, out, meta, one_piece)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m backend.training.export_onnx", description=__doc__.split("\n")[0])
-    ap.add_argument("run", help="training run folder (holds ckpt.pt)")
-    ap.add_argument("out", help="output folder for eps.onnx and neural_noise.json")
+    ap.add_argument("run", help="training run folder (holds ckpt.pt), or with --from-export an export folder")
+    ap.add_argument("out", help="output folder for the .onnx files and neural_noise.json")
     ap.add_argument("--raw", action="store_true", help="export the raw weights instead of the EMA")
+    ap.add_argument("--one-piece", action="store_true", help="one eps.onnx instead of encoder + denoiser")
+    ap.add_argument("--from-export", action="store_true", help="RUN is an export folder: re-export its weights")
     a = ap.parse_args(argv)
+    if a.from_export:
+        if os.path.realpath(a.run) == os.path.realpath(a.out):
+            print("export: error: --from-export needs an output folder other than its source", file=sys.stderr)
+            return 2
+        doc = reexport(a.run, a.out, a.one_piece)
+        print(json.dumps(doc["files"], indent=1))
+        return 0
     if not os.path.isfile(os.path.join(a.run, "ckpt.pt")):
         print(f"export: error: no checkpoint in {a.run}", file=sys.stderr)
         return 2
-    doc = export(a.run, a.out, a.raw)
+    doc = export(a.run, a.out, a.raw, one_piece=a.one_piece)
     print(json.dumps(doc["files"], indent=1))
     return 0
 

@@ -104,6 +104,12 @@ def run_figures(run: str | None, meta: dict, wall_minutes: float | None = None,
     return wall_minutes, final_mse, "the run's log when it finished (the run folder is not kept)"
 
 
+def _sampler_words(ev: dict) -> str:
+    """'30 DDIM steps' (evaluations before samplers were selectable) or the sampler the evaluation names."""
+    smp = ev.get("sampler", dict(name="ddim", steps=ev["model"]["steps"]))
+    return f"{smp['steps']} {smp['name'].upper().replace('DPMPP_2M', 'DPM-Solver++(2M)')} steps"
+
+
 def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_command: str, hardware: str | None = None,
          previous: dict | None = None, previous_label: str = "previous model", ablation_label: str = "",
          ablation_reference: dict | None = None, compare: dict | None = None, kept: str = "",
@@ -139,11 +145,12 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
         f"- **Steps:** {meta['step']}. **Wall time:** {wall:.1f} min.",
         f"- **Final training MSE** (mean of the last log window): {mse:.4f}. Wall time and loss are from {source}.",
         f"- **Weights:** {meta['weights']} (exported with `python -m backend.training.export_onnx`).",
-        f"- **sha256** of `eps.onnx`: `{meta['files']['eps.onnx']}`.",
+        f"- **Form:** {meta.get('form', 'one-piece')}; **sha256** "
+        + ", ".join(f"of `{name}`: `{digest}`" for name, digest in sorted(meta["files"].items())) + ".",
         "",
         "## Evaluation (`bench/eval_neural.py`)",
         "",
-        f"{ev['model']['n']} samples per class, {ev['model']['steps']} DDIM steps. The zoo classifier is accurate to "
+        f"{ev['model']['n']} samples per class, {_sampler_words(ev)}. The zoo classifier is accurate to "
         f"{ev['zoo_accuracy']} on held-out zoo samples.",
         "",
         _table(ev),

@@ -15,6 +15,14 @@ The network takes that grid already embedded, so spatial blends of classes
 
 Shapes: x (B, 1, H, W) float32 with H, W multiples of 8; t (B,) float32 in [0, T);
 cond (B, E + P, H, W) float32 -> ε (B, 1, H, W).
+
+The SPADE branch depends on the conditioning alone, not on x_t or t, so the
+forward pass is two functions (one code path for training and both exports):
+
+    maps = encode(cond, tile)          per ResBlock k: (B, 2 C_k, H_k, W_k) = [1 + γ₂, β₂]
+    ε    = denoise(x, t, maps, tile)   the rest of the network
+
+A sampler runs ``encode`` once per image and ``denoise`` at every step.
 """
 from __future__ import annotations
 
@@ -70,10 +78,16 @@ class SPADE(nn.Module):
         self.gamma = Conv3(hid, channels)
         self.beta = Conv3(hid, channels)
 
-    def forward(self, h, feat):
-        f = F.interpolate(feat, size=h.shape[-2:], mode="nearest")
-        f = self.shared(f)
-        return h * (1.0 + self.gamma(f)) + self.beta(f)
+    def maps(self, feat):
+        """feat already resized to the block -> [1 + γ, β] stacked on channels (B, 2C, h, w)."""
+        f = self.shared(feat)
+        return torch.cat([1.0 + self.gamma(f), self.beta(f)], 1)
+
+    @staticmethod
+    def apply(h, maps):
+        """h * (1 + γ) + β with ``maps`` from :meth:`maps`."""
+        g1, b = maps.chunk(2, dim=1)
+        return h * g1 + b
 
 
 class ResBlock(nn.Module):
@@ -87,11 +101,11 @@ class ResBlock(nn.Module):
         self.norm2 = nn.GroupNorm(groups, cout)
         self.skip = nn.Conv2d(cin, cout, 1) if cin != cout else nn.Identity()
 
-    def forward(self, x, temb, feat):
-        """block 1: conv -> GroupNorm -> x(1+γ₁)+β₁ (time) -> x(1+γ₂)+β₂ (SPADE) -> SiLU; block 2 plain."""
+    def forward(self, x, temb, maps):
+        """block 1: conv -> GroupNorm -> x(1+γ₁)+β₁ (time) -> x(1+γ₂)+β₂ (SPADE maps) -> SiLU; block 2 plain."""
         g, b = self.time(F.silu(temb)).chunk(2, dim=1)
         h = self.norm1(self.conv1(x)) * (1.0 + g[:, :, None, None]) + b[:, :, None, None]
-        h = F.silu(self.spade(h, feat))
+        h = F.silu(SPADE.apply(h, maps))
         h = F.silu(self.norm2(self.conv2(h)))
         return h + self.skip(x)
 
@@ -135,32 +149,59 @@ class UNet(nn.Module):
         e = self.class_emb(class_ids).permute(0, 3, 1, 2)
         return torch.cat([e, params], 1)
 
-    def forward(self, x, t, cond, tile=None):
-        """tile: None, or a float tensor (1,) of 0 (zero padding) or 1 (circular: seamless tiles)."""
+    def blocks(self) -> list:
+        """Every ResBlock with its downsampling level (resolution H / 2^level), in the order of the forward pass."""
+        n = len(self.widths)
+        out = [(blk, i) for i, blocks in enumerate(self.down) for blk in blocks]
+        out += [(blk, n) for blk in self.mid]
+        out += [(blk, n - 1 - j) for j, blocks in enumerate(self.up) for blk in blocks]
+        return out + [(self.final, 0)]
+
+    def _set_tile(self, tile, like) -> None:
+        """Every Conv3's padding for this pass: zeros (tile None or 0) or circular (1 or ``circular``)."""
         if tile is None and self.circular:
-            tile = torch.ones(1, device=x.device)
+            tile = torch.ones(1, device=like.device)
         for m in self.modules():
             if isinstance(m, Conv3):
-                m.tile = None if tile is None else tile.reshape(()).to(x.dtype)
+                m.tile = None if tile is None else tile.reshape(()).to(like.dtype)
+
+    def encode(self, cond, tile=None) -> list:
+        """cond (B, E + P, H, W) -> [maps of each ResBlock in :meth:`blocks` order] (see SPADE.maps)."""
+        self._set_tile(tile, cond)
         feat = self.cond_mlp(cond)
+        H, W = cond.shape[-2:]
+        levels = {}
+        for _, lvl in self.blocks():
+            if lvl not in levels:  # nearest resize by 2^lvl, once per level (Park et al.: F resized to the block)
+                levels[lvl] = feat if lvl == 0 else F.interpolate(feat, size=(H >> lvl, W >> lvl), mode="nearest")
+        return [blk.spade.maps(levels[lvl]) for blk, lvl in self.blocks()]
+
+    def denoise(self, x, t, maps, tile=None):
+        """ε from x (B, 1, H, W), t (B,) and :meth:`encode`'s maps."""
+        self._set_tile(tile, x)
+        maps = iter(maps)
         temb = self.temb(t)
         h = self.init(x)
         h0 = h
         skips = []
         for blocks, down in zip(self.down, self.downsample):
             for blk in blocks:
-                h = blk(h, temb, feat)
+                h = blk(h, temb, next(maps))
             skips.append(h)
             h = down(h)
         for blk in self.mid:
-            h = blk(h, temb, feat)
+            h = blk(h, temb, next(maps))
         for blocks, up in zip(self.up, self.upsample):
             h = up(F.interpolate(h, scale_factor=2.0, mode="nearest"))
             h = torch.cat([h, skips.pop()], 1)
             for blk in blocks:
-                h = blk(h, temb, feat)
-        h = self.final(torch.cat([h, h0], 1), temb, feat)
+                h = blk(h, temb, next(maps))
+        h = self.final(torch.cat([h, h0], 1), temb, next(maps))
         return self.out(h)
+
+    def forward(self, x, t, cond, tile=None):
+        """tile: None, or a float tensor (1,) of 0 (zero padding) or 1 (circular: seamless tiles)."""
+        return self.denoise(x, t, self.encode(cond, tile), tile)
 
 
 def set_circular(model: "UNet", on: bool = True) -> "UNet":

@@ -24,34 +24,45 @@ import os
 import numpy as np
 import torch
 
-from ..onnx_models import load_model_json, sha256_file
+from ..onnx_models import fingerprint, load_model_json
 
 __all__ = ["exported_weights", "warm_start", "torch_from_export"]
 
 
-def exported_weights(folder: str, sha256: str) -> dict:
-    """{parameter name: float32 array} of the export in ``folder``, refusing an ``eps.onnx`` whose hash is not ``sha256``."""
+def _graph_weights(path: str) -> dict:
+    """Named weights of one exported graph.  The split form's graphs wrap the UNet as ``net``
+    (see :mod:`.export_onnx`), so that prefix is dropped from names and node scopes."""
     import onnx
     from onnx import numpy_helper
 
-    path = os.path.join(folder, "eps.onnx")
-    if not os.path.isfile(path):
-        raise ValueError(f"init_onnx: no eps.onnx in {folder}")
-    got = sha256_file(path)
-    if got != sha256:
-        raise ValueError(f"init_onnx: {path} has sha256 {got[:12]}..., the config pins {sha256[:12]}... "
-                         "(restore the pinned file from git history)")
-    doc = load_model_json(folder, "neural_noise.json")  # checks the JSON's own hash of eps.onnx
     graph = onnx.load(path).graph
     inits = {i.name: numpy_helper.to_array(i) for i in graph.initializer}
-    out = {k: v for k, v in inits.items() if not k.startswith("onnx::")}
+    out = {k.removeprefix("net."): v for k, v in inits.items() if not k.startswith("onnx::")}
     affine = {"Mul": "weight", "Add": "bias"}
     for node in graph.node:
         scope, _, op = node.name.rpartition("/")
         if op in affine and "/norm" in scope:
             anon = [i for i in node.input if i in inits and i.startswith("onnx::")]
             if len(anon) == 1:
-                out[scope.strip("/").replace("/", ".") + "." + affine[op]] = inits[anon[0]].reshape(-1)
+                name = scope.strip("/").removeprefix("net/").replace("/", ".")
+                out[name + "." + affine[op]] = inits[anon[0]].reshape(-1)
+    return out
+
+
+def exported_weights(folder: str, sha256: str) -> dict:
+    """{parameter name: float32 array} of the export in ``folder`` (either form), refusing weights whose
+    :func:`backend.onnx_models.fingerprint` is not ``sha256``."""
+    if not os.path.isfile(os.path.join(folder, "neural_noise.json")):
+        raise ValueError(f"init_onnx: no neural_noise.json in {folder}")
+    doc = load_model_json(folder, "neural_noise.json")  # checks every file against the JSON's hashes
+    got = fingerprint(doc["files"])
+    if got != sha256:
+        raise ValueError(f"init_onnx: {folder} has weights {got[:12]}..., the config pins {sha256[:12]}... "
+                         "(restore the pinned export from git history)")
+    out = {}
+    for name in sorted(doc["files"]):
+        if name.endswith(".onnx"):
+            out.update(_graph_weights(os.path.join(folder, name)))
     out["class_emb.weight"] = np.asarray(doc["class_embedding"], np.float32)
     return {k: np.asarray(v, np.float32) for k, v in out.items()}
 
@@ -96,5 +107,5 @@ def torch_from_export(folder: str):
     doc = load_model_json(folder, "neural_noise.json")
     cfg = TrainConfig.from_dict(doc["config"])
     model = UNet(len(doc["classes"]), len(doc["params"]), emb_dim=cfg.emb_dim, widths=cfg.widths)
-    warm_start(model, exported_weights(folder, doc["files"]["eps.onnx"]))
+    warm_start(model, exported_weights(folder, fingerprint(doc["files"])))
     return model.eval()
