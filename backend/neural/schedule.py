@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cosine_alphas_cumprod", "ddim_timesteps", "T_DEFAULT"]
+__all__ = ["cosine_alphas_cumprod", "ddim_timesteps", "timesteps", "SPACINGS", "T_DEFAULT", "alphas_from_config"]
 
 T_DEFAULT = 1000
 
@@ -30,3 +30,48 @@ def ddim_timesteps(steps: int, T: int = T_DEFAULT) -> np.ndarray:
     if not 1 <= steps <= T:
         raise ValueError(f"steps must lie in [1, {T}], got {steps}")
     return np.unique(np.linspace(0, T - 1, steps).round().astype(np.int64))[::-1].copy()
+
+
+SPACINGS = ("uniform", "logsnr", "karras")
+
+
+def timesteps(steps: int, alphas_cumprod: np.ndarray, spacing: str = "uniform", rho: float = 7.0) -> np.ndarray:
+    """Descending int64 timesteps from T-1 to 0 for a sampler, ``steps`` of them (fewer if two round together).
+
+    uniform  even in t (DDIM's sub-sequence, :func:`ddim_timesteps`)
+    logsnr   even in λ = log(α / σ) = ½ log(ᾱ / (1 - ᾱ)) (Lu et al. 2022's recommendation for few steps)
+    karras   s_i = (s_max^{1/ρ} + i/(n-1) (s_min^{1/ρ} - s_max^{1/ρ}))^ρ in s = σ / α (Karras et al. 2022, Eq. 5)
+    Each continuous target is rounded to the discrete timestep nearest in λ.
+    """
+    ab = np.asarray(alphas_cumprod, np.float64)
+    T = len(ab)
+    if spacing == "uniform":
+        return ddim_timesteps(steps, T)
+    if not 1 <= steps <= T:
+        raise ValueError(f"steps must lie in [1, {T}], got {steps}")
+    lam = 0.5 * np.log(ab / (1.0 - ab))  # increasing as t decreases
+    if steps == 1:
+        return np.array([T - 1], np.int64)
+    if spacing == "logsnr":
+        target = np.linspace(lam[-1], lam[0], steps)
+    elif spacing == "karras":
+        s_max, s_min = np.exp(-lam[-1]), np.exp(-lam[0])
+        r = np.linspace(0.0, 1.0, steps)
+        target = -np.log((s_max ** (1 / rho) + r * (s_min ** (1 / rho) - s_max ** (1 / rho))) ** rho)
+    else:
+        raise ValueError(f"unknown spacing {spacing!r}; choose one of {', '.join(SPACINGS)}")
+    # lam is decreasing in t: search on the reversed (increasing) array
+    idx = np.clip(np.searchsorted(lam[::-1], target), 1, T - 1)
+    lo, hi = lam[::-1][idx - 1], lam[::-1][idx]
+    idx = np.where(np.abs(target - lo) <= np.abs(target - hi), idx - 1, idx)
+    ts = (T - 1 - idx).astype(np.int64)
+    ts[0], ts[-1] = T - 1, 0
+    return np.unique(ts)[::-1].copy()
+
+
+def alphas_from_config(schedule: dict) -> np.ndarray:
+    """ᾱ of a model JSON's ``schedule`` ({"kind": "cosine", "T": 1000, "s": 0.008}); ValueError for another kind."""
+    kind = schedule.get("kind")
+    if kind != "cosine":
+        raise ValueError(f"unsupported noise schedule {kind!r} (the runtime knows: cosine)")
+    return cosine_alphas_cumprod(int(schedule.get("T", T_DEFAULT)), float(schedule.get("s", 0.008)))

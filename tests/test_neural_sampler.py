@@ -1,0 +1,140 @@
+"""The sampler contract (torch-free): schedules and timestep grids, and every sampler against an analytic model.
+
+For data x₀ ~ N(0, s²) per pixel the exact ε-model is ε(x, t) = σ_t x / (α_t² s² + σ_t²), and the
+probability-flow ODE keeps x_t / √(α_t² s² + σ_t²) constant, so the exact data prediction at t = 0 is
+
+    x̂₀ = x_T · α₀ s² / (√(α₀² s² + σ₀²) √(α_T² s² + σ_T²)).
+
+Golden values pin each sampler's output for one fixed input (as diffusers tests its schedulers); they were
+computed by this implementation after the convergence tests below established that it solves the ODE.
+"""
+import numpy as np
+import pytest
+
+from backend.errors import SettingError
+from backend.neural.generate import check_sampler
+from backend.neural.sampler import (DEFAULT_SAMPLER, DEFAULT_STEPS, SAMPLERS, ddim_sample, evaluations,
+                                    initial_noise, sample, step_noise_rng)
+from backend.neural.schedule import alphas_from_config, cosine_alphas_cumprod, ddim_timesteps, timesteps
+
+AB = cosine_alphas_cumprod(1000)
+S_DATA = 0.5
+
+
+def gaussian_eps(x, t, cond):
+    a = AB[int(t[0])]
+    return (np.sqrt(1 - a) * x / (a * S_DATA ** 2 + 1 - a)).astype(np.float32)
+
+
+def exact_x0(xT):
+    a0, aT = AB[0], AB[-1]
+    return xT * np.sqrt(a0) * S_DATA ** 2 / (np.sqrt(a0 * S_DATA ** 2 + 1 - a0) * np.sqrt(aT * S_DATA ** 2 + 1 - aT))
+
+
+XT = initial_noise(0, (1, 1, 4, 4))
+
+
+def err(name, steps, **kw):
+    return float(np.abs(sample(name, gaussian_eps, XT, None, steps, clip=False, **kw) - exact_x0(XT)).max())
+
+
+def test_every_sampler_converges_to_the_exact_ode_solution():
+    for name in SAMPLERS:
+        e = [err(name, n) for n in (10, 20, 40, 80)]
+        assert e[0] > e[1] > e[2] > e[3], (name, e)
+        assert e[3] < 0.025, (name, e)
+
+
+def test_order_of_accuracy():
+    """DDIM is first order (error halves as steps double); DPM-Solver++(2M) and Heun are second order."""
+    d = [err("ddim", n) for n in (20, 40, 80)]
+    assert 1.8 < d[0] / d[1] < 2.2 and 1.8 < d[1] / d[2] < 2.2
+    h = [err("heun", n) for n in (10, 20, 40)]
+    assert h[0] / h[1] > 3.0 and h[1] / h[2] > 3.0
+    # at equal model evaluations the second-order solvers beat DDIM by far
+    assert err("dpmpp_2m", 15) < err("ddim", 15) / 5
+    assert err("heun", 8) < err("ddim", evaluations("heun", 8)) / 2
+
+
+def test_golden_values():
+    x = initial_noise(7, (1, 1, 2, 3))
+    cases = {
+        ("ddim", 10): [-0.16374, -0.39715, -0.25111, -0.25111, 0.2986, 0.54685],
+        ("dpmpp_2m", 10): [-0.18253, -0.44273, -0.27993, -0.27993, 0.33287, 0.60961],
+        ("heun", 6): [-0.20918, -0.50737, -0.3208, -0.32081, 0.38148, 0.69862],
+    }
+    for (name, steps), want in cases.items():
+        got = sample(name, gaussian_eps, x, None, steps, clip=False).ravel()
+        np.testing.assert_allclose(got, want, atol=2e-5, err_msg=name)
+    exact = exact_x0(x).ravel()  # -0.2172 ... 0.7255: the second-order solvers are the nearer
+    assert np.abs(cases[("ddim", 10)] - exact).max() > 2 * np.abs(cases[("dpmpp_2m", 10)] - exact).max()
+
+
+def test_ddim_eta_zero_is_deterministic_and_eta_one_adds_seeded_noise():
+    a = ddim_sample(gaussian_eps, XT, None, 10, clip=False)
+    np.testing.assert_array_equal(a, ddim_sample(gaussian_eps, XT, None, 10, clip=False, eta=0.0))
+    b = ddim_sample(gaussian_eps, XT, None, 10, clip=False, eta=1.0, rng=step_noise_rng(3))
+    c = ddim_sample(gaussian_eps, XT, None, 10, clip=False, eta=1.0, rng=step_noise_rng(3))
+    np.testing.assert_array_equal(b, c)
+    assert np.abs(a - b).max() > 1e-3
+    with pytest.raises(ValueError, match="needs an rng"):
+        ddim_sample(gaussian_eps, XT, None, 10, eta=0.5)
+    # η = 1 over every timestep is DDPM's ancestral sampler: it reproduces the data's spread s (up to the
+    # shrinkage of the final prediction, α₀ s² / √(α₀² s² + σ₀²) = 0.49996); with 50 steps it is 7% low
+    many = initial_noise(11, (1, 1, 128, 128))
+    out = ddim_sample(gaussian_eps, many, None, 1000, clip=False, eta=1.0, rng=step_noise_rng(1))
+    assert abs(out.std() - S_DATA) < 0.008
+
+
+def test_callback_counts_model_evaluations_and_may_cancel():
+    for name in SAMPLERS:
+        seen, calls = [], []
+
+        def model(x, t, c):
+            calls.append(int(t[0]))
+            return gaussian_eps(x, t, c)
+
+        sample(name, model, XT, None, 7, callback=lambda i, n, x0: seen.append((i, n)))
+        n = evaluations(name, 7)
+        assert len(calls) == n and seen == [(i, n) for i in range(n)], name
+        assert calls[0] == 999 and calls[-1] == 0
+
+    def stop(i, n, x0):
+        if i == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sample(DEFAULT_SAMPLER, gaussian_eps, XT, None, 10, callback=stop)
+
+
+def test_timestep_grids():
+    np.testing.assert_array_equal(timesteps(10, AB, "uniform"), ddim_timesteps(10))
+    for spacing in ("uniform", "logsnr", "karras"):
+        ts = timesteps(12, AB, spacing)
+        assert ts[0] == 999 and ts[-1] == 0 and np.all(np.diff(ts) < 0) and len(ts) <= 12
+    lam = 0.5 * np.log(AB / (1 - AB))
+    dl = np.diff(lam[timesteps(20, AB, "logsnr")])
+    # even steps in λ away from t = T - 1, where whole timesteps are λ-steps of ~0.7 and the first targets round apart
+    assert np.abs(dl[4:] / dl[4:].mean() - 1).max() < 0.1
+    with pytest.raises(ValueError, match="unknown spacing"):
+        timesteps(5, AB, "geometric")
+    with pytest.raises(ValueError, match="steps must lie"):
+        timesteps(0, AB, "logsnr")
+
+
+def test_schedule_is_read_from_the_model_json():
+    np.testing.assert_array_equal(alphas_from_config(dict(kind="cosine", T=1000, s=0.008)), AB)
+    assert len(alphas_from_config(dict(kind="cosine", T=250))) == 250
+    with pytest.raises(ValueError, match="unsupported noise schedule 'linear'"):
+        alphas_from_config(dict(kind="linear"))
+
+
+def test_sampler_settings_are_checked_in_one_place():
+    check_sampler(DEFAULT_SAMPLER, DEFAULT_STEPS)
+    for args, msg in [(("euler_a", 10), "unknown sampler 'euler_a'"), (("ddim", 0), "steps"),
+                      (("ddim", 2.5), "steps"), (("heun", 1), "at least 2"), (("ddim", 10, "zigzag"), "spacing"),
+                      (("ddim", 10, "uniform", float("nan")), "eta"), (("dpmpp_2m", 10, "uniform", 0.5), "DDIM setting")]:
+        with pytest.raises(SettingError, match=msg):
+            check_sampler(*args)
+    with pytest.raises(ValueError, match="unknown sampler"):
+        sample("euler_a", gaussian_eps, XT, None, 4)
