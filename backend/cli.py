@@ -95,13 +95,21 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--force", action="store_true", help="re-bake outputs that are up to date")
     b.add_argument("--keep-going", action="store_true", help="after a failed bake, carry on with the others")
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
+    b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (default 0: all cores)")
     b.add_argument("--quiet", action="store_true")
 
     n = sub.add_parser("neural", help="neural noise (Maesumi et al. 2024) from the trained ONNX model")
     n.add_argument("--noise", help="class name (see --list)")
     n.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
     n.add_argument("--size", type=int, default=256, help="output side in pixels")
-    n.add_argument("--steps", type=int, default=30, help="DDIM steps")
+    n.add_argument("--sampler", default=None, help="ddim, dpmpp_2m or heun (default: dpmpp_2m)")
+    n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 12)")
+    n.add_argument("--spacing", default="uniform", help="timestep spacing: uniform (default), logsnr or karras")
+    n.add_argument("--eta", type=float, default=0.0, help="ddim only: step noise, 0 (deterministic) .. 1 (DDPM)")
+    n.add_argument("--tile", type=int, default=None,
+                   help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "
+                        "else 512 px tiles; 0: never)")
+    n.add_argument("--threads", type=int, default=0, help="CPU threads for onnxruntime (default 0: all cores)")
     n.add_argument("--seed", type=int, default=0)
     n.add_argument("--tileable", action="store_true", help="seamless tile (circular padding); size a multiple of 8")
     n.add_argument("--blend", metavar="MASK", help="grayscale mask image: white areas take --noise2 / --param2")
@@ -243,6 +251,14 @@ def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
     return 0
 
 
+def _set_threads(n: int) -> None:
+    from .onnx_models import set_default_threads
+
+    if n < 0:
+        raise SettingError("--threads", f"must be >= 0 (0: all cores), got {n}")
+    set_default_threads(n)
+
+
 def run_bake_job(a: argparse.Namespace) -> int:
     from .jobs import JobError, load_job, run_job
 
@@ -259,6 +275,7 @@ def run_bake_job(a: argparse.Namespace) -> int:
                 print(f"  {state:10s} {name}: {list(spec.grid.resolution)} -> {spec.output}"
                       + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))
         return 1 if bad else 0
+    _set_threads(a.threads)
     bars = {}
 
     def progress(name, i, count, frac):
@@ -338,6 +355,16 @@ def run_neural(a: argparse.Namespace) -> int:
     from .neural.generate import generate
     from .neural.model import ModelError, NeuralNoiseModel
 
+    from .neural.generate import check_sampler
+    from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+
+    _set_threads(a.threads)
+    sampler = a.sampler or DEFAULT_SAMPLER
+    steps = DEFAULT_STEPS if a.steps is None else a.steps
+    check_sampler(sampler, steps, a.spacing, a.eta)
+    tile = a.tile
+    if tile is not None and tile < 0:
+        raise SettingError("--tile", f"must be >= 0 (0: never tile), got {tile}")
     folder = a.model or DEFAULT_MODEL
     try:
         model = NeuralNoiseModel(folder)
@@ -375,7 +402,8 @@ def run_neural(a: argparse.Namespace) -> int:
             raise SettingError("--noise2", "a second noise needs --blend MASK")
         cond = conditioning.uniform(model, spec, a.size, a.size)
     bar = _Bar(a.quiet)
-    img = generate(model, cond, a.seed, a.steps, a.tileable, callback=lambda i, n, x0: bar((i + 1) / n))
+    img = generate(model, cond, a.seed, steps, a.tileable, callback=lambda i, n, x0: bar((i + 1) / n),
+                   sampler=sampler, spacing=a.spacing, eta=a.eta, tile=tile)
     from export.images import preview_8bit, write_image, write_png
 
     if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch

@@ -5,5 +5,5 @@ class SettingError(ValueError):
     """A user-facing setting is invalid.  ``str(err)`` is a one-line message."""
 
     def __init__(self, setting: str, message: str):
-        self.setting = setting
+        self.setting, self.message = setting, message
         super().__init__(f"{setting}: {message}")

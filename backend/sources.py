@@ -175,8 +175,18 @@ class NeuralSource:
 
     def __init__(self, model_folder: str, noise: str, params: dict | None = None, noise2: str | None = None,
                  params2: dict | None = None, mask: np.ndarray | None = None, width: float = 32.0,
-                 sharpness: float = 1.0, steps: int = 30, seed: int = 0, tileable: bool = False):
+                 sharpness: float = 1.0, steps: int | None = None, seed: int = 0, tileable: bool = False,
+                 sampler: str | None = None):
+        from .neural.generate import check_sampler
         from .neural.model import ModelError, NeuralNoiseModel
+        from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+
+        self.sampler = DEFAULT_SAMPLER if sampler is None else sampler
+        steps = DEFAULT_STEPS if steps is None else steps
+        try:
+            check_sampler(self.sampler, steps)
+        except SettingError as exc:
+            raise SettingError("source." + exc.setting, exc.message) from None
 
         try:
             self.model = NeuralNoiseModel(model_folder)
@@ -213,12 +223,12 @@ class NeuralSource:
             if cancel is not None and cancel():
                 raise Cancelled("cancelled")
 
-        img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done)
+        img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done, sampler=self.sampler)
         return np.ascontiguousarray(img[::-1])  # bakes index rows by +y; files put +y at the top
 
     def to_dict(self) -> dict:
         d = dict(kind=self.kind, model=self.model.config["files"], spec=[self.spec[0], self.spec[1]],
-                 steps=self.steps, seed=self.seed, tileable=self.tileable)
+                 sampler=self.sampler, steps=self.steps, seed=self.seed, tileable=self.tileable)
         if self.mask is not None:
             d.update(spec2=[self.spec2[0], self.spec2[1]], width=self.width, sharpness=self.sharpness,
                      mask_sha256=hashlib.sha256(np.ascontiguousarray(self.mask).tobytes()).hexdigest())
@@ -302,8 +312,8 @@ class SolidSource:
 
 SOURCE_KINDS = ("wave", "neural", "solid")
 _SOLID_KEYS = ("model", "exemplar", "seed", "scale", "density", "refine")
-_NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "steps", "seed",
-                "tileable")
+_NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
+                "seed", "tileable")
 
 
 def _check_keys(d: dict, known: tuple, kind: str) -> None:
@@ -331,8 +341,8 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     elif "noise2" in d or "params2" in d:
         raise SettingError("source.noise2", "a second noise needs blend = MASK")
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
-                        d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps", 30), d.get("seed", 0),
-                        d.get("tileable", False))
+                        d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps"), d.get("seed", 0),
+                        d.get("tileable", False), d.get("sampler"))
 
 
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:

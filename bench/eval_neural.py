@@ -31,8 +31,12 @@ def main() -> int:
     ap.add_argument("--threads", type=int, default=0, help="CPU threads for torch and numba (0: their defaults); "
                                                            "the classifier is reproducible for a fixed count")
     ap.add_argument("--n", type=int, default=32, help="samples per class")
-    ap.add_argument("--steps", type=int, default=30, help="DDIM steps")
+    ap.add_argument("--steps", type=int, default=30, help="sampler steps")
+    ap.add_argument("--sampler", default="ddim", help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py)")
+    ap.add_argument("--spacing", default="uniform", help="timestep spacing: uniform, logsnr or karras")
     ap.add_argument("--clf-steps", type=int, default=600)
+    ap.add_argument("--classifier-cache", metavar="DIR",
+                    help="keep the trained classifier here and reuse it (same classes, size, steps, threads)")
     ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
     ap.add_argument("--timing-only", action="store_true",
                     help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
@@ -58,16 +62,19 @@ def _run(a, model, classes) -> int:
     if a.timing_only:
         with open(a.out, encoding="utf-8") as fh:
             res = json.load(fh)
-        if res.get("model", {}).get("sha256") != model.config["files"]["eps.onnx"]:
+        if res.get("model", {}).get("sha256") != model.fingerprint:
             print(f"eval_neural: error: {a.out} evaluates another model than {a.model}", file=sys.stderr)
             return 2
         a.n, a.steps = res["model"]["n"], res["model"]["steps"]
         classes = tuple(res["model"].get("classes", classes))
     else:
-        res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr))
+        res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr),
+                       sampler=a.sampler, spacing=a.spacing, classifier_cache=a.classifier_cache)
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
-    res["model"] = dict(step=model.config["step"], sha256=model.config["files"]["eps.onnx"], n=a.n, steps=a.steps,
+    if not a.timing_only:
+        res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing)
+    res["model"] = dict(step=model.config["step"], sha256=model.fingerprint, n=a.n, steps=a.steps,
                         classes=list(classes))
     print("| class | FD | acc | PSD err | response err (param) |")
     print("|---|---|---|---|---|")

@@ -34,10 +34,21 @@ def _mod(name: str):
     return importlib.import_module(f"{backend.__name__}.{name}")
 
 
+_SAMPLERS = _mod("neural.sampler")  # numpy only: cheap at register time
+DEFAULT_SAMPLER, DEFAULT_STEPS = _SAMPLERS.DEFAULT_SAMPLER, _SAMPLERS.DEFAULT_STEPS
+#: the samplers of backend.neural.sampler, as the panel lists them
+SAMPLER_ITEMS = [("dpmpp_2m", "DPM-Solver++(2M)", "Second-order multistep: the fewest steps for a clean image"),
+                 ("ddim", "DDIM", "First order; the sampler of earlier OmniNoise versions (30 steps)"),
+                 ("heun", "Heun", "Second order, two model evaluations per step")]
+
+
 def model():
-    """The shipped model, loaded on first use (never at register time)."""
-    if "m" not in _MODEL:
-        _MODEL["m"] = _mod("neural.model").NeuralNoiseModel(_model_folder())
+    """The shipped model, loaded on first use (never at register time), with onnxruntime on the
+    preferences' CPU threads (a changed preference loads sessions with the new count)."""
+    n = threads()
+    if _MODEL.get("threads") != n:
+        _MODEL.clear()
+        _MODEL.update(threads=n, m=_mod("neural.model").NeuralNoiseModel(_model_folder(), threads=n))
     return _MODEL["m"]
 
 
@@ -94,7 +105,10 @@ class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
     sharpness: FloatProperty(name="Sharpness", description="Transition exponent (1 = linear)", default=1.0,
                              min=0.1, soft_max=8.0)
     size: IntProperty(name="Size", default=512, min=8, soft_max=4096, max=16384)
-    steps: IntProperty(name="Steps", default=30, min=1, max=1000)
+    sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default=DEFAULT_SAMPLER,
+                          description="How the image is denoised; DPM-Solver++(2M) needs the fewest steps")
+    steps: IntProperty(name="Steps", default=DEFAULT_STEPS, min=2, max=1000,
+                       description="Sampler timesteps (model evaluations: the same, twice for Heun)")
     seed: IntProperty(name="Seed", default=0, min=0)
     tileable: BoolProperty(name="Tileable", description="Seamless tile (the size becomes a multiple of 8)")
     depth: EnumProperty(name="Depth", items=[("8", "8-bit", ""), ("16", "16-bit half", ""), ("32", "32-bit float", "")],
@@ -198,7 +212,7 @@ class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
         if gib > 16:
             self.report({"ERROR"}, f"{size}² needs about {gib:.0f} GiB; bake a smaller size")
             return None
-        seed, tileable, depth = p.seed, p.tileable, p.depth
+        seed, tileable, depth, sampler = p.seed, p.tileable, p.depth, p.sampler
         name = p.name + (" Preview" if self.preview else "")
         save_path = None
         if p.save != "NONE" and not self.preview:
@@ -217,7 +231,7 @@ class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
                 if cancel():
                     raise backend.Cancelled("cancelled")
 
-            img = _mod("neural.generate").generate(m, cond, seed, steps, tileable, callback=step)
+            img = _mod("neural.generate").generate(m, cond, seed, steps, tileable, callback=step, sampler=sampler)
             if save_path is not None:  # atomic, off the main thread
                 from ._deps import export
 
@@ -308,7 +322,7 @@ class OMNINOISE_OT_blend_map_new(bpy.types.Operator):
 # -- presets: the swatch set and layout as a shareable JSON file ---------------------------------
 
 PRESET_FORMAT = 1
-_PRESET_KEYS = ("mode", "width", "sharpness", "size", "steps", "seed", "tileable", "depth")
+_PRESET_KEYS = ("mode", "width", "sharpness", "size", "sampler", "steps", "seed", "tileable", "depth")
 
 
 def preset_dict(p) -> dict:
@@ -514,6 +528,7 @@ def draw_neural(layout, context) -> None:
         layout.prop(p, "sharpness")
     col = layout.column(align=True)
     col.prop(p, "size")
+    col.prop(p, "sampler", text="")
     col.prop(p, "steps")
     col.prop(p, "seed")
     layout.prop(p, "tileable")

@@ -1,4 +1,5 @@
-"""Neural noise runtime: ONNX export vs torch, hash check, DDIM, conditioning grids, any size, tiling, CLI."""
+"""Neural noise runtime: ONNX export (split and one-piece) vs torch, hash check, samplers, conditioning grids,
+any size, tiling, CLI."""
 import json
 import os
 
@@ -14,7 +15,8 @@ from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
 from backend.neural.sampler import ddim_sample, initial_noise  # noqa: E402
-from backend.training.export_onnx import export  # noqa: E402
+from backend.onnx_models import fingerprint  # noqa: E402
+from backend.training.export_onnx import export, reexport  # noqa: E402
 from backend.training.train import TrainConfig, build_model, train  # noqa: E402
 from backend.training.unet import set_circular  # noqa: E402
 
@@ -24,11 +26,70 @@ TINY = dict(size=16, batch=4, steps=3, widths=(8, 16, 16), emb_dim=8, log_every=
 
 @pytest.fixture(scope="module")
 def exported(tmp_path_factory):
+    """A tiny trained run and its export in the default (split) form."""
     run = tmp_path_factory.mktemp("run")
     out = tmp_path_factory.mktemp("model")
     train(TrainConfig.from_dict(TINY), str(run), log=lambda s: None)
     export(str(run), str(out))
     return run, out
+
+
+@pytest.fixture(scope="module")
+def one_piece(exported, tmp_path_factory):
+    """The same weights as one eps.onnx (the form of exports made before the split)."""
+    out = tmp_path_factory.mktemp("one_piece")
+    export(str(exported[0]), str(out), one_piece=True)
+    return out
+
+
+def test_split_export_equals_the_one_piece_network(exported, one_piece):
+    """encoder + denoiser = the one-piece ε-network within 1e-4, plain and circular padding, any batch and size."""
+    _, out = exported
+    split, whole = NeuralNoiseModel(str(out)), NeuralNoiseModel(str(one_piece))
+    assert split.form == "split" and whole.form == "one-piece"
+    assert sorted(split.config["files"]) == ["denoiser.onnx", "encoder.onnx"]
+    assert split.config["blocks"]["names"][0] == "m00" and len(split.config["blocks"]["levels"]) == 15
+    rng = np.random.default_rng(1)
+    for shape in ((2, 24, 40), (1, 16, 16)):
+        B, H, W = shape
+        x = rng.standard_normal((B, 1, H, W)).astype(np.float32)
+        t = rng.uniform(0, 999, B).astype(np.float32)
+        cond = rng.standard_normal((B, split.embedding.shape[1] + len(split.params), H, W)).astype(np.float32)
+        for tile in (False, True):
+            np.testing.assert_allclose(split.eps_fn(tile)(x, t, cond), whole.eps_fn(tile)(x, t, cond), atol=1e-4)
+    # the encoder runs once per conditioning array: same cond object, cached maps; a new array, new maps
+    calls = []
+    enc = split.encode
+    split.encode = lambda c, tileable=False: calls.append(1) or enc(c, tileable)
+    f = split.eps_fn(False)
+    cond = C.uniform(split, ("perlin", {}), 16, 16)[None]
+    a = f(x[:1, :, :16, :16], t[:1], cond)
+    f(x[:1, :, :16, :16], t[:1], cond)
+    b = f(x[:1, :, :16, :16], t[:1], C.uniform(split, ("spots", {}), 16, 16)[None])
+    assert len(calls) == 2 and np.abs(a - b).max() > 1e-4
+
+
+def test_reexport_from_an_export_keeps_the_weights(exported, one_piece, tmp_path):
+    """An older one-piece export is re-exported to the split form from its own weights (no checkpoint)."""
+    doc = reexport(str(one_piece), str(tmp_path / "split"))
+    assert doc["form"] == "split" and doc["reexported_from"]["files"] == NeuralNoiseModel(str(one_piece)).config["files"]
+    a, b = NeuralNoiseModel(str(one_piece)), NeuralNoiseModel(str(tmp_path / "split"))
+    assert a.config["step"] == b.config["step"] and a.classes == b.classes
+    cond = C.uniform(a, ("cells_f1", {}), 24, 24)
+    np.testing.assert_allclose(generate(a, cond, seed=3, steps=4), generate(b, cond, seed=3, steps=4), atol=1e-4)
+
+
+def test_model_json_must_declare_what_the_runtime_runs(exported, tmp_path):
+    _, out = exported
+    for f in os.listdir(out):
+        (tmp_path / f).write_bytes((out / f).read_bytes())
+    doc = json.loads((tmp_path / "neural_noise.json").read_text())
+    for change, msg in ((dict(form="sideways"), "unknown model form"), (dict(prediction="v"), "epsilon only"),
+                        (dict(schedule=dict(kind="linear")), "unsupported noise schedule"),
+                        (dict(files={"encoder.onnx": doc["files"]["encoder.onnx"]}), "no sha256 for denoiser.onnx")):
+        (tmp_path / "neural_noise.json").write_text(json.dumps(dict(doc, **change)))
+        with pytest.raises(ModelError, match=msg):
+            NeuralNoiseModel(str(tmp_path))
 
 
 def _torch_model(run, circular=False):
@@ -53,19 +114,22 @@ def test_onnx_matches_torch(exported):
     np.testing.assert_allclose(model.embedding, tm.class_emb.weight.detach().numpy(), atol=1e-6)
 
 
-def test_hash_is_checked(exported, tmp_path):
-    _, out = exported
+@pytest.mark.parametrize("form", ["split", "one-piece"])
+def test_hash_is_checked(exported, one_piece, tmp_path, form):
+    out = exported[1] if form == "split" else one_piece
     for f in os.listdir(out):
         (tmp_path / f).write_bytes((out / f).read_bytes())
-    with open(tmp_path / "eps.onnx", "ab") as fh:
-        fh.write(b"\0")
-    with pytest.raises(ModelError, match="sha256 does not match"):
-        NeuralNoiseModel(str(tmp_path))
-    (tmp_path / "eps.onnx").write_bytes((out / "eps.onnx").read_bytes())
-    NeuralNoiseModel(str(tmp_path))  # restored: loads again
-    os.remove(tmp_path / "eps.onnx")
-    with pytest.raises(ModelError, match="missing"):
-        NeuralNoiseModel(str(tmp_path))
+    for name in NeuralNoiseModel(str(out)).config["files"]:
+        with open(tmp_path / name, "ab") as fh:
+            fh.write(b"\0")
+        with pytest.raises(ModelError, match="sha256 does not match"):
+            NeuralNoiseModel(str(tmp_path))
+        (tmp_path / name).write_bytes((out / name).read_bytes())
+        NeuralNoiseModel(str(tmp_path))  # restored: loads again
+        os.remove(tmp_path / name)
+        with pytest.raises(ModelError, match="missing"):
+            NeuralNoiseModel(str(tmp_path))
+        (tmp_path / name).write_bytes((out / name).read_bytes())
 
 
 def test_generate_any_size_seeded_and_sampler_equals_torch(exported):
@@ -88,6 +152,28 @@ def test_generate_any_size_seeded_and_sampler_equals_torch(exported):
                                ddim_sample(torch_eps, xT, cond16, steps=5), atol=1e-3)
     with pytest.raises(SettingError, match="multiples of 8"):
         generate(model, cond, tileable=True)
+
+
+def test_tiled_generation(exported):
+    """Tiles: one tile covering the image is the one-piece path; smaller tiles give the same statistics,
+    stay seeded, and tileable output still wraps."""
+    _, out = exported
+    model = NeuralNoiseModel(str(out))
+    cond = C.uniform(model, ("cells_f1", {}), 96, 128)
+    whole = generate(model, cond, seed=2, steps=3, tile=0)
+    np.testing.assert_array_equal(whole, generate(model, cond, seed=2, steps=3, tile=128))
+    tiled = generate(model, cond, seed=2, steps=3, tile=64, overlap=16)
+    np.testing.assert_array_equal(tiled, generate(model, cond, seed=2, steps=3, tile=64, overlap=16))
+    assert abs(tiled.mean() - whole.mean()) < 0.05 and abs(tiled.std() - whole.std()) < 0.05
+    assert np.corrcoef(tiled.ravel(), whole.ravel())[0, 1] > 0.9
+    wrap = generate(model, C.uniform(model, ("perlin", {}), 64, 96), seed=4, steps=3, tileable=True, tile=32,
+                    overlap=8)
+    inner_x, inner_y = np.abs(np.diff(wrap, axis=1)).mean(), np.abs(np.diff(wrap, axis=0)).mean()
+    assert np.abs(wrap[:, 0] - wrap[:, -1]).mean() < 1.5 * inner_x
+    assert np.abs(wrap[0] - wrap[-1]).mean() < 1.5 * inner_y
+    for tile, overlap, msg in ((60, 8, "multiple of 8"), (16, 0, "at least 32"), (64, 40, "half the tile")):
+        with pytest.raises(SettingError, match=msg):
+            generate(model, cond, steps=2, tile=tile, overlap=overlap)
 
 
 def test_tileable_sampling_wraps(exported):
@@ -191,6 +277,21 @@ def test_neural_cli(exported, tmp_path, capsys):
         assert msg in capsys.readouterr().err
     assert main(["neural", "--model", str(tmp_path / "none"), "--noise", "spots", "-o", png]) == 2
     assert "no neural_noise.json" in capsys.readouterr().err
+    # sampler settings: the CLI's output equals generate() with the same settings; bad ones: one line, exit 2
+    npy = str(tmp_path / "s.npy")
+    model = NeuralNoiseModel(str(out))
+    cond = C.uniform(model, ("spots", {}), 24, 24)
+    for extra, kw in ((["--sampler", "ddim", "--eta", "0.5"], dict(sampler="ddim", eta=0.5)),
+                      (["--sampler", "heun", "--spacing", "karras"], dict(sampler="heun", spacing="karras")),
+                      (["--tile", "0", "--threads", "1"], {})):
+        assert main(base + ["--noise", "spots", "--size", "24", "-o", npy] + extra) == 0
+        np.testing.assert_array_equal(np.load(npy), generate(model, cond, seed=0, steps=3, **kw))
+    for extra, msg in ((["--sampler", "euler"], "unknown sampler 'euler'"), (["--steps", "0"], "steps: must be"),
+                       (["--threads", "-1"], "--threads: must be >= 0"), (["--tile", "20"], "multiple of 8"),
+                       (["--eta", "2"], "eta: must lie in [0, 1]"), (["--spacing", "odd"], "unknown spacing")):
+        assert main(base + ["--noise", "spots", "--size", "24", "-o", npy] + extra) == 2
+        err = capsys.readouterr().err
+        assert msg in err and len(err.strip().splitlines()) == 1, err
 
 
 # an evaluation document as bench/eval_neural.py writes it, one class, for the card tests
@@ -209,7 +310,7 @@ def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
     ev = EVAL
     text = card(str(run), str(out), ev, dict(ev, locality=0.5), "python -m backend.training.train ...", "test CPU")
     meta = json.loads((out / "neural_noise.json").read_text())
-    assert meta["files"]["eps.onnx"] in text and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
+    assert all(digest in text for digest in meta["files"].values()) and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
     assert "| without CutMix | 0.5 |" in text and "test CPU" in text
     worse = dict(ev, classes={"spots": dict(fd=3.0, acc=0.25, psd=0.4, response=0.2, param="scale")}, locality=0.5)
     text = card(str(run), str(out), ev, None, "train", "test CPU", previous=worse, previous_label="3000-step model")
@@ -293,13 +394,16 @@ blend = "mask.png"
 noise2 = "perlin"
 steps = 3
 seed = 4
+sampler = "ddim"
 """)
     assert [o.status for o in run_job(str(tmp_path / "job.toml"))] == ["baked"]
     got = np.load(tmp_path / "n.npy")[::-1]  # .npy rows run by +y; image rows top-down
     model = NeuralNoiseModel(str(out))
     ref = generate(model, C.blend(model, ("spots", {"coverage": 0.6}), ("perlin", {}),
-                                  C.mask_weight(mask > 127, 32.0, 1.0)), seed=4, steps=3)
+                                  C.mask_weight(mask > 127, 32.0, 1.0)), seed=4, steps=3, sampler="ddim")
     np.testing.assert_allclose(got, ref, atol=1e-6)
+    with pytest.raises(SettingError, match="source.sampler: unknown sampler 'fast'"):
+        NeuralSource(str(out), "spots", sampler="fast")
     src = NeuralSource(str(out), "spots", steps=5)
     calls = []
     with pytest.raises(Cancelled):
@@ -325,13 +429,17 @@ def test_the_shipped_model_loads_and_generates():
         assert img.shape == (32, 32) and img.std() > 0.01
 
 
-def test_warm_start_reads_an_export_back_exactly(exported, tmp_path):
+@pytest.mark.parametrize("form", ["split", "one-piece"])
+def test_warm_start_reads_an_export_back_exactly(exported, one_piece, tmp_path, form):
     """A run started from an export (init_onnx) begins with the exported EMA weights, GroupNorm affines included."""
     from backend.neural.model import sha256_file
     from backend.training.train import main as train_main
 
     run, out = exported
-    sha = sha256_file(str(out / "eps.onnx"))
+    if form == "one-piece":
+        out = one_piece
+        assert fingerprint(NeuralNoiseModel(str(out)).config["files"]) == sha256_file(str(out / "eps.onnx"))
+    sha = NeuralNoiseModel(str(out)).fingerprint
     ref = torch.load(os.path.join(run, "ckpt.pt"), weights_only=False)["ema"]
     assert any(".norm1.weight" in k for k in ref)
     cfg = TrainConfig.from_dict(dict(TINY, steps=1, lr=0.0, init_onnx=str(out), init_sha256=sha))
@@ -349,12 +457,14 @@ def test_warm_start_reads_an_export_back_exactly(exported, tmp_path):
         TrainConfig.from_dict(dict(TINY, init_onnx=str(out)))
 
 
-def test_torch_is_rebuilt_from_the_export_alone(exported):
+@pytest.mark.parametrize("form", ["split", "one-piece"])
+def test_torch_is_rebuilt_from_the_export_alone(exported, one_piece, form):
     """The step timing needs no checkpoint: torch runs the export's own weights, as onnxruntime does."""
     from backend.training.evaluate import step_seconds
     from backend.training.warm_start import torch_from_export
 
     run, out = exported
+    out = out if form == "split" else one_piece
     ref = _torch_model(run).state_dict()
     got = torch_from_export(str(out)).state_dict()
     assert set(got) == set(ref)

@@ -203,3 +203,36 @@ def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
     cfg = TrainConfig.from_dict(dict(gpu, batch=2, steps=1, device="cpu", sample_every=0))
     last = train(cfg, str(tmp_path / "gpu"), log=lambda s: None)
     assert last["step"] == 1 and np.isfinite(last["mse"])
+
+
+def test_precision_is_bf16_only_where_the_cpu_computes_it():
+    from backend.training.precision import autocast, cpu_bf16_native, resolve
+
+    assert cpu_bf16_native("processor : 0\nflags : fpu avx2 avx512f amx_bf16 amx_tile\n")
+    assert cpu_bf16_native("flags : fpu avx2 avx512_bf16\n")
+    assert not cpu_bf16_native("flags : fpu avx2 fma\n") and not cpu_bf16_native("no flags here")
+    cpu = torch.device("cpu")
+    assert resolve("fp32", cpu) == "fp32" and resolve("bf16", cpu) == "bf16"
+    assert resolve("auto", cpu) == ("bf16" if cpu_bf16_native() else "fp32")
+    with pytest.raises(ValueError, match="precision must be one of"):
+        resolve("fp16", cpu)
+    with pytest.raises(ValueError, match="precision must be one of"):
+        TrainConfig.from_dict(dict(precision="int8"))
+    with autocast("bf16", cpu):
+        assert (torch.ones(2, 2) @ torch.ones(2, 2)).dtype == torch.bfloat16
+    with autocast("fp32", cpu):
+        assert (torch.ones(2, 2) @ torch.ones(2, 2)).dtype == torch.float32
+
+
+def test_bf16_training_steps_follow_the_fp32_loss(tmp_path):
+    """A short bf16 + channels_last run tracks the fp32 run's loss (same data, same seed)."""
+    base = dict(size=16, batch=4, steps=6, widths=(8, 16, 16), emb_dim=8, log_every=6, checkpoint_every=100,
+                sample_every=0, classes=("perlin", "spots"), lr=1e-3)
+    logs = {}
+    for prec, cl in (("fp32", False), ("bf16", True)):
+        rec = []
+        train(TrainConfig.from_dict(dict(base, precision=prec, channels_last=cl)), str(tmp_path / prec),
+              log=lambda s, rec=rec: rec.append(s))
+        logs[prec] = json.loads(rec[-1])
+        assert logs[prec]["precision"] == prec
+    assert abs(logs["bf16"]["mse"] - logs["fp32"]["mse"]) < 0.1 * logs["fp32"]["mse"]

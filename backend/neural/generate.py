@@ -1,10 +1,16 @@
-"""Neural noise images from a conditioning grid: DDIM through the ONNX model.
+"""Neural noise images from a conditioning grid: a sampler of :mod:`.sampler` over the ONNX model.
 
 Any size: the network needs sides that are multiples of ``model.multiple_of``;
 other sizes are generated on the next larger such grid (the conditioning grid
 padded by edge replication) and cropped.  Tileable output uses the circular-
 padding network and needs sides that are multiples already (a crop would
 break the wrap).  The seed fully determines the output.
+
+Large images are denoised in overlapping tiles (:mod:`.tiles`), which bounds
+memory.  By default (``tile=None``) images up to ``AUTO_WHOLE`` px a side are made
+in one piece (the encoder's maps take about 2080·H·W bytes: 2.2 GB at 1024²) and
+larger ones in tiles of ``AUTO_TILE`` px; the encoder's maps are kept for every
+tile while they fit ``MAP_CACHE_BYTES``, else recomputed at each step.
 """
 from __future__ import annotations
 
@@ -13,29 +19,79 @@ from typing import Callable
 import numpy as np
 
 from ..errors import SettingError
-from .sampler import ddim_sample, initial_noise
+from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, step_noise_rng
+from .schedule import SPACINGS, alphas_from_config
 
-__all__ = ["generate"]
+__all__ = ["generate", "check_sampler", "auto_tile", "AUTO_WHOLE", "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES"]
 
 _F = np.float32
+AUTO_WHOLE = 1024          #: with tile=None, sides up to this are generated in one piece ...
+AUTO_TILE = 512            #: ... and larger images in tiles of this side
+DEFAULT_OVERLAP = 64       #: overlap of neighbouring tiles (px)
+MAP_CACHE_BYTES = 2 << 30  #: keep the encoder's maps of all tiles while they take at most this
 
 
-def generate(model, cond: np.ndarray, seed: int = 0, steps: int = 30, tileable: bool = False,
-             callback: Callable[[int, int, np.ndarray], None] | None = None) -> np.ndarray:
-    """cond float32 (E + P, H, W) -> image float32 (H, W) in [0, 1]."""
+def auto_tile(H: int, W: int) -> int:
+    """The tile side ``tile=None`` means for an H x W image (0: one piece)."""
+    return 0 if max(H, W) <= AUTO_WHOLE else AUTO_TILE
+
+
+def check_sampler(sampler: str, steps: int, spacing: str = "uniform", eta: float = 0.0) -> None:
+    """SettingError naming the first bad sampler setting."""
+    if sampler not in SAMPLERS:
+        raise SettingError("sampler", f"unknown sampler {sampler!r}; choose one of {', '.join(SAMPLERS)}")
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 1 <= steps <= 1000:
+        raise SettingError("steps", f"must be a whole number in [1, 1000], got {steps!r}")
+    if sampler == "heun" and steps < 2:
+        raise SettingError("steps", "heun needs at least 2 steps")
+    if spacing not in SPACINGS:
+        raise SettingError("spacing", f"unknown spacing {spacing!r}; choose one of {', '.join(SPACINGS)}")
+    if not (np.isfinite(eta) and 0.0 <= eta <= 1.0):
+        raise SettingError("eta", f"must lie in [0, 1], got {eta!r}")
+    if eta and sampler != "ddim":
+        raise SettingError("eta", f"eta > 0 is a DDIM setting; {sampler} is deterministic")
+
+
+def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS, tileable: bool = False,
+             callback: Callable[[int, int, np.ndarray], None] | None = None, sampler: str = DEFAULT_SAMPLER,
+             spacing: str = "uniform", eta: float = 0.0, tile: int | None = None,
+             overlap: int = DEFAULT_OVERLAP) -> np.ndarray:
+    """cond float32 (E + P, H, W) -> image float32 (H, W) in [0, 1].
+
+    ``steps`` timesteps of ``sampler`` (see :data:`backend.neural.sampler.SAMPLERS`) on the
+    model's own schedule (its JSON); callback(i, n, x̂₀) after each of the n model evaluations.
+    Sides above ``tile`` px are denoised in tiles overlapping by ``overlap`` px (0: never tile;
+    None: :func:`auto_tile`).
+    """
     cond = np.asarray(cond, _F)
     C, H, W = cond.shape
     want = model.embedding.shape[1] + len(model.params)
     if C != want:
         raise SettingError("conditioning", f"expected {want} channels, got {C}")
-    if not 1 <= steps <= 1000:
-        raise SettingError("steps", f"must lie in [1, 1000], got {steps}")
+    check_sampler(sampler, steps, spacing, eta)
     k = model.multiple_of
     if tileable and (H % k or W % k):
         raise SettingError("size", f"tileable output needs sides that are multiples of {k}, got {W}x{H}")
     Hp, Wp = -(-H // k) * k, -(-W // k) * k
     if (Hp, Wp) != (H, W):
         cond = np.pad(cond, ((0, 0), (0, Hp - H), (0, Wp - W)), mode="edge")
-    x0 = ddim_sample(model.eps_fn(tileable), initial_noise(seed, (1, 1, Hp, Wp)), cond[None], steps=steps,
-                     callback=callback)
+    if tile is None:
+        tile = auto_tile(Hp, Wp)
+    if tile and (tile % k or tile < 4 * k or not 0 <= overlap <= tile // 2 or overlap % k):
+        raise SettingError("tile", f"tile must be a multiple of {k} of at least {4 * k} px and overlap a multiple of "
+                           f"{k} of at most half the tile; got tile {tile}, overlap {overlap}")
+    kw = dict(eta=eta, rng=step_noise_rng(seed)) if eta else {}
+    if tile and max(Hp, Wp) > tile:
+        from .tiles import map_bytes, plan, tiled_eps
+
+        if tileable and min(Hp, Wp) <= tile:  # every tile must be smaller than the torus it wraps around
+            tile = (min(Hp, Wp) - 1) // k * k
+            overlap = min(overlap, tile // 2 // k * k)
+        count = len(plan(Hp, Wp, tile, overlap, tileable))
+        cache = count * map_bytes(model, min(tile, Hp), min(tile, Wp)) <= MAP_CACHE_BYTES
+        eps = tiled_eps(model, cond[None], tile, overlap, tileable, cache)
+    else:
+        eps = model.eps_fn(tileable)
+    x0 = sample(sampler, eps, initial_noise(seed, (1, 1, Hp, Wp)), cond[None], steps,
+                callback=callback, alphas_cumprod=model.alphas_cumprod, spacing=spacing, **kw)
     return np.clip((x0[0, 0, :H, :W] + 1.0) * 0.5, 0.0, 1.0).astype(_F)

@@ -30,7 +30,7 @@ import torch.nn.functional as F
 
 from . import zoo
 
-__all__ = ["Classifier", "train_classifier", "frechet", "radial_psd", "evaluate"]
+__all__ = ["Classifier", "train_classifier", "cached_classifier", "frechet", "radial_psd", "evaluate"]
 
 
 class Classifier(nn.Module):
@@ -106,14 +106,43 @@ def _centroid(imgs):
     return float((p * k).sum() / p.sum())
 
 
-def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print) -> dict:
-    """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`)."""
+def cached_classifier(classes, size: int, steps: int, cache: str | None = None, log=None):
+    """:func:`train_classifier`, or the one saved in folder ``cache`` for the same classes, size, steps
+    and thread count (training is reproducible for a fixed count), so that runs that compare
+    samplers or models use one instrument without training it again."""
+    if not cache:
+        return train_classifier(classes, size, steps, log=log)
+    import hashlib
+    import json
+    import os
+
+    key = json.dumps(dict(classes=list(classes), size=size, steps=steps, threads=torch.get_num_threads()))
+    path = os.path.join(cache, "classifier_" + hashlib.sha256(key.encode()).hexdigest()[:16] + ".pt")
+    if os.path.isfile(path):
+        saved = torch.load(path, weights_only=False)
+        clf = Classifier(len(classes))
+        clf.load_state_dict(saved["state"])
+        return clf.eval(), saved["accuracy"]
+    clf, acc = train_classifier(classes, size, steps, log=log)
+    os.makedirs(cache, exist_ok=True)
+    torch.save(dict(state=clf.state_dict(), accuracy=acc, key=key), path + ".tmp")
+    os.replace(path + ".tmp", path)
+    return clf, acc
+
+
+def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print,
+             sampler: str = "ddim", spacing: str = "uniform", classifier_cache: str | None = None) -> dict:
+    """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`),
+    sampled by ``sampler`` with ``steps`` timesteps (the same seeds for every sampler)."""
     from ..neural import conditioning as C
-    from ..neural.generate import generate
-    from ..neural.sampler import ddim_sample, initial_noise
+    from ..neural.generate import generate as _generate
+    from ..neural.sampler import initial_noise, sample as _sample
+
+    def generate(*args, **kw):
+        return _generate(*args, sampler=sampler, spacing=spacing, **kw)
 
     S = int(model.config["train_size"])
-    clf, zoo_acc = train_classifier(classes, S, clf_steps, log=log)
+    clf, zoo_acc = cached_classifier(classes, S, clf_steps, classifier_cache, log=log)
     index = {c: i for i, c in enumerate(classes)}
     rng = np.random.default_rng(123)
     rows = {}
@@ -121,7 +150,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
 
     def sample(spec, count, seed0):
         cond = np.repeat(C.uniform(model, spec, S, S)[None], count, 0)
-        x = ddim_sample(eps_fn, initial_noise(seed0, (count, 1, S, S)), cond, steps=steps)
+        x = _sample(sampler, eps_fn, initial_noise(seed0, (count, 1, S, S)), cond, steps,
+                    alphas_cumprod=model.alphas_cumprod, spacing=spacing)
         return (x[:, 0] + 1) * 0.5
 
     def feats(imgs):
