@@ -58,7 +58,7 @@ def main(out: str) -> int:
     os.makedirs(out, exist_ok=True)
     write_png(os.path.join(out, "neural.png"), preview_8bit(sheet, 0.0, 1.0))
     info = dict(classes=names, sweep=dict(cls=names[0], param=first["name"]), blend=[names[0], other], steps=STEPS, size=S,
-                seconds=round(time.perf_counter() - t0, 1), model_sha256=model.config["files"]["eps.onnx"])
+                seconds=round(time.perf_counter() - t0, 1), model_sha256=model.fingerprint)
     write_json(os.path.join(out, "neural.json"), info)
     print(f"wrote {out}/neural.png in {info['seconds']} s")
     return 0

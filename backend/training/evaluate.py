@@ -225,7 +225,7 @@ def step_seconds(model_folder: str, size: int = 256, reps: int = 3) -> dict:
         args = (torch.from_numpy(x), torch.from_numpy(t), torch.from_numpy(cond))
         diff = float(np.abs(tm(*args).numpy() - eps(x, t, cond)).max())
         if diff > 1e-3:
-            raise RuntimeError(f"torch and onnxruntime disagree on {model_folder}/eps.onnx (max |Δε| {diff:.2g})")
+            raise RuntimeError(f"torch and onnxruntime disagree on {model_folder} (max |Δε| {diff:.2g})")
         t0 = time.perf_counter()
         for _ in range(reps):
             tm(*args)

@@ -71,7 +71,7 @@ class TrainConfig:
     sample_steps: int = 20
     threads: int = 0               # CPU threads for torch and numba (0: their defaults), see .threads
     init_onnx: str = ""            # a fresh run starts from this export's weights (see .warm_start) ...
-    init_sha256: str = ""          # ... which must have this eps.onnx sha256
+    init_sha256: str = ""          # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
     precision: str = "auto"        # auto | fp32 | bf16: bf16 autocast where the CPU/GPU computes bf16 natively (.precision)
     channels_last: bool = False    # NHWC activations and weights (faster with bf16 on oneDNN)
 
@@ -90,7 +90,7 @@ class TrainConfig:
         if d.get("precision", "auto") not in PRECISIONS:
             raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {d['precision']!r}")
         if d.get("init_onnx") and not d.get("init_sha256"):
-            raise ValueError("init_onnx needs init_sha256 (the eps.onnx hash the run starts from)")
+            raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         return cls(**d)
 
 

@@ -1,4 +1,4 @@
-"""Start a training run from a shipped neural-noise export (``eps.onnx`` + ``neural_noise.json``).
+"""Start a training run from a shipped neural-noise export (``neural_noise.json`` and its .onnx files, either form).
 
 Checkpoints stay out of git, so the only durable copy of a trained model is its
 export.  This reads the exported weights back into a :class:`.unet.UNet` built
