@@ -40,3 +40,18 @@ class Recorder:
             self.log.append((name, args[1] if len(args) > 1 else None, kw.get("text")))
             return Recorder(self.log) if name in ("row", "column", "box") else type("Op", (), {})()
         return call
+
+
+def _has_openvdb() -> bool:
+    try:
+        from export.vdb import openvdb_module
+
+        openvdb_module()
+        return True
+    except (RuntimeError, ImportError):
+        return False
+
+
+#: .vdb steps need Blender's OpenVDB module, which the bpy 4.2 wheel lacks (Blender 4.2 itself ships pyopenvdb)
+needs_openvdb = pytest.mark.skipif(not _has_openvdb(), reason="this bpy build has no OpenVDB Python module "
+                                                             "(the bpy 4.2 wheel; Blender 4.2 ships pyopenvdb)")

@@ -5,6 +5,7 @@ import time
 
 import numpy as np
 import pytest
+from conftest import needs_openvdb
 
 bpy = pytest.importorskip("bpy")
 
@@ -79,6 +80,7 @@ def test_presets_set_the_ramp(scene):
         assert p.use_temperature == ref.has_temperature
 
 
+@needs_openvdb
 def test_bake_volume_operator_makes_a_renderable_volume(scene, tmp_path):
     p = scene.omninoise_bake
     p.preset = "smoke"  # dark smoke: absorbs the white world where it is dense
@@ -130,6 +132,7 @@ def test_bake_volume_operator_makes_a_renderable_volume(scene, tmp_path):
                                                                             spearman)
 
 
+@needs_openvdb
 def test_animated_volume_is_a_sequence(scene, tmp_path):
     p = scene.omninoise_bake
     p.wave.speed = 2.0
@@ -187,6 +190,7 @@ def test_bad_settings_report_one_line(scene, tmp_path):
     assert os.listdir(tmp_path) == []
 
 
+@needs_openvdb
 def test_worker_keeps_main_thread_free_and_cancels(scene, tmp_path):
     from blender_addon import tasks
 
@@ -236,6 +240,7 @@ dim = 2
 """
 
 
+@needs_openvdb
 def test_job_in_blender_matches_the_command_line(tmp_path):
     from backend.cli import main
 

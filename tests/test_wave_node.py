@@ -12,6 +12,7 @@ bpy = pytest.importorskip("bpy")
 from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
 from backend.wave import select_output  # noqa: E402
 from blender_addon.field_eval import evaluate_field  # noqa: E402
+from blender_addon.compat import ensure_node_tree  # noqa: E402
 from blender_addon.wave_nodes import SETTINGS_KEY, add_wave_node, build_wave_group, settings_from_json  # noqa: E402,E501
 
 OUT = {"Value": "real", "Imaginary": "imag", "Modulus": "modulus", "Phase": "phase"}
@@ -97,7 +98,7 @@ def _plane_material(grp, kw):
     bpy.context.scene.collection.objects.link(ob)
     mat = bpy.data.materials.new("wave")
     ob.data.materials.append(mat)
-    nt = mat.node_tree
+    nt = ensure_node_tree(mat)
     nt.nodes.clear()
     g = add_wave_node(nt, grp)
     tc = g.inputs["Vector"].links[0].from_node
@@ -166,7 +167,7 @@ def test_rebuild_keeps_links_and_interface():
     s, _ = CASES["3d"]
     grp = build_wave_group(s, "ShaderNodeTree")
     mat = bpy.data.materials.new("links")
-    nt = mat.node_tree
+    nt = ensure_node_tree(mat)
     nt.nodes.clear()
     g = nt.nodes.new("ShaderNodeGroup")
     g.node_tree = grp

@@ -25,11 +25,20 @@ out["error"] = tree.omninoise_wave.error
 out["directions_after_error"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
 out["cache_dir"] = importlib.import_module(MOD + ".blender_addon.preferences").cache_dir()
 # a volume bake through the installed package (its relative backend/export imports, bundled openvdb)
+vdb = importlib.import_module(MOD + ".export.vdb")
+try:
+    vdb.openvdb_module()
+    out["openvdb"] = True
+except RuntimeError:  # the bpy 4.2 wheel: no OpenVDB module; the bake must say so in one line
+    out["openvdb"] = False
 bake = bpy.context.scene.omninoise_bake
 bake.bounds_mode = "CUSTOM"
 bake.volume_resolution = (8, 8, 8)
 bake.name = "Installed"
-out["bake"] = sorted(bpy.ops.omninoise.bake_volume())
+try:
+    out["bake"] = sorted(bpy.ops.omninoise.bake_volume())
+except RuntimeError as exc:
+    out["bake"], out["bake_error"] = ["ERROR"], str(exc)
 obj = bpy.data.objects.get("Installed")
 out["bake_grids"] = sorted(g.name for g in obj.data.grids) if obj else []
 out["bake_file"] = bpy.path.abspath(obj.data.filepath) if obj else ""
