@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: all setup demo test bench dist clean
+.PHONY: all setup demo test test-blender bench dist clean
 
 all: test
 
@@ -33,6 +33,27 @@ $(VENV)/.train: $(STAMP) requirements-train.txt
 test: $(STAMP) $(VENV)/.train
 	$(BIN)/python -m pytest -q
 
+# The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS and 4.5 LTS
+# (Python 3.11) and 5.2 (Python 3.13; Blender 5.1+ runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
+PY313 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.13*/bin/python3.13) $(shell command -v python3.13))
+BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy52
+.venv-bpy42/.installed: requirements-blender.txt
+	$(PY) -m venv .venv-bpy42
+	.venv-bpy42/bin/python -m pip install -q bpy==4.2.23 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
+	@touch $@
+.venv-bpy45/.installed: requirements-blender.txt
+	$(PY) -m venv .venv-bpy45
+	.venv-bpy45/bin/python -m pip install -q bpy==4.5.15 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
+	@touch $@
+.venv-bpy52/.installed: requirements-blender.txt
+	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.2 (set PY313=...)"; exit 2; }
+	$(PY313) -m venv .venv-bpy52
+	.venv-bpy52/bin/python -m pip install -q bpy==5.2.3 -r requirements-blender.txt
+	@touch $@
+
+test-blender: $(STAMP) $(addsuffix /.installed,$(BPY_VENVS))
+	$(BIN)/python tools/blender_versions.py $(BPY_VENVS)
+
 $(VENV)/.bench: $(STAMP) requirements-bench.txt
 	$(BIN)/python -m pip install -q setuptools wheel
 	$(BIN)/python -m pip install -q --no-build-isolation -r requirements-bench.txt
@@ -47,4 +68,4 @@ dist: $(STAMP)
 	$(BIN)/python tools/build_dist.py --out dist
 
 clean:
-	rm -rf $(VENV) out build dist wheels *.egg-info
+	rm -rf $(VENV) $(BPY_VENVS) out build dist wheels *.egg-info

@@ -62,10 +62,12 @@ def renders(tmp_path_factory):
 
 
 def _read(path):
+    """Combined colour and the P AOV: one part per layer (Blender 5.0+) or one part with every
+    layer's channels (4.x); the OpenEXR module groups NAME.R/G/B/A into NAME either way."""
     with OpenEXR.File(str(path)) as f:
-        parts = {p.name(): p for p in f.parts}
-        color = parts["ViewLayer.Combined"].channels["ViewLayer.Combined"].pixels
-        pos = parts["ViewLayer.P"].channels["ViewLayer.P"].pixels
+        channels = {name: ch for part in f.parts for name, ch in part.channels.items()}
+        color = channels["ViewLayer.Combined"].pixels
+        pos = channels["ViewLayer.P"].pixels
     return np.asarray(color, np.float32), np.asarray(pos, np.float32)
 
 

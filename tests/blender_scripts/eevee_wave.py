@@ -22,6 +22,7 @@ sys.path.insert(0, os.path.join(ROOT, "bench"))
 
 from bench_node import scene  # noqa: E402  (the plane and orthographic camera of the render bench)
 from backend.settings import settings_from_dict  # noqa: E402
+from blender_addon.compat import eevee_engine, ensure_node_tree, set_multilayer_exr  # noqa: E402
 from blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402
 
 ENC = 0.1
@@ -29,13 +30,13 @@ ENC = 0.1
 
 def render(name: str, spec: dict, out_dir: str, res: int) -> float:
     sc, mat = scene(res, 1)
-    sc.render.engine = "BLENDER_EEVEE"
+    sc.render.engine = eevee_engine()
     sc.eevee.taa_render_samples = 1
     sc.render.filter_size = 0.0
     sc.view_settings.view_transform = "Standard"
     aov = sc.view_layers[0].aovs.add()
     aov.name, aov.type = "P", "COLOR"
-    nt = mat.node_tree
+    nt = ensure_node_tree(mat)
     nt.nodes.clear()
     g = add_wave_node(nt, build_wave_group(settings_from_dict(spec["settings"]), "ShaderNodeTree"))
     for key, val in spec["inputs"].items():
@@ -55,8 +56,7 @@ def render(name: str, spec: dict, out_dir: str, res: int) -> float:
     an.aov_name = "P"
     nt.links.new(g.inputs["Vector"].links[0].from_node.outputs["Object"], an.inputs["Color"])
     fmt = sc.render.image_settings
-    fmt.media_type = "MULTI_LAYER_IMAGE"
-    fmt.file_format = "OPEN_EXR_MULTILAYER"
+    set_multilayer_exr(fmt)
     fmt.color_depth = "32"
     sc.render.filepath = os.path.join(out_dir, name + ".exr")
     t = time.perf_counter()

@@ -1,0 +1,220 @@
+"""Neural noise speed: today's path against the new default, in one run: `python bench/bench_neural.py`.
+
+Today's path is the one-piece network (``eps.onnx``, re-exported from the shipped
+weights into a temporary folder) sampled by DDIM with 30 steps; the new default is
+the split export (encoder once, denoiser per step) with the default sampler and
+step count, in tiles above 1024 px.  Every configuration runs in a process of its
+own, so its peak resident memory is its own.  Per size it prints seconds per step
+(one network evaluation), seconds per image, where the time goes (encoder,
+denoiser, numpy around them) and peak RSS; below 1024² the image is generated in
+full, above it the per-image figure is encoder + steps x measured step (tiles:
+a measured tiled step) and marked "est.".  The network's FLOP count (from torch's
+layers, if torch is installed) over the measured step time gives the achieved
+GFLOP/s, beside a float32 matrix product of the same machine in the same run.
+Also the whole command (`omninoise neural`, model loading included) at 256².
+
+Writes out/bench/neural_speed.json.  Options: --sizes, --threads, --quick (256² and 512² only).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+import numpy as np  # noqa: E402
+
+FULL_UP_TO = 512  # generate whole images up to this size; above, estimate from measured steps
+
+
+def _worker(a) -> dict:
+    """One configuration in this process: prints a JSON line."""
+    from backend.neural import conditioning as C
+    from backend.neural.generate import auto_tile, generate
+    from backend.neural.model import NeuralNoiseModel
+    from backend.neural.sampler import evaluations
+    from backend.neural.tiles import map_bytes, plan, tiled_eps
+
+    t0 = time.perf_counter()
+    m = NeuralNoiseModel(a.model, threads=a.threads)
+    S = a.size
+    cond = C.uniform(m, ("cells_f1", {}), S, S)
+    x = np.random.default_rng(0).standard_normal((1, 1, S, S)).astype(np.float32)
+    t = np.array([500.0], np.float32)
+    tile = auto_tile(S, S) if m.form == "split" else 0
+    out = dict(size=S, form=m.form, sampler=a.sampler, steps=a.steps, evaluations=evaluations(a.sampler, a.steps),
+               tile=tile, load_s=round(time.perf_counter() - t0, 3))
+    if tile:
+        count = len(plan(S, S, tile, 64, False))
+        cache = count * map_bytes(m, tile, tile) <= (2 << 30)
+        f = tiled_eps(m, cond[None], tile, 64, False, cache)
+        t1 = time.perf_counter()
+        f(x, t, None)  # first step: encoder of every tile (cached if they fit) + denoiser
+        first = time.perf_counter() - t1
+        if cache:
+            t1 = time.perf_counter()
+            f(x, t, None)
+            step = time.perf_counter() - t1
+            enc = first - step
+        else:
+            step, enc = first, 0.0
+        out.update(tiles=count, maps_cached=cache, encoder_s=round(enc, 3), step_s=round(step, 3))
+        out["image_s"] = round(enc + out["evaluations"] * step, 1)
+        out["estimated"] = True
+    else:
+        f = m.eps_fn(False)
+        t1 = time.perf_counter()
+        f(x, t, cond[None])
+        first = time.perf_counter() - t1
+        reps = 3 if S <= 512 else 1
+        t1 = time.perf_counter()
+        for _ in range(reps):
+            f(x, t, cond[None])
+        step = (time.perf_counter() - t1) / reps
+        enc = 0.0
+        if m.form == "split":
+            t1 = time.perf_counter()
+            m.encode(cond[None])
+            enc = time.perf_counter() - t1
+        out.update(encoder_s=round(enc, 3), step_s=round(step, 3), first_call_s=round(first, 3))
+        if S <= FULL_UP_TO:
+            t1 = time.perf_counter()
+            generate(m, cond, seed=1, steps=a.steps, sampler=a.sampler)
+            img = time.perf_counter() - t1
+            out.update(image_s=round(img, 2), estimated=False,
+                       numpy_share=round(max(img - enc - out["evaluations"] * step, 0.0) / img, 3))
+        else:
+            out.update(image_s=round(enc + out["evaluations"] * step, 1), estimated=True)
+    out["peak_rss_mib"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
+    print("RESULT " + json.dumps(out), flush=True)
+    return out
+
+
+def _run(cfg: dict) -> dict:
+    cmd = [sys.executable, os.path.abspath(__file__), "--worker"] + [f"--{k}={v}" for k, v in cfg.items()]
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    line = [ln for ln in r.stdout.splitlines() if ln.startswith("RESULT ")]
+    if r.returncode or not line:
+        raise RuntimeError(f"worker {cfg} failed: {r.stderr[-2000:]}")
+    return json.loads(line[0][7:])
+
+
+def matmul_gflops(threads: int) -> float:
+    """float32 2048² matrix product, best of 5, in GFLOP/s (numpy's BLAS, in a worker with the same threads)."""
+    code = ("import numpy as np, time; a=np.random.rand(2048,2048).astype(np.float32); b=a.copy(); a@b; "
+            "ts=[]\nfor _ in range(5):\n t=time.perf_counter(); a@b; ts.append(time.perf_counter()-t)\n"
+            "print(2*2048**3/min(ts)/1e9)")
+    env = dict(os.environ)
+    if threads:
+        env.update(OMP_NUM_THREADS=str(threads), OPENBLAS_NUM_THREADS=str(threads))
+    return float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                                check=True).stdout)
+
+
+def network_gflop(model_folder: str, size: int) -> dict | None:
+    """GFLOP of one encoder and one denoiser pass at size² (convolutions and linear layers), via torch."""
+    try:
+        import torch
+
+        from backend.training.warm_start import torch_from_export
+    except ImportError:
+        return None
+    net = torch_from_export(model_folder)
+    count = {"n": 0}
+
+    def hook(mod, inp, out):
+        if isinstance(mod, torch.nn.Conv2d):
+            k = mod.weight[0].numel()  # Cin/groups * kh * kw
+            count["n"] += 2 * k * out.numel()
+        elif isinstance(mod, torch.nn.Linear):
+            count["n"] += 2 * mod.in_features * out.numel()
+
+    hs = [m.register_forward_hook(hook) for m in net.modules() if isinstance(m, (torch.nn.Conv2d, torch.nn.Linear))]
+    C = net.emb_dim + net.n_params
+    with torch.no_grad():
+        maps = net.encode(torch.zeros(1, C, size, size))
+        enc = count["n"]
+        count["n"] = 0
+        net.denoise(torch.zeros(1, 1, size, size), torch.tensor([500.0]), maps)
+    for h in hs:
+        h.remove()
+    return dict(encoder=enc / 1e9, denoiser=count["n"] / 1e9)
+
+
+def whole_command(args: list, threads: int) -> float:
+    with tempfile.TemporaryDirectory() as d:
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "backend", "neural", "--noise", "cells_f1", "--size", "256", "--quiet",
+                        "--threads", str(threads), "-o", os.path.join(d, "n.png")] + args, check=True, cwd=ROOT)
+        return time.perf_counter() - t0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
+    ap.add_argument("--size", type=int, default=256, help=argparse.SUPPRESS)
+    ap.add_argument("--sampler", default="ddim", help=argparse.SUPPRESS)
+    ap.add_argument("--steps", type=int, default=30, help=argparse.SUPPRESS)
+    ap.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024, 2048])
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--quick", action="store_true", help="256² and 512² only")
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_speed.json"))
+    a = ap.parse_args()
+    if a.worker:
+        _worker(a)
+        return 0
+    from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from backend.training.export_onnx import reexport
+
+    sizes = [s for s in a.sizes if s <= 512] if a.quick else a.sizes
+    tmp = tempfile.mkdtemp(prefix="omninoise_onepiece_")
+    reexport(a.model, tmp, one_piece=True)  # today's network, from the shipped weights
+    res = dict(threads=a.threads, matmul_gflops=round(matmul_gflops(a.threads), 1), rows=[])
+    flops = network_gflop(a.model, 256)
+    print(f"float32 matmul 2048²: {res['matmul_gflops']} GFLOP/s on {a.threads} threads")
+    if flops:
+        res["gflop_256"] = {k: round(v, 1) for k, v in flops.items()}
+        print(f"one network evaluation at 256²: encoder {flops['encoder']:.1f} GFLOP + denoiser "
+              f"{flops['denoiser']:.1f} GFLOP")
+    print("| size | path | s/step | encoder s | s/image | numpy share | peak RSS MiB | GFLOP/s |")
+    print("|---|---|---|---|---|---|---|---|")
+    for S in sizes:
+        pair = []
+        for label, folder, sampler, steps in (("today: one-piece, DDIM 30", tmp, "ddim", 30),
+                                              (f"new: split, {DEFAULT_SAMPLER} {DEFAULT_STEPS}", a.model,
+                                               DEFAULT_SAMPLER, DEFAULT_STEPS)):
+            r = _run(dict(model=folder, size=S, sampler=sampler, steps=steps, threads=a.threads))
+            r["path"] = label
+            if flops and not r.get("tile"):
+                per_step = (flops["denoiser"] + (flops["encoder"] if r["form"] == "one-piece" else 0)) * (S / 256) ** 2
+                r["gflops_per_s"] = round(per_step / r["step_s"], 1)
+            res["rows"].append(r)
+            pair.append(r)
+            est = " est." if r.get("estimated") else ""
+            tiles = f" ({r['tiles']} tiles)" if r.get("tiles") else ""
+            print(f"| {S}² | {label}{tiles} | {r['step_s']} | {r['encoder_s']} | {r['image_s']}{est} | "
+                  f"{r.get('numpy_share', '')} | {r['peak_rss_mib']} | {r.get('gflops_per_s', '')} |", flush=True)
+        print(f"|  | speed-up per image | {pair[0]['step_s'] / pair[1]['step_s']:.2f}x per step | | "
+              f"{pair[0]['image_s'] / pair[1]['image_s']:.2f}x | | | |", flush=True)
+    old = whole_command(["--model", tmp, "--sampler", "ddim", "--steps", "30"], a.threads)
+    new = whole_command([], a.threads)
+    res["whole_command_256"] = dict(today_s=round(old, 2), new_s=round(new, 2), ratio=round(old / new, 2))
+    print(f"\nwhole command at 256² (start-up and model loading included): today {old:.1f} s, new {new:.1f} s "
+          f"({old / new:.2f}x)")
+    os.makedirs(os.path.dirname(a.out), exist_ok=True)
+    from export.atomic import write_json
+
+    write_json(a.out, res)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

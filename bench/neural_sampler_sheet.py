@@ -1,0 +1,75 @@
+"""Side-by-side sheet of two samplers on the same seeds: `python bench/neural_sampler_sheet.py OUT.png`.
+
+Each row is one conditioning (a class at its default parameters, or a mask, four-corner or painted blend);
+the left image is DDIM with 30 steps (the sampler before DPM-Solver++), the right one the runtime's default
+sampler and step count, from the same x_T.  Writes OUT.png and OUT.json (settings and seconds).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from backend.neural import conditioning as C  # noqa: E402
+from backend.neural.generate import generate  # noqa: E402
+from backend.neural.model import NeuralNoiseModel  # noqa: E402
+from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS  # noqa: E402
+from export.atomic import write_json  # noqa: E402
+from export.images import preview_8bit, write_png  # noqa: E402
+
+CLASSES = ("cells_f1", "perlin", "clouds", "spots", "fibers", "damascus", "gabor", "wave_cellular")
+
+
+def conditions(model, S: int) -> list:
+    """(label, cond) rows: the classes, then a mask blend, a four-corner blend and a painted map."""
+    rows = [(n, C.uniform(model, (n, {}), S, S)) for n in CLASSES]
+    yy, xx = np.mgrid[0:S, 0:S]
+    mask = (xx + 0.25 * S * np.sin(yy / S * 2 * np.pi)) > S / 2
+    rows.append(("mask blend cells_f1 | noise", C.blend(model, ("cells_f1", {}), ("noise", {}),
+                                                         C.mask_weight(mask, S / 8, 1.0))))
+    rows.append(("four corners", C.four_corner(model, [(n, {}) for n in ("cells_borders", "spots", "clouds",
+                                                                          "gabor")], S, S)))
+    painted = np.zeros((S, S), np.int64)
+    painted[(xx - S / 2) ** 2 + (yy - S / 2) ** 2 < (S / 3) ** 2] = 1
+    rows.append(("painted disc", C.painted(model, painted, {0: ("perlin", {}), 1: ("cells_f1", {"scale": 14})},
+                                           S / 16, 1.0)))
+    return rows
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("out")
+    ap.add_argument("--size", type=int, default=128)
+    ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
+    ap.add_argument("--threads", type=int, default=0)
+    a = ap.parse_args()
+    model = NeuralNoiseModel(a.model, threads=a.threads)
+    S, gap = a.size, 4
+    rows, times, labels = [], {"ddim": 0.0, DEFAULT_SAMPLER: 0.0}, []
+    for i, (label, cond) in enumerate(conditions(model, S)):
+        labels.append(label)
+        t0 = time.perf_counter()
+        ref = generate(model, cond, seed=100 + i, steps=30, sampler="ddim")
+        t1 = time.perf_counter()
+        new = generate(model, cond, seed=100 + i)
+        times["ddim"] += t1 - t0
+        times[DEFAULT_SAMPLER] += time.perf_counter() - t1
+        rows.append(np.concatenate([ref, np.ones((S, gap), np.float32), new], 1))
+    sheet = np.concatenate([np.concatenate([r, np.ones((gap, r.shape[1]), np.float32)]) for r in rows])[:-gap]
+    write_png(a.out, preview_8bit(sheet, 0.0, 1.0))
+    write_json(os.path.splitext(a.out)[0] + ".json", dict(
+        rows=labels, size=S, left="ddim 30", right=f"{DEFAULT_SAMPLER} {DEFAULT_STEPS}",
+        seconds={k: round(v, 1) for k, v in times.items()}, model=model.fingerprint))
+    print(f"{a.out}: left DDIM 30 ({times['ddim']:.0f} s), right {DEFAULT_SAMPLER} {DEFAULT_STEPS} "
+          f"({times[DEFAULT_SAMPLER]:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
