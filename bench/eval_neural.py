@@ -33,7 +33,7 @@ def main() -> int:
     ap.add_argument("--n", type=int, default=32, help="samples per class")
     ap.add_argument("--steps", type=int, default=30, help="sampler steps")
     ap.add_argument("--sampler", default="ddim", help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py)")
-    ap.add_argument("--spacing", default="uniform", help="timestep spacing: uniform, logsnr or karras")
+    ap.add_argument("--spacing", help="timestep spacing: uniform, logsnr or karras (default: the sampler's own)")
     ap.add_argument("--clf-steps", type=int, default=600)
     ap.add_argument("--classifier-cache", metavar="DIR",
                     help="keep the trained classifier here and reuse it (same classes, size, steps, threads)")
@@ -73,7 +73,9 @@ def _run(a, model, classes) -> int:
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
     if not a.timing_only:
-        res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing)
+        from backend.neural.sampler import DEFAULT_SPACING
+
+        res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing or DEFAULT_SPACING[a.sampler])
     res["model"] = dict(step=model.config["step"], sha256=model.fingerprint, n=a.n, steps=a.steps,
                         classes=list(classes))
     print("| class | FD | acc | PSD err | response err (param) |")

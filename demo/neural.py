@@ -19,10 +19,11 @@ sys.path.insert(0, ROOT)
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, write_png  # noqa: E402
 
-STEPS = 30
+STEPS = DEFAULT_STEPS  # the runtime's default sampler (DPM-Solver++(2M), log-SNR spacing) and step count
 PER_ROW = 8  # tiles per row of the sheet; the classes wrap onto as many rows as they need
 
 
@@ -57,7 +58,8 @@ def main(out: str) -> int:
     sheet = np.concatenate([pad(r) if r.shape[1] < wide else r[:, :wide] for r in rows], 0)
     os.makedirs(out, exist_ok=True)
     write_png(os.path.join(out, "neural.png"), preview_8bit(sheet, 0.0, 1.0))
-    info = dict(classes=names, sweep=dict(cls=names[0], param=first["name"]), blend=[names[0], other], steps=STEPS, size=S,
+    info = dict(classes=names, sweep=dict(cls=names[0], param=first["name"]), blend=[names[0], other],
+                sampler=DEFAULT_SAMPLER, steps=STEPS, size=S,
                 seconds=round(time.perf_counter() - t0, 1), model_sha256=model.fingerprint)
     write_json(os.path.join(out, "neural.json"), info)
     print(f"wrote {out}/neural.png in {info['seconds']} s")

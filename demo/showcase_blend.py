@@ -103,7 +103,7 @@ def add_neural_plane(sc, out: str):
         return
     blender_addon.register()
     p = sc.omninoise_neural
-    p.size, p.steps, p.seed, p.name = 128, 30, 11, "Neural Blend"
+    p.size, p.seed, p.name = 128, 11, "Neural Blend"  # the panel's default sampler and steps
     for noise, colour in (("cells_f1", (1.0, 0.0, 0.0)), ("damascus", (0.0, 0.0, 1.0))):
         bpy.ops.omninoise.swatch_add()
         p.swatches[-1].noise = noise

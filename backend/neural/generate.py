@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import SettingError
-from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, step_noise_rng
+from .sampler import DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, step_noise_rng
 from .schedule import SPACINGS, alphas_from_config
 
 __all__ = ["generate", "check_sampler", "auto_tile", "AUTO_WHOLE", "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES"]
@@ -36,15 +36,15 @@ def auto_tile(H: int, W: int) -> int:
     return 0 if max(H, W) <= AUTO_WHOLE else AUTO_TILE
 
 
-def check_sampler(sampler: str, steps: int, spacing: str = "uniform", eta: float = 0.0) -> None:
-    """SettingError naming the first bad sampler setting."""
+def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: float = 0.0) -> None:
+    """SettingError naming the first bad sampler setting (spacing None: the sampler's default)."""
     if sampler not in SAMPLERS:
         raise SettingError("sampler", f"unknown sampler {sampler!r}; choose one of {', '.join(SAMPLERS)}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 1 <= steps <= 1000:
         raise SettingError("steps", f"must be a whole number in [1, 1000], got {steps!r}")
     if sampler == "heun" and steps < 2:
         raise SettingError("steps", "heun needs at least 2 steps")
-    if spacing not in SPACINGS:
+    if spacing is not None and spacing not in SPACINGS:
         raise SettingError("spacing", f"unknown spacing {spacing!r}; choose one of {', '.join(SPACINGS)}")
     if not (np.isfinite(eta) and 0.0 <= eta <= 1.0):
         raise SettingError("eta", f"must lie in [0, 1], got {eta!r}")
@@ -54,12 +54,13 @@ def check_sampler(sampler: str, steps: int, spacing: str = "uniform", eta: float
 
 def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS, tileable: bool = False,
              callback: Callable[[int, int, np.ndarray], None] | None = None, sampler: str = DEFAULT_SAMPLER,
-             spacing: str = "uniform", eta: float = 0.0, tile: int | None = None,
+             spacing: str | None = None, eta: float = 0.0, tile: int | None = None,
              overlap: int = DEFAULT_OVERLAP) -> np.ndarray:
     """cond float32 (E + P, H, W) -> image float32 (H, W) in [0, 1].
 
     ``steps`` timesteps of ``sampler`` (see :data:`backend.neural.sampler.SAMPLERS`) on the
-    model's own schedule (its JSON); callback(i, n, x̂₀) after each of the n model evaluations.
+    model's own schedule (its JSON), spaced by ``spacing`` (None: the sampler's DEFAULT_SPACING);
+    callback(i, n, x̂₀) after each of the n model evaluations.
     Sides above ``tile`` px are denoised in tiles overlapping by ``overlap`` px (0: never tile;
     None: :func:`auto_tile`).
     """
@@ -69,6 +70,7 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
     if C != want:
         raise SettingError("conditioning", f"expected {want} channels, got {C}")
     check_sampler(sampler, steps, spacing, eta)
+    spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
     k = model.multiple_of
     if tileable and (H % k or W % k):
         raise SettingError("size", f"tileable output needs sides that are multiples of {k}, got {W}x{H}")

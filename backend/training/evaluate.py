@@ -131,12 +131,16 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
 
 
 def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print,
-             sampler: str = "ddim", spacing: str = "uniform", classifier_cache: str | None = None) -> dict:
+             sampler: str = "ddim", spacing: str | None = None, classifier_cache: str | None = None) -> dict:
     """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`),
     sampled by ``sampler`` with ``steps`` timesteps (the same seeds for every sampler)."""
     from ..neural import conditioning as C
     from ..neural.generate import generate as _generate
     from ..neural.sampler import initial_noise, sample as _sample
+
+    from ..neural.sampler import DEFAULT_SPACING
+
+    spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
 
     def generate(*args, **kw):
         return _generate(*args, sampler=sampler, spacing=spacing, **kw)
