@@ -70,23 +70,24 @@ def _worker(a) -> dict:
         out["estimated"] = True
     else:
         f = m.eps_fn(False)
+        c = cond[None]  # one array: a split model encodes it once (a new array would be encoded again)
         t1 = time.perf_counter()
-        f(x, t, cond[None])
+        f(x, t, c)
         first = time.perf_counter() - t1
         reps = 3 if S <= 512 else 1
         t1 = time.perf_counter()
         for _ in range(reps):
-            f(x, t, cond[None])
+            f(x, t, c)
         step = (time.perf_counter() - t1) / reps
         enc = 0.0
         if m.form == "split":
             t1 = time.perf_counter()
-            m.encode(cond[None])
+            m.encode(c)
             enc = time.perf_counter() - t1
         out.update(encoder_s=round(enc, 3), step_s=round(step, 3), first_call_s=round(first, 3))
         if S <= FULL_UP_TO:
             t1 = time.perf_counter()
-            generate(m, cond, seed=1, steps=a.steps, sampler=a.sampler)
+            generate(m, cond, seed=1, steps=a.steps, sampler=a.sampler)  # the sampler's default spacing
             img = time.perf_counter() - t1
             out.update(image_s=round(img, 2), estimated=False,
                        numpy_share=round(max(img - enc - out["evaluations"] * step, 0.0) / img, 3))
@@ -101,6 +102,8 @@ def _run(cfg: dict) -> dict:
     cmd = [sys.executable, os.path.abspath(__file__), "--worker"] + [f"--{k}={v}" for k, v in cfg.items()]
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     line = [ln for ln in r.stdout.splitlines() if ln.startswith("RESULT ")]
+    if r.returncode == -9 and not line:  # the kernel's out-of-memory killer (24 GB here)
+        return dict(size=cfg["size"], failed="killed: out of memory")
     if r.returncode or not line:
         raise RuntimeError(f"worker {cfg} failed: {r.stderr[-2000:]}")
     return json.loads(line[0][7:])
@@ -193,6 +196,11 @@ def main() -> int:
                                                DEFAULT_SAMPLER, DEFAULT_STEPS)):
             r = _run(dict(model=folder, size=S, sampler=sampler, steps=steps, threads=a.threads))
             r["path"] = label
+            if "failed" in r:
+                res["rows"].append(r)
+                pair.append(None)
+                print(f"| {S}² | {label} | {r['failed']} | | | | | |", flush=True)
+                continue
             if flops and not r.get("tile"):
                 per_step = (flops["denoiser"] + (flops["encoder"] if r["form"] == "one-piece" else 0)) * (S / 256) ** 2
                 r["gflops_per_s"] = round(per_step / r["step_s"], 1)
@@ -202,8 +210,9 @@ def main() -> int:
             tiles = f" ({r['tiles']} tiles)" if r.get("tiles") else ""
             print(f"| {S}² | {label}{tiles} | {r['step_s']} | {r['encoder_s']} | {r['image_s']}{est} | "
                   f"{r.get('numpy_share', '')} | {r['peak_rss_mib']} | {r.get('gflops_per_s', '')} |", flush=True)
-        print(f"|  | speed-up per image | {pair[0]['step_s'] / pair[1]['step_s']:.2f}x per step | | "
-              f"{pair[0]['image_s'] / pair[1]['image_s']:.2f}x | | | |", flush=True)
+        if None not in pair:
+            print(f"|  | speed-up per image | {pair[0]['step_s'] / pair[1]['step_s']:.2f}x per step | | "
+                  f"{pair[0]['image_s'] / pair[1]['image_s']:.2f}x | | | |", flush=True)
     old = whole_command(["--model", tmp, "--sampler", "ddim", "--steps", "30"], a.threads)
     new = whole_command([], a.threads)
     res["whole_command_256"] = dict(today_s=round(old, 2), new_s=round(new, 2), ratio=round(old / new, 2))

@@ -56,7 +56,9 @@ class NeuralNoiseModel:
         except ValueError as exc:
             raise ModelError(f"{folder}: {exc}") from None
         self.threads = threads
-        self._sessions = SessionCache(folder, threads)
+        # no CPU arena: at 1024² it kept 11.8 GB against 4.4 GB without, with steps no slower (bench_neural.py),
+        # and inside Blender the arena would hold that memory after every bake
+        self._sessions = SessionCache(folder, threads, arena=False)
 
     def session(self, name: str | None = None):
         """The onnxruntime session of ``name`` (default: the ε-network of a one-piece export, the denoiser of a split one)."""
