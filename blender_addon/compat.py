@@ -17,8 +17,7 @@ from __future__ import annotations
 
 import bpy
 
-__all__ = ["VERSION", "eevee_engine", "has_gabor_node", "ensure_node_tree", "set_multilayer_exr",
-           "id_property", "set_id_property"]
+__all__ = ["VERSION", "eevee_engine", "has_gabor_node", "ensure_node_tree", "set_multilayer_exr", "id_property"]
 
 VERSION: tuple = tuple(bpy.app.version[:2])
 
@@ -59,6 +58,3 @@ def id_property(idblock, key: str, *legacy: str):
             return v
     return None
 
-
-def set_id_property(idblock, key: str, value: str) -> None:
-    idblock[key] = value

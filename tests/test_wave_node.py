@@ -197,3 +197,23 @@ def test_table_image_is_float_and_survives_save(tmp_path):
     img = bpy.data.images[name]
     assert np.array_equal(np.array(img.pixels[:], np.float32), ref)
     bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def test_settings_key_and_the_key_of_older_files():
+    """The settings live under a key no registered property uses (before 5.0 the two share storage);
+    trees saved by OmniNoise 0.1 on Blender 5.0 under the old key still give their settings."""
+    from blender_addon.compat import VERSION
+    from blender_addon.wave_nodes import LEGACY_SETTINGS_KEY, tree_settings_json
+
+    s, _ = CASES["2d"]
+    grp = build_wave_group(s, "ShaderNodeTree")
+    assert SETTINGS_KEY != LEGACY_SETTINGS_KEY and settings_from_json(tree_settings_json(grp)) == s
+    if VERSION < (5, 0):
+        pytest.skip("before Blender 5.0 the old key names the registered property and holds no settings")
+    text = grp[SETTINGS_KEY]
+    del grp[SETTINGS_KEY]
+    grp[LEGACY_SETTINGS_KEY] = text  # as OmniNoise 0.1 stored it
+    assert tree_settings_json(grp) == text
+    del grp[LEGACY_SETTINGS_KEY]
+    assert tree_settings_json(grp) is None
+    bpy.data.node_groups.remove(grp)

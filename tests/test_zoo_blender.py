@@ -70,6 +70,10 @@ CASES = [
 
 @pytest.mark.parametrize("name, node, settings, inputs", CASES)
 def test_blender_named_classes_match_the_nodes(name, node, settings, inputs):
+    from blender_addon.compat import has_gabor_node
+
+    if node == "ShaderNodeTexGabor" and not has_gabor_node():
+        pytest.skip("Blender's Gabor Texture node needs Blender 4.3")
     ours = zoo.generate(name, inputs, torch.arange(4), S).numpy()
     theirs = blender_images(node, settings, inputs)
     centroid, psd, hist = distances(theirs, ours)
