@@ -6,8 +6,7 @@ import hashlib
 import json
 import os
 
-__all__ = ["ModelError", "sha256_file", "load_model_json", "fingerprint", "SessionCache", "set_default_threads",
-           "default_threads"]
+__all__ = ["ModelError", "sha256_file", "load_model_json", "fingerprint", "SessionCache", "set_default_threads"]
 
 _THREADS = {"default": 0}
 
@@ -19,9 +18,6 @@ def set_default_threads(n: int) -> None:
         raise ValueError(f"threads must be a whole number >= 0, got {n!r}")
     _THREADS["default"] = n
 
-
-def default_threads() -> int:
-    return _THREADS["default"]
 
 
 class ModelError(RuntimeError):

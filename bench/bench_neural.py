@@ -37,10 +37,9 @@ FULL_UP_TO = 512  # generate whole images up to this size; above, estimate from 
 def _worker(a) -> dict:
     """One configuration in this process: prints a JSON line."""
     from backend.neural import conditioning as C
-    from backend.neural.generate import auto_tile, generate
+    from backend.neural.generate import auto_tile, generate, image_eps
     from backend.neural.model import NeuralNoiseModel
     from backend.neural.sampler import evaluations
-    from backend.neural.tiles import map_bytes, plan, tiled_eps
 
     t0 = time.perf_counter()
     m = NeuralNoiseModel(a.model, threads=a.threads)
@@ -52,9 +51,7 @@ def _worker(a) -> dict:
     out = dict(size=S, form=m.form, sampler=a.sampler, steps=a.steps, evaluations=evaluations(a.sampler, a.steps),
                tile=tile, load_s=round(time.perf_counter() - t0, 3))
     if tile:
-        count = len(plan(S, S, tile, 64, False))
-        cache = count * map_bytes(m, tile, tile) <= (2 << 30)
-        f = tiled_eps(m, cond[None], tile, 64, False, cache)
+        f, count, cache = image_eps(m, cond[None], False, tile)  # generate()'s tiles and map cache
         t1 = time.perf_counter()
         f(x, t, None)  # first step: encoder of every tile (cached if they fit) + denoiser
         first = time.perf_counter() - t1

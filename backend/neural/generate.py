@@ -22,7 +22,7 @@ from ..errors import SettingError
 from .sampler import DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, step_noise_rng
 from .schedule import SPACINGS, alphas_from_config
 
-__all__ = ["generate", "check_sampler", "auto_tile", "AUTO_WHOLE", "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES"]
+__all__ = ["generate", "check_sampler", "image_eps", "auto_tile", "AUTO_WHOLE", "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES"]
 
 _F = np.float32
 AUTO_WHOLE = 1024          #: with tile=None, sides up to this are generated in one piece ...
@@ -34,6 +34,24 @@ MAP_CACHE_BYTES = 2 << 30  #: keep the encoder's maps of all tiles while they ta
 def auto_tile(H: int, W: int) -> int:
     """The tile side ``tile=None`` means for an H x W image (0: one piece)."""
     return 0 if max(H, W) <= AUTO_WHOLE else AUTO_TILE
+
+
+def image_eps(model, cond: np.ndarray, tileable: bool, tile: int, overlap: int = DEFAULT_OVERLAP):
+    """The model(x, t, cond) callable for a (1, C, H, W) conditioning grid whose sides are multiples of
+    ``model.multiple_of``: one piece when no side exceeds ``tile`` (or tile is 0), else overlapping tiles
+    whose encoder maps are kept while they fit MAP_CACHE_BYTES.  Returns (eps, tiles, maps_cached)."""
+    H, W = cond.shape[-2:]
+    if not tile or max(H, W) <= tile:
+        return model.eps_fn(tileable), 1, True
+    from .tiles import map_bytes, plan, tiled_eps
+
+    k = model.multiple_of
+    if tileable and min(H, W) <= tile:  # every tile must be smaller than the torus it wraps around
+        tile = (min(H, W) - 1) // k * k
+        overlap = min(overlap, tile // 2 // k * k)
+    count = len(plan(H, W, tile, overlap, tileable))
+    cache = count * map_bytes(model, min(tile, H), min(tile, W)) <= MAP_CACHE_BYTES
+    return tiled_eps(model, cond, tile, overlap, tileable, cache), count, cache
 
 
 def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: float = 0.0) -> None:
@@ -83,17 +101,7 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
         raise SettingError("tile", f"tile must be a multiple of {k} of at least {4 * k} px and overlap a multiple of "
                            f"{k} of at most half the tile; got tile {tile}, overlap {overlap}")
     kw = dict(eta=eta, rng=step_noise_rng(seed)) if eta else {}
-    if tile and max(Hp, Wp) > tile:
-        from .tiles import map_bytes, plan, tiled_eps
-
-        if tileable and min(Hp, Wp) <= tile:  # every tile must be smaller than the torus it wraps around
-            tile = (min(Hp, Wp) - 1) // k * k
-            overlap = min(overlap, tile // 2 // k * k)
-        count = len(plan(Hp, Wp, tile, overlap, tileable))
-        cache = count * map_bytes(model, min(tile, Hp), min(tile, Wp)) <= MAP_CACHE_BYTES
-        eps = tiled_eps(model, cond[None], tile, overlap, tileable, cache)
-    else:
-        eps = model.eps_fn(tileable)
+    eps, _, _ = image_eps(model, cond[None], tileable, tile, overlap)
     x0 = sample(sampler, eps, initial_noise(seed, (1, 1, Hp, Wp)), cond[None], steps,
                 callback=callback, alphas_cumprod=model.alphas_cumprod, spacing=spacing, **kw)
     return np.clip((x0[0, 0, :H, :W] + 1.0) * 0.5, 0.0, 1.0).astype(_F)

@@ -23,6 +23,11 @@ __all__ = ["NeuralNoiseModel", "ModelError", "sha256_file"]
 _F = np.float32
 
 
+def _tile_flag(tileable: bool) -> np.ndarray:
+    """The graphs' ``tile`` input: [1.0] circular padding (seamless tiles), [0.0] zero padding."""
+    return np.array([1.0 if tileable else 0.0], _F)
+
+
 class NeuralNoiseModel:
     """ε-network plus what the sampler and the conditioning need.
 
@@ -67,7 +72,7 @@ class NeuralNoiseModel:
     def encode(self, cond: np.ndarray, tileable: bool = False) -> dict:
         """Split form: cond float32 (B, C, H, W) -> {m00: [1 + γ, β] of ResBlock 0, ...} for the denoiser."""
         sess = self.session("encoder.onnx")
-        tile = np.array([1.0 if tileable else 0.0], _F)
+        tile = _tile_flag(tileable)
         names = [o.name for o in sess.get_outputs()]
         return dict(zip(names, sess.run(None, {"cond": np.ascontiguousarray(cond, _F), "tile": tile})))
 
@@ -77,7 +82,7 @@ class NeuralNoiseModel:
         With a split export the encoder runs when ``cond`` is a new array (by identity:
         a sampler passes the same array at every step) and its maps are reused.
         """
-        tile = np.array([1.0 if tileable else 0.0], _F)
+        tile = _tile_flag(tileable)
         if self.form == "one-piece":
             sess = self.session()
 

@@ -64,8 +64,7 @@ class _Counter:
         self.model, self.cond, self.total, self.callback, self.i = model, cond, total, callback, 0
 
     def __call__(self, x, t):
-        eps = np.asarray(self.model(x, np.full(x.shape[0], t, _F), self.cond), _F)
-        return eps
+        return np.asarray(self.model(x, np.full(x.shape[0], t, _F), self.cond), _F)
 
     def done(self, x0):
         if self.callback is not None:

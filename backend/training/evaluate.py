@@ -123,10 +123,12 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
         clf = Classifier(len(classes))
         clf.load_state_dict(saved["state"])
         return clf.eval(), saved["accuracy"]
+    from .._export import export
+
     clf, acc = train_classifier(classes, size, steps, log=log)
     os.makedirs(cache, exist_ok=True)
-    torch.save(dict(state=clf.state_dict(), accuracy=acc, key=key), path + ".tmp")
-    os.replace(path + ".tmp", path)
+    with export.atomic_path(path) as tmp:
+        torch.save(dict(state=clf.state_dict(), accuracy=acc, key=key), tmp)
     return clf, acc
 
 

@@ -90,13 +90,14 @@ def _export_split(model, out: str, size: int) -> dict:
     cond, tile = torch.randn(1, C, size, size), torch.zeros(1)
     names = map_names(model)
     hw = {0: "batch", 2: "height", 3: "width"}
+    map_axes = {n: {0: "batch", 2: f"h{n}", 3: f"w{n}"} for n in names}  # block k is at H / 2^level_k
     onnx_export(_Encoder(model), (cond, tile), os.path.join(out, "encoder.onnx"), ["cond", "tile"], names,
-                {"cond": hw, **{n: {0: "batch", 2: f"h{n}", 3: f"w{n}"} for n in names}})
+                {"cond": hw, **map_axes})
     with torch.no_grad():
         maps = model.encode(cond, tile)
     args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), tile, *maps)
     onnx_export(_Denoiser(model), args, os.path.join(out, "denoiser.onnx"), ["x", "t", "tile"] + names, ["eps"],
-                {"x": hw, "t": {0: "batch"}, "eps": hw, **{n: {0: "batch", 2: f"h{n}", 3: f"w{n}"} for n in names}})
+                {"x": hw, "t": {0: "batch"}, "eps": hw, **map_axes})
     return dict(names=names, channels=[int(m.shape[1]) for m in maps], levels=[lvl for _, lvl in model.blocks()])
 
 
