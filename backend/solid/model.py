@@ -89,9 +89,23 @@ def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setti
 
 @dataclass(frozen=True)
 class TextureCode:
-    """What the sampler needs: the extended code e float32 (E,) and the octave transforms T float32 (m, D, D)."""
+    """What the sampler needs: the extended code e float32 (E,) and the octave transforms T float32 (m, D, D);
+    for photo models (``colour_model`` "affine") also the exemplar's colour: mean ``mu`` float32 (3,) and the
+    Cholesky factor ``L`` float32 (3, 3) of its colour covariance (rgb = mu + L d)."""
     e: np.ndarray
     T: np.ndarray
+    mu: np.ndarray | None = None
+    L: np.ndarray | None = None
+
+
+def colour_stats(img: np.ndarray, eps: float = 1e-4) -> np.ndarray:
+    """Mean colour and Cholesky factor of the colour covariance of an image (H, W, 3): float32 (12,) = [mu, L.ravel()]
+    (the numpy twin of ``backend.training.solid.model.colour_stats``)."""
+    x = np.asarray(img, np.float64).reshape(-1, 3)
+    mu = x.mean(0)
+    xc = x - mu
+    cov = xc.T @ xc / x.shape[0] + eps * np.eye(3)
+    return np.concatenate([mu, np.linalg.cholesky(cov).ravel()]).astype(_F)
 
 
 class SolidTextureModel:
@@ -105,6 +119,9 @@ class SolidTextureModel:
         self.octaves, self.channels, self.code_dim = int(c["octaves"]), int(c["channels"]), int(c["code_dim"])
         self.px_per_unit = float(c["px_per_unit"]) / float(c.get("exemplar_scale", 1.0))
         self.codes = {k: np.asarray(v, _F) for k, v in c.get("codes", {}).items()}
+        #: photo models append the exemplar's colour statistics (12 values) to the encoder's latent z
+        self.colour_stats = int(c.get("colour_stats", 0))
+        self.z_dim = int(c.get("z_dim", 8))
         self._session = SessionCache(folder, threads)
 
     # -- codes ----------------------------------------------------------------------------------
@@ -130,6 +147,11 @@ class SolidTextureModel:
             raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
         img = img[..., :3]
         S = int(self.config.get("encoder_size", 128))
+        scale = float(self.config.get("exemplar_scale", 1.0))
+        if scale != 1.0:        # the encoder saw exemplars resampled by this factor in training
+            from PIL import Image
+            h, w = max(1, round(img.shape[0] * scale)), max(1, round(img.shape[1] * scale))
+            img = np.stack([np.asarray(Image.fromarray(img[..., c]).resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
         if min(img.shape[:2]) < S:
             from PIL import Image
             f = S / min(img.shape[:2])
@@ -140,16 +162,24 @@ class SolidTextureModel:
         ys = np.unique(np.linspace(0, H - S, -(-(H - S) // (S // 2)) + 1).round().astype(int))
         xs = np.unique(np.linspace(0, W - S, -(-(W - S) // (S // 2)) + 1).round().astype(int))
         crops = np.stack([img[y:y + S, x:x + S].transpose(2, 0, 1) for y in ys for x in xs]).astype(_F)
-        z = self._session("encoder.onnx").run(None, {"exemplar": np.clip(crops, 0.0, 1.0)})[0]
-        return z.mean(0).astype(_F)
+        z = self._session("encoder.onnx").run(None, {"exemplar": np.clip(crops, 0.0, 1.0)})[0].mean(0)
+        if self.colour_stats:
+            z = np.concatenate([z, colour_stats(img)])
+        return z.astype(_F)
 
     def translate(self, z) -> TextureCode:
         """Space mode, translator h(z) -> (e, T) (Sec. 3)."""
         if self.mode != "space":
             raise SettingError("code", f"model {self.name!r} has no translator (single-exemplar model)")
-        z = np.asarray(z, _F).reshape(1, -1)
-        e, T = self._session("translator.onnx").run(None, {"z": z})
-        return TextureCode(e[0].astype(_F), T[0].astype(_F))
+        z = np.asarray(z, _F).reshape(-1)
+        if z.shape[0] != self.z_dim + self.colour_stats:
+            raise SettingError("code", f"code has {z.shape[0]} values, model {self.name!r} needs "
+                                       f"{self.z_dim + self.colour_stats}")
+        e, T = self._session("translator.onnx").run(None, {"z": z[:self.z_dim].reshape(1, -1)})
+        if not self.colour_stats:
+            return TextureCode(e[0].astype(_F), T[0].astype(_F))
+        c = z[self.z_dim:]
+        return TextureCode(e[0].astype(_F), T[0].astype(_F), c[:3].copy(), c[3:12].reshape(3, 3).copy())
 
     def code(self, exemplar: str | None = None) -> TextureCode:
         """A named training exemplar's code (space models), or the default code."""
@@ -194,7 +224,12 @@ class SolidTextureModel:
             b = min(N, a + chunk)
             noise = lattice_noise(pts[a:b], T, seed, self.channels)
             e = code.e if code.e.ndim == 1 else code.e[a:b]
-            out[a:b] = self.decode(noise, e)
+            d = self.decode(noise, e)
+            if self.colour_stats:
+                if code.mu is None or code.L is None:
+                    raise SettingError("code", f"model {self.name!r} needs the exemplar's colour (mu, L) in its code")
+                d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
+            out[a:b] = d
             if progress is not None:
                 progress(b, N)
         return out

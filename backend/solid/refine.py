@@ -13,7 +13,9 @@ statistics that need no network:
   normalised: orientation.
 
 A candidate replaces z only when it lowers the distance, so the result is never
-worse than the encoder's code under this measure.
+worse than the encoder's code under this measure.  Photo models carry the
+exemplar's measured colour (mean and covariance) after the latent: the search
+moves only the latent, so refinement never changes the colours.
 
 Shapes: images float32 (H, W, 3) sRGB values in [0, 1].
 """
@@ -83,11 +85,13 @@ def refine_code(model, z0, exemplar: np.ndarray, steps: int = 40, seed: int = 0,
     z = np.asarray(z0, np.float32).copy()
     best = cost(z)
     hist = [best]
-    step = float(sigma) * max(float(np.std(z)), 1e-3)
+    k = int(getattr(model, "z_dim", z.shape[0]))       # the latent; photo models' colour statistics stay
+    step = float(sigma) * max(float(np.std(z[:k])), 1e-3)
     for i in range(int(steps)):
         if cancel is not None and cancel():
             raise Cancelled("cancelled")
-        cand = (z + rng.normal(0.0, step, z.shape)).astype(np.float32)
+        cand = z.copy()
+        cand[:k] = (z[:k] + rng.normal(0.0, step, k)).astype(np.float32)
         c = cost(cand)
         if c < best:
             z, best = cand, c

@@ -2,7 +2,8 @@
 
 Writes, each atomically:
 
-    OUT_DIR/decoder.onnx     inputs noise (N, m*C), code (B, E) with B = 1 or N -> rgb (N, 3);
+    OUT_DIR/decoder.onnx     inputs noise (N, m*C), code (B, E) with B = 1 or N -> rgb (N, 3)
+                             (colour "affine": the whitened colour d; the runtime adds mu + L d);
                              f(n | e) of Eq. 5 with its first layer split as W_n n + (W_e e + b), so
                              one code is broadcast over all points and per-point codes still work
     OUT_DIR/encoder.onnx     space mode: exemplar (B, 3, 128, 128) in [0, 1] -> z (B, z_dim)
@@ -24,6 +25,8 @@ from torch import nn
 from ..._export import export as _ex
 from ...onnx_models import sha256_file
 from ..export_onnx import onnx_export as _onnx
+from . import exemplars as ex
+from .model import COLOUR_STATS, colour_stats
 from .train import SolidConfig, build_model, training_images
 
 __all__ = ["export", "SplitDecoder", "FORMAT", "ENCODER_SIZE"]
@@ -37,6 +40,7 @@ class SplitDecoder(nn.Module):
 
     def __init__(self, dec, n_noise: int):
         super().__init__()
+        self.sigmoid = dec.sigmoid
         first = dec.net[0]
         self.wn = nn.Linear(n_noise, first.out_features, bias=False)
         self.we = nn.Linear(first.in_features - n_noise, first.out_features)
@@ -47,7 +51,8 @@ class SplitDecoder(nn.Module):
         self.rest = dec.net[1:]
 
     def forward(self, noise, code):
-        return torch.sigmoid(self.rest(self.wn(noise) + self.we(code)))
+        y = self.rest(self.wn(noise) + self.we(code))
+        return torch.sigmoid(y) if self.sigmoid else y
 
 
 class _Translator(nn.Module):
@@ -77,7 +82,8 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                paper="Henzler, Mitra, Ritschel 2020, Learning a Neural 3D Texture Space from 2D Exemplars",
                mode=cfg.mode, dim=cfg.dim, octaves=cfg.octaves, channels=cfg.channels, code_dim=cfg.code_dim,
                z_dim=cfg.z_dim, px_per_unit=cfg.px_per_unit, exemplar_scale=cfg.exemplar_scale,
-               exemplars=list(cfg.exemplars), colour="sRGB", step=int(state["step"]),
+               exemplars=list(cfg.exemplars), colour="sRGB", colour_model=cfg.colour,
+               colour_stats=COLOUR_STATS if cfg.colour == "affine" else 0, step=int(state["step"]),
                train_seconds=round(float(state.get("elapsed", 0.0)), 1), n_params=int(state["n_params"]),
                config=state["config"])
     with torch.no_grad():
@@ -93,12 +99,20 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
             files["encoder.onnx"] = sha256_file(os.path.join(out, "encoder.onnx"))
             files["translator.onnx"] = sha256_file(os.path.join(out, "translator.onnx"))
             # codes of the training exemplars: mean z over a grid of 128 px crops
+            # (photo models: one named code per category, its first training photo; z gets the photo's colour)
             codes = {}
-            for name, img in zip(cfg.exemplars, training_images(cfg)):
+            for name, img in zip(ex.expand(cfg.exemplars), training_images(cfg)):
+                key = os.path.splitext(os.path.basename(name))[0]
+                if "__" in key:
+                    key = key.split("__", 1)[0]
+                    if key in codes:
+                        continue
                 crops = img.unfold(1, ENCODER_SIZE, ENCODER_SIZE // 2).unfold(2, ENCODER_SIZE, ENCODER_SIZE // 2)
                 crops = crops.permute(1, 2, 0, 3, 4).reshape(-1, 3, ENCODER_SIZE, ENCODER_SIZE)
-                codes[os.path.splitext(os.path.basename(name))[0]] = \
-                    model.encoder(crops).mean(0).numpy().astype(float).round(6).tolist()
+                z = model.encoder(crops).mean(0)
+                if cfg.colour == "affine":
+                    z = torch.cat([z, colour_stats(img.unsqueeze(0))[0]])
+                codes[key] = z.numpy().astype(float).round(6).tolist()
             doc["codes"] = codes
             doc["encoder_size"] = ENCODER_SIZE
     doc["files"] = files

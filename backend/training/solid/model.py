@@ -9,6 +9,15 @@ sigmoid) over [n, e]; position x never enters it, which is what gives
 diversity by construction (Sec. 4).  Single mode optimises e and T directly
 (with the decoder); space mode trains g, h and f jointly.
 
+Colour (``colour="affine"``, the photo models): the decoder's output d is
+linear, and the colour is mu + L d with the exemplar's mean colour mu and the
+Cholesky factor L of its colour covariance, computed from the exemplar's
+pixels (:func:`colour_stats`), not learned.  The mean colour of the texture
+is then the photo's by construction whatever the encoder makes of it (the
+first space model, which had to learn colour through a sigmoid, was off by
+0.165 on unseen photos); the network learns the whitened texture.
+``colour="sigmoid"`` is the paper's RGB through a sigmoid (earlier models).
+
 Every T_i starts as a fixed random rotation R_i (seeded), so the octaves'
 lattices are not aligned with each other or with the axes; the translator and
 the single-mode parameters learn T_i = R_i (I + Delta_i).
@@ -21,7 +30,7 @@ from torch import nn
 
 from .lattice import lattice_noise
 
-__all__ = ["Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
+__all__ = ["colour_stats", "COLOUR_STATS", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
 
 
 def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
@@ -37,11 +46,32 @@ def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
     return torch.stack(out).to(torch.float32)
 
 
-class Decoder(nn.Module):
-    """f(n | e): (..., m*C + E) -> RGB (..., 3) in (0, 1)."""
+COLOUR_STATS = 12   #: mu (3) and L (3 x 3, row-major) appended to a photo model's code z
 
-    def __init__(self, n_noise: int, code_dim: int = 64, width: int = 128, layers: int = 4, init: str = "he"):
+
+def colour_stats(img: torch.Tensor, eps: float = 1e-4) -> torch.Tensor:
+    """Mean colour and Cholesky factor of the colour covariance: (B, 3, H, W) -> (B, 12) = [mu, L.ravel()]."""
+    x = img.flatten(2)                                   # (B, 3, P)
+    mu = x.mean(2)
+    xc = x - mu.unsqueeze(2)
+    cov = xc @ xc.transpose(1, 2) / x.shape[2] + eps * torch.eye(3, dtype=img.dtype)
+    L = torch.linalg.cholesky(cov)
+    return torch.cat([mu, L.flatten(1)], dim=1)
+
+
+def apply_colour(d: torch.Tensor, stats: torch.Tensor) -> torch.Tensor:
+    """rgb = mu + L d: d (B, N, 3), stats (B, 12) -> (B, N, 3)."""
+    mu, L = stats[:, :3], stats[:, 3:].view(-1, 3, 3)
+    return mu.unsqueeze(1) + torch.einsum("bij,bnj->bni", L, d)
+
+
+class Decoder(nn.Module):
+    """f(n | e): (..., m*C + E) -> RGB (..., 3) in (0, 1) (``sigmoid``) or whitened colour d (..., 3) (linear)."""
+
+    def __init__(self, n_noise: int, code_dim: int = 64, width: int = 128, layers: int = 4, init: str = "he",
+                 sigmoid: bool = True):
         super().__init__()
+        self.sigmoid = sigmoid
         mods, cin = [], n_noise + code_dim
         for _ in range(layers):
             mods += [nn.Linear(cin, width), nn.ReLU()]
@@ -59,7 +89,8 @@ class Decoder(nn.Module):
                 nn.init.zeros_(lin.bias)
 
     def forward(self, noise: torch.Tensor, code: torch.Tensor) -> torch.Tensor:
-        return torch.sigmoid(self.net(torch.cat([noise, code], dim=-1)))
+        y = self.net(torch.cat([noise, code], dim=-1))
+        return torch.sigmoid(y) if self.sigmoid else y
 
 
 class Encoder(nn.Module):
@@ -97,14 +128,43 @@ class Encoder(nn.Module):
         return self.fc(torch.cat(stats, dim=1))
 
 
-class Translator(nn.Module):
-    """h(z) -> (e (B, E), T (B, m, D, D)) with T_i = R_i (I + tanh(Delta_i(z))) (entries of Delta bounded by 1)."""
+#: bounded transforms: eigenvalues of the symmetric stretch S within +-MAX_STRETCH, octave scale within e^+-MAX_LOG_SCALE
+MAX_STRETCH = 0.6
+MAX_LOG_SCALE = 0.5
 
-    def __init__(self, z_dim: int, code_dim: int, octaves: int, dim: int, width: int = 128, seed: int = 0):
+
+def bounded_transform(raw: torch.Tensor, R: torch.Tensor) -> torch.Tensor:
+    """T_i = R_i exp(c_i) (I + S_i) from raw (B, m, D*D + 1): S_i = sym(M_i) scaled so its Frobenius norm
+    (a bound on every eigenvalue) stays <= MAX_STRETCH, c_i = MAX_LOG_SCALE tanh(raw_i[-1]).
+
+    Singular values of T_i then lie in [0.4, 1.6] x e^+-0.5: anisotropic (grain, layers) up to a ratio of 4,
+    but never the near-singular T of the free parametrisation, whose zero singular values extruded the
+    noise along one direction (the diagonal streaks of the first space model: its T_i had singular values
+    down to 0.0)."""
+    B, m, _ = raw.shape
+    D = R.shape[-1]
+    M = raw[..., :D * D].view(B, m, D, D)
+    S = 0.5 * (M + M.transpose(-1, -2))
+    n = S.flatten(2).norm(dim=2).view(B, m, 1, 1)
+    S = S * (MAX_STRETCH * torch.tanh(n) / n.clamp_min(1e-6))
+    c = torch.exp(MAX_LOG_SCALE * torch.tanh(raw[..., D * D:])).view(B, m, 1, 1)
+    eye = torch.eye(D, dtype=raw.dtype, device=raw.device)
+    return R @ ((eye + S) * c)
+
+
+class Translator(nn.Module):
+    """h(z) -> (e (B, E), T (B, m, D, D)): ``free`` T_i = R_i (I + tanh(Delta_i(z))) (entries of Delta bounded
+    by 1: the first models), or ``bounded`` (:func:`bounded_transform`)."""
+
+    def __init__(self, z_dim: int, code_dim: int, octaves: int, dim: int, width: int = 128, seed: int = 0,
+                 transform: str = "free"):
         super().__init__()
-        self.code_dim, self.octaves, self.dim = code_dim, octaves, dim
+        if transform not in ("free", "bounded"):
+            raise ValueError(f"transform must be 'free' or 'bounded', got {transform!r}")
+        self.code_dim, self.octaves, self.dim, self.transform = code_dim, octaves, dim, transform
+        per = dim * dim + (transform == "bounded")
         self.net = nn.Sequential(nn.Linear(z_dim, width), nn.ReLU(), nn.Linear(width, width), nn.ReLU(),
-                                 nn.Linear(width, code_dim + octaves * dim * dim))
+                                 nn.Linear(width, code_dim + octaves * per))
         with torch.no_grad():  # start near T = R; the code part keeps its full scale, so e varies with z
             self.net[-1].weight[code_dim:].mul_(0.1)   # from the first step (a x0.1 code part left e nearly
             self.net[-1].bias.zero_()                  # constant and the encoder unused: every code one texture)
@@ -113,6 +173,8 @@ class Translator(nn.Module):
     def forward(self, z: torch.Tensor):
         out = self.net(z)
         e = out[:, :self.code_dim]
+        if self.transform == "bounded":
+            return e, bounded_transform(out[:, self.code_dim:].view(z.shape[0], self.octaves, -1), self.R)
         # bounded: an unbounded Delta let a space run grow every T_i to ~100x (all octaves at the pixel
         # scale: fine grain of one average colour for every exemplar)
         delta = torch.tanh(out[:, self.code_dim:]).view(-1, self.octaves, self.dim, self.dim)
@@ -124,18 +186,22 @@ class SolidTexture(nn.Module):
     """Decoder plus either single-mode parameters (e, T) or an encoder and translator (space mode)."""
 
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
-                 mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he"):
+                 mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
+                 colour: str = "sigmoid", transform: str = "free"):
         super().__init__()
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
+        if colour not in ("sigmoid", "affine"):
+            raise ValueError(f"colour must be 'sigmoid' or 'affine', got {colour!r}")
         self.dim, self.octaves, self.channels, self.code_dim, self.mode = dim, octaves, channels, code_dim, mode
-        self.decoder = Decoder(octaves * channels, code_dim, width, layers, decoder_init)
+        self.colour = colour
+        self.decoder = Decoder(octaves * channels, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid")
         if mode == "single":
             self.code = nn.Parameter(torch.rand(code_dim) * 2.0 - 1.0)     # U(-1, 1) as the authors' code
             self.T = nn.Parameter(random_rotations(octaves, dim, seed).clone())
         else:
             self.encoder = Encoder(z_dim)
-            self.translator = Translator(z_dim, code_dim, octaves, dim, seed=seed)
+            self.translator = Translator(z_dim, code_dim, octaves, dim, seed=seed, transform=transform)
 
     def codes(self, exemplars: torch.Tensor | None = None, batch: int = 1):
         """(e (B, E), T (B, m, D, D)) for a batch: the single-mode parameters, or h(g(exemplars))."""
@@ -143,10 +209,17 @@ class SolidTexture(nn.Module):
             return self.code.unsqueeze(0).expand(batch, -1), self.T.unsqueeze(0).expand(batch, -1, -1, -1)
         return self.translator(self.encoder(exemplars))
 
-    def sample(self, x: torch.Tensor, e: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor) -> torch.Tensor:
-        """s(x | z) (Eq. 5): x (B, N, D), e (B, E), T (B, m, D, D), seeds int64 (B, m) -> RGB (B, N, 3)."""
+    def sample(self, x: torch.Tensor, e: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor,
+               stats: torch.Tensor | None = None) -> torch.Tensor:
+        """s(x | z) (Eq. 5): x (B, N, D), e (B, E), T (B, m, D, D), seeds int64 (B, m) -> RGB (B, N, 3);
+        ``stats`` (B, 12): the exemplars' :func:`colour_stats` (``colour="affine"`` only)."""
         n = lattice_noise(x, T, seeds, self.channels)
-        return self.decoder(n, e.unsqueeze(1).expand(-1, x.shape[1], -1))
+        out = self.decoder(n, e.unsqueeze(1).expand(-1, x.shape[1], -1))
+        if self.colour == "affine":
+            if stats is None:
+                raise ValueError("an affine-colour model needs the exemplars' colour statistics")
+            out = apply_colour(out, stats)
+        return out
 
     def n_params(self) -> int:
         return sum(p.numel() for p in self.parameters())

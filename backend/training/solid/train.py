@@ -34,9 +34,10 @@ from ..._export import export as _ex
 from ..threads import cpu_threads
 from ..train import check_config_keys
 from . import exemplars as ex
-from .features import RandomFeatures, style_loss
+from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import SolidTexture, slice_points
+from .model import SolidTexture, colour_stats, slice_points
+from .swd import SlicedFeatures, swd_loss
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
 
@@ -65,6 +66,12 @@ class SolidConfig:
     augment: bool | None = None     # random rotations/flips of crops; default: on in 3D
     extent: float = 64.0            # slice offsets drawn from [-extent, extent]^D units
     hist_weight: float = 10.0
+    colour: str = "sigmoid"         # "sigmoid" (RGB through a sigmoid) or "affine" (mu + L d from the exemplar)
+    transform: str = "free"         # space mode: "free" T_i = R_i (I + tanh Delta) or "bounded" (model.bounded_transform)
+    loss: str = "gram"              # "gram" (random-feature Gram matrices) or "swd" (sliced Wasserstein, swd.py)
+    swd_width: int = 32             # swd: random filters per size and pyramid level
+    swd_kernels: tuple = (3, 7)     # swd: filter sizes
+    swd_levels: int = 5             # swd: pyramid levels
     seed: int = 0
     log_every: int = 25
     checkpoint_every: int = 250
@@ -76,14 +83,19 @@ class SolidConfig:
     def from_dict(cls, d: dict) -> "SolidConfig":
         check_config_keys(cls, d)
         d = dict(d)
-        if "exemplars" in d:
-            d["exemplars"] = tuple(d["exemplars"])
+        for key in ("exemplars", "swd_kernels"):
+            if key in d:
+                d[key] = tuple(d[key])
         cfg = cls(**d)
         if cfg.mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {cfg.mode!r}")
         if cfg.dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {cfg.dim}")
-        if cfg.mode == "single" and len(cfg.exemplars) != 1:
+        if cfg.loss not in ("gram", "swd"):
+            raise ValueError(f"loss must be 'gram' or 'swd', got {cfg.loss!r}")
+        if cfg.colour not in ("sigmoid", "affine"):
+            raise ValueError(f"colour must be 'sigmoid' or 'affine', got {cfg.colour!r}")
+        if cfg.mode == "single" and len(ex.expand(cfg.exemplars)) != 1:
             raise ValueError(f"single mode takes exactly one exemplar, got {len(cfg.exemplars)}")
         return cfg
 
@@ -107,7 +119,7 @@ def _seed_run(src: str, out: str) -> None:
 
 def build_model(cfg: SolidConfig) -> SolidTexture:
     return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
-                        cfg.layers, cfg.seed, cfg.decoder_init)
+                        cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
@@ -119,19 +131,34 @@ def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
 
 def training_images(cfg: SolidConfig) -> list:
     """The training regions of the config's exemplars, resampled: list of (3, H, W)."""
-    return [_resample(ex.train_region(ex.exemplar(n), n), cfg.exemplar_scale) for n in cfg.exemplars]
+    return [_resample(ex.train_region(ex.exemplar(n), n), cfg.exemplar_scale) for n in ex.expand(cfg.exemplars)]
 
 
-def render(model: SolidTexture, e: torch.Tensor, T: torch.Tensor, x: torch.Tensor, seeds, size: int) -> torch.Tensor:
+def render(model: SolidTexture, e: torch.Tensor, T: torch.Tensor, x: torch.Tensor, seeds, size: int,
+           stats: torch.Tensor | None = None) -> torch.Tensor:
     """Sampler images at slice points x (B, size*size, D) -> (B, 3, size, size)."""
     s = octave_seeds(seeds, model.octaves, x.device)
-    return model.sample(x, e, T, s).view(x.shape[0], size, size, 3).permute(0, 3, 1, 2)
+    return model.sample(x, e, T, s, stats).view(x.shape[0], size, size, 3).permute(0, 3, 1, 2)
+
+
+def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, gen: torch.Generator) -> torch.Tensor:
+    """The config's style loss of rendered images against reference crops (both (B, 3, S, S))."""
+    per_sample = cfg.mode == "space"
+    if cfg.loss == "gram":
+        return style_loss(feats, img, ref, cfg.hist_weight, per_sample=per_sample)
+    return swd_loss(feats, img, ref, per_sample=per_sample, generator=gen) + \
+        cfg.hist_weight * histogram_loss(img, ref, per_sample=per_sample)
+
+
+def loss_features(cfg: SolidConfig):
+    if cfg.loss == "gram":
+        return RandomFeatures(seed=0)
+    return SlicedFeatures(seed=0, levels=cfg.swd_levels, width=cfg.swd_width, kernels=cfg.swd_kernels)
 
 
 def _save(path: str, obj) -> None:
-    tmp = path + ".tmp"
-    torch.save(obj, tmp)
-    os.replace(tmp, path)
+    with _ex.atomic_path(path) as tmp:
+        torch.save(obj, tmp)
 
 
 def train(cfg: SolidConfig, out: str, max_steps: int | None = None, log=print) -> dict:
@@ -145,7 +172,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed + 1)
     model = build_model(cfg)
-    feats = RandomFeatures(seed=0)
+    feats = loss_features(cfg)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
     ckpt_path = os.path.join(out, "ckpt.pt")
@@ -172,16 +199,18 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         if cfg.mode == "single":
             ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
             e, T = model.codes(batch=cfg.batch)
+            stats = colour_stats(images[0].unsqueeze(0)).expand(cfg.batch, -1)
         else:
             # distinct exemplars within a batch (while there are enough): each step contrasts textures
             pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
             pick = pick[:cfg.batch]
             ref = torch.cat([ex.random_crops(images[k], 1, cfg.crop, gen, augment) for k in pick])
             e, T = model.codes(ref)
+            stats = colour_stats(ref)
         x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen)
         seeds = torch.randint(0, 2 ** 31 - 1, (cfg.batch,), generator=gen).numpy()
-        img = render(model, e, T, x, seeds, cfg.crop)
-        loss = style_loss(feats, img, ref, cfg.hist_weight, per_sample=cfg.mode == "space")
+        img = render(model, e, T, x, seeds, cfg.crop, stats if cfg.colour == "affine" else None)
+        loss = texture_loss(cfg, feats, img, ref, gen)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)

@@ -1,0 +1,169 @@
+"""Solid textures from held-out photos: ``python bench/eval_solid_photos.py [--model DIR] [--limit N] [--sheet PNG]``.
+
+For every photo of the photo set's validation split (whole photos that
+training never saw, ``data/photos/val``), the texture-space model encodes the
+photo (one click in the add-on: no refinement) and its 3D texture is sliced
+normal to x, y and z (SIZE² px at the photo's resolution, ``--seeds`` seeds).
+Against the photo, per slice axis and pooled:
+
+- ``swd``: the patch distance of :mod:`backend.training.solid.photo_eval` (7 x 7
+  Laplacian-pyramid neighbourhoods, sliced Wasserstein, x 1000), lower is better,
+  beside the baselines built from the same photo (pixel shuffle, random phase
+  noise, Perlin coloured by the photo's histogram) and ``photo_crop`` (a
+  SIZE² crop of the photo itself: how far a real piece of it lies);
+- ``colour``: mean colour error (mean over R, G, B of |difference of means|);
+- ``diversity``: mean absolute difference between two seeds' z slices;
+- ``axis_spread``: (max - min) / mean of the three axes' swd: 0 when x, y and z
+  slices are alike (a solid texture, not a 2D one extruded).
+
+Writes the table as JSON (``-o``, default out/bench/solid_photos.json) and,
+with ``--sheet``, a picture: photo | z slice | x slice | seed 2 | a cube whose
+three visible faces are sampled from the 3D texture (isometric projection).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+import numpy as np  # noqa: E402
+
+from export.atomic import atomic_path, write_json  # noqa: E402
+from backend.solid.model import SolidTextureModel  # noqa: E402
+from backend.training.solid import photo_eval as pe  # noqa: E402
+
+SIZE = 128
+
+
+def photos(split: str = "val") -> list:
+    folder = os.path.join(ROOT, "data", "photos", split)
+    return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith((".jpg", ".png")))
+
+
+def read(path: str) -> np.ndarray:
+    from PIL import Image
+
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"), np.float32) / 255.0
+
+
+def slice_image(model: SolidTextureModel, code, axis: str, seed: int, size: int = SIZE) -> np.ndarray:
+    off = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}[axis]
+    return model.image(size, code, seed=seed, axis=axis, offset=off)
+
+
+def cube(model: SolidTextureModel, code, seed: int = 0, n: int = 96, out: int = 192) -> np.ndarray:
+    """An isometric picture (out, out, 3) of the unit-ish cube [0, s]^3 whose visible faces (x = s, y = s, z = s)
+    are sampled from the 3D texture; background white."""
+    s = n / model.px_per_unit
+    img = np.ones((out, out, 3), np.float32)
+    # isometric axes on the screen
+    ex_, ey_, ez_ = np.array([0.866, 0.5]), np.array([-0.866, 0.5]), np.array([0.0, -1.0])
+    scale = out / (2.2 * s)
+    centre = np.array([out / 2, out / 2 + 0.1 * out])
+    t = (np.arange(n) + 0.5) / n * s
+    a, b = np.meshgrid(t, t, indexing="ij")
+    faces = [np.stack([np.full_like(a, s), a, b], -1), np.stack([a, np.full_like(a, s), b], -1),
+             np.stack([a, b, np.full_like(a, s)], -1)]
+    shade = [0.8, 0.65, 1.0]
+    for pts, k in zip(faces, shade):
+        rgb = model.evaluate(pts.reshape(-1, 3), code, seed).reshape(n, n, 3) * k
+        scr = (pts[..., 0:1] * ex_ + pts[..., 1:2] * ey_ + pts[..., 2:3] * ez_) * scale + centre
+        # splat each sample over a 2 x 2 px footprint (faces are n x n samples over ~n px)
+        for dy in (0, 1):
+            for dx in (0, 1):
+                xi = np.clip((scr[..., 0] + dx).astype(int), 0, out - 1)
+                yi = np.clip((scr[..., 1] + dy).astype(int), 0, out - 1)
+                img[yi, xi] = rgb
+    return img
+
+
+def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None) -> dict:
+    rows = {}
+    for path in files:
+        photo = read(path)
+        rng = np.random.default_rng(0)
+        t = time.time()
+        code = model.translate(model.encode(photo))
+        imgs = {ax: [slice_image(model, code, ax, s) for s in range(seeds)] for ax in "xyz"}
+        seconds = time.time() - t
+        r = {ax: round(pe.patch_swd(v, photo), 1) for ax, v in imgs.items()}
+        pooled = [im for v in imgs.values() for im in v]
+        r["swd"] = round(pe.patch_swd(pooled, photo), 1)
+        r["colour"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in pooled])), 4)
+        r["diversity"] = round(float(np.abs(imgs["z"][0] - imgs["z"][1]).mean()), 4) if seeds > 1 else None
+        ax = np.array([r["x"], r["y"], r["z"]])
+        r["axis_spread"] = round(float((ax.max() - ax.min()) / max(ax.mean(), 1e-9)), 3)
+        for name, fn in pe.BASELINES.items():
+            r[name] = round(pe.patch_swd([fn(photo, SIZE, rng) for _ in range(seeds)], photo), 1)
+            r[name + "_colour"] = round(pe.mean_colour_error(fn(photo, SIZE, rng), photo), 4)
+        r["photo_crop"] = round(pe.patch_swd(photo[:SIZE, :SIZE], photo), 1)
+        r["seconds"] = round(seconds, 2)
+        rows[os.path.basename(path)] = r
+        print(os.path.basename(path), {k: r[k] for k in ("swd", "colour", "random_phase", "pixel_shuffle")},
+              flush=True)
+        if sheet is not None:
+            sheet.append((photo, imgs, cube(model, code)))
+    return rows
+
+
+def summary(rows: dict) -> dict:
+    def med(k):
+        return round(float(np.median([r[k] for r in rows.values()])), 4)
+
+    swd = np.array([r["swd"] for r in rows.values()])
+    return dict(photos=len(rows), median_swd=med("swd"), median_random_phase=med("random_phase"),
+                median_pixel_shuffle=med("pixel_shuffle"), median_perlin_hist=med("perlin_hist"),
+                median_photo_crop=med("photo_crop"),
+                ratio_to_random_phase=round(med("swd") / med("random_phase"), 3),
+                beats_pixel_shuffle=int(sum(r["swd"] < r["pixel_shuffle"] for r in rows.values())),
+                beats_random_phase=int(sum(r["swd"] < r["random_phase"] for r in rows.values())),
+                median_colour=med("colour"), max_colour=round(float(max(r["colour"] for r in rows.values())), 4),
+                median_diversity=med("diversity"), median_axis_spread=med("axis_spread"),
+                median_seconds=med("seconds"), worst_swd=float(swd.max()))
+
+
+def write_sheet(sheet: list, path: str, size: int = 128) -> None:
+    from PIL import Image
+
+    rows = []
+    for photo, imgs, cb in sheet:
+        cells = [photo[:size, :size], imgs["z"][0], imgs["x"][0], imgs["z"][1],
+                 np.asarray(Image.fromarray((cb * 255).astype(np.uint8)).resize((size, size)), np.float32) / 255]
+        rows.append(np.concatenate(cells, 1))
+    a = (np.clip(np.concatenate(rows, 0), 0, 1) * 255 + 0.5).astype(np.uint8)
+    with atomic_path(path) as tmp:
+        Image.fromarray(a).save(tmp, format="PNG")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
+    ap.add_argument("--limit", type=int, default=0, help="only every k-th photo so that about N are evaluated")
+    ap.add_argument("--seeds", type=int, default=2)
+    ap.add_argument("--sheet", help="write a picture of (up to 8) photos and their textures")
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_photos.json"))
+    a = ap.parse_args(argv)
+    model = SolidTextureModel(a.model)
+    files = photos()
+    if a.limit:
+        files = files[::max(1, len(files) // a.limit)][:a.limit]
+    sheet = [] if a.sheet else None
+    rows = evaluate(model, files, a.seeds, sheet)
+    doc = dict(model=a.model, model_sha=model.config["files"], size=SIZE, seeds=a.seeds, summary=summary(rows),
+               photos=rows)
+    os.makedirs(os.path.dirname(a.out), exist_ok=True)
+    write_json(a.out, doc)
+    if sheet:
+        pick = sheet[:: max(1, len(sheet) // 8)][:8]
+        write_sheet(pick, a.sheet)
+    print(doc["summary"])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

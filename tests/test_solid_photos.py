@@ -1,0 +1,168 @@
+"""The photo set, the photo models' colour path and bounded transforms, the sliced Wasserstein loss and the
+held-out photo evaluation (issue 20)."""
+import hashlib
+import json
+import os
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+
+import build_photo_set as bps  # noqa: E402
+from backend.training.solid import photo_eval as pe  # noqa: E402
+
+PHOTOS = os.path.join(ROOT, "data", "photos")
+
+
+def _manifest():
+    with open(os.path.join(PHOTOS, "manifest.json"), encoding="utf-8") as fh:
+        return json.load(fh)
+
+
+def test_photo_set_manifest_matches_the_files():
+    m = _manifest()
+    photos = m["photos"]
+    assert len(photos) >= 200
+    on_disk = {f"{s}/{f}" for s in ("train", "val") for f in os.listdir(os.path.join(PHOTOS, s))}
+    assert on_disk == {e["file"] for e in photos}
+    for e in photos:
+        with open(os.path.join(PHOTOS, e["file"]), "rb") as fh:
+            assert hashlib.sha256(fh.read()).hexdigest() == e["sha256"], e["file"]
+        assert e["licence"] in bps.LICENCES
+        assert e["split"] == bps.split_of(e["path"]) and e["file"].startswith(e["split"] + "/")
+        assert e["package"] in bps.PACKAGES and e["version"] != "unknown"
+    # whole photos are held out: no source is in both splits, and each split has many categories
+    src = {}
+    for e in photos:
+        src.setdefault(e["source_sha256"], set()).add(e["split"])
+    assert all(len(v) == 1 for v in src.values())
+    cats = {s: {e["category"] for e in photos if e["split"] == s} for s in ("train", "val")}
+    assert len(cats["train"]) >= 10 and len(cats["val"]) >= 8
+    with open(os.path.join(PHOTOS, "ATTRIBUTION.md"), encoding="utf-8") as fh:
+        text = fh.read()
+    assert all(e["file"] in text for e in photos)
+
+
+def test_curation_helpers():
+    rng = np.random.default_rng(0)
+    assert bps.category("art/textures/terrain/types/alpine_arctic/gravel_dirt_01") == "gravel"
+    assert bps.category("temp_grass_norm") is None and bps.category("portrait") is None
+    assert bps.stationary(np.full((64, 64, 3), 0.5, np.float32)) == (False, "flat")
+    ramp = np.repeat(np.linspace(0, 1, 64, dtype=np.float32)[None, :, None], 64, 0).repeat(3, 2)
+    assert bps.stationary(ramp)[0] is False
+    assert bps.stationary(rng.random((64, 64, 3)).astype(np.float32))[0] is True
+    text = ("Files: a/b.png\n c/d.png\nCopyright:\n Someone\nLicense: CC0\n\n"
+            "Files: e.png\nCopyright: X\nLicense: GPL-2\n")
+    assert bps.parse_dep5(text) == {"a/b.png": ("CC0", "Someone"), "c/d.png": ("CC0", "Someone"),
+                                    "e.png": ("GPL-2", "X")}
+
+
+def test_patch_distance_sees_structure_and_colour():
+    rng = np.random.default_rng(1)
+    # a structured image: bright blobs on dark ground, two independent draws of it
+    def blobs(seed):
+        r = np.random.default_rng(seed)
+        img = np.full((128, 128, 3), 0.2, np.float32)
+        yy, xx = np.mgrid[0:128, 0:128]
+        for cy, cx in r.integers(0, 128, (40, 2)):
+            img[(yy - cy) ** 2 + (xx - cx) ** 2 < 16] = (0.9, 0.8, 0.6)
+        return img
+
+    a, b = blobs(0), blobs(1)
+    same = pe.patch_swd(a, b)
+    assert same < pe.patch_swd(pe.pixel_shuffle(b, 128, rng), b)      # same colours, no blobs
+    assert same < pe.patch_swd(np.clip(a + 0.1, 0, 1), b)             # same blobs, wrong colour
+    assert pe.mean_colour_error(a + 0.05, a) == pytest.approx(0.05, abs=1e-6)
+    # the pyramid's levels add back up to the image
+    pyr = pe.laplacian_pyramid(a, 3)
+    assert [p.shape[0] for p in pyr] == [128, 64, 32]
+
+
+def test_random_phase_keeps_colour_and_spectrum():
+    rng = np.random.default_rng(2)
+    photo = np.clip(rng.random((64, 64, 3)) * 0.3 + np.array([0.5, 0.3, 0.1]), 0, 1).astype(np.float32)
+    out = pe.random_phase(photo, 64, rng)
+    assert pe.mean_colour_error(out, photo) < 0.005
+    P = lambda x: np.abs(np.fft.fft2(x[..., 0] - x[..., 0].mean()))   # noqa: E731
+    np.testing.assert_allclose(P(out), P(photo), rtol=0.05, atol=0.05)
+    assert np.abs(out - photo).mean() > 0.05                           # not the photo itself
+    hist = pe.perlin_hist(photo, 32, rng)
+    assert hist.shape == (32, 32, 3) and pe.mean_colour_error(hist, photo) < 0.02
+
+
+torch = pytest.importorskip("torch")
+
+from backend.solid.model import SolidTextureModel, colour_stats  # noqa: E402
+from backend.solid.refine import refine_code  # noqa: E402
+from backend.training.solid import exemplars as ex  # noqa: E402
+from backend.training.solid.export import export  # noqa: E402
+from backend.training.solid.model import bounded_transform, colour_stats as colour_stats_t, random_rotations  # noqa: E402
+from backend.training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
+from backend.training.solid.train import SolidConfig, build_model, train  # noqa: E402
+
+
+def test_colour_stats_twins_agree_and_rebuild_the_covariance():
+    img = torch.rand(1, 3, 40, 30) * torch.tensor([0.5, 0.2, 0.9]).view(1, 3, 1, 1)
+    t = colour_stats_t(img)[0].numpy()
+    n = colour_stats(img[0].permute(1, 2, 0).numpy())
+    np.testing.assert_allclose(t, n, atol=1e-5)
+    L = n[3:].reshape(3, 3)
+    x = img[0].flatten(1).numpy()
+    np.testing.assert_allclose(L @ L.T, np.cov(x, bias=True) + 1e-4 * np.eye(3), atol=1e-5)
+
+
+def test_bounded_transforms_are_never_singular():
+    R = random_rotations(8, 3).unsqueeze(0)
+    for scale in (0.1, 10.0, 1000.0):
+        T = bounded_transform(torch.randn(4, 8, 10) * scale, R)
+        s = torch.linalg.svdvals(T)
+        assert s.min() >= 0.4 * np.exp(-0.5) - 1e-5 and s.max() <= 1.6 * np.exp(0.5) + 1e-5
+
+
+def test_swd_loss_prefers_the_texture_to_its_shuffle():
+    g = torch.Generator().manual_seed(0)
+    feats = SlicedFeatures(width=16, kernels=(3, 7), levels=3)
+    img = ex.procedural("granite", 0, 96)[None]
+    other = ex.procedural("granite", 1, 96)[None]
+    shuffled = other.flatten(2)[:, :, torch.randperm(96 * 96, generator=g)].view_as(other)
+    assert swd_loss(feats, other, img, generator=g) < 0.5 * swd_loss(feats, shuffled, img, generator=g)
+    out = other.clone().requires_grad_()
+    swd_loss(feats, out, img, per_sample=True, generator=g).backward()
+    assert out.grad.abs().sum() > 0
+
+
+def test_photo_space_model_colour_path_export_and_refine(tmp_path):
+    photos = ex.photo_set("train")[:2]
+    cfg = dict(name="tiny_photo", mode="space", dim=3, crop=128, batch=2, steps=2, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=photos, colour="affine", loss="swd", transform="bounded",
+               swd_width=8, swd_levels=2)
+    state = train(SolidConfig.from_dict(cfg), str(tmp_path / "run"), log=lambda *_: None)
+    doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
+    assert doc["colour_stats"] == 12 and len(next(iter(doc["codes"].values()))) == 8 + 12
+    rt = SolidTextureModel(str(tmp_path / "m"))
+    photo = ex.load_image(ex.photo_set("val")[0]).permute(1, 2, 0).numpy()
+    z = rt.encode(photo)
+    np.testing.assert_allclose(z[8:], colour_stats(photo), atol=1e-5)
+    code = rt.translate(z)
+    # the runtime's colour path equals torch's: mu + L d of the same decoder output
+    m = build_model(SolidConfig.from_dict(state["config"]))
+    m.load_state_dict(state["model"])
+    pts = np.random.default_rng(0).uniform(-3, 3, (500, 3))
+    from backend.training.solid.lattice import octave_seeds
+    with torch.no_grad():
+        e, T = m.translator(torch.from_numpy(z[:8])[None])
+        ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),
+                       torch.from_numpy(z[8:])[None])[0].clamp(0, 1).numpy()
+    np.testing.assert_allclose(rt.evaluate(pts, code, seed=5), ref, atol=2e-4)
+    # the colour is the photo's by construction: moving mu moves the texture's mean colour by as much
+    from dataclasses import replace
+    base = rt.image(32, code, seed=1).reshape(-1, 3).mean(0)
+    shifted = rt.image(32, replace(code, mu=code.mu - 0.05), seed=1).reshape(-1, 3).mean(0)
+    assert np.all(np.abs((base - shifted) - 0.05) < 0.01)
+    # refinement searches the latent only: the colour statistics are kept
+    z2, hist = refine_code(rt, z, photo, steps=3)
+    np.testing.assert_array_equal(z2[8:], z[8:])
+    assert hist[-1] <= hist[0]
