@@ -74,7 +74,7 @@ CATEGORIES = (
     ("soil", ("dirt", "soil", "mud", "ground", "earth", "farmland", "clay", "wall_dirt")),
 )
 #: maps of other things than colour, and images that are not materials
-EXCLUDE = re.compile(r"(_norm|_nm|_spec|_sm|_ao|_height|_gloss|_mask|lava|water|ocean|road|path|edge|decal|blend|test)",
+EXCLUDE = re.compile(r"(_norm|_nrm|_normal|_nm|_spec|_sm|_ao|_height|_gloss|_mask|lava|water|ocean|road|path|edge|decal|blend|test)",
                      re.I)
 
 
