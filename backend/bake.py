@@ -37,6 +37,7 @@ from typing import Callable
 
 import numpy as np
 
+from . import limits
 from .errors import SettingError
 from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
@@ -81,6 +82,8 @@ class BakeSpec:
 
     def validate(self) -> "BakeSpec":
         self.grid.validate()
+        limits.finite("time", self.time)
+        limits.positive("time_step", self.time_step)
         ext = os.path.splitext(self.output)[1].lower()
         if ext not in FORMATS:
             raise SettingError("output", f"{self.output!r}: unsupported type {ext or '(none)'}; use {', '.join(FORMATS)}")

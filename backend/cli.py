@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from . import limits
 from .errors import SettingError
 from .grid import evaluate_grid
 from .spectra import SPECTRUM_KINDS, Spectrum
@@ -160,8 +161,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def settings_from_args(a: argparse.Namespace) -> WaveSettings:
-    if a.directions < 1:
-        raise SettingError("--directions", f"must be at least 1, got {a.directions}")
+    if not 1 <= a.directions <= limits.MAX_DIRECTIONS:
+        raise SettingError("--directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {a.directions}")
+    if a.period is not None:
+        limits.positive("--period", a.period)
+    limits.check_int("--table-size", a.table_size, 16, limits.MAX_TABLE_SIZE)
     if a.fmin > a.fmax:
         raise SettingError("--fmin", f"{a.fmin:g} is greater than --fmax {a.fmax:g}")
     example = None
@@ -221,6 +225,12 @@ def run_wave(a: argparse.Namespace) -> int:
         raise SettingError("--range", "maps values onto a ramp; give --transfer too")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
+    limits.positive("--extent", a.extent)
+    limits.finite("--time", a.time)
+    if a.example_extent is not None:
+        limits.positive("--example-extent", a.example_extent)
+    limits.check_memory("--size", float(a.size) ** (min(a.dim, 3) if ext in (".npy", ".vdb") else 2)
+                        * 4 * (5 if a.transfer else 2), f"a {a.size}-sample {a.dim}D grid")
     folder = os.path.dirname(os.path.abspath(a.out))
     if not os.path.isdir(folder):
         raise SettingError("-o", f"output folder does not exist: {folder}")

@@ -69,6 +69,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .bake import BakeResult, BakeSpec, Cancelled, run_bake
+from . import limits
 from .errors import SettingError
 from .sources import BoxGrid, source_from_dict
 from .transfer import load_transfer, transfer_from_dict
@@ -130,13 +131,15 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
         raise SettingError("transfer", f"expected a preset name, a .json file or a table, got {tf!r}")
     frames = d.get("frames")
     if frames is not None:
-        if not (isinstance(frames, list) and len(frames) == 2):
+        if not (isinstance(frames, list) and len(frames) == 2
+                and all(isinstance(f, int) and not isinstance(f, bool) for f in frames)):
             raise SettingError("frames", f"expected [start, end], got {frames!r}")
         frames = (frames[0], frames[1])
     output = os.path.normpath(os.path.join(base_dir, str(d["output"])))
     return BakeSpec(name=name, source=source, grid=grid, output=output, transfer=tf, frames=frames,
-                    time=float(d.get("time", 0.0)), time_step=float(d.get("time_step", 1.0 / 24.0)),
-                    half=bool(d.get("half", False)), make_folders=True).validate()
+                    time=limits.finite("time", d.get("time", 0.0)),
+                    time_step=limits.positive("time_step", d.get("time_step", 1.0 / 24.0)),
+                    half=limits.as_bool("half", d.get("half", False)), make_folders=True).validate()
 
 
 def parse_job(doc: dict, base_dir: str) -> list:

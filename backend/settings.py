@@ -13,6 +13,7 @@ import numpy as np
 from .byexample import PLANES, example_table
 from .cellular import CELLULAR_MODES, CellularNoise
 from .directions import DirectionSet, Domain
+from . import limits
 from .errors import SettingError
 from .spectra import Spectrum
 from .tables import DEFAULT_SIZE, WAVEFORMS, build_axis_table, build_table, build_waveform_table
@@ -82,8 +83,18 @@ class WaveSettings:
     def validate(self) -> "WaveSettings":
         if self.dim not in (2, 3, 4):
             raise SettingError("dim", f"must be 2, 3 or 4, got {self.dim}")
-        if int(self.directions) < 1:
-            raise SettingError("directions", f"must be at least 1, got {self.directions}")
+        if not 1 <= int(self.directions) <= limits.MAX_DIRECTIONS:
+            raise SettingError("directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {self.directions}")
+        limits.finite("speed", self.speed)
+        for name in ("slice_width", "cell_size", "table_period"):
+            if getattr(self, name) is not None:
+                limits.positive(name.replace("_", " "), getattr(self, name))
+        limits.in_range("stit probability", self.stit_probability, 0.0, 1.0)
+        limits.check_int("stit depth", int(self.stit_depth), 0, 16)
+        limits.check_int("table size", int(self.table_size), 16, limits.MAX_TABLE_SIZE)
+        limits.check_int("sectors", int(self.sectors), 1, 64)
+        limits.positive("example extent", self.example_extent)
+        limits.positive("transition length", self.transition_length)
         if self.output not in OUTPUTS:
             raise SettingError("output", f"unknown output {self.output!r}; choose one of {', '.join(OUTPUTS)}")
         if self.waveform not in WAVEFORMS:
@@ -94,7 +105,7 @@ class WaveSettings:
             raise SettingError("anisotropy", f"unknown mode {self.anisotropy!r}; choose one of {', '.join(ANISOTROPY)}")
         if self.example is not None and self.example_plane not in PLANES:
             raise SettingError("example plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")
-        if not 0.0 < self.spread <= 90.0:
+        if not 0.0 < limits.finite("spread", self.spread) <= 90.0:
             raise SettingError("spread", f"must lie in (0, 90] degrees, got {self.spread:g}")
         self.spectrum.validate()
         return self

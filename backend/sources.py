@@ -19,6 +19,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
+from . import limits
 from .errors import SettingError
 
 __all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "source_from_dict", "SOURCE_KINDS"]
@@ -45,10 +46,14 @@ class BoxGrid:
         if lo.shape != (3,) or hi.shape != (3,):
             raise SettingError("bounds", f"expected [[x0, y0, z0], [x1, y1, z1]], got {self.bounds}")
         n = len(res)
+        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+            raise SettingError("bounds", f"must be finite numbers, got {self.bounds}")
         if not np.all(hi[:n] > lo[:n]):
             raise SettingError("bounds", f"max must exceed min on x, y{', z' if n == 3 else ''}: {self.bounds}")
         if np.prod(np.asarray(res, np.float64)) > 2 ** 34:
             raise SettingError("resolution", f"{list(res)} is more than 2^34 voxels")
+        # the baked field (float32), with RGBA colour four times that
+        limits.check_memory("resolution", float(np.prod(np.asarray(res, np.float64))) * 4 * 5, f"a {list(res)} grid")
         return self
 
     @property

@@ -1,0 +1,91 @@
+"""Checks of user numbers shared by the CLI, job files and panels: finite, in range, affordable.
+
+Every check raises :class:`SettingError` naming the setting, so each front-end
+reports a one-line error (exit status 2) instead of a traceback, a hang or a
+crash in a compiled kernel (NaN or infinite time used to reach the numba row
+kernel and end the process with a segmentation fault).
+
+Limits (documented in the README, "Limits"):
+
+MAX_DIRECTIONS     wave directions K (a table per direction; 4096 is far past visible benefit)
+MAX_TABLE_SIZE     samples per wave table
+MEMORY_LIMIT       bytes one request may allocate for its result, OMNINOISE_MEMORY_LIMIT overrides
+"""
+from __future__ import annotations
+
+import math
+import os
+
+from .errors import SettingError
+
+__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "memory_limit", "finite", "positive", "in_range", "check_int",
+           "check_memory", "as_bool"]
+
+MAX_DIRECTIONS = 4096
+MAX_TABLE_SIZE = 1 << 20
+_DEFAULT_MEMORY = 16 << 30
+
+
+def memory_limit() -> int:
+    """Bytes a single result may take: OMNINOISE_MEMORY_LIMIT (bytes, or with a K/M/G suffix), default 16 GiB."""
+    v = os.environ.get("OMNINOISE_MEMORY_LIMIT", "").strip().upper()
+    if not v:
+        return _DEFAULT_MEMORY
+    mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(v[-1], 1)
+    try:
+        return int(float(v.rstrip("KMG")) * mult)
+    except ValueError:
+        raise SettingError("OMNINOISE_MEMORY_LIMIT", f"expected bytes like 8G, got {v!r}") from None
+
+
+def _num(name: str, value) -> float:
+    if isinstance(value, (bool, str)):
+        raise SettingError(name, f"expected a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise SettingError(name, f"expected a number, got {value!r}") from None
+
+
+def finite(name: str, value) -> float:
+    v = _num(name, value)
+    if not math.isfinite(v):
+        raise SettingError(name, f"must be a finite number, got {value!r}")
+    return v
+
+
+def positive(name: str, value) -> float:
+    v = finite(name, value)
+    if v <= 0.0:
+        raise SettingError(name, f"must be positive, got {v:g}")
+    return v
+
+
+def in_range(name: str, value, lo: float, hi: float) -> float:
+    v = finite(name, value)
+    if not lo <= v <= hi:
+        raise SettingError(name, f"must lie in [{lo:g}, {hi:g}], got {v:g}")
+    return v
+
+
+def check_int(name: str, value, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise SettingError(name, f"expected a whole number, got {value!r}")
+    if not lo <= value <= hi:
+        raise SettingError(name, f"must lie in [{lo}, {hi}], got {value}")
+    return value
+
+
+def check_memory(name: str, n_bytes: float, what: str) -> None:
+    """Refuse a result of ``n_bytes`` above :func:`memory_limit`, saying how much it would need."""
+    limit = memory_limit()
+    if n_bytes > limit:
+        raise SettingError(name, f"{what} needs {n_bytes / 2 ** 30:.1f} GiB, above the limit of "
+                                 f"{limit / 2 ** 30:.1f} GiB (set OMNINOISE_MEMORY_LIMIT to raise it)")
+
+
+def as_bool(name: str, value) -> bool:
+    """A strict boolean: TOML true/false only (the string "no" is not false, and not true either)."""
+    if not isinstance(value, bool):
+        raise SettingError(name, f"expected true or false, got {value!r}")
+    return value

@@ -1,0 +1,62 @@
+"""Bad numbers never reach the kernels (issue 24): NaN/inf time and speed, zero extent and period, absurd
+directions, table sizes and grid sizes each give a one-line error naming the setting, exit 2, nothing written."""
+import os
+import re
+
+import pytest
+
+from backend import limits
+from backend.cli import main
+from backend.errors import SettingError
+from backend.jobs import run_job
+
+from test_jobs import JOB, RAMP
+
+
+@pytest.mark.parametrize("args,setting", [
+    (["--time", "nan"], "--time"),                           # was a segmentation fault in the row kernel
+    (["--dim", "3", "--speed", "inf"], "speed"),             # likewise
+    (["--directions", "100000000"], "--directions"),         # was a hang
+    (["--extent", "0"], "--extent"),                         # was ZeroDivisionError
+    (["--period", "0"], "--period"),
+    (["--size", "100000000"], "--size"),                     # was MemoryError
+    (["--table-size", "1000000000"], "--table-size"),
+    (["--slice-width", "-1"], "slice width"),
+    (["--stit-probability", "2"], "stit probability"),
+    (["--spread", "nan"], "spread"),
+])
+def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
+    out = tmp_path / "x.npy"
+    rc = main(["wave", "--size", "16", "--quiet", *args, "-o", str(out)])
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(lines) == 1 and setting in lines[0], lines
+    assert not out.exists()
+
+
+def test_memory_error_says_how_much(monkeypatch):
+    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "1M")
+    assert limits.memory_limit() == 1 << 20
+    with pytest.raises(SettingError, match=r"needs 0\.0 GiB|needs .* GiB, above the limit of 0\.0 GiB"):
+        limits.check_memory("size", 2 << 20, "a grid")
+    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "lots")
+    with pytest.raises(SettingError, match="OMNINOISE_MEMORY_LIMIT"):
+        limits.memory_limit()
+
+
+@pytest.mark.parametrize("edit, match", [
+    (("time_step = 0.5", "time_step = nan"), "time_step: must be a finite number"),   # was a segfault
+    (("time_step = 0.5", 'time_step = "x"'), "time_step: expected a number"),
+    (("frames = [1, 2]", 'frames = ["a", "b"]'), "frames: expected"),
+    (("half = true", 'half = "no"'), "half: expected true or false"),                 # "no" was taken as true
+    (("resolution = [32, 16]", "resolution = [100000000, 100000]"), "resolution"),
+    (("bounds = [[-1, -1, 0], [1, 1, 1]]", "bounds = [[-1, -1, 0], [inf, 1, 1]]"), "bounds: must be finite"),
+])
+def test_bad_job_numbers_are_named(tmp_path, edit, match):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "ramp.json").write_text(RAMP)
+    job = tmp_path / "job.toml"
+    job.write_text(JOB.replace(*edit))
+    res = run_job(str(job))
+    failed = [r for r in res if r.status == "failed"]
+    assert failed and re.search(match, failed[0].message), [r.message for r in res]
+    assert os.listdir(tmp_path / "out") == []
