@@ -47,7 +47,10 @@ def quality(n: int, models_dir: str = MODELS) -> dict:
     for m in models.values():
         if m.mode == "single":
             singles.setdefault(m.config["exemplars"][0], {})[m.dim] = m
-    names = sorted(set(singles) | (set(space.codes) if space else set()))
+    # the space model's codes that name a shipped exemplar (photo models' codes name categories of the
+    # photo set, evaluated on held-out photos by bench/eval_solid_photos.py)
+    known = set(ex.PHOTOS) | set(ex.PROCEDURAL)
+    names = sorted(set(singles) | ((set(space.codes) & known) if space else set()))
     table = {}
     for name in names:
         methods, scale = {}, None
@@ -59,7 +62,7 @@ def quality(n: int, models_dir: str = MODELS) -> dict:
                                                for i in range(n)])
             else:
                 methods["ours_3d"] = slices_3d(lambda p, i: m.evaluate(p, code, i), n, EVAL_SIZE, ppu)
-        if space is not None and name in space.codes:
+        if space is not None and name in space.codes and not space.colour_stats:
             held = ex.heldout_region(name).permute(1, 2, 0).numpy()
             code = space.translate(space.encode(held))
             ppu = space.config["px_per_unit"]

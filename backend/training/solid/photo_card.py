@@ -1,0 +1,101 @@
+"""The photo texture-space section of the solid-texture model card.
+
+    python -m backend.training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
+        [--shipped] -o models/solid/MODEL_CARD.md
+
+Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``), and two
+``bench/eval_solid_photos.py`` JSONs (the model shipped before, the
+candidate) and writes the section between the markers
+``<!-- photo-space:begin -->`` / ``<!-- photo-space:end -->`` of the card
+(appended when the card has none), leaving the rest of the card as it is.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import sys
+
+from ..._export import export as _ex
+from ..model_card import _hardware, read_json
+
+BEGIN, END = "<!-- photo-space:begin -->", "<!-- photo-space:end -->"
+
+ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase noise, same photos", "median_random_phase"),
+        ("… pixel shuffle", "median_pixel_shuffle"), ("… Perlin with the photo's histogram", "median_perlin_hist"),
+        ("… a crop of the photo itself", "median_photo_crop"),
+        ("ratio to random phase ↓ (target ≤ 1.5)", "ratio_to_random_phase"),
+        ("photos where it beats the pixel shuffle", "beats_pixel_shuffle"),
+        ("photos where it beats random phase", "beats_random_phase"),
+        ("median mean-colour error ↓ (target ≤ 0.03)", "median_colour"), ("worst mean-colour error", "max_colour"),
+        ("median diversity between seeds", "median_diversity"), ("median axis spread (x/y/z) ↓", "median_axis_spread"),
+        ("median seconds: encode + six 128² slices", "median_seconds"))
+
+
+def section(run: str, prev: dict, new: dict, shipped: bool) -> str:
+    import torch
+
+    state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
+    cfg = state["config"]
+    with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
+        log = [json.loads(line) for line in fh if line.strip()]
+    last = sorted(r["loss"] for r in log[-10:])
+    n_photos = len([f for f in os.listdir(os.path.join("data", "photos", "train"))]) if os.path.isdir(
+        os.path.join("data", "photos", "train")) else "?"
+    ps, ns = prev["summary"], new["summary"]
+    L = [BEGIN, "## Photo texture space (issue 20)", "",
+         f"**{'Shipped as `space`' if shipped else 'Candidate, not shipped'}.** Trained on the photo set "
+         f"(`data/photos/train`, {n_photos} colour photographs from Debian's 0ad-data, ufoai-textures and "
+         "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
+         "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
+         "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
+         f"python -m backend.training.solid.train --config configs/solid/photo_space_3d.json --out {run}",
+         f"python -m backend.training.solid.export {run} models/solid/space",
+         "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
+         f"- **Run:** {state['step']} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
+         f"{float(state.get('elapsed', 0)) / 60:.1f} min wall on {_hardware()}, {cfg['threads']} threads, fp32 "
+         f"(no native bf16 on this CPU); final loss (median of the last ten logged) {last[len(last) // 2]:.4f}.",
+         "- **Colour from the photo:** the decoder outputs a whitened colour d and the texture is mu + L d, with "
+         "the photo's mean colour mu and the Cholesky factor L of its colour covariance appended to the code z "
+         "(20 values: 8 learned, 12 measured). Refinement moves only the learned part.",
+         "- **Loss:** sliced Wasserstein distance (Heitz et al. 2021) of random multi-scale features (5 x 5 colour "
+         f"neighbourhoods and {cfg['swd_width']} zero-mean ReLU filters of sizes {cfg['swd_kernels']} on "
+         f"{cfg['swd_levels']} pyramid levels) plus the sliced colour-histogram term (weight {cfg['hist_weight']}).",
+         "- **Bounded octave transforms:** T_i = R_i e^{c_i} (I + S_i), S_i symmetric with eigenvalues within "
+         "±0.6: stretch up to 4:1, never singular. The previous space model's transforms had singular values "
+         "down to 0.0, i.e. noise extruded along a line: the diagonal streaks in all its output.", "",
+         "Held-out photos (`bench/eval_solid_photos.py`: every photo of `data/photos/val`, whole photos training "
+         f"never saw; {ns['photos']} photos, 128² slices normal to x, y and z, two seeds; patch distance = sliced "
+         "Wasserstein of 7 x 7 Laplacian-pyramid neighbourhoods x 1000):", "",
+         "| measure | previous space model (7 exemplars) | this model |", "|---|---|---|"]
+    for label, key in ROWS:
+        L.append(f"| {label} | {ps.get(key)} | {ns.get(key)} |")
+    L += ["", END]
+    return "\n".join(L)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--run", required=True)
+    ap.add_argument("--prev", required=True)
+    ap.add_argument("--new", required=True)
+    ap.add_argument("--shipped", action="store_true")
+    ap.add_argument("-o", "--out", default=os.path.join("models", "solid", "MODEL_CARD.md"))
+    a = ap.parse_args(argv)
+    text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped)
+    with open(a.out, encoding="utf-8") as fh:
+        card = fh.read()
+    if BEGIN in card and END in card:
+        card = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: text, card, flags=re.S)
+    else:
+        card = card.rstrip("\n") + "\n\n" + text + "\n"
+    with _ex.atomic_path(a.out) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(card)
+    print(a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
