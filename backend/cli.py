@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from export.images import ImageError
 from . import limits
 from .errors import SettingError
 from .grid import evaluate_grid
@@ -333,11 +334,15 @@ def _painted_cond(model, a: argparse.Namespace):
         raise SettingError("--map", f"map not found: {a.map}")
     if not a.region:
         raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
-    from PIL import Image
+    from export.images import decode
 
-    with Image.open(a.map) as im:
-        colour = any(r.startswith("#") for r in a.region)
-        img = np.asarray(im.convert("RGB" if colour else "L"))
+    colour = any(r.startswith("#") for r in a.region)
+    px = decode(a.map)
+    px = px[..., :3] if px.shape[2] >= 3 else np.repeat(px[..., :1], 3, axis=2)
+    # region keys are 8-bit values (#rrggbb or a grey level): files of any depth are read at 8 bits
+    img = np.rint(np.clip(px, 0, 1) * 255.0).astype(np.uint8)
+    if not colour:
+        img = np.rint(img.astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)).astype(np.uint8)
     if img.shape[:2] != (a.size, a.size):
         raise SettingError("--map", f"map is {img.shape[1]}x{img.shape[0]} but --size is {a.size}")
     specs = {}
@@ -563,7 +568,7 @@ def main(argv: list[str] | None = None) -> int:
             return run_neural(a)
         if a.command == "solid":
             return run_solid(a)
-    except (SettingError, FileNotFoundError, PermissionError) as exc:
+    except (SettingError, FileNotFoundError, PermissionError, ImageError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2
     except Exception as exc:

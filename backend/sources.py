@@ -342,7 +342,10 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
             raise SettingError("source.blend", f"mask not found: {path}")
         from ._export import export
 
-        mask = export.read_image(path)
+        try:
+            mask = export.read_image(path)
+        except export.ImageError as exc:
+            raise SettingError("source.blend", str(exc)) from None
     elif "noise2" in d or "params2" in d:
         raise SettingError("source.noise2", "a second noise needs blend = MASK")
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
@@ -397,7 +400,10 @@ def source_from_dict(d: dict, base_dir: str = ".") -> Source:
             raise SettingError("source.example", f"image not found: {path}")
         from ._export import export
 
-        example = export.read_image(path)
+        try:
+            example = export.read_image(path)
+        except export.ImageError as exc:
+            raise SettingError("source.example", str(exc)) from None
     w_offset = float(d.pop("w_offset", 0.0))
     return WaveSource(settings_from_dict(d, example), w_offset)
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from .atomic import atomic_path
 
-__all__ = ["write_npy", "write_png", "write_exr", "write_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
+__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -110,42 +110,107 @@ def write_image(path: str, array: np.ndarray) -> None:
         raise ValueError(f"unsupported output type {ext!r} (use .npy, .exr or .png)")
 
 
-def read_image(path: str) -> np.ndarray:
-    """Read an image as float32 grayscale (H, W) in [0, 1] (.npy, .exr or any Pillow format)."""
+MAX_PIXELS = 1 << 27          #: largest image any input reads (about 11585 x 11585; below Pillow's own bomb limit)
+
+
+class ImageError(ValueError):
+    """An input image that cannot be used; the message is one line naming the file."""
+
+
+def decode(path: str) -> np.ndarray:
+    """The one reader of every image input: float32 (H, W, C) with C in 1..4, values by the file's own range.
+
+    8-bit files are divided by 255, 16-bit ones by 65535 (a 16-bit mask is not
+    read as nearly white), float files (.exr, float TIFF, .npy) are kept as
+    they are.  Empty, truncated, non-image, non-finite and oversized
+    (> MAX_PIXELS, 2^27) files raise :class:`ImageError`; a missing one
+    FileNotFoundError.
+    """
     if not os.path.isfile(path):
         raise FileNotFoundError(f"image not found: {path}")
+    if os.path.getsize(path) == 0:
+        raise ImageError(f"{path}: empty file")
     ext = os.path.splitext(path)[1].lower()
-    if ext == ".npy":
-        a = np.load(path).astype(np.float32)
-    elif ext == ".exr":
-        import OpenEXR
+    try:
+        if ext == ".npy":
+            a = np.load(path, allow_pickle=False)
+            if a.dtype.kind not in "fiub":
+                raise ImageError(f"{path}: a .npy image must hold numbers, got {a.dtype}")
+            a = a.astype(np.float32)
+        elif ext == ".exr":
+            import OpenEXR
 
-        with OpenEXR.File(path) as f:
-            chans = f.channels()
-            key = "Y" if "Y" in chans else ("RGB" if "RGB" in chans else next(iter(chans)))
-            a = np.asarray(chans[key].pixels, dtype=np.float32)
-    else:
-        from PIL import Image
-
-        with Image.open(path) as im:
-            a = np.asarray(im.convert("F"), dtype=np.float32) / 255.0
-    if a.ndim == 3:
-        a = a[..., :3].mean(axis=2)
+            with OpenEXR.File(path) as f:
+                chans = f.channels()
+                key = "Y" if "Y" in chans else ("RGBA" if "RGBA" in chans else
+                                                ("RGB" if "RGB" in chans else next(iter(chans))))
+                a = np.asarray(chans[key].pixels, dtype=np.float32)
+        else:
+            a = _decode_pillow(path)
+    except ImageError:
+        raise
+    except (OSError, ValueError, EOFError, SyntaxError, MemoryError) as exc:
+        raise ImageError(f"{path}: cannot read the image ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") \
+            from None
+    if a.ndim == 2:
+        a = a[..., None]
+    if a.ndim != 3 or a.shape[2] > 4 or 0 in a.shape:
+        raise ImageError(f"{path}: expected an image (H, W) or (H, W, 1..4), got shape {a.shape}")
+    if a.shape[0] * a.shape[1] > MAX_PIXELS:
+        raise ImageError(f"{path}: {a.shape[1]}x{a.shape[0]} px is more than the {MAX_PIXELS} px an input may have")
+    if not np.all(np.isfinite(a)):
+        raise ImageError(f"{path}: the image holds NaN or infinite values")
     return a
 
 
-def read_rgb(path: str) -> np.ndarray:
-    """Read an 8/16-bit image file as float32 (H, W, 3) in [0, 1], its stored (sRGB) values;
-    greyscale is repeated, alpha dropped.  The exemplar format of the solid textures."""
-    if not os.path.isfile(path):
-        raise FileNotFoundError(f"image not found: {path}")
+def _decode_pillow(path: str) -> np.ndarray:
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     try:
-        with Image.open(path) as im:
-            return np.asarray(im.convert("RGB"), dtype=np.float32) / 255.0
-    except UnidentifiedImageError:
-        raise ValueError(f"not an image Pillow can read: {path}") from None
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(path) as im:
+                w, h = im.size
+                if w * h > MAX_PIXELS:
+                    raise ImageError(f"{path}: {w}x{h} px is more than the {MAX_PIXELS} px an input may have")
+                im.load()
+                mode = im.mode
+                if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
+                    return np.asarray(im, dtype=np.float32) / 65535.0
+                if mode == "I":        # 16-bit PNGs open as 32-bit integers holding 0..65535
+                    a = np.asarray(im, dtype=np.float32)
+                    return a / (65535.0 if a.max() <= 65535 else float(2 ** 31 - 1))
+                if mode == "F":
+                    return np.asarray(im, dtype=np.float32)
+                if mode not in ("L", "LA", "RGB", "RGBA"):
+                    im = im.convert("RGBA" if "A" in mode or "transparency" in im.info else "RGB")
+                return np.asarray(im, dtype=np.float32) / 255.0
+    except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
+        if isinstance(exc, UnidentifiedImageError):
+            raise ImageError(f"{path}: not an image file this reader knows") from None
+        raise ImageError(f"{path}: the image is more than the {MAX_PIXELS} px an input may have") from None
+
+
+def read_image(path: str) -> np.ndarray:
+    """Read an image as float32 grayscale (H, W) in the file's own range (.npy, .exr or any Pillow format):
+    the mean of its colour channels, alpha dropped."""
+    a = decode(path)
+    if a.shape[2] in (2, 4):
+        a = a[..., :-1]
+    return a.mean(axis=2) if a.shape[2] > 1 else a[..., 0]
+
+
+def read_rgb(path: str) -> np.ndarray:
+    """Read an image file as float32 (H, W, 3) in [0, 1], its stored (sRGB) values; greyscale is repeated,
+    alpha dropped.  The exemplar format of the solid textures."""
+    a = decode(path)
+    if a.shape[2] in (2, 4):
+        a = a[..., :-1]
+    if a.shape[2] == 1:
+        a = np.repeat(a, 3, axis=2)
+    return np.clip(a, 0.0, 1.0)
 
 
 def _png_text(path: str) -> dict:

@@ -1,0 +1,80 @@
+"""One reader for every image input (issue 24): files of any depth by their own range, broken files refused in
+one line naming the file, and the CLI turning each into exit 2."""
+import struct
+import zlib
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from backend.cli import main
+from export.images import MAX_PIXELS, ImageError, decode, read_image, read_rgb
+
+
+def _png16(path, a):
+    Image.fromarray(a.astype(np.uint16)).save(path)
+
+
+def _huge_png(path, w, h):
+    """A valid-looking PNG whose header claims w x h pixels (its data is one row)."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    raw = zlib.compress(b"\x00" * (w + 1))
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0))
+                     + chunk(b"IDAT", raw) + chunk(b"IEND", b""))
+
+
+def test_sixteen_bit_images_are_read_by_their_range(tmp_path):
+    m = np.zeros((20, 20), np.uint16)
+    m[:, :11] = 65535                                     # 55% white
+    _png16(tmp_path / "mask16.png", m)
+    a = read_image(str(tmp_path / "mask16.png"))
+    assert a.dtype == np.float32 and a.max() == pytest.approx(1.0) and (a > 0.5).mean() == pytest.approx(0.55)
+    g = np.full((8, 8), 30000, np.uint16)
+    _png16(tmp_path / "grey16.png", g)
+    assert read_rgb(str(tmp_path / "grey16.png"))[0, 0, 0] == pytest.approx(30000 / 65535, abs=1e-6)
+    Image.fromarray(np.full((4, 4, 3), 51, np.uint8)).save(tmp_path / "rgb8.png")
+    assert read_rgb(str(tmp_path / "rgb8.png")).shape == (4, 4, 3)
+    assert read_image(str(tmp_path / "rgb8.png"))[0, 0] == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda p: p.write_bytes(b""), "empty file"),
+    (lambda p: p.write_text("hello, not an image"), "not an image file"),
+    (lambda p: p.write_bytes((lambda b: b[: len(b) // 2])(_png_bytes())), "cannot read the image"),
+    (lambda p: _huge_png(p, 40000, 40000), "more than the"),
+])
+def test_broken_images_are_refused_in_one_line(tmp_path, make, match):
+    p = tmp_path / "bad.png"
+    make(p)
+    with pytest.raises(ImageError, match=match) as exc:
+        decode(str(p))
+    assert str(p) in str(exc.value) and "\n" not in str(exc.value)
+
+
+def _png_bytes():
+    import io
+    buf = io.BytesIO()
+    Image.fromarray(np.random.default_rng(0).integers(0, 255, (64, 64, 3), dtype=np.uint8)).save(buf, "PNG")
+    return buf.getvalue()
+
+
+def test_bad_npy_inputs(tmp_path):
+    (tmp_path / "corrupt.npy").write_bytes(b"\x93NUMPY garbage")
+    with pytest.raises(ImageError, match="corrupt.npy: cannot read"):
+        decode(str(tmp_path / "corrupt.npy"))
+    np.save(tmp_path / "nan.npy", np.array([[0.0, np.nan]], np.float32))
+    with pytest.raises(ImageError, match="NaN or infinite"):
+        decode(str(tmp_path / "nan.npy"))
+    np.save(tmp_path / "cube.npy", np.zeros((4, 4, 4, 4), np.float32))
+    with pytest.raises(ImageError, match="expected an image"):
+        decode(str(tmp_path / "cube.npy"))
+    assert MAX_PIXELS == 1 << 27
+
+
+def test_cli_image_inputs_exit_2(tmp_path, capsys):
+    (tmp_path / "t.png").write_bytes(_png_bytes()[:300])
+    rc = main(["wave", "--size", "16", "--quiet", "--example", str(tmp_path / "t.png"), "-o", str(tmp_path / "o.png")])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and "t.png" in err[0]
+    assert not (tmp_path / "o.png").exists()
