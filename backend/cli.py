@@ -286,7 +286,7 @@ def run_bake_job(a: argparse.Namespace) -> int:
                 state = "up to date" if fresh == len(frames) else "to bake"
                 print(f"  {state:10s} {name}: {list(spec.grid.resolution)} -> {spec.output}"
                       + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))
-        return 1 if bad else 0
+        return 2 if bad else 0
     _set_threads(a.threads)
     bars = {}
 
@@ -301,7 +301,12 @@ def run_bake_job(a: argparse.Namespace) -> int:
         if o.status in ("baked", "up to date") and not a.quiet:
             print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
     for o in failed:
-        print(f"omninoise bake: error: {o.message}", file=sys.stderr)
+        print(f"omninoise bake: {'cancelled' if o.status == 'cancelled' else 'error'}: {o.message}", file=sys.stderr)
+    # exit status as documented: 2 bad input, 130 interrupted, 1 a failure while running
+    if any(o.status == "invalid" for o in failed):
+        return 2
+    if any(o.status == "cancelled" for o in failed):
+        return 130
     return 1 if failed else 0
 
 

@@ -86,7 +86,7 @@ class JobError(ValueError):
 @dataclass
 class JobOutcome:
     name: str
-    status: str  # "baked" | "up to date" | "failed" | "cancelled"
+    status: str  # "baked" | "up to date" | "invalid" (bad settings, nothing run) | "failed" | "cancelled"
     message: str = ""
     result: BakeResult | None = None
 
@@ -198,10 +198,10 @@ def run_job(path: str, keep_going: bool = False, force: bool = False, only: list
     if not keep_going:
         for name, spec in entries:
             if isinstance(spec, JobError):
-                return [JobOutcome(name, "failed", str(spec))]
+                return [JobOutcome(name, "invalid", str(spec))]
     for i, (name, spec) in enumerate(entries):
         if isinstance(spec, JobError):
-            outcomes.append(JobOutcome(name, "failed", str(spec)))
+            outcomes.append(JobOutcome(name, "invalid", str(spec)))
             continue
         cb = None if progress is None else (lambda f, i=i, name=name: progress(name, i, len(entries), f))
         try:

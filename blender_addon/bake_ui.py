@@ -304,7 +304,7 @@ class OMNINOISE_OT_run_job(_TaskOperator, bpy.types.Operator):
             return backend.jobs.run_job(path, keep_going=keep_going, force=force, progress=prog, cancel=cancel)
 
         def done(outcomes):
-            bad = [o for o in outcomes if o.status in ("failed", "cancelled")]
+            bad = [o for o in outcomes if o.status in ("invalid", "failed", "cancelled")]
             text = "; ".join(f"{o.name}: {o.status}" for o in outcomes)
             _message(text if not bad else "; ".join(o.message for o in bad))
             if bad:

@@ -57,6 +57,6 @@ def test_bad_job_numbers_are_named(tmp_path, edit, match):
     job = tmp_path / "job.toml"
     job.write_text(JOB.replace(*edit))
     res = run_job(str(job))
-    failed = [r for r in res if r.status == "failed"]
+    failed = [r for r in res if r.status == "invalid"]
     assert failed and re.search(match, failed[0].message), [r.message for r in res]
     assert os.listdir(tmp_path / "out") == []

@@ -85,7 +85,7 @@ def test_job_paths_are_relative_to_the_job_file(job, tmp_path, monkeypatch):
 def test_bad_bakes_are_named_and_nothing_is_baked(job, edit, match):
     job.write_text(JOB.replace(*edit))
     out = run_job(str(job))
-    assert out[-1].status == "failed"
+    assert out[-1].status == "invalid"
     assert __import__("re").search(match, out[-1].message), out[-1].message
     assert os.listdir(job.parent / "out") == []  # invalid bakes fail before any work
 
@@ -93,7 +93,7 @@ def test_bad_bakes_are_named_and_nothing_is_baked(job, edit, match):
 def test_keep_going_bakes_the_others(job):
     job.write_text(JOB.replace("fmax = 6}", "fmax = 6, bogus = 1}"))
     out = run_job(str(job), keep_going=True)
-    assert [o.status for o in out] == ["failed", "baked"]
+    assert [o.status for o in out] == ["invalid", "baked"]
     assert os.listdir(job.parent / "out") == ["marble.exr"]
 
 
@@ -117,11 +117,16 @@ def test_cli_exit_codes_and_messages(job, capsys):
     assert main(["bake", str(job), "--dry-run"]) == 0
     assert "up to date clouds" in capsys.readouterr().out
     job.write_text(JOB.replace("fmax = 6}", "fmax = 6, bogus = 1}"))
-    assert main(["bake", str(job), "--quiet"]) == 1
+    assert main(["bake", str(job), "--quiet"]) == 2          # bad settings: exit 2, as for every bad input
     err = capsys.readouterr().err
     assert "omninoise bake: error: bake 'clouds': spectrum: unknown key 'bogus'" in err
     assert main(["bake", str(job), "--only", "nope"]) == 2
     assert "no bake named 'nope'" in capsys.readouterr().err
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    # a failure while running (the output folder is a file) exits 1
+    job.write_text(JOB.replace('output = "out/marble.exr"', 'output = "blocker/marble.exr"'))
+    (job.parent / "blocker").write_text("a file where a folder belongs")
+    assert main(["bake", str(job), "--quiet", "--only", "marble"]) == 1
 
 
 def test_console_script_bakes(job):
