@@ -573,7 +573,7 @@ def main(argv: list[str] | None = None) -> int:
             return run_neural(a)
         if a.command == "solid":
             return run_solid(a)
-    except (SettingError, FileNotFoundError, PermissionError, ImageError) as exc:
+    except (SettingError, FileNotFoundError, PermissionError, IsADirectoryError, ImageError) as exc:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2
     except Exception as exc:

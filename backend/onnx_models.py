@@ -40,7 +40,10 @@ def load_model_json(folder: str, json_name: str) -> dict:
         raise ModelError(f"no {json_name} in {folder}")
     with open(path, encoding="utf-8") as fh:
         doc = json.load(fh)
-    for name, digest in doc.get("files", {}).items():
+    files = doc.get("files") if isinstance(doc, dict) else None
+    if not isinstance(files, dict) or not files:
+        raise ModelError(f"{path} lists no files with their sha256 ('files'): the model cannot be verified")
+    for name, digest in files.items():
         fp = os.path.join(folder, name)
         if not os.path.isfile(fp):
             raise ModelError(f"model file missing: {fp}")

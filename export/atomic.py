@@ -1,13 +1,19 @@
 """Atomic file output: write to a temporary file beside the target, then rename.
 
 A failed or cancelled write leaves no partial file and never touches an
-earlier result at the target path.
+earlier result at the target path.  The temporary file is flushed to disk
+(fsync) before the rename, so a power cut leaves either the old file or the
+new one; temporaries that a killed process left behind (``.omninoise-*``
+older than a day) are removed from the folder on the next write there.
 """
 from __future__ import annotations
 
 import contextlib
 import os
 import tempfile
+import time
+
+STALE_SECONDS = 24 * 3600   #: age after which a leftover ``.omninoise-*`` temporary is removed
 
 
 @contextlib.contextmanager
@@ -18,16 +24,46 @@ def atomic_path(path: str, suffix: str | None = None):
         raise FileNotFoundError(f"output folder does not exist: {folder}")
     if not os.access(folder, os.W_OK):
         raise PermissionError(f"output folder is not writable: {folder}")
+    if os.path.isdir(path):
+        raise IsADirectoryError(f"output path is a folder, not a file: {path}")
+    remove_stale(folder)
     suffix = suffix if suffix is not None else os.path.splitext(path)[1]
     fd, tmp = tempfile.mkstemp(prefix=".omninoise-", suffix=suffix, dir=folder)
     os.close(fd)
     try:
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; results get the usual permissions
+        _fsync(tmp)
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
+
+
+def _fsync(path: str) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def remove_stale(folder: str, max_age: float = STALE_SECONDS) -> list:
+    """Remove ``.omninoise-*`` temporaries older than ``max_age`` seconds in ``folder``; returns their names."""
+    now, gone = time.time(), []
+    try:
+        names = [n for n in os.listdir(folder) if n.startswith(".omninoise-")]
+    except OSError:
+        return gone
+    for n in names:
+        p = os.path.join(folder, n)
+        try:
+            if os.path.isfile(p) and now - os.path.getmtime(p) > max_age:
+                os.remove(p)
+                gone.append(n)
+        except OSError:
+            pass        # another process's file, or gone already
+    return gone
 
 
 def _umask() -> int:

@@ -60,3 +60,38 @@ def test_bad_job_numbers_are_named(tmp_path, edit, match):
     failed = [r for r in res if r.status == "invalid"]
     assert failed and re.search(match, failed[0].message), [r.message for r in res]
     assert os.listdir(tmp_path / "out") == []
+
+
+def test_atomic_writes_refuse_folders_and_clean_stale_temporaries(tmp_path, capsys):
+    import time
+
+    from export.atomic import STALE_SECONDS, atomic_path
+
+    old = tmp_path / ".omninoise-dead.npy"          # left by a killed process
+    old.write_bytes(b"x")
+    past = time.time() - STALE_SECONDS - 60
+    os.utime(old, (past, past))
+    fresh = tmp_path / ".omninoise-live.npy"        # another process's write in progress
+    fresh.write_bytes(b"x")
+    with atomic_path(str(tmp_path / "a.txt")) as tmp:
+        with open(tmp, "w") as fh:
+            fh.write("ok")
+    assert (tmp_path / "a.txt").read_text() == "ok"
+    assert not old.exists() and fresh.exists()
+    (tmp_path / "dir.npy").mkdir()
+    with pytest.raises(IsADirectoryError, match="is a folder"):
+        with atomic_path(str(tmp_path / "dir.npy")):
+            pass
+    rc = main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "dir.npy")])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and "is a folder" in err[0]
+
+
+def test_model_without_hashes_is_refused(tmp_path):
+    import json
+
+    from backend.onnx_models import ModelError, load_model_json
+
+    (tmp_path / "solid.json").write_text(json.dumps({"model": "neural_solid_texture"}))
+    with pytest.raises(ModelError, match="lists no files with their sha256"):
+        load_model_json(str(tmp_path), "solid.json")
