@@ -383,6 +383,9 @@ def run_neural(a: argparse.Namespace) -> int:
     sampler = a.sampler or DEFAULT_SAMPLER
     steps = DEFAULT_STEPS if a.steps is None else a.steps
     check_sampler(sampler, steps, a.spacing, a.eta)
+    if not 0 <= a.seed < 2 ** 32:
+        raise SettingError("--seed", f"must lie in [0, 2^32), got {a.seed}")
+    limits.check_memory("--size", float(a.size) ** 2 * 4 * 160, f"a {a.size}² neural image (activations)")
     tile = a.tile
     if tile is not None and tile < 0:
         raise SettingError("--tile", f"must be >= 0 (0: never tile), got {tile}")
@@ -449,8 +452,10 @@ def run_solid(a: argparse.Namespace) -> int:
         raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
-    if not a.scale > 0:
-        raise SettingError("--scale", f"must be > 0, got {a.scale}")
+    limits.positive("--scale", a.scale)
+    if a.seed < 0:
+        raise SettingError("--seed", f"must be >= 0, got {a.seed}")
+    limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     if not 0.0 <= a.mix <= 1.0:
         raise SettingError("--mix", f"must be in [0, 1], got {a.mix}")
     if a.refine < 0:
@@ -522,6 +527,9 @@ def run_zoo(a: argparse.Namespace) -> int:
         raise SettingError("zoo", "give --noise CLASS and -o OUT (or --list)")
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
+    if os.path.splitext(a.out)[1].lower() not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {os.path.splitext(a.out)[1] or a.out!r}; use .png, .exr or .npy")
+    limits.check_memory("--size", float(a.size) ** 2 * 4 * 8, f"a {a.size}² zoo image")
     try:
         params = zoo.parse_params(a.noise, a.param)
     except ValueError as exc:

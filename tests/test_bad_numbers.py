@@ -95,3 +95,17 @@ def test_model_without_hashes_is_refused(tmp_path):
     (tmp_path / "solid.json").write_text(json.dumps({"model": "neural_solid_texture"}))
     with pytest.raises(ModelError, match="lists no files with their sha256"):
         load_model_json(str(tmp_path), "solid.json")
+
+
+@pytest.mark.parametrize("args, setting", [
+    (["neural", "--noise", "perlin", "--seed", "-1", "-o", "{d}/n.png"], "--seed"),
+    (["neural", "--noise", "perlin", "--size", "100000000", "-o", "{d}/n.png"], "--size"),
+    (["solid", "--exemplar", "gravel", "--scale", "inf", "-o", "{d}/s.png"], "--scale"),
+    (["solid", "--exemplar", "gravel", "--size", "100000000", "-o", "{d}/s.png"], "--size"),
+    (["zoo", "--noise", "perlin", "-o", "{d}/o.txt"], "-o"),
+])
+def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
+    rc = main([x.format(d=tmp_path) for x in args])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and setting in err[0], err
+    assert os.listdir(tmp_path) == []
