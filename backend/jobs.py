@@ -151,7 +151,7 @@ def parse_job(doc: dict, base_dir: str) -> list:
     if not isinstance(bakes, list) or not bakes:
         raise JobError("no [[bake]] tables: nothing to do")
     defaults = doc.get("defaults", {})
-    out, seen = [], set()
+    out, seen, outputs = [], set(), {}
     for i, b in enumerate(bakes):
         d = _merge(defaults, b)
         name = d.get("name") or f"bake {i + 1}"
@@ -160,9 +160,18 @@ def parse_job(doc: dict, base_dir: str) -> list:
             continue
         seen.add(name)
         try:
-            out.append((name, _spec(d, base_dir, i)))
+            spec = _spec(d, base_dir, i)
         except (SettingError, FileNotFoundError) as exc:
             out.append((name, JobError(f"bake {name!r}: {exc}")))
+            continue
+        # two bakes writing one file (or one numbered sequence) would overwrite each other
+        key = os.path.normcase(os.path.abspath(spec.output))
+        if key in outputs:
+            out.append((name, JobError(f"bake {name!r}: output {spec.output} is also written by bake "
+                                       f"{outputs[key]!r}")))
+            continue
+        outputs[key] = name
+        out.append((name, spec))
     return out
 
 

@@ -50,6 +50,9 @@ def test_memory_error_says_how_much(monkeypatch):
     (("half = true", 'half = "no"'), "half: expected true or false"),                 # "no" was taken as true
     (("resolution = [32, 16]", "resolution = [100000000, 100000]"), "resolution"),
     (("bounds = [[-1, -1, 0], [1, 1, 1]]", "bounds = [[-1, -1, 0], [inf, 1, 1]]"), "bounds: must be finite"),
+    (('[[bake]]\nname = "marble"', '[[bake]]\nname = "first"\noutput = "out/../out/marble.exr"\n'
+      'resolution = [8, 8]\n[bake.source]\ndim = 2\n\n[[bake]]\nname = "marble"'),
+     "bake 'marble': output .* is also written by bake 'first'"),              # was a silent overwrite
 ])
 def test_bad_job_numbers_are_named(tmp_path, edit, match):
     (tmp_path / "out").mkdir()
