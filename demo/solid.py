@@ -30,6 +30,8 @@ from export.images import preview_8bit, read_rgb, write_png  # noqa: E402
 
 MODELS = SHIPPED_MODELS
 EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
+#: a held-out colour photo (never trained on) that the texture-space model encodes for Suzanne
+PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")
 
 
 def slices_sheet(out: str, size: int = 160) -> list:
@@ -89,7 +91,7 @@ def build_scene(out: str) -> dict:
     p.folder = os.path.join(out, "bakes")
     space = os.path.isfile(os.path.join(MODELS, "space", "solid.json"))
     plan = [("Cube", "gravel_3d", None, "UV_IMAGE", 1.5), ("Sphere", "grass_3d", None, "UV_IMAGE", 1.0),
-            ("Suzanne", "space" if space else "gravel_3d", "gravel.png" if space else None, "COLOR_ATTRIBUTE", 1.0),
+            ("Suzanne", "space" if space else "gravel_3d", PHOTO if space else None, "COLOR_ATTRIBUTE", 1.0),
             ("Cylinder", "wood_3d", None, "UV_IMAGE", 1.0)]
     used = {}
     x = -3.3
@@ -99,7 +101,7 @@ def build_scene(out: str) -> dict:
         obj = _add(kind, x)
         x += 2.2
         if photo:   # the texture-space model encodes the photograph itself
-            p.source, p.image = "IMAGE", bpy.data.images.load(os.path.join(EXEMPLARS, photo))
+            p.source, p.image = "IMAGE", bpy.data.images.load(photo)
         else:
             p.source, p.texture = "SHIPPED", f"single:{model}"
         p.target, p.scale, p.name, p.size = target, scale, f"{kind} {model}", 1024

@@ -45,17 +45,21 @@ def section(run: str, prev: dict, new: dict, shipped: bool) -> str:
         os.path.join("data", "photos", "train")) else "?"
     ps, ns = prev["summary"], new["summary"]
     L = [BEGIN, "## Photo texture space (issue 20)", "",
-         f"**{'Shipped as `space`' if shipped else 'Candidate, not shipped'}.** Trained on the photo set "
+         f"**{'Shipped as `space`; the tables above that name `space` describe the seven-exemplar model it replaced' if shipped else 'Candidate, not shipped'}.** Trained on the photo set "
          f"(`data/photos/train`, {n_photos} colour photographs from Debian's 0ad-data, ufoai-textures and "
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
-         f"python -m backend.training.solid.train --config configs/solid/photo_space_3d.json --out {run}",
-         f"python -m backend.training.solid.export {run} models/solid/space",
+         "python -m backend.training.solid.train --config configs/solid/photo_space_3d.json --out runs/solid/photo_space",
+         "python -m backend.training.solid.export runs/solid/photo_space models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {state['step']} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
-         f"{float(state.get('elapsed', 0)) / 60:.1f} min wall on {_hardware()}, {cfg['threads']} threads, fp32 "
-         f"(no native bf16 on this CPU); final loss (median of the last ten logged) {last[len(last) // 2]:.4f}.",
+         f"{float(state.get('elapsed', 0)) / 60:.1f} min wall on {_hardware().split(',')[0]}, {cfg['threads']} "
+         f"threads, fp32 (no native bf16 on this CPU); final loss (median of the last ten logged) "
+         f"{last[len(last) // 2]:.4f}."
+         + (f" Stopped at step {state['step']} of its {cfg['steps']}-step cosine schedule (the session's time; "
+            f"learning rate {log[-1].get('lr', 0):.2g} at the end); `--out` the same folder resumes it."
+            if state["step"] < cfg["steps"] else ""),
          "- **Colour from the photo:** the decoder outputs a whitened colour d and the texture is mu + L d, with "
          "the photo's mean colour mu and the Cholesky factor L of its colour covariance appended to the code z "
          "(20 values: 8 learned, 12 measured). Refinement moves only the learned part.",
