@@ -182,8 +182,14 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
             raise SettingError("--profile", "--waveform custom needs --profile FILE")
         if not os.path.isfile(a.profile):
             raise SettingError("--profile", f"file not found: {a.profile}")
-        prof = np.load(a.profile) if a.profile.endswith(".npy") else np.loadtxt(a.profile)
-        profile = tuple(np.asarray(prof, np.float64).ravel())
+        try:
+            prof = np.load(a.profile, allow_pickle=False) if a.profile.endswith(".npy") else np.loadtxt(a.profile)
+            profile = tuple(np.asarray(prof, np.float64).ravel())
+        except (ValueError, OSError, EOFError, TypeError) as exc:
+            raise SettingError("--profile", f"{a.profile}: not a list of numbers "
+                                            f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") from None
+        if not profile or not np.all(np.isfinite(profile)):
+            raise SettingError("--profile", f"{a.profile}: needs finite numbers, got {len(profile)} values")
     return WaveSettings(
         dim=a.dim, spectrum=Spectrum(a.spectrum, a.fmin, a.fmax, a.exponent), directions=a.directions,
         seed=a.seed, output=a.output, speed=a.speed, slice_width=a.slice_width, waveform=a.waveform,

@@ -112,3 +112,13 @@ def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert rc == 2 and len(err) == 1 and setting in err[0], err
     assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("content, name", [("0 1 banana 2\n", "p.txt"), ("", "p.txt"), ("0 nan 1\n", "p.txt"),
+                                           ("\x93NUMPY broken", "p.npy")])
+def test_bad_custom_profiles(tmp_path, capsys, content, name):
+    (tmp_path / name).write_text(content)
+    rc = main(["wave", "--size", "8", "--quiet", "--waveform", "custom", "--profile", str(tmp_path / name),
+               "-o", str(tmp_path / "o.npy")])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and "--profile" in err[0], err
