@@ -25,7 +25,7 @@ from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
 from .lattice import lattice_noise
 
-__all__ = ["SolidTextureModel", "TextureCode", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points",
+__all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points",
            "exemplar_z"]
 
 _F = np.float32
@@ -98,6 +98,14 @@ class TextureCode:
     L: np.ndarray | None = None
 
 
+def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
+    """Bilinear resize of a float32 image (H, W, 3) to (h, w, 3), channel by channel (Pillow's float mode)."""
+    from PIL import Image
+
+    return np.stack([np.asarray(Image.fromarray(np.ascontiguousarray(img[..., c], np.float32))
+                                .resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
+
+
 def colour_stats(img: np.ndarray, eps: float = 1e-4) -> np.ndarray:
     """Mean colour and Cholesky factor of the colour covariance of an image (H, W, 3): float32 (12,) = [mu, L.ravel()]
     (the numpy twin of ``backend.training.solid.model.colour_stats``)."""
@@ -149,14 +157,10 @@ class SolidTextureModel:
         S = int(self.config.get("encoder_size", 128))
         scale = float(self.config.get("exemplar_scale", 1.0))
         if scale != 1.0:        # the encoder saw exemplars resampled by this factor in training
-            from PIL import Image
-            h, w = max(1, round(img.shape[0] * scale)), max(1, round(img.shape[1] * scale))
-            img = np.stack([np.asarray(Image.fromarray(img[..., c]).resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
+            img = resize_rgb(img, max(1, round(img.shape[0] * scale)), max(1, round(img.shape[1] * scale)))
         if min(img.shape[:2]) < S:
-            from PIL import Image
             f = S / min(img.shape[:2])
-            h, w = max(S, round(img.shape[0] * f)), max(S, round(img.shape[1] * f))
-            img = np.stack([np.asarray(Image.fromarray(img[..., c]).resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
+            img = resize_rgb(img, max(S, round(img.shape[0] * f)), max(S, round(img.shape[1] * f)))
         H, W, _ = img.shape
         # crops at most S/2 apart that cover the whole image
         ys = np.unique(np.linspace(0, H - S, -(-(H - S) // (S // 2)) + 1).round().astype(int))

@@ -57,10 +57,9 @@ def _exemplar_crops(exemplar: np.ndarray, scale: float, n: int = 4) -> list:
     """The exemplar resampled to the model's training resolution, cut into up to n square crops."""
     img = np.asarray(exemplar, np.float32)
     if scale != 1.0:
-        from PIL import Image
+        from .model import resize_rgb
 
-        h, w = max(RENDER_SIZE, round(img.shape[0] * scale)), max(RENDER_SIZE, round(img.shape[1] * scale))
-        img = np.stack([np.asarray(Image.fromarray(img[..., c]).resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
+        img = resize_rgb(img, max(RENDER_SIZE, round(img.shape[0] * scale)), max(RENDER_SIZE, round(img.shape[1] * scale)))
     H, W, _ = img.shape
     S = min(H, W, 128)
     ys = np.linspace(0, H - S, 2).astype(int)

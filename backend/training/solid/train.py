@@ -95,8 +95,9 @@ class SolidConfig:
             raise ValueError(f"loss must be 'gram' or 'swd', got {cfg.loss!r}")
         if cfg.colour not in ("sigmoid", "affine"):
             raise ValueError(f"colour must be 'sigmoid' or 'affine', got {cfg.colour!r}")
-        if cfg.mode == "single" and len(ex.expand(cfg.exemplars)) != 1:
-            raise ValueError(f"single mode takes exactly one exemplar, got {len(cfg.exemplars)}")
+        n_exemplars = len(ex.expand(cfg.exemplars))
+        if cfg.mode == "single" and n_exemplars != 1:
+            raise ValueError(f"single mode takes exactly one exemplar, got {n_exemplars}")
         return cfg
 
 
@@ -191,6 +192,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     logf = open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8")
     t0 = time.time() - elapsed
+    # single mode: one exemplar, so one colour statistic for the whole run
+    single_stats = colour_stats(images[0].unsqueeze(0)).expand(cfg.batch, -1) if cfg.mode == "single" else None
     state = None
     while step < end:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / cfg.steps))
@@ -199,7 +202,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         if cfg.mode == "single":
             ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
             e, T = model.codes(batch=cfg.batch)
-            stats = colour_stats(images[0].unsqueeze(0)).expand(cfg.batch, -1)
+            stats = single_stats
         else:
             # distinct exemplars within a batch (while there are enough): each step contrasts textures
             pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
