@@ -166,3 +166,23 @@ def test_photo_space_model_colour_path_export_and_refine(tmp_path):
     z2, hist = refine_code(rt, z, photo, steps=3)
     np.testing.assert_array_equal(z2[8:], z[8:])
     assert hist[-1] <= hist[0]
+
+
+def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
+    """The card section is written from the shipped export's solid.json (config, steps, wall time) when the run
+    folder is not kept, with the two evaluations side by side and the ledger rows as given."""
+    from backend.training.solid import photo_card
+
+    space = os.path.join(ROOT, "models", "solid", "space")
+    with open(os.path.join(space, "solid.json"), encoding="utf-8") as fh:
+        meta = json.load(fh)
+    prev = dict(summary=dict(photos=87, median_swd=300.0, ratio_to_random_phase=2.5, beats_pixel_shuffle=70))
+    new = dict(summary=dict(photos=87, median_swd=210.0, ratio_to_random_phase=1.9, beats_pixel_shuffle=77))
+    text = photo_card.section(space, prev, new, True, "older", (("a stage", 5, "1 min", 1.0, 2.0, "3", "4", "no"),))
+    assert f"**Run:** {meta['step']} steps of batch {meta['config']['batch']}" in text
+    assert f"{meta['train_seconds'] / 60:.1f} min wall" in text
+    assert "| median patch distance (swd) ↓ | 300.0 | 210.0 |" in text
+    assert "| measure | older | this model |" in text
+    assert "| a stage | 5 | 1 min | 1.0 | 2.0 | 3 | 4 | no |" in text
+    with pytest.raises(SystemExit, match="neither ckpt.pt"):
+        photo_card.run_facts(str(tmp_path))

@@ -3,7 +3,8 @@
     python -m backend.training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
         [--shipped] -o models/solid/MODEL_CARD.md
 
-Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``), and two
+Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``; or its export's ``solid.json``
+when the run folder is gone), and two
 ``bench/eval_solid_photos.py`` JSONs (the model shipped before, the
 candidate) and writes the section between the markers
 ``<!-- photo-space:begin -->`` / ``<!-- photo-space:end -->`` of the card
@@ -33,15 +34,30 @@ ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase no
         ("median seconds: encode + six 128² slices", "median_seconds"))
 
 
-def section(run: str, prev: dict, new: dict, shipped: bool) -> str:
-    import torch
+def run_facts(run: str) -> dict:
+    """Steps, config, wall seconds, final loss and last learning rate of a run folder (``ckpt.pt`` and
+    ``log.jsonl``) or, when the run folder is gone, of its export (``solid.json``: no loss or learning rate)."""
+    if os.path.isfile(os.path.join(run, "ckpt.pt")):
+        import torch
 
-    state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
-    cfg = state["config"]
-    with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
-        log = [json.loads(line) for line in fh if line.strip()]
-    last = sorted(r["loss"] for r in log[-10:])
-    n_photos = len([f for f in os.listdir(os.path.join("data", "photos", "train"))]) if os.path.isdir(
+        state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
+        with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
+            log = [json.loads(line) for line in fh if line.strip()]
+        last = sorted(r["loss"] for r in log[-10:])
+        return dict(step=int(state["step"]), config=state["config"], seconds=float(state.get("elapsed", 0)),
+                    loss=last[len(last) // 2] if last else None, lr=log[-1].get("lr") if log else None)
+    if os.path.isfile(os.path.join(run, "solid.json")):
+        meta = read_json(os.path.join(run, "solid.json"))
+        return dict(step=int(meta["step"]), config=meta["config"], seconds=float(meta.get("train_seconds", 0)),
+                    loss=None, lr=None)
+    raise SystemExit(f"photo_card: error: {run} has neither ckpt.pt (a run) nor solid.json (an export)")
+
+
+def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "previous space model",
+            ledger: tuple = ()) -> str:
+    f = run_facts(run)
+    cfg, step = f["config"], f["step"]
+    n_photos = len([n for n in os.listdir(os.path.join("data", "photos", "train"))]) if os.path.isdir(
         os.path.join("data", "photos", "train")) else "?"
     ps, ns = prev["summary"], new["summary"]
     L = [BEGIN, "## Photo texture space (issue 20)", "",
@@ -53,13 +69,14 @@ def section(run: str, prev: dict, new: dict, shipped: bool) -> str:
          "python -m backend.training.solid.train --config configs/solid/photo_space_3d.json --out runs/solid/photo_space",
          "python -m backend.training.solid.export runs/solid/photo_space models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
-         f"- **Run:** {state['step']} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
-         f"{float(state.get('elapsed', 0)) / 60:.1f} min wall on {_hardware().split(',')[0]}, {cfg['threads']} "
-         f"threads, fp32 (no native bf16 on this CPU); final loss (median of the last ten logged) "
-         f"{last[len(last) // 2]:.4f}."
-         + (f" Stopped at step {state['step']} of its {cfg['steps']}-step cosine schedule (the session's time; "
-            f"learning rate {log[-1].get('lr', 0):.2g} at the end); `--out` the same folder resumes it."
-            if state["step"] < cfg["steps"] else ""),
+         f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
+         f"{f['seconds'] / 60:.1f} min wall on {_hardware().split(',')[0]}, {cfg['threads']} "
+         f"threads, fp32 (no native bf16 on this CPU)"
+         + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
+            " (read from the export; the run folder and its loss log were not kept).")
+         + (f" Stopped at step {step} of its {cfg['steps']}-step cosine schedule (the session's time; "
+            f"learning rate {f['lr']:.2g} at the end); `--out` the same folder resumes it."
+            if step < cfg["steps"] and f["lr"] is not None else ""),
          "- **Colour from the photo:** the decoder outputs a whitened colour d and the texture is mu + L d, with "
          "the photo's mean colour mu and the Cholesky factor L of its colour covariance appended to the code z "
          "(20 values: 8 learned, 12 measured). Refinement moves only the learned part.",
@@ -72,9 +89,15 @@ def section(run: str, prev: dict, new: dict, shipped: bool) -> str:
          "Held-out photos (`bench/eval_solid_photos.py`: every photo of `data/photos/val`, whole photos training "
          f"never saw; {ns['photos']} photos, 128² slices normal to x, y and z, two seeds; patch distance = sliced "
          "Wasserstein of 7 x 7 Laplacian-pyramid neighbourhoods x 1000):", "",
-         "| measure | previous space model (7 exemplars) | this model |", "|---|---|---|"]
+         f"| measure | {prev_label} | this model |", "|---|---|---|"]
     for label, key in ROWS:
         L.append(f"| {label} | {ps.get(key)} | {ns.get(key)} |")
+    if ledger:
+        L += ["", "Ledger of this model's stages (oldest first; a stage ships only when the held-out evaluation "
+              "says it is better):", "", "| stage | steps | wall time | median swd | ratio to random phase | "
+              "beats pixel shuffle | colour error median / worst | shipped |", "|---|---|---|---|---|---|---|---|"]
+        for row in ledger:
+            L.append("| " + " | ".join(str(c) for c in row) + " |")
     L += ["", END]
     return "\n".join(L)
 
@@ -85,9 +108,13 @@ def main(argv=None) -> int:
     ap.add_argument("--prev", required=True)
     ap.add_argument("--new", required=True)
     ap.add_argument("--shipped", action="store_true")
+    ap.add_argument("--prev-label", default="previous space model", help="the column header of --prev")
+    ap.add_argument("--ledger", help="a JSON list of rows (stage, steps, wall time, swd, ratio, beats, colour, "
+                                     "shipped) for the ledger table")
     ap.add_argument("-o", "--out", default=os.path.join("models", "solid", "MODEL_CARD.md"))
     a = ap.parse_args(argv)
-    text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped)
+    text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped, a.prev_label,
+                   tuple(read_json(a.ledger)) if a.ledger else ())
     with open(a.out, encoding="utf-8") as fh:
         card = fh.read()
     if BEGIN in card and END in card:
