@@ -38,6 +38,10 @@ def main() -> int:
     ap.add_argument("--classifier-cache", metavar="DIR",
                     help="keep the trained classifier here and reuse it (same classes, size, steps, threads)")
     ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
+    ap.add_argument("--eval-size", type=int, help="resolution of the quality evaluation (default: the model's "
+                                                  "training size); compare two models at one size")
+    ap.add_argument("--clf-stages", type=int, default=2, help="stride-2 stages of the classifier (3 or more for "
+                                                              "64² and larger: a wider receptive field)")
     ap.add_argument("--timing-only", action="store_true",
                     help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
     ap.add_argument("--no-timing", action="store_true", help="skip the DDIM step timing (a busy machine)")
@@ -69,7 +73,8 @@ def _run(a, model, classes) -> int:
         classes = tuple(res["model"].get("classes", classes))
     else:
         res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr),
-                       sampler=a.sampler, spacing=a.spacing, classifier_cache=a.classifier_cache)
+                       sampler=a.sampler, spacing=a.spacing, classifier_cache=a.classifier_cache,
+                       size=a.eval_size, clf_stages=a.clf_stages)
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
     if not a.timing_only:
@@ -78,10 +83,11 @@ def _run(a, model, classes) -> int:
         res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing or DEFAULT_SPACING[a.sampler])
     res["model"] = dict(step=model.config["step"], sha256=model.fingerprint, n=a.n, steps=a.steps,
                         classes=list(classes))
-    print("| class | FD | acc | PSD err | response err (param) |")
-    print("|---|---|---|---|---|")
+    print("| class | FD | acc | PSD err | low-frequency PSD err | coherence err (zoo) | response err (param) |")
+    print("|---|---|---|---|---|---|---|")
     for name, r in res["classes"].items():
-        print(f"| {name} | {r['fd']} | {r['acc']} | {r['psd']} | {r['response']} ({r['param']}) |")
+        print(f"| {name} | {r['fd']} | {r['acc']} | {r['psd']} | {r.get('psd_low', '—')} | "
+              f"{r.get('coherence', '—')} ({r.get('coherence_zoo', '—')}) | {r['response']} ({r['param']}) |")
     print(f"\nzoo accuracy of the classifier: {res['zoo_accuracy']}")
     print(f"seam ratio: tileable {res['seam_tileable']}, plain {res['seam_plain']}; blend locality {res['locality']}")
     t = res.get("timing")

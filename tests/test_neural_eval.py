@@ -28,3 +28,45 @@ def test_zoo_classifier_learns_distinct_classes():
     assert acc > 0.85, acc
     with torch.no_grad():
         assert clf.features(torch.rand(3, 1, 16, 16)).shape == (3, 128)
+
+
+def test_orientation_coherence_tells_bands_from_isotropic_texture():
+    from backend.training.evaluate import orientation_coherence
+
+    y, x = np.mgrid[0:64, 0:64].astype(np.float64)
+    rng = np.random.default_rng(1)
+    bands = [np.sin(2 * np.pi * (np.cos(a) * x + np.sin(a) * y) / 11.0) for a in (0.0, 0.7, 2.1)]
+    white = rng.standard_normal((4, 64, 64))
+    coh = orientation_coherence(np.stack(bands))
+    assert coh.shape == (3,) and coh.min() > 0.9, coh  # straight bands at any angle
+    assert orientation_coherence(white).max() < 0.1  # isotropic
+    # bands whose orientation turns across the image (long-range orientation lost) score low
+    patch = np.concatenate([np.concatenate([bands[0][:32, :32], bands[2][:32, 32:]], 1),
+                            np.concatenate([bands[2][32:, :32], bands[0][32:, 32:]], 1)], 0)
+    assert orientation_coherence(patch[None])[0] < 0.6
+    assert orientation_coherence(np.zeros((1, 16, 16)))[0] == 0.0
+
+
+def test_low_frequency_psd_error_sees_what_the_full_error_averages_away():
+    from backend.training.evaluate import psd_error
+
+    rng = np.random.default_rng(2)
+    y, x = np.mgrid[0:64, 0:64]
+    real = rng.standard_normal((8, 64, 64)) + 3 * np.sin(2 * np.pi * x / 32.0)[None]  # a long-range band
+    gen = rng.standard_normal((8, 64, 64))  # the same fine grain without it
+    assert psd_error(gen, real, low=True) > 3 * psd_error(gen, real)
+    assert psd_error(real, real, low=True) == 0.0
+
+
+def test_classifier_stages_widen_the_receptive_field():
+    from backend.training.evaluate import Classifier
+
+    two, three = Classifier(4), Classifier(4, stages=3)
+    x = torch.zeros(1, 1, 64, 64, requires_grad=True)
+    for net, expect in ((two, 21), (three, 45)):
+        out = net.body(x * 2.0 - 1.0)
+        centre = out[0, :, out.shape[2] // 2, out.shape[3] // 2].sum()
+        (g,) = torch.autograd.grad(centre, x)
+        rows = np.nonzero(g[0, 0].abs().sum(1).numpy())[0]
+        assert rows.max() - rows.min() + 1 == expect, (rows.max() - rows.min() + 1)
+    assert three.features(torch.rand(2, 1, 64, 64)).shape == (2, 128)

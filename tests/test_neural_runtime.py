@@ -499,3 +499,26 @@ def test_warm_start_grows_the_class_table_and_parameter_slots():
     assert torch.allclose(a, b, atol=1e-5)
     with pytest.raises(ValueError, match="init_onnx: init.weight has shape"):
         warm_start(UNet(3, 2, emb_dim=4, widths=(16, 16, 16)), {k: v.numpy() for k, v in small.state_dict().items()})
+
+
+def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(exported, tmp_path):
+    """bench/eval_neural.py's evaluate(): at --eval-size (not the training size), with the structure measures;
+    a class's samples, generated as one batch, equal the same seeds generated one by one."""
+    from backend.neural.sampler import sample
+    from backend.training.evaluate import evaluate
+
+    _, out = exported
+    m = NeuralNoiseModel(str(out))
+    res = evaluate(m, ("perlin", "spots"), n=3, steps=2, clf_steps=3, log=lambda s: None, size=24,
+                   classifier_cache=str(tmp_path), clf_stages=3)
+    assert res["size"] == 24 and res["classifier"] == dict(steps=3, stages=3)
+    for r in res["classes"].values():
+        assert set(r) >= {"fd", "acc", "psd", "psd_low", "coherence", "coherence_zoo", "response"}
+        assert 0.0 <= r["coherence"] <= 1.0 and np.isfinite(r["psd_low"])
+    assert list(tmp_path.glob("classifier_*.pt"))  # the 3-stage instrument is cached for the next model
+    eps = m.eps_fn(False)
+    cond = np.stack([C.uniform(m, ("spots", {"scale": v}), 24, 24) for v in (4.0, 9.0)])
+    x0 = np.concatenate([initial_noise(1000 + i, (1, 1, 24, 24)) for i in range(2)])
+    both = sample("dpmpp_2m", eps, x0, cond, 3, alphas_cumprod=m.alphas_cumprod)
+    one = sample("dpmpp_2m", eps, x0[1:], cond[1:].copy(), 3, alphas_cumprod=m.alphas_cumprod)
+    np.testing.assert_allclose(both[1:], one, atol=1e-4)
