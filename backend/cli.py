@@ -15,9 +15,8 @@ import numpy as np
 from export.images import ImageError
 from . import limits
 from .errors import SettingError
-from .grid import evaluate_grid
 from .spectra import SPECTRUM_KINDS, Spectrum
-from .settings import WaveSettings, compile_noise
+from .settings import WaveSettings
 from .cellular import CELLULAR_MODES
 from .tables import WAVEFORMS
 from .transfer import PRESETS, load_transfer
@@ -217,8 +216,6 @@ class _Bar:
 
 
 def run_wave(a: argparse.Namespace) -> int:
-    from export.images import write_image
-
     ext = os.path.splitext(a.out)[1].lower()
     if ext not in (".npy", ".exr", ".png", ".vdb"):
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .npy, .exr, .png or .vdb")
@@ -230,6 +227,8 @@ def run_wave(a: argparse.Namespace) -> int:
         raise SettingError("--transfer", ".npy holds raw values; use .vdb, .exr or .png for a ramp")
     if a.range and not a.transfer:
         raise SettingError("--range", "maps values onto a ramp; give --transfer too")
+    if a.half and ext not in (".exr", ".vdb"):
+        raise SettingError("--half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.positive("--extent", a.extent)
@@ -246,16 +245,13 @@ def run_wave(a: argparse.Namespace) -> int:
     if a.fmax > nyq and a.cellular == "none" and not a.quiet:
         print(f"omninoise wave: warning: --fmax {a.fmax:g} is above the grid's Nyquist {nyq:g}; "
               "the image will alias", file=sys.stderr)
-    if ext == ".vdb" or a.transfer or a.half:
-        return _bake_wave(a, s, ext)
-    noise = compile_noise(s)
-    arr = evaluate_grid(noise, a.size, a.extent, s.output, a.time, s.cellular, progress=_Bar(a.quiet))
-    write_image(a.out, arr)
-    return 0
+    return _bake_wave(a, s, ext)
 
 
 def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
-    """``wave`` through the bake pipeline: voxel-centred grid over [0, E)^d, ramp, atomic write."""
+    """``wave``, every output type, through the bake pipeline: one sampling convention (docs/conventions.md:
+    sample centres (i + 1/2) E / N over [0, E)^d; .npy indexed [y, x] / [z, y, x]; images with +y up), the
+    ramp, an atomic write."""
     from .bake import BakeSpec, run_bake
     from .sources import BoxGrid, WaveSource
 
