@@ -1,7 +1,10 @@
 """Batch bake jobs from TOML files (``omninoise bake JOB.toml``, the Blender panel, ``bpy``).
 
 A job file lists bakes; paths are relative to the job file's folder and
-missing output folders are created::
+missing output folders are created.  Outputs must lie inside the job's folder
+unless the job names another root, ``output_root = "../renders"`` (relative to
+the job file, or absolute) at the top of the file: a job cannot write anywhere
+on a farm machine by accident (``output = "../../x"``)::
 
     # optional: merged into every bake (a bake's own keys win, tables merge key by key)
     [defaults]
@@ -144,9 +147,14 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
 
 def parse_job(doc: dict, base_dir: str) -> list:
     """Job document -> list of (name, BakeSpec or JobError)."""
-    unknown = sorted(set(doc) - {"defaults", "bake"})
+    unknown = sorted(set(doc) - {"defaults", "bake", "output_root"})
     if unknown:
-        raise JobError(f"unknown top-level key {unknown[0]!r}; a job has [defaults] and [[bake]] tables")
+        raise JobError(f"unknown top-level key {unknown[0]!r}; a job has output_root, [defaults] and [[bake]] "
+                       "tables")
+    root = doc.get("output_root", ".")
+    if not isinstance(root, str) or not root.strip():
+        raise JobError(f"output_root: expected a folder path (a string), got {root!r}")
+    root = os.path.realpath(os.path.join(base_dir, root))
     bakes = doc.get("bake")
     if not isinstance(bakes, list) or not bakes:
         raise JobError("no [[bake]] tables: nothing to do")
@@ -163,6 +171,15 @@ def parse_job(doc: dict, base_dir: str) -> list:
             spec = _spec(d, base_dir, i)
         except (SettingError, FileNotFoundError) as exc:
             out.append((name, JobError(f"bake {name!r}: {exc}")))
+            continue
+        real = os.path.realpath(spec.output)
+        try:
+            inside = os.path.commonpath([root, real]) == root
+        except ValueError:  # another drive (Windows)
+            inside = False
+        if not inside:
+            out.append((name, JobError(f"bake {name!r}: output {spec.output} lies outside the output root {root}; "
+                                       "set output_root at the top of the job file to allow that folder")))
             continue
         # two bakes writing one file (or one numbered sequence) would overwrite each other
         key = os.path.normcase(os.path.abspath(spec.output))

@@ -155,3 +155,37 @@ def test_wave_cli_vdb_and_transfer(tmp_path, capsys):
     assert "needs --dim 3 or 4" in capsys.readouterr().err
     assert main(["wave", "--size", "16", "--quiet", "--range", "0", "1", "-o", str(tmp_path / "a.png")]) == 2
     assert "give --transfer too" in capsys.readouterr().err
+
+
+def test_outputs_stay_inside_the_output_root(tmp_path):
+    """A job writes only inside its own folder unless it names output_root (issue 24: output = "../../x")."""
+    jobdir = tmp_path / "jobs" / "a"
+    jobdir.mkdir(parents=True)
+    body = ('[[bake]]\nname = "w"\noutput = "{out}"\nresolution = [8, 8]\n'
+            '[bake.source]\ndim = 2\ndirections = 2\n')
+    job = jobdir / "job.toml"
+    for out in ("../../x.npy", str(tmp_path / "elsewhere.npy"), "sub/../../y.npy"):
+        job.write_text(body.format(out=out))
+        (entry,) = load_job(str(job))
+        assert isinstance(entry[1], JobError) and "outside the output root" in str(entry[1]), entry
+        assert "output_root" in str(entry[1])
+    job.write_text(body.format(out="sub/ok.npy"))
+    assert not isinstance(load_job(str(job))[0][1], JobError)
+    job.write_text('output_root = "../.."\n' + body.format(out="../../x.npy"))
+    assert [o.status for o in run_job(str(job))] == ["baked"] and (tmp_path / "x.npy").is_file()
+    job.write_text(f'output_root = "{tmp_path}"\n' + body.format(out=str(tmp_path / "elsewhere.npy")))
+    assert not isinstance(load_job(str(job))[0][1], JobError)
+    for bad in ("3", '""'):
+        job.write_text(f"output_root = {bad}\n" + body.format(out="ok.npy"))
+        with pytest.raises(JobError, match="output_root"):
+            load_job(str(job))
+
+
+def test_a_symlink_does_not_lead_outside_the_output_root(tmp_path):
+    jobdir = tmp_path / "job"
+    jobdir.mkdir()
+    (jobdir / "link").symlink_to(tmp_path)
+    (jobdir / "job.toml").write_text('[[bake]]\nname = "w"\noutput = "link/x.npy"\nresolution = [8, 8]\n'
+                                     '[bake.source]\ndim = 2\ndirections = 2\n')
+    (entry,) = load_job(str(jobdir / "job.toml"))
+    assert isinstance(entry[1], JobError) and "outside the output root" in str(entry[1])
