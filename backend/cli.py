@@ -288,7 +288,11 @@ def run_bake_job(a: argparse.Namespace) -> int:
                 state = "up to date" if fresh == len(frames) else "to bake"
                 print(f"  {state:10s} {name}: {list(spec.grid.resolution)} -> {spec.output}"
                       + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))
-        return 2 if bad else 0
+        if bad:
+            print(f"omninoise bake: error: {len(bad)} of {len(entries)} bakes are invalid (listed above)",
+                  file=sys.stderr)
+            return 2
+        return 0
     _set_threads(a.threads)
     bars = {}
 

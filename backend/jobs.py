@@ -159,10 +159,19 @@ def parse_job(doc: dict, base_dir: str) -> list:
     if not isinstance(bakes, list) or not bakes:
         raise JobError("no [[bake]] tables: nothing to do")
     defaults = doc.get("defaults", {})
+    if not isinstance(defaults, dict):
+        raise JobError(f"defaults: expected a [defaults] table, got {defaults!r}")
+    bad = [i for i, b in enumerate(bakes) if not isinstance(b, dict)]
+    if bad:
+        raise JobError(f"bake {bad[0] + 1}: expected a [[bake]] table, got {bakes[bad[0]]!r}")
     out, seen, outputs = [], set(), {}
     for i, b in enumerate(bakes):
         d = _merge(defaults, b)
         name = d.get("name") or f"bake {i + 1}"
+        if not isinstance(name, str):
+            name = f"bake {i + 1}"
+            out.append((name, JobError(f"{name}: name: expected a string, got {d['name']!r}")))
+            continue
         if name in seen:
             out.append((name, JobError(f"bake {name!r}: the name is used twice")))
             continue

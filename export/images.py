@@ -149,7 +149,7 @@ def decode(path: str) -> np.ndarray:
             a = _decode_pillow(path)
     except ImageError:
         raise
-    except (OSError, ValueError, EOFError, SyntaxError, MemoryError) as exc:
+    except (OSError, ValueError, EOFError, SyntaxError, MemoryError, RuntimeError) as exc:  # OpenEXR: RuntimeError
         raise ImageError(f"{path}: cannot read the image ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") \
             from None
     if a.ndim == 2:
