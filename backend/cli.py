@@ -47,6 +47,8 @@ def _lobe_arg(text: str) -> tuple:
 
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="omninoise", description="OmniNoise: wave noise and neural noise bakes.")
+    ap.add_argument("--debug", action="store_true",
+                    help="show the Python traceback of an internal error (default: one line, exit 1)")
     sub = ap.add_subparsers(dest="command", required=True)
     w = sub.add_parser("wave", help="evaluate wave noise (Guehl et al. 2025) on a grid")
     w.add_argument("--dim", type=int, choices=(2, 3, 4), default=2)
@@ -600,7 +602,13 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, Cancelled):
             print(f"omninoise {a.command}: cancelled", file=sys.stderr)
             return 130
-        raise
+        if a.debug:
+            raise
+        what = str(exc).splitlines()[0] if str(exc) else ""
+        print(f"omninoise {a.command}: internal error: {type(exc).__name__}{': ' + what if what else ''} "
+              "(a bug: please report it with the command; --debug before the command shows the traceback)",
+              file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"\nomninoise {a.command}: interrupted; no partial file was left", file=sys.stderr)
         return 130

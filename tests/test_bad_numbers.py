@@ -122,3 +122,19 @@ def test_bad_custom_profiles(tmp_path, capsys, content, name):
                "-o", str(tmp_path / "o.npy")])
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert rc == 2 and len(err) == 1 and "--profile" in err[0], err
+
+
+def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp_path, capsys, monkeypatch):
+    """Exit 1 and one line naming the exception for a bug; `omninoise --debug ...` re-raises it."""
+    import backend.cli as cli
+
+    def broken(a):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr(cli, "run_zoo", broken)
+    assert cli.main(["zoo", "--noise", "perlin", "-o", str(tmp_path / "z.png")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "internal error: ZeroDivisionError: float division by zero" in err[0]
+    assert "--debug" in err[0]
+    with pytest.raises(ZeroDivisionError):
+        cli.main(["--debug", "zoo", "--noise", "perlin", "-o", str(tmp_path / "z.png")])
