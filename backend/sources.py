@@ -206,6 +206,15 @@ class NeuralSource:
         if self.spec2 is not None:
             self.model.param_vector(*self.spec2)
 
+    def check_grid(self, shape) -> None:
+        """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask of
+        another size (found only while baking before, as a failure with exit 1)."""
+        if len(shape) != 2:
+            raise SettingError("grid", "neural noise bakes images (resolution [width, height])")
+        if self.mask is not None and self.mask.shape != tuple(shape):
+            raise SettingError("source.blend", f"mask is {self.mask.shape[1]}x{self.mask.shape[0]} but the "
+                               f"resolution is {shape[1]}x{shape[0]}")
+
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .grid import Cancelled
         from .neural import conditioning as C

@@ -414,8 +414,9 @@ sampler = "ddim"
         NeuralSource(str(out), "spots", {"size": 3})
     (tmp_path / "job.toml").write_text((tmp_path / "job.toml").read_text().replace("resolution = [40, 24]",
                                                                                   "resolution = [32, 24]"))
-    out2 = run_job(str(tmp_path / "job.toml"), force=True)
-    assert out2[0].status == "failed" and "mask is 40x24 but the resolution is 32x24" in out2[0].message
+    out2 = run_job(str(tmp_path / "job.toml"), force=True)  # refused before anything runs (was a failure, exit 1)
+    assert out2[0].status == "invalid" and "mask is 40x24 but the resolution is 32x24" in out2[0].message
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 2
 
 
 def test_the_shipped_model_loads_and_generates():
