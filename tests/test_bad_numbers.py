@@ -46,6 +46,7 @@ def test_memory_error_says_how_much(monkeypatch):
 @pytest.mark.parametrize("edit, match", [
     (("time_step = 0.5", "time_step = nan"), "time_step: must be a finite number"),   # was a segfault
     (("time_step = 0.5", 'time_step = "x"'), "time_step: expected a number"),
+    (("time_step = 0.5", 'time_step = 0.5\ntime = "x"'), "time: expected a number"),       # was a ValueError
     (("frames = [1, 2]", 'frames = ["a", "b"]'), "frames: expected"),
     (("half = true", 'half = "no"'), "half: expected true or false"),                 # "no" was taken as true
     (("resolution = [32, 16]", "resolution = [100000000, 100000]"), "resolution"),
