@@ -17,4 +17,4 @@ from . import bake, jobs, sources, transfer  # noqa: E402  (bake pipeline: sourc
 
 __all__ = ["SettingError", "Spectrum", "WaveTable", "build_table", "WaveSettings", "compile_noise",
            "evaluate_grid", "evaluate_points", "Cancelled"]
-__version__ = "0.1.0"
+from .version import __version__  # noqa: E402  (its own module: submodules read it without importing the package)

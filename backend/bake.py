@@ -125,7 +125,7 @@ class BakeSpec:
 
     def key(self, frame) -> str:
         """sha256 of everything that determines the file of ``frame``."""
-        from . import __version__
+        from .version import __version__
 
         ext = os.path.splitext(self.output)[1].lower()
         doc = dict(version=__version__, source=self.source.to_dict(), grid=self.grid.to_dict(),

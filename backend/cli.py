@@ -449,7 +449,8 @@ def run_solid(a: argparse.Namespace) -> int:
     import json
 
     from .onnx_models import ModelError
-    from .solid.model import SHIPPED_MODELS, SolidTextureModel, exemplar_z, load_models
+    from .solid.model import SHIPPED_MODELS, SolidTextureModel, load_models
+    from .solid.refine import exemplar_z
 
     if a.list:
         out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
@@ -501,7 +502,7 @@ def run_solid(a: argparse.Namespace) -> int:
             z = (1.0 - a.mix) * z + a.mix * z_of(a.to, "--to")
         code = model.translate(z)
     bar = _Bar(a.quiet)
-    from .solid.bake import srgb_to_linear
+    from .colour import srgb_to_linear
 
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
         from .bake import BakeSpec, run_bake

@@ -295,7 +295,7 @@ class SolidSource:
                                                       "an exemplar needs a space model")
             self.code = self.model.default_code()
             return
-        from .solid.model import exemplar_z
+        from .solid.refine import exemplar_z
 
         self.z, img, _ = exemplar_z(self.model, exemplar, self.refine, "source.exemplar")
         if img is not None:
@@ -303,7 +303,7 @@ class SolidSource:
         self.code = self.model.translate(self.z)
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
-        from .solid.bake import srgb_to_linear
+        from .colour import srgb_to_linear
 
         n = len(shape)
         start = np.zeros(n, int) if start is None else np.asarray(start)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..colour import srgb_to_linear
 from ..errors import SettingError
 from ..sources import BoxGrid
 from .model import SolidTextureModel, TextureCode
@@ -22,12 +23,6 @@ from .model import SolidTextureModel, TextureCode
 __all__ = ["srgb_to_linear", "bake_volume"]
 
 _F = np.float32
-
-
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    """sRGB-encoded values in [0, 1] -> scene-linear float32 (IEC 61966-2-1)."""
-    c = np.clip(np.asarray(c, _F), 0.0, 1.0)
-    return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4)).astype(_F)
 
 
 def bake_volume(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, path: str, seed: int = 0,

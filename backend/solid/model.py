@@ -25,8 +25,7 @@ from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
 from .lattice import lattice_noise
 
-__all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points",
-           "exemplar_z"]
+__all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
@@ -62,29 +61,6 @@ def load_models(root: str = SHIPPED_MODELS, threads: int = 0, cache: dict | None
         if not isinstance(m, ModelError):
             out[name] = m
     return out
-
-
-def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setting: str = "exemplar",
-               progress=None):
-    """A space model's z for a training exemplar's name or an image file (encoded, then refined by ``refine``
-    search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement distances or [])."""
-    if exemplar in model.codes:
-        return model.codes[exemplar], None, []
-    if exemplar is None or not os.path.isfile(exemplar):
-        raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
-                                    f"({', '.join(model.codes) or 'none'})")
-    from .._export import export
-
-    try:
-        img = export.read_rgb(exemplar)
-    except ValueError as exc:
-        raise SettingError(setting, str(exc)) from None
-    z, hist = model.encode(img), []
-    if refine > 0:
-        from .refine import refine_code
-
-        z, hist = refine_code(model, z, img, steps=refine, progress=progress)
-    return z, img, hist
 
 
 @dataclass(frozen=True)

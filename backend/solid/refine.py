@@ -21,11 +21,16 @@ Shapes: images float32 (H, W, 3) sRGB values in [0, 1].
 """
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
+from .._export import export
+from ..errors import SettingError
 from ..grid import Cancelled
+from .model import resize_rgb
 
-__all__ = ["texture_stats", "stats_distance", "refine_code", "RENDER_SIZE"]
+__all__ = ["texture_stats", "stats_distance", "refine_code", "exemplar_z", "RENDER_SIZE"]
 
 RENDER_SIZE = 64
 
@@ -57,8 +62,6 @@ def _exemplar_crops(exemplar: np.ndarray, scale: float, n: int = 4) -> list:
     """The exemplar resampled to the model's training resolution, cut into up to n square crops."""
     img = np.asarray(exemplar, np.float32)
     if scale != 1.0:
-        from .model import resize_rgb
-
         img = resize_rgb(img, max(RENDER_SIZE, round(img.shape[0] * scale)), max(RENDER_SIZE, round(img.shape[1] * scale)))
     H, W, _ = img.shape
     S = min(H, W, 128)
@@ -101,3 +104,22 @@ def refine_code(model, z0, exemplar: np.ndarray, steps: int = 40, seed: int = 0,
         if progress is not None:
             progress((i + 1) / steps)
     return z, hist
+
+
+def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setting: str = "exemplar",
+               progress=None):
+    """A space model's z for a training exemplar's name or an image file (encoded, then refined by ``refine``
+    search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement distances or [])."""
+    if exemplar in model.codes:
+        return model.codes[exemplar], None, []
+    if exemplar is None or not os.path.isfile(exemplar):
+        raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
+                                    f"({', '.join(model.codes) or 'none'})")
+    try:
+        img = export.read_rgb(exemplar)
+    except ValueError as exc:
+        raise SettingError(setting, str(exc)) from None
+    z, hist = model.encode(img), []
+    if refine > 0:
+        z, hist = refine_code(model, z, img, steps=refine, progress=progress)
+    return z, img, hist

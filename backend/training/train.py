@@ -20,7 +20,7 @@ import json
 import os
 import sys
 import time
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict
 
 import numpy as np
 import torch
@@ -28,75 +28,14 @@ import torch
 from . import zoo
 from .cutmix import cutmix
 from .diffusion import Diffusion
-from .precision import PRECISIONS, autocast, resolve
+from .config import TrainConfig, check_config_keys, load_config  # noqa: F401  (re-exported)
+from .precision import autocast, resolve
 from .threads import cpu_threads
 from .unet import UNet
 from .warm_start import exported_weights, warm_start
 from ..onnx_models import ModelError
 
 __all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names", "check_config_keys"]
-
-
-def check_config_keys(cls, d: dict) -> None:
-    """ValueError naming the first key of ``d`` that is not a field of the config dataclass ``cls``."""
-    known = {f.name for f in fields(cls)}
-    unknown = sorted(set(d) - known)
-    if unknown:
-        raise ValueError(f"unknown config key {unknown[0]!r}; known: {', '.join(sorted(known))}")
-
-
-@dataclass
-class TrainConfig:
-    size: int = 64                 # training resolution (px); multiples of 8
-    batch: int = 16
-    steps: int = 100_000
-    lr: float = 8e-5
-    betas: tuple = (0.9, 0.99)
-    weight_decay: float = 0.01
-    grad_clip: float = 1.0
-    ema_decay: float = 0.999
-    cutmix_p: float = 0.5
-    offset_noise: float = 0.1
-    emb_lambda: float = 0.02
-    emb_dim: int = 32
-    widths: tuple = (32, 64, 128)
-    classes: tuple = field(default_factory=lambda: zoo.CLASS_NAMES)
-    seeds_per_set: int = 4
-    sets_per_class: int = 16384
-    seed: int = 0
-    device: str = "auto"
-    log_every: int = 50
-    checkpoint_every: int = 1000
-    sample_every: int = 5000
-    sample_steps: int = 20
-    threads: int = 0               # CPU threads for torch and numba (0: their defaults), see .threads
-    init_onnx: str = ""            # a fresh run starts from this export's weights (see .warm_start) ...
-    init_sha256: str = ""          # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
-    precision: str = "auto"        # auto | fp32 | bf16: bf16 autocast where the CPU/GPU computes bf16 natively (.precision)
-    channels_last: bool = False    # NHWC activations and weights (faster with bf16 on oneDNN)
-
-    @classmethod
-    def from_dict(cls, d: dict) -> "TrainConfig":
-        check_config_keys(cls, d)
-        d = dict(d)
-        for k in ("betas", "widths", "classes"):
-            if k in d:
-                d[k] = tuple(d[k])
-        bad = [c for c in d.get("classes", ()) if c not in zoo.CLASSES]
-        if bad:
-            raise ValueError(f"unknown class {bad[0]!r}")
-        if d.get("size", 64) % 8:
-            raise ValueError(f"size must be a multiple of 8, got {d['size']}")
-        if d.get("precision", "auto") not in PRECISIONS:
-            raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {d['precision']!r}")
-        if d.get("init_onnx") and not d.get("init_sha256"):
-            raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
-        return cls(**d)
-
-
-def load_config(path: str) -> TrainConfig:
-    with open(path, encoding="utf-8") as fh:
-        return TrainConfig.from_dict(json.load(fh))
 
 
 def build_model(cfg: TrainConfig, state: dict | None = None) -> UNet:

@@ -25,6 +25,7 @@ import numpy as np
 import torch
 
 from ..onnx_models import fingerprint, load_model_json
+from .config import TrainConfig
 
 __all__ = ["exported_weights", "warm_start", "torch_from_export"]
 
@@ -101,7 +102,6 @@ def torch_from_export(folder: str):
     by :func:`exported_weights`, so torch runs the very weights onnxruntime does
     without the run's checkpoint (which is not kept).
     """
-    from .train import TrainConfig
     from .unet import UNet
 
     doc = load_model_json(folder, "neural_noise.json")

@@ -32,7 +32,7 @@ import torch
 
 from ..._export import export as _ex
 from ..threads import cpu_threads
-from ..train import check_config_keys
+from ..config import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds

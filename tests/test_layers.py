@@ -1,0 +1,130 @@
+"""The import graph keeps its layers (issue 23): no cycles, not even through imports inside functions, and
+dependencies point one way.
+
+    blender_addon  ->  backend (runtime: wave, neural, solid, bakes, cli)  ->  export (file writers)
+    backend.training (torch)  ->  backend runtime
+
+Read statically from the source (every ``import`` anywhere in a module, function bodies included), so a cycle
+held together by a function-level import counts, and nothing needs torch or bpy to run this test.
+"""
+import ast
+import os
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PACKAGES = ("backend", "export", "blender_addon")
+
+
+def modules() -> dict:
+    """{dotted module name: file path} of every module of the packages above."""
+    out = {}
+    for top in PACKAGES:
+        for folder, _, files in os.walk(os.path.join(ROOT, top)):
+            for f in files:
+                if f.endswith(".py"):
+                    path = os.path.join(folder, f)
+                    name = os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
+                    out[name[: -len(".__init__")] if name.endswith(".__init__") else name] = path
+    return out
+
+
+def imports(name: str, path: str, known: dict) -> dict:
+    """{imported name: line} of one module: project modules resolved to their dotted names, others as written
+    (``torch``, ``bpy.types`` ...)."""
+    package = name if path.endswith("__init__.py") else name.rpartition(".")[0]
+    with open(path, encoding="utf-8") as fh:
+        tree = ast.parse(fh.read(), path)
+    out = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                out.setdefault(a.name, node.lineno)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[: len(parts) - node.level + 1] + ([node.module] if node.module else []))
+            else:
+                base = node.module or ""
+            for a in node.names:
+                full = f"{base}.{a.name}"
+                out.setdefault(full if full in known else base, node.lineno)
+    return out
+
+
+def graph() -> tuple:
+    known = modules()
+    edges = {m: imports(m, p, known) for m, p in known.items()}
+    return known, edges
+
+
+def cycles(edges: dict, known: dict) -> list:
+    """Strongly connected components with more than one module (Tarjan), each sorted."""
+    adj = {m: [d for d in deps if d in known and d != m] for m, deps in edges.items()}
+    index, low, stack, on, out, counter = {}, {}, [], set(), [], [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in adj[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(adj):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_cycles():
+    known, edges = graph()
+    found = cycles(edges, known)
+    detail = [" <-> ".join(c) + ": " + "; ".join(f"{m} imports {d} (line {edges[m][d]})" for m in c
+                                                  for d in edges[m] if d in c) for c in found]
+    assert not found, "\n".join(detail)
+
+
+def test_the_cycle_finder_finds_a_cycle_through_a_function_level_import(tmp_path):
+    """The instrument itself: two modules that import each other, one of them inside a function."""
+    (tmp_path / "a.py").write_text("from . import b\n")
+    (tmp_path / "b.py").write_text("def f():\n    from .a import x\n")
+    known = {"pkg.a": str(tmp_path / "a.py"), "pkg.b": str(tmp_path / "b.py")}
+    edges = {m: imports(m, p, known) for m, p in known.items()}
+    assert cycles(edges, known) == [["pkg.a", "pkg.b"]]
+
+
+#: the command line sits on top of both the runtime and training: `omninoise zoo` renders the training zoo (torch),
+#: imported inside that one command, which says so when torch is missing
+FRONT_ENDS = ("backend.cli",)
+
+
+def test_dependencies_point_one_way():
+    known, edges = graph()
+    bad = []
+    for m, deps in edges.items():
+        runtime = (m.startswith(("backend", "export")) and not m.startswith("backend.training")
+                   and m not in FRONT_ENDS)
+        for d, line in deps.items():
+            where = f"{m} (line {line}) imports {d}"
+            if d.split(".")[0] == "bpy" and not m.startswith("blender_addon"):
+                bad.append(where + ": only blender_addon may import bpy")
+            if runtime and (d.startswith("backend.training") or d.split(".")[0] in ("torch", "onnx")):
+                bad.append(where + ": the runtime never imports training code or torch")
+            if m.startswith("export") and d.startswith(("backend", "blender_addon")):
+                bad.append(where + ": the file writers sit below the engines")
+            if m.startswith("backend") and d.startswith("blender_addon"):
+                bad.append(where + ": the core never imports the Blender layer")
+    assert not bad, "\n".join(bad)
