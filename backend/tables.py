@@ -26,7 +26,6 @@ centred at ``(i + 0.5) / size``.
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -85,13 +84,10 @@ class WaveTable:
         """Write ``.npz`` (values + JSON metadata) atomically."""
         header = dict(format=_FORMAT, version=_VERSION, period=self.period, mode=self.mode,
                       dim=self.dim, meta=self.meta)
-        tmp = f"{path}.tmp-{os.getpid()}.npz"
-        try:
+        from ._export import export
+
+        with export.atomic_path(path, ".npz") as tmp:
             np.savez(tmp, values=self.values, header=np.frombuffer(json.dumps(header).encode(), np.uint8))
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
 
     @classmethod
     def load(cls, path: str) -> "WaveTable":

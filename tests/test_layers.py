@@ -128,3 +128,18 @@ def test_dependencies_point_one_way():
             if m.startswith("backend") and d.startswith("blender_addon"):
                 bad.append(where + ": the core never imports the Blender layer")
     assert not bad, "\n".join(bad)
+
+
+def test_files_are_replaced_only_by_the_atomic_helper():
+    """One atomic-write helper (export/atomic.py: fsync, stale-temporary clean-up): no other module renames a
+    hand-written temporary file onto its result (issue 23, item 8)."""
+    known, _ = graph()
+    bad = []
+    for name, path in known.items():
+        if name == "export.atomic":
+            continue
+        with open(path, encoding="utf-8") as fh:
+            for n, line in enumerate(fh, 1):
+                if "os.replace(" in line or "os.rename(" in line:
+                    bad.append(f"{name}:{n}: {line.strip()}")
+    assert not bad, "\n".join(bad)

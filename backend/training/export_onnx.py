@@ -47,10 +47,11 @@ FORMAT = 2  # 2: "form" (one-piece | split); a format-1 JSON is a one-piece expo
 
 def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dynamic: dict) -> None:
     """``torch.onnx.export`` (opset 17, TorchScript exporter) to a temporary file, then renamed onto ``path``."""
-    tmp = path + ".tmp"
-    torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
-                      opset_version=17, dynamo=False)
-    os.replace(tmp, path)
+    from .._export import export
+
+    with export.atomic_path(path) as tmp:
+        torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
+                          opset_version=17, dynamo=False)
 
 
 def _export_one(model, path: str, size: int) -> None:

@@ -239,9 +239,11 @@ def main(argv=None) -> int:
                     ref, cmp, kept, a.wall_minutes, a.final_mse, a.note)
     except ValueError as exc:
         ap.error(str(exc))
-    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
-        fh.write(text)
-    os.replace(a.out + ".tmp", a.out)
+    from .._export import export
+
+    with export.atomic_path(a.out) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
     return 0
 
 

@@ -63,9 +63,10 @@ def _device(name: str) -> torch.device:
 
 
 def _save(path: str, obj) -> None:
-    tmp = path + ".tmp"
-    torch.save(obj, tmp)
-    os.replace(tmp, path)
+    from .._export import export
+
+    with export.atomic_path(path) as tmp:
+        torch.save(obj, tmp)
 
 
 def _conditions(ids: torch.Tensor, conds: torch.Tensor, size: int):

@@ -26,6 +26,7 @@ import sys
 import numpy as np
 import torch
 
+from ... import _export as _ex
 from .. import noise_ops as ops
 
 __all__ = ["PHOTO_DIR", "expand", "photo_set", "PHOTOS", "PROCEDURAL", "DATA_DIR", "load_image", "procedural", "exemplar", "train_region",
@@ -168,8 +169,8 @@ def main(argv=None) -> int:
     for name in PROCEDURAL:
         a = (procedural(name, 0).permute(1, 2, 0).numpy() * 255.0 + 0.5).astype(np.uint8)
         path = os.path.join(out, f"{name}.png")
-        Image.fromarray(a).save(path + ".tmp.png")
-        os.replace(path + ".tmp.png", path)
+        with _ex.export.atomic_path(path) as tmp:
+            Image.fromarray(a).save(tmp, format="PNG")
         print(path)
     return 0
 

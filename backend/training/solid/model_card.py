@@ -208,9 +208,11 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     rejected = dict(r.split("=", 1) for r in a.rejected)
     text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected)
-    with open(a.out + ".tmp", "w", encoding="utf-8") as fh:
-        fh.write(text)
-    os.replace(a.out + ".tmp", a.out)
+    from ..._export import export
+
+    with export.atomic_path(a.out) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
     print(a.out)
     return 0
 
