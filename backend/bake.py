@@ -150,6 +150,11 @@ class BakeResult:
     skipped: list = field(default_factory=list)
 
 
+def has_frame_field(pattern: str) -> bool:
+    """Whether a file name has a '#' run for the frame number (``clouds_####.vdb``)."""
+    return bool(_FRAME.search(os.path.basename(pattern)))
+
+
 def frame_path(pattern: str, frame) -> str:
     """``clouds_####.vdb``, 7 -> ``clouds_0007.vdb`` (the last run of '#' in the file name)."""
     if frame is None:

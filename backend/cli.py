@@ -126,6 +126,13 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--map", metavar="PAINTED", help="multi-class map: an indexed/grey or colour-coded image")
     n.add_argument("--region", action="append", default=[], metavar="KEY=SPEC",
                    help="--map region: grey index (0-255) or #rrggbb colour = CLASS[:NAME=V,...] (repeat)")
+    n.add_argument("--keys", metavar="KEYS.toml", help="animate: keyframes of class and parameters over frames "
+                                                       "(see backend/neural/animate.py); needs --frames")
+    n.add_argument("--frames", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                   help="animate: write frames FIRST..LAST into -o with '#' for the frame number")
+    n.add_argument("--latent", choices=("fixed", "slerp", "drift"), default="fixed",
+                   help="animate: how the initial latent moves (fixed; slerp between the keys' seeds; drift)")
+    n.add_argument("--drift", type=float, default=0.05, help="animate, --latent drift: radians per frame")
     n.add_argument("--model", help="model folder (default: models/neural_noise beside the package)")
     n.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
     n.add_argument("--quiet", action="store_true")
@@ -405,6 +412,8 @@ def run_neural(a: argparse.Namespace) -> int:
     if a.list:
         print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))
         return 0
+    if a.keys or a.frames:
+        return _animate_neural(a, model, sampler, steps, tile)
     if not (a.noise or a.corners or a.map) or not a.out:
         raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
     if a.size < 8:
@@ -442,6 +451,49 @@ def run_neural(a: argparse.Namespace) -> int:
         write_png(a.out, preview_8bit(img, 0.0, 1.0))
     else:
         write_image(a.out, img)
+    return 0
+
+
+def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
+    """``neural --keys KEYS.toml --frames FIRST LAST -o name_####.png``: one file per frame, each written
+    atomically (an interrupted run keeps the frames it finished)."""
+    from .bake import frame_path, has_frame_field
+    from .neural.animate import animate, read_keys
+    from export.images import preview_8bit, write_image, write_png
+
+    if not (a.keys and a.frames):
+        raise SettingError("--keys", "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
+    if a.noise or a.corners or a.map or a.blend:
+        raise SettingError("--keys", "the keyframes set the classes; leave out --noise, --corners, --map and --blend")
+    if not a.out or not has_frame_field(a.out):
+        raise SettingError("-o", "an animation writes one file per frame: put '#' for the frame number in the "
+                                 "name, e.g. -o noise_####.png")
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    first, last = a.frames
+    if last < first:
+        raise SettingError("--frames", f"expected FIRST LAST with LAST >= FIRST, got {first} {last}")
+    if last - first >= 100_000:
+        raise SettingError("--frames", f"{last - first + 1} frames is more than the 100000 one run may write")
+    limits.finite("--drift", a.drift)
+    folder = os.path.dirname(os.path.abspath(a.out))
+    if not os.path.isdir(folder):
+        raise SettingError("-o", f"output folder does not exist: {folder}")
+    keys = read_keys(a.keys)
+    n = last - first + 1
+    bar = _Bar(a.quiet, "frames ")
+    frames = animate(model, keys, (first, last), a.size, a.size, latent=a.latent, speed=a.drift, steps=steps,
+                     sampler=sampler, spacing=a.spacing, tileable=a.tileable, tile=tile)
+    for i, (f, img) in enumerate(frames):
+        path = frame_path(a.out, f)
+        if ext == ".png":
+            write_png(path, preview_8bit(img, 0.0, 1.0))
+        else:
+            write_image(path, img)
+        bar((i + 1) / n)
     return 0
 
 

@@ -523,3 +523,79 @@ def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(expor
     both = sample("dpmpp_2m", eps, x0, cond, 3, alphas_cumprod=m.alphas_cumprod)
     one = sample("dpmpp_2m", eps, x0[1:], cond[1:].copy(), 3, alphas_cumprod=m.alphas_cumprod)
     np.testing.assert_allclose(both[1:], one, atol=1e-4)
+
+
+KEYS = """
+[[key]]
+frame = 1
+noise = "perlin"
+params = {scale = 4}
+seed = 2
+
+[[key]]
+frame = 7
+noise = "cells_f1"
+seed = 9
+"""
+
+
+def test_animation_hits_its_keyframes_and_moves_smoothly_between_them(exported, tmp_path):
+    """Issue 26: frames at keyframes equal plain generation; frames between move in small, even steps."""
+    from backend.neural.animate import animate, frame_cond, frame_latent, parse_keys, temporal_coherence
+    import tomllib
+
+    _, out = exported
+    m = NeuralNoiseModel(str(out))
+    keys = parse_keys(tomllib.loads(KEYS))
+    assert [k.frame for k in keys] == [1, 7] and keys[0].params == {"scale": 4.0}
+    frames = dict(animate(m, keys, (0, 8), 16, 16, latent="fixed", steps=4))
+    assert sorted(frames) == list(range(0, 9))
+    # keyframes: the plain image of the key's spec from the first key's seed
+    np.testing.assert_array_equal(frames[1], generate(m, C.uniform(m, ("perlin", {"scale": 4.0}), 16, 16), seed=2,
+                                                       steps=4))
+    np.testing.assert_array_equal(frames[7], generate(m, C.uniform(m, ("cells_f1", {}), 16, 16), seed=2, steps=4))
+    np.testing.assert_array_equal(frames[0], frames[1])  # held before the first key and after the last
+    np.testing.assert_array_equal(frames[8], frames[7])
+    # halfway: the conditioning is the w = 1/2 blend
+    half = frame_cond(m, keys, 4, 16, 16)
+    np.testing.assert_allclose(half, C.blend(m, keys[0].spec, keys[1].spec, np.full((16, 16), 0.5)), atol=1e-6)
+    seq = [frames[f] for f in range(1, 8)]
+    other = generate(m, C.uniform(m, ("perlin", {"scale": 4.0}), 16, 16), seed=77, steps=4)
+    coh = temporal_coherence(seq, float(np.abs(other - frames[1]).mean()))
+    assert coh["step_over_independent"] < 0.5, coh  # far from flicker
+    # latents: slerp goes from one key's seed to the other's, keeping the norm; drift circles
+    a, b = frame_latent(keys, 1, (16, 16), "slerp"), frame_latent(keys, 7, (16, 16), "slerp")
+    mid = frame_latent(keys, 4, (16, 16), "slerp")
+    assert np.linalg.norm(mid) == pytest.approx((np.linalg.norm(a) + np.linalg.norm(b)) / 2, rel=0.05)
+    assert np.abs(mid - a).mean() > 0.1 and np.abs(mid - b).mean() > 0.1
+    d0, d1 = frame_latent(keys, 1, (16, 16), "drift", 0.1), frame_latent(keys, 2, (16, 16), "drift", 0.1)
+    assert 0 < np.abs(d1 - d0).mean() < 0.2 * np.abs(d0).mean()
+
+
+def test_animation_cli_writes_numbered_frames_and_refuses_bad_input(exported, tmp_path, capsys):
+    _, out = exported
+    keys = tmp_path / "keys.toml"
+    keys.write_text(KEYS)
+    base = ["neural", "--model", str(out), "--size", "16", "--steps", "2", "--quiet"]
+    assert main(base + ["--keys", str(keys), "--frames", "1", "3", "-o", str(tmp_path / "a_###.png")]) == 0
+    assert sorted(p.name for p in tmp_path.glob("a_*.png")) == ["a_001.png", "a_002.png", "a_003.png"]
+    bad = [
+        (["--keys", str(keys), "--frames", "3", "1", "-o", str(tmp_path / "b_#.png")], "--frames"),
+        (["--keys", str(keys), "--frames", "1", "2", "-o", str(tmp_path / "b.png")], "'#'"),
+        (["--keys", str(tmp_path / "none.toml"), "--frames", "1", "2", "-o", str(tmp_path / "b_#.png")], "not found"),
+        (["--frames", "1", "2", "-o", str(tmp_path / "b_#.png")], "--keys"),
+        (["--keys", str(keys), "--frames", "1", "2", "--noise", "perlin", "-o", str(tmp_path / "b_#.png")], "--keys"),
+    ]
+    for extra, what in bad:
+        assert main(base + extra) == 2, extra
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and what in err[0], (extra, err)
+    for text, what in (("[[key]]\nframe = 1\n", "noise"), ('[[key]]\nframe = "a"\nnoise = "perlin"\n', "frame"),
+                       ('[[key]]\nframe = 1\nnoise = "bogus"\n', "bogus"), ("x = 1\n", "unknown top-level"),
+                       ('[[key]]\nframe = 1\nnoise = "perlin"\n[[key]]\nframe = 1\nnoise = "perlin"\n', "two keyframes"),
+                       ('[[key]]\nframe = 1\nnoise = "perlin"\nparams = {scale = nan}\n', "params")):
+        keys.write_text(text)
+        assert main(base + ["--keys", str(keys), "--frames", "1", "2", "-o", str(tmp_path / "c_#.png")]) == 2, text
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and what in err[0], (text, err)
+    assert not list(tmp_path.glob("b_*")) and not list(tmp_path.glob("c_*"))

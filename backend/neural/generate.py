@@ -73,8 +73,11 @@ def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: flo
 def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS, tileable: bool = False,
              callback: Callable[[int, int, np.ndarray], None] | None = None, sampler: str = DEFAULT_SAMPLER,
              spacing: str | None = None, eta: float = 0.0, tile: int | None = None,
-             overlap: int = DEFAULT_OVERLAP) -> np.ndarray:
+             overlap: int = DEFAULT_OVERLAP, x_T: np.ndarray | None = None) -> np.ndarray:
     """cond float32 (E + P, H, W) -> image float32 (H, W) in [0, 1].
+
+    ``x_T``: the initial latent float32 (H', W') with H', W' the sides rounded up to the model's multiple
+    (default: ``initial_noise(seed)``); animation passes latents that move smoothly between frames.
 
     ``steps`` timesteps of ``sampler`` (see :data:`backend.neural.sampler.SAMPLERS`) on the
     model's own schedule (its JSON), spaced by ``spacing`` (None: the sampler's DEFAULT_SPACING);
@@ -102,6 +105,13 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
                            f"{k} of at most half the tile; got tile {tile}, overlap {overlap}")
     kw = dict(eta=eta, rng=step_noise_rng(seed)) if eta else {}
     eps, _, _ = image_eps(model, cond[None], tileable, tile, overlap)
-    x0 = sample(sampler, eps, initial_noise(seed, (1, 1, Hp, Wp)), cond[None], steps,
+    if x_T is None:
+        x_T = initial_noise(seed, (1, 1, Hp, Wp))
+    else:
+        x_T = np.asarray(x_T, _F)
+        if x_T.shape != (Hp, Wp):
+            raise SettingError("x_T", f"the initial latent must be {Wp}x{Hp} for a {W}x{H} image, got {x_T.shape}")
+        x_T = x_T[None, None]
+    x0 = sample(sampler, eps, x_T, cond[None], steps,
                 callback=callback, alphas_cumprod=model.alphas_cumprod, spacing=spacing, **kw)
     return np.clip((x0[0, 0, :H, :W] + 1.0) * 0.5, 0.0, 1.0).astype(_F)
