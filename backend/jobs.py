@@ -44,6 +44,21 @@ A neural noise image (Maesumi et al. 2024) is a 2D bake with a neural source::
     seed = 3
     tileable = false
 
+Animated neural noise (a numbered image sequence): ``keys`` gives keyframes of class and parameters, as a
+file (see :mod:`backend.neural.animate`) or inline, whose ``frame`` numbers are the bake's frames (the bake's
+time is the frame number unless ``time`` / ``time_step`` say otherwise); ``latent`` = "fixed" | "slerp" |
+"drift" (``drift`` radians per frame)::
+
+    [[bake]]
+    name = "morph"
+    output = "out/morph_####.png"
+    resolution = [256, 256]
+    frames = [1, 48]
+    [bake.source]
+    kind = "neural"
+    keys = [{frame = 1, noise = "perlin", params = {scale = 4}}, {frame = 48, noise = "cells_f1"}]
+    latent = "fixed"
+
 A neural solid texture (Henzler et al. 2020) bakes colours: a volume's ``color``
 grid (with a constant ``density``), an RGB EXR, an sRGB PNG or a (..., 3) .npy::
 
@@ -139,9 +154,13 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
             raise SettingError("frames", f"expected [start, end], got {frames!r}")
         frames = (frames[0], frames[1])
     output = os.path.normpath(os.path.join(base_dir, str(d["output"])))
+    time0, dt = 0.0, 1.0 / 24.0
+    keys = getattr(source, "keys", None)
+    if keys:  # animated neural noise: the bake's time is the frame number its keyframes name
+        time0, dt = float(frames[0] if frames else keys[0].frame), 1.0
     return BakeSpec(name=name, source=source, grid=grid, output=output, transfer=tf, frames=frames,
-                    time=limits.finite("time", d.get("time", 0.0)),
-                    time_step=limits.positive("time_step", d.get("time_step", 1.0 / 24.0)),
+                    time=limits.finite("time", d.get("time", time0)),
+                    time_step=limits.positive("time_step", d.get("time_step", dt)),
                     half=limits.as_bool("half", d.get("half", False)), make_folders=True).validate()
 
 

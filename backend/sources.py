@@ -181,7 +181,7 @@ class NeuralSource:
     def __init__(self, model_folder: str, noise: str, params: dict | None = None, noise2: str | None = None,
                  params2: dict | None = None, mask: np.ndarray | None = None, width: float = 32.0,
                  sharpness: float = 1.0, steps: int | None = None, seed: int = 0, tileable: bool = False,
-                 sampler: str | None = None):
+                 sampler: str | None = None, keys: list | None = None, latent: str = "fixed", drift: float = 0.05):
         from .neural.generate import check_sampler
         from .neural.model import ModelError, NeuralNoiseModel
         from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
@@ -205,6 +205,20 @@ class NeuralSource:
         self.model.param_vector(*self.spec)  # unknown classes / parameters fail now, with their names
         if self.spec2 is not None:
             self.model.param_vector(*self.spec2)
+        # animation (issue 26): keyframes whose `frame` is the bake's time (a job sets time = frame number)
+        from .neural.animate import LATENT_MODES
+
+        self.keys = list(keys) if keys else None
+        self.animated = self.keys is not None
+        self.latent, self.drift = str(latent), limits.finite("source.drift", drift)
+        if self.keys is not None:
+            if self.mask is not None:
+                raise SettingError("source.keys", "keyframes set the classes of the whole image; leave out blend")
+            if self.latent not in LATENT_MODES:
+                raise SettingError("source.latent", f"unknown latent motion {self.latent!r}; choose one of "
+                                                    f"{', '.join(LATENT_MODES)}")
+            for k in self.keys:
+                self.model.param_vector(*k.spec)
 
     def check_grid(self, shape) -> None:
         """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask of
@@ -223,7 +237,14 @@ class NeuralSource:
         if len(shape) != 2:
             raise SettingError("grid", "neural noise bakes images (resolution [width, height])")
         H, W = shape
-        if self.mask is None:
+        x_T = None
+        if self.keys is not None:
+            from .neural.animate import frame_cond, frame_latent
+
+            k = self.model.multiple_of
+            cond = frame_cond(self.model, self.keys, float(time), H, W)
+            x_T = frame_latent(self.keys, float(time), (-(-H // k) * k, -(-W // k) * k), self.latent, self.drift)
+        elif self.mask is None:
             cond = C.uniform(self.model, self.spec, H, W)
         else:
             if self.mask.shape != (H, W):
@@ -237,7 +258,8 @@ class NeuralSource:
             if cancel is not None and cancel():
                 raise Cancelled("cancelled")
 
-        img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done, sampler=self.sampler)
+        img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done, sampler=self.sampler,
+                       x_T=x_T)
         return np.ascontiguousarray(img[::-1])  # bakes index rows by +y; files put +y at the top
 
     def to_dict(self) -> dict:
@@ -246,6 +268,9 @@ class NeuralSource:
         if self.mask is not None:
             d.update(spec2=[self.spec2[0], self.spec2[1]], width=self.width, sharpness=self.sharpness,
                      mask_sha256=hashlib.sha256(np.ascontiguousarray(self.mask).tobytes()).hexdigest())
+        if self.keys is not None:
+            d.update(keys=[[k.frame, k.noise, k.params, k.seed] for k in self.keys], latent=self.latent,
+                     drift=self.drift)
         return d
 
 
@@ -327,7 +352,7 @@ class SolidSource:
 SOURCE_KINDS = ("wave", "neural", "solid")
 _SOLID_KEYS = ("model", "exemplar", "seed", "scale", "density", "refine")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
-                "seed", "tileable")
+                "seed", "tileable", "keys", "latent", "drift")
 
 
 def _check_keys(d: dict, known: tuple, kind: str) -> None:
@@ -340,6 +365,20 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     import os
 
     _check_keys(d, _NEURAL_KEYS, "neural")
+    keys = None
+    if "keys" in d:  # animation: a keyframe file (relative to the job) or an inline list of [[key]] tables
+        from .neural.animate import parse_keys, read_keys
+
+        if isinstance(d["keys"], str):
+            keys = read_keys(os.path.join(base_dir, d["keys"]))
+        elif isinstance(d["keys"], list):
+            keys = parse_keys({"key": d["keys"]}, "source.keys")
+        else:
+            raise SettingError("source.keys", f"expected a keyframe file or a list of tables, got {d['keys']!r}")
+        d.setdefault("noise", keys[0].noise)
+        d.setdefault("params", keys[0].params)
+    elif "latent" in d or "drift" in d:
+        raise SettingError("source.latent", "latent motion animates keyframes: give keys too")
     if "noise" not in d:
         raise SettingError("source.noise", "a neural source needs noise = CLASS")
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -359,7 +398,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         raise SettingError("source.noise2", "a second noise needs blend = MASK")
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
                         d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps"), d.get("seed", 0),
-                        d.get("tileable", False), d.get("sampler"))
+                        d.get("tileable", False), d.get("sampler"), keys, d.get("latent", "fixed"), d.get("drift", 0.05))
 
 
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:

@@ -599,3 +599,47 @@ def test_animation_cli_writes_numbered_frames_and_refuses_bad_input(exported, tm
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and what in err[0], (text, err)
     assert not list(tmp_path.glob("b_*")) and not list(tmp_path.glob("c_*"))
+
+
+def test_animation_in_a_job_file_equals_the_cli_frames(exported, tmp_path):
+    """A job with keys and frames bakes the same frames as `neural --keys --frames` (the job's time is the
+    frame number); the keys enter the bake key, and blend with keys is refused."""
+    from backend.jobs import load_job, run_job
+
+    _, out = exported
+    (tmp_path / "keys.toml").write_text(KEYS)
+    job = tmp_path / "job.toml"
+    job.write_text(f"""
+[[bake]]
+name = "morph"
+output = "seq/m_##.npy"
+resolution = [16, 16]
+frames = [1, 3]
+[bake.source]
+kind = "neural"
+model = "{out}"
+keys = "keys.toml"
+latent = "slerp"
+steps = 2
+""")
+    assert [o.status for o in run_job(str(job))] == ["baked"]
+    assert main(["neural", "--model", str(out), "--size", "16", "--steps", "2", "--quiet", "--keys",
+                 str(tmp_path / "keys.toml"), "--frames", "1", "3", "--latent", "slerp", "-o",
+                 str(tmp_path / "cli_#.npy")]) == 0
+    for f in (1, 2, 3):
+        np.testing.assert_allclose(np.load(tmp_path / "seq" / f"m_0{f}.npy")[::-1],  # bakes index rows by +y
+                                   np.load(tmp_path / f"cli_{f}.npy"), atol=1e-6)
+    assert not np.allclose(np.load(tmp_path / "seq" / "m_01.npy"), np.load(tmp_path / "seq" / "m_03.npy"))
+    inline = job.read_text().replace('keys = "keys.toml"', 'keys = [{frame = 1, noise = "perlin"}, '
+                                                              '{frame = 3, noise = "spots"}]')
+    job.write_text(inline)
+    (spec,) = [s for _, s in load_job(str(job))]
+    assert spec.source.animated and spec.time == 1.0 and spec.time_step == 1.0
+    from backend.sources import describe
+    from export.images import write_png
+
+    assert '"spots"' in describe(spec.source) and '"latent":"slerp"' in describe(spec.source)  # in the bake key
+    write_png(str(tmp_path / "mask.png"), np.zeros((16, 16), np.uint8))
+    job.write_text(inline.replace('latent = "slerp"', 'latent = "slerp"\nblend = "mask.png"'))
+    (_, bad), = load_job(str(job))
+    assert "source.keys: keyframes set the classes of the whole image; leave out blend" in str(bad)
