@@ -190,6 +190,49 @@ def evaluate_slabs(source: Source, grid: BoxGrid, time: float, progress=None, ca
         yield a, np.asarray(vals, _F)
 
 
+def volume_grids(spec: BakeSpec) -> dict:
+    """{grid name: "float" | "vec3"} of the .vdb a spec writes: raw ``density``; with a ramp also ``color``
+    (and ``temperature`` where the ramp has temperature stops); a colour source ``color`` and ``density``."""
+    if getattr(spec.source, "rgb", False):
+        return {"density": "float", "color": "vec3"}
+    grids = {"density": "float"}
+    if spec.transfer is not None:
+        grids["color"] = "vec3"
+        if spec.transfer.has_temperature:
+            grids["temperature"] = "float"
+    return grids
+
+
+def volume_channels(spec: BakeSpec, vals: np.ndarray) -> dict:
+    """A slab of source values (nz, ny, nx) (or (nz, ny, nx, 3) colours) -> {grid name: slab} as the .vdb
+    holds them (Sec. 7.1 of the wave-noise paper: the ramp's alpha times the density scale, colour and
+    temperature zero where the density is); any z range may be computed alone (bricks on a farm)."""
+    if getattr(spec.source, "rgb", False):
+        return {"color": vals, "density": np.full(vals.shape[:-1], spec.source.density, _F)}
+    tf = spec.transfer
+    if tf is None:
+        return {"density": vals}
+    rgba = tf.rgba(vals)
+    dens = tf.density(rgba)
+    empty = dens <= 0.0
+    dens[empty] = 0.0
+    col = rgba[..., :3]
+    col[empty] = 0.0
+    out = {"density": dens, "color": col}
+    if tf.has_temperature:
+        temp = tf.kelvin(vals)
+        temp[empty] = 0.0
+        out["temperature"] = temp
+    return out
+
+
+def bake_frame(spec: BakeSpec, frame, progress=None, cancel=None) -> str:
+    """Write the file of one frame (None: the single output) whatever its state -> its path."""
+    path = frame_path(spec.output, frame)
+    _bake_file(spec, path, spec.frame_time(frame), spec.key(frame), progress, cancel)
+    return path
+
+
 def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:
     from ._export import export
 
@@ -199,28 +242,10 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
     if getattr(spec.source, "rgb", False):
         return _bake_rgb_file(spec, path, time, meta, progress, cancel)
     if ext == ".vdb":
-        grids = {"density": "float"}
-        if tf is not None:
-            grids["color"] = "vec3"
-            if tf.has_temperature:
-                grids["temperature"] = "float"
-        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, grids, meta, half=spec.half)
+        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, volume_grids(spec), meta, half=spec.half)
         for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
-            if tf is None:
-                writer.add("density", z0, vals)
-                continue
-            rgba = tf.rgba(vals)
-            dens = tf.density(rgba)
-            empty = dens <= 0.0
-            dens[empty] = 0.0
-            col = rgba[..., :3]
-            col[empty] = 0.0
-            writer.add("density", z0, dens)
-            writer.add("color", z0, col)
-            if tf.has_temperature:
-                temp = tf.kelvin(vals)
-                temp[empty] = 0.0
-                writer.add("temperature", z0, temp)
+            for name, slab in volume_channels(spec, vals).items():
+                writer.add(name, z0, slab)
         if cancel is not None and cancel():
             raise Cancelled("cancelled")
         writer.write(path)
@@ -252,11 +277,10 @@ def _bake_rgb_file(spec: BakeSpec, path: str, time: float, meta: dict, progress,
 
     ext = os.path.splitext(path)[1].lower()
     if ext == ".vdb":
-        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, {"density": "float", "color": "vec3"}, meta,
-                                     half=spec.half)
+        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, volume_grids(spec), meta, half=spec.half)
         for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
-            writer.add("color", z0, vals)
-            writer.add("density", z0, np.full(vals.shape[:-1], spec.source.density, _F))
+            for name, slab in volume_channels(spec, vals).items():
+                writer.add(name, z0, slab)
         if cancel is not None and cancel():
             raise Cancelled("cancelled")
         writer.write(path)

@@ -100,6 +100,15 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
     b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (default 0: all cores)")
     b.add_argument("--quiet", action="store_true")
+    farm = b.add_argument_group("farm (Dask distributed; pip install .[farm])")
+    farm.add_argument("--workers", type=int, metavar="N", help="bake on a local cluster of N worker processes")
+    farm.add_argument("--cluster", metavar="ADDRESS", help="bake on a running Dask scheduler (tcp:// or tls://)")
+    farm.add_argument("--retries", type=int, default=2, help="farm: runs of a failed task after the first (default 2)")
+    farm.add_argument("--brick-voxels", type=int, help="farm: voxels per brick of a large volume (default: from "
+                                                       "the workers' memory)")
+    farm.add_argument("--tls-ca-file", help="farm, tls://: the CA certificate")
+    farm.add_argument("--tls-cert", help="farm, tls://: this client's certificate")
+    farm.add_argument("--tls-key", help="farm, tls://: this client's private key")
 
     n = sub.add_parser("neural", help="neural noise (Maesumi et al. 2024) from the trained ONNX model")
     n.add_argument("--noise", help="class name (see --list)")
@@ -274,6 +283,62 @@ def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
     return 0
 
 
+def _bake_on_farm(a: argparse.Namespace) -> int:
+    """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (backend/farm.py); exit codes as locally."""
+    from .jobs import JobError
+
+    if a.workers is not None and a.cluster:
+        raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
+    if a.workers is not None and not 1 <= a.workers <= 512:
+        raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
+    if a.retries < 0:
+        raise SettingError("--retries", f"must be >= 0, got {a.retries}")
+    if a.brick_voxels is not None and a.brick_voxels < 1:
+        raise SettingError("--brick-voxels", f"must be >= 1, got {a.brick_voxels}")
+    if not os.path.isfile(a.job):
+        raise JobError(f"job file not found: {a.job}")
+    try:
+        from . import farm
+    except ImportError as exc:
+        raise SettingError("--workers" if a.workers else "--cluster",
+                           f"needs Dask ({exc}); pip install 'dask[distributed]' or the farm extra") from None
+    try:
+        client = farm.local_client(a.workers) if a.workers else farm.remote_client(a.cluster, a.tls_ca_file,
+                                                                                   a.tls_cert, a.tls_key)
+    except ImportError as exc:
+        raise SettingError("--workers" if a.workers else "--cluster",
+                           f"needs Dask distributed ({exc}); pip install 'dask[distributed]'") from None
+    except OSError as exc:
+        raise SettingError("--cluster", f"cannot reach the scheduler {a.cluster}: {exc}") from None
+    try:
+        if not a.quiet and client.dashboard_link:
+            print(f"omninoise bake: Dask dashboard {client.dashboard_link}", file=sys.stderr)
+
+        def progress(done, total, moved, eta):
+            if not a.quiet:
+                sys.stderr.write(f"\r  {done}/{total} tasks, {moved / 2 ** 20:.1f} MiB, ETA {eta:.0f} s   ")
+                if done == total:
+                    sys.stderr.write("\n")
+                sys.stderr.flush()
+
+        outcomes = farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
+                                 retries=a.retries, progress=progress)
+    finally:
+        cluster = getattr(client, "cluster", None)
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    for o in outcomes:
+        if o.status in ("baked", "up to date") and not a.quiet:
+            print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
+    bad = [o for o in outcomes if o.status not in ("baked", "up to date")]
+    for o in bad:
+        print(f"omninoise bake: error: {o.message}", file=sys.stderr)
+    if any(o.status == "invalid" for o in bad):
+        return 2
+    return 1 if bad else 0
+
+
 def _set_threads(n: int) -> None:
     from .onnx_models import set_default_threads
 
@@ -303,6 +368,8 @@ def run_bake_job(a: argparse.Namespace) -> int:
             return 2
         return 0
     _set_threads(a.threads)
+    if a.workers is not None or a.cluster:
+        return _bake_on_farm(a)
     bars = {}
 
     def progress(name, i, count, frac):

@@ -28,7 +28,7 @@ def atomic_path(path: str, suffix: str | None = None):
         raise IsADirectoryError(f"output path is a folder, not a file: {path}")
     remove_stale(folder)
     suffix = suffix if suffix is not None else os.path.splitext(path)[1]
-    fd, tmp = tempfile.mkstemp(prefix=".omninoise-", suffix=suffix, dir=folder)
+    fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path), suffix=suffix, dir=folder)
     os.close(fd)
     try:
         yield tmp
@@ -46,6 +46,28 @@ def _fsync(path: str) -> None:
         os.fsync(fd)
     finally:
         os.close(fd)
+
+
+def partial_prefix(path: str) -> str:
+    """The name prefix of the temporaries that become ``path``: ``.omninoise-NAME.`` (then random)."""
+    return f".omninoise-{os.path.basename(path)}."
+
+
+def remove_partials(path: str) -> list:
+    """Remove the temporaries of ``path`` left by writers that died (a worker killed mid-write); call it only
+    when no writer of ``path`` can still be running.  Returns their names."""
+    folder, prefix, gone = os.path.dirname(os.path.abspath(path)), partial_prefix(path), []
+    try:
+        names = [n for n in os.listdir(folder) if n.startswith(prefix)]
+    except OSError:
+        return gone
+    for n in names:
+        try:
+            os.remove(os.path.join(folder, n))
+            gone.append(n)
+        except OSError:
+            pass
+    return gone
 
 
 def remove_stale(folder: str, max_age: float = STALE_SECONDS) -> list:

@@ -125,6 +125,8 @@ def test_dependencies_point_one_way():
                 bad.append(where + ": the runtime never imports training code or torch")
             if m.startswith("export") and d.startswith(("backend", "blender_addon")):
                 bad.append(where + ": the file writers sit below the engines")
+            if d.split(".")[0] in ("dask", "distributed") and m != "backend.farm":
+                bad.append(where + ": only backend/farm.py uses Dask (an optional extra)")
             if m.startswith("backend") and d.startswith("blender_addon"):
                 bad.append(where + ": the core never imports the Blender layer")
     assert not bad, "\n".join(bad)

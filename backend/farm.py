@@ -1,0 +1,294 @@
+"""Job files on a Dask cluster (issue 25): `omninoise bake JOB.toml --workers N` or `--cluster ADDRESS`.
+
+The same bakes as a one-machine `omninoise bake`, spread over Dask distributed workers; scheduling, transport
+and retries are Dask's. Imported only when one of those flags is given (Dask is the `farm` extra, never needed
+by the Blender extension).
+
+Units of work, each independent:
+
+- a file: one output, or one frame of a sequence (images, neural and solid bakes, small volumes); the worker
+  bakes it with the one-machine code (:func:`backend.bake.bake_frame`) and writes it atomically into the output
+  folder (shared storage on a farm), returning its size and sha256;
+- a brick: a z range of one large volume (more voxels than ``brick_voxels``, chosen from the workers' memory);
+  the worker returns the brick's grids (:func:`backend.bake.volume_channels`) and the client assembles the
+  bricks into one sparse OpenVDB file, voxel for voxel the file a one-machine bake writes.
+
+The client checks every result (the file exists with the reported size and hash), removes what a killed
+worker left half-written, and keeps a manifest beside the job (``JOB.manifest.json``: per output its bake,
+frame, key, size and sha256). A rerun skips outputs that are up to date: files that carry the bake's key in
+their metadata, or (``.npy``) whose manifest entry has the key and the file still has the recorded hash;
+``force`` redoes them. A worker killed mid-task makes Dask run the task elsewhere (``retries`` more times for
+errors raised by the task itself).
+
+Workers import this package, so every worker needs the backend installed (``pip install .[farm]``) and the
+job's folder, its inputs and its output root at the same paths (shared storage).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .bake import BakeSpec, KEY_NAME, bake_frame, frame_path, volume_channels, volume_grids
+from .jobs import JobError, JobOutcome, load_job
+
+__all__ = ["Task", "plan", "run_farm", "local_client", "remote_client", "brick_voxels_for", "CRASH_ENV"]
+
+#: fault injection for the test that kills a worker mid-task: a worker that finds the file this variable names
+#: deletes it, leaves a partial temporary beside its output and exits at once (as a killed process would)
+CRASH_ENV = "OMNINOISE_FARM_CRASH_ONCE"
+BYTES_PER_VOXEL = 96   #: worker memory one brick voxel may need: values, rgba, density, colour, temperature, copies
+
+
+@dataclass(frozen=True)
+class Task:
+    """One unit of work: the file of ``frame`` of bake ``bake`` (None: its single output), or with ``brick``
+    the z range (z0, z1) of that volume."""
+    bake: str
+    frame: int | None
+    path: str
+    brick: tuple | None = None
+
+
+def file_record(path: str) -> dict:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return dict(path=path, bytes=os.path.getsize(path), sha256=h.hexdigest())
+
+
+# -- the worker side --------------------------------------------------------------------------------------
+
+_SPECS: dict = {}
+
+
+def _job_spec(job: str, bake: str) -> BakeSpec:
+    """The bake ``bake`` of job file ``job``, parsed once per worker process (and again if the file changes)."""
+    key = (job, os.path.getmtime(job))
+    if key not in _SPECS:
+        _SPECS.clear()
+        _SPECS[key] = {n: s for n, s in load_job(job)}
+    spec = _SPECS[key][bake]
+    if isinstance(spec, JobError):
+        raise spec
+    return spec
+
+
+def _maybe_crash(path: str) -> None:
+    marker = os.environ.get(CRASH_ENV)
+    if not marker or not os.path.exists(marker):
+        return
+    try:
+        os.remove(marker)
+    except OSError:
+        return  # another worker took it
+    from ._export import export
+
+    partial = os.path.join(os.path.dirname(path), export.partial_prefix(path) + "crash")
+    with open(partial, "wb") as fh:
+        fh.write(b"half a file")
+    os._exit(70)
+
+
+def run_file(job: str, bake: str, frame) -> dict:
+    """Worker: bake one file (whatever its state) -> :func:`file_record` of it."""
+    spec = _job_spec(job, bake)
+    path = frame_path(spec.output, frame)
+    _maybe_crash(path)
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    return file_record(bake_frame(spec, frame))
+
+
+def run_brick(job: str, bake: str, frame, z0: int, z1: int) -> dict:
+    """Worker: the grids of z = z0 .. z1 - 1 of a volume -> {grid name: float32 slab (z1 - z0, ny, nx[, 3])}."""
+    spec = _job_spec(job, bake)
+    _maybe_crash(frame_path(spec.output, frame))
+    g = spec.grid
+    vals = spec.source.evaluate((z1 - z0,) + tuple(g.shape[1:]), g.first, g.voxel, spec.frame_time(frame), None,
+                                None, (0, 0, int(z0)))
+    return volume_channels(spec, np.asarray(vals, np.float32))
+
+
+# -- the client side --------------------------------------------------------------------------------------
+
+def manifest_path(job: str) -> str:
+    return os.path.splitext(os.path.abspath(job))[0] + ".manifest.json"
+
+
+def read_manifest(job: str) -> dict:
+    try:
+        with open(manifest_path(job), encoding="utf-8") as fh:
+            doc = json.load(fh)
+        return doc.get("outputs", {}) if isinstance(doc, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def _up_to_date(spec: BakeSpec, frame, manifest: dict) -> bool:
+    key = spec.key(frame)
+    path = frame_path(spec.output, frame)
+    if os.path.splitext(path)[1].lower() != ".npy":
+        return spec.is_up_to_date(frame, key)
+    rec = manifest.get(os.path.abspath(path))
+    if not rec or rec.get("key") != key or not os.path.isfile(path) or os.path.getsize(path) != rec.get("bytes"):
+        return False
+    return file_record(path)["sha256"] == rec.get("sha256")
+
+
+def plan(entries: list, force: bool, brick_voxels: int, manifest: dict) -> tuple:
+    """(tasks, skipped paths, {path: (spec, frame, n_bricks)}) for valid ``entries`` [(name, spec)]."""
+    tasks, skipped, volumes = [], [], {}
+    for name, spec in entries:
+        for frame in spec.frame_list():
+            path = frame_path(spec.output, frame)
+            if not force and _up_to_date(spec, frame, manifest):
+                skipped.append(path)
+                continue
+            g = spec.grid
+            big = g.rank == 3 and path.lower().endswith(".vdb") and int(np.prod(g.shape)) > brick_voxels
+            if not big:
+                tasks.append(Task(name, frame, path))
+                continue
+            per = max(1, brick_voxels // int(np.prod(g.shape[1:])))
+            bricks = [(z, min(g.shape[0], z + per)) for z in range(0, g.shape[0], per)]
+            volumes[path] = (spec, frame, len(bricks))
+            tasks += [Task(name, frame, path, b) for b in bricks]
+    return tasks, skipped, volumes
+
+
+def brick_voxels_for(client, default: int = 1 << 24) -> int:
+    """Voxels per brick so that one brick's grids fit comfortably in the smallest worker's memory limit."""
+    try:
+        limits = [w.get("memory_limit") or 0 for w in client.scheduler_info()["workers"].values()]
+    except Exception:  # noqa: BLE001  (an old or unusual scheduler: keep the default)
+        return default
+    limits = [m for m in limits if m > 0]
+    return max(1 << 12, int(min(limits) // BYTES_PER_VOXEL // 4)) if limits else default
+
+
+def local_client(workers: int, memory_limit: str = "auto"):
+    """A local cluster of ``workers`` processes (one thread each) listening on 127.0.0.1 only -> Client."""
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address="127.0.0.1:0", memory_limit=memory_limit,
+                           silence_logs=logging.ERROR)
+    return Client(cluster)
+
+
+def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None = None, tls_key: str | None = None):
+    """A client of a running scheduler; ``tls://`` addresses take Dask's Security from the certificate files."""
+    from distributed import Client
+
+    security = None
+    if tls_ca or tls_cert or tls_key or address.startswith("tls://"):
+        from distributed.security import Security
+
+        if not (tls_ca and tls_cert and tls_key):
+            raise JobError("a tls:// scheduler needs --tls-ca-file, --tls-cert and --tls-key")
+        security = Security(tls_ca_file=tls_ca, tls_client_cert=tls_cert, tls_client_key=tls_key,
+                            require_encryption=True)
+    return Client(address, security=security, timeout="30s")
+
+
+def run_farm(job: str, client, force: bool = False, only: list | None = None, brick_voxels: int | None = None,
+             retries: int = 2, progress=None, log=None) -> list:
+    """Run a job file's bakes on ``client``'s cluster -> list of :class:`backend.jobs.JobOutcome` (one per bake).
+
+    ``progress(done, total, bytes_moved, eta_seconds)`` after every finished task.  Invalid bakes fail the
+    job before anything is sent (as one-machine runs do).  A failed task fails its output, named in the
+    outcome; every other output is still written.
+    """
+    from distributed import as_completed
+
+    from ._export import export
+
+    job = os.path.abspath(job)
+    entries = load_job(job)
+    if only:
+        names = [n for n, _ in entries]
+        missing = [n for n in only if n not in names]
+        if missing:
+            raise JobError(f"no bake named {missing[0]!r}; the job has {', '.join(names)}")
+        entries = [(n, s) for n, s in entries if n in only]
+    bad = [(n, s) for n, s in entries if isinstance(s, JobError)]
+    if bad:
+        return [JobOutcome(n, "invalid", str(s)) for n, s in bad]
+    manifest = read_manifest(job)
+    tasks, skipped, volumes = plan(entries, force, brick_voxels or brick_voxels_for(client), manifest)
+    specs = dict(entries)
+    futures = {}
+    for t in tasks:
+        if t.brick is None:
+            fut = client.submit(run_file, job, t.bake, t.frame, retries=retries, pure=False)
+        else:
+            fut = client.submit(run_brick, job, t.bake, t.frame, t.brick[0], t.brick[1], retries=retries,
+                                pure=False)
+        futures[fut] = t
+    writers, bricks_done, failed, written = {}, {}, {}, {}
+    done, moved, t0 = 0, 0, time.perf_counter()
+    for fut in as_completed(list(futures)):
+        t = futures[fut]
+        done += 1
+        spec = specs[t.bake]
+        try:
+            res = fut.result()
+        except Exception as exc:  # noqa: BLE001  (the task's own error, after Dask's retries)
+            failed.setdefault(t.path, f"{os.path.basename(t.path)}: {type(exc).__name__}: {exc}")
+            writers.pop(t.path, None)
+            res = None
+        if res is not None and t.brick is None:
+            rec = file_record(t.path) if os.path.isfile(t.path) else None
+            if rec is None or rec["bytes"] != res["bytes"] or rec["sha256"] != res["sha256"]:
+                failed.setdefault(t.path, f"{os.path.basename(t.path)}: the file does not match what the worker "
+                                          "reported (shared storage?)")
+            else:
+                moved += rec["bytes"]
+                written[t.path] = dict(rec, bake=t.bake, frame=t.frame, key=spec.key(t.frame))
+            export.remove_partials(t.path)
+        elif res is not None and t.path not in failed:
+            w = writers.get(t.path)
+            if w is None:
+                meta = {KEY_NAME: spec.key(t.frame), "omninoise_source": spec.source.kind,
+                        "omninoise_bake": spec.name}
+                w = writers[t.path] = export.VolumeWriter(spec.grid.voxel, spec.grid.first, volume_grids(spec),
+                                                          meta, half=spec.half)
+            for name, slab in res.items():
+                w.add(name, t.brick[0], slab)
+                moved += slab.nbytes
+            bricks_done[t.path] = bricks_done.get(t.path, 0) + 1
+            if bricks_done[t.path] == volumes[t.path][2]:
+                os.makedirs(os.path.dirname(os.path.abspath(t.path)), exist_ok=True)
+                writers.pop(t.path).write(t.path)
+                export.remove_partials(t.path)
+                written[t.path] = dict(file_record(t.path), bake=t.bake, frame=t.frame, key=spec.key(t.frame))
+        if progress is not None:
+            rate = (time.perf_counter() - t0) / done
+            progress(done, len(tasks), moved, rate * (len(tasks) - done))
+    for path in failed:
+        export.remove_partials(path)
+    manifest.update({os.path.abspath(p): r for p, r in written.items()})
+    for p in failed:
+        manifest.pop(os.path.abspath(p), None)
+    export.write_json(manifest_path(job), dict(job=job, outputs=manifest))
+    outcomes = []
+    for name, spec in entries:
+        paths = [frame_path(spec.output, f) for f in spec.frame_list()]
+        bad_here = [failed[p] for p in paths if p in failed]
+        n_written = sum(p in written for p in paths)
+        n_skipped = sum(p in skipped for p in paths)
+        if bad_here:
+            outcomes.append(JobOutcome(name, "failed", f"bake {name!r}: {len(bad_here)} of {len(paths)} outputs "
+                                                       f"failed: {'; '.join(bad_here[:3])}"))
+        else:
+            outcomes.append(JobOutcome(name, "baked" if n_written else "up to date",
+                                       f"{n_written} written, {n_skipped} up to date"))
+        if log is not None:
+            log(outcomes[-1].message)
+    return outcomes

@@ -1,0 +1,185 @@
+"""Job files on a Dask cluster (issue 25), on a local cluster of 2 worker processes over loopback: the same
+files as a one-machine bake (images, a sequence, a bricked volume, a neural map), a worker killed mid-task,
+resume, and a failing output that leaves the others written."""
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from backend import farm  # noqa: E402
+from backend.cli import main  # noqa: E402
+from backend.jobs import run_job  # noqa: E402
+from export import read_volume  # noqa: E402
+from export.images import decode  # noqa: E402
+from tests.conftest import needs_openvdb  # noqa: E402
+
+JOB = """
+[[bake]]
+name = "image"
+output = "out/img.exr"
+resolution = [32, 24]
+[bake.source]
+dim = 2
+directions = 4
+seed = 3
+
+[[bake]]
+name = "seq"
+output = "out/seq_##.png"
+resolution = [16, 16]
+frames = [1, 3]
+transfer = "marble"
+[bake.source]
+dim = 2
+speed = 0.5
+directions = 4
+
+[[bake]]
+name = "cloud"
+output = "out/cloud.vdb"
+resolution = [20, 18, 17]
+bounds = [[0, 0, 0], [2, 2, 2]]
+transfer = "fire"
+[bake.source]
+dim = 3
+directions = 4
+seed = 5
+
+[[bake]]
+name = "raw"
+output = "out/raw.npy"
+resolution = [8, 8, 8]
+[bake.source]
+dim = 3
+directions = 2
+
+[[bake]]
+name = "neural"
+output = "out/n.npy"
+resolution = [16, 16]
+[bake.source]
+kind = "neural"
+noise = "perlin"
+steps = 2
+"""
+OUTPUTS = ["img.exr", "seq_01.png", "seq_02.png", "seq_03.png", "cloud.vdb", "raw.npy", "n.npy"]
+BRICK = 20 * 18 * 5  # the 17-slice volume goes as 4 bricks
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory):
+    """One local cluster for the module; its workers inherit the crash hook's variable (armed by one test)."""
+    marker = tmp_path_factory.mktemp("crash") / "crash-once"
+    old = os.environ.get(farm.CRASH_ENV)
+    os.environ[farm.CRASH_ENV] = str(marker)
+    c = farm.local_client(2)
+    try:
+        yield c, marker
+    finally:
+        c.close()
+        c.cluster.close()
+        if old is None:
+            os.environ.pop(farm.CRASH_ENV, None)
+        else:
+            os.environ[farm.CRASH_ENV] = old
+
+
+def job_in(folder, text=JOB) -> str:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "job.toml").write_text(text)
+    return str(folder / "job.toml")
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The one-machine bake of the job."""
+    job = job_in(tmp_path_factory.mktemp("local"))
+    assert {o.status for o in run_job(job)} == {"baked"}
+    return os.path.dirname(job)
+
+
+def assert_same_outputs(a: str, b: str) -> None:
+    for name in OUTPUTS:
+        pa, pb = os.path.join(a, "out", name), os.path.join(b, "out", name)
+        if name.endswith(".npy"):
+            np.testing.assert_array_equal(np.load(pa), np.load(pb), err_msg=name)
+        elif name.endswith(".vdb"):
+            from export.vdb import openvdb_module
+
+            vdb = openvdb_module()
+            for grid, shape in (("density", (17, 18, 20)), ("color", (17, 18, 20, 3)), ("temperature", (17, 18, 20))):
+                np.testing.assert_array_equal(read_volume(pa, grid, shape[:3]), read_volume(pb, grid, shape[:3]),
+                                              err_msg=f"{name}:{grid}")
+                assert vdb.read(pa, grid).activeVoxelCount() == vdb.read(pb, grid).activeVoxelCount()
+        else:
+            np.testing.assert_array_equal(decode(pa), decode(pb), err_msg=name)
+    left = [n for n in os.listdir(os.path.join(b, "out")) if n.startswith(".omninoise-")]
+    assert not left, left  # no partial file
+
+
+@needs_openvdb
+def test_a_mixed_job_on_two_workers_equals_the_one_machine_bake(client, reference, tmp_path):
+    c, _ = client
+    job = job_in(tmp_path)
+    seen = []
+    outcomes = farm.run_farm(job, c, brick_voxels=BRICK, progress=lambda *p: seen.append(p))
+    assert [(o.name, o.status) for o in outcomes] == [(n, "baked") for n in ("image", "seq", "cloud", "raw", "neural")]
+    assert len(seen) == 3 + 3 + 4 and seen[-1][0] == seen[-1][1] == 10 and seen[-1][2] > 0  # 6 files + 4 bricks
+    assert_same_outputs(reference, str(tmp_path))
+    # resume: everything is up to date (the .npy outputs through the manifest), --force redoes it all
+    assert {o.status for o in farm.run_farm(job, c, brick_voxels=BRICK)} == {"up to date"}
+    np.save(tmp_path / "out" / "raw.npy", np.zeros((8, 8, 8), np.float32))  # changed behind the manifest's back
+    again = {o.name: o.status for o in farm.run_farm(job, c, brick_voxels=BRICK)}
+    assert again["raw"] == "baked" and again["image"] == "up to date"
+    assert {o.status for o in farm.run_farm(job, c, brick_voxels=BRICK, force=True)} == {"baked"}
+    assert_same_outputs(reference, str(tmp_path))
+
+
+@needs_openvdb
+def test_a_worker_killed_mid_task_changes_nothing(client, reference, tmp_path):
+    """The first task to run kills its worker after leaving half a file; Dask runs the task again on a live
+    worker, and the outputs equal a clean run with no partial file left."""
+    c, marker = client
+    marker.write_text("armed")
+    job = job_in(tmp_path)
+    outcomes = farm.run_farm(job, c, brick_voxels=BRICK)
+    assert not marker.exists()  # a worker did die
+    assert {o.status for o in outcomes} == {"baked"}
+    assert_same_outputs(reference, str(tmp_path))
+
+
+def test_a_failing_output_is_named_and_the_others_are_written(client, tmp_path):
+    c, _ = client
+    (tmp_path / "blocked").write_text("a file where the bake wants a folder")
+    job = job_in(tmp_path, """
+[[bake]]
+name = "good"
+output = "out/good.npy"
+resolution = [8, 8]
+[bake.source]
+dim = 2
+directions = 2
+
+[[bake]]
+name = "bad"
+output = "blocked/x.npy"
+resolution = [8, 8]
+[bake.source]
+dim = 2
+directions = 2
+""")
+    outcomes = {o.name: o for o in farm.run_farm(job, c, retries=0)}
+    assert outcomes["good"].status == "baked" and (tmp_path / "out" / "good.npy").is_file()
+    assert outcomes["bad"].status == "failed" and "x.npy" in outcomes["bad"].message
+
+
+def test_the_cli_runs_a_job_on_a_local_cluster(tmp_path, capsys):
+    job = job_in(tmp_path, JOB.split("[[bake]]\nname = \"seq\"")[0])  # the image bake alone
+    assert main(["bake", job, "--workers", "1", "--quiet"]) == 0
+    assert (tmp_path / "out" / "img.exr").is_file()
+    assert main(["bake", job, "--workers", "0"]) == 2
+    assert "--workers" in capsys.readouterr().err
+    assert main(["bake", job, "--workers", "1", "--cluster", "tcp://127.0.0.1:1"]) == 2
