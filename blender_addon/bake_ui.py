@@ -17,6 +17,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
     IntVectorProperty, PointerProperty, StringProperty
 
 from . import tasks
+from .tasks import TaskOperator
 from ._deps import backend
 from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
                            transfer_from_color_ramp, world_bounds)
@@ -165,53 +166,7 @@ def _message(text: str) -> None:
     print(f"OmniNoise: {text}")
 
 
-class _TaskOperator:
-    """An operator whose work is a :mod:`.tasks` Task: modal with Esc in the UI, blocking in scripts."""
-
-    blocking: BoolProperty(name="Blocking", description="Wait for the work to finish (scripts)", default=False,
-                           options={"SKIP_SAVE", "HIDDEN"})
-
-    @classmethod
-    def poll(cls, context):
-        return tasks.current() is None
-
-    def _start(self, context, blocking: bool):
-        """Start the task (None after reporting why it could not start)."""
-        raise NotImplementedError
-
-    def execute(self, context):
-        task = self._start(context, blocking=True)
-        if task is None:
-            return {"CANCELLED"}
-        if task.status != "done":
-            self.report({"ERROR"} if task.status == "failed" else {"WARNING"}, task.message or task.status)
-            return {"CANCELLED"}
-        return {"FINISHED"}
-
-    def invoke(self, context, event):
-        if self.blocking or bpy.app.background:
-            return self.execute(context)
-        self._task = self._start(context, blocking=False)
-        if self._task is None:
-            return {"CANCELLED"}
-        context.window_manager.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
-
-    def modal(self, context, event):
-        task = self._task
-        if not task.running:
-            if task.status == "failed":
-                self.report({"ERROR"}, task.message)
-            elif task.status == "cancelled":
-                self.report({"WARNING"}, f"{task.label}: cancelled")
-            return {"FINISHED"} if task.status == "done" else {"CANCELLED"}
-        if event.type == "ESC" and event.value == "PRESS":
-            task.cancel()
-            return {"RUNNING_MODAL"}
-        return {"PASS_THROUGH"}
-
-
-class _BakeOperator(_TaskOperator):
+class _BakeOperator(TaskOperator):
     bl_options = {"REGISTER"}
     target = "VOLUME"
 
@@ -279,7 +234,7 @@ class OMNINOISE_OT_cancel(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class OMNINOISE_OT_run_job(_TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_run_job(TaskOperator, bpy.types.Operator):
     """Run the bakes of a TOML job file (the same as `omninoise bake JOB.toml`)"""
 
     bl_idname = "omninoise.run_job"

@@ -20,7 +20,8 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatPrope
 
 from . import tasks
 from ._deps import backend
-from .bake_ui import _TaskOperator, draw_progress
+from .bake_ui import draw_progress
+from .tasks import TaskOperator
 from .preferences import threads
 
 __all__ = ["model", "build_conditioning", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
@@ -186,7 +187,7 @@ def _store(name: str, img: np.ndarray, depth: str):
     return ima
 
 
-class OMNINOISE_OT_neural_bake(_TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
     """Bake neural noise from the swatches and the blend layout into an image"""
 
     bl_idname = "omninoise.neural_bake"
@@ -441,7 +442,7 @@ def thumbnail_name(index: int) -> str:
     return f".OmniNoise Swatch {index + 1}"   # leading dot: hidden from image browsers
 
 
-class OMNINOISE_OT_swatch_thumbnails(_TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_swatch_thumbnails(TaskOperator, bpy.types.Operator):
     """Generate a small preview of every swatch with the model (32 px, 10 steps)"""
 
     bl_idname = "omninoise.swatch_thumbnails"

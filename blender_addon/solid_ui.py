@@ -29,7 +29,8 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty,
 from . import tasks
 from ._deps import backend
 from .compat import ensure_node_tree
-from .bake_ui import _TaskOperator, draw_progress
+from .bake_ui import draw_progress
+from .tasks import TaskOperator
 from .preferences import threads
 
 __all__ = ["models_dir", "load_model", "texture", "register", "unregister"]
@@ -240,7 +241,7 @@ def _material_with(obj, name: str, make_node):
     return mat
 
 
-class OMNINOISE_OT_solid_preview(_TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
     """Preview the solid texture: a 128 px slice through the texture (z = 0 plane) as an image"""
 
     bl_idname = "omninoise.solid_preview"
@@ -267,7 +268,7 @@ class OMNINOISE_OT_solid_preview(_TaskOperator, bpy.types.Operator):
         return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
 
 
-class OMNINOISE_OT_solid_bake(_TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
     """Bake the solid texture onto the active object: UV image, colour attribute or volume"""
 
     bl_idname = "omninoise.solid_bake"

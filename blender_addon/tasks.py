@@ -19,10 +19,11 @@ import traceback
 from typing import Callable
 
 import bpy
+from bpy.props import BoolProperty
 
 from ._deps import backend
 
-__all__ = ["Task", "start", "current", "cancel", "wait", "POLL_SECONDS"]
+__all__ = ["Task", "TaskOperator", "start", "current", "cancel", "wait", "POLL_SECONDS"]
 
 POLL_SECONDS = 0.1
 _current: "Task | None" = None
@@ -159,3 +160,52 @@ def wait(task: Task, timeout: float = 600.0) -> Task:
         bpy.app.timers.unregister(task.poll)
     task.finish()
     return task
+
+
+class TaskOperator:
+    """The one base of every operator whose work is a :class:`Task` (bakes, previews, thumbnails, jobs):
+    modal with Esc to cancel in the UI, blocking in scripts and background mode; reports failures and
+    cancellation.  A subclass implements ``_start(context, blocking) -> Task | None`` (None after reporting
+    why it could not start)."""
+
+    blocking: BoolProperty(name="Blocking", description="Wait for the work to finish (scripts)", default=False,
+                           options={"SKIP_SAVE", "HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return current() is None
+
+    def _start(self, context, blocking: bool):
+        """Start the task (None after reporting why it could not start)."""
+        raise NotImplementedError
+
+    def execute(self, context):
+        task = self._start(context, blocking=True)
+        if task is None:
+            return {"CANCELLED"}
+        if task.status != "done":
+            self.report({"ERROR"} if task.status == "failed" else {"WARNING"}, task.message or task.status)
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if self.blocking or bpy.app.background:
+            return self.execute(context)
+        self._task = self._start(context, blocking=False)
+        if self._task is None:
+            return {"CANCELLED"}
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        task = self._task
+        if not task.running:
+            if task.status == "failed":
+                self.report({"ERROR"}, task.message)
+            elif task.status == "cancelled":
+                self.report({"WARNING"}, f"{task.label}: cancelled")
+            return {"FINISHED"} if task.status == "done" else {"CANCELLED"}
+        if event.type == "ESC" and event.value == "PRESS":
+            task.cancel()
+            return {"RUNNING_MODAL"}
+        return {"PASS_THROUGH"}
