@@ -18,5 +18,8 @@ def register():
 
 
 def unregister():
+    from . import tasks
+
+    tasks.shutdown()  # a bake still running is cancelled and joined, its timer dropped: nothing keeps running
     for m in reversed(_modules()):
         m.unregister()

@@ -23,7 +23,7 @@ from bpy.props import BoolProperty
 
 from ._deps import backend
 
-__all__ = ["Task", "TaskOperator", "start", "current", "cancel", "wait", "POLL_SECONDS"]
+__all__ = ["Task", "TaskOperator", "start", "current", "cancel", "wait", "shutdown", "POLL_SECONDS"]
 
 POLL_SECONDS = 0.1
 _current: "Task | None" = None
@@ -148,6 +148,24 @@ def cancel() -> bool:
         return False
     _current.cancel()
     return True
+
+
+def shutdown(timeout: float = 10.0) -> None:
+    """Leave nothing running (the add-on is being disabled): cancel the task, wait for its worker thread, drop
+    its timer.  Its callbacks do not run: the classes they would use are going away."""
+    global _current
+    task = _current
+    if task is None:
+        return
+    task.cancel()
+    if task._thread is not None:
+        task._thread.join(timeout)
+    if bpy.app.timers.is_registered(task.poll):
+        bpy.app.timers.unregister(task.poll)
+    if task.status == "running":
+        task.status = "cancelled"
+    task._finished = True
+    _current = None
 
 
 def wait(task: Task, timeout: float = 600.0) -> Task:

@@ -5,6 +5,8 @@ argv[-1]: the extension zip.  Prints one JSON line of what it observed.
 import importlib
 import json
 import sys
+import threading
+import time
 
 import bpy
 
@@ -42,10 +44,34 @@ except RuntimeError as exc:
 obj = bpy.data.objects.get("Installed")
 out["bake_grids"] = sorted(g.name for g in obj.data.grids) if obj else []
 out["bake_file"] = bpy.path.abspath(obj.data.filepath) if obj else ""
+# a task still running when the add-on is disabled is cancelled, its thread joined and its timer dropped
+tasks = importlib.import_module(MOD + ".blender_addon.tasks")
+
+
+def spin(progress, cancelled):
+    while not cancelled():
+        time.sleep(0.01)
+
+
+task = tasks.start(tasks.Task("spin", spin), blocking=False)
+out["task_running_before_disable"] = task.running and task._thread.is_alive()
 bpy.ops.preferences.addon_disable(module=MOD)
+out["task_thread_alive_after_disable"] = task._thread.is_alive()
+out["task_timer_after_disable"] = bpy.app.timers.is_registered(task.poll)
+out["task_status_after_disable"] = task.status
 out["disabled_bake_props"] = hasattr(bpy.types.Scene, "omninoise_bake")
 out["disabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
 bpy.ops.preferences.addon_enable(module=MOD)
 out["reenabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
 bpy.ops.preferences.addon_disable(module=MOD)
+# enable / disable three times more: classes, properties and threads come and go cleanly
+cycles = []
+for _ in range(3):
+    bpy.ops.preferences.addon_enable(module=MOD)
+    on = hasattr(bpy.types.NodeTree, "omninoise_wave") and hasattr(bpy.types.Scene, "omninoise_bake")
+    bpy.ops.preferences.addon_disable(module=MOD)
+    off = hasattr(bpy.types.NodeTree, "omninoise_wave") or hasattr(bpy.types.Scene, "omninoise_bake")
+    cycles.append([on, off])
+out["cycles"] = cycles
+out["threads_left"] = sorted(t.name for t in threading.enumerate() if t.name.startswith("omninoise"))
 print("RESULT " + json.dumps(out))
