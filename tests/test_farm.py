@@ -3,6 +3,7 @@ files as a one-machine bake (images, a sequence, a bricked volume, a neural map)
 resume, and a failing output that leaves the others written."""
 import os
 import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -183,3 +184,42 @@ def test_the_cli_runs_a_job_on_a_local_cluster(tmp_path, capsys):
     assert main(["bake", job, "--workers", "0"]) == 2
     assert "--workers" in capsys.readouterr().err
     assert main(["bake", job, "--workers", "1", "--cluster", "tcp://127.0.0.1:1"]) == 2
+
+
+def _certs(folder) -> tuple:
+    """A throwaway CA and one certificate for 127.0.0.1 signed by it (openssl), as a farm's admin would make."""
+    ca_key, ca, key, csr, cert = (str(folder / n) for n in ("ca.key", "ca.pem", "node.key", "node.csr", "node.pem"))
+    run = lambda *a: subprocess.run(a, check=True, capture_output=True)  # noqa: E731
+    run("openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1", "-subj", "/CN=omninoise-test-ca",
+        "-keyout", ca_key, "-out", ca)
+    run("openssl", "req", "-newkey", "rsa:2048", "-nodes", "-subj", "/CN=127.0.0.1", "-keyout", key, "-out", csr)
+    ext = folder / "ext.cnf"
+    ext.write_text("subjectAltName = IP:127.0.0.1\n")
+    run("openssl", "x509", "-req", "-in", csr, "-CA", ca, "-CAkey", ca_key, "-CAcreateserial", "-days", "1",
+        "-extfile", str(ext), "-out", cert)
+    return ca, cert, key
+
+
+@pytest.mark.skipif(shutil.which("openssl") is None, reason="needs openssl to make test certificates")
+def test_a_tls_scheduler_is_reached_with_dask_security(tmp_path):
+    """`--cluster tls://...` with --tls-ca-file/--tls-cert/--tls-key: the job runs over an encrypted
+    connection; without the certificates the address is refused with a one-line error."""
+    from distributed import LocalCluster
+    from distributed.security import Security
+
+    ca, cert, key = _certs(tmp_path)
+    sec = Security(tls_ca_file=ca, tls_scheduler_cert=cert, tls_scheduler_key=key, tls_worker_cert=cert,
+                   tls_worker_key=key, tls_client_cert=cert, tls_client_key=key, require_encryption=True)
+    cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=True, protocol="tls://", host="127.0.0.1",
+                           security=sec, dashboard_address=None)
+    try:
+        address = cluster.scheduler_address
+        assert address.startswith("tls://127.0.0.1:")
+        job = job_in(tmp_path / "job", JOB.split("[[bake]]\nname = \"seq\"")[0])
+        assert main(["bake", job, "--cluster", address, "--tls-ca-file", ca, "--tls-cert", cert, "--tls-key", key,
+                     "--quiet"]) == 0
+        assert (tmp_path / "job" / "out" / "img.exr").is_file()
+        with pytest.raises(Exception, match="tls-ca-file"):
+            farm.remote_client(address)
+    finally:
+        cluster.close()
