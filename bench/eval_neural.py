@@ -40,6 +40,8 @@ def main() -> int:
     ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
     ap.add_argument("--eval-size", type=int, help="resolution of the quality evaluation (default: the model's "
                                                   "training size); compare two models at one size")
+    ap.add_argument("--clf-threads", type=int, help="torch threads the classifier is trained with (and cached "
+                                                    "under); default: --threads")
     ap.add_argument("--clf-stages", type=int, default=2, help="stride-2 stages of the classifier (3 or more for "
                                                               "64² and larger: a wider receptive field)")
     ap.add_argument("--timing-only", action="store_true",
@@ -74,7 +76,7 @@ def _run(a, model, classes) -> int:
     else:
         res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr),
                        sampler=a.sampler, spacing=a.spacing, classifier_cache=a.classifier_cache,
-                       size=a.eval_size, clf_stages=a.clf_stages)
+                       size=a.eval_size, clf_stages=a.clf_stages, clf_threads=a.clf_threads)
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
     if not a.timing_only:

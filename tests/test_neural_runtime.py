@@ -511,8 +511,8 @@ def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(expor
     _, out = exported
     m = NeuralNoiseModel(str(out))
     res = evaluate(m, ("perlin", "spots"), n=3, steps=2, clf_steps=3, log=lambda s: None, size=24,
-                   classifier_cache=str(tmp_path), clf_stages=3)
-    assert res["size"] == 24 and res["classifier"] == dict(steps=3, stages=3)
+                   classifier_cache=str(tmp_path), clf_stages=3, clf_threads=1)
+    assert res["size"] == 24 and res["classifier"] == dict(steps=3, stages=3, threads=1)
     for r in res["classes"].values():
         assert set(r) >= {"fd", "acc", "psd", "psd_low", "coherence", "coherence_zoo", "response"}
         assert 0.0 <= r["coherence"] <= 1.0 and np.isfinite(r["psd_low"])

@@ -148,10 +148,20 @@ def _centroid(imgs):
     return float((p * k).sum() / p.sum())
 
 
-def cached_classifier(classes, size: int, steps: int, cache: str | None = None, log=None, stages: int = 2):
+def cached_classifier(classes, size: int, steps: int, cache: str | None = None, log=None, stages: int = 2,
+                      threads: int | None = None):
     """:func:`train_classifier`, or the one saved in folder ``cache`` for the same classes, size, steps
     and thread count (training is reproducible for a fixed count), so that runs that compare
-    samplers or models use one instrument without training it again."""
+    samplers or models use one instrument without training it again.  ``threads``: train with this many
+    torch threads (and key the cache by it) whatever the caller's own count, so an instrument trained
+    beside other work can be reused by evaluations that use every core."""
+    if threads:
+        saved = torch.get_num_threads()
+        torch.set_num_threads(int(threads))
+        try:
+            return cached_classifier(classes, size, steps, cache, log, stages)
+        finally:
+            torch.set_num_threads(saved)
     if not cache:
         return train_classifier(classes, size, steps, log=log, stages=stages)
     import hashlib
@@ -179,7 +189,7 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
 
 def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print,
              sampler: str = "ddim", spacing: str | None = None, classifier_cache: str | None = None,
-             size: int | None = None, clf_stages: int = 2) -> dict:
+             size: int | None = None, clf_stages: int = 2, clf_threads: int | None = None) -> dict:
     """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`),
     sampled by ``sampler`` with ``steps`` timesteps (the same seeds for every sampler) at ``size``² px
     (default: the model's training size; two models compare only at one size, with one classifier).
@@ -196,7 +206,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
         return _generate(*args, sampler=sampler, spacing=spacing, **kw)
 
     S = int(size or model.config["train_size"])
-    clf, zoo_acc = cached_classifier(classes, S, clf_steps, classifier_cache, log=log, stages=clf_stages)
+    clf, zoo_acc = cached_classifier(classes, S, clf_steps, classifier_cache, log=log, stages=clf_stages,
+                                     threads=clf_threads)
     index = {c: i for i, c in enumerate(classes)}
     rng = np.random.default_rng(123)
     rows = {}
@@ -254,7 +265,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
         _, pred = feats(np.stack([img[:, : S], img[:, -S:]]))
         hits += int(pred[0] == index[a]) + int(pred[1] == index[b])
         total += 2
-    return dict(classes=rows, size=S, classifier=dict(steps=clf_steps, stages=clf_stages), zoo_accuracy=round(zoo_acc, 3), seam_tileable=round(seam(tile), 3),
+    return dict(classes=rows, size=S, classifier=dict(steps=clf_steps, stages=clf_stages, threads=clf_threads),
+                zoo_accuracy=round(zoo_acc, 3), seam_tileable=round(seam(tile), 3),
                 seam_plain=round(seam(plain), 3), locality=round(hits / total, 3))
 
 
