@@ -16,6 +16,7 @@ from export.images import ImageError
 from . import limits
 from .errors import SettingError
 from .spectra import SPECTRUM_KINDS, Spectrum
+from .paths import neural_model
 from .settings import WaveSettings
 from .cellular import CELLULAR_MODES
 from .tables import WAVEFORMS
@@ -392,7 +393,6 @@ def run_bake_job(a: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-DEFAULT_MODEL = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "neural_noise")
 
 
 def _param_items(items: list, flag: str) -> dict:
@@ -471,7 +471,7 @@ def run_neural(a: argparse.Namespace) -> int:
     tile = a.tile
     if tile is not None and tile < 0:
         raise SettingError("--tile", f"must be >= 0 (0: never tile), got {tile}")
-    folder = a.model or DEFAULT_MODEL
+    folder = a.model or neural_model()
     try:
         model = NeuralNoiseModel(folder)
     except ModelError as exc:

@@ -380,8 +380,9 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         raise SettingError("source.latent", "latent motion animates keyframes: give keys too")
     if "noise" not in d:
         raise SettingError("source.noise", "a neural source needs noise = CLASS")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    model = os.path.join(base_dir, d["model"]) if "model" in d else os.path.join(root, "models", "neural_noise")
+    from .paths import neural_model
+
+    model = os.path.join(base_dir, d["model"]) if "model" in d else neural_model()
     mask = None
     if "blend" in d:
         path = os.path.join(base_dir, d["blend"])

@@ -421,9 +421,11 @@ sampler = "ddim"
 
 def test_the_shipped_model_loads_and_generates():
     """models/neural_noise: the committed ONNX passes its hash check and samples every trained class."""
-    import backend.cli
+    from backend.paths import neural_model
 
-    model = NeuralNoiseModel(backend.cli.DEFAULT_MODEL)
+    assert neural_model() == os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models",
+                                          "neural_noise")  # the repository's own models
+    model = NeuralNoiseModel(neural_model())
     assert set(model.config["trained_classes"]) <= set(model.classes) and model.config["step"] > 0
     for name in model.config["trained_classes"][:2]:
         img = generate(model, C.uniform(model, (name, {}), 32, 32), seed=1, steps=3)

@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import SettingError
 from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
+from ..paths import solid_models
 from .lattice import lattice_noise
 
 __all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
@@ -30,8 +31,7 @@ __all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "DE
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
 #: the models the extension ships (``models/solid`` beside ``backend``)
-SHIPPED_MODELS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-                              "models", "solid")
+SHIPPED_MODELS = solid_models()
 
 
 def plane_points(size: int, px_per_unit: float) -> np.ndarray:
