@@ -50,6 +50,10 @@ class Task:
         self._cancel = threading.Event()
         self._thread: threading.Thread | None = None
         self._finished = False
+        # the timer callback, bound once: bpy.app.timers compares callbacks by identity and a fresh bound
+        # method (task.poll) is never "registered", so it could not be unregistered (a timer left behind made
+        # Blender 4.5 hang at exit)
+        self.timer = self.poll
 
     # -- worker side (no bpy) ----------------------------------------------------------
     def _report(self, fraction: float) -> None:
@@ -138,7 +142,7 @@ def start(task: Task, blocking: bool = False) -> Task:
         return task
     task._thread = threading.Thread(target=task._run, name=f"omninoise: {task.label}", daemon=True)
     task._thread.start()
-    bpy.app.timers.register(task.poll, first_interval=POLL_SECONDS)
+    bpy.app.timers.register(task.timer, first_interval=POLL_SECONDS)
     return task
 
 
@@ -160,8 +164,8 @@ def shutdown(timeout: float = 10.0) -> None:
     task.cancel()
     if task._thread is not None:
         task._thread.join(timeout)
-    if bpy.app.timers.is_registered(task.poll):
-        bpy.app.timers.unregister(task.poll)
+    if bpy.app.timers.is_registered(task.timer):
+        bpy.app.timers.unregister(task.timer)
     if task.status == "running":
         task.status = "cancelled"
     task._finished = True
@@ -174,8 +178,8 @@ def wait(task: Task, timeout: float = 600.0) -> Task:
         task._thread.join(timeout)
     if task._thread is not None and task._thread.is_alive():
         raise TimeoutError(f"{task.label} still running after {timeout:g} s")
-    if bpy.app.timers.is_registered(task.poll):
-        bpy.app.timers.unregister(task.poll)
+    if bpy.app.timers.is_registered(task.timer):
+        bpy.app.timers.unregister(task.timer)
     task.finish()
     return task
 

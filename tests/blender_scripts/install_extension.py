@@ -55,9 +55,10 @@ def spin(progress, cancelled):
 
 task = tasks.start(tasks.Task("spin", spin), blocking=False)
 out["task_running_before_disable"] = task.running and task._thread.is_alive()
+out["task_timer_before_disable"] = bpy.app.timers.is_registered(task.timer)
 bpy.ops.preferences.addon_disable(module=MOD)
 out["task_thread_alive_after_disable"] = task._thread.is_alive()
-out["task_timer_after_disable"] = bpy.app.timers.is_registered(task.poll)
+out["task_timer_after_disable"] = bpy.app.timers.is_registered(task.timer)
 out["task_status_after_disable"] = task.status
 out["disabled_bake_props"] = hasattr(bpy.types.Scene, "omninoise_bake")
 out["disabled_props"] = hasattr(bpy.types.NodeTree, "omninoise_wave")
