@@ -239,9 +239,7 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
     ext = os.path.splitext(path)[1].lower()
     meta = {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}
     tf = spec.transfer
-    if getattr(spec.source, "rgb", False):
-        return _bake_rgb_file(spec, path, time, meta, progress, cancel)
-    if ext == ".vdb":
+    if ext == ".vdb":  # values and colour sources alike: volume_grids / volume_channels
         writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, volume_grids(spec), meta, half=spec.half)
         for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
             for name, slab in volume_channels(spec, vals).items():
@@ -250,6 +248,8 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
             raise Cancelled("cancelled")
         writer.write(path)
         return
+    if getattr(spec.source, "rgb", False):
+        return _bake_rgb_file(spec, path, time, meta, progress, cancel)
     shape = spec.grid.shape
     values = np.empty(shape, _F)
     for a, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
@@ -271,20 +271,11 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
 
 
 def _bake_rgb_file(spec: BakeSpec, path: str, time: float, meta: dict, progress, cancel) -> None:
-    """Files of a colour source (scene-linear RGB values (..., 3)): VDB color + constant density,
-    RGB EXR, sRGB PNG, or (..., 3) .npy."""
+    """Image and array files of a colour source (scene-linear RGB values (..., 3)): RGB EXR, sRGB PNG, or
+    (..., 3) .npy (its volumes go through _bake_file's .vdb branch: color + constant density)."""
     from ._export import export
 
     ext = os.path.splitext(path)[1].lower()
-    if ext == ".vdb":
-        writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, volume_grids(spec), meta, half=spec.half)
-        for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
-            for name, slab in volume_channels(spec, vals).items():
-                writer.add(name, z0, slab)
-        if cancel is not None and cancel():
-            raise Cancelled("cancelled")
-        writer.write(path)
-        return
     values = np.empty(spec.grid.shape + (3,), _F)
     for a, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
         values[a: a + vals.shape[0]] = vals

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bake import BakeSpec, KEY_NAME, bake_frame, frame_path, volume_channels, volume_grids
-from .jobs import JobError, JobOutcome, load_job
+from .jobs import JobError, JobOutcome, load_job, select_bakes
 
 __all__ = ["Task", "plan", "run_farm", "local_client", "remote_client", "brick_voxels_for", "CRASH_ENV"]
 
@@ -210,13 +210,7 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
     from ._export import export
 
     job = os.path.abspath(job)
-    entries = load_job(job)
-    if only:
-        names = [n for n, _ in entries]
-        missing = [n for n in only if n not in names]
-        if missing:
-            raise JobError(f"no bake named {missing[0]!r}; the job has {', '.join(names)}")
-        entries = [(n, s) for n, s in entries if n in only]
+    entries = select_bakes(load_job(job), only)
     bad = [(n, s) for n, s in entries if isinstance(s, JobError)]
     if bad:
         return [JobOutcome(n, "invalid", str(s)) for n, s in bad]

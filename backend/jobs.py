@@ -92,7 +92,7 @@ from .errors import SettingError
 from .sources import BoxGrid, source_from_dict
 from .transfer import load_transfer, transfer_from_dict
 
-__all__ = ["JobError", "load_job", "parse_job", "run_job", "JobOutcome", "BAKE_KEYS"]
+__all__ = ["JobError", "load_job", "parse_job", "run_job", "select_bakes", "JobOutcome", "BAKE_KEYS"]
 
 BAKE_KEYS = ("name", "output", "resolution", "bounds", "transfer", "frames", "time", "time_step", "half", "source")
 
@@ -231,6 +231,17 @@ def load_job(path: str) -> list:
     return parse_job(doc, os.path.dirname(os.path.abspath(path)))
 
 
+def select_bakes(entries: list, only: list | None) -> list:
+    """The (name, spec) entries named in ``only`` (all when empty); JobError for a name the job lacks."""
+    if not only:
+        return entries
+    names = [n for n, _ in entries]
+    missing = [n for n in only if n not in names]
+    if missing:
+        raise JobError(f"no bake named {missing[0]!r}; the job has {', '.join(names)}")
+    return [(n, s) for n, s in entries if n in only]
+
+
 def run_job(path: str, keep_going: bool = False, force: bool = False, only: list | None = None,
             progress: Callable[[str, int, int, float], None] | None = None,
             cancel: Callable[[], bool] | None = None, log: Callable[[str], None] | None = None) -> list:
@@ -241,13 +252,7 @@ def run_job(path: str, keep_going: bool = False, force: bool = False, only: list
     it); invalid bakes fail before anything is baked.  Outputs whose stored key
     matches are skipped unless ``force``.
     """
-    entries = load_job(path)
-    if only:
-        names = [n for n, _ in entries]
-        missing = [n for n in only if n not in names]
-        if missing:
-            raise JobError(f"no bake named {missing[0]!r}; the job has {', '.join(names)}")
-        entries = [(n, s) for n, s in entries if n in only]
+    entries = select_bakes(load_job(path), only)
     outcomes = []
     if not keep_going:
         for name, spec in entries:
