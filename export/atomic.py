@@ -53,28 +53,12 @@ def partial_prefix(path: str) -> str:
     return f".omninoise-{os.path.basename(path)}."
 
 
-def remove_partials(path: str) -> list:
-    """Remove the temporaries of ``path`` left by writers that died (a worker killed mid-write); call it only
-    when no writer of ``path`` can still be running.  Returns their names."""
-    folder, prefix, gone = os.path.dirname(os.path.abspath(path)), partial_prefix(path), []
-    try:
-        names = [n for n in os.listdir(folder) if n.startswith(prefix)]
-    except OSError:
-        return gone
-    for n in names:
-        try:
-            os.remove(os.path.join(folder, n))
-            gone.append(n)
-        except OSError:
-            pass
-    return gone
-
-
-def remove_stale(folder: str, max_age: float = STALE_SECONDS) -> list:
-    """Remove ``.omninoise-*`` temporaries older than ``max_age`` seconds in ``folder``; returns their names."""
+def _remove_temporaries(folder: str, prefix: str, max_age: float) -> list:
+    """Remove the files in ``folder`` whose names start with ``prefix`` and are older than ``max_age``
+    seconds (a negative age: any file); returns their names."""
     now, gone = time.time(), []
     try:
-        names = [n for n in os.listdir(folder) if n.startswith(".omninoise-")]
+        names = [n for n in os.listdir(folder) if n.startswith(prefix)]
     except OSError:
         return gone
     for n in names:
@@ -86,6 +70,17 @@ def remove_stale(folder: str, max_age: float = STALE_SECONDS) -> list:
         except OSError:
             pass        # another process's file, or gone already
     return gone
+
+
+def remove_partials(path: str) -> list:
+    """Remove the temporaries of ``path`` left by writers that died (a worker killed mid-write); call it only
+    when no writer of ``path`` can still be running.  Returns their names."""
+    return _remove_temporaries(os.path.dirname(os.path.abspath(path)), partial_prefix(path), -1.0)
+
+
+def remove_stale(folder: str, max_age: float = STALE_SECONDS) -> list:
+    """Remove ``.omninoise-*`` temporaries older than ``max_age`` seconds in ``folder``; returns their names."""
+    return _remove_temporaries(folder, ".omninoise-", max_age)
 
 
 def _umask() -> int:
