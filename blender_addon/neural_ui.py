@@ -6,7 +6,9 @@ own parameter names) and a colour; the blend map is an image painted in those
 colours with Blender's texture-paint tools.  The bake builds the conditioning
 grid on the main thread, denoises on a :mod:`.tasks` worker (progress per DDIM
 step, Esc / Cancel stop within one step) and stores the result as an image
-datablock, optionally wired into the active material as Non-Color data.
+datablock, optionally wired into the active material as Non-Color data.  The sequence bake animates the
+conditioning between keyframes (the swatches spread over a frame range, or a TOML keyframe file), writes one
+file per frame and loads them as one image sequence on the Image Texture node.
 """
 from __future__ import annotations
 
@@ -24,7 +26,7 @@ from .bake_ui import draw_progress
 from .tasks import TaskOperator
 from .preferences import threads
 
-__all__ = ["model", "build_conditioning", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
+__all__ = ["model", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
 
 _MODEL = {}
 N_PARAMS = 4
@@ -122,6 +124,22 @@ class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
                            description="Where saved images go ('//' = beside the .blend, or the cache folder)")
     add_node: BoolProperty(name="Add Image Texture Node", default=True,
                            description="Wire the result into the active material as Non-Color data")
+    # animation: an image sequence whose classes and parameters move between keyframes (Fig. 11)
+    frame_start: IntProperty(name="Start", default=1, min=0, description="First frame of the sequence")
+    frame_end: IntProperty(name="End", default=48, min=0, description="Last frame of the sequence")
+    key_source: EnumProperty(name="Keyframes", items=[
+        ("SWATCHES", "Swatches", "Swatch 1 on the first frame, the last swatch on the last frame, the others "
+                                 "evenly between (swatch i uses seed + i)"),
+        ("FILE", "Keyframe File", "A TOML keyframe file, as the command line's --keys")], default="SWATCHES")
+    keys_file: StringProperty(name="Keyframe File", subtype="FILE_PATH", description="[[key]] tables with frame, "
+                              "noise, params and seed (see backend/neural/animate.py)")
+    latent: EnumProperty(name="Latent", items=[
+        ("fixed", "Fixed", "One initial latent for every frame: only the classes and parameters move"),
+        ("slerp", "Between Seeds", "The latent moves along the sphere between the keyframes' seeds"),
+        ("drift", "Drift", "The latent circles at a constant speed, so the noise flows even between keys")],
+        default="fixed")
+    drift: FloatProperty(name="Drift Speed", default=0.05, min=0.0, soft_max=0.5,
+                         description="Radians per frame of the drifting latent")
 
 
 # -- conditioning from the settings (main thread) -----------------------------------------
@@ -258,6 +276,105 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
         return tasks.start(tasks.Task(f"Neural {name}", work, done, None, threads()), blocking=blocking)
 
 
+def sequence_keys(p) -> list:
+    """The keyframes of the scene's animation settings (main thread); SettingError naming what is wrong."""
+    A = _mod("neural.animate")
+    if p.frame_end < p.frame_start:
+        raise backend.SettingError("frames", f"the end frame {p.frame_end} is before the start {p.frame_start}")
+    if p.key_source == "FILE":
+        if not p.keys_file:
+            raise backend.SettingError("keyframe file", "pick a keyframe file (.toml)")
+        keys = A.read_keys(bpy.path.abspath(p.keys_file))
+    else:
+        keys = A.even_keys([s.spec() for s in p.swatches], p.frame_start, p.frame_end, p.seed)
+    for k in keys:
+        model().param_vector(*k.spec)  # unknown classes or parameters fail before the first frame
+    return keys
+
+
+def _wire_sequence(ima, first: int, n: int, node) -> None:
+    """Play the sequence's files first..first+n-1 on scene frames first..first+n-1."""
+    u = node.image_user
+    u.frame_duration, u.frame_start, u.frame_offset = n, first, first - 1
+    u.use_auto_refresh, u.use_cyclic = True, False
+
+
+class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
+    """Bake animated neural noise (classes and parameters moving between keyframes) into an image sequence
+    on disk, loaded as one sequence image"""
+
+    bl_idname = "omninoise.neural_bake_sequence"
+    bl_label = "Bake Sequence"
+    bl_options = {"REGISTER"}
+
+    def _start(self, context, blocking: bool):
+        from .bake_blender import output_folder
+
+        p = context.scene.omninoise_neural
+        size = p.size + (-p.size) % 8 if p.tileable else p.size
+        try:
+            m = model()
+            keys = sequence_keys(p)
+            folder = output_folder(p.folder)
+        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        except OSError as exc:
+            self.report({"ERROR"}, f"output folder: {exc}")
+            return None
+        ext = "png" if p.save == "PNG" else "exr"  # a sequence lives on disk: EXR unless PNG was picked
+        pattern = os.path.join(folder, bpy.path.clean_name(p.name) + "_####." + ext)
+        first, last = p.frame_start, p.frame_end
+        n = last - first + 1
+        kw = dict(latent=p.latent, speed=p.drift, steps=p.steps, sampler=p.sampler, tileable=p.tileable)
+        half, name = p.depth != "32", p.name + " Sequence"
+        obj, add_node = context.active_object, p.add_node
+        frame_path = _mod("bake").frame_path
+
+        def work(progress, cancel):
+            from ._deps import export
+
+            finished = []
+
+            def step(i, steps, x0):
+                progress((len(finished) + (i + 1) / steps) / n)
+                if cancel():
+                    raise backend.Cancelled("cancelled")
+
+            for f, img in _mod("neural.animate").animate(m, keys, (first, last), size, size, cancel=cancel,
+                                                          callback=step, **kw):
+                path = frame_path(pattern, f)
+                if ext == "png":
+                    export.write_png(path, export.preview_8bit(img, 0.0, 1.0))
+                else:
+                    export.write_exr(path, img, half=half)
+                finished.append(path)
+                task.label = f"Neural sequence: frame {f} ({len(finished)}/{n})"
+            return finished
+
+        def done(paths):
+            old = bpy.data.images.get(name)
+            if old is not None:
+                bpy.data.images.remove(old)
+            ima = bpy.data.images.load(paths[0], check_existing=False)
+            ima.name = name
+            ima.source = "SEQUENCE"
+            ima.colorspace_settings.name = "Non-Color"
+            ima["omninoise_file"] = pattern
+            if add_node and obj is not None and obj.active_material is not None \
+                    and obj.active_material.node_tree is not None:
+                nt = obj.active_material.node_tree
+                node = next((nd for nd in nt.nodes if nd.type == "TEX_IMAGE" and nd.image == ima), None)
+                if node is None:
+                    node = nt.nodes.new("ShaderNodeTexImage")
+                    node.image = ima
+                _wire_sequence(ima, first, n, node)
+                nt.nodes.active = node
+
+        task = tasks.Task(f"Neural sequence ({n} frames)", work, done, None, threads())
+        return tasks.start(task, blocking=blocking)
+
+
 class OMNINOISE_OT_swatch_add(bpy.types.Operator):
     """Add a noise swatch"""
 
@@ -323,7 +440,8 @@ class OMNINOISE_OT_blend_map_new(bpy.types.Operator):
 # -- presets: the swatch set and layout as a shareable JSON file ---------------------------------
 
 PRESET_FORMAT = 1
-_PRESET_KEYS = ("mode", "width", "sharpness", "size", "sampler", "steps", "seed", "tileable", "depth")
+_PRESET_KEYS = ("mode", "width", "sharpness", "size", "sampler", "steps", "seed", "tileable", "depth", "frame_start",
+                "frame_end", "key_source", "latent", "drift")
 
 
 def preset_dict(p) -> dict:
@@ -543,6 +661,20 @@ def draw_neural(layout, context) -> None:
     row.enabled = tasks.current() is None
     row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Preview", icon="HIDE_OFF").preview = True
     row.operator(OMNINOISE_OT_neural_bake.bl_idname, icon="RENDER_STILL")
+    box = layout.box()
+    box.label(text="Animation", icon="RENDER_ANIMATION")
+    row = box.row(align=True)
+    row.prop(p, "frame_start")
+    row.prop(p, "frame_end")
+    box.prop(p, "key_source")
+    if p.key_source == "FILE":
+        box.prop(p, "keys_file")
+    box.prop(p, "latent")
+    if p.latent == "drift":
+        box.prop(p, "drift")
+    row = box.row()
+    row.enabled = tasks.current() is None
+    row.operator(OMNINOISE_OT_neural_bake_sequence.bl_idname, icon="RENDER_ANIMATION")
 
 
 class OMNINOISE_PT_neural_image(bpy.types.Panel):
@@ -569,7 +701,8 @@ class OMNINOISE_PT_neural_shader(bpy.types.Panel):
         draw_neural(self.layout, context)
 
 
-classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_swatch_add,
+classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_neural_bake_sequence,
+           OMNINOISE_OT_swatch_add,
            OMNINOISE_OT_neural_preset_save, OMNINOISE_OT_neural_preset_load, OMNINOISE_OT_swatch_thumbnails,
            OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches,
            OMNINOISE_PT_neural_image, OMNINOISE_PT_neural_shader)

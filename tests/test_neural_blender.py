@@ -9,6 +9,7 @@ bpy = pytest.importorskip("bpy")
 import blender_addon  # noqa: E402
 from conftest import Recorder  # noqa: E402
 from blender_addon import neural_ui, tasks  # noqa: E402
+from blender_addon.compat import ensure_node_tree  # noqa: E402
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -216,3 +217,75 @@ def test_painted_regions_carry_their_swatch_spectra(scene):
     left, right = psd(img[:, 4:28]), psd(img[:, 36:60])
     d = lambda a, b: float(np.abs(a - b).mean())  # noqa: E731
     assert d(left, refs[0]) < d(left, refs[1]) and d(right, refs[1]) < d(right, refs[0])
+
+
+def _material_object():
+    bpy.ops.mesh.primitive_plane_add(size=2)
+    obj = bpy.context.active_object
+    mat = bpy.data.materials.new("Noise")
+    obj.data.materials.append(mat)
+    return obj, ensure_node_tree(mat)
+
+
+def _bake_emission(obj, nt, node, size):
+    """Cycles bakes the node's colour (as emission) into a size² image through the plane's UVs: (size, size)."""
+    for other in [n for n in nt.nodes if n != node]:
+        nt.nodes.remove(other)
+    em, out = nt.nodes.new("ShaderNodeEmission"), nt.nodes.new("ShaderNodeOutputMaterial")
+    nt.links.new(node.outputs["Color"], em.inputs["Color"])
+    nt.links.new(em.outputs[0], out.inputs["Surface"])
+    target = bpy.data.images.new("bake target", size, size, float_buffer=True)
+    target.colorspace_settings.name = "Non-Color"
+    tex = nt.nodes.new("ShaderNodeTexImage")
+    tex.image = target
+    nt.nodes.active = tex
+    obj.select_set(True)
+    bpy.ops.object.bake(type="EMIT", margin=0)
+    px = np.array(target.pixels[:], np.float32).reshape(size, size, 4)
+    return np.flipud(px[..., 0])
+
+
+def test_sequence_bake_writes_the_frames_and_plays_them(scene, tmp_path):
+    from export.images import read_image
+    from backend.neural.animate import animate
+
+    p = scene.omninoise_neural
+    p.size, p.steps, p.frame_start, p.frame_end = 16, 2, 3, 6
+    p.folder, p.name, p.latent = str(tmp_path) + os.sep, "Anim", "slerp"
+    scene.render.engine, scene.cycles.device, scene.cycles.samples = "CYCLES", "CPU", 1
+    obj, nt = _material_object()
+    assert bpy.ops.omninoise.neural_bake_sequence() == {"FINISHED"}
+    assert sorted(os.listdir(tmp_path)) == [f"Anim_{f:04d}.exr" for f in range(3, 7)]
+    keys = neural_ui.sequence_keys(p)  # swatch 1 on the first frame, swatch 2 on the last, seeds 5 and 6
+    assert [(k.frame, k.noise, k.seed) for k in keys] == [(3, "spots", 5), (6, "damascus", 6)]
+    ref = dict(animate(neural_ui.model(), keys, (3, 6), 16, 16, latent="slerp", steps=2, sampler=p.sampler))
+    for f, img in ref.items():
+        np.testing.assert_allclose(read_image(str(tmp_path / f"Anim_{f:04d}.exr")), img, atol=1e-6)
+    assert np.abs(ref[3] - ref[6]).mean() > 0.02  # the frames move
+    ima = bpy.data.images["Anim Sequence"]
+    node = next(n for n in nt.nodes if n.type == "TEX_IMAGE")
+    assert ima.source == "SEQUENCE" and node.image == ima and ima.colorspace_settings.name == "Non-Color"
+    node.interpolation = "Closest"
+    for f in (3, 5, 6):  # scene frame f shows file f in a render
+        scene.frame_set(f)
+        np.testing.assert_allclose(_bake_emission(obj, nt, node, 16), ref[f], atol=1e-5)
+
+
+def test_sequence_bake_says_what_is_wrong(scene, tmp_path):
+    p = scene.omninoise_neural
+    p.folder = str(tmp_path) + os.sep
+    p.frame_start, p.frame_end = 10, 4
+    with pytest.raises(RuntimeError, match="end frame 4 is before the start 10"):
+        bpy.ops.omninoise.neural_bake_sequence()
+    p.frame_start, p.frame_end = 1, 1
+    with pytest.raises(RuntimeError, match="2 keyframes need at least 2 frames"):
+        bpy.ops.omninoise.neural_bake_sequence()
+    p.frame_end, p.key_source = 8, "FILE"
+    with pytest.raises(RuntimeError, match="pick a keyframe file"):
+        bpy.ops.omninoise.neural_bake_sequence()
+    bad = tmp_path / "keys.toml"
+    bad.write_text('[[key]]\nframe = 1\nnoise = "no_such_class"\n')
+    p.keys_file = str(bad)
+    with pytest.raises(RuntimeError, match="no_such_class"):
+        bpy.ops.omninoise.neural_bake_sequence()
+    assert os.listdir(tmp_path) == ["keys.toml"]  # nothing written

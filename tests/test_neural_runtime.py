@@ -645,3 +645,4 @@ steps = 2
     job.write_text(inline.replace('latent = "slerp"', 'latent = "slerp"\nblend = "mask.png"'))
     (_, bad), = load_job(str(job))
     assert "source.keys: keyframes set the classes of the whole image; leave out blend" in str(bad)
+

@@ -41,7 +41,7 @@ from . import conditioning as C
 from .generate import generate
 from .sampler import initial_noise
 
-__all__ = ["Keyframe", "LATENT_MODES", "read_keys", "parse_keys", "frame_weight", "frame_cond", "frame_latent",
+__all__ = ["Keyframe", "LATENT_MODES", "read_keys", "parse_keys", "even_keys", "frame_weight", "frame_cond", "frame_latent",
            "animate", "temporal_coherence"]
 
 LATENT_MODES = ("fixed", "slerp", "drift")
@@ -92,6 +92,22 @@ def parse_keys(doc: dict, where: str = "keys") -> list:
     if dup:
         raise SettingError(where, f"two keyframes at frame {dup[0]}")
     return out
+
+
+def even_keys(specs: list, first: int, last: int, seed: int = 0) -> list:
+    """Keyframes that visit ``specs`` ((class, params) pairs, in order) evenly over frames ``first``..``last``:
+    the first on ``first``, the last on ``last``, key i with seed ``seed + i`` (its latent for "slerp").
+    One spec gives one keyframe (a still conditioning; only the latent may move)."""
+    if not specs:
+        raise SettingError("keys", "no classes to animate: add a swatch first")
+    if last < first:
+        raise SettingError("frames", f"expected FIRST <= LAST, got {first} {last}")
+    n = len(specs)
+    if n > 1 and last - first + 1 < n:
+        raise SettingError("frames", f"{n} keyframes need at least {n} frames, got {last - first + 1}")
+    frames = [first] if n == 1 else [first + round(i * (last - first) / (n - 1)) for i in range(n)]
+    return [Keyframe(int(f), name, {str(k): float(v) for k, v in params.items()}, (int(seed) + i) % 2 ** 32)
+            for i, (f, (name, params)) in enumerate(zip(frames, specs))]
 
 
 def read_keys(path: str) -> list:
