@@ -143,6 +143,10 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--latent", choices=("fixed", "slerp", "drift"), default="fixed",
                    help="animate: how the initial latent moves (fixed; slerp between the keys' seeds; drift)")
     n.add_argument("--drift", type=float, default=0.05, help="animate, --latent drift: radians per frame")
+    n.add_argument("--fit", metavar="IMAGE", help="inverse design: find the class weights, parameters and seed whose "
+                                                  "noise looks like IMAGE (grey; colour is converted), write it to -o")
+    n.add_argument("--report", metavar="FIT.json", help="--fit: write the fitted classes, parameters and seed here")
+    n.add_argument("--fit-size", type=int, default=64, help="--fit: side of the windows compared, px (default 64)")
     n.add_argument("--model", help="model folder (default: models/neural_noise beside the package)")
     n.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
     n.add_argument("--quiet", action="store_true")
@@ -481,6 +485,10 @@ def run_neural(a: argparse.Namespace) -> int:
         return 0
     if a.keys or a.frames:
         return _animate_neural(a, model, sampler, steps, tile)
+    if a.fit:
+        return _fit_neural(a, model, sampler, steps, tile)
+    if a.report:
+        raise SettingError("--report", "a fit report needs --fit IMAGE")
     if not (a.noise or a.corners or a.map) or not a.out:
         raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
     if a.size < 8:
@@ -561,6 +569,59 @@ def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile
         else:
             write_image(path, img)
         bar((i + 1) / n)
+    return 0
+
+
+def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
+    """``neural --fit IMAGE -o OUT [--report FIT.json]``: inverse design (backend/neural/fit.py), then the fitted
+    noise at --size with the sampler settings."""
+    import json
+
+    from export.atomic import write_json
+    from export.images import decode, preview_8bit, write_image, write_png
+    from .neural.fit import fit, fitted_conditioning, load_bank, prepare_target
+    from .neural.generate import generate
+    from .onnx_models import ModelError
+    from .paths import fit_bank
+
+    if a.noise or a.corners or a.map or a.blend:
+        raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
+    if not a.out:
+        raise SettingError("-o", "--fit writes the fitted noise: give -o OUT (.png, .exr or .npy)")
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    if not os.path.isfile(a.fit):
+        raise SettingError("--fit", f"image not found: {a.fit}")
+    try:
+        img = decode(a.fit)
+    except (OSError, ValueError) as exc:
+        raise SettingError("--fit", f"{a.fit}: not an image we can read ({exc})") from None
+    try:
+        bank = load_bank(fit_bank())
+    except ModelError as exc:  # the fit still works, starting from every class at mid-range parameters
+        print(f"note: no inverse-design bank ({exc}); trying every class", file=sys.stderr)
+        bank = None
+    img = img[..., 0] if img.shape[2] == 1 else img
+    for note in prepare_target(img, model.multiple_of, os.path.basename(a.fit))[1]:  # refuses too small images
+        print("note: " + note, file=sys.stderr)
+    bar = _Bar(a.quiet, "fit    ")
+    res = fit(model, img, size=a.fit_size, seed=a.seed, bank=bank, progress=lambda f: bar(0.8 * f))
+    cond = fitted_conditioning(model, res, a.size, a.size)
+    out = generate(model, cond, res.seed, steps, a.tileable, callback=lambda i, n, x0: bar(0.8 + 0.2 * (i + 1) / n),
+                   sampler=sampler, spacing=a.spacing, tile=tile)
+    if ext == ".png":
+        write_png(a.out, preview_8bit(out, 0.0, 1.0))
+    else:
+        write_image(a.out, out)
+    report = dict(res.to_json(), image=os.path.abspath(a.fit), output=os.path.abspath(a.out), size=a.size,
+                  model=model.fingerprint)
+    if a.report:
+        write_json(a.report, report)
+    if not a.quiet:
+        print(json.dumps(dict(classes=res.classes, params=res.params, seed=res.seed, command=res.command())))
     return 0
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 import sys
 
-__all__ = ["models_root", "neural_model", "solid_models"]
+__all__ = ["models_root", "neural_model", "solid_models", "fit_bank"]
 
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the folder holding backend/
 
@@ -46,3 +46,8 @@ def neural_model() -> str:
 def solid_models() -> str:
     """The folder of the shipped solid texture models (one subfolder each)."""
     return os.path.join(models_root(), "solid")
+
+
+def fit_bank() -> str:
+    """The folder of the inverse-design bank (statistics of zoo images, ``tools`` of backend.training.fit_bank)."""
+    return os.path.join(models_root(), "fit_bank")

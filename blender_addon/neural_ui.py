@@ -138,6 +138,8 @@ class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
         ("slerp", "Between Seeds", "The latent moves along the sphere between the keyframes' seeds"),
         ("drift", "Drift", "The latent circles at a constant speed, so the noise flows even between keys")],
         default="fixed")
+    fit_image: PointerProperty(name="Fit Image", type=bpy.types.Image,
+                               description="An image to imitate: Fit to Image finds the class, parameters and seed")
     drift: FloatProperty(name="Drift Speed", default=0.05, min=0.0, soft_max=0.5,
                          description="Radians per frame of the drifting latent")
 
@@ -373,6 +375,68 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
 
         task = tasks.Task(f"Neural sequence ({n} frames)", work, done, None, threads())
         return tasks.start(task, blocking=blocking)
+
+
+def image_pixels(ima) -> np.ndarray:
+    """An image datablock's pixels as float32 (H, W, C), top row first (Blender stores rows bottom-up)."""
+    w, h = ima.size
+    if w == 0 or h == 0:
+        raise backend.SettingError("fit image", f"{ima.name!r} has no pixels (missing file?)")
+    c = ima.channels
+    px = np.empty(w * h * c, np.float32)
+    ima.pixels.foreach_get(px)
+    return np.flipud(px.reshape(h, w, c))
+
+
+class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
+    """Find the noise class, parameters and seed that look like the Fit Image (inverse design), and put them
+    into the active swatch"""
+
+    bl_idname = "omninoise.neural_fit"
+    bl_label = "Fit to Image"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def _start(self, context, blocking: bool):
+        p = context.scene.omninoise_neural
+        F = _mod("neural.fit")
+        try:
+            m = model()
+            if p.fit_image is None:
+                raise backend.SettingError("fit image", "pick an image to fit")
+            px = image_pixels(p.fit_image)
+            if px.shape[2] == 4:
+                px = px[..., :3]
+            img, notes = F.prepare_target(px if px.shape[2] > 1 else px[..., 0], m.multiple_of, p.fit_image.name)
+        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+        try:
+            bank = F.load_bank(_mod("paths").fit_bank())
+        except _mod("onnx_models").ModelError:
+            bank = None
+        for note in notes:
+            self.report({"INFO"}, note)
+        seed = p.seed
+
+        def work(progress, cancel):
+            return F.fit(m, img, seed=seed, bank=bank, progress=progress, cancel=cancel)
+
+        def done(res):
+            name = max(res.classes, key=res.classes.get)
+            if not p.swatches:
+                bpy.ops.omninoise.swatch_add()
+            sw = p.swatches[min(p.active, len(p.swatches) - 1)]
+            sw.noise = name
+            spec = m.class_params[name]["params"][:N_PARAMS]
+            for i, prm in enumerate(spec):
+                setattr(sw, f"p{i}", res.params[name][prm["name"]])
+            p.seed = res.seed
+            wm = bpy.context.window_manager
+            if wm is not None and hasattr(wm, "omninoise_message"):
+                wm.omninoise_message = "Fit: " + ", ".join(
+                    f"{n} {w:.0%}" for n, w in sorted(res.classes.items(), key=lambda kv: -kv[1]))
+
+        return tasks.start(tasks.Task("Fit to image", work, done, None, threads()), blocking=blocking)
 
 
 class OMNINOISE_OT_swatch_add(bpy.types.Operator):
@@ -638,6 +702,11 @@ def draw_neural(layout, context) -> None:
             spec = []
         for i, prm in enumerate(spec[:N_PARAMS]):
             box.prop(sw, f"p{i}", text=f"{prm['name']} [{prm['min']:g}, {prm['max']:g}]")
+    row = layout.row(align=True)
+    row.prop(p, "fit_image", text="")
+    sub = row.row(align=True)
+    sub.enabled = tasks.current() is None
+    sub.operator(OMNINOISE_OT_neural_fit.bl_idname, icon="EYEDROPPER")
     layout.prop(p, "mode")
     if p.mode == "MAP":
         row = layout.row(align=True)
@@ -702,7 +771,7 @@ class OMNINOISE_PT_neural_shader(bpy.types.Panel):
 
 
 classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_neural_bake_sequence,
-           OMNINOISE_OT_swatch_add,
+           OMNINOISE_OT_neural_fit, OMNINOISE_OT_swatch_add,
            OMNINOISE_OT_neural_preset_save, OMNINOISE_OT_neural_preset_load, OMNINOISE_OT_swatch_thumbnails,
            OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches,
            OMNINOISE_PT_neural_image, OMNINOISE_PT_neural_shader)

@@ -289,3 +289,30 @@ def test_sequence_bake_says_what_is_wrong(scene, tmp_path):
     with pytest.raises(RuntimeError, match="no_such_class"):
         bpy.ops.omninoise.neural_bake_sequence()
     assert os.listdir(tmp_path) == ["keys.toml"]  # nothing written
+
+
+def test_fit_to_image_fills_the_active_swatch_as_the_runtime_fits(scene):
+    from backend.neural import conditioning as C
+    from backend.neural.fit import fit
+    from backend.neural.generate import generate
+
+    m = neural_ui.model()
+    target = generate(m, C.uniform(m, ("cells_f1", {"scale": 10.0}), 32, 32), seed=9, steps=6)
+    ima = bpy.data.images.new("target", 32, 32, float_buffer=True)
+    rgba = np.ones((32, 32, 4), np.float32)
+    rgba[..., :3] = np.flipud(target)[..., None]
+    ima.pixels.foreach_set(rgba.ravel())
+    p = scene.omninoise_neural
+    p.fit_image, p.active = ima, 1
+    assert bpy.ops.omninoise.neural_fit() == {"FINISHED"}
+    want = fit(m, np.repeat(target[..., None], 3, axis=2), seed=5)  # the panel's seed; 32 px: no bank, every class
+    name = max(want.classes, key=want.classes.get)
+    sw = p.swatches[1]
+    assert sw.noise == name and p.seed == want.seed
+    spec = m.class_params[name]["params"]
+    assert [round(getattr(sw, f"p{i}"), 4) for i in range(len(spec))] == \
+        [round(want.params[name][q["name"]], 4) for q in spec]
+    assert bpy.context.window_manager.omninoise_message.startswith("Fit: " + name)
+    p.fit_image = None
+    with pytest.raises(RuntimeError, match="pick an image to fit"):
+        bpy.ops.omninoise.neural_fit()
