@@ -42,13 +42,14 @@ def test_the_statistic_sees_feature_size_orientation_and_levels():
 
 
 def test_targets_are_checked_and_converted_with_a_note():
-    grey, notes = prepare_target(np.ones((20, 24, 3), np.float32) * [0.2, 0.4, 0.6], 8, "photo.png")
-    assert grey.shape == (20, 24) and np.allclose(grey, 0.4) and notes == [
-        "photo.png: colour converted to grey (the mean of its 3 channels)"]
-    scaled, notes = prepare_target(np.linspace(-1, 3, 400, dtype=np.float32).reshape(20, 20), 8)
-    assert scaled.min() == 0 and scaled.max() == 1 and "scaled to [0, 1]" in notes[0]
+    ramp = np.linspace(0, 1, 480, dtype=np.float32).reshape(20, 24)
+    grey, notes = prepare_target(ramp[..., None] * [0.5, 1.0, 1.5], 8, "photo.png")
+    assert grey.shape == (20, 24) and np.allclose(grey, np.clip((ramp - 0.01) / 0.98, 0, 1), atol=1e-5)
+    assert notes == ["photo.png: colour converted to grey (the mean of its 3 channels)"]  # full range: no stretch
+    pale, notes = prepare_target(0.6 + 0.1 * ramp, 8)
+    assert pale.min() == 0 and pale.max() == 1 and "stretched from [0.601, 0.699]" in notes[0]
     for img, msg in [(np.zeros((12, 40)), "40x12 px; fitting needs at least 16x16"), (np.full((20, 20), np.nan), "NaN"),
-                     (np.zeros((4, 4, 4, 4)), "expected an image")]:
+                     (np.zeros((4, 4, 4, 4)), "expected an image"), (np.full((20, 20), 0.3), "flat")]:
         with pytest.raises(SettingError, match=msg):
             prepare_target(img, 8)
 

@@ -127,7 +127,9 @@ def target_statistic(img: np.ndarray, size: int) -> dict:
 
 def prepare_target(img: np.ndarray, multiple: int, where: str = "image") -> tuple:
     """(grey float32 (H, W) in [0, 1], notes): colour (H, W, 3|4) becomes the mean of its channels with a note;
-    an image smaller than 16 px or than the model's multiple is refused."""
+    the grey levels are stretched so that the 1st and 99th percentiles become 0 and 1 (the zoo's noises span
+    [0, 1], and a pale, low-contrast photo should be matched by its pattern, not its exposure; a note says so
+    when the stretch is large); an image smaller than 16 px or than the model's multiple, or flat, is refused."""
     a = np.asarray(img, np.float32)
     notes = []
     if a.ndim == 3:
@@ -144,11 +146,12 @@ def prepare_target(img: np.ndarray, multiple: int, where: str = "image") -> tupl
         raise SettingError(where, f"{W}x{H} px; fitting needs at least {least}x{least} px")
     if not np.all(np.isfinite(a)):
         raise SettingError(where, "the image holds NaN or infinite values")
-    lo, hi = float(a.min()), float(a.max())
-    if lo < 0.0 or hi > 1.0:  # a float image outside [0, 1]: scaled into it, as a preview would be
-        notes.append(f"{where}: values in [{lo:.3g}, {hi:.3g}] scaled to [0, 1]")
-        a = (a - lo) / max(hi - lo, 1e-12)
-    return a, notes
+    lo, hi = (float(v) for v in np.percentile(a, [1, 99]))
+    if hi - lo < 1e-4:
+        raise SettingError(where, "the image is flat (one grey level): there is no texture to fit")
+    if hi - lo < 0.9 or lo < -0.05 or hi > 1.05:  # the zoo's noises span [0, 1]: compare patterns, not exposure
+        notes.append(f"{where}: grey levels stretched from [{lo:.3g}, {hi:.3g}] (1st-99th percentile) to [0, 1]")
+    return np.clip((a - lo) / (hi - lo), 0.0, 1.0).astype(np.float32), notes
 
 
 @dataclass(frozen=True)
