@@ -9,6 +9,7 @@ held together by a function-level import counts, and nothing needs torch or bpy 
 """
 import ast
 import os
+import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PACKAGES = ("backend", "export", "blender_addon")
@@ -145,3 +146,26 @@ def test_files_are_replaced_only_by_the_atomic_helper():
                 if "os.replace(" in line or "os.rename(" in line:
                     bad.append(f"{name}:{n}: {line.strip()}")
     assert not bad, "\n".join(bad)
+
+
+#: the test files that exercise training and evaluation (backend.training, torch); every other test file must run
+#: without torch (the runtime's tests use tests/data/tiny_* and the shipped models)
+TORCH_TEST_FILES = {"test_neural_eval.py", "test_neural_runtime.py", "test_neural_training.py", "test_solid_eval.py",
+                    "test_solid_model.py", "test_solid_photos.py", "test_zoo.py", "test_zoo_blender.py"}
+
+
+def test_only_training_and_evaluation_tests_need_torch(tmp_path):
+    import re
+    import subprocess
+
+    blocker = tmp_path / "torch"
+    blocker.mkdir()
+    (blocker / "__init__.py").write_text('raise ModuleNotFoundError("No module named torch (blocked)", name="torch")\n')
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(tmp_path), os.environ.get("PYTHONPATH")])))
+    tests = os.path.dirname(os.path.abspath(__file__))
+    r = subprocess.run([sys.executable, "-m", "pytest", "--co", "-q", "-rs", "-p", "no:cacheprovider", tests],
+                       capture_output=True, text=True, env=env, cwd=os.path.dirname(tests))
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    skipped = {m.group(1) for m in re.finditer(r"SKIPPED \[\d+\] \S*?(test_\w+\.py):\d+: could not import 'torch'",
+                                                r.stdout)}
+    assert skipped == TORCH_TEST_FILES, (sorted(skipped - TORCH_TEST_FILES), sorted(TORCH_TEST_FILES - skipped))

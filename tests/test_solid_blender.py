@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 bpy = pytest.importorskip("bpy")
-torch = pytest.importorskip("torch")
 
 import blender_addon  # noqa: E402
 from conftest import Recorder  # noqa: E402
@@ -19,17 +18,10 @@ SHIPPED = solid_ui.MODELS_DIR
 
 @pytest.fixture(scope="module", autouse=True)
 def addon(tmp_path_factory):
-    """A models folder with the shipped gravel model and a tiny texture-space model trained here."""
-    from backend.training.solid.export import export
-    from backend.training.solid.train import SolidConfig, train
-
+    """A models folder with the shipped gravel model and the shipped texture-space model (no torch needed)."""
     root = tmp_path_factory.mktemp("solid_models")
-    shutil.copytree(os.path.join(SHIPPED, "gravel_3d"), root / "gravel_3d")
-    cfg = SolidConfig.from_dict(dict(name="space", mode="space", dim=3, crop=128, batch=1, steps=2, width=16,
-                                     threads=1, exemplars=["gravel", "grass"]))
-    train(cfg, str(root / "run"), log=lambda *_: None)
-    export(str(root / "run"), str(root / "space"))
-    shutil.rmtree(root / "run")
+    for name in ("gravel_3d", "space"):
+        shutil.copytree(os.path.join(SHIPPED, name), root / name)
     solid_ui.MODELS_DIR = str(root)
     blender_addon.register()
     yield
@@ -61,7 +53,9 @@ def _pixels(name):
 
 def test_catalogue_lists_single_models_and_space_exemplars(scene):
     ids = [i[0] for i in solid_ui._catalogue()]
-    assert ids == ["single:gravel_3d", "space:space:grass", "space:space:gravel"]
+    space = _model("space")
+    assert ids == ["single:gravel_3d"] + [f"space:space:{n}" for n in sorted(space.codes)]
+    assert {"gravel", "grass", "wood"} <= set(space.codes)
 
 
 def test_uv_image_bake_is_the_texture_at_each_texels_surface_point(scene):

@@ -1,27 +1,20 @@
-"""The `omninoise solid` command-line contract (tiny models trained for a few steps)."""
+"""The `omninoise solid` command-line contract, without torch (tiny committed models and the shipped space model)."""
 import os
 
 import numpy as np
 import pytest
 
-torch = pytest.importorskip("torch")
+from backend.cli import main
+from backend.paths import solid_models
 
-from backend.cli import main  # noqa: E402
-from backend.training.solid.export import export  # noqa: E402
-from backend.training.solid.train import SolidConfig, train  # noqa: E402
+TINY = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "tiny_solid")
 
 
 @pytest.fixture(scope="module")
-def models(tmp_path_factory):
-    root = tmp_path_factory.mktemp("solid_models")
-    out = {}
-    for mode, dim, ex in (("single", 3, ["gravel"]), ("single", 2, ["gravel"]), ("space", 3, ["gravel", "grass"])):
-        cfg = SolidConfig.from_dict(dict(name=f"{mode}{dim}", mode=mode, dim=dim, crop=32 if mode == "single" else 128,
-                                         batch=1, steps=2, width=16, threads=1, exemplars=ex))
-        train(cfg, str(root / f"run_{mode}{dim}"), log=lambda *_: None)
-        export(str(root / f"run_{mode}{dim}"), str(root / f"{mode}{dim}"))
-        out[f"{mode}{dim}"] = str(root / f"{mode}{dim}")
-    return out
+def models():
+    """Tiny single-exemplar models (tools/make_tiny_model.py) and the shipped texture-space model: no torch."""
+    return dict(single3=os.path.join(TINY, "single3"), single2=os.path.join(TINY, "single2"),
+                space3=os.path.join(solid_models(), "space"))
 
 
 def run(capsys, *args):
@@ -93,7 +86,7 @@ def test_errors_models(models, tmp_path, capsys):
     rc, err = run(capsys, "--model", models["single2"], "--exemplar", "g", "--dim", "3", "-o", str(tmp_path / "a.npy"))
     assert rc == 2 and "is 2D; it cannot fill a volume" in err
     rc, err = run(capsys, "--model", models["space3"], "--exemplar", "nothing.png", "-o", str(tmp_path / "a.png"))
-    assert rc == 2 and "neither an image file nor an exemplar the model knows (gravel, grass)" in err
+    assert rc == 2 and "neither an image file nor an exemplar the model knows (brick, concrete," in err
     bad = tmp_path / "bad.png"
     bad.write_bytes(b"not an image")
     rc, err = run(capsys, "--model", models["space3"], "--exemplar", str(bad), "-o", str(tmp_path / "a.png"))
