@@ -48,6 +48,8 @@ class Task:
         self.result = None
         self.started = time.perf_counter()
         self._cancel = threading.Event()
+        #: set at the first progress report (scripts and tests wait on it instead of spinning)
+        self.progressed = threading.Event()
         self._thread: threading.Thread | None = None
         self._finished = False
         # the timer callback, bound once: bpy.app.timers compares callbacks by identity and a fresh bound
@@ -58,6 +60,7 @@ class Task:
     # -- worker side (no bpy) ----------------------------------------------------------
     def _report(self, fraction: float) -> None:
         self.progress = min(1.0, max(self.progress, float(fraction)))
+        self.progressed.set()
 
     def cancelled(self) -> bool:
         return self._cancel.is_set()

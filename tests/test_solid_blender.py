@@ -182,8 +182,7 @@ def test_worker_bake_cancels_and_leaves_nothing(scene):
     op = solid_ui.OMNINOISE_OT_solid_bake
     task = op._start(type("Op", (), {"report": lambda *a: None, "_start_target": op._start_target})(),
                      bpy.context, False)
-    while task.progress == 0 and task._thread.is_alive():
-        pass
+    assert task.progressed.wait(120)  # the first step is done; no spinning
     task.cancel()
     tasks.wait(task)
     assert task.status == "cancelled" and task.progress < 0.9 and "Solid Texture" not in bpy.data.images
