@@ -22,7 +22,7 @@ _WAVEFORMS = [("gaussian", "Gaussian", "Random-phase waves (Gaussian noise)"),
 _ANISO = [("none", "Isotropic", "Directions over the whole (half) sphere"),
           ("lobes", "Lobe", "Directions within a cone around an axis (Fig. 5 right)"),
           ("axes", "Per Axis", "One band per axis, interpolated by direction (Fig. 5 left)")]
-#: most directions Cycles' shader stack holds, per dimension (tests/test_wave_node.py)
+#: most directions Cycles' shader stack holds, per dimension (tests/blender/test_wave_node.py)
 MAX_DIRECTIONS = {2: 64, 3: 32, 4: 32}
 
 

@@ -20,9 +20,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TESTS = ["tests/test_wave_node.py", "tests/test_cellular_node.py", "tests/test_extension.py",
-         "tests/test_bake_blender.py", "tests/test_neural_blender.py", "tests/test_solid_blender.py",
-         "tests/test_zoo_blender.py", "tests/test_hashing.py", "tests/test_wave_eevee.py"]
+TESTS = ["tests/blender"]  # every test that uses bpy (tests/ mirrors the layers)
 KNOWN_EXIT_CRASH = ("4.2.",)  # bpy versions whose interpreter exit crashes (see the module docstring)
 
 

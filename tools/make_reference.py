@@ -1,4 +1,4 @@
-"""Write the stored reference values of tests/test_reference_values.py: ``python tools/make_reference.py``.
+"""Write the stored reference values of tests/core/test_reference_values.py: ``python tools/make_reference.py``.
 
 Run it only on purpose: when a change is meant to alter outputs (a new shipped model, a fixed bug in an
 engine). The test then compares every later run with these numbers, so a change that silently alters the wave

@@ -21,7 +21,7 @@ sys.path.insert(0, ROOT)
 #: the tiny solid models: name -> (mode, dim, exemplars)
 SOLID = {"single3": ("single", 3, ["gravel"]), "single2": ("single", 2, ["gravel"]),
          "space3": ("space", 3, ["gravel", "grass"])}
-#: the tests' tiny training configuration (tests/test_neural_runtime.py trains the same)
+#: the tests' tiny training configuration (tests/training/test_neural_runtime.py trains the same)
 TINY = dict(size=16, batch=4, steps=3, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=3,
             sample_every=0, classes=("perlin", "spots", "cells_f1"), seed=0)
 

@@ -1,4 +1,4 @@
-"""Run by tests/test_wave_eevee.py in a fresh Python: EEVEE renders of the Wave Noise node.
+"""Run by tests/blender/test_wave_eevee.py in a fresh Python: EEVEE renders of the Wave Noise node.
 
 argv: CASES.json OUT_DIR RES.  CASES.json maps a case name to {"settings": settings dict,
 "inputs": {"Scale"|"Time"|"W": value}}.  For each case an orthographic camera looks

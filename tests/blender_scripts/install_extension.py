@@ -1,4 +1,4 @@
-"""Run by tests/test_extension.py in a fresh Python with temporary Blender user folders.
+"""Run by tests/blender/test_extension.py in a fresh Python with temporary Blender user folders.
 
 argv[-1]: the extension zip.  Prints one JSON line of what it observed.
 """

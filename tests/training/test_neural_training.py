@@ -189,7 +189,7 @@ def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
     from backend.training.solid.train import load_config as load_solid
     from backend.training.train import load_config
 
-    root = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "configs")
+    root = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "configs")
     neural = sorted(glob.glob(os.path.join(root, "*.json")))
     solid = sorted(glob.glob(os.path.join(root, "solid", "*.json")))
     assert len(neural) >= 4 and len(solid) >= 14

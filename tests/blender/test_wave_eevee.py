@@ -28,13 +28,13 @@ from backend.settings import settings_to_dict  # noqa: E402
 from backend.wave import select_output  # noqa: E402
 from test_wave_node import CASES as NODE_CASES, SOCKETS, _engine  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(ROOT, "tests", "blender_scripts", "eevee_wave.py")
 RES = 40
 ENC = 0.1  # as in the script
 REQUIRED = os.environ.get("OMNINOISE_REQUIRE_EEVEE") == "1"
 
-#: the cases of the Cycles bake test (tests/test_wave_node.py)
+#: the cases of the Cycles bake test (tests/blender/test_wave_node.py)
 CASES = {name: NODE_CASES[name] for name in ("2d", "3d", "4d", "3d+t")}
 
 

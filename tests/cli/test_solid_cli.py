@@ -7,7 +7,7 @@ import pytest
 from backend.cli import main
 from backend.paths import solid_models
 
-TINY = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "tiny_solid")
+TINY = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_solid")
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from backend.neural.generate import generate
 from backend.neural.model import NeuralNoiseModel
 from backend.neural.sampler import ddim_sample, initial_noise
 
-TINY_MODEL = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "tiny_neural")
+TINY_MODEL = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_neural")
 
 
 KEYS = """
@@ -230,7 +230,7 @@ def test_the_shipped_model_loads_and_generates():
     """models/neural_noise: the committed ONNX passes its hash check and samples every trained class."""
     from backend.paths import neural_model
 
-    assert neural_model() == os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models",
+    assert neural_model() == os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "models",
                                           "neural_noise")  # the repository's own models
     model = NeuralNoiseModel(neural_model())
     assert set(model.config["trained_classes"]) <= set(model.classes) and model.config["step"] > 0

@@ -11,7 +11,7 @@ from backend.solid.bake import srgb_to_linear
 from backend.solid.model import SolidTextureModel
 from backend.sources import BoxGrid, SolidSource, source_from_dict
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 GRAVEL = os.path.join(ROOT, "models", "solid", "gravel_3d")
 
 
