@@ -418,49 +418,73 @@ def _spec_arg(text: str, flag: str) -> tuple:
     return name, _param_items([p for p in rest.split(",") if p], flag)
 
 
-def _painted_cond(model, a: argparse.Namespace):
-    from .neural import conditioning
+def _painted_parts(a: argparse.Namespace) -> tuple:
+    """--map and its --region flags -> (regions int (H, W) into specs, specs)."""
+    from export.images import decode
+    from .neural.request import region_key, regions_from_map
 
     if not os.path.isfile(a.map):
         raise SettingError("--map", f"map not found: {a.map}")
     if not a.region:
         raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
-    from export.images import decode
-
-    colour = any(r.startswith("#") for r in a.region)
     px = decode(a.map)
-    px = px[..., :3] if px.shape[2] >= 3 else np.repeat(px[..., :1], 3, axis=2)
-    # region keys are 8-bit values (#rrggbb or a grey level): files of any depth are read at 8 bits
-    img = np.rint(np.clip(px, 0, 1) * 255.0).astype(np.uint8)
-    if not colour:
-        img = np.rint(img.astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)).astype(np.uint8)
-    if img.shape[:2] != (a.size, a.size):
-        raise SettingError("--map", f"map is {img.shape[1]}x{img.shape[0]} but --size is {a.size}")
-    specs = {}
+    if px.shape[:2] != (a.size, a.size):
+        raise SettingError("--map", f"map is {px.shape[1]}x{px.shape[0]} but --size is {a.size}")
+    keys, specs = [], []
     for r in a.region:
         key, sep, spec = r.partition("=")
         if not sep:
             raise SettingError("--region", f"expected KEY=SPEC, got {r!r}")
-        if key.startswith("#"):
-            try:
-                k = tuple(int(key[i: i + 2], 16) for i in (1, 3, 5))
-            except ValueError:
-                raise SettingError("--region", f"bad colour {key!r}; use #rrggbb") from None
-        else:
-            try:
-                k = int(key)
-            except ValueError:
-                raise SettingError("--region", f"bad index {key!r}; use 0-255 or #rrggbb") from None
-        specs[k] = _spec_arg(spec, "--region")
-    return conditioning.painted(model, img, specs, a.width, a.sharpness)
+        keys.append(region_key(key, "--region"))
+        specs.append(_spec_arg(spec, "--region"))
+    return regions_from_map(px, keys, "--map"), specs
+
+
+def neural_request(a: argparse.Namespace, model):
+    """The :class:`backend.neural.request.NeuralRequest` of ``omninoise neural`` flags (checked)."""
+    from .neural.request import NeuralRequest
+    from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
+        raise SettingError("--blend", "choose one of --blend, --corners and --map")
+    kw = dict(width=a.size, height=a.size, transition=a.width, sharpness=a.sharpness, seed=a.seed,
+              steps=DEFAULT_STEPS if a.steps is None else a.steps, sampler=a.sampler or DEFAULT_SAMPLER,
+              spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=a.tile)
+    spec = (a.noise, _param_items(a.param, "--param"))
+    if a.corners:
+        req = NeuralRequest("corners", [_spec_arg(c, "--corners") for c in a.corners], **kw)
+    elif a.map:
+        regions, specs = _painted_parts(a)
+        req = NeuralRequest("painted", specs, regions=regions, **kw)
+    elif a.blend:
+        from export.images import read_image
+
+        if not os.path.isfile(a.blend):
+            raise SettingError("--blend", f"mask not found: {a.blend}")
+        mask = read_image(a.blend)
+        if mask.shape != (a.size, a.size):
+            raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
+        spec2 = (a.noise2 or a.noise, _param_items(a.param2, "--param2"))
+        req = NeuralRequest("blend", [spec, spec2], mask=mask > 0.5, **kw)
+    else:
+        if a.noise2 or a.param2:
+            raise SettingError("--noise2", "a second noise needs --blend MASK")
+        req = NeuralRequest("uniform", [spec], **kw)
+    try:
+        return req.check(model)
+    except SettingError as exc:  # name the flag where the request's field has one
+        flag = {"noise": "--noise", "map": "--map", "blend": "--blend", "size": "--size", "seed": "--seed",
+                "width": "--width"}.get(exc.setting, exc.setting)
+        raise SettingError(flag, exc.message) from None
 
 
 def run_neural(a: argparse.Namespace) -> int:
     import json
 
-    from .neural import conditioning
-    from .neural.generate import generate
     from .neural.model import ModelError, NeuralNoiseModel
+    from .neural.request import generate_request
 
     from .neural.generate import check_sampler
     from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
@@ -491,35 +515,12 @@ def run_neural(a: argparse.Namespace) -> int:
         raise SettingError("--report", "a fit report needs --fit IMAGE")
     if not (a.noise or a.corners or a.map) or not a.out:
         raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
-    if a.size < 8:
-        raise SettingError("--size", f"must be >= 8, got {a.size}")
     ext = os.path.splitext(a.out)[1].lower()
     if ext not in (".png", ".exr", ".npy"):
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
-    spec = (a.noise, _param_items(a.param, "--param"))
-    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
-        raise SettingError("--blend", "choose one of --blend, --corners and --map")
-    if a.corners:
-        cond = conditioning.four_corner(model, [_spec_arg(c, "--corners") for c in a.corners], a.size, a.size)
-    elif a.map:
-        cond = _painted_cond(model, a)
-    elif a.blend:
-        from export.images import read_image
-
-        if not os.path.isfile(a.blend):
-            raise SettingError("--blend", f"mask not found: {a.blend}")
-        mask = read_image(a.blend)
-        if mask.shape != (a.size, a.size):
-            raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
-        spec2 = (a.noise2 or a.noise, _param_items(a.param2, "--param2"))
-        cond = conditioning.blend(model, spec, spec2, conditioning.mask_weight(mask > 0.5, a.width, a.sharpness))
-    else:
-        if a.noise2 or a.param2:
-            raise SettingError("--noise2", "a second noise needs --blend MASK")
-        cond = conditioning.uniform(model, spec, a.size, a.size)
+    req = neural_request(a, model)
     bar = _Bar(a.quiet)
-    img = generate(model, cond, a.seed, steps, a.tileable, callback=lambda i, n, x0: bar((i + 1) / n),
-                   sampler=sampler, spacing=a.spacing, eta=a.eta, tile=tile)
+    img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
     from export.images import preview_8bit, write_image, write_png
 
     if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch

@@ -44,6 +44,15 @@ A neural noise image (Maesumi et al. 2024) is a 2D bake with a neural source::
     seed = 3
     tileable = false
 
+The other layouts of the command line, with the same class specs (``"CLASS:NAME=VALUE,..."`` or
+``{noise = CLASS, params = {...}}``) and the same checks (:class:`backend.neural.request.NeuralRequest`)::
+
+    corners = ["spots:coverage=0.3", "perlin", {noise = "cells_f1", params = {scale = 10}}, "spots"]
+    # or a painted map: each region's colour (or grey level "0".."255") names its class
+    map = "painted.png"
+    regions = {"#ff0000" = "spots", "#0000ff" = "gabor:frequency=12"}
+    width = 32                          # transition width (px) of blend masks and painted maps
+
 Animated neural noise (a numbered image sequence): ``keys`` gives keyframes of class and parameters, as a
 file (see :mod:`backend.neural.animate`) or inline, whose ``frame`` numbers are the bake's frames (the bake's
 time is the frame number unless ``time`` / ``time_step`` say otherwise); ``latent`` = "fixed" | "slerp" |

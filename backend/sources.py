@@ -164,12 +164,14 @@ class WaveSource:
 
 
 class NeuralSource:
-    """Neural noise (Maesumi et al. 2024) as a 2D bake source: one class, or two blended by a mask.
+    """Neural noise (Maesumi et al. 2024) as a 2D bake source: any layout of a
+    :class:`backend.neural.request.NeuralRequest` (one class, a mask blend of two, four corners, a painted map),
+    or keyframed classes (animation).
 
     The whole image is denoised at once (``chunkable`` is False); progress is per
-    DDIM step and cancel is polled after each step.  Pixels are the model's
+    sampler step and cancel is polled after each step.  Pixels are the model's
     pixels: the grid's resolution is the image size and its bounds only place it.
-    Image rows run top to bottom like the mask's, so a mask lines up with the file
+    Image rows run top to bottom like the maps', so a mask lines up with the file
     a bake writes.
     """
 
@@ -181,7 +183,8 @@ class NeuralSource:
     def __init__(self, model_folder: str, noise: str, params: dict | None = None, noise2: str | None = None,
                  params2: dict | None = None, mask: np.ndarray | None = None, width: float = 32.0,
                  sharpness: float = 1.0, steps: int | None = None, seed: int = 0, tileable: bool = False,
-                 sampler: str | None = None, keys: list | None = None, latent: str = "fixed", drift: float = 0.05):
+                 sampler: str | None = None, keys: list | None = None, latent: str = "fixed", drift: float = 0.05,
+                 corners: list | None = None, regions: np.ndarray | None = None, region_specs: list | None = None):
         from .neural.generate import check_sampler
         from .neural.model import ModelError, NeuralNoiseModel
         from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
@@ -200,11 +203,19 @@ class NeuralSource:
         self.spec = (noise, dict(params or {}))
         self.spec2 = None if mask is None else (noise2 or noise, dict(params2 or {}))
         self.mask = None if mask is None else np.asarray(mask, np.float32)
+        self.regions = None if regions is None else np.asarray(regions, np.int64)
+        if corners is not None:
+            self.layout, self.specs = "corners", [tuple(c) for c in corners]
+        elif self.regions is not None:
+            self.layout, self.specs = "painted", [tuple(c) for c in region_specs]
+        elif self.mask is not None:
+            self.layout, self.specs = "blend", [self.spec, self.spec2]
+        else:
+            self.layout, self.specs = "uniform", [self.spec]
         self.width, self.sharpness = float(width), float(sharpness)
         self.steps, self.seed, self.tileable = int(steps), int(seed), bool(tileable)
-        self.model.param_vector(*self.spec)  # unknown classes / parameters fail now, with their names
-        if self.spec2 is not None:
-            self.model.param_vector(*self.spec2)
+        for spec in self.specs:
+            self.model.param_vector(*spec)  # unknown classes / parameters fail now, with their names
         # animation (issue 26): keyframes whose `frame` is the bake's time (a job sets time = frame number)
         from .neural.animate import LATENT_MODES
 
@@ -212,8 +223,9 @@ class NeuralSource:
         self.animated = self.keys is not None
         self.latent, self.drift = str(latent), limits.finite("source.drift", drift)
         if self.keys is not None:
-            if self.mask is not None:
-                raise SettingError("source.keys", "keyframes set the classes of the whole image; leave out blend")
+            if self.layout != "uniform":
+                raise SettingError("source.keys", "keyframes set the classes of the whole image; leave out blend, "
+                                                  "corners and map")
             if self.latent not in LATENT_MODES:
                 raise SettingError("source.latent", f"unknown latent motion {self.latent!r}; choose one of "
                                                     f"{', '.join(LATENT_MODES)}")
@@ -221,36 +233,29 @@ class NeuralSource:
                 self.model.param_vector(*k.spec)
 
     def check_grid(self, shape) -> None:
-        """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask of
-        another size (found only while baking before, as a failure with exit 1)."""
+        """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask or
+        painted map of another size (found only while baking before, as a failure with exit 1)."""
         if len(shape) != 2:
             raise SettingError("grid", "neural noise bakes images (resolution [width, height])")
-        if self.mask is not None and self.mask.shape != tuple(shape):
-            raise SettingError("source.blend", f"mask is {self.mask.shape[1]}x{self.mask.shape[0]} but the "
-                               f"resolution is {shape[1]}x{shape[0]}")
+        for key, arr in (("blend", self.mask), ("map", self.regions)):
+            if arr is not None and arr.shape != tuple(shape):
+                raise SettingError(f"source.{key}", f"{'mask' if key == 'blend' else 'map'} is {arr.shape[1]}x"
+                                   f"{arr.shape[0]} but the resolution is {shape[1]}x{shape[0]}")
+
+    def request(self, shape):
+        """The :class:`backend.neural.request.NeuralRequest` of this source on an (H, W) grid (not animated)."""
+        from .neural.request import NeuralRequest
+
+        self.check_grid(shape)
+        H, W = shape
+        return NeuralRequest(self.layout, self.specs, W, H, mask=None if self.mask is None else self.mask > 0.5,
+                             regions=self.regions, transition=self.width, sharpness=self.sharpness, seed=self.seed,
+                             steps=self.steps, sampler=self.sampler, tileable=self.tileable)
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .grid import Cancelled
-        from .neural import conditioning as C
         from .neural.generate import generate
-
-        if len(shape) != 2:
-            raise SettingError("grid", "neural noise bakes images (resolution [width, height])")
-        H, W = shape
-        x_T = None
-        if self.keys is not None:
-            from .neural.animate import frame_cond, frame_latent
-
-            k = self.model.multiple_of
-            cond = frame_cond(self.model, self.keys, float(time), H, W)
-            x_T = frame_latent(self.keys, float(time), (-(-H // k) * k, -(-W // k) * k), self.latent, self.drift)
-        elif self.mask is None:
-            cond = C.uniform(self.model, self.spec, H, W)
-        else:
-            if self.mask.shape != (H, W):
-                raise SettingError("source.blend", f"mask is {self.mask.shape[1]}x{self.mask.shape[0]} but the "
-                                   f"resolution is {W}x{H}")
-            cond = C.blend(self.model, self.spec, self.spec2, C.mask_weight(self.mask > 0.5, self.width, self.sharpness))
+        from .neural.request import generate_request
 
         def step_done(i, n, x0):
             if progress is not None:
@@ -258,16 +263,31 @@ class NeuralSource:
             if cancel is not None and cancel():
                 raise Cancelled("cancelled")
 
+        if self.keys is None:
+            try:
+                img = generate_request(self.model, self.request(shape), callback=step_done)
+            except SettingError as exc:
+                raise SettingError("source." + exc.setting, exc.message) from None
+            return np.ascontiguousarray(img[::-1])  # bakes index rows by +y; files put +y at the top
+        from .neural.animate import frame_cond, frame_latent
+
+        self.check_grid(shape)
+        H, W = shape
+        k = self.model.multiple_of
+        cond = frame_cond(self.model, self.keys, float(time), H, W)
+        x_T = frame_latent(self.keys, float(time), (-(-H // k) * k, -(-W // k) * k), self.latent, self.drift)
         img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done, sampler=self.sampler,
                        x_T=x_T)
-        return np.ascontiguousarray(img[::-1])  # bakes index rows by +y; files put +y at the top
+        return np.ascontiguousarray(img[::-1])
 
     def to_dict(self) -> dict:
-        d = dict(kind=self.kind, model=self.model.config["files"], spec=[self.spec[0], self.spec[1]],
-                 sampler=self.sampler, steps=self.steps, seed=self.seed, tileable=self.tileable)
-        if self.mask is not None:
-            d.update(spec2=[self.spec2[0], self.spec2[1]], width=self.width, sharpness=self.sharpness,
-                     mask_sha256=hashlib.sha256(np.ascontiguousarray(self.mask).tobytes()).hexdigest())
+        d = dict(kind=self.kind, model=self.model.config["files"], layout=self.layout,
+                 specs=[[n, dict(sorted(p.items()))] for n, p in self.specs], sampler=self.sampler, steps=self.steps,
+                 seed=self.seed, tileable=self.tileable)
+        if self.layout in ("blend", "painted"):
+            arr = self.mask if self.layout == "blend" else self.regions
+            d.update(width=self.width, sharpness=self.sharpness,
+                     map_sha256=hashlib.sha256(np.ascontiguousarray(arr).tobytes()).hexdigest())
         if self.keys is not None:
             d.update(keys=[[k.frame, k.noise, k.params, k.seed] for k in self.keys], latent=self.latent,
                      drift=self.drift)
@@ -351,7 +371,7 @@ class SolidSource:
 
 _SOLID_KEYS = ("model", "exemplar", "seed", "scale", "density", "refine")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
-                "seed", "tileable", "keys", "latent", "drift")
+                "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
 
 def _check_keys(d: dict, known: tuple, kind: str) -> None:
@@ -364,6 +384,8 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     import os
 
     _check_keys(d, _NEURAL_KEYS, "neural")
+    if "regions" in d and "map" not in d:
+        raise SettingError("source.regions", "regions name the colours of a painted map: give map = FILE too")
     keys = None
     if "keys" in d:  # animation: a keyframe file (relative to the job) or an inline list of [[key]] tables
         from .neural.animate import parse_keys, read_keys
@@ -378,11 +400,39 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         d.setdefault("params", keys[0].params)
     elif "latent" in d or "drift" in d:
         raise SettingError("source.latent", "latent motion animates keyframes: give keys too")
-    if "noise" not in d:
-        raise SettingError("source.noise", "a neural source needs noise = CLASS")
+    if "noise" not in d and "corners" not in d and "map" not in d:
+        raise SettingError("source.noise", "a neural source needs noise = CLASS (or corners, or map and regions)")
     from .paths import neural_model
 
     model = os.path.join(base_dir, d["model"]) if "model" in d else neural_model()
+    layouts = [k for k in ("blend", "corners", "map") if k in d]
+    if len(layouts) > 1:
+        raise SettingError(f"source.{layouts[1]}", f"choose one of blend, corners and map (got {' and '.join(layouts)})")
+    corners = regions = region_specs = None
+    if "corners" in d:
+        c = d["corners"]
+        if not isinstance(c, list) or len(c) != 4:
+            raise SettingError("source.corners", f"expected four class specs (top-left, top-right, bottom-left, "
+                                                 f"bottom-right), got {c!r}")
+        corners = [_spec_value(v, f"source.corners[{i}]") for i, v in enumerate(c)]
+    if "map" in d:
+        from ._export import export
+        from .neural.request import region_key, regions_from_map
+
+        path = os.path.join(base_dir, d["map"])
+        if not os.path.isfile(path):
+            raise SettingError("source.map", f"map not found: {path}")
+        table = d.get("regions")
+        if not isinstance(table, dict) or not table:
+            raise SettingError("source.regions", "a map needs regions = {\"#rrggbb\" = SPEC, ...} for its colours")
+        region_keys = [region_key(k, "source.regions") for k in table]
+        region_specs = [_spec_value(v, f"source.regions.{k}") for k, v in table.items()]
+        try:
+            regions = regions_from_map(export.decode(path), region_keys, "source.map")
+        except export.ImageError as exc:
+            raise SettingError("source.map", str(exc)) from None
+    if corners is not None or regions is not None:
+        d.setdefault("noise", (corners or region_specs)[0][0])
     mask = None
     if "blend" in d:
         path = os.path.join(base_dir, d["blend"])
@@ -398,7 +448,31 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         raise SettingError("source.noise2", "a second noise needs blend = MASK")
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
                         d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps"), d.get("seed", 0),
-                        d.get("tileable", False), d.get("sampler"), keys, d.get("latent", "fixed"), d.get("drift", 0.05))
+                        d.get("tileable", False), d.get("sampler"), keys, d.get("latent", "fixed"), d.get("drift", 0.05),
+                        corners, regions, region_specs)
+
+
+def _spec_value(v, where: str) -> tuple:
+    """A class spec of a job file: "CLASS" / "CLASS:NAME=V,..." (as the command line) or {noise, params}."""
+    if isinstance(v, str):
+        name, _, rest = v.partition(":")
+        params = {}
+        for item in filter(None, rest.split(",")):
+            k, sep, val = item.partition("=")
+            try:
+                params[k.strip()] = float(val) if sep else float("nan")
+            except ValueError:
+                raise SettingError(where, f"expected NAME=VALUE with a number, got {item!r}") from None
+            if not sep or not np.isfinite(params[k.strip()]):
+                raise SettingError(where, f"expected NAME=VALUE with a finite number, got {item!r}")
+        return name.strip(), params
+    if isinstance(v, dict) and isinstance(v.get("noise"), str) and set(v) <= {"noise", "params"}:
+        params = v.get("params", {})
+        if not isinstance(params, dict) or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                   and np.isfinite(x) for x in params.values()):
+            raise SettingError(where, f"params: expected a table of finite numbers, got {params!r}")
+        return v["noise"], {str(k): float(x) for k, x in params.items()}
+    raise SettingError(where, f"expected \"CLASS:NAME=VALUE,...\" or {{noise = CLASS, params = {{...}}}}, got {v!r}")
 
 
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
@@ -466,7 +540,8 @@ def source_from_dict(d: dict, base_dir: str = ".") -> Source:
 
     Wave: the keys of :class:`~backend.settings.WaveSettings`; ``example = "img.png"``
     (relative to ``base_dir``) for by-example noise; ``w_offset`` for 4D.
-    Neural: noise, params, [blend = "mask.png", noise2, params2, width, sharpness],
+    Neural: noise, params, [blend = "mask.png", noise2, params2 | corners = [4 specs] | map = "painted.png",
+    regions = {"#rrggbb" = SPEC}], [width, sharpness],
     steps, seed, tileable, [model = folder], [keys, latent, drift] (see :class:`NeuralSource`).
     Solid: model (a folder, or a shipped model's name), [exemplar, refine], seed, scale, density
     (see :class:`SolidSource`).

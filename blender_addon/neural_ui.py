@@ -26,7 +26,7 @@ from .bake_ui import draw_progress
 from .tasks import TaskOperator
 from .preferences import threads
 
-__all__ = ["model", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
+__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
 
 _MODEL = {}
 N_PARAMS = 4
@@ -146,25 +146,26 @@ class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
 
 # -- conditioning from the settings (main thread) -----------------------------------------
 
-def build_conditioning(p: OMNINOISE_PG_neural, size: int):
-    """(E + P, H, W) float32 grid for the scene's settings; SettingError naming what is wrong."""
-    C = _mod("neural.conditioning")
+def panel_request(p: OMNINOISE_PG_neural, size: int, steps: int | None = None):
+    """The :class:`backend.neural.request.NeuralRequest` of the scene's settings at ``size``² (checked);
+    SettingError naming what is wrong."""
+    R = _mod("neural.request")
     m = model()
     sw = list(p.swatches)
     if not sw:
         raise backend.SettingError("swatches", "add a swatch first")
-    H = W = size
+    kw = dict(width=size, height=size, transition=p.width, sharpness=p.sharpness, seed=p.seed,
+              steps=p.steps if steps is None else steps, sampler=p.sampler, tileable=p.tileable)
     if p.mode == "SINGLE":
-        return C.uniform(m, sw[min(p.active, len(sw) - 1)].spec(), H, W)
+        return R.NeuralRequest("uniform", [sw[min(p.active, len(sw) - 1)].spec()], **kw).check(m)
     if p.mode == "GRADIENT":
         if len(sw) < 2:
             raise backend.SettingError("swatches", "a left-to-right blend needs two swatches")
-        w = np.broadcast_to(np.linspace(0.0, 1.0, W, dtype=np.float32)[None, :], (H, W))
-        return C.blend(m, sw[0].spec(), sw[1].spec(), w)
+        return R.NeuralRequest("gradient", [sw[0].spec(), sw[1].spec()], **kw).check(m)
     if p.mode == "CORNERS":
         if len(sw) < 4:
             raise backend.SettingError("swatches", "a four-corner blend needs four swatches")
-        return C.four_corner(m, [s.spec() for s in sw[:4]], H, W)
+        return R.NeuralRequest("corners", [s.spec() for s in sw[:4]], **kw).check(m)
     img = p.blend_map
     if img is None:
         raise backend.SettingError("blend map", "pick or create a blend map image")
@@ -174,16 +175,17 @@ def build_conditioning(p: OMNINOISE_PG_neural, size: int):
     px = np.empty(iw * ih * 4, np.float32)
     img.pixels.foreach_get(px)
     rgb = np.flipud(px.reshape(ih, iw, 4)[..., :3])  # Blender stores rows bottom-up
-    if (iw, ih) != (W, H):  # nearest resampling of the painted regions
-        rgb = rgb[(np.arange(H) * ih // H)[:, None], (np.arange(W) * iw // W)[None, :]]
-    cols = np.array([tuple(s.color) for s in sw], np.float32)
-    d = np.abs(rgb[:, :, None, :] - cols[None, None]).max(-1)  # (H, W, swatches)
-    nearest, err = d.argmin(-1), d.min(-1)
-    if np.mean(err > 0.2) > 0.01:
-        raise backend.SettingError("blend map", f"{np.mean(err > 0.2) * 100:.0f}% of the map matches no swatch "
-                                   "colour; paint with the swatch colours")
-    present = sorted(set(np.unique(nearest).tolist()))
-    return C.painted(m, nearest, {i: sw[i].spec() for i in present}, p.width * size / max(iw, 1), p.sharpness)
+    if (iw, ih) != (size, size):  # nearest resampling of the painted regions
+        rgb = rgb[(np.arange(size) * ih // size)[:, None], (np.arange(size) * iw // size)[None, :]]
+    # brush strokes blend colours at their edges: each pixel takes its nearest swatch colour
+    regions = R.regions_from_colours(rgb, [tuple(s.color) for s in sw], tolerance=0.2, where="blend map")
+    kw["transition"] = p.width * size / max(iw, 1)
+    return R.NeuralRequest("painted", [s.spec() for s in sw], regions=regions, **kw).check(m)
+
+
+def build_conditioning(p: OMNINOISE_PG_neural, size: int):
+    """(E + P, H, W) float32 grid for the scene's settings; SettingError naming what is wrong."""
+    return panel_request(p, size).conditioning(model())
 
 
 def _store(name: str, img: np.ndarray, depth: str):
@@ -225,15 +227,15 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
         steps = min(p.steps, 10) if self.preview else p.steps
         try:
             m = model()
-            cond = build_conditioning(p, size)
+            req = panel_request(p, size, steps)
         except (backend.SettingError, _mod("neural.model").ModelError) as exc:
             self.report({"ERROR"}, str(exc))
             return None
-        gib = cond.nbytes * 12 / 2**30  # activations of the U-Net: about 12x the conditioning grid
+        gib = (m.embedding.shape[1] + len(m.params)) * size * size * 4 * 12 / 2**30  # U-Net activations: ~12x cond
         if gib > 16:
             self.report({"ERROR"}, f"{size}² needs about {gib:.0f} GiB; bake a smaller size")
             return None
-        seed, tileable, depth, sampler = p.seed, p.tileable, p.depth, p.sampler
+        depth = p.depth
         name = p.name + (" Preview" if self.preview else "")
         save_path = None
         if p.save != "NONE" and not self.preview:
@@ -252,7 +254,7 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
                 if cancel():
                     raise backend.Cancelled("cancelled")
 
-            img = _mod("neural.generate").generate(m, cond, seed, steps, tileable, callback=step, sampler=sampler)
+            img = _mod("neural.request").generate_request(m, req, callback=step)
             if save_path is not None:  # atomic, off the main thread
                 from ._deps import export
 

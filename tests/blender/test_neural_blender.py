@@ -315,3 +315,40 @@ def test_fit_to_image_fills_the_active_swatch_as_the_runtime_fits(scene):
     p.fit_image = None
     with pytest.raises(RuntimeError, match="pick an image to fit"):
         bpy.ops.omninoise.neural_fit()
+
+
+@pytest.mark.parametrize("mode", ["SINGLE", "CORNERS", "MAP"])
+def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
+    from backend.cli import build_parser, neural_request
+    from export.images import write_png
+
+    p = scene.omninoise_neural
+    p.mode, p.width = mode, 6.0
+    while len(p.swatches) < 4:
+        bpy.ops.omninoise.swatch_add()
+    specs = [s.spec() for s in p.swatches]
+    flag = lambda spec: spec[0] + ":" + ",".join(f"{k}={v!r}" for k, v in spec[1].items())  # noqa: E731
+    args = ["--size", "32", "--seed", "5", "--steps", "3", "--sampler", p.sampler, "--width", "6"]
+    if mode == "SINGLE":
+        p.active = 1
+        args += ["--noise", specs[1][0]] + [a for k, v in specs[1][1].items() for a in ("--param", f"{k}={v!r}")]
+    elif mode == "CORNERS":
+        args += ["--corners"] + [flag(s) for s in specs]
+    else:
+        bpy.ops.omninoise.blend_map_new()  # swatch 1's colour, swatch 2's on the right half
+        ima = p.blend_map
+        n = ima.size[0]
+        px = np.empty(n * n * 4, np.float32)
+        ima.pixels.foreach_get(px)
+        write_png(str(tmp_path / "map.png"), np.rint(np.flipud(px.reshape(n, n, 4)[..., :3]) * 255).astype(np.uint8))
+        args += ["--map", str(tmp_path / "map.png")]
+        for s in p.swatches[:2]:
+            args += ["--region", "#%02x%02x%02x=" % tuple(round(c * 255) for c in s.color) + flag(s.spec())]
+        args[1] = str(n)
+    panel = neural_ui.panel_request(p, int(args[1]))
+    cli = neural_request(build_parser().parse_args(["neural", *args, "-o", "x.png"]), neural_ui.model())
+    if mode == "MAP":  # the panel lists every swatch; the map uses the first two
+        assert [s for s in panel.specs[:2]] == list(cli.specs) and np.array_equal(panel.regions, cli.regions)
+        np.testing.assert_array_equal(panel.conditioning(neural_ui.model()), cli.conditioning(neural_ui.model()))
+    else:
+        assert panel.key() == cli.key()

@@ -1,0 +1,121 @@
+"""One request for every front-end (issue 23): equal neural-noise settings from command-line flags and from a job
+file give equal requests and equal images (the panel's: tests/blender/test_neural_blender.py); job files take every
+layout the command line does. On the committed tiny model (no torch)."""
+import os
+
+import numpy as np
+import pytest
+
+from backend.cli import build_parser, main, neural_request
+from backend.errors import SettingError
+from backend.neural.model import NeuralNoiseModel
+from backend.neural.request import NeuralRequest, generate_request
+from backend.sources import source_from_dict
+from export.images import write_png
+
+TINY = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_neural")
+SAMPLING = ["--size", "32", "--seed", "3", "--steps", "3", "--sampler", "ddim"]
+
+
+@pytest.fixture(scope="module")
+def model():
+    return NeuralNoiseModel(TINY)
+
+
+@pytest.fixture
+def maps(tmp_path):
+    mask = np.zeros((32, 32), np.uint8)
+    mask[:, 12:] = 255
+    write_png(str(tmp_path / "mask.png"), mask)
+    paint = np.zeros((32, 32, 3), np.uint8)
+    paint[8:24, 8:24] = (255, 0, 0)
+    paint[:, 28:] = (0, 0, 255)
+    write_png(str(tmp_path / "paint.png"), paint)
+    return tmp_path
+
+
+CASES = {
+    "uniform": (["--noise", "spots", "--param", "coverage=0.4"],
+                dict(noise="spots", params={"coverage": 0.4})),
+    "blend": (["--noise", "spots", "--blend", "mask.png", "--noise2", "perlin", "--param2", "scale=10", "--width", "8"],
+              dict(noise="spots", blend="mask.png", noise2="perlin", params2={"scale": 10}, width=8)),
+    "corners": (["--corners", "spots:coverage=0.3", "perlin", "cells_f1:scale=10,jitter=0.5", "spots"],
+                dict(corners=["spots:coverage=0.3", "perlin", {"noise": "cells_f1", "params": {"scale": 10, "jitter": 0.5}},
+                              "spots"])),
+    "painted": (["--map", "paint.png", "--region", "#000000=spots", "--region", "#ff0000=perlin:scale=9",
+                 "--region", "#0000ff=cells_f1", "--sharpness", "2"],
+                dict(map="paint.png", regions={"#000000": "spots", "#ff0000": {"noise": "perlin", "params": {"scale": 9}},
+                                               "#0000ff": "cells_f1"}, sharpness=2)),
+}
+
+
+@pytest.mark.parametrize("layout", sorted(CASES))
+def test_flags_and_job_tables_give_the_same_request(layout, model, maps, monkeypatch):
+    flags, table = CASES[layout]
+    monkeypatch.chdir(maps)
+    cli = neural_request(build_parser().parse_args(["neural", "--model", TINY, *flags, *SAMPLING, "-o", "x.png"]),
+                         model)
+    job = source_from_dict(dict(kind="neural", model=TINY, seed=3, steps=3, sampler="ddim", **table),
+                           str(maps)).request((32, 32))
+    assert cli.layout == job.layout == layout
+    assert cli.key() == job.key()
+    np.testing.assert_array_equal(cli.conditioning(model), job.conditioning(model))
+
+
+def test_a_painted_job_bakes_the_command_lines_image(model, maps):
+    flags, _ = CASES["painted"]
+    assert main(["neural", "--model", TINY, "--quiet", *[f if not f.endswith(".png") else str(maps / f) for f in flags],
+                 *SAMPLING, "-o", str(maps / "cli.npy")]) == 0
+    (maps / "job.toml").write_text(f"""
+[[bake]]
+name = "painted"
+output = "job.png"
+resolution = [32, 32]
+[bake.source]
+kind = "neural"
+model = "{TINY}"
+map = "paint.png"
+regions = {{"#000000" = "spots", "#ff0000" = "perlin:scale=9", "#0000ff" = {{noise = "cells_f1"}}}}
+sharpness = 2
+seed = 3
+steps = 3
+sampler = "ddim"
+""")
+    assert main(["bake", str(maps / "job.toml"), "--quiet"]) == 0
+    from export.images import read_image
+
+    np.testing.assert_allclose(read_image(str(maps / "job.png")), np.load(maps / "cli.npy"), atol=0.5 / 255 + 1e-6)
+
+
+@pytest.mark.parametrize("table, msg", [
+    (dict(corners=["spots", "perlin", "spots"]), "source.corners: expected four class specs"),
+    (dict(regions={"#ff0000": "spots"}), "source.regions: regions name the colours of a painted map"),
+    (dict(map="paint.png", corners=["spots"] * 4), "choose one of blend, corners and map"),
+    (dict(map="paint.png", regions={"#ff00": "spots"}), "bad colour '#ff00'"),
+    (dict(map="paint.png", regions={"#000000": "spots", "#ff0000": "perlin"}),
+     "the map uses (0, 0, 255) but no spec is given for it"),
+    (dict(map="paint.png", regions={"#000000": "spots", "#ff0000": "perlin", "#0000ff": "lava"}), "unknown class 'lava'"),
+    (dict(corners=["spots:coverage", "perlin", "spots", "spots"]), "expected NAME=VALUE with a finite number"),
+    (dict(corners=["spots", "perlin", {"noise": "spots", "size": 2}, "spots"]), "expected \"CLASS:NAME=VALUE"),
+])
+def test_job_layouts_say_what_is_wrong(table, msg, maps):
+    with pytest.raises(SettingError) as e:
+        source_from_dict(dict(kind="neural", model=TINY, **table), str(maps))
+    assert msg in str(e.value)
+
+
+def test_requests_check_what_every_front_end_shares(model):
+    ok = NeuralRequest("uniform", [("spots", {})], 16, 16, steps=2)
+    assert generate_request(model, ok).shape == (16, 16)
+    for req, msg in [(NeuralRequest("spiral", [("spots", {})], 16, 16), "unknown layout 'spiral'"),
+                     (NeuralRequest("corners", [("spots", {})] * 3, 16, 16), "takes 4 class specs, got 3"),
+                     (NeuralRequest("blend", [("spots", {}), ("perlin", {})], 16, 16), "mask is none"),
+                     (NeuralRequest("painted", [("spots", {})], 16, 16, regions=np.ones((16, 16), int)),
+                      "region indices must lie in [0, 1)"),
+                     (NeuralRequest("uniform", [("spots", {"size": 1})], 16, 16), "no parameter 'size'"),
+                     (NeuralRequest("uniform", [("spots", {})], 4, 16), "must be >= 8"),
+                     (NeuralRequest("uniform", [("spots", {})], 20, 16, tileable=True), "multiples of 8"),
+                     (NeuralRequest("uniform", [("spots", {})], 16, 16, steps=0), "must be")]:
+        with pytest.raises(SettingError, match=None) as e:
+            req.check(model)
+        assert msg in str(e.value), (msg, str(e.value))
