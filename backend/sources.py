@@ -419,6 +419,8 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         from ._export import export
         from .neural.request import region_key, regions_from_map
 
+        if not isinstance(d["map"], str):
+            raise SettingError("source.map", f"expected an image file name, got {d['map']!r}")
         path = os.path.join(base_dir, d["map"])
         if not os.path.isfile(path):
             raise SettingError("source.map", f"map not found: {path}")

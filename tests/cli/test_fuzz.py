@@ -222,7 +222,11 @@ HOSTILE_SOURCES = st.fixed_dictionaries({"kind": st.sampled_from(["wave", "neura
     "noise": st.sampled_from(["perlin", "bogus", 3]), "steps": st.sampled_from([1, 2, 0, -1, 10 ** 6, "x"]),
     "params": st.sampled_from([{"scale": 8}, {"scale": math.nan}, {"bogus": 1}, "x"]),
     "model": st.sampled_from(["gravel_3d", "/no/model", 3]), "scale": SCALARS, "density": SCALARS,
-    "blend": st.sampled_from(["missing.png", "broken.png"]), "bogus": SCALARS})
+    "blend": st.sampled_from(["missing.png", "broken.png"]), "bogus": SCALARS,
+    "corners": st.sampled_from([["perlin"] * 4, ["perlin"] * 3, ["perlin:scale=x"] * 4, [{"noise": 3}] * 4, [3] * 4,
+                                "perlin", [{"noise": "perlin", "params": {"scale": math.nan}}] * 4]),
+    "map": st.sampled_from(["missing.png", "broken.png", 3, ""]),
+    "regions": st.sampled_from([{"#ff0000": "perlin"}, {"#ff00": "perlin"}, {"300": "perlin"}, {"0": 3}, {}, "x"])})
 VALID = {"output": st.sampled_from(["out/a.npy", "out/a.exr", "out/a.png", "out/a.vdb", "out/b_####.npy"]),
          "resolution": st.sampled_from([[8, 8], [16, 8], [8, 8, 8]]), "source": VALID_SOURCES}
 HOSTILE = {
