@@ -6,7 +6,9 @@ the runtime's tests (conditioning, sampling, tiles, CLI, job files, animation) n
 tiny solid texture models (2 training steps, width 16: single-exemplar 3D and 2D, and a texture-space model) in
 ``tests/data/tiny_solid`` for the solid CLI and Blender tests. Their images are not textures an artist would want;
 the tests check properties (shapes, seeds, files, equality of paths), never pictures. Rerun after a change of an
-export format; the torch tests train and export their own models.
+export format; the torch tests train and export their own models. The committed ``tiny_neural`` is in the
+older split form (one denoiser with a ``tile`` input, exported before the per-padding denoisers): the runtime
+must keep loading it (tests/core/test_neural_onnx.py), so it is kept as it is; a rerun writes the current form.
 """
 from __future__ import annotations
 

@@ -91,13 +91,16 @@ class NeuralNoiseModel:
                                        "cond": np.ascontiguousarray(cond, _F), "tile": tile})[0]
 
             return eps
-        sess = self.session("denoiser.onnx")
+        # one denoiser per padding (no tile input), or an older export's one denoiser with a tile input
+        name = "denoiser_tile.onnx" if tileable and "denoiser_tile.onnx" in self.config["files"] else "denoiser.onnx"
+        sess = self.session(name)
+        extra = {"tile": tile} if "tile" in {i.name for i in sess.get_inputs()} else {}
         cache = {"cond": None, "maps": None}
 
         def eps(x, t, cond):
             if cache["cond"] is not cond:
                 cache["cond"], cache["maps"] = cond, self.encode(cond, tileable)
-            feed = dict(cache["maps"], x=np.ascontiguousarray(x, _F), t=np.ascontiguousarray(t, _F), tile=tile)
+            feed = dict(cache["maps"], x=np.ascontiguousarray(x, _F), t=np.ascontiguousarray(t, _F), **extra)
             return sess.run(None, feed)[0]
 
         return eps

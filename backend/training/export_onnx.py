@@ -6,14 +6,18 @@ is a graph of its own that a sampler runs once per image:
 
     OUT_DIR/encoder.onnx       inputs cond, tile -> m00 .. mNN: every ResBlock's [1 + γ₂, β₂]
                                (batch, height, width dynamic; block k at H / 2^level_k)
-    OUT_DIR/denoiser.onnx      inputs x, t, tile, m00 .. mNN -> eps
+    OUT_DIR/denoiser.onnx      inputs x, t, m00 .. mNN -> eps, zero padding
+    OUT_DIR/denoiser_tile.onnx the same with circular padding (seamless tiles)
+    OUT_DIR/denoiser.weights   the two denoisers' weights, once (ONNX external data)
+
+(Exports before November 2026 had one denoiser with a ``tile`` input, which blended both paddings at every
+convolution: 20 % of each step at 256²; the runtime still loads them.)
 
 ``one-piece`` (``--one-piece``; the form of models exported before the split):
 
     OUT_DIR/eps.onnx           inputs x, t, cond, tile -> eps (batch, height, width dynamic)
 
-In both, tile = [0.0] means zero padding and [1.0] circular padding (seamless
-tiles): one graph for both so the weights ship once.  And:
+A ``tile`` input of [0.0] means zero padding and [1.0] circular padding (seamless tiles).  And:
 
     OUT_DIR/neural_noise.json  schedule, class and parameter names and ranges, the class-embedding
                                table, the training config and step, the run's record (wall time
@@ -31,6 +35,7 @@ import json
 import os
 import sys
 
+import numpy as np
 import torch
 
 from .._export import export as _ex
@@ -43,6 +48,10 @@ from .train import TrainConfig, build_model, model_names
 __all__ = ["export", "export_model", "reexport", "onnx_export"]
 
 FORMAT = 2  # 2: "form" (one-piece | split); a format-1 JSON is a one-piece export
+#: the files of a split export: the encoder (with a tile input), one denoiser per padding (no tile input: zero
+#: padding, or circular for seamless tiles; the blend of both in one graph cost 20 % of every step), and the
+#: denoisers' weights, shared (external data)
+SPLIT_FILES = ("encoder.onnx", "denoiser.onnx", "denoiser_tile.onnx", "denoiser.weights")
 
 
 def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dynamic: dict) -> None:
@@ -72,12 +81,50 @@ class _Encoder(torch.nn.Module):
 
 
 class _Denoiser(torch.nn.Module):
-    def __init__(self, net):
-        super().__init__()
-        self.net = net
+    """The denoiser with one padding baked in: zeros (``mode`` None) or circular (``mode`` "circular")."""
 
-    def forward(self, x, t, tile, *maps):
-        return self.net.denoise(x, t, list(maps), tile)
+    def __init__(self, net, mode=None):
+        super().__init__()
+        self.net, self.mode = net, mode
+
+    def forward(self, x, t, *maps):
+        return self.net.denoise(x, t, list(maps), self.mode)
+
+
+def share_weights(folder: str, graphs: list, weights: str) -> None:
+    """Move the large initializers of ``graphs`` (ONNX files in ``folder``) into one external-data file
+    ``weights``, each distinct tensor once: graphs exported from the same network then ship its weights once.
+    Tensors under 1 KiB stay inline."""
+    import hashlib
+
+    import onnx
+    from onnx import external_data_helper, numpy_helper
+
+    from .._export import export
+
+    models = [onnx.load(os.path.join(folder, g)) for g in graphs]
+    where, blob = {}, bytearray()
+    for model in models:
+        for init in model.graph.initializer:
+            arr = numpy_helper.to_array(init)
+            raw = np.ascontiguousarray(arr).astype(arr.dtype.newbyteorder("<")).tobytes()
+            if len(raw) < 1024:
+                continue
+            key = hashlib.sha256(raw + str(arr.dtype).encode() + str(arr.shape).encode()).digest()
+            if key not in where:
+                blob += b"\0" * (-len(blob) % 64)  # 64-byte aligned tensors
+                where[key] = (len(blob), len(raw))
+                blob += raw
+            init.CopyFrom(numpy_helper.from_array(arr, init.name))  # raw_data form
+            external_data_helper.set_external_data(init, location=weights, offset=where[key][0], length=len(raw))
+            init.data_location = onnx.TensorProto.EXTERNAL
+            init.ClearField("raw_data")
+    with export.atomic_path(os.path.join(folder, weights)) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(bytes(blob))
+    for g, model in zip(graphs, models):
+        with export.atomic_path(os.path.join(folder, g)) as tmp:
+            onnx.save(model, tmp, save_as_external_data=False)
 
 
 def map_names(model) -> list:
@@ -96,9 +143,11 @@ def _export_split(model, out: str, size: int) -> dict:
                 {"cond": hw, **map_axes})
     with torch.no_grad():
         maps = model.encode(cond, tile)
-    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), tile, *maps)
-    onnx_export(_Denoiser(model), args, os.path.join(out, "denoiser.onnx"), ["x", "t", "tile"] + names, ["eps"],
-                {"x": hw, "t": {0: "batch"}, "eps": hw, **map_axes})
+    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), *maps)
+    for name, mode in (("denoiser.onnx", None), ("denoiser_tile.onnx", "circular")):
+        onnx_export(_Denoiser(model, mode), args, os.path.join(out, name), ["x", "t"] + names, ["eps"],
+                    {"x": hw, "t": {0: "batch"}, "eps": hw, **map_axes})
+    share_weights(out, ["denoiser.onnx", "denoiser_tile.onnx"], "denoiser.weights")
     return dict(names=names, channels=[int(m.shape[1]) for m in maps], levels=[lvl for _, lvl in model.blocks()])
 
 
@@ -119,7 +168,7 @@ def export_model(model, out: str, meta: dict, one_piece: bool = False) -> dict:
         doc.update(form="one-piece", files={"eps.onnx": sha256_file(os.path.join(out, "eps.onnx"))})
     else:
         doc.update(form="split", blocks=_export_split(model, out, size))
-        doc["files"] = {n: sha256_file(os.path.join(out, n)) for n in ("encoder.onnx", "denoiser.onnx")}
+        doc["files"] = {n: sha256_file(os.path.join(out, n)) for n in SPLIT_FILES}
     _ex.write_json(os.path.join(out, "neural_noise.json"), doc)
     return doc
 

@@ -48,6 +48,8 @@ class Conv3(nn.Conv2d):
         self.tile = None  # set by UNet.forward
 
     def forward(self, x):
+        if isinstance(self.tile, str):  # "circular": a graph for seamless tiles only (no blend with zeros)
+            return super().forward(F.pad(x, (1, 1, 1, 1), mode="circular"))
         zero = F.pad(x, (1, 1, 1, 1))
         if self.tile is None:
             return super().forward(zero)
@@ -158,12 +160,13 @@ class UNet(nn.Module):
         return out + [(self.final, 0)]
 
     def _set_tile(self, tile, like) -> None:
-        """Every Conv3's padding for this pass: zeros (tile None or 0) or circular (1 or ``circular``)."""
+        """Every Conv3's padding for this pass: zeros (tile None or 0) or circular (1 or ``circular``); the
+        string "circular" pads circularly without the zero branch (the export's tileable-only graph)."""
         if tile is None and self.circular:
             tile = torch.ones(1, device=like.device)
         for m in self.modules():
             if isinstance(m, Conv3):
-                m.tile = None if tile is None else tile.reshape(()).to(like.dtype)
+                m.tile = tile if tile is None or isinstance(tile, str) else tile.reshape(()).to(like.dtype)
 
     def encode(self, cond, tile=None) -> list:
         """cond (B, E + P, H, W) -> [maps of each ResBlock in :meth:`blocks` order] (see SPADE.maps)."""

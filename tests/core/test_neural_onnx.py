@@ -237,6 +237,21 @@ def test_the_shipped_model_loads_and_generates():
     for name in model.config["trained_classes"][:2]:
         img = generate(model, C.uniform(model, (name, {}), 32, 32), seed=1, steps=3)
         assert img.shape == (32, 32) and img.std() > 0.01
+    # one denoiser per padding, sharing one weights file; the tileable one wraps without a seam
+    assert {"denoiser.onnx", "denoiser_tile.onnx", "denoiser.weights"} <= set(model.config["files"])
+    wrap = generate(model, C.uniform(model, ("cells_f1", {}), 32, 32), seed=1, steps=3, tileable=True)
+    assert np.abs(wrap[:, 0] - wrap[:, -1]).mean() < 1.5 * np.abs(np.diff(wrap, axis=1)).mean()
+
+
+def test_an_export_with_one_tile_input_denoiser_still_loads(tiny):
+    """tests/data/tiny_neural is in the older split form (one denoiser with a tile input): plain and tileable
+    sampling still work and differ only at the borders' padding."""
+    model = NeuralNoiseModel(tiny)
+    assert "denoiser_tile.onnx" not in model.config["files"]
+    assert "tile" in {i.name for i in model.session("denoiser.onnx").get_inputs()}
+    cond = C.uniform(model, ("perlin", {}), 32, 32)
+    plain, wrap = (generate(model, cond, seed=2, steps=3, tileable=t) for t in (False, True))
+    assert plain.shape == wrap.shape == (32, 32) and np.abs(plain - wrap).max() > 0
 
 
 def test_animation_hits_its_keyframes_and_moves_smoothly_between_them(tiny, tmp_path):

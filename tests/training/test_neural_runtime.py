@@ -46,7 +46,7 @@ def test_split_export_equals_the_one_piece_network(exported, one_piece):
     _, out = exported
     split, whole = NeuralNoiseModel(str(out)), NeuralNoiseModel(str(one_piece))
     assert split.form == "split" and whole.form == "one-piece"
-    assert sorted(split.config["files"]) == ["denoiser.onnx", "encoder.onnx"]
+    assert sorted(split.config["files"]) == ["denoiser.onnx", "denoiser.weights", "denoiser_tile.onnx", "encoder.onnx"]
     assert split.config["blocks"]["names"][0] == "m00" and len(split.config["blocks"]["levels"]) == 15
     rng = np.random.default_rng(1)
     for shape in ((2, 24, 40), (1, 16, 16)):
