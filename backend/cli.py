@@ -631,7 +631,7 @@ def run_solid(a: argparse.Namespace) -> int:
 
     from .onnx_models import ModelError
     from .solid.model import SHIPPED_MODELS, SolidTextureModel, load_models
-    from .solid.refine import exemplar_z
+    from .solid.refine import texture_code
 
     if a.list:
         out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
@@ -646,10 +646,6 @@ def run_solid(a: argparse.Namespace) -> int:
     if a.seed < 0:
         raise SettingError("--seed", f"must be >= 0, got {a.seed}")
     limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
-    if not 0.0 <= a.mix <= 1.0:
-        raise SettingError("--mix", f"must be in [0, 1], got {a.mix}")
-    if a.refine < 0:
-        raise SettingError("--refine", f"must be >= 0, got {a.refine}")
     ext = os.path.splitext(a.out)[1].lower()
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
     if ext not in allowed:
@@ -665,23 +661,12 @@ def run_solid(a: argparse.Namespace) -> int:
         raise SettingError("--model", f"{exc}; see models/solid/MODEL_CARD.md or pass --model") from None
     if a.dim == 3 and model.dim != 3:
         raise SettingError("--dim", f"model {model.name!r} is 2D; it cannot fill a volume")
-    if model.mode == "single":
-        if a.to:
-            raise SettingError("--to", f"model {model.name!r} holds one texture; interpolation needs the space model")
-        if a.refine:
-            raise SettingError("--refine", f"model {model.name!r} holds one texture; refining needs the space model")
-        code = model.default_code()
-    else:
-        def z_of(name, flag):
-            z, _, hist = exemplar_z(model, name, a.refine, flag, _Bar(a.quiet, "refine "))
-            if hist and not a.quiet:
-                print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
-            return z
 
-        z = z_of(a.exemplar, "--exemplar")
-        if a.to:
-            z = (1.0 - a.mix) * z + a.mix * z_of(a.to, "--to")
-        code = model.translate(z)
+    def report(name, hist):
+        if not a.quiet:
+            print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
+
+    code, _ = texture_code(model, a.exemplar, a.to, a.mix, a.refine, "--", _Bar(a.quiet, "refine "), report)
     bar = _Bar(a.quiet)
     from .colour import srgb_to_linear
 

@@ -81,6 +81,8 @@ grid (with a constant ``density``), an RGB EXR, an sRGB PNG or a (..., 3) .npy::
     model = "gravel_3d"                 # a shipped model's name, or a model folder
     # exemplar = "photo.png"            # space models: an image to encode (or a training exemplar's name)
     # refine = 40                       # search steps refining the encoded code
+    # to = "wood"                       # space models: a second exemplar (name or image) ...
+    # mix = 0.3                         # ... and its share, as `omninoise solid --to --mix`
     seed = 0
     scale = 1.0                         # texture units per world unit
     density = 1.0

@@ -312,9 +312,10 @@ class SolidSource:
     rgb = True
 
     def __init__(self, model, exemplar: str | None = None, seed: int = 0, scale: float = 1.0,
-                 density: float = 1.0, refine: int = 0, code=None):
+                 density: float = 1.0, refine: int = 0, code=None, to: str | None = None, mix: float = 0.0):
         """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
-        code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds)."""
+        code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds);
+        to, mix: a space model's second exemplar and the share of it (interpolation, as ``omninoise solid``)."""
         from .onnx_models import ModelError
         from .solid.model import SolidTextureModel
 
@@ -326,26 +327,16 @@ class SolidSource:
             raise SettingError("source.scale", f"must be > 0, got {scale}")
         self.dim = self.model.dim
         self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
-        self.exemplar = exemplar
+        self.exemplar, self.to, self.mix = exemplar, to, float(mix)
         self.input_sha256 = None
-        self.z = None
         if code is not None:
             self.code = code
             self.input_sha256 = hashlib.sha256(np.concatenate([np.ravel(code.e), np.ravel(code.T)])
                                                .astype(np.float32).tobytes()).hexdigest()
             return
-        if self.model.mode == "single":
-            if exemplar is not None:
-                raise SettingError("source.exemplar", f"model {self.model.name!r} holds one texture; "
-                                                      "an exemplar needs a space model")
-            self.code = self.model.default_code()
-            return
-        from .solid.refine import exemplar_z
+        from .solid.refine import texture_code
 
-        self.z, img, _ = exemplar_z(self.model, exemplar, self.refine, "source.exemplar")
-        if img is not None:
-            self.input_sha256 = hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest()
-        self.code = self.model.translate(self.z)
+        self.code, self.input_sha256 = texture_code(self.model, exemplar, to, self.mix, self.refine, "source.")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
@@ -364,12 +355,15 @@ class SolidSource:
         return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
 
     def to_dict(self) -> dict:
-        return dict(kind=self.kind, model=self.model.config["files"], exemplar=self.exemplar,
-                    input_sha256=self.input_sha256, refine=self.refine, seed=self.seed, scale=self.scale,
-                    density=self.density)
+        d = dict(kind=self.kind, model=self.model.config["files"], exemplar=self.exemplar,
+                 input_sha256=self.input_sha256, refine=self.refine, seed=self.seed, scale=self.scale,
+                 density=self.density)
+        if self.to is not None:
+            d.update(to=self.to, mix=self.mix)
+        return d
 
 
-_SOLID_KEYS = ("model", "exemplar", "seed", "scale", "density", "refine")
+_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
@@ -492,7 +486,11 @@ def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
     ex = d.get("exemplar")
     if ex is not None and os.path.isfile(os.path.join(base_dir, ex)):
         ex = os.path.join(base_dir, ex)
-    return SolidSource(folder, ex, d.get("seed", 0), d.get("scale", 1.0), d.get("density", 1.0), d.get("refine", 0))
+    to = d.get("to")
+    if to is not None and os.path.isfile(os.path.join(base_dir, to)):
+        to = os.path.join(base_dir, to)
+    return SolidSource(folder, ex, d.get("seed", 0), d.get("scale", 1.0), d.get("density", 1.0), d.get("refine", 0),
+                       to=to, mix=limits.finite("source.mix", d.get("mix", 0.5 if to is not None else 0.0)))
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

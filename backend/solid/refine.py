@@ -123,3 +123,50 @@ def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setti
     if refine > 0:
         z, hist = refine_code(model, z, img, steps=refine, progress=progress)
     return z, img, hist
+
+
+def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: str | None = None, mix: float = 0.0,
+                 refine: int = 0, where: str = "", progress=None, report=None):
+    """The one place a texture request becomes a code, for the command line, job files and the farm:
+    (TextureCode, the input images' sha256 or None).
+
+    A single-exemplar model gives its own texture (``to``, ``refine`` and an ``exemplar`` other than its own are
+    errors); a space model
+    gives ``exemplar`` (a training exemplar's name or an image file, refined by ``refine`` steps), mixed with
+    ``to`` by ``mix`` in [0, 1] (Henzler et al. 2020, Sec. 4: interpolation in the latent space). ``where``
+    prefixes the setting names in errors ("source." for job files, "--" for flags); ``report(name, history)``
+    hears each refinement's distances."""
+    import hashlib
+
+    def name(key):
+        return f"{where}{key}"
+
+    if not np.isfinite(mix) or not 0.0 <= mix <= 1.0:
+        raise SettingError(name("mix"), f"must be in [0, 1], got {mix}")
+    if refine < 0:
+        raise SettingError(name("refine"), f"must be >= 0, got {refine}")
+    if model.mode == "single":  # an exemplar may only name the model's own texture
+        own = {model.name} | {str(e) for e in model.config.get("exemplars", [])}
+        for key, bad, why in (("exemplar", exemplar is not None and exemplar not in own, "another exemplar"),
+                              ("to", to, "interpolation"), ("refine", refine, "refining")):
+            if bad:
+                raise SettingError(name(key), f"model {model.name!r} holds one texture; {why} needs the space model")
+        return model.default_code(), None
+    if exemplar is None:
+        raise SettingError(name("exemplar"), f"the space model needs an exemplar (one of {', '.join(model.codes)}, "
+                                             "or an image file)")
+    digests = []
+
+    def z_of(ex, key):
+        z, img, hist = exemplar_z(model, ex, refine, name(key), progress)
+        if img is not None:
+            digests.append(hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest())
+        if hist and report is not None:
+            report(ex, hist)
+        return z
+
+    z = z_of(exemplar, "exemplar")
+    if to is not None:
+        z = (1.0 - mix) * z + mix * z_of(to, "to")
+    sha = hashlib.sha256("".join(digests).encode()).hexdigest() if digests else None
+    return model.translate(z), sha

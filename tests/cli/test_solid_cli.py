@@ -106,3 +106,34 @@ def test_refine_option(models, tmp_path, capsys):
     assert rc == 0 and "texture-statistics distance" in err and np.load(p).shape == (8, 8, 3)
     rc, err = run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--refine", "3", "-o", p)
     assert rc == 2 and "refining needs the space model" in err
+
+
+def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
+    """`to` and `mix` in a job file (issue 23: job files take everything the command line does) give the volume
+    `omninoise solid --to --mix` writes."""
+    from backend.solid.model import SolidTextureModel
+
+    space = SolidTextureModel(models["space3"])
+    cli = str(tmp_path / "cli.npy")
+    assert run(capsys, "--model", models["space3"], "--exemplar", "gravel", "--to", "wood", "--mix", "0.3", "--dim", "3",
+               "--size", "8", "--seed", "2", "-o", cli)[0] == 0
+    e = 8 / space.px_per_unit
+    (tmp_path / "job.toml").write_text(f"""
+[[bake]]
+name = "mixed"
+output = "job.npy"
+resolution = [8, 8, 8]
+bounds = [[0, 0, 0], [{e!r}, {e!r}, {e!r}]]
+[bake.source]
+kind = "solid"
+model = "{models['space3']}"
+exemplar = "gravel"
+to = "wood"
+mix = 0.3
+seed = 2
+""")
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
+    np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))
+    (tmp_path / "job.toml").write_text((tmp_path / "job.toml").read_text().replace("mix = 0.3", "mix = 1.5"))
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 2
+    assert "source.mix: must be in [0, 1], got 1.5" in capsys.readouterr().err
