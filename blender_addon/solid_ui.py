@@ -145,11 +145,8 @@ def texture(p):
         pixels = _image_pixels(p.image)   # main thread: bpy data
         steps = int(p.refine)
 
-        def code():
-            z = m.encode(pixels)
-            if steps > 0:
-                z = _mod("solid.refine").refine_code(m, z, pixels, steps)[0]
-            return m.translate(z)
+        def code():  # the code path of the command line and job files, on pixels instead of a file
+            return _mod("solid.refine").texture_code(m, pixels, refine=steps)[0]
 
         return m, code
     ident = p.texture
@@ -159,7 +156,7 @@ def texture(p):
     m = load_model(parts[1])
     if parts[0] == "single":
         return m, m.default_code
-    return m, lambda: m.code(parts[2])
+    return m, lambda: _mod("solid.refine").texture_code(m, parts[2])[0]
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:

@@ -108,8 +108,17 @@ def refine_code(model, z0, exemplar: np.ndarray, steps: int = 40, seed: int = 0,
 
 def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setting: str = "exemplar",
                progress=None):
-    """A space model's z for a training exemplar's name or an image file (encoded, then refined by ``refine``
-    search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement distances or [])."""
+    """A space model's z for a training exemplar's name, an image file or pixels float (H, W, 3) (encoded, then
+    refined by ``refine`` search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement
+    distances or [])."""
+    if isinstance(exemplar, np.ndarray):  # pixels already read (the Blender panel): float (H, W, 3) sRGB in [0, 1]
+        img = np.asarray(exemplar, np.float32)
+        if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
+            raise SettingError(setting, f"expected finite RGB pixels (H, W, 3), got shape {img.shape}")
+        z, hist = model.encode(img), []
+        if refine > 0:
+            z, hist = refine_code(model, z, img, steps=refine, progress=progress)
+        return z, img, hist
     if exemplar in model.codes:
         return model.codes[exemplar], None, []
     if exemplar is None or not os.path.isfile(exemplar):
@@ -147,7 +156,8 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
         raise SettingError(name("refine"), f"must be >= 0, got {refine}")
     if model.mode == "single":  # an exemplar may only name the model's own texture
         own = {model.name} | {str(e) for e in model.config.get("exemplars", [])}
-        for key, bad, why in (("exemplar", exemplar is not None and exemplar not in own, "another exemplar"),
+        other = exemplar is not None and (not isinstance(exemplar, str) or exemplar not in own)
+        for key, bad, why in (("exemplar", other, "another exemplar"),
                               ("to", to, "interpolation"), ("refine", refine, "refining")):
             if bad:
                 raise SettingError(name(key), f"model {model.name!r} holds one texture; {why} needs the space model")

@@ -137,3 +137,32 @@ seed = 2
     (tmp_path / "job.toml").write_text((tmp_path / "job.toml").read_text().replace("mix = 0.3", "mix = 1.5"))
     assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 2
     assert "source.mix: must be in [0, 1], got 1.5" in capsys.readouterr().err
+
+
+def test_texture_codes_are_made_in_one_place(models, tmp_path):
+    """A file, the same pixels (the panel's input) and a training exemplar's name all go through texture_code."""
+    from PIL import Image
+
+    from backend.errors import SettingError
+    from backend.solid.model import SolidTextureModel
+    from backend.solid.refine import texture_code
+    from export.images import read_rgb
+
+    space, single = SolidTextureModel(models["space3"]), SolidTextureModel(models["single3"])
+    img = tmp_path / "ex.png"
+    Image.fromarray((np.random.default_rng(2).random((130, 140, 3)) * 255).astype(np.uint8)).save(img)
+    a, sha_a = texture_code(space, str(img))
+    b, sha_b = texture_code(space, read_rgb(str(img)))
+    np.testing.assert_array_equal(a.e, b.e)
+    assert sha_a == sha_b is not None
+    named, sha = texture_code(space, "grass")
+    np.testing.assert_array_equal(named.e, space.code("grass").e)
+    assert sha is None
+    assert texture_code(single, "gravel")[0].e is not None  # its own exemplar's name
+    for kw, msg in [(dict(exemplar="grass"), "holds one texture; another exemplar needs the space model"),
+                    (dict(exemplar=None, to="grass"), "interpolation needs the space model"),
+                    (dict(exemplar=None, mix=float("nan")), r"mix: must be in \[0, 1\]")]:
+        with pytest.raises(SettingError, match=msg):
+            texture_code(single, **kw)
+    with pytest.raises(SettingError, match="needs an exemplar"):
+        texture_code(space)
