@@ -8,7 +8,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import blender_addon  # noqa: E402
-from conftest import Recorder  # noqa: E402
+from conftest import Recorder, needs_openvdb  # noqa: E402
 from blender_addon import solid_ui, tasks  # noqa: E402
 from backend.solid.bake import srgb_to_linear  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
@@ -126,6 +126,7 @@ def test_color_attribute_bake(scene):
     assert node.layer_name == "Solid Texture"
 
 
+@needs_openvdb
 def test_volume_bake(scene, tmp_path):
     bpy.ops.mesh.primitive_cube_add(size=2.0, location=(1.0, 0.0, 0.0))
     p = scene.omninoise_solid
