@@ -76,7 +76,7 @@ def test_the_fit_improves_on_its_start_and_the_cli_gives_the_same(model, tmp_pat
     res = fit(model, target, seed=0)  # 32 px: smaller than the bank's 64, so every class is tried
     first = res.trace[0]
     assert first["stage"] == "classes" and len(first["distances"]) == len(model.config["trained_classes"])
-    assert res.distance <= min(first["distances"].values()) and res.fit_size == 32
+    assert res.distance <= min(first["distances"].values()) + 1e-4 and res.fit_size == 32  # trace rounds to 1e-4
     assert abs(sum(res.classes.values()) - 1) < 1e-6 and 1 <= len(res.classes) <= 2
     for name, values in res.params.items():
         spec = {q["name"]: q for q in model.class_params[name]["params"]}
