@@ -268,14 +268,8 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
             ima = _store(name, img, depth)
             if save_path is not None:
                 ima["omninoise_file"] = save_path
-            if add_node and obj is not None and obj.active_material is not None \
-                    and obj.active_material.node_tree is not None:
-                nt = obj.active_material.node_tree
-                node = next((n for n in nt.nodes if n.type == "TEX_IMAGE" and n.image == ima), None)
-                if node is None:
-                    node = nt.nodes.new("ShaderNodeTexImage")
-                    node.image = ima
-                nt.nodes.active = node
+            if add_node:
+                _image_node(obj, ima)
 
         return tasks.start(tasks.Task(f"Neural {name}", work, done, None, threads()), blocking=blocking)
 
@@ -296,7 +290,22 @@ def sequence_keys(p) -> list:
     return keys
 
 
-def _wire_sequence(ima, first: int, n: int, node) -> None:
+def _image_node(obj, ima):
+    """The active material's Image Texture node showing ``ima`` (added if missing), made active; None when the
+    object has no node-based material."""
+    mat = None if obj is None else obj.active_material
+    if mat is None or mat.node_tree is None:
+        return None
+    nt = mat.node_tree
+    node = next((nd for nd in nt.nodes if nd.type == "TEX_IMAGE" and nd.image == ima), None)
+    if node is None:
+        node = nt.nodes.new("ShaderNodeTexImage")
+        node.image = ima
+    nt.nodes.active = node
+    return node
+
+
+def _wire_sequence(node, first: int, n: int) -> None:
     """Play the sequence's files first..first+n-1 on scene frames first..first+n-1."""
     u = node.image_user
     u.frame_duration, u.frame_start, u.frame_offset = n, first, first - 1
@@ -365,15 +374,9 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
             ima.source = "SEQUENCE"
             ima.colorspace_settings.name = "Non-Color"
             ima["omninoise_file"] = pattern
-            if add_node and obj is not None and obj.active_material is not None \
-                    and obj.active_material.node_tree is not None:
-                nt = obj.active_material.node_tree
-                node = next((nd for nd in nt.nodes if nd.type == "TEX_IMAGE" and nd.image == ima), None)
-                if node is None:
-                    node = nt.nodes.new("ShaderNodeTexImage")
-                    node.image = ima
-                _wire_sequence(ima, first, n, node)
-                nt.nodes.active = node
+            node = _image_node(obj, ima) if add_node else None
+            if node is not None:
+                _wire_sequence(node, first, n)
 
         task = tasks.Task(f"Neural sequence ({n} frames)", work, done, None, threads())
         return tasks.start(task, blocking=blocking)
