@@ -186,3 +186,62 @@ def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
     assert "| a stage | 5 | 1 min | 1.0 | 2.0 | 3 | 4 | no |" in text
     with pytest.raises(SystemExit, match="neither ckpt.pt"):
         photo_card.run_facts(str(tmp_path))
+
+
+@pytest.mark.parametrize("film", [False, True])
+def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
+    """A run continued from an export (init_onnx) starts from the very weights that were exported: the rebuilt
+    torch model equals the trained one on every tensor the export holds, continues at the export's step, and a
+    wrong fingerprint or a missing one is refused in one line.  With ``film`` (code-modulated decoder, encoder
+    on standardised crops) the runtime's ONNX decoder and encoder also equal torch's."""
+    from backend.onnx_models import fingerprint
+    from backend.training.solid.warm_start import exported_weights, warm_start
+
+    photos = ex.photo_set("train")[:2]
+    cfg = dict(name="tiny_photo", mode="space", dim=3, crop=64, batch=2, steps=4, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=photos, colour="affine", loss="swd", transform="bounded",
+               swd_width=8, swd_levels=2, film=film, standardise=film)
+    state = train(SolidConfig.from_dict(dict(cfg, steps=2)), str(tmp_path / "run"), log=lambda *_: None)
+    doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
+    sha = fingerprint(doc["files"])
+    m = build_model(SolidConfig.from_dict(cfg))
+    warm_start(m, exported_weights(str(tmp_path / "m"), sha))
+    got = m.state_dict()
+    for name, ref in state["model"].items():
+        if name.startswith("encoder.norms.4."):
+            continue          # not in the export (its output is never read)
+        np.testing.assert_allclose(got[name].numpy(), ref.numpy(), atol=1e-6, err_msg=name)
+    if film:
+        film_w = float(m.decoder.film.weight.abs().sum())
+        assert np.isfinite(film_w) and film_w > 0, film_w          # trained away from its zero start
+        rt = SolidTextureModel(str(tmp_path / "m"))
+        photo = ex.load_image(ex.photo_set("val")[0]).permute(1, 2, 0).numpy()
+        z = rt.encode(photo)
+        crop = torch.from_numpy(np.ascontiguousarray(photo[:128, :128].transpose(2, 0, 1)))[None]
+        with torch.no_grad():
+            assert float(m.encoder(crop).abs().max()) > 0
+            # standardised input: a crop's colour and contrast do not change its code
+            np.testing.assert_allclose(m.encoder(crop * 0.5 + 0.2).numpy(), m.encoder(crop).numpy(), rtol=5e-3, atol=5e-3)
+        pts = np.random.default_rng(0).uniform(-3, 3, (300, 3))
+        from backend.training.solid.lattice import octave_seeds
+        with torch.no_grad():
+            e, T = m.translator(torch.from_numpy(z[:8])[None])
+            ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),
+                           torch.from_numpy(z[8:])[None])[0].clamp(0, 1).numpy()
+        np.testing.assert_allclose(rt.evaluate(pts, rt.translate(z), seed=5), ref, atol=2e-4)
+    logs = []
+    cont = train(SolidConfig.from_dict(dict(cfg, init_onnx=str(tmp_path / "m"), init_sha256=sha, warmup=2)),
+                 str(tmp_path / "cont"), log=logs.append)
+    assert any("at step 2" in line for line in logs) and cont["step"] == 4 and cont["first_step"] == 2
+    with pytest.raises(ValueError, match="the config pins"):
+        exported_weights(str(tmp_path / "m"), "0" * 64)
+    with pytest.raises(ValueError, match="init_onnx needs init_sha256"):
+        SolidConfig.from_dict(dict(cfg, init_onnx=str(tmp_path / "m")))
+    # single mode: e and T come back from the JSON
+    one = dict(cfg, mode="single", exemplars=photos[:1], steps=1, checkpoint_every=1)
+    state1 = train(SolidConfig.from_dict(one), str(tmp_path / "run1"), log=lambda *_: None)
+    doc1 = export(str(tmp_path / "run1"), str(tmp_path / "m1"))
+    m1 = build_model(SolidConfig.from_dict(one))
+    warm_start(m1, exported_weights(str(tmp_path / "m1"), fingerprint(doc1["files"])))
+    for name, ref in state1["model"].items():
+        np.testing.assert_allclose(m1.state_dict()[name].numpy(), ref.numpy(), atol=1e-6, err_msg=name)

@@ -36,11 +36,13 @@ ENCODER_SIZE = 128
 
 
 class SplitDecoder(nn.Module):
-    """The decoder with its first layer split: same outputs as Decoder(cat(n, e)), broadcasting e."""
+    """The decoder with its first layer split: same outputs as Decoder(cat(n, e)), broadcasting e
+    (and its code modulation ``film``, when it has one)."""
 
     def __init__(self, dec, n_noise: int):
         super().__init__()
-        self.sigmoid = dec.sigmoid
+        self.sigmoid, self.layers = dec.sigmoid, dec.layers
+        self.film = dec.film
         first = dec.net[0]
         self.wn = nn.Linear(n_noise, first.out_features, bias=False)
         self.we = nn.Linear(first.in_features - n_noise, first.out_features)
@@ -51,7 +53,14 @@ class SplitDecoder(nn.Module):
         self.rest = dec.net[1:]
 
     def forward(self, noise, code):
-        y = self.rest(self.wn(noise) + self.we(code))
+        if self.film is None:
+            y = self.rest(self.wn(noise) + self.we(code))
+        else:
+            h = torch.relu(self.wn(noise) + self.we(code))
+            mod = self.film(code).chunk(2 * (self.layers - 1), dim=-1)
+            for j in range(1, self.layers):
+                h = torch.relu((1.0 + mod[2 * j - 2]) * self.rest[2 * j - 1](h) + mod[2 * j - 1])
+            y = self.rest[2 * self.layers - 1](h)
         return torch.sigmoid(y) if self.sigmoid else y
 
 

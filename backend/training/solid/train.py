@@ -38,6 +38,8 @@ from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
 from .model import SolidTexture, colour_stats, slice_points
 from .swd import SlicedFeatures, swd_loss
+from .warm_start import exported_weights, warm_start
+from ...onnx_models import load_model_json
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
 
@@ -68,6 +70,8 @@ class SolidConfig:
     hist_weight: float = 10.0
     colour: str = "sigmoid"         # "sigmoid" (RGB through a sigmoid) or "affine" (mu + L d from the exemplar)
     transform: str = "free"         # space mode: "free" T_i = R_i (I + tanh Delta) or "bounded" (model.bounded_transform)
+    film: bool = False              # the code modulates every hidden layer of the decoder (model.Decoder)
+    standardise: bool = False       # space mode: the encoder sees each crop with its channels standardised
     loss: str = "gram"              # "gram" (random-feature Gram matrices) or "swd" (sliced Wasserstein, swd.py)
     swd_width: int = 32             # swd: random filters per size and pyramid level
     swd_kernels: tuple = (3, 7)     # swd: filter sizes
@@ -78,6 +82,9 @@ class SolidConfig:
     threads: int = 0                # CPU threads for torch and numba (0: their defaults)
     device: str = "cpu"
     init_from: str = ""             # a run folder to continue (its ckpt.pt and log.jsonl seed a new run)
+    init_onnx: str = ""             # or an export folder to continue (its weights; Adam's moments start afresh) ...
+    init_sha256: str = ""           # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
+    warmup: int = 0                 # steps of linear learning-rate warm-up from where this run starts
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -96,6 +103,10 @@ class SolidConfig:
         if cfg.colour not in ("sigmoid", "affine"):
             raise ValueError(f"colour must be 'sigmoid' or 'affine', got {cfg.colour!r}")
         n_exemplars = len(ex.expand(cfg.exemplars))
+        if cfg.init_onnx and not cfg.init_sha256:
+            raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
+        if cfg.init_onnx and cfg.init_from:
+            raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
         if cfg.mode == "single" and n_exemplars != 1:
             raise ValueError(f"single mode takes exactly one exemplar, got {n_exemplars}")
         return cfg
@@ -120,7 +131,8 @@ def _seed_run(src: str, out: str) -> None:
 
 def build_model(cfg: SolidConfig) -> SolidTexture:
     return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
-                        cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform)
+                        cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform, cfg.film,
+                        cfg.standardise)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
@@ -176,6 +188,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     feats = loss_features(cfg)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
+    first = 0              # the step this run's optimiser started at (warm-up counts from it)
     ckpt_path = os.path.join(out, "ckpt.pt")
     if cfg.init_from and not os.path.isfile(ckpt_path):
         _seed_run(cfg.init_from, out)
@@ -186,7 +199,15 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         opt.load_state_dict(state["opt"])
         step, elapsed = state["step"], state.get("elapsed", 0.0)
         gen.set_state(state["gen"])
+        first = state.get("first_step", 0)
         log(f"resumed at step {step}")
+    elif cfg.init_onnx:
+        # the export's step and training time carry on, so the ledger and the cosine schedule continue
+        model_json = load_model_json(cfg.init_onnx, "solid.json")
+        warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256))
+        step, elapsed = int(model_json.get("step", 0)), float(model_json.get("train_seconds", 0.0))
+        first = step
+        log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...) at step {step}")
     images = training_images(cfg)
     augment = cfg.dim == 3 if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
@@ -197,6 +218,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     state = None
     while step < end:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / cfg.steps))
+        if cfg.warmup:     # fresh Adam moments (a run continued from an export) start with small steps
+            lr *= min(1.0, (step - first + 1) / cfg.warmup)
         for g in opt.param_groups:
             g["lr"] = lr
         if cfg.mode == "single":
@@ -226,7 +249,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             log(f"step {step}/{cfg.steps} loss {loss.item():.4f} ({rec['seconds']:.0f} s)")
         if step % cfg.checkpoint_every == 0 or step == end:
             state = dict(config=asdict(cfg), model=model.state_dict(), opt=opt.state_dict(), step=step,
-                         elapsed=time.time() - t0, gen=gen.get_state(), n_params=model.n_params())
+                         elapsed=time.time() - t0, gen=gen.get_state(), n_params=model.n_params(),
+                         first_step=first)
             _save(ckpt_path, state)
     logf.close()
     if state is None:
