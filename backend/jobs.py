@@ -78,7 +78,8 @@ grid (with a constant ``density``), an RGB EXR, an sRGB PNG or a (..., 3) .npy::
     bounds = [[-1, -1, -1], [1, 1, 1]]
     [bake.source]
     kind = "solid"
-    model = "gravel_3d"                 # a shipped model's name, or a model folder
+    model = "gravel_3d"                 # a shipped model's name or a model folder; left out: chosen from the
+                                        # exemplar, as `omninoise solid` does (its own model, else the space model)
     # exemplar = "photo.png"            # space models: an image to encode (or a training exemplar's name)
     # refine = 40                       # search steps refining the encoded code
     # to = "wood"                       # space models: a second exemplar (name or image) ...
@@ -254,11 +255,13 @@ def select_bakes(entries: list, only: list | None) -> list:
 
 
 def run_job(path: str, keep_going: bool = False, force: bool = False, only: list | None = None,
-            progress: Callable[[str, int, int, float], None] | None = None,
-            cancel: Callable[[], bool] | None = None, log: Callable[[str], None] | None = None) -> list:
+            progress: Callable[[float], None] | None = None,
+            cancel: Callable[[], bool] | None = None, log: Callable[[str], None] | None = None,
+            on_bake: Callable[[str, int, int], None] | None = None) -> list:
     """Run every bake of a job file in order -> list of :class:`JobOutcome`.
 
-    progress(name, index, count, fraction) after each slab.  Without
+    ``progress(fraction)`` of the whole job after each slab (the core's one
+    progress contract); ``on_bake(name, index, count)`` as each bake starts.  Without
     ``keep_going`` the first failure stops the job (the returned list ends with
     it); invalid bakes fail before anything is baked.  Outputs whose stored key
     matches are skipped unless ``force``.
@@ -273,7 +276,9 @@ def run_job(path: str, keep_going: bool = False, force: bool = False, only: list
         if isinstance(spec, JobError):
             outcomes.append(JobOutcome(name, "invalid", str(spec)))
             continue
-        cb = None if progress is None else (lambda f, i=i, name=name: progress(name, i, len(entries), f))
+        if on_bake is not None:
+            on_bake(name, i, len(entries))
+        cb = None if progress is None else (lambda f, i=i: progress((i + f) / len(entries)))
         try:
             res = run_bake(spec, cb, cancel, force, log)
         except Cancelled:

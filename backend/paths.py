@@ -49,5 +49,5 @@ def solid_models() -> str:
 
 
 def fit_bank() -> str:
-    """The folder of the inverse-design bank (statistics of zoo images, ``tools`` of backend.training.fit_bank)."""
+    """The folder of the inverse-design bank (statistics of zoo images, ``tools`` of training.fit_bank)."""
     return os.path.join(models_root(), "fit_bank")

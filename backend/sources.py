@@ -334,9 +334,10 @@ class SolidSource:
             self.input_sha256 = hashlib.sha256(np.concatenate([np.ravel(code.e), np.ravel(code.T)])
                                                .astype(np.float32).tobytes()).hexdigest()
             return
-        from .solid.refine import texture_code
+        from .solid.request import SolidRequest
 
-        self.code, self.input_sha256 = texture_code(self.model, exemplar, to, self.mix, self.refine, "source.")
+        req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed).check("source.")
+        self.code, self.input_sha256 = req.code(self.model, "source.")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
@@ -350,8 +351,7 @@ class SolidSource:
             pts = np.concatenate([pts, np.full((len(pts), 1), first[2])], axis=1)
         if self.dim == 2:
             pts = pts[:, :2]
-        prog = None if progress is None else (lambda d, t: progress(d / t))
-        rgb = self.model.evaluate(pts * self.scale, self.code, self.seed, progress=prog, cancel=cancel)
+        rgb = self.model.evaluate(pts * self.scale, self.code, self.seed, progress=progress, cancel=cancel)
         return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
 
     def to_dict(self) -> dict:
@@ -471,26 +471,28 @@ def _spec_value(v, where: str) -> tuple:
     raise SettingError(where, f"expected \"CLASS:NAME=VALUE,...\" or {{noise = CLASS, params = {{...}}}}, got {v!r}")
 
 
-def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
+def solid_request_from_dict(d: dict, base_dir: str = "."):
+    """The :class:`backend.solid.request.SolidRequest` of a job file's solid source, checked (paths relative to
+    the job file; ``model`` a folder, a shipped model's name, or left out as on the command line)."""
     import os
 
-    _check_keys(d, _SOLID_KEYS, "solid")
-    if "model" not in d:
-        raise SettingError("source.model", "a solid source needs model = FOLDER (e.g. models/solid/gravel_3d)")
-    from .solid.model import SHIPPED_MODELS
+    from .solid.request import SolidRequest
 
-    model = d["model"]
-    folder = os.path.join(base_dir, model)
-    if not os.path.isdir(folder) and os.path.isdir(os.path.join(SHIPPED_MODELS, model)):
-        folder = os.path.join(SHIPPED_MODELS, model)     # a shipped model by name
-    ex = d.get("exemplar")
-    if ex is not None and os.path.isfile(os.path.join(base_dir, ex)):
-        ex = os.path.join(base_dir, ex)
-    to = d.get("to")
-    if to is not None and os.path.isfile(os.path.join(base_dir, to)):
-        to = os.path.join(base_dir, to)
-    return SolidSource(folder, ex, d.get("seed", 0), d.get("scale", 1.0), d.get("density", 1.0), d.get("refine", 0),
-                       to=to, mix=limits.finite("source.mix", d.get("mix", 0.5 if to is not None else 0.0)))
+    _check_keys(d, _SOLID_KEYS, "solid")
+
+    def path(v):
+        return os.path.join(base_dir, v) if isinstance(v, str) and os.path.exists(os.path.join(base_dir, v)) else v
+
+    to = path(d.get("to"))
+    mix = d.get("mix", 0.5)
+    return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
+                        d.get("seed", 0)).check("source.")
+
+
+def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
+    req = solid_request_from_dict(d, base_dir)
+    return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
+                       to=req.to, mix=req.mix)
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

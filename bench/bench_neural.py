@@ -123,7 +123,7 @@ def network_gflop(model_folder: str, size: int) -> dict | None:
     try:
         import torch
 
-        from backend.training.warm_start import torch_from_export
+        from training.warm_start import torch_from_export
     except ImportError:
         return None
     net = torch_from_export(model_folder)
@@ -151,7 +151,7 @@ def network_gflop(model_folder: str, size: int) -> dict | None:
 def whole_command(args: list, threads: int) -> float:
     with tempfile.TemporaryDirectory() as d:
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "backend", "neural", "--noise", "cells_f1", "--size", "256", "--quiet",
+        subprocess.run([sys.executable, "-m", "cli", "neural", "--noise", "cells_f1", "--size", "256", "--quiet",
                         "--threads", str(threads), "-o", os.path.join(d, "n.png")] + args, check=True, cwd=ROOT)
         return time.perf_counter() - t0
 
@@ -172,7 +172,7 @@ def main() -> int:
         _worker(a)
         return 0
     from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
-    from backend.training.export_onnx import reexport
+    from training.export_onnx import reexport
 
     sizes = [s for s in a.sizes if s <= 512] if a.quick else a.sizes
     tmp = tempfile.mkdtemp(prefix="omninoise_onepiece_")

@@ -1,6 +1,6 @@
 """Inverse design, evaluated: `python bench/eval_fit.py OUT_PREFIX [--size 128] [--fit-size 64] [--per-class 1]`.
 
-Held-out zoo images: for every trained class, ``--per-class`` images rendered by the zoo (backend/training/zoo.py)
+Held-out zoo images: for every trained class, ``--per-class`` images rendered by the zoo (training/zoo.py)
 with parameters drawn uniformly in their ranges and seeds the training never drew (10⁶ and up). Each is fitted
 (backend/neural/fit.py) and regenerated at its own size with the shipped sampler defaults and the fitted seed.
 Reported: class accuracy (the fitted dominant class is the true one), the normalised parameter error of correctly
@@ -40,7 +40,7 @@ from export.images import read_rgb, write_png  # noqa: E402
 def zoo_image(name: str, u: np.ndarray, seed: int, size: int, classes: dict) -> tuple:
     import torch
 
-    from backend.training import zoo
+    from training import zoo
 
     spec = classes[name]["params"]
     params = {p["name"]: float(p["min"] + uu * (p["max"] - p["min"])) for p, uu in zip(spec, u)}

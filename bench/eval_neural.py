@@ -1,6 +1,6 @@
 """Evaluate a neural noise model: `python bench/eval_neural.py --model models/neural_noise`.
 
-Prints the per-class table of backend/training/evaluate.py (Fréchet distance in
+Prints the per-class table of training/evaluate.py (Fréchet distance in
 a zoo classifier's features, classifier accuracy on generated samples, power-
 spectrum error, parameter-response error), the seam ratio of tileable output,
 blend locality, and seconds per DDIM step for onnxruntime and torch with the
@@ -19,8 +19,8 @@ sys.path.insert(0, ROOT)
 
 from backend.neural.model import NeuralNoiseModel  # noqa: E402
 from export.atomic import write_json  # noqa: E402
-from backend.training.evaluate import evaluate, step_seconds  # noqa: E402
-from backend.training.threads import cpu_threads  # noqa: E402
+from training.evaluate import evaluate, step_seconds  # noqa: E402
+from training.threads import cpu_threads  # noqa: E402
 
 
 def main() -> int:

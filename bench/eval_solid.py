@@ -5,7 +5,7 @@ model, style error (independent random-feature Gram distance + colour term),
 PSD error, diversity and success of ``ours`` (2D model, and slices of the 3D
 model), the texture-space model (its code for the exemplar's *held-out* pixels,
 so it measures generalisation), and the baselines of
-backend/training/solid/evaluate.py (tiled exemplar, Perlin coloured by the
+training/solid/evaluate.py (tiled exemplar, Perlin coloured by the
 exemplar's histogram, a linear noise transform).
 
 Speed and memory (Table 2): points per second and peak resident memory for a
@@ -36,8 +36,8 @@ MODELS = os.path.join(ROOT, "models", "solid")
 def quality(n: int, models_dir: str = MODELS) -> dict:
     import torch
 
-    from backend.training.solid import exemplars as ex
-    from backend.training.solid.evaluate import EVAL_SIZE, evaluate_exemplar, slices_3d
+    from training.solid import exemplars as ex
+    from training.solid.evaluate import EVAL_SIZE, evaluate_exemplar, slices_3d
 
     from backend.solid.model import load_models
 
@@ -120,8 +120,8 @@ def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
     else:
         import torch
 
-        from backend.training.solid.lattice import octave_seeds
-        from backend.training.solid.train import SolidConfig, build_model
+        from training.solid.lattice import octave_seeds
+        from training.solid.train import SolidConfig, build_model
 
         state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
         tm = build_model(SolidConfig.from_dict(state["config"]))

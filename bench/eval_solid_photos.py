@@ -6,7 +6,7 @@ photo (one click in the add-on: no refinement) and its 3D texture is sliced
 normal to x, y and z (SIZE² px at the photo's resolution, ``--seeds`` seeds).
 Against the photo, per slice axis and pooled:
 
-- ``swd``: the patch distance of :mod:`backend.training.solid.photo_eval` (7 x 7
+- ``swd``: the patch distance of :mod:`training.solid.photo_eval` (7 x 7
   Laplacian-pyramid neighbourhoods, sliced Wasserstein, x 1000), lower is better,
   beside the baselines built from the same photo (pixel shuffle, random phase
   noise, Perlin coloured by the photo's histogram) and ``photo_crop`` (a
@@ -34,7 +34,7 @@ import numpy as np  # noqa: E402
 
 from export.atomic import atomic_path, write_json  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
-from backend.training.solid import photo_eval as pe  # noqa: E402
+from training.solid import photo_eval as pe  # noqa: E402
 
 SIZE = 128
 

@@ -4,7 +4,7 @@ The classes whose structure spans more than a small crop (damascus bands, fibre 
 orientation and frequency, by default) at their default parameters: one row per class, the zoo's ground truth
 first, then each model's generation from the same seed, side by side. Beside each image its orientation
 coherence (1 = one orientation over the whole image, 0 = isotropic) and under the sheet a JSON with those and
-the low-frequency spectrum error against the zoo (the measures of backend/training/evaluate.py), so the
+the low-frequency spectrum error against the zoo (the measures of training/evaluate.py), so the
 picture and the numbers can be read together. Writes OUT.png and OUT.json.
 """
 from __future__ import annotations
@@ -40,8 +40,8 @@ def main() -> int:
     a = ap.parse_args()
     import torch
 
-    from backend.training import zoo
-    from backend.training.evaluate import orientation_coherence, psd_error
+    from training import zoo
+    from training.evaluate import orientation_coherence, psd_error
 
     classes = [c.strip() for c in a.classes.split(",") if c.strip()]
     labels = a.label or [os.path.basename(os.path.normpath(m)) for m in a.model]

@@ -10,7 +10,7 @@ multi-scale features + colour histogram) and, for comparison, the earlier
 Gram loss.  If the loss sees structure, the optimised image shows the photo's
 stones, grains and bricks; a loss that only sees colour and spectrum gives
 blotches.  The sheet: photo | Gram loss | sliced Wasserstein loss, one row per
-photo; the patch distance of :mod:`backend.training.solid.photo_eval` for
+photo; the patch distance of :mod:`training.solid.photo_eval` for
 each is printed and written beside the sheet (JSON).
 """
 from __future__ import annotations
@@ -29,9 +29,9 @@ import torch  # noqa: E402
 import torch.nn.functional as F  # noqa: E402
 
 from export.atomic import atomic_path, write_json  # noqa: E402
-from backend.training.solid import exemplars as ex  # noqa: E402
-from backend.training.solid import photo_eval as pe  # noqa: E402
-from backend.training.solid.train import SolidConfig, load_config, loss_features, texture_loss  # noqa: E402
+from training.solid import exemplars as ex  # noqa: E402
+from training.solid import photo_eval as pe  # noqa: E402
+from training.solid.train import SolidConfig, load_config, loss_features, texture_loss  # noqa: E402
 
 DEFAULT_PHOTOS = ("gravel", "rock", "brick", "wood", "paving", "grass")
 

@@ -28,8 +28,8 @@ def main() -> int:
     import torch
     from PIL import Image, ImageDraw
 
-    from backend.training import zoo
-    from backend.training.evaluate import orientation_coherence
+    from training import zoo
+    from training.evaluate import orientation_coherence
 
     S, cols, label_h, gap = a.size, a.columns, 14, 4
     names = list(zoo.CLASS_NAMES)

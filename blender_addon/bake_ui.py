@@ -253,10 +253,7 @@ class OMNINOISE_OT_run_job(TaskOperator, bpy.types.Operator):
         keep_going, force = self.keep_going or p.keep_going, self.force or p.force
 
         def work(progress, cancel):
-            def prog(name, i, count, frac):
-                progress((i + frac) / count)
-
-            return backend.jobs.run_job(path, keep_going=keep_going, force=force, progress=prog, cancel=cancel)
+            return backend.jobs.run_job(path, keep_going=keep_going, force=force, progress=progress, cancel=cancel)
 
         def done(outcomes):
             bad = [o for o in outcomes if o.status in ("invalid", "failed", "cancelled")]

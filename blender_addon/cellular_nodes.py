@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 
 from ._deps import backend
-from .wave_nodes import INPUTS, SETTINGS_KEY, _clear, _group_io, _new_group, _Nodes, settings_to_json
+from .wave_nodes import INPUTS, SETTINGS_KEY, clear_tree, group_io, new_group, NodeBuilder, settings_to_json
 
 __all__ = ["build_cellular_group", "new_cellular_tree", "CELL_OUTPUTS"]
 
@@ -31,12 +31,12 @@ _OFFSET, _PLANE, _CODE = 24, 25, 26  # backend.cellular streams
 
 
 def new_cellular_tree(name: str = "Wave Cellular", tree_type: str = "ShaderNodeTree") -> bpy.types.NodeTree:
-    tree = _new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in CELL_OUTPUTS))
+    tree = new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in CELL_OUTPUTS))
     tree.interface.items_tree["Scale"].min_value = -1000.0
     return tree
 
 
-def _value(b: _Nodes, x, y, z, w):
+def _value(b: NodeBuilder, x, y, z, w):
     node = b.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
     b.put(node.inputs["Vector"], b.combine(x, y, z))
     b.put(node.inputs["W"], w)
@@ -52,13 +52,13 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
     if tree is None:
         tree = new_cellular_tree(name, tree_type)
     else:
-        _clear(tree)
+        clear_tree(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
     seed = float(noise.seed)
     C = noise.cell_size
     inv = float(_F(1.0 / C))
-    b = _Nodes(tree)
-    _, go, x, w = _group_io(b)
+    b = NodeBuilder(tree)
+    _, go, x, w = group_io(b)
     dim = noise.dim
     dist, code = None, 0.0
     for f, normal in enumerate(noise.normals):

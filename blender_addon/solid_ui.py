@@ -33,7 +33,7 @@ from .bake_ui import draw_progress
 from .tasks import TaskOperator
 from .preferences import threads
 
-__all__ = ["models_dir", "load_model", "texture", "register", "unregister"]
+__all__ = ["models_dir", "load_model", "panel_request", "texture", "register", "unregister"]
 
 #: where the shipped models live (``backend.solid.model.SHIPPED_MODELS``, computed here without importing the
 #: backend, so register() stays cheap); tests point it elsewhere
@@ -133,30 +133,31 @@ def _image_pixels(ima) -> np.ndarray:
     return np.ascontiguousarray(np.flipud(rgb), np.float32)
 
 
-def texture(p):
-    """(model, code_fn) for the panel's settings; code_fn() runs on the worker (it may encode an image)."""
+def panel_request(p):
+    """The panel's :class:`backend.solid.request.SolidRequest`: the one request of the command line and job
+    files, built from the properties (an image's pixels are read here, on the main thread: bpy data)."""
+    SolidRequest = _mod("solid.request").SolidRequest
     if p.source == "IMAGE":
         if p.image is None:
             raise backend.SettingError("image", "pick an exemplar image (or switch Source to Shipped)")
         name = _space_model_name()
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
-        m = load_model(name)
-        pixels = _image_pixels(p.image)   # main thread: bpy data
-        steps = int(p.refine)
-
-        def code():  # the code path of the command line and job files, on pixels instead of a file
-            return _mod("solid.refine").texture_code(m, pixels, refine=steps)[0]
-
-        return m, code
+        return SolidRequest(os.path.join(models_dir(), name), _image_pixels(p.image), refine=int(p.refine),
+                            seed=int(p.seed)).check()
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
     parts = ident.split(":")
-    m = load_model(parts[1])
-    if parts[0] == "single":
-        return m, m.default_code
-    return m, lambda: _mod("solid.refine").texture_code(m, parts[2])[0]
+    exemplar = None if parts[0] == "single" else parts[2]
+    return SolidRequest(os.path.join(models_dir(), parts[1]), exemplar, seed=int(p.seed)).check()
+
+
+def texture(p):
+    """(model, code_fn) for the panel's settings; code_fn() runs on the worker (it may encode an image)."""
+    req = panel_request(p)
+    m = load_model(os.path.basename(req.model))
+    return m, lambda: req.code(m)[0]
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:
@@ -257,7 +258,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         def work(progress, cancel):
             code = code_fn()
             progress(0.2)
-            return m.image(128, code, seed, progress=lambda d, n: progress(0.2 + 0.8 * d / n), cancel=cancel)
+            return m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
 
         def done(img):
             _store_image(name, np.flipud(img)).preview_ensure()
@@ -301,7 +302,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
                 mask, pts = surface.dilate(mask, pts, margin)
                 rgb = np.zeros((size, size, 3), np.float32)
                 rgb[mask] = m.evaluate(pts[mask] * scale, code, seed,
-                                       progress=lambda d, n: progress(0.3 + 0.7 * d / n), cancel=cancel)
+                                       progress=lambda f: progress(0.3 + 0.7 * f), cancel=cancel)
                 return rgb
 
             def done(rgb):
@@ -322,7 +323,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
 
             def work(progress, cancel):
                 code = code_fn()
-                rgb = m.evaluate(co * scale, code, seed, progress=lambda d, n: progress(d / n), cancel=cancel)
+                rgb = m.evaluate(co * scale, code, seed, progress=progress, cancel=cancel)
                 return linear(rgb)
 
             def done(rgb):

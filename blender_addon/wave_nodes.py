@@ -45,7 +45,7 @@ from ._deps import backend
 from .compat import id_property
 
 __all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json", "settings_from_json",
-           "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json"]
+           "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group", "clear_tree", "group_io"]
 
 _F = np.float32
 SETTINGS_KEY = "omninoise_wave_settings"
@@ -108,7 +108,7 @@ def ensure_table_image(values: np.ndarray, slope: bool = False) -> bpy.types.Ima
 
 # -- a small node-building helper ---------------------------------------------
 
-class _Nodes:
+class NodeBuilder:
     """Adds math nodes to a shader or geometry tree; constants go into socket defaults."""
 
     def __init__(self, tree: bpy.types.NodeTree):
@@ -204,7 +204,7 @@ class _Nodes:
         return self.vmath("MULTIPLY_ADD", self.image(imgs[1], where), t, c=self.image(imgs[0], where))
 
 
-def _new_group(name: str, tree_type: str, inputs, outputs) -> bpy.types.NodeTree:
+def new_group(name: str, tree_type: str, inputs, outputs) -> bpy.types.NodeTree:
     tree = bpy.data.node_groups.new(name, tree_type)
     for nm, st, default in inputs:
         s = tree.interface.new_socket(nm, in_out="INPUT", socket_type=st)
@@ -221,7 +221,7 @@ _STRATUM_INPUTS = (("Sum", "NodeSocketVector", None), ("Position", "NodeSocketVe
                    ("W", "NodeSocketFloat", None), ("Shift", "NodeSocketFloat", None))
 
 
-def _direction(b: _Nodes, u, dim: int, full: bool, g) -> tuple:
+def _direction(b: NodeBuilder, u, dim: int, full: bool, g) -> tuple:
     """map_directions (backend.directions) for a cap domain: u sockets (dim-1) -> (vec3, w)."""
     u = list(u)
     sign = None
@@ -284,8 +284,8 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: tuple,
     (Sum - Sum), exactly zero: that data dependency makes the compiler finish
     stratum k before it starts stratum k+1.
     """
-    tree = _new_group(name, tree_type, _STRATUM_INPUTS, (("Sum", "NodeSocketVector"),))
-    b = _Nodes(tree)
+    tree = new_group(name, tree_type, _STRATUM_INPUTS, (("Sum", "NodeSocketVector"),))
+    b = NodeBuilder(tree)
     gi = b.new("NodeGroupInput")
     go = b.new("NodeGroupOutput")
     b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, imgs, rows,
@@ -293,7 +293,7 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: tuple,
     return tree
 
 
-def _stratum_nodes(b: _Nodes, ins: dict, dim: int, full: bool, imgs: tuple, rows: int, mode: str, consts: dict):
+def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: tuple, rows: int, mode: str, consts: dict):
     """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket.
 
     imgs: the (table, slope) images of :func:`ensure_table_image`; Shift carries
@@ -392,7 +392,7 @@ def _stratum_constants(noise, k: int) -> dict:
     }
 
 
-def _clear(tree: bpy.types.NodeTree) -> None:
+def clear_tree(tree: bpy.types.NodeTree) -> None:
     for n in list(tree.nodes):
         if n.bl_idname == "ShaderNodeGroup" or n.bl_idname == "GeometryNodeGroup":
             sub = n.node_tree
@@ -405,7 +405,7 @@ def _clear(tree: bpy.types.NodeTree) -> None:
 
 def new_wave_tree(name: str = "Wave Noise", tree_type: str = "ShaderNodeTree") -> bpy.types.NodeTree:
     """An empty group with the Wave Noise interface (INPUTS in, OUTPUTS out), ready for build_wave_group."""
-    tree = _new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in OUTPUTS))
+    tree = new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in OUTPUTS))
     tree.interface.items_tree["Scale"].min_value = -1000.0
     return tree
 
@@ -427,7 +427,7 @@ def add_wave_node(node_tree: bpy.types.NodeTree, group: bpy.types.NodeTree, loca
     return node
 
 
-def _group_io(b: _Nodes) -> tuple:
+def group_io(b: NodeBuilder) -> tuple:
     """Group input and output nodes, and the scaled inputs every OmniNoise group starts from:
     (group input, group output, Vector x Scale, W x Scale)."""
     gi = b.new("NodeGroupInput")
@@ -455,13 +455,13 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     if tree is None:
         tree = new_wave_tree(name, tree_type)
     else:
-        _clear(tree)
+        clear_tree(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
     imgs = (ensure_table_image(table.values), ensure_table_image(table.values, slope=True))
     dim = noise.dim
     full = any(d.full for d in noise.dirs.domains)
-    b = _Nodes(tree)
-    gi, go, x, w = _group_io(b)
+    b = NodeBuilder(tree)
+    gi, go, x, w = group_io(b)
     # v t (Eq. 9) plus half a texel in world units: the lookup reads texel floor(c N - 1/2)
     shift = b.math("MULTIPLY_ADD", gi.outputs["Time"], float(_F(noise.speed)),
                    float(_F(0.5 * noise.table.period / table.size)))

@@ -1,8 +1,9 @@
 """The import graph keeps its layers (issue 23): no cycles, not even through imports inside functions, and
 dependencies point one way.
 
-    blender_addon  ->  backend (runtime: wave, neural, solid, bakes, cli)  ->  export (file writers)
-    backend.training (torch)  ->  backend runtime
+    cli (omninoise, farms)  ->  backend (core: wave, neural, solid, bakes, job files)  ->  export (file writers)
+    blender_addon           ->  backend
+    training (torch)        ->  backend
 
 Read statically from the source (every ``import`` anywhere in a module, function bodies included), so a cycle
 held together by a function-level import counts, and nothing needs torch or bpy to run this test.
@@ -12,8 +13,7 @@ import os
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PACKAGES = ("backend", "export", "blender_addon")
-
+PACKAGES = ("backend", "export", "blender_addon", "cli", "training")
 
 def modules() -> dict:
     """{dotted module name: file path} of every module of the packages above."""
@@ -26,7 +26,6 @@ def modules() -> dict:
                     name = os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
                     out[name[: -len(".__init__")] if name.endswith(".__init__") else name] = path
     return out
-
 
 def imports(name: str, path: str, known: dict) -> dict:
     """{imported name: line} of one module: project modules resolved to their dotted names, others as written
@@ -50,12 +49,10 @@ def imports(name: str, path: str, known: dict) -> dict:
                 out.setdefault(full if full in known else base, node.lineno)
     return out
 
-
 def graph() -> tuple:
     known = modules()
     edges = {m: imports(m, p, known) for m, p in known.items()}
     return known, edges
-
 
 def cycles(edges: dict, known: dict) -> list:
     """Strongly connected components with more than one module (Tarjan), each sorted."""
@@ -89,14 +86,12 @@ def cycles(edges: dict, known: dict) -> list:
             visit(v)
     return out
 
-
 def test_no_import_cycles():
     known, edges = graph()
     found = cycles(edges, known)
     detail = [" <-> ".join(c) + ": " + "; ".join(f"{m} imports {d} (line {edges[m][d]})" for m in c
                                                   for d in edges[m] if d in c) for c in found]
     assert not found, "\n".join(detail)
-
 
 def test_the_cycle_finder_finds_a_cycle_through_a_function_level_import(tmp_path):
     """The instrument itself: two modules that import each other, one of them inside a function."""
@@ -106,32 +101,28 @@ def test_the_cycle_finder_finds_a_cycle_through_a_function_level_import(tmp_path
     edges = {m: imports(m, p, known) for m, p in known.items()}
     assert cycles(edges, known) == [["pkg.a", "pkg.b"]]
 
-
-#: the command line sits on top of both the runtime and training: `omninoise zoo` renders the training zoo (torch),
-#: imported inside that one command, which says so when torch is missing
-FRONT_ENDS = ("backend.cli",)
-
-
 def test_dependencies_point_one_way():
     known, edges = graph()
     bad = []
     for m, deps in edges.items():
-        runtime = (m.startswith(("backend", "export")) and not m.startswith("backend.training")
-                   and m not in FRONT_ENDS)
+        runtime = m.split(".")[0] in ("backend", "export")
         for d, line in deps.items():
             where = f"{m} (line {line}) imports {d}"
             if d.split(".")[0] == "bpy" and not m.startswith("blender_addon"):
                 bad.append(where + ": only blender_addon may import bpy")
-            if runtime and (d.startswith("backend.training") or d.split(".")[0] in ("torch", "onnx")):
+            if runtime and d.split(".")[0] in ("training", "torch", "onnx"):
                 bad.append(where + ": the runtime never imports training code or torch")
+            if m.split(".")[0] in ("backend", "export", "blender_addon", "training") and d.split(".")[0] == "cli":
+                bad.append(where + ": nothing below the command line imports it")
+            if m.split(".")[0] == "blender_addon" and d.split(".")[0] == "training":
+                bad.append(where + ": the add-on never imports training code")
             if m.startswith("export") and d.startswith(("backend", "blender_addon")):
                 bad.append(where + ": the file writers sit below the engines")
-            if d.split(".")[0] in ("dask", "distributed") and m != "backend.farm":
-                bad.append(where + ": only backend/farm.py uses Dask (an optional extra)")
+            if d.split(".")[0] in ("dask", "distributed") and m != "cli.farm":
+                bad.append(where + ": only cli/farm.py uses Dask (an optional extra)")
             if m.startswith("backend") and d.startswith("blender_addon"):
                 bad.append(where + ": the core never imports the Blender layer")
     assert not bad, "\n".join(bad)
-
 
 def test_files_are_replaced_only_by_the_atomic_helper():
     """One atomic-write helper (export/atomic.py: fsync, stale-temporary clean-up): no other module renames a
@@ -147,12 +138,10 @@ def test_files_are_replaced_only_by_the_atomic_helper():
                     bad.append(f"{name}:{n}: {line.strip()}")
     assert not bad, "\n".join(bad)
 
-
-#: the test files that exercise training and evaluation (backend.training, torch); every other test file must run
+#: the test files that exercise training and evaluation (training, torch); every other test file must run
 #: without torch (the runtime's tests use tests/data/tiny_* and the shipped models)
 TORCH_TEST_FILES = {"test_neural_eval.py", "test_neural_runtime.py", "test_neural_training.py", "test_solid_eval.py",
                     "test_solid_model.py", "test_solid_photos.py", "test_zoo.py", "test_zoo_blender.py"}
-
 
 def test_only_training_and_evaluation_tests_need_torch(tmp_path):
     import re
@@ -169,3 +158,16 @@ def test_only_training_and_evaluation_tests_need_torch(tmp_path):
     skipped = {m.group(1) for m in re.finditer(r"SKIPPED \[\d+\] \S*?(test_\w+\.py):\d+: could not import 'torch'",
                                                 r.stdout)}
     assert skipped == TORCH_TEST_FILES, (sorted(skipped - TORCH_TEST_FILES), sorted(TORCH_TEST_FILES - skipped))
+
+
+def test_modules_import_only_public_names_from_each_other():
+    """Public names only across modules (issue 23, item 5): no ``from .x import _private`` in the project."""
+    bad = []
+    for name, path in modules().items():
+        with open(path, encoding="utf-8") as fh:
+            tree = ast.parse(fh.read(), path)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").split(".")[0] in PACKAGES):
+                bad += [f"{name} (line {node.lineno}) imports {a.name} from {node.module or '.'}"
+                        for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not bad, "\n".join(bad)

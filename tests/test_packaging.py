@@ -1,5 +1,5 @@
 """A non-editable install holds every runtime package (issue 23: it used to leave out backend.neural,
-backend.solid and backend.training)."""
+backend.solid and training)."""
 import os
 import tomllib
 
@@ -13,10 +13,10 @@ def test_every_package_folder_is_installed():
         cfg = tomllib.load(fh)["tool"]["setuptools"]["packages"]["find"]
     found = set(find_packages(ROOT, include=cfg["include"]))
     on_disk = {os.path.relpath(d, ROOT).replace(os.sep, ".")
-               for top in ("backend", "export") for d, _, files in os.walk(os.path.join(ROOT, top))
+               for top in ("backend", "export", "cli", "training") for d, _, files in os.walk(os.path.join(ROOT, top))
                if "__init__.py" in files}
     assert on_disk <= found, sorted(on_disk - found)
-    assert {"backend.neural", "backend.solid", "backend.training.solid"} <= found
+    assert {"backend.neural", "backend.solid", "cli", "training", "training.solid"} <= found
     assert not any(p.startswith(("tests", "blender_addon", "bench")) for p in found)
 
 
@@ -33,8 +33,8 @@ def test_a_non_editable_install_runs_every_subcommand(tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     (wheel,) = wheels.glob("omninoise-*.whl")
     names = zipfile.ZipFile(wheel).namelist()
-    for module in ("backend/cli.py", "backend/neural/generate.py", "backend/solid/model.py", "backend/farm.py",
-                   "backend/training/zoo.py", "export/vdb.py"):
+    for module in ("cli/main.py", "backend/neural/generate.py", "backend/solid/model.py", "cli/farm.py",
+                   "training/zoo.py", "export/vdb.py"):
         assert module in names, module
     prefix = tmp_path / "prefix"
     r = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--ignore-installed", "-q", "--prefix", str(prefix),
@@ -44,7 +44,7 @@ def test_a_non_editable_install_runs_every_subcommand(tmp_path):
     (site,) = prefix.glob("lib/python3*/site-packages")
     assert (prefix / "share" / "omninoise" / "models" / "neural_noise" / "denoiser.onnx").is_file()
     code = ("import sys, os; sys.path = [p for p in sys.path if os.path.abspath(p or '.') != %r]; "
-            "sys.path.insert(0, %r); import backend.cli as c; assert c.__file__.startswith(%r), c.__file__; "
+            "sys.path.insert(0, %r); import cli.main as c; assert c.__file__.startswith(%r), c.__file__; "
             "out = %r; "
             "rc = [c.main(['wave', '--size', '8', '--quiet', '-o', out + '/w.npy']), "
             "c.main(['transfer', '--list']), c.main(['neural', '--list']), c.main(['solid', '--list']), "
@@ -71,7 +71,7 @@ def test_every_shipped_model_folder_is_in_the_data_files():
 
 def test_omninoise_models_points_every_front_end_at_another_model_folder(tmp_path, monkeypatch, capsys):
     from backend import paths
-    from backend.cli import main
+    from cli.main import main
 
     monkeypatch.setenv("OMNINOISE_MODELS", str(tmp_path / "farm-models"))
     assert paths.neural_model() == str(tmp_path / "farm-models" / "neural_noise")

@@ -36,7 +36,7 @@ PLATFORMS = {  # Blender platform -> pip platform tag
     "macos-arm64": "macosx_14_0_arm64",
 }
 RUNTIME = ("__init__.py", "blender_manifest.toml", "blender_addon", "backend", "export", "models")
-EXCLUDE_DIRS = {"__pycache__", "training"}
+EXCLUDE_DIRS = {"__pycache__"}
 
 
 def blender_ext() -> str:

@@ -43,7 +43,7 @@ def wave_points(dim: int) -> np.ndarray:
 
 
 def wave_values(flags: list) -> np.ndarray:
-    from backend.cli import build_parser, settings_from_args
+    from cli.main import build_parser, settings_from_args
     from backend.grid import evaluate_points
     from backend.settings import compile_noise
 
@@ -55,7 +55,7 @@ def wave_values(flags: list) -> np.ndarray:
 def zoo_values(name: str) -> np.ndarray:
     import torch
 
-    from backend.training import zoo
+    from training import zoo
 
     return zoo.generate(name, zoo.default_params(name), torch.tensor([0]), 8)[0].numpy()
 
@@ -94,7 +94,7 @@ def model_fingerprint(kind: str, folder: str) -> str:
 
 
 def main() -> int:
-    from backend.training import zoo
+    from training import zoo
 
     os.makedirs(OUT, exist_ok=True)
     r = lambda a: np.round(np.asarray(a, np.float64), 7).tolist()  # noqa: E731

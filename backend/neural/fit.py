@@ -87,7 +87,7 @@ def distance(s: dict, t: dict) -> float:
 
 def load_bank(folder: str) -> dict:
     """The inverse-design bank of ``folder`` (fit_bank.json + bank.npz, sha256-checked; built by
-    ``backend.training.fit_bank``): {classes, size, cls int (N,), u float32 (N, 4), one float32 (N, n) array per
+    ``training.fit_bank``): {classes, size, cls int (N,), u float32 (N, 4), one float32 (N, n) array per
     statistic group}."""
     from ..onnx_models import load_model_json
 

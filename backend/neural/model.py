@@ -1,7 +1,7 @@
 """The exported neural noise model, run by onnxruntime (no torch).
 
 A model folder holds ``neural_noise.json`` and, by its ``form`` (see
-``backend/training/export_onnx.py``), either ``encoder.onnx`` + ``denoiser.onnx``
+``training/export_onnx.py``), either ``encoder.onnx`` + ``denoiser.onnx``
 (``split``: the conditioning's SPADE maps are computed once per image and only
 the denoiser runs at every step) or one ``eps.onnx`` (``one-piece``, the form of
 older exports, still loaded).  Loading checks every file's sha256 against the

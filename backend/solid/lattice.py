@@ -13,7 +13,7 @@ decoder never sees x itself, only these values.
 
 The hash is ``lowbias32`` (Chris Wellons' 32-bit integer hash) chained over
 the lattice coordinates, computed in int64 with 32-bit masks, so numpy, numba
-and the torch training code (``backend.training.solid.lattice``) produce the
+and the torch training code (``training.solid.lattice``) produce the
 same lattice values bit for bit.
 
 Shapes: points (N, D) float, D in {2, 3}; transforms (m, D, D) float32;

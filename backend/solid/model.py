@@ -2,7 +2,7 @@
 
 A model folder holds ``solid.json`` and ``decoder.onnx`` (space models also
 ``encoder.onnx`` and ``translator.onnx``), written by
-``backend/training/solid/export.py``.  Loading checks every file's sha256
+``training/solid/export.py``.  Loading checks every file's sha256
 against the JSON; sessions are created on first use.
 
     tex = SolidTextureModel("models/solid/gravel_3d")
@@ -84,7 +84,7 @@ def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
 
 def colour_stats(img: np.ndarray, eps: float = 1e-4) -> np.ndarray:
     """Mean colour and Cholesky factor of the colour covariance of an image (H, W, 3): float32 (12,) = [mu, L.ravel()]
-    (the numpy twin of ``backend.training.solid.model.colour_stats``)."""
+    (the numpy twin of ``training.solid.model.colour_stats``)."""
     x = np.asarray(img, np.float64).reshape(-1, 3)
     mu = x.mean(0)
     xc = x - mu
@@ -182,7 +182,7 @@ class SolidTextureModel:
         """s(x | z) (Eq. 5) at points float (N, D) in texture units -> sRGB float32 (N, 3) in [0, 1].
 
         Works in chunks of ``chunk`` points (memory stays flat whatever N);
-        ``progress(done, total)`` after each chunk; ``cancel()`` returning True
+        ``progress(fraction)`` after each chunk (the one progress contract of the core); ``cancel()`` returning True
         stops early with :class:`Cancelled`.  2D points on a 3D model are
         read on the z = 0 plane.
         """
@@ -211,7 +211,7 @@ class SolidTextureModel:
                 d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
             out[a:b] = d
             if progress is not None:
-                progress(b, N)
+                progress(b / N)
         return out
 
     def image(self, size: int, code: TextureCode, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),

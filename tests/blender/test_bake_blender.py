@@ -246,7 +246,7 @@ dim = 2
 
 @needs_openvdb
 def test_job_in_blender_matches_the_command_line(tmp_path):
-    from backend.cli import main
+    from cli.main import main
 
     for sub in ("cli", "bpy"):
         (tmp_path / sub).mkdir()

@@ -319,7 +319,7 @@ def test_fit_to_image_fills_the_active_swatch_as_the_runtime_fits(scene):
 
 @pytest.mark.parametrize("mode", ["SINGLE", "CORNERS", "MAP"])
 def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
-    from backend.cli import build_parser, neural_request
+    from cli.main import build_parser, neural_request
     from export.images import write_png
 
     p = scene.omninoise_neural

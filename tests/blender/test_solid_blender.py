@@ -196,3 +196,32 @@ def test_panel_draws(scene):
     props = [a for n, a, t in log if n == "prop"]
     assert {"source", "texture", "scale", "seed", "coords", "target", "size", "margin", "name"} <= set(props)
     assert [t for n, a, t in log if n == "operator"] == ["Preview", "Bake"]
+
+
+def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
+    """The panel, the command line and job files build one request (backend.solid.request): equal settings give
+    equal keys, an image datablock's pixels count as the file they came from."""
+    from backend.sources import solid_request_from_dict
+    from cli.main import build_parser, solid_request
+    from export.images import write_png
+
+    p = scene.omninoise_solid
+    space = os.path.join(solid_ui.MODELS_DIR, "space")
+
+    def flags(*args):
+        return solid_request(build_parser().parse_args(["solid", *args, "--seed", "3", "-o", "x.png"]))
+
+    p.texture = "single:gravel_3d"
+    gravel = os.path.join(solid_ui.MODELS_DIR, "gravel_3d")
+    assert solid_ui.panel_request(p).key() == flags("--model", gravel).key() == \
+        solid_request_from_dict({"model": gravel, "seed": 3}).key()
+    p.texture = "space:space:grass"
+    assert solid_ui.panel_request(p).key() == flags("--model", space, "--exemplar", "grass").key()
+    rgb = np.random.default_rng(2).integers(0, 256, (40, 48, 3)).astype(np.uint8)
+    write_png(str(tmp_path / "ex.png"), rgb)
+    ima = bpy.data.images.load(str(tmp_path / "ex.png"))
+    p.source, p.image, p.refine = "IMAGE", ima, 4
+    req = solid_ui.panel_request(p)
+    assert req.key() == flags("--model", space, "--exemplar", str(tmp_path / "ex.png"), "--refine", "4").key()
+    assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
+                                                 "seed": 3}).key()

@@ -12,9 +12,9 @@ import pytest
 torch = pytest.importorskip("torch")
 bpy = pytest.importorskip("bpy")
 
-from backend.training import noise_ops as ops  # noqa: E402
-from backend.training import zoo  # noqa: E402
-from backend.training.evaluate import radial_psd  # noqa: E402
+from training import noise_ops as ops  # noqa: E402
+from training import zoo  # noqa: E402
+from training.evaluate import radial_psd  # noqa: E402
 from blender_addon.field_eval import evaluate_field  # noqa: E402
 
 S = 128

@@ -6,7 +6,7 @@ import re
 import pytest
 
 from backend import limits
-from backend.cli import main
+from cli.main import main
 from backend.errors import SettingError
 from backend.jobs import run_job
 
@@ -127,7 +127,7 @@ def test_bad_custom_profiles(tmp_path, capsys, content, name):
 
 def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp_path, capsys, monkeypatch):
     """Exit 1 and one line naming the exception for a bug; `omninoise --debug ...` re-raises it."""
-    import backend.cli as cli
+    import cli.main as cli
 
     def broken(a):
         raise ZeroDivisionError("float division by zero")

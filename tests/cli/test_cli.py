@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from backend.cli import main
+from cli.main import main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -65,7 +65,7 @@ def test_existing_output_survives_failure(tmp_path, capsys):
 
 def test_python_dash_m_backend(tmp_path):
     out = str(tmp_path / "m.npy")
-    r = subprocess.run([sys.executable, "-m", "backend", "wave", "--size", "8", "--quiet", "-o", out],
+    r = subprocess.run([sys.executable, "-m", "cli", "wave", "--size", "8", "--quiet", "-o", out],
                        cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert np.load(out).shape == (8, 8)

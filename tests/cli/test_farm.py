@@ -10,8 +10,8 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from backend import farm  # noqa: E402
-from backend.cli import main  # noqa: E402
+from cli import farm  # noqa: E402
+from cli.main import main  # noqa: E402
 from backend.jobs import run_job  # noqa: E402
 from export import read_volume  # noqa: E402
 from export.images import decode  # noqa: E402
@@ -126,9 +126,11 @@ def test_a_mixed_job_on_two_workers_equals_the_one_machine_bake(client, referenc
     c, _ = client
     job = job_in(tmp_path)
     seen = []
-    outcomes = farm.run_farm(job, c, brick_voxels=BRICK, progress=lambda *p: seen.append(p))
+    fractions = []
+    outcomes = farm.run_farm(job, c, brick_voxels=BRICK, progress=fractions.append, status=lambda *p: seen.append(p))
     assert [(o.name, o.status) for o in outcomes] == [(n, "baked") for n in ("image", "seq", "cloud", "raw", "neural")]
     assert len(seen) == 3 + 3 + 4 and seen[-1][0] == seen[-1][1] == 10 and seen[-1][2] > 0  # 6 files + 4 bricks
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0 and len(fractions) == 10
     assert_same_outputs(reference, str(tmp_path))
     # resume: everything is up to date (the .npy outputs through the manifest), --force redoes it all
     assert {o.status for o in farm.run_farm(job, c, brick_voxels=BRICK)} == {"up to date"}

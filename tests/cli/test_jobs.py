@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from backend.cli import main
+from cli.main import main
 from backend.jobs import JobError, load_job, run_job
 from export import read_volume
 
@@ -53,8 +53,12 @@ def job(tmp_path):
 
 
 def test_job_bakes_then_skips(job):
-    out = run_job(str(job))
+    fractions, bakes = [], []
+    out = run_job(str(job), progress=fractions.append, on_bake=lambda *b: bakes.append(b))
     assert [(o.name, o.status) for o in out] == [("clouds", "baked"), ("marble", "baked")]
+    # the core's one progress contract: the job's fraction, rising to 1; each bake announced as it starts
+    assert bakes == [("clouds", 0, 2), ("marble", 1, 2)]
+    assert fractions == sorted(fractions) and fractions[-1] == pytest.approx(1.0) and 0.5 in fractions
     files = sorted(os.listdir(job.parent / "out"))
     assert files == ["clouds_01.vdb", "clouds_02.vdb", "marble.exr"]
     again = run_job(str(job))

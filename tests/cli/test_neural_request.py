@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from backend.cli import build_parser, main, neural_request
+from cli.main import build_parser, main, neural_request
 from backend.errors import SettingError
 from backend.neural.model import NeuralNoiseModel
 from backend.neural.request import NeuralRequest, generate_request

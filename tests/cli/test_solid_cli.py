@@ -4,7 +4,7 @@ import os
 import numpy as np
 import pytest
 
-from backend.cli import main
+from cli.main import main
 from backend.paths import solid_models
 
 TINY = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_solid")

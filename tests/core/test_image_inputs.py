@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from backend.cli import main
+from cli.main import main
 from export.images import MAX_PIXELS, ImageError, decode, read_image, read_rgb
 
 

@@ -6,7 +6,7 @@ import shutil
 import numpy as np
 import pytest
 
-from backend.cli import main
+from cli.main import main
 from backend.errors import SettingError
 from backend.grid import Cancelled
 from backend.neural import conditioning as C

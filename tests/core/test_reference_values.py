@@ -37,7 +37,7 @@ def test_wave_variants_match_their_stored_values(variant):
 
 def test_every_zoo_class_matches_its_stored_image():
     pytest.importorskip("torch")
-    from backend.training import zoo
+    from training import zoo
 
     want = stored("zoo.json")
     assert list(want) == list(zoo.CLASS_NAMES), "classes were added or renamed: rerun tools/make_reference.py"

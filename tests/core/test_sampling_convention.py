@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from backend import WaveSettings, compile_noise
-from backend.cli import build_parser, main, settings_from_args
+from cli.main import build_parser, main, settings_from_args
 from backend.grid import evaluate_grid
 from export import read_volume
 from export.images import read_image

@@ -83,7 +83,7 @@ seed = 4
 
 
 @pytest.mark.parametrize("source, msg", [
-    ({"kind": "solid"}, "needs model = FOLDER"),
+    ({"kind": "solid"}, "source.exemplar: the space model needs an exemplar"),
     ({"kind": "solid", "model": "gravel_3d", "colour": 1}, "unknown solid setting"),
     ({"kind": "solid", "model": "gravel_3d", "exemplar": "x.png"}, "holds one texture"),
     ({"kind": "solid", "model": "nope"}, "no solid.json"),
@@ -99,3 +99,18 @@ def test_transfer_is_refused(tmp_path):
     spec = BakeSpec("t", SolidSource(GRAVEL), BoxGrid((4, 4, 4)), str(tmp_path / "t.vdb"), preset("clouds"))
     with pytest.raises(SettingError, match="has its own colours"):
         run_bake(spec)
+
+
+def test_evaluate_reports_fractions_and_cancels_between_chunks():
+    """The core's one progress contract: ``progress(fraction)``, rising to 1.0; cancel stops before the next chunk."""
+    from backend.grid import Cancelled
+
+    m = SolidTextureModel(GRAVEL)
+    pts = np.random.default_rng(1).uniform(-2, 2, (1000, 3))
+    seen = []
+    out = m.evaluate(pts, m.default_code(), 0, chunk=300, progress=seen.append)
+    assert seen == pytest.approx([0.3, 0.6, 0.9, 1.0]) and out.shape == (1000, 3)
+    calls = []
+    with pytest.raises(Cancelled):
+        m.evaluate(pts, m.default_code(), 0, chunk=300, progress=calls.append, cancel=lambda: len(calls) >= 2)
+    assert calls == pytest.approx([0.3, 0.6])

@@ -83,7 +83,7 @@ def test_bad_shapes_raise():
 @pytest.mark.parametrize("D", [2, 3])
 def test_torch_twin_matches_runtime(D):
     torch = pytest.importorskip("torch")
-    from backend.training.solid.lattice import lattice_noise, octave_seeds
+    from training.solid.lattice import lattice_noise, octave_seeds
     rng = np.random.default_rng(5)
     x = rng.uniform(-2, 2, (2, 2000, D)).astype(np.float32)
     T = rng.normal(size=(8, D, D)).astype(np.float32)

@@ -4,7 +4,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from backend.training.evaluate import frechet, radial_psd, train_classifier  # noqa: E402
+from training.evaluate import frechet, radial_psd, train_classifier  # noqa: E402
 
 
 def test_frechet_distance():
@@ -31,7 +31,7 @@ def test_zoo_classifier_learns_distinct_classes():
 
 
 def test_orientation_coherence_tells_bands_from_isotropic_texture():
-    from backend.training.evaluate import orientation_coherence
+    from training.evaluate import orientation_coherence
 
     y, x = np.mgrid[0:64, 0:64].astype(np.float64)
     rng = np.random.default_rng(1)
@@ -48,7 +48,7 @@ def test_orientation_coherence_tells_bands_from_isotropic_texture():
 
 
 def test_low_frequency_psd_error_sees_what_the_full_error_averages_away():
-    from backend.training.evaluate import psd_error
+    from training.evaluate import psd_error
 
     rng = np.random.default_rng(2)
     y, x = np.mgrid[0:64, 0:64]
@@ -59,7 +59,7 @@ def test_low_frequency_psd_error_sees_what_the_full_error_averages_away():
 
 
 def test_classifier_stages_widen_the_receptive_field():
-    from backend.training.evaluate import Classifier
+    from training.evaluate import Classifier
 
     two, three = Classifier(4), Classifier(4, stages=3)
     x = torch.zeros(1, 1, 64, 64, requires_grad=True)

@@ -10,11 +10,11 @@ torch = pytest.importorskip("torch")
 
 from backend.neural.sampler import ddim_sample, ddim_step, initial_noise  # noqa: E402
 from backend.neural.schedule import cosine_alphas_cumprod, ddim_timesteps  # noqa: E402
-from backend.training import zoo  # noqa: E402
-from backend.training.cutmix import cutmix  # noqa: E402
-from backend.training.diffusion import Diffusion  # noqa: E402
-from backend.training.train import TrainConfig, train  # noqa: E402
-from backend.training.unet import UNet, set_circular  # noqa: E402
+from training import zoo  # noqa: E402
+from training.cutmix import cutmix  # noqa: E402
+from training.diffusion import Diffusion  # noqa: E402
+from training.train import TrainConfig, train  # noqa: E402
+from training.unet import UNet, set_circular  # noqa: E402
 
 TINY = dict(size=16, batch=4, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=2, sample_every=0,
             classes=("perlin", "spots", "cells_f1"))
@@ -159,7 +159,7 @@ def test_config_errors():
 
 def test_checkpoints_of_a_smaller_zoo_still_load():
     """The zoo is append-only: a model made before classes were added uses the first ids and slots."""
-    from backend.training.train import build_model, model_names
+    from training.train import build_model, model_names
 
     cfg = TrainConfig.from_dict(dict(TINY))
     old = UNet(len(zoo.CLASS_NAMES) - 1, len(zoo.PARAM_NAMES) - 3, emb_dim=8, widths=(8, 16, 16))
@@ -172,7 +172,7 @@ def test_checkpoints_of_a_smaller_zoo_still_load():
 def test_cpu_threads_limits_torch_and_numba_and_restores_them():
     """One training thread must also mean one numba worker (the zoo's wave classes run numba kernels)."""
     numba = pytest.importorskip("numba")
-    from backend.training.threads import cpu_threads
+    from training.threads import cpu_threads
 
     before = torch.get_num_threads(), numba.get_num_threads()
     with cpu_threads(1):
@@ -186,8 +186,8 @@ def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
     """configs/: each file loads; the production (GPU) config runs one step at its resolution on the CPU."""
     import glob
 
-    from backend.training.solid.train import load_config as load_solid
-    from backend.training.train import load_config
+    from training.solid.train import load_config as load_solid
+    from training.train import load_config
 
     root = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "configs")
     neural = sorted(glob.glob(os.path.join(root, "*.json")))
@@ -206,7 +206,7 @@ def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
 
 
 def test_precision_is_bf16_only_where_the_cpu_computes_it():
-    from backend.training.precision import autocast, cpu_bf16_native, resolve
+    from training.precision import autocast, cpu_bf16_native, resolve
 
     assert cpu_bf16_native("processor : 0\nflags : fpu avx2 avx512f amx_bf16 amx_tile\n")
     assert cpu_bf16_native("flags : fpu avx2 avx512_bf16\n")

@@ -10,12 +10,12 @@ torch = pytest.importorskip("torch")
 from backend.errors import SettingError  # noqa: E402
 from backend.onnx_models import ModelError  # noqa: E402
 from backend.solid.model import SolidTextureModel, TextureCode  # noqa: E402
-from backend.training.solid import exemplars as ex  # noqa: E402
-from backend.training.solid.export import export  # noqa: E402
-from backend.training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
-from backend.training.solid.lattice import octave_seeds  # noqa: E402
-from backend.training.solid.model import random_rotations, slice_points  # noqa: E402
-from backend.training.solid.train import SolidConfig, build_model, train  # noqa: E402
+from training.solid import exemplars as ex  # noqa: E402
+from training.solid.export import export  # noqa: E402
+from training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
+from training.solid.lattice import octave_seeds  # noqa: E402
+from training.solid.model import random_rotations, slice_points  # noqa: E402
+from training.solid.train import SolidConfig, build_model, train  # noqa: E402
 
 
 def _tiny(tmp_path, mode="single", dim=3, steps=4, **kw):
@@ -70,7 +70,7 @@ def test_features_see_structure_and_colour():
 
 def _fixed_loss(state, img):
     """Style loss of a model on fixed slices, seeds and crops (no batch-to-batch noise)."""
-    from backend.training.solid.train import render
+    from training.solid.train import render
     cfg = SolidConfig.from_dict(state["config"])
     m = build_model(cfg)
     m.load_state_dict(state["model"])
@@ -103,7 +103,7 @@ def test_resume_continues_from_checkpoint(tmp_path):
 def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_path):
     import json
 
-    from backend.training.solid.model_card import card
+    from training.solid.model_card import card
 
     base = dict(name="c", dim=2, crop=32, batch=1, steps=4, width=16, checkpoint_every=2, log_every=1, threads=1,
                 exemplars=["gravel"])

@@ -12,7 +12,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 
 import build_photo_set as bps  # noqa: E402
-from backend.training.solid import photo_eval as pe  # noqa: E402
+from training.solid import photo_eval as pe  # noqa: E402
 
 PHOTOS = os.path.join(ROOT, "data", "photos")
 
@@ -97,11 +97,11 @@ torch = pytest.importorskip("torch")
 
 from backend.solid.model import SolidTextureModel, colour_stats  # noqa: E402
 from backend.solid.refine import refine_code  # noqa: E402
-from backend.training.solid import exemplars as ex  # noqa: E402
-from backend.training.solid.export import export  # noqa: E402
-from backend.training.solid.model import bounded_transform, colour_stats as colour_stats_t, random_rotations  # noqa: E402
-from backend.training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
-from backend.training.solid.train import SolidConfig, build_model, train  # noqa: E402
+from training.solid import exemplars as ex  # noqa: E402
+from training.solid.export import export  # noqa: E402
+from training.solid.model import bounded_transform, colour_stats as colour_stats_t, random_rotations  # noqa: E402
+from training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
+from training.solid.train import SolidConfig, build_model, train  # noqa: E402
 
 
 def test_colour_stats_twins_agree_and_rebuild_the_covariance():
@@ -151,7 +151,7 @@ def test_photo_space_model_colour_path_export_and_refine(tmp_path):
     m = build_model(SolidConfig.from_dict(state["config"]))
     m.load_state_dict(state["model"])
     pts = np.random.default_rng(0).uniform(-3, 3, (500, 3))
-    from backend.training.solid.lattice import octave_seeds
+    from training.solid.lattice import octave_seeds
     with torch.no_grad():
         e, T = m.translator(torch.from_numpy(z[:8])[None])
         ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),
@@ -171,7 +171,7 @@ def test_photo_space_model_colour_path_export_and_refine(tmp_path):
 def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
     """The card section is written from the shipped export's solid.json (config, steps, wall time) when the run
     folder is not kept, with the two evaluations side by side and the ledger rows as given."""
-    from backend.training.solid import photo_card
+    from training.solid import photo_card
 
     space = os.path.join(ROOT, "models", "solid", "space")
     with open(os.path.join(space, "solid.json"), encoding="utf-8") as fh:
@@ -195,7 +195,7 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
     wrong fingerprint or a missing one is refused in one line.  With ``film`` (code-modulated decoder, encoder
     on standardised crops) the runtime's ONNX decoder and encoder also equal torch's."""
     from backend.onnx_models import fingerprint
-    from backend.training.solid.warm_start import exported_weights, warm_start
+    from training.solid.warm_start import exported_weights, warm_start
 
     photos = ex.photo_set("train")[:2]
     cfg = dict(name="tiny_photo", mode="space", dim=3, crop=64, batch=2, steps=4, width=16, log_every=1,
@@ -223,7 +223,7 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
             # standardised input: a crop's colour and contrast do not change its code
             np.testing.assert_allclose(m.encoder(crop * 0.5 + 0.2).numpy(), m.encoder(crop).numpy(), rtol=5e-3, atol=5e-3)
         pts = np.random.default_rng(0).uniform(-3, 3, (300, 3))
-        from backend.training.solid.lattice import octave_seeds
+        from training.solid.lattice import octave_seeds
         with torch.no_grad():
             e, T = m.translator(torch.from_numpy(z[:8])[None])
             ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),

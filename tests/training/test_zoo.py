@@ -6,8 +6,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from backend.cli import main  # noqa: E402
-from backend.training import zoo  # noqa: E402
+from cli.main import main  # noqa: E402
+from training import zoo  # noqa: E402
 
 
 def centroid(img: np.ndarray) -> float:

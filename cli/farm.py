@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bake import BakeSpec, KEY_NAME, bake_frame, frame_path, volume_channels, volume_grids
-from .jobs import JobError, JobOutcome, load_job, select_bakes
+from backend.bake import BakeSpec, KEY_NAME, bake_frame, frame_path, volume_channels, volume_grids
+from backend.jobs import JobError, JobOutcome, load_job, select_bakes
 
 __all__ = ["Task", "plan", "run_farm", "local_client", "remote_client", "brick_voxels_for", "CRASH_ENV"]
 
@@ -88,7 +88,7 @@ def _maybe_crash(path: str) -> None:
         os.remove(marker)
     except OSError:
         return  # another worker took it
-    from ._export import export
+    from backend._export import export
 
     partial = os.path.join(os.path.dirname(path), export.partial_prefix(path) + "crash")
     with open(partial, "wb") as fh:
@@ -198,16 +198,17 @@ def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None 
 
 
 def run_farm(job: str, client, force: bool = False, only: list | None = None, brick_voxels: int | None = None,
-             retries: int = 2, progress=None, log=None) -> list:
+             retries: int = 2, progress=None, log=None, status=None) -> list:
     """Run a job file's bakes on ``client``'s cluster -> list of :class:`backend.jobs.JobOutcome` (one per bake).
 
-    ``progress(done, total, bytes_moved, eta_seconds)`` after every finished task.  Invalid bakes fail the
+    ``progress(fraction)`` (the core's contract) and ``status(done, total, bytes_moved, eta_seconds)`` after
+    every finished task.  Invalid bakes fail the
     job before anything is sent (as one-machine runs do).  A failed task fails its output, named in the
     outcome; every other output is still written.
     """
     from distributed import as_completed
 
-    from ._export import export
+    from backend._export import export
 
     job = os.path.abspath(job)
     entries = select_bakes(load_job(job), only)
@@ -263,8 +264,10 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
                 export.remove_partials(t.path)
                 written[t.path] = dict(file_record(t.path), bake=t.bake, frame=t.frame, key=spec.key(t.frame))
         if progress is not None:
+            progress(done / len(tasks))
+        if status is not None:
             rate = (time.perf_counter() - t0) / done
-            progress(done, len(tasks), moved, rate * (len(tasks) - done))
+            status(done, len(tasks), moved, rate * (len(tasks) - done))
     for path in failed:
         export.remove_partials(path)
     manifest.update({os.path.abspath(p): r for p, r in written.items()})

@@ -1,4 +1,4 @@
-"""Train the neural noise model: ``python -m backend.training.train --config CONFIG.json --out RUN``.
+"""Train the neural noise model: ``python -m training.train --config CONFIG.json --out RUN``.
 
 Data is generated on the fly by :mod:`.zoo` (no files), on the CPU or the GPU.
 Every step: a zoo batch -> CutMix (p = 0.5) -> random flips -> ε-prediction loss
@@ -33,7 +33,7 @@ from .precision import autocast, resolve
 from .threads import cpu_threads
 from .unet import UNet
 from .warm_start import exported_weights, warm_start
-from ..onnx_models import ModelError
+from backend.onnx_models import ModelError
 
 __all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names", "check_config_keys"]
 
@@ -63,7 +63,7 @@ def _device(name: str) -> torch.device:
 
 
 def _save(path: str, obj) -> None:
-    from .._export import export
+    from backend._export import export
 
     with export.atomic_path(path) as tmp:
         torch.save(obj, tmp)
@@ -77,7 +77,7 @@ def _conditions(ids: torch.Tensor, conds: torch.Tensor, size: int):
 
 def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0) -> np.ndarray:
     """DDIM samples of a few classes at their default parameters: float32 (n, S, S) in [0, 1]."""
-    from ..neural.sampler import ddim_sample, initial_noise
+    from backend.neural.sampler import ddim_sample, initial_noise
 
     names = list(names or cfg.classes[:8])
     S = cfg.size
@@ -176,7 +176,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
 
 def save_samples(model: UNet, cfg: TrainConfig, device, path: str) -> None:
     """A row of EMA samples (first 8 classes, default parameters) as a PNG."""
-    from .._export import export
+    from backend._export import export
 
     imgs = sample_grid(model, cfg, device)
     row = np.concatenate(list(imgs), axis=1)
@@ -184,7 +184,7 @@ def save_samples(model: UNet, cfg: TrainConfig, device, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m backend.training.train", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m training.train", description=__doc__.split("\n")[0])
     ap.add_argument("--config", required=True, help="JSON config (see TrainConfig)")
     ap.add_argument("--out", required=True, help="run folder: checkpoint, log, samples")
     ap.add_argument("--max-steps", type=int, help="stop after this many more steps (resume later)")

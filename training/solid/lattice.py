@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from ...solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
+from backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
 
 __all__ = ["octave_seeds", "lattice_noise"]
 

@@ -1,6 +1,6 @@
 """The photo texture-space section of the solid-texture model card.
 
-    python -m backend.training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
+    python -m training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
         [--shipped] -o models/solid/MODEL_CARD.md
 
 Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``; or its export's ``solid.json``
@@ -18,8 +18,8 @@ import os
 import re
 import sys
 
-from ..._export import export as _ex
-from ..model_card import _hardware, read_json
+from backend._export import export as _ex
+from ..model_card import hardware_line, read_json
 
 BEGIN, END = "<!-- photo-space:begin -->", "<!-- photo-space:end -->"
 
@@ -66,11 +66,11 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
-         "python -m backend.training.solid.train --config configs/solid/photo_space_3d.json --out runs/solid/photo_space",
-         "python -m backend.training.solid.export runs/solid/photo_space models/solid/space",
+         "python -m training.solid.train --config configs/solid/photo_space_3d.json --out runs/solid/photo_space",
+         "python -m training.solid.export runs/solid/photo_space models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
-         f"{f['seconds'] / 60:.1f} min wall on {_hardware().split(',')[0]}, {cfg['threads']} "
+         f"{f['seconds'] / 60:.1f} min wall on {hardware_line().split(',')[0]}, {cfg['threads']} "
          f"threads, fp32 (no native bf16 on this CPU)"
          + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
             " (read from the export; the run folder and its loss log were not kept).")

@@ -16,7 +16,7 @@ import math
 
 import torch
 
-from ..neural.schedule import T_DEFAULT, cosine_alphas_cumprod
+from backend.neural.schedule import T_DEFAULT, cosine_alphas_cumprod
 
 __all__ = ["Diffusion"]
 

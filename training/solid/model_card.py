@@ -1,6 +1,6 @@
-"""Write the solid-texture model card: ``python -m backend.training.solid.model_card``.
+"""Write the solid-texture model card: ``python -m training.solid.model_card``.
 
-    python -m backend.training.solid.model_card --models models/solid --runs runs/solid \\
+    python -m training.solid.model_card --models models/solid --runs runs/solid \\
         --eval out/bench/solid_eval.json -o models/solid/MODEL_CARD.md
 
 Everything in the card is read from files the project's own commands wrote:
@@ -14,7 +14,7 @@ import json
 import os
 import sys
 
-from ..model_card import _hardware, read_json, wall_seconds
+from ..model_card import hardware_line, read_json, wall_seconds
 
 __all__ = ["card"]
 
@@ -92,16 +92,16 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
             ev = json.load(fh)
     L = ["# Neural solid texture models", "",
          "Solid textures after Henzler, Mitra and Ritschel, \"Learning a Neural 3D Texture Space from 2D "
-         "Exemplars\" (CVPR 2020), trained by this project's code (`backend/training/solid/`) on CPU.", "",
+         "Exemplars\" (CVPR 2020), trained by this project's code (`training/solid/`) on CPU.", "",
          "## How they were made", "", "```sh",
          "# one model per config; configs/solid/NAME.json names its exemplar, dimension and schedule",
-         "python -m backend.training.solid.train --config configs/solid/NAME.json --out runs/solid/NAME",
-         "python -m backend.training.solid.export runs/solid/NAME models/solid/NAME",
+         "python -m training.solid.train --config configs/solid/NAME.json --out runs/solid/NAME",
+         "python -m training.solid.export runs/solid/NAME models/solid/NAME",
          "python bench/eval_solid.py --speed",
-         "python -m backend.training.solid.model_card -o models/solid/MODEL_CARD.md", "```", "",
+         "python -m training.solid.model_card -o models/solid/MODEL_CARD.md", "```", "",
          "- **Exemplars:** the CC0 photographs brick, grass and gravel from scikit-image's data "
          "(`data/exemplars/README.md`; training never crops their right quarter) and the procedural classes "
-         "wood, marble, rust and granite of `backend/training/solid/exemplars.py` (seed 0 trains, seed 1 is held out).",
+         "wood, marble, rust and granite of `training/solid/exemplars.py` (seed 0 trains, seed 1 is held out).",
          "- **Model** (Sec. 3-4, Eq. 5): 8 octaves of lattice value noise, 3 values per lattice point, octave i "
          "read at T_i 2^(i-1) x; decoder MLP of four 128-wide ReLU layers over [noise (24), e (64)] to RGB "
          "(sigmoid, sRGB values). Single mode learns e, T and the decoder; the space model learns an "
@@ -113,7 +113,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "- **3D from 2D:** each step renders 128² slices through random points of 3D space, axis-aligned "
          "(random axis permutation) or, half the time, randomly rotated; every slice must match the exemplar's "
          "statistics. Exemplar crops are randomly rotated/flipped for 3D models.",
-         f"- **Hardware:** {_hardware()}; one torch thread per run, two or three runs sharing the two cores "
+         f"- **Hardware:** {hardware_line()}; one torch thread per run, two or three runs sharing the two cores "
          "(wall times include that sharing).",
          "- **gravel_3d** was trained before the decoder's He initialisation became the default; its config "
          "names `decoder_init = \"torch\"`, which reproduces it. Every other model uses He initialisation.", "",
@@ -137,7 +137,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
               "(`init_from` names the first run; a longer `steps` restarts the cosine learning-rate decay at the "
               "step where the first run ended), each with the `train` command above. Wall time and loss cover "
               "both stages. This is the longest CPU training the session allowed (no GPU was lent): "
-              "`python -m backend.training.solid.train --config configs/solid/NAME_long.json "
+              "`python -m training.solid.train --config configs/solid/NAME_long.json "
               "--out runs/solid/NAME_long` after the first run."]
     L += ["", "Full sha256 of every file: each model's `solid.json` (`files`); the runtime refuses a file whose "
           "hash differs. Configs: `configs/solid/<model>.json` (the space model: `space_3d.json`).", ""]
@@ -196,7 +196,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m backend.training.solid.model_card", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m training.solid.model_card", description=__doc__.split("\n")[0])
     ap.add_argument("--models", default="models/solid")
     ap.add_argument("--runs", default="runs/solid")
     ap.add_argument("--eval", default="out/bench/solid_eval.json")
@@ -208,7 +208,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     rejected = dict(r.split("=", 1) for r in a.rejected)
     text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected)
-    from ..._export import export
+    from backend._export import export
 
     with export.atomic_path(a.out) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:

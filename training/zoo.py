@@ -291,9 +291,9 @@ def _blender_gabor(x, y, s, p, n):
 
 def _wave_engine(kind: str):
     def gen(x, y, s, p, n):
-        from ..grid import evaluate_box
-        from ..settings import WaveSettings, compile_noise
-        from ..spectra import Spectrum
+        from backend.grid import evaluate_box
+        from backend.settings import WaveSettings, compile_noise
+        from backend.spectra import Spectrum
 
         out = []
         for b in range(x.shape[0]):

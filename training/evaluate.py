@@ -178,7 +178,7 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
         clf = Classifier(len(classes), stages=stages)
         clf.load_state_dict(saved["state"])
         return clf.eval(), saved["accuracy"]
-    from .._export import export
+    from backend._export import export
 
     clf, acc = train_classifier(classes, size, steps, log=log, stages=stages)
     os.makedirs(cache, exist_ok=True)
@@ -194,11 +194,11 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
     sampled by ``sampler`` with ``steps`` timesteps (the same seeds for every sampler) at ``size``² px
     (default: the model's training size; two models compare only at one size, with one classifier).
     The n samples of a class are generated as one batch, each from its own seed as before."""
-    from ..neural import conditioning as C
-    from ..neural.generate import generate as _generate
-    from ..neural.sampler import initial_noise, sample as _sample
+    from backend.neural import conditioning as C
+    from backend.neural.generate import generate as _generate
+    from backend.neural.sampler import initial_noise, sample as _sample
 
-    from ..neural.sampler import DEFAULT_SPACING
+    from backend.neural.sampler import DEFAULT_SPACING
 
     spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
 
@@ -277,7 +277,7 @@ def step_seconds(model_folder: str, size: int = 256, reps: int = 3) -> dict:
     its output is checked against onnxruntime's first (max |Δε| reported), so both time the
     same network.
     """
-    from ..neural.model import NeuralNoiseModel
+    from backend.neural.model import NeuralNoiseModel
     from .warm_start import torch_from_export
 
     m = NeuralNoiseModel(model_folder)

@@ -1,6 +1,6 @@
-"""Write a model's card from its run, export and evaluation: ``python -m backend.training.model_card ...``.
+"""Write a model's card from its run, export and evaluation: ``python -m training.model_card ...``.
 
-    python -m backend.training.model_card [--run RUN] --model MODEL_DIR --eval EVAL.json \\
+    python -m training.model_card [--run RUN] --model MODEL_DIR --eval EVAL.json \\
         [--ablation-eval EVAL_NO_CUTMIX.json] --train-command "..." -o MODEL_DIR/MODEL_CARD.md
 
 Everything in the card is read from files the project's own commands wrote:
@@ -51,7 +51,7 @@ def read_json(path: str | None):
         return json.load(fh)
 
 
-def _hardware() -> str:
+def hardware_line() -> str:
     cpu = platform.processor() or platform.machine()
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as fh:
@@ -137,14 +137,14 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
         train_command.strip(),
         "```",
         "",
-        f"- **Data:** `backend/training/zoo.py`, generated on the fly. Classes: {', '.join(meta['trained_classes'])}. "
+        f"- **Data:** `training/zoo.py`, generated on the fly. Classes: {', '.join(meta['trained_classes'])}. "
         f"Halton parameter sets, {cfg['seeds_per_set']} seeds each, {cfg['size']}² px.",
         f"- **Config:** size {cfg['size']}, batch {cfg['batch']}, {cfg['steps']} steps, lr {cfg['lr']}, "
         f"EMA {cfg['ema_decay']}, CutMix p {cfg['cutmix_p']}, widths {cfg['widths']}, embedding {cfg['emb_dim']}-D.",
-        f"- **Hardware:** {hardware or _hardware()}.",
+        f"- **Hardware:** {hardware or hardware_line()}.",
         f"- **Steps:** {meta['step']}. **Wall time:** {wall:.1f} min.",
         f"- **Final training MSE** (mean of the last log window): {mse:.4f}. Wall time and loss are from {source}.",
-        f"- **Weights:** {meta['weights']} (exported with `python -m backend.training.export_onnx`).",
+        f"- **Weights:** {meta['weights']} (exported with `python -m training.export_onnx`).",
         f"- **Form:** {meta.get('form', 'one-piece')}; **sha256** "
         + ", ".join(f"of `{name}`: `{digest}`" for name, digest in sorted(meta["files"].items())) + ".",
         "",
@@ -203,7 +203,7 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m backend.training.model_card", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m training.model_card", description=__doc__.split("\n")[0])
     ap.add_argument("--run", help="the training run (its log.jsonl); default: the export's training record")
     ap.add_argument("--wall-minutes", type=float, help="without --run or a training record: the run's wall time")
     ap.add_argument("--final-mse", type=float, help="without --run or a training record: the run's final MSE")
@@ -239,7 +239,7 @@ def main(argv=None) -> int:
                     ref, cmp, kept, a.wall_minutes, a.final_mse, a.note)
     except ValueError as exc:
         ap.error(str(exc))
-    from .._export import export
+    from backend._export import export
 
     with export.atomic_path(a.out) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:

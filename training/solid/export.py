@@ -1,4 +1,4 @@
-"""Export a trained solid texture to ONNX: ``python -m backend.training.solid.export RUN OUT_DIR``.
+"""Export a trained solid texture to ONNX: ``python -m training.solid.export RUN OUT_DIR``.
 
 Writes, each atomically:
 
@@ -22,8 +22,8 @@ import sys
 import torch
 from torch import nn
 
-from ..._export import export as _ex
-from ...onnx_models import sha256_file
+from backend._export import export as _ex
+from backend.onnx_models import sha256_file
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
 from .model import COLOUR_STATS, colour_stats
@@ -132,7 +132,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m backend.training.solid.export", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m training.solid.export", description=__doc__.split("\n")[0])
     ap.add_argument("run", help="training run folder (holds ckpt.pt)")
     ap.add_argument("out", help="output folder for the .onnx files and solid.json")
     a = ap.parse_args(argv)

@@ -1,4 +1,4 @@
-"""``omninoise`` command line (also ``python -m backend``).
+"""``omninoise`` command line (also ``python -m cli``).
 
 Command-line only: imports the ``export`` package for file output, which the
 add-on reaches through its own relative imports instead.
@@ -7,21 +7,22 @@ from __future__ import annotations
 
 import argparse
 import os
+import warnings
 import sys
 import time
 
 import numpy as np
 
 from export.images import ImageError
-from . import limits
-from .errors import SettingError
-from .spectra import SPECTRUM_KINDS, Spectrum
-from .paths import neural_model
-from .settings import WaveSettings
-from .cellular import CELLULAR_MODES
-from .tables import WAVEFORMS
-from .transfer import PRESETS, load_transfer
-from .wave import OUTPUTS
+from backend import limits
+from backend.errors import SettingError
+from backend.spectra import SPECTRUM_KINDS, Spectrum
+from backend.paths import neural_model
+from backend.settings import WaveSettings
+from backend.cellular import CELLULAR_MODES
+from backend.tables import WAVEFORMS
+from backend.transfer import PRESETS, load_transfer
+from backend.wave import OUTPUTS
 
 __all__ = ["main", "build_parser", "settings_from_args"]
 
@@ -205,7 +206,9 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
         if not os.path.isfile(a.profile):
             raise SettingError("--profile", f"file not found: {a.profile}")
         try:
-            prof = np.load(a.profile, allow_pickle=False) if a.profile.endswith(".npy") else np.loadtxt(a.profile)
+            with warnings.catch_warnings():     # an empty file is reported below, in one line, not as a warning too
+                warnings.simplefilter("ignore", UserWarning)
+                prof = np.load(a.profile, allow_pickle=False) if a.profile.endswith(".npy") else np.loadtxt(a.profile)
             profile = tuple(np.asarray(prof, np.float64).ravel())
         except (ValueError, OSError, EOFError, TypeError) as exc:
             raise SettingError("--profile", f"{a.profile}: not a list of numbers "
@@ -275,8 +278,8 @@ def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
     """``wave``, every output type, through the bake pipeline: one sampling convention (docs/conventions.md:
     sample centres (i + 1/2) E / N over [0, E)^d; .npy indexed [y, x] / [z, y, x]; images with +y up), the
     ramp, an atomic write."""
-    from .bake import BakeSpec, run_bake
-    from .sources import BoxGrid, WaveSource
+    from backend.bake import BakeSpec, run_bake
+    from backend.sources import BoxGrid, WaveSource
 
     tf = load_transfer(a.transfer) if a.transfer else None
     if tf is not None and a.range:
@@ -289,8 +292,8 @@ def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
 
 
 def _bake_on_farm(a: argparse.Namespace) -> int:
-    """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (backend/farm.py); exit codes as locally."""
-    from .jobs import JobError
+    """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (cli/farm.py); exit codes as locally."""
+    from backend.jobs import JobError
 
     if a.workers is not None and a.cluster:
         raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
@@ -319,7 +322,7 @@ def _bake_on_farm(a: argparse.Namespace) -> int:
         if not a.quiet and client.dashboard_link:
             print(f"omninoise bake: Dask dashboard {client.dashboard_link}", file=sys.stderr)
 
-        def progress(done, total, moved, eta):
+        def status(done, total, moved, eta):
             if not a.quiet:
                 sys.stderr.write(f"\r  {done}/{total} tasks, {moved / 2 ** 20:.1f} MiB, ETA {eta:.0f} s   ")
                 if done == total:
@@ -327,7 +330,7 @@ def _bake_on_farm(a: argparse.Namespace) -> int:
                 sys.stderr.flush()
 
         outcomes = farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
-                                 retries=a.retries, progress=progress)
+                                 retries=a.retries, status=status)
     finally:
         cluster = getattr(client, "cluster", None)
         client.close()
@@ -345,7 +348,7 @@ def _bake_on_farm(a: argparse.Namespace) -> int:
 
 
 def _set_threads(n: int) -> None:
-    from .onnx_models import set_default_threads
+    from backend.onnx_models import set_default_threads
 
     if n < 0:
         raise SettingError("--threads", f"must be >= 0 (0: all cores), got {n}")
@@ -353,7 +356,7 @@ def _set_threads(n: int) -> None:
 
 
 def run_bake_job(a: argparse.Namespace) -> int:
-    from .jobs import JobError, load_job, run_job
+    from backend.jobs import JobError, load_job, run_job
 
     if a.dry_run:
         entries = load_job(a.job)
@@ -375,14 +378,16 @@ def run_bake_job(a: argparse.Namespace) -> int:
     _set_threads(a.threads)
     if a.workers is not None or a.cluster:
         return _bake_on_farm(a)
-    bars = {}
+    now = {}      # the bake in progress: one bar per bake
 
-    def progress(name, i, count, frac):
-        if name not in bars:
-            bars[name] = _Bar(a.quiet, f"[{i + 1}/{count}] {name} ")
-        bars[name](frac)
+    def on_bake(name, i, count):
+        now.update(bar=_Bar(a.quiet, f"[{i + 1}/{count}] {name} "), i=i, count=count)
 
-    outcomes = run_job(a.job, keep_going=a.keep_going, force=a.force, only=a.only, progress=progress)
+    def progress(frac):   # the job's fraction -> this bake's
+        now["bar"](min(1.0, max(0.0, frac * now["count"] - now["i"])))
+
+    outcomes = run_job(a.job, keep_going=a.keep_going, force=a.force, only=a.only, progress=progress,
+                       on_bake=on_bake)
     failed = [o for o in outcomes if o.status != "baked" and o.status != "up to date"]
     for o in outcomes:
         if o.status in ("baked", "up to date") and not a.quiet:
@@ -421,7 +426,7 @@ def _spec_arg(text: str, flag: str) -> tuple:
 def _painted_parts(a: argparse.Namespace) -> tuple:
     """--map and its --region flags -> (regions int (H, W) into specs, specs)."""
     from export.images import decode
-    from .neural.request import region_key, regions_from_map
+    from backend.neural.request import region_key, regions_from_map
 
     if not os.path.isfile(a.map):
         raise SettingError("--map", f"map not found: {a.map}")
@@ -442,8 +447,8 @@ def _painted_parts(a: argparse.Namespace) -> tuple:
 
 def neural_request(a: argparse.Namespace, model):
     """The :class:`backend.neural.request.NeuralRequest` of ``omninoise neural`` flags (checked)."""
-    from .neural.request import NeuralRequest
-    from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from backend.neural.request import NeuralRequest
+    from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
 
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
@@ -483,11 +488,11 @@ def neural_request(a: argparse.Namespace, model):
 def run_neural(a: argparse.Namespace) -> int:
     import json
 
-    from .neural.model import ModelError, NeuralNoiseModel
-    from .neural.request import generate_request
+    from backend.neural.model import ModelError, NeuralNoiseModel
+    from backend.neural.request import generate_request
 
-    from .neural.generate import check_sampler
-    from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from backend.neural.generate import check_sampler
+    from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
 
     _set_threads(a.threads)
     sampler = a.sampler or DEFAULT_SAMPLER
@@ -533,8 +538,8 @@ def run_neural(a: argparse.Namespace) -> int:
 def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     """``neural --keys KEYS.toml --frames FIRST LAST -o name_####.png``: one file per frame, each written
     atomically (an interrupted run keeps the frames it finished)."""
-    from .bake import frame_path, has_frame_field
-    from .neural.animate import animate, read_keys
+    from backend.bake import frame_path, has_frame_field
+    from backend.neural.animate import animate, read_keys
     from export.images import preview_8bit, write_image, write_png
 
     if not (a.keys and a.frames):
@@ -580,10 +585,10 @@ def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) ->
 
     from export.atomic import write_json
     from export.images import decode, preview_8bit, write_image, write_png
-    from .neural.fit import fit, fitted_conditioning, load_bank, prepare_target
-    from .neural.generate import generate
-    from .onnx_models import ModelError
-    from .paths import fit_bank
+    from backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
+    from backend.neural.generate import generate
+    from backend.onnx_models import ModelError
+    from backend.paths import fit_bank
 
     if a.noise or a.corners or a.map or a.blend:
         raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
@@ -626,12 +631,17 @@ def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) ->
     return 0
 
 
+def solid_request(a: argparse.Namespace):
+    """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
+    from backend.solid.request import SolidRequest
+
+    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed).check("--")
+
+
 def run_solid(a: argparse.Namespace) -> int:
     import json
 
-    from .onnx_models import ModelError
-    from .solid.model import SHIPPED_MODELS, SolidTextureModel, load_models
-    from .solid.refine import texture_code
+    from backend.solid.model import load_models
 
     if a.list:
         out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
@@ -643,22 +653,13 @@ def run_solid(a: argparse.Namespace) -> int:
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.positive("--scale", a.scale)
-    if a.seed < 0:
-        raise SettingError("--seed", f"must be >= 0, got {a.seed}")
     limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     ext = os.path.splitext(a.out)[1].lower()
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
     if ext not in allowed:
         raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
-    folder = a.model
-    if folder is None:
-        named = os.path.join(SHIPPED_MODELS, os.path.basename(a.exemplar))
-        folder = named if os.path.isfile(os.path.join(named, "solid.json")) and not a.to else \
-            os.path.join(SHIPPED_MODELS, "space")
-    try:
-        model = SolidTextureModel(folder)
-    except ModelError as exc:
-        raise SettingError("--model", f"{exc}; see models/solid/MODEL_CARD.md or pass --model") from None
+    req = solid_request(a)
+    model = req.load("--")
     if a.dim == 3 and model.dim != 3:
         raise SettingError("--dim", f"model {model.name!r} is 2D; it cannot fill a volume")
 
@@ -666,19 +667,19 @@ def run_solid(a: argparse.Namespace) -> int:
         if not a.quiet:
             print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
 
-    code, _ = texture_code(model, a.exemplar, a.to, a.mix, a.refine, "--", _Bar(a.quiet, "refine "), report)
+    code, _ = req.code(model, "--", _Bar(a.quiet, "refine "), report)
     bar = _Bar(a.quiet)
-    from .colour import srgb_to_linear
+    from backend.colour import srgb_to_linear
 
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
-        from .bake import BakeSpec, run_bake
-        from .sources import BoxGrid, SolidSource
+        from backend.bake import BakeSpec, run_bake
+        from backend.sources import BoxGrid, SolidSource
 
         extent = a.size / (model.px_per_unit * a.scale)
         grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
         run_bake(BakeSpec("solid", SolidSource(model, seed=a.seed, code=code), grid, a.out), bar, force=True)
         return 0
-    rgb = model.image(a.size, code, a.seed, scale=a.scale, progress=lambda d, n: bar(d / n))
+    rgb = model.image(a.size, code, a.seed, scale=a.scale, progress=bar)
     from export.images import preview_8bit, write_image, write_png
 
     if ext == ".png":
@@ -692,7 +693,7 @@ def run_zoo(a: argparse.Namespace) -> int:
     import json
 
     try:
-        from .training import zoo
+        from training import zoo
     except ImportError as exc:
         raise SettingError("zoo", f"needs torch ({exc}); pip install -r requirements-train.txt") from None
     if a.list:
@@ -723,7 +724,7 @@ def run_zoo(a: argparse.Namespace) -> int:
 def run_transfer(a: argparse.Namespace) -> int:
     import json
 
-    from .transfer import preset
+    from backend.transfer import preset
 
     if a.list or not a.preset:
         print("\n".join(PRESETS))
@@ -760,8 +761,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2
     except Exception as exc:
-        from .grid import Cancelled
-        from .jobs import JobError
+        from backend.grid import Cancelled
+        from backend.jobs import JobError
 
         if isinstance(exc, JobError):
             print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)

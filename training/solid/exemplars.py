@@ -7,7 +7,7 @@ greyscale; the model still outputs RGB.
 
 Procedural classes (wood rings, marble veins, rust, granite) are generated
 here from the noise zoo's operators, in colour, at any seed:
-``python -m backend.training.solid.exemplars OUT_DIR`` writes the shipped
+``python -m training.solid.exemplars OUT_DIR`` writes the shipped
 ones (seed 0 for training, seed 1 held out).
 
 Held-out split: for the photographs, the right quarter (columns >= 3/4 of
@@ -26,15 +26,15 @@ import sys
 import numpy as np
 import torch
 
-from ... import _export as _ex
+from backend._export import export as _export
 from .. import noise_ops as ops
 
 __all__ = ["PHOTO_DIR", "expand", "photo_set", "PHOTOS", "PROCEDURAL", "DATA_DIR", "load_image", "procedural", "exemplar", "train_region",
            "heldout_region", "random_crops"]
 
-DATA_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "..", "data", "exemplars")
+DATA_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "data", "exemplars")
 #: the colour photo set (tools/build_photo_set.py): data/photos/{train,val}/CATEGORY__NAME.jpg
-PHOTO_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "..", "data", "photos")
+PHOTO_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "data", "photos")
 PHOTOS = ("brick", "grass", "gravel")
 PROCEDURAL = ("wood", "marble", "rust", "granite")
 
@@ -169,7 +169,7 @@ def main(argv=None) -> int:
     for name in PROCEDURAL:
         a = (procedural(name, 0).permute(1, 2, 0).numpy() * 255.0 + 0.5).astype(np.uint8)
         path = os.path.join(out, f"{name}.png")
-        with _ex.export.atomic_path(path) as tmp:
+        with _export.atomic_path(path) as tmp:
             Image.fromarray(a).save(tmp, format="PNG")
         print(path)
     return 0

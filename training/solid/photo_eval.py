@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...solid.lattice import lattice_noise
+from backend.solid.lattice import lattice_noise
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
            "BASELINES"]

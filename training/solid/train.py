@@ -1,4 +1,4 @@
-"""Train a neural solid texture: ``python -m backend.training.solid.train --config CONFIG.json --out RUN``.
+"""Train a neural solid texture: ``python -m training.solid.train --config CONFIG.json --out RUN``.
 
 Single mode (``mode: "single"``): one exemplar; the decoder f, the code e and
 the transforms T_i are optimised directly (Henzler et al. 2020, Sec. 4,
@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass
 
 import torch
 
-from ..._export import export as _ex
+from backend._export import export as _ex
 from ..threads import cpu_threads
 from ..config import check_config_keys
 from . import exemplars as ex
@@ -39,7 +39,7 @@ from .lattice import octave_seeds
 from .model import SolidTexture, colour_stats, slice_points
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
-from ...onnx_models import load_model_json
+from backend.onnx_models import load_model_json
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
 
@@ -259,7 +259,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m backend.training.solid.train", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m training.solid.train", description=__doc__.split("\n")[0])
     ap.add_argument("--config", required=True, help="JSON config (keys: SolidConfig)")
     ap.add_argument("--out", required=True, help="run folder (ckpt.pt, log.jsonl)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=JSON", help="override a config key")

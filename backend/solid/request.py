@@ -1,0 +1,111 @@
+"""One solid texture, whatever asked for it: the typed request the command line, job files and the Blender panel
+all build (issue 23), validated in one place and turned into a texture code in one place.
+
+A request names a model (a folder, a shipped model's name, or None: chosen from the exemplar as the command line
+always did), an exemplar (a space model's training exemplar by name, an image file, or pixels a front-end already
+holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al. 2020, Sec. 4: interpolation in
+the latent space), ``refine`` search steps, and the ``seed`` of the noise.  Where the texture is read (grid,
+zoom, scale) belongs to the bake, not to the texture.
+:meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
+prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
+sha256): equal settings from any front-end give equal keys (tests/cli/test_solid_request.py).
+
+Shapes: pixel exemplars float32 (H, W, 3) sRGB values in [0, 1], top row first.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import SettingError
+from ..paths import solid_models
+
+__all__ = ["SolidRequest", "MAX_SEED"]
+
+MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the lattice hash, backend/solid/lattice.py)
+
+
+def _pixels_sha(x: np.ndarray) -> str:
+    """sha256 of pixels quantised to 16 bits: an 8-bit image gives the same digest whether it was decoded here
+    (v / 255) or by Blender (v * (1 / 255), which differs in the last float bit)."""
+    q = np.round(np.clip(np.asarray(x, np.float64), 0.0, 1.0) * 65535.0).astype("<u2")
+    return "pixels:" + hashlib.sha256(np.ascontiguousarray(q).tobytes() + repr(q.shape).encode()).hexdigest()
+
+
+def _digest(x) -> str | None:
+    """What an exemplar is, for the key: a name as itself, a file or pixels by the sha256 of the pixels."""
+    if x is None:
+        return None
+    if isinstance(x, np.ndarray):
+        return _pixels_sha(x)
+    if os.path.isfile(x):      # a file as the pixels it decodes to: equal to the same pixels handed over
+        from .._export import export
+
+        return _pixels_sha(export.read_rgb(x))
+    return str(x)
+
+
+@dataclass(frozen=True, eq=False)
+class SolidRequest:
+    """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
+    model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
+    steps, ``seed`` in [0, 2^32)."""
+
+    model: str | None = None
+    exemplar: str | np.ndarray | None = field(default=None, repr=False)
+    to: str | np.ndarray | None = field(default=None, repr=False)
+    mix: float = 0.0
+    refine: int = 0
+    seed: int = 0
+
+    def check(self, where: str = "") -> "SolidRequest":
+        """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
+        def bad(key, why):
+            return SettingError(f"{where}{key}", why)
+
+        if not isinstance(self.mix, (int, float)) or not np.isfinite(self.mix) or not 0.0 <= self.mix <= 1.0:
+            raise bad("mix", f"must be in [0, 1], got {self.mix}")
+        if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) or self.refine < 0:
+            raise bad("refine", f"must be a whole number >= 0, got {self.refine}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
+            raise bad("seed", f"must be a whole number in [0, {MAX_SEED}], got {self.seed}")
+        return self
+
+    def folder(self, models: str | None = None) -> str:
+        """The model folder: ``model`` itself, a shipped model by name, or (no model) the exemplar's own shipped
+        model when there is one and nothing is interpolated, else the texture-space model."""
+        models = models or solid_models()
+        if self.model is not None:
+            named = os.path.join(models, self.model)
+            return self.model if os.path.isdir(self.model) or not os.path.isdir(named) else named
+        if isinstance(self.exemplar, str) and self.to is None:
+            own = os.path.join(models, os.path.basename(self.exemplar))
+            if os.path.isfile(os.path.join(own, "solid.json")):
+                return own
+        return os.path.join(models, "space")
+
+    def load(self, where: str = "", threads: int = 0, models: str | None = None):
+        """The :class:`~backend.solid.model.SolidTextureModel` of :meth:`folder`; SettingError on a missing or
+        altered folder."""
+        from ..onnx_models import ModelError
+        from .model import SolidTextureModel
+
+        try:
+            return SolidTextureModel(self.folder(models), threads)
+        except ModelError as exc:
+            raise SettingError(f"{where}model", f"{exc}; see models/solid/MODEL_CARD.md") from None
+
+    def code(self, model, where: str = "", progress=None, report=None):
+        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.refine.texture_code`."""
+        from .refine import texture_code
+
+        return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report)
+
+    def key(self) -> dict:
+        """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256)."""
+        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
+                    to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
+                    refine=int(self.refine), seed=int(self.seed))

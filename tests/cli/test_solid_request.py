@@ -1,0 +1,67 @@
+"""One solid-texture request for every front-end (issue 23): the command line's flags and a job file's source
+table give equal requests for equal settings, and the same errors, named in each front-end's own terms."""
+import os
+
+import numpy as np
+import pytest
+
+from backend.errors import SettingError
+from backend.solid.request import SolidRequest
+from backend.sources import solid_request_from_dict
+from cli.main import build_parser, solid_request
+from export import read_rgb
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")
+
+
+def cli(*args):
+    return solid_request(build_parser().parse_args(["solid", *args, "-o", "x.png"]))
+
+
+@pytest.mark.parametrize("flags, table", [
+    (["--exemplar", "gravel"], {"exemplar": "gravel"}),
+    (["--exemplar", "gravel", "--seed", "7"], {"exemplar": "gravel", "seed": 7}),
+    (["--exemplar", PHOTO, "--refine", "3"], {"exemplar": PHOTO, "refine": 3}),
+    (["--exemplar", "grass", "--to", PHOTO, "--mix", "0.25"], {"exemplar": "grass", "to": PHOTO, "mix": 0.25}),
+    (["--exemplar", "grass", "--to", "gravel"], {"exemplar": "grass", "to": "gravel"}),
+    (["--exemplar", "gravel", "--model", "space"], {"exemplar": "gravel", "model": "space"}),
+])
+def test_flags_and_job_tables_give_equal_requests(flags, table):
+    a, b = cli(*flags), solid_request_from_dict(dict(table))
+    assert a.key() == b.key() and a.folder() == b.folder()
+
+
+def test_a_file_and_its_pixels_are_one_exemplar():
+    """The panel hands over pixels, the command line a file: the same image is the same request."""
+    by_file = SolidRequest(exemplar=PHOTO, refine=2)
+    by_pixels = SolidRequest(exemplar=read_rgb(PHOTO), refine=2)
+    assert by_file.key() == by_pixels.key()
+    assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, seed=1).key()
+
+
+def test_the_model_is_chosen_as_the_command_line_always_did():
+    assert os.path.basename(SolidRequest(exemplar="gravel_3d").folder()) == "gravel_3d"   # its own model
+    assert os.path.basename(SolidRequest(exemplar=PHOTO).folder()) == "space"           # an image: encoded
+    assert os.path.basename(SolidRequest(exemplar="gravel_3d", to="x").folder()) == "space"
+
+
+@pytest.mark.parametrize("flags, table, field, why", [
+    (["--mix", "1.5", "--to", "grass"], {"mix": 1.5, "to": "grass"}, "mix", "must be in [0, 1]"),
+    (["--refine", "-1"], {"refine": -1}, "refine", "whole number >= 0"),
+    (["--seed", "-3"], {"seed": -3}, "seed", "whole number in [0, 4294967295]"),
+    (["--seed", str(2 ** 32)], {"seed": 2 ** 32}, "seed", "whole number in [0, 4294967295]"),
+])
+def test_the_same_errors_in_each_front_ends_terms(flags, table, field, why):
+    with pytest.raises(SettingError) as e1:
+        cli("--exemplar", "gravel", *flags)
+    with pytest.raises(SettingError) as e2:
+        solid_request_from_dict(dict(table, exemplar="gravel"))
+    assert e1.value.setting == "--" + field and e2.value.setting == "source." + field
+    assert why in str(e1.value) and why in str(e2.value)
+
+
+def test_job_refine_must_be_a_whole_number():
+    with pytest.raises(SettingError, match="source.refine"):
+        solid_request_from_dict({"exemplar": "gravel", "refine": 2.5})
+    assert np.isclose(solid_request_from_dict({"exemplar": "gravel"}).mix, 0.5)
