@@ -9,9 +9,9 @@ Wave noise (Guehl et al., "Multi-Dimensional Procedural Wave Noise", TOG 2025):
 Nothing here imports ``bpy`` or ``torch``.
 """
 from .errors import SettingError
-from .spectra import Spectrum
-from .tables import WaveTable, build_table
-from .settings import WaveSettings, compile_noise
+from .wavenoise.spectra import Spectrum
+from .wavenoise.tables import WaveTable, build_table
+from .wavenoise.settings import WaveSettings, compile_noise
 from .grid import evaluate_grid, evaluate_points, Cancelled
 from . import bake, jobs, sources, transfer  # noqa: E402  (bake pipeline: sources -> ramp -> files)
 

@@ -53,7 +53,7 @@ SLAB_VOXELS = 1 << 19
 _FRAME = re.compile(r"#+")
 
 
-@dataclass
+@dataclass(frozen=True)
 class BakeSpec:
     """One bake.
 

@@ -16,10 +16,10 @@ from typing import Callable
 
 import numpy as np
 
-from .cellular import CellularNoise
+from .wavenoise.cellular import CellularNoise
 from .errors import SettingError
-from . import fast
-from .wave import OUTPUTS, WaveNoise, select_output
+from .wavenoise import fast
+from .wavenoise.wave import OUTPUTS, WaveNoise, select_output
 
 __all__ = ["Cancelled", "evaluate_grid", "evaluate_box", "grid_shape", "evaluate_points"]
 
@@ -137,7 +137,7 @@ def evaluate_box(noise: WaveNoise | CellularNoise, shape: tuple, lo, step, outpu
 
 
 def _plan_rows(plan, xs, others, output, dst) -> None:
-    """Rows through the compiled row kernel of :mod:`backend.fast`: xs (nx,), others (rows, dim-1)."""
+    """Rows through the compiled row kernel of :mod:`backend.wavenoise.fast`: xs (nx,), others (rows, dim-1)."""
     re = dst if type(dst) is np.ndarray and output == "real" else np.empty(dst.shape, _F)
     im = None if output == "real" else np.empty(dst.shape, _F)
     plan.rows(xs, others, re, im)

@@ -113,7 +113,7 @@ class Source(Protocol):
 
 
 class WaveSource:
-    """Wave noise (Guehl et al. 2025) from :class:`~backend.settings.WaveSettings`.
+    """Wave noise (Guehl et al. 2025) from :class:`~backend.wavenoise.settings.WaveSettings`.
 
     3D grids need a 3D or 4D noise; a 2D grid of a 3D/4D noise is the plane z = z0.
     4D noise takes W = ``w_offset`` + time; 2D+t and 3D+t noise take time directly.
@@ -123,7 +123,7 @@ class WaveSource:
     chunkable = True
 
     def __init__(self, settings, w_offset: float = 0.0):
-        from .settings import compile_noise
+        from .wavenoise.settings import compile_noise
 
         self.settings = settings.validate()
         self.w_offset = float(w_offset)
@@ -154,7 +154,7 @@ class WaveSource:
                             s.cellular, progress=progress, cancel=cancel, start=start)
 
     def to_dict(self) -> dict:
-        from .settings import settings_to_dict
+        from .wavenoise.settings import settings_to_dict
 
         d = dict(kind=self.kind, settings=settings_to_dict(self.settings), w_offset=self.w_offset)
         if self.settings.example is not None:
@@ -498,7 +498,7 @@ def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
     import os
 
-    from .settings import settings_from_dict
+    from .wavenoise.settings import settings_from_dict
 
     example = None
     if "example" in d:
@@ -540,7 +540,7 @@ def source_kinds() -> tuple:
 def source_from_dict(d: dict, base_dir: str = ".") -> Source:
     """A source from a job-file table: ``kind`` (default "wave") names a registered builder (:data:`SOURCES`).
 
-    Wave: the keys of :class:`~backend.settings.WaveSettings`; ``example = "img.png"``
+    Wave: the keys of :class:`~backend.wavenoise.settings.WaveSettings`; ``example = "img.png"``
     (relative to ``base_dir``) for by-example noise; ``w_offset`` for 4D.
     Neural: noise, params, [blend = "mask.png", noise2, params2 | corners = [4 specs] | map = "painted.png",
     regions = {"#rrggbb" = SPEC}], [width, sharpness],

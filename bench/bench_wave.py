@@ -29,7 +29,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
-from backend import fast  # noqa: E402
+from backend.wavenoise import fast  # noqa: E402
 
 
 def timed(fn, repeat):

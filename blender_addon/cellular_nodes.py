@@ -1,6 +1,6 @@
 """The Wave Cellular node: cellular wave noise (Guehl et al. 2025, Sec. 6.3, Alg. 2) from Blender's own nodes.
 
-It computes what :class:`backend.cellular.CellularNoise` computes with STIT depth
+It computes what :class:`backend.wavenoise.cellular.CellularNoise` computes with STIT depth
 0.  For each of the 2K plane families (normal n_f, cell size C, offset o_f):
 
     p = (x · n_f) / C + o_f,   j = floor(p),   φ = p - j
@@ -27,7 +27,7 @@ __all__ = ["build_cellular_group", "new_cellular_tree", "CELL_OUTPUTS"]
 
 CELL_OUTPUTS = ("Cell", "Distance")
 _F = np.float32
-_OFFSET, _PLANE, _CODE = 24, 25, 26  # backend.cellular streams
+_OFFSET, _PLANE, _CODE = 24, 25, 26  # backend.wavenoise.cellular streams
 
 
 def new_cellular_tree(name: str = "Wave Cellular", tree_type: str = "ShaderNodeTree") -> bpy.types.NodeTree:
@@ -63,7 +63,7 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
     dist, code = None, 0.0
     for f, normal in enumerate(noise.normals):
         n3 = tuple(float(v) for v in (list(normal[:3]) + [0.0] * 3)[:3])
-        off = float(np.asarray(backend.hashing.white_noise4(_F(f), _F(0), _F(_OFFSET), noise.seed)).reshape(-1)[0])
+        off = float(np.asarray(backend.wavenoise.hashing.white_noise4(_F(f), _F(0), _F(_OFFSET), noise.seed)).reshape(-1)[0])
         dot = b.vmath("DOT_PRODUCT", x, n3)
         if dim == 4:
             dot = b.math("MULTIPLY_ADD", w, float(normal[3]), dot)

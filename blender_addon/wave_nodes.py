@@ -1,13 +1,13 @@
 """The Wave Noise node: a node group built from Blender's own nodes (no OSL).
 
-The group computes exactly the sum of :mod:`backend.wave` (Guehl et al. 2025,
+The group computes exactly the sum of :mod:`backend.wavenoise.wave` (Guehl et al. 2025,
 Eq. 6 and 9, Algorithm 1), node for node:
 
 * per stratum k: slice coordinate p = x . s_k + o_k, slice n = floor(p), f = p - n;
 * slice records of n and n+1 from Blender's White Noise Texture (4D) at
-  (k, slice, stream, seed), which :mod:`backend.hashing` reproduces bit for bit;
+  (k, slice, stream, seed), which :mod:`backend.wavenoise.hashing` reproduces bit for bit;
 * the jittered direction by the same equal-measure map as
-  :func:`backend.directions.map_directions` (2D angle; 3D arccos; 4D with five
+  :func:`backend.wavenoise.directions.map_directions` (2D angle; 3D arccos; 4D with five
   Newton steps for psi), Householder-rotated onto the lobe axis;
 * the wave (x . omega - v t) / L + zeta read from the complex table with the
   engine's linear interpolation (texel centres at (i + 1/2) / N), done in nodes:
@@ -60,18 +60,18 @@ def tree_settings_json(tree) -> str | None:
 INPUTS = (("Vector", "NodeSocketVector", (0.0, 0.0, 0.0)), ("W", "NodeSocketFloat", 0.0),
           ("Scale", "NodeSocketFloat", 1.0), ("Time", "NodeSocketFloat", 0.0))
 OUTPUTS = ("Value", "Imaginary", "Modulus", "Phase")
-STREAM = backend.wave.STREAM
+STREAM = backend.wavenoise.wave.STREAM
 
 
 # -- settings <-> JSON ----------------------------------------------------------
 
 def settings_to_json(s) -> str:
     """WaveSettings -> JSON stored on the tree (by-example images are bake-only)."""
-    return json.dumps(backend.settings.settings_to_dict(s), sort_keys=True)
+    return json.dumps(backend.wavenoise.settings.settings_to_dict(s), sort_keys=True)
 
 
 def settings_from_json(text: str):
-    return backend.settings.settings_from_dict(json.loads(text))
+    return backend.wavenoise.settings.settings_from_dict(json.loads(text))
 
 
 # -- the table as a packed float image ---------------------------------------------
@@ -165,7 +165,7 @@ class NodeBuilder:
     def white(self, k: float, n, stream: int, seed) -> bpy.types.NodeSocket:
         """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> its Color socket.
 
-        Channel c of the Color is backend.wave.white_color4(k, n, stream, seed, c).
+        Channel c of the Color is backend.wavenoise.wave.white_color4(k, n, stream, seed, c).
         The slice id n sits in the Combine XYZ, so the node depends on the stratum's chain
         (a constant Combine could be scheduled early and crowd Cycles' SVM stack).
         """
@@ -222,7 +222,7 @@ _STRATUM_INPUTS = (("Sum", "NodeSocketVector", None), ("Position", "NodeSocketVe
 
 
 def _direction(b: NodeBuilder, u, dim: int, full: bool, g) -> tuple:
-    """map_directions (backend.directions) for a cap domain: u sockets (dim-1) -> (vec3, w)."""
+    """map_directions (backend.wavenoise.directions) for a cap domain: u sockets (dim-1) -> (vec3, w)."""
     u = list(u)
     sign = None
     if full:  # the last u coordinate picks the hemisphere
@@ -247,7 +247,7 @@ def _direction(b: NodeBuilder, u, dim: int, full: bool, g) -> tuple:
         # psi - sin psi cos psi = u2 (sigma - sin sigma cos sigma): safeguarded Newton (psi_inverse)
         c = b.math("MULTIPLY", u[2], g["Cap"])
         psi = b.math("MINIMUM", b.math("POWER", b.math("MULTIPLY", c, 1.5), float(_F(1.0 / 3.0))), g["Spread"])
-        for _ in range(backend.directions.NEWTON_STEPS):
+        for _ in range(backend.wavenoise.directions.NEWTON_STEPS):
             sp = b.math("SINE", psi)
             gv = b.math("SUBTRACT", b.math("SUBTRACT", psi, b.math("MULTIPLY", sp, b.math("COSINE", psi))), c)
             dg = b.math("ADD", b.math("MULTIPLY", 2.0, b.math("MULTIPLY", sp, sp)), 1e-6)
@@ -299,7 +299,7 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: tuple,
     imgs: the (table, slope) images of :func:`ensure_table_image`; Shift carries
     v t + L / (2 N), so the coordinate below is already half a texel early.
 
-    Per slice one White Noise node gives (zeta, jitter 0, jitter 1) (backend.wave
+    Per slice one White Noise node gives (zeta, jitter 0, jitter 1) (backend.wavenoise.wave
     slice_records); one vector multiply-add maps them into the stratum's box.
     """
     g = dict(consts)
@@ -326,8 +326,8 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: tuple,
         zeta, uu = zu[0], list(zu[1:min(dim, 3)])
         if side == 0:  # border ramp of slice n0: slpos = SLPOS_MIN + SLPOS_RANGE fract(16 zeta_0)
             frac = b.math("FRACT", b.math("MULTIPLY", zeta, 16.0))
-            slpos = b.math("MULTIPLY_ADD", frac, backend.wave.SLPOS_RANGE, backend.wave.SLPOS_MIN)
-            u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wave.BLEND_HALF_WIDTH, 0.5)
+            slpos = b.math("MULTIPLY_ADD", frac, backend.wavenoise.wave.SLPOS_RANGE, backend.wavenoise.wave.SLPOS_MIN)
+            u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wavenoise.wave.BLEND_HALF_WIDTH, 0.5)
         if dim == 4:
             jb = b.channel(b.white(k, n, STREAM["slice_b"], seed), 0)
             uu.append(b.math("MULTIPLY_ADD", jb, box_size[2], box_lo[2]))

@@ -16,13 +16,13 @@ import numpy as np
 from export.images import ImageError
 from backend import limits
 from backend.errors import SettingError
-from backend.spectra import SPECTRUM_KINDS, Spectrum
+from backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
 from backend.paths import neural_model
-from backend.settings import WaveSettings
-from backend.cellular import CELLULAR_MODES
-from backend.tables import WAVEFORMS
+from backend.wavenoise.settings import WaveSettings
+from backend.wavenoise.cellular import CELLULAR_MODES
+from backend.wavenoise.tables import WAVEFORMS
 from backend.transfer import PRESETS, load_transfer
-from backend.wave import OUTPUTS
+from backend.wavenoise.wave import OUTPUTS
 
 __all__ = ["main", "build_parser", "settings_from_args"]
 

@@ -45,7 +45,7 @@ def wave_points(dim: int) -> np.ndarray:
 def wave_values(flags: list) -> np.ndarray:
     from cli.main import build_parser, settings_from_args
     from backend.grid import evaluate_points
-    from backend.settings import compile_noise
+    from backend.wavenoise.settings import compile_noise
 
     a = build_parser().parse_args(["wave"] + flags + ["-o", "x.npy"])
     s = settings_from_args(a)

@@ -292,8 +292,8 @@ def _blender_gabor(x, y, s, p, n):
 def _wave_engine(kind: str):
     def gen(x, y, s, p, n):
         from backend.grid import evaluate_box
-        from backend.settings import WaveSettings, compile_noise
-        from backend.spectra import Spectrum
+        from backend.wavenoise.settings import WaveSettings, compile_noise
+        from backend.wavenoise.spectra import Spectrum
 
         out = []
         for b in range(x.shape[0]):

@@ -1,4 +1,4 @@
-"""The Wave Cellular node against backend.cellular (polytope distance and cell code), in Geometry Nodes."""
+"""The Wave Cellular node against backend.wavenoise.cellular (polytope distance and cell code), in Geometry Nodes."""
 import numpy as np
 import pytest
 

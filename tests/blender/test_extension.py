@@ -25,7 +25,7 @@ def test_zip_holds_runtime_files_only(built_zip):
     import zipfile
     names = zipfile.ZipFile(built_zip).namelist()
     assert "blender_manifest.toml" in names and "blender_addon/wave_nodes.py" in names
-    assert "backend/wave.py" in names and "export/images.py" in names
+    assert "backend/wavenoise/wave.py" in names and "export/images.py" in names
     assert "blender_addon/solid_ui.py" in names and "backend/solid/model.py" in names
     assert "models/solid/gravel_3d/decoder.onnx" in names and "models/solid/gravel_3d/solid.json" in names
     assert not [n for n in names if n.startswith(("tests/", "bench/", "demo/", "tools/", "training/"))

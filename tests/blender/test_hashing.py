@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from backend.hashing import hash_uint, hash_uint4, white_noise4, white_noise3, float_bits
+from backend.wavenoise.hashing import hash_uint, hash_uint4, white_noise4, white_noise3, float_bits
 
 # Stored reference samples (lookup3, Blender's constants): guard against
 # regressions even where bpy is unavailable.

@@ -10,7 +10,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
-from backend.wave import select_output  # noqa: E402
+from backend.wavenoise.wave import select_output  # noqa: E402
 from blender_addon.field_eval import evaluate_field  # noqa: E402
 from blender_addon.compat import ensure_node_tree  # noqa: E402
 from blender_addon.wave_nodes import SETTINGS_KEY, add_wave_node, build_wave_group, settings_from_json  # noqa: E402,E501

@@ -145,7 +145,7 @@ def test_wave_cli_vdb_and_transfer(tmp_path, capsys):
     assert main(["wave", "--dim", "3", "--size", "16", "--fmin", "1", "--fmax", "3", "--seed", "5", "--quiet",
                  "-o", vdb]) == 0
     from backend import WaveSettings, compile_noise, evaluate_points
-    from backend.spectra import Spectrum
+    from backend.wavenoise.spectra import Spectrum
 
     d = read_volume(vdb, "density", (16, 16, 16))
     c = (np.arange(16) + 0.5) * 4.0 / 16

@@ -11,7 +11,7 @@ from backend.bake import BakeSpec, Cancelled, frame_path, run_bake
 from backend.errors import SettingError
 from backend.grid import evaluate_box
 from backend.sources import BoxGrid, WaveSource
-from backend.spectra import Spectrum
+from backend.wavenoise.spectra import Spectrum
 from backend.transfer import preset
 from export import read_metadata, read_volume
 from export.images import read_image

@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 
 from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
-from backend import fast
-from backend.tables import WaveTable, build_table
-from backend.settings import table_rng
+from backend.wavenoise import fast
+from backend.wavenoise.tables import WaveTable, build_table
+from backend.wavenoise.settings import table_rng
 from conftest import radial_psd
 
 
@@ -122,7 +122,7 @@ def test_fast_path_matches_numpy(dim, speed):
 def _grid_reference(noise, size, extent, output, time, origin):
     """The numpy path at the grid's points, reshaped like evaluate_grid's output."""
     from backend.grid import grid_shape
-    from backend.wave import select_output
+    from backend.wavenoise.wave import select_output
     shape = grid_shape(noise.dim, size)
     g = np.arange(size, dtype=np.float32) * np.float32(extent / size)
     axes = np.meshgrid(*([g] * len(shape)), indexing="ij")[::-1]  # x fastest

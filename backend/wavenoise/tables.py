@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import SettingError
+from ..errors import SettingError
 from .spectra import Spectrum
 
 __all__ = ["WaveTable", "build_table", "build_axis_table", "build_waveform_table",
@@ -84,7 +84,7 @@ class WaveTable:
         """Write ``.npz`` (values + JSON metadata) atomically."""
         header = dict(format=_FORMAT, version=_VERSION, period=self.period, mode=self.mode,
                       dim=self.dim, meta=self.meta)
-        from ._export import export
+        from .._export import export
 
         with export.atomic_path(path, ".npz") as tmp:
             np.savez(tmp, values=self.values, header=np.frombuffer(json.dumps(header).encode(), np.uint8))
@@ -156,7 +156,7 @@ def build_axis_table(spectra: list[Spectrum], dim: int, rng: np.random.Generator
 
     One row per spectrum; the rows are normalised together so their relative
     energies are kept.  ``mode`` is ``axes`` (one row per coordinate axis) or
-    ``sectors`` (rows for angular sectors, used by :mod:`backend.byexample`).
+    ``sectors`` (rows for angular sectors, used by :mod:`backend.wavenoise.byexample`).
     """
     if mode == "axes" and len(spectra) != dim:
         raise SettingError("anisotropy", f"per-axis anisotropy needs {dim} spectra, got {len(spectra)}")

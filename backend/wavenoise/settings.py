@@ -2,7 +2,7 @@
 
 :class:`WaveSettings` holds only numbers, strings and tuples, so the CLI, job
 files and Blender properties can all build one; :func:`compile_noise` turns it
-into a :class:`~backend.wave.WaveNoise` or :class:`~backend.cellular.CellularNoise`.
+into a :class:`~backend.wavenoise.wave.WaveNoise` or :class:`~backend.wavenoise.cellular.CellularNoise`.
 """
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ import numpy as np
 from .byexample import PLANES, example_table
 from .cellular import CELLULAR_MODES, CellularNoise
 from .directions import DirectionSet, Domain
-from . import limits
-from .errors import SettingError
+from .. import limits
+from ..errors import SettingError
 from .spectra import Spectrum
 from .tables import DEFAULT_SIZE, WAVEFORMS, build_axis_table, build_table, build_waveform_table
 from .wave import OUTPUTS, Transition, WaveNoise

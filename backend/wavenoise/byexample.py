@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import SettingError
+from ..errors import SettingError
 from .spectra import Spectrum
 from .tables import WaveTable, build_axis_table
 

@@ -14,7 +14,7 @@ normal.  Replacing the sum of waves by a min gives
                 (drawn from its code) by a new, finer set of families with random
                 directions, up to ``depth`` levels.
 
-All random numbers come from Blender's White Noise hash (see backend.hashing).
+All random numbers come from Blender's White Noise hash (see backend.wavenoise.hashing).
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .directions import DirectionSet, map_directions
-from .errors import SettingError
+from ..errors import SettingError
 from .hashing import MAX_EXACT_ID, white_noise4
 
 __all__ = ["CellularNoise", "CELLULAR_MODES"]

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import SettingError
+from ..errors import SettingError
 from .hashing import white_noise4
 
 __all__ = ["Domain", "DirectionSet", "strata", "map_directions", "psi_inverse", "NEWTON_STEPS"]

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import SettingError
+from ..errors import SettingError
 
 __all__ = ["Spectrum", "SPECTRUM_KINDS"]
 

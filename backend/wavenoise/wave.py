@@ -12,7 +12,7 @@ w0 = cos(pi/2 s), w1 = sin(pi/2 s), s = smoothstep(u): w0^2 + w1^2 = 1, so the
 variance does not dip between slices.  Stratum weights a_k = sqrt(1/K) make
 E|N|^2 = 1 whatever the number of directions K.
 
-Every random number comes from :func:`backend.hashing.white_noise4`,
+Every random number comes from :func:`backend.wavenoise.hashing.white_noise4`,
 Blender's White Noise node; so Blender nodes can evaluate the same function.
 A slice's records use the node's Color output, whose three channels are the
 4D hash at the input permutations (x, y, z, w), (z, x, w, y), (w, z, y, x)
@@ -28,7 +28,7 @@ import numpy as np
 
 from . import fast
 from .directions import DirectionSet, map_directions
-from .errors import SettingError
+from ..errors import SettingError
 from .hashing import MAX_EXACT_ID, white_noise4
 from .tables import WaveTable, table_lookup
 
@@ -183,7 +183,7 @@ class WaveNoise:
 
         ``time`` (scalar or (P,)) shifts every wave by speed * time along its
         direction (Eq. 9).  For 4D noise the fourth coordinate is part of x.
-        ``accelerate`` uses the compiled path of :mod:`backend.fast` when it applies.
+        ``accelerate`` uses the compiled path of :mod:`backend.wavenoise.fast` when it applies.
         """
         x = np.ascontiguousarray(x, dtype=_F)
         if x.ndim != 2 or x.shape[1] != self.dim:

@@ -1,4 +1,4 @@
-"""Optional compiled evaluation of wave noise (numba), identical maths to backend.wave.
+"""Optional compiled evaluation of wave noise (numba), identical maths to backend.wavenoise.wave.
 
 Used when numba is importable (the project's .venv installs it; Blender's
 bundled Python does not, and then the numpy path runs).  Covers single-table
@@ -6,7 +6,7 @@ noises: isotropic, lobes, animated, custom waveforms.  Axis/sector tables and
 transitions use the numpy path.
 
 Random numbers are not re-implemented here: per-slice records (border position,
-direction, offset) come from :meth:`backend.wave.WaveNoise.slice_records` for the
+direction, offset) come from :meth:`backend.wavenoise.wave.WaveNoise.slice_records` for the
 range of slice ids a chunk touches, and the kernel gathers them.  The blend
 weights cos/sin(pi/2 s) use polynomials accurate to 5e-7.
 Set OMNINOISE_NO_JIT=1 to disable.
