@@ -26,7 +26,7 @@ from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
 from .lattice import lattice_noise
 
-__all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
+__all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
@@ -67,11 +67,13 @@ def load_models(root: str = SHIPPED_MODELS, threads: int = 0, cache: dict | None
 class TextureCode:
     """What the sampler needs: the extended code e float32 (E,) and the octave transforms T float32 (m, D, D);
     for photo models (``colour_model`` "affine") also the exemplar's colour: mean ``mu`` float32 (3,) and the
-    Cholesky factor ``L`` float32 (3, 3) of its colour covariance (rgb = mu + L d)."""
+    Cholesky factor ``L`` float32 (3, 3) of its colour covariance (rgb = mu + L d); for spectral models the
+    per-octave ``gains`` float32 (m,) measured from the exemplar (:func:`spectral_gains`)."""
     e: np.ndarray
     T: np.ndarray
     mu: np.ndarray | None = None
     L: np.ndarray | None = None
+    gains: np.ndarray | None = None
 
 
 def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
@@ -92,6 +94,32 @@ def colour_stats(img: np.ndarray, eps: float = 1e-4) -> np.ndarray:
     return np.concatenate([mu, np.linalg.cholesky(cov).ravel()]).astype(_F)
 
 
+GAIN_RANGE = (0.1, 3.0)   #: as training.solid.model.GAIN_RANGE
+
+
+def spectral_gains(img: np.ndarray, octaves: int = 8, px_per_unit: float = 128.0) -> np.ndarray:
+    """Per-octave gains of an image (H, W, 3): float32 (octaves,), the numpy twin of
+    ``training.solid.model.spectral_gains`` (the Haar-pyramid share of the luminance's variance at the level
+    each noise octave makes, g_i = sqrt(m s_i / sum s), clamped to GAIN_RANGE)."""
+    top = int(round(np.log2(px_per_unit)))
+    levels = [max(top - i, 0) for i in range(octaves)]
+    y = np.asarray(img, np.float64)[..., :3].mean(axis=2)
+    g = y - y.mean()
+    energy = []
+    for _ in range(max(levels) + 1):
+        h, w = g.shape[0] // 2 * 2, g.shape[1] // 2 * 2
+        if h < 2 or w < 2:          # coarser than the image: the coarsest level it has stands in
+            energy.append(energy[-1] if energy else 0.0)
+            continue
+        g = g[:h, :w]
+        c = g.reshape(h // 2, 2, w // 2, 2).mean(axis=(1, 3))
+        band = g - np.repeat(np.repeat(c, 2, axis=0), 2, axis=1)
+        energy.append(float((band ** 2).mean()))
+        g = c
+    e = np.array([energy[L] for L in levels]) + 1e-12
+    return np.clip(np.sqrt(octaves * e / e.sum()), *GAIN_RANGE).astype(_F)
+
+
 class SolidTextureModel:
     def __init__(self, folder: str, threads: int = 0):
         self.config = load_model_json(folder, "solid.json")
@@ -105,6 +133,8 @@ class SolidTextureModel:
         self.codes = {k: np.asarray(v, _F) for k, v in c.get("codes", {}).items()}
         #: photo models append the exemplar's colour statistics (12 values) to the encoder's latent z
         self.colour_stats = int(c.get("colour_stats", 0))
+        #: spectral models also append the exemplar's per-octave noise gains (``octaves`` values)
+        self.spectral_gains = int(c.get("spectral_gains", 0))
         self.z_dim = int(c.get("z_dim", 8))
         self._session = SessionCache(folder, threads)
 
@@ -145,6 +175,10 @@ class SolidTextureModel:
         z = self._session("encoder.onnx").run(None, {"exemplar": np.clip(crops, 0.0, 1.0)})[0].mean(0)
         if self.colour_stats:
             z = np.concatenate([z, colour_stats(img)])
+        if self.spectral_gains:   # as training measures them: crop by crop, here averaged over the crops
+            ppu = float(self.config["px_per_unit"])
+            z = np.concatenate([z, np.mean([spectral_gains(c.transpose(1, 2, 0), self.octaves, ppu)
+                                            for c in crops], axis=0)])
         return z.astype(_F)
 
     def translate(self, z) -> TextureCode:
@@ -152,14 +186,15 @@ class SolidTextureModel:
         if self.mode != "space":
             raise SettingError("code", f"model {self.name!r} has no translator (single-exemplar model)")
         z = np.asarray(z, _F).reshape(-1)
-        if z.shape[0] != self.z_dim + self.colour_stats:
-            raise SettingError("code", f"code has {z.shape[0]} values, model {self.name!r} needs "
-                                       f"{self.z_dim + self.colour_stats}")
+        need = self.z_dim + self.colour_stats + self.spectral_gains
+        if z.shape[0] != need:
+            raise SettingError("code", f"code has {z.shape[0]} values, model {self.name!r} needs {need}")
         e, T = self._session("translator.onnx").run(None, {"z": z[:self.z_dim].reshape(1, -1)})
         if not self.colour_stats:
             return TextureCode(e[0].astype(_F), T[0].astype(_F))
-        c = z[self.z_dim:]
-        return TextureCode(e[0].astype(_F), T[0].astype(_F), c[:3].copy(), c[3:12].reshape(3, 3).copy())
+        c = z[self.z_dim:self.z_dim + self.colour_stats]
+        gains = z[self.z_dim + self.colour_stats:].copy() if self.spectral_gains else None
+        return TextureCode(e[0].astype(_F), T[0].astype(_F), c[:3].copy(), c[3:12].reshape(3, 3).copy(), gains)
 
     def code(self, exemplar: str | None = None) -> TextureCode:
         """A named training exemplar's code (space models), or the default code."""
@@ -203,6 +238,10 @@ class SolidTextureModel:
                 raise Cancelled("cancelled")
             b = min(N, a + chunk)
             noise = lattice_noise(pts[a:b], T, seed, self.channels)
+            if self.spectral_gains:
+                if code.gains is None:
+                    raise SettingError("code", f"model {self.name!r} needs the exemplar's spectral gains in its code")
+                noise *= np.repeat(np.asarray(code.gains, _F), self.channels)   # octave-major: i*C + c
             e = code.e if code.e.ndim == 1 else code.e[a:b]
             d = self.decode(noise, e)
             if self.colour_stats:

@@ -200,7 +200,7 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
     photos = ex.photo_set("train")[:2]
     cfg = dict(name="tiny_photo", mode="space", dim=3, crop=64, batch=2, steps=4, width=16, log_every=1,
                checkpoint_every=2, threads=1, exemplars=photos, colour="affine", loss="swd", transform="bounded",
-               swd_width=8, swd_levels=2, film=film, standardise=film)
+               swd_width=8, swd_levels=2, film=film, standardise=film, spectral=film)
     state = train(SolidConfig.from_dict(dict(cfg, steps=2)), str(tmp_path / "run"), log=lambda *_: None)
     doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
     sha = fingerprint(doc["files"])
@@ -224,10 +224,11 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
             np.testing.assert_allclose(m.encoder(crop * 0.5 + 0.2).numpy(), m.encoder(crop).numpy(), rtol=5e-3, atol=5e-3)
         pts = np.random.default_rng(0).uniform(-3, 3, (300, 3))
         from training.solid.lattice import octave_seeds
+        assert z.shape == (8 + 12 + 8,) and rt.translate(z).gains.shape == (8,)
         with torch.no_grad():
             e, T = m.translator(torch.from_numpy(z[:8])[None])
             ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),
-                           torch.from_numpy(z[8:])[None])[0].clamp(0, 1).numpy()
+                           torch.from_numpy(z[8:20])[None], torch.from_numpy(z[20:])[None])[0].clamp(0, 1).numpy()
         np.testing.assert_allclose(rt.evaluate(pts, rt.translate(z), seed=5), ref, atol=2e-4)
     logs = []
     cont = train(SolidConfig.from_dict(dict(cfg, init_onnx=str(tmp_path / "m"), init_sha256=sha, warmup=2)),
@@ -238,10 +239,29 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
     with pytest.raises(ValueError, match="init_onnx needs init_sha256"):
         SolidConfig.from_dict(dict(cfg, init_onnx=str(tmp_path / "m")))
     # single mode: e and T come back from the JSON
-    one = dict(cfg, mode="single", exemplars=photos[:1], steps=1, checkpoint_every=1)
+    one = dict(cfg, mode="single", exemplars=photos[:1], steps=1, checkpoint_every=1, spectral=False)
     state1 = train(SolidConfig.from_dict(one), str(tmp_path / "run1"), log=lambda *_: None)
     doc1 = export(str(tmp_path / "run1"), str(tmp_path / "m1"))
     m1 = build_model(SolidConfig.from_dict(one))
     warm_start(m1, exported_weights(str(tmp_path / "m1"), fingerprint(doc1["files"])))
     for name, ref in state1["model"].items():
         np.testing.assert_allclose(m1.state_dict()[name].numpy(), ref.numpy(), atol=1e-6, err_msg=name)
+
+
+def test_spectral_gains_twins_agree_and_follow_the_grain():
+    """The per-octave gains (training.solid.model.spectral_gains and its numpy twin) agree; a fine-grained image
+    raises the fine octaves' gains, a smooth one the coarse octaves'; a flat image gives 1 everywhere."""
+    from backend.solid.model import spectral_gains as gains_np
+    from training.solid.model import spectral_gains as gains_t
+
+    rng = np.random.default_rng(0)
+    fine = rng.random((128, 128, 3)).astype(np.float32)                 # pixel noise: detail at 1-2 px
+    coarse = np.kron(rng.random((8, 8, 3)), np.ones((16, 16, 1))).astype(np.float32)   # 16 px blocks
+    for img in (fine, coarse, ex.load_image(ex.photo_set("val")[3]).permute(1, 2, 0).numpy()[:128, :128]):
+        t = gains_t(torch.from_numpy(np.ascontiguousarray(img.transpose(2, 0, 1)))[None])[0].numpy()
+        np.testing.assert_allclose(gains_np(img), t, rtol=1e-4, atol=1e-5)
+    gf, gc = gains_np(fine), gains_np(coarse)
+    assert gf[7] > 2 * gf[2] and gc[3] > 2 * gc[7]                      # octave 7: 1 px lattice; octave 3: 16 px
+    np.testing.assert_allclose(gains_np(np.full((64, 64, 3), 0.3, np.float32)), 1.0, atol=1e-4)
+    with pytest.raises(ValueError, match="spectral gains"):
+        SolidConfig.from_dict(dict(mode="single", exemplars=["gravel"], spectral=True))

@@ -26,7 +26,7 @@ from backend._export import export as _ex
 from backend.onnx_models import sha256_file
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
-from .model import COLOUR_STATS, colour_stats
+from .model import COLOUR_STATS, colour_stats, spectral_gains
 from .train import SolidConfig, build_model, training_images
 
 __all__ = ["export", "SplitDecoder", "FORMAT", "ENCODER_SIZE"]
@@ -92,7 +92,8 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                mode=cfg.mode, dim=cfg.dim, octaves=cfg.octaves, channels=cfg.channels, code_dim=cfg.code_dim,
                z_dim=cfg.z_dim, px_per_unit=cfg.px_per_unit, exemplar_scale=cfg.exemplar_scale,
                exemplars=list(cfg.exemplars), colour="sRGB", colour_model=cfg.colour,
-               colour_stats=COLOUR_STATS if cfg.colour == "affine" else 0, step=int(state["step"]),
+               colour_stats=COLOUR_STATS if cfg.colour == "affine" else 0,
+               spectral_gains=cfg.octaves if cfg.spectral else 0, step=int(state["step"]),
                train_seconds=round(float(state.get("elapsed", 0.0)), 1), n_params=int(state["n_params"]),
                config=state["config"])
     with torch.no_grad():
@@ -121,6 +122,8 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                 z = model.encoder(crops).mean(0)
                 if cfg.colour == "affine":
                     z = torch.cat([z, colour_stats(img.unsqueeze(0))[0]])
+                if cfg.spectral:   # as the runtime's encode: crop by crop, averaged
+                    z = torch.cat([z, spectral_gains(crops, cfg.octaves, cfg.px_per_unit).mean(0)])
                 codes[key] = z.numpy().astype(float).round(6).tolist()
             doc["codes"] = codes
             doc["encoder_size"] = ENCODER_SIZE

@@ -24,13 +24,14 @@ the single-mode parameters learn T_i = R_i (I + Delta_i).
 """
 from __future__ import annotations
 
+import math
 
 import torch
 from torch import nn
 
 from .lattice import lattice_noise
 
-__all__ = ["colour_stats", "COLOUR_STATS", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
+__all__ = ["colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
 
 
 def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
@@ -47,6 +48,42 @@ def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
 
 
 COLOUR_STATS = 12   #: mu (3) and L (3 x 3, row-major) appended to a photo model's code z
+GAIN_RANGE = (0.1, 3.0)   #: spectral gains are clamped to this range
+
+
+def detail_levels(px_per_unit: float, octaves: int) -> list:
+    """The Haar-pyramid level whose detail octave i of the noise makes: value noise of lattice spacing
+    s = px_per_unit / 2^i px varies at frequencies below 1/(2 s), the band of level log2(s) (level L: means
+    over 2^L px blocks minus means over 2^(L+1) px blocks), clamped to >= 0."""
+    top = int(round(math.log2(px_per_unit)))
+    return [max(top - i, 0) for i in range(octaves)]
+
+
+def spectral_gains(img: torch.Tensor, octaves: int = 8, px_per_unit: float = 128.0) -> torch.Tensor:
+    """Per-octave gains g_i of an exemplar: (B, 3, H, W) -> (B, octaves) in GAIN_RANGE.
+
+    The luminance's variance is split over the levels of a Haar pyramid (band_L = G_L - up(G_{L+1}) with 2x2
+    means G; the bands' mean squares add up to the variance); octave i reads the share s_i of its level
+    (:func:`detail_levels`) and g_i = sqrt(m s_i / sum_j s_j): 1 everywhere for an image whose detail is
+    spread evenly, larger where it has more.  The sampler multiplies octave i's noise by g_i before the
+    decoder (Eq. 5), so a fine-grained photo gets fine-grained noise and a smooth one smooth noise, measured
+    from the photo as its colours are (the numpy twin: ``backend.solid.model.spectral_gains``)."""
+    levels = detail_levels(px_per_unit, octaves)
+    y = img.mean(1, keepdim=True)
+    g = y - y.mean(dim=(2, 3), keepdim=True)
+    energy = []
+    for _ in range(max(levels) + 1):
+        h, w = g.shape[-2] // 2 * 2, g.shape[-1] // 2 * 2
+        if h < 2 or w < 2:          # coarser than the image: the coarsest level it has stands in
+            energy.append(energy[-1] if energy else g.new_zeros(g.shape[0]))
+            continue
+        g = g[..., :h, :w]
+        c = torch.nn.functional.avg_pool2d(g, 2)
+        band = g - torch.nn.functional.interpolate(c, scale_factor=2, mode="nearest")
+        energy.append((band ** 2).mean(dim=(1, 2, 3)))
+        g = c
+    e = torch.stack([energy[L] for L in levels], dim=1) + 1e-12
+    return torch.sqrt(octaves * e / e.sum(dim=1, keepdim=True)).clamp(*GAIN_RANGE)
 
 
 def colour_stats(img: torch.Tensor, eps: float = 1e-4) -> torch.Tensor:
@@ -239,10 +276,14 @@ class SolidTexture(nn.Module):
         return self.translator(self.encoder(exemplars))
 
     def sample(self, x: torch.Tensor, e: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor,
-               stats: torch.Tensor | None = None) -> torch.Tensor:
+               stats: torch.Tensor | None = None, gains: torch.Tensor | None = None) -> torch.Tensor:
         """s(x | z) (Eq. 5): x (B, N, D), e (B, E), T (B, m, D, D), seeds int64 (B, m) -> RGB (B, N, 3);
-        ``stats`` (B, 12): the exemplars' :func:`colour_stats` (``colour="affine"`` only)."""
+        ``stats`` (B, 12): the exemplars' :func:`colour_stats` (``colour="affine"`` only); ``gains`` (B, m): the
+        exemplars' :func:`spectral_gains`, multiplying each octave's noise (``spectral`` models)."""
         n = lattice_noise(x, T, seeds, self.channels)
+        if gains is not None:
+            B, N, _ = n.shape
+            n = (n.view(B, N, self.octaves, self.channels) * gains.view(B, 1, self.octaves, 1)).view(B, N, -1)
         out = self.decoder(n, e.unsqueeze(1))
         if self.colour == "affine":
             if stats is None:

@@ -36,7 +36,7 @@ from ..config import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import SolidTexture, colour_stats, slice_points
+from .model import SolidTexture, colour_stats, slice_points, spectral_gains
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from backend.onnx_models import load_model_json
@@ -72,6 +72,7 @@ class SolidConfig:
     transform: str = "free"         # space mode: "free" T_i = R_i (I + tanh Delta) or "bounded" (model.bounded_transform)
     film: bool = False              # the code modulates every hidden layer of the decoder (model.Decoder)
     standardise: bool = False       # space mode: the encoder sees each crop with its channels standardised
+    spectral: bool = False          # octave i's noise times the exemplar's measured gain g_i (model.spectral_gains)
     loss: str = "gram"              # "gram" (random-feature Gram matrices) or "swd" (sliced Wasserstein, swd.py)
     swd_width: int = 32             # swd: random filters per size and pyramid level
     swd_kernels: tuple = (3, 7)     # swd: filter sizes
@@ -103,6 +104,8 @@ class SolidConfig:
         if cfg.colour not in ("sigmoid", "affine"):
             raise ValueError(f"colour must be 'sigmoid' or 'affine', got {cfg.colour!r}")
         n_exemplars = len(ex.expand(cfg.exemplars))
+        if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
+            raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
         if cfg.init_onnx and not cfg.init_sha256:
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         if cfg.init_onnx and cfg.init_from:
@@ -148,10 +151,10 @@ def training_images(cfg: SolidConfig) -> list:
 
 
 def render(model: SolidTexture, e: torch.Tensor, T: torch.Tensor, x: torch.Tensor, seeds, size: int,
-           stats: torch.Tensor | None = None) -> torch.Tensor:
+           stats: torch.Tensor | None = None, gains: torch.Tensor | None = None) -> torch.Tensor:
     """Sampler images at slice points x (B, size*size, D) -> (B, 3, size, size)."""
     s = octave_seeds(seeds, model.octaves, x.device)
-    return model.sample(x, e, T, s, stats).view(x.shape[0], size, size, 3).permute(0, 3, 1, 2)
+    return model.sample(x, e, T, s, stats, gains).view(x.shape[0], size, size, 3).permute(0, 3, 1, 2)
 
 
 def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, gen: torch.Generator) -> torch.Tensor:
@@ -225,7 +228,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         if cfg.mode == "single":
             ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
             e, T = model.codes(batch=cfg.batch)
-            stats = single_stats
+            stats, gains = single_stats, None
         else:
             # distinct exemplars within a batch (while there are enough): each step contrasts textures
             pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
@@ -233,9 +236,10 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             ref = torch.cat([ex.random_crops(images[k], 1, cfg.crop, gen, augment) for k in pick])
             e, T = model.codes(ref)
             stats = colour_stats(ref)
+            gains = spectral_gains(ref, cfg.octaves, cfg.px_per_unit) if cfg.spectral else None
         x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen)
         seeds = torch.randint(0, 2 ** 31 - 1, (cfg.batch,), generator=gen).numpy()
-        img = render(model, e, T, x, seeds, cfg.crop, stats if cfg.colour == "affine" else None)
+        img = render(model, e, T, x, seeds, cfg.crop, stats if cfg.colour == "affine" else None, gains)
         loss = texture_loss(cfg, feats, img, ref, gen)
         opt.zero_grad(set_to_none=True)
         loss.backward()
