@@ -173,21 +173,26 @@ def _slabs(n_outer: int, per_outer: int, chunkable: bool):
         yield a, min(n_outer, a + step)
 
 
+def evaluate_rows(source: Source, grid: BoxGrid, time: float, a: int, b: int, progress=None,
+                  cancel=None) -> np.ndarray:
+    """The source on rows a .. b - 1 of the grid's outermost axis (z of a volume, y of an image): float32
+    (b - a, ...) - the one sub-box call of a slab-wise bake and a farm's brick."""
+    start = [0] * grid.rank
+    start[grid.rank - 1] = int(a)          # start is (x, y[, z]); the outermost array axis is the last of them
+    vals = source.evaluate((b - a,) + tuple(grid.shape[1:]), grid.first, grid.voxel, time, progress, cancel,
+                           tuple(start))
+    return np.asarray(vals, _F)
+
+
 def evaluate_slabs(source: Source, grid: BoxGrid, time: float, progress=None, cancel=None):
     """Yield (start, values) over the grid's outermost axis; values float32 (n, ...) slabs."""
     shape = grid.shape
-    first = grid.first
-    step = grid.voxel
     per = int(np.prod(shape[1:]))
-    outer = grid.rank - 1  # z for volumes, y for images
     for a, b in _slabs(shape[0], per, getattr(source, "chunkable", True)):
         if cancel is not None and cancel():
             raise Cancelled("cancelled")
-        start = [0] * grid.rank
-        start[outer] = a
         sub = None if progress is None else (lambda x, a=a, b=b: progress((a + x * (b - a)) / shape[0]))
-        vals = source.evaluate((b - a,) + tuple(shape[1:]), first, step, time, sub, cancel, tuple(start))
-        yield a, np.asarray(vals, _F)
+        yield a, evaluate_rows(source, grid, time, a, b, sub, cancel)
 
 
 def volume_grids(spec: BakeSpec) -> dict:

@@ -254,7 +254,6 @@ class NeuralSource:
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .grid import Cancelled
-        from .neural.generate import generate
         from .neural.request import generate_request
 
         def step_done(i, n, x0):
@@ -269,15 +268,11 @@ class NeuralSource:
             except SettingError as exc:
                 raise SettingError("source." + exc.setting, exc.message) from None
             return np.ascontiguousarray(img[::-1])  # bakes index rows by +y; files put +y at the top
-        from .neural.animate import frame_cond, frame_latent
+        from .neural.animate import frame_image
 
         self.check_grid(shape)
-        H, W = shape
-        k = self.model.multiple_of
-        cond = frame_cond(self.model, self.keys, float(time), H, W)
-        x_T = frame_latent(self.keys, float(time), (-(-H // k) * k, -(-W // k) * k), self.latent, self.drift)
-        img = generate(self.model, cond, self.seed, self.steps, self.tileable, callback=step_done, sampler=self.sampler,
-                       x_T=x_T)
+        img = frame_image(self.model, self.keys, float(time), *shape, self.latent, self.drift, seed=self.seed,
+                          steps=self.steps, tileable=self.tileable, callback=step_done, sampler=self.sampler)
         return np.ascontiguousarray(img[::-1])
 
     def to_dict(self) -> dict:

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from backend.bake import BakeSpec, KEY_NAME, bake_frame, frame_path, volume_channels, volume_grids
+from backend.bake import BakeSpec, KEY_NAME, bake_frame, evaluate_rows, frame_path, volume_channels, volume_grids
 from backend.jobs import JobError, JobOutcome, load_job, select_bakes
 
 __all__ = ["Task", "plan", "run_farm", "local_client", "remote_client", "brick_voxels_for", "CRASH_ENV"]
@@ -109,10 +109,7 @@ def run_brick(job: str, bake: str, frame, z0: int, z1: int) -> dict:
     """Worker: the grids of z = z0 .. z1 - 1 of a volume -> {grid name: float32 slab (z1 - z0, ny, nx[, 3])}."""
     spec = _job_spec(job, bake)
     _maybe_crash(frame_path(spec.output, frame))
-    g = spec.grid
-    vals = spec.source.evaluate((z1 - z0,) + tuple(g.shape[1:]), g.first, g.voxel, spec.frame_time(frame), None,
-                                None, (0, 0, int(z0)))
-    return volume_channels(spec, np.asarray(vals, np.float32))
+    return volume_channels(spec, evaluate_rows(spec.source, spec.grid, spec.frame_time(frame), z0, z1))
 
 
 # -- the client side --------------------------------------------------------------------------------------

@@ -41,7 +41,7 @@ from . import conditioning as C
 from .generate import generate
 from .sampler import initial_noise
 
-__all__ = ["Keyframe", "LATENT_MODES", "read_keys", "parse_keys", "even_keys", "frame_weight", "frame_cond", "frame_latent",
+__all__ = ["Keyframe", "LATENT_MODES", "read_keys", "parse_keys", "even_keys", "frame_weight", "frame_cond", "frame_latent", "frame_image",
            "animate", "temporal_coherence"]
 
 LATENT_MODES = ("fixed", "slerp", "drift")
@@ -183,8 +183,6 @@ def animate(model, keys: list, frames: tuple, H: int, W: int, latent: str = "fix
         raise SettingError("--eta", "animation needs a deterministic sampler (eta = 0): step noise flickers")
     for k in keys:
         model.param_vector(*k.spec)  # unknown classes or parameters fail before the first frame
-    k = model.multiple_of
-    shape = (-(-H // k) * k, -(-W // k) * k)
     if latent == "drift" and not np.isfinite(speed):
         raise SettingError("--drift", f"must be a finite number, got {speed}")
     for f in range(first, last + 1):
@@ -192,9 +190,17 @@ def animate(model, keys: list, frames: tuple, H: int, W: int, latent: str = "fix
             from ..grid import Cancelled
 
             raise Cancelled("cancelled")
-        img = generate(model, frame_cond(model, keys, f, H, W), x_T=frame_latent(keys, f, shape, latent, speed),
-                       **generate_kw)
-        yield f, img
+        yield f, frame_image(model, keys, f, H, W, latent, speed, **generate_kw)
+
+
+def frame_image(model, keys: list, frame: float, H: int, W: int, latent: str = "fixed", speed: float = 0.05,
+                **generate_kw) -> np.ndarray:
+    """One frame (any real frame number) of a keyframed sequence: float32 (H, W); the one path of
+    :func:`animate` and of animated bakes (``backend.sources.NeuralSource``)."""
+    k = model.multiple_of
+    shape = (-(-H // k) * k, -(-W // k) * k)
+    return generate(model, frame_cond(model, keys, frame, H, W), x_T=frame_latent(keys, frame, shape, latent, speed),
+                    **generate_kw)
 
 
 def temporal_coherence(frames: list, independent: float) -> dict:

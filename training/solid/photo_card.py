@@ -54,7 +54,7 @@ def run_facts(run: str) -> dict:
 
 
 def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "previous space model",
-            ledger: tuple = ()) -> str:
+            ledger: tuple = (), config: str = "configs/solid/photo_space_3d.json") -> str:
     f = run_facts(run)
     cfg, step = f["config"], f["step"]
     n_photos = len([n for n in os.listdir(os.path.join("data", "photos", "train"))]) if os.path.isdir(
@@ -66,8 +66,8 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
-         "python -m training.solid.train --config configs/solid/photo_space_3d.json --out runs/solid/photo_space",
-         "python -m training.solid.export runs/solid/photo_space models/solid/space",
+         f"python -m training.solid.train --config {config} --out runs/solid/{cfg['name']}",
+         f"python -m training.solid.export runs/solid/{cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
          f"{f['seconds'] / 60:.1f} min wall on {hardware_line().split(',')[0]}, {cfg['threads']} "
@@ -79,7 +79,18 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
             if step < cfg["steps"] and f["lr"] is not None else ""),
          "- **Colour from the photo:** the decoder outputs a whitened colour d and the texture is mu + L d, with "
          "the photo's mean colour mu and the Cholesky factor L of its colour covariance appended to the code z "
-         "(20 values: 8 learned, 12 measured). Refinement moves only the learned part.",
+         f"({cfg.get('z_dim', 8) + 12 + (cfg.get('octaves', 8) if cfg.get('spectral') else 0)} values: "
+         f"{cfg.get('z_dim', 8)} learned, {12 + (cfg.get('octaves', 8) if cfg.get('spectral') else 0)} measured). "
+         "Refinement moves only the learned part.",
+         *(["- **Spectral gains from the photo:** octave i of the noise is multiplied by g_i = sqrt(m s_i / sum s), "
+            "s_i the share of the photo's luminance variance at the Haar-pyramid level that octave's lattice makes "
+            "(measured crop by crop, like the colour), so a fine-grained photo gets fine-grained noise and a smooth "
+            "one smooth noise without the encoder having to learn it."] if cfg.get("spectral") else []),
+         *(["- **Code-modulated decoder, colour-blind encoder:** the code e modulates every hidden layer of the "
+            "decoder (FiLM: h <- relu((1 + gamma(e)) (W h + b) + beta(e))), and the encoder reads each crop with "
+            "its channels standardised (texture, not colour: colour is measured). The model before them mapped "
+            "every photo to one texture: its decoder's output differed between photos by 1.4 % of its spread "
+            "within one image."] if cfg.get("film") else []),
          "- **Loss:** sliced Wasserstein distance (Heitz et al. 2021) of random multi-scale features (5 x 5 colour "
          f"neighbourhoods and {cfg['swd_width']} zero-mean ReLU filters of sizes {cfg['swd_kernels']} on "
          f"{cfg['swd_levels']} pyramid levels) plus the sliced colour-histogram term (weight {cfg['hist_weight']}).",
@@ -111,10 +122,11 @@ def main(argv=None) -> int:
     ap.add_argument("--prev-label", default="previous space model", help="the column header of --prev")
     ap.add_argument("--ledger", help="a JSON list of rows (stage, steps, wall time, swd, ratio, beats, colour, "
                                      "shipped) for the ledger table")
+    ap.add_argument("--config", default="configs/solid/photo_space_3d.json", help="the run's config (for the command)")
     ap.add_argument("-o", "--out", default=os.path.join("models", "solid", "MODEL_CARD.md"))
     a = ap.parse_args(argv)
     text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped, a.prev_label,
-                   tuple(read_json(a.ledger)) if a.ledger else ())
+                   tuple(read_json(a.ledger)) if a.ledger else (), a.config)
     with open(a.out, encoding="utf-8") as fh:
         card = fh.read()
     if BEGIN in card and END in card:
