@@ -171,11 +171,7 @@ class _BakeOperator(TaskOperator):
     target = "VOLUME"
 
     def _start(self, context, blocking: bool):
-        try:
-            spec = build_spec(context, self.target)
-        except (backend.SettingError, OSError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
+        spec = build_spec(context, self.target)
         target, obj = self.target, context.active_object
         raw = spec.transfer is None
         mat = None

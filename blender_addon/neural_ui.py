@@ -225,12 +225,8 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
         if p.tileable and size % 8:
             size += 8 - size % 8
         steps = min(p.steps, 10) if self.preview else p.steps
-        try:
-            m = model()
-            req = panel_request(p, size, steps)
-        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
+        m = model()
+        req = panel_request(p, size, steps)
         gib = (m.embedding.shape[1] + len(m.params)) * size * size * 4 * 12 / 2**30  # U-Net activations: ~12x cond
         if gib > 16:
             self.report({"ERROR"}, f"{size}² needs about {gib:.0f} GiB; bake a smaller size")
@@ -404,17 +400,13 @@ class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_neural
         F = _mod("neural.fit")
-        try:
-            m = model()
-            if p.fit_image is None:
-                raise backend.SettingError("fit image", "pick an image to fit")
-            px = image_pixels(p.fit_image)
-            if px.shape[2] == 4:
-                px = px[..., :3]
-            img, notes = F.prepare_target(px if px.shape[2] > 1 else px[..., 0], m.multiple_of, p.fit_image.name)
-        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
+        m = model()
+        if p.fit_image is None:
+            raise backend.SettingError("fit image", "pick an image to fit")
+        px = image_pixels(p.fit_image)
+        if px.shape[2] == 4:
+            px = px[..., :3]
+        img, notes = F.prepare_target(px if px.shape[2] > 1 else px[..., 0], m.multiple_of, p.fit_image.name)
         try:
             bank = F.load_bank(_mod("paths").fit_bank())
         except _mod("onnx_models").ModelError:
@@ -638,14 +630,10 @@ class OMNINOISE_OT_swatch_thumbnails(TaskOperator, bpy.types.Operator):
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_neural
-        try:
-            m = model()
-            C = _mod("neural.conditioning")
-            specs = [s.spec() for s in p.swatches]
-            conds = [C.uniform(m, spec, THUMB_SIZE, THUMB_SIZE) for spec in specs]
-        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
+        m = model()
+        C = _mod("neural.conditioning")
+        specs = [s.spec() for s in p.swatches]
+        conds = [C.uniform(m, spec, THUMB_SIZE, THUMB_SIZE) for spec in specs]
         if not conds:
             self.report({"ERROR"}, "add a swatch first")
             return None

@@ -248,11 +248,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_solid
-        try:
-            m, code_fn = texture(p)
-        except (backend.SettingError, _mod("onnx_models").ModelError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
+        m, code_fn = texture(p)
         seed, name = p.seed, f"{p.name} Preview"
 
         def work(progress, cancel):
@@ -276,18 +272,14 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_solid
         obj = context.active_object
-        try:
-            if obj is None:
-                raise backend.SettingError("object", "select an object to bake onto")
-            if p.target != "VOLUME" and obj.type != "MESH":
-                raise backend.SettingError("object", f"{obj.name!r} is not a mesh; bake a mesh or choose Volume")
-            m, code_fn = texture(p)
-            if m.dim != 3:
-                raise backend.SettingError("model", f"model {m.name!r} is 2D; surfaces need a 3D solid texture")
-            return self._start_target(context, p, obj, m, code_fn, blocking)
-        except (backend.SettingError, _mod("onnx_models").ModelError, OSError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
+        if obj is None:
+            raise backend.SettingError("object", "select an object to bake onto")
+        if p.target != "VOLUME" and obj.type != "MESH":
+            raise backend.SettingError("object", f"{obj.name!r} is not a mesh; bake a mesh or choose Volume")
+        m, code_fn = texture(p)
+        if m.dim != 3:
+            raise backend.SettingError("model", f"model {m.name!r} is 2D; surfaces need a 3D solid texture")
+        return self._start_target(context, p, obj, m, code_fn, blocking)
 
     def _start_target(self, context, p, obj, m, code_fn, blocking):
         world, scale, seed, name = p.coords == "WORLD", float(p.scale), int(p.seed), p.name

@@ -201,11 +201,23 @@ class TaskOperator:
         return current() is None
 
     def _start(self, context, blocking: bool):
-        """Start the task (None after reporting why it could not start)."""
+        """Start the task: a :class:`Task`, or None after reporting why it could not start.  A setting error,
+        a missing or altered model or an unreadable file may simply be raised: :meth:`_begin` reports it."""
         raise NotImplementedError
 
+    def _begin(self, context, blocking: bool):
+        """:meth:`_start`, with the errors that refuse a start reported in one line (nothing is started)."""
+        from importlib import import_module
+
+        refused = (backend.SettingError, OSError, import_module(f"{backend.__name__}.onnx_models").ModelError)
+        try:
+            return self._start(context, blocking)
+        except refused as exc:
+            self.report({"ERROR"}, str(exc))
+            return None
+
     def execute(self, context):
-        task = self._start(context, blocking=True)
+        task = self._begin(context, blocking=True)
         if task is None:
             return {"CANCELLED"}
         if task.status != "done":
@@ -216,7 +228,7 @@ class TaskOperator:
     def invoke(self, context, event):
         if self.blocking or bpy.app.background:
             return self.execute(context)
-        self._task = self._start(context, blocking=False)
+        self._task = self._begin(context, blocking=False)
         if self._task is None:
             return {"CANCELLED"}
         context.window_manager.modal_handler_add(self)

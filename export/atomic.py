@@ -89,11 +89,15 @@ def _umask() -> int:
     return mask
 
 
+def write_text(path: str, text: str) -> None:
+    """Write ``text`` (UTF-8) atomically."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
+
+
 def write_json(path: str, doc, indent: int = 1) -> None:
     """Write ``doc`` as JSON (UTF-8) atomically."""
     import json
 
-    text = json.dumps(doc, indent=indent)
-    with atomic_path(path) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(text)
+    write_text(path, json.dumps(doc, indent=indent))

@@ -241,9 +241,7 @@ def main(argv=None) -> int:
         ap.error(str(exc))
     from backend._export import export
 
-    with export.atomic_path(a.out) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(text)
+    export.write_text(a.out, text)
     return 0
 
 

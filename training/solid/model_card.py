@@ -210,9 +210,7 @@ def main(argv=None) -> int:
     text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected)
     from backend._export import export
 
-    with export.atomic_path(a.out) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(text)
+    export.write_text(a.out, text)
     print(a.out)
     return 0
 

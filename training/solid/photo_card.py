@@ -133,9 +133,7 @@ def main(argv=None) -> int:
         card = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: text, card, flags=re.S)
     else:
         card = card.rstrip("\n") + "\n\n" + text + "\n"
-    with _ex.atomic_path(a.out) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(card)
+    _ex.write_text(a.out, card)
     print(a.out)
     return 0
 
