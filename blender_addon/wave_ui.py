@@ -58,7 +58,7 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
     fmin: FloatProperty(name="Min Frequency", description="Lower band limit, cycles per unit (after Scale)",
                         default=2.0, min=0.0, soft_max=64.0, update=_rebuild)
     fmax: FloatProperty(name="Max Frequency", description="Upper band limit, cycles per unit (after Scale)",
-                        default=6.0, min=0.01, soft_max=64.0, update=_rebuild)
+                        default=8.0, min=0.01, soft_max=64.0, update=_rebuild)
     exponent: FloatProperty(name="Exponent", description="Fractal spectrum falls as 1/f^exponent",
                             default=1.0, min=0.0, max=4.0, update=_rebuild)
     waveform: EnumProperty(name="Waveform", items=_WAVEFORMS, default="gaussian", update=_rebuild)

@@ -59,7 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--time", type=float, default=0.0, help="animation time, or W for --dim 4")
     w.add_argument("--speed", type=float, default=0.0, help="wave speed (units per unit time); animated noise")
     w.add_argument("--spectrum", choices=[k for k in SPECTRUM_KINDS if k != "custom"], default="gaussian")
-    w.add_argument("--fmin", type=float, default=4.0, help="band low, cycles per unit")
+    w.add_argument("--fmin", type=float, default=2.0, help="band low, cycles per unit (default 2, as job files and the node)")
     w.add_argument("--fmax", type=float, default=8.0, help="band high, cycles per unit")
     w.add_argument("--exponent", type=float, default=1.0, help="fractal amplitude exponent (A ~ f^-n)")
     w.add_argument("--directions", type=int, default=16)
@@ -215,14 +215,20 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
                                             f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") from None
         if not profile or not np.all(np.isfinite(profile)):
             raise SettingError("--profile", f"{a.profile}: needs finite numbers, got {len(profile)} values")
+    # the by-example and transition lengths default to the output's extent only where they are used, so
+    # equal settings from flags, job files and the panel are equal requests (tests/blender/test_wave_front_ends.py)
+    used = {}
+    if example is not None:
+        used["example_extent"] = a.example_extent or a.extent
+    if a.transition is not None:
+        used["transition_length"] = a.transition_length or a.extent
     return WaveSettings(
         dim=a.dim, spectrum=Spectrum(a.spectrum, a.fmin, a.fmax, a.exponent), directions=a.directions,
         seed=a.seed, output=a.output, speed=a.speed, slice_width=a.slice_width, waveform=a.waveform,
         profile=profile, cellular=a.cellular, cell_size=a.cell_size, stit_probability=a.stit_probability,
         stit_depth=a.stit_depth, anisotropy=a.anisotropy, axis_spectra=tuple(a.axis_spectrum),
-        lobes=tuple(a.lobe), spread=a.spread, example=example, example_plane=a.example_plane,
-        example_extent=a.example_extent or a.extent, sectors=a.sectors, transition_to=a.transition,
-        transition_length=a.transition_length or a.extent, table_size=a.table_size, table_period=a.period)
+        lobes=tuple(a.lobe), spread=a.spread, example=example, example_plane=a.example_plane, sectors=a.sectors,
+        transition_to=a.transition, table_size=a.table_size, table_period=a.period, **used)
 
 
 class _Bar:

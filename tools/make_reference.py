@@ -30,7 +30,7 @@ WAVE_VARIANTS = {
                         "--waveform", "crystal", "--seed", "5"],
     "2d_bandpass_modulus": ["--spectrum", "bandpass", "--fmin", "3", "--fmax", "5", "--output", "modulus"],
     "2d_lobes": ["--anisotropy", "lobes", "--lobe", "1,0:1", "--spread", "15", "--fmin", "2", "--fmax", "4"],
-    "2d_stit": ["--cellular", "stit", "--cell-size", "0.5", "--seed", "2"],
+    "2d_stit": ["--cellular", "stit", "--cell-size", "0.5", "--seed", "2", "--fmin", "4", "--fmax", "8"],
     "3d_fractal": ["--dim", "3", "--spectrum", "fractal", "--fmin", "1", "--fmax", "6", "--seed", "7"],
     "3d_animated": ["--dim", "3", "--speed", "0.5", "--time", "1.25", "--fmin", "2", "--fmax", "4"],
     "4d": ["--dim", "4", "--time", "0.5", "--fmin", "2", "--fmax", "4", "--seed", "11"],

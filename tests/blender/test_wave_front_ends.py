@@ -1,0 +1,45 @@
+"""One wave request for every front-end (issue 23): the command line's flags, a job file's source table and the
+Wave Noise node's panel give the same frozen WaveSettings for the same settings."""
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+import blender_addon  # noqa: E402
+from backend.sources import source_from_dict  # noqa: E402
+from cli.main import build_parser, settings_from_args  # noqa: E402
+
+CASES = [
+    # (flags, job-file table, panel properties)
+    (["--dim", "3", "--spectrum", "bandpass", "--fmin", "3", "--fmax", "7", "--directions", "12", "--seed", "5"],
+     {"dim": 3, "spectrum": "bandpass", "fmin": 3.0, "fmax": 7.0, "directions": 12, "seed": 5},
+     dict(dimensions="3", spectrum="bandpass", fmin=3.0, fmax=7.0, directions=12, seed=5)),
+    (["--dim", "2", "--spectrum", "fractal", "--fmin", "1", "--fmax", "16", "--exponent", "1.5", "--waveform",
+      "crystal", "--speed", "0.5"],
+     {"dim": 2, "spectrum": {"kind": "fractal", "fmin": 1.0, "fmax": 16.0, "exponent": 1.5}, "waveform": "crystal",
+      "speed": 0.5},
+     dict(dimensions="2", spectrum="fractal", fmin=1.0, fmax=16.0, exponent=1.5, waveform="crystal", speed=0.5)),
+    (["--dim", "3", "--anisotropy", "lobes", "--lobe", "1,0,0:1", "--spread", "25"],
+     {"dim": 3, "anisotropy": "lobes", "lobes": [[[1, 0, 0], 1.0]], "spread": 25.0},
+     dict(dimensions="3", anisotropy="lobes", axis=(1.0, 0.0, 0.0), spread=25.0)),
+]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def addon():
+    blender_addon.register()
+    yield
+    blender_addon.unregister()
+
+
+@pytest.mark.parametrize("flags, table, props", CASES)
+def test_flags_job_tables_and_the_panel_give_equal_settings(flags, table, props):
+    cli = settings_from_args(build_parser().parse_args(["wave", *flags, "-o", "x.npy"]))
+    job = source_from_dict(dict(table), ".").settings
+    bpy.ops.wm.read_homefile(use_empty=True)
+    tree = bpy.data.node_groups.new("Wave", "ShaderNodeTree")
+    p = tree.omninoise_wave
+    for k, v in props.items():
+        setattr(p, k, v)
+    panel = p.to_settings()
+    assert cli == job, (cli, job)
+    assert panel == cli, (panel, cli)
