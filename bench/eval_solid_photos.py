@@ -127,6 +127,19 @@ def summary(rows: dict) -> dict:
                 median_seconds=med("seconds"), worst_swd=float(swd.max()))
 
 
+def by_category(rows: dict) -> dict:
+    """{category (the file name's prefix before "__"): photos and medians of the model's and baselines' patch
+    distances and colour error}."""
+    out = {}
+    for cat in sorted({name.split("__")[0] for name in rows}):
+        rs = [r for name, r in rows.items() if name.split("__")[0] == cat]
+        med = lambda k: round(float(np.median([r[k] for r in rs])), 1 if k != "colour" else 4)  # noqa: E731
+        out[cat] = dict(photos=len(rs), swd=med("swd"), random_phase=med("random_phase"),
+                        pixel_shuffle=med("pixel_shuffle"), perlin_hist=med("perlin_hist"), colour=med("colour"),
+                        beats_random_phase=sum(r["swd"] < r["random_phase"] for r in rs))
+    return out
+
+
 def write_sheet(sheet: list, path: str, size: int = 128) -> None:
     from PIL import Image
 
@@ -155,7 +168,7 @@ def main(argv=None) -> int:
     sheet = [] if a.sheet else None
     rows = evaluate(model, files, a.seeds, sheet)
     doc = dict(model=a.model, model_sha=model.config["files"], size=SIZE, seeds=a.seeds, summary=summary(rows),
-               photos=rows)
+               by_category=by_category(rows), photos=rows)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
     if sheet:
