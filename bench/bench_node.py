@@ -3,10 +3,13 @@
 Headless Cycles (CPU), orthographic camera on a plane filling the frame,
 emission shader, R x R pixels, S samples; each shader is rendered once to
 compile, then timed over ``--repeat`` renders (the minimum is kept).  Prints ns
-per pixel-sample and ratios against Blender's Gabor Texture (the issue's target),
+per pixel-sample (from the difference between S and 2S samples, so set-up and
+shader compilation cancel) and ratios against Blender's Gabor Texture (the issue's target),
 the node count of each built tree, and writes out/bench/node.json.  Two "floor"
 rows time the cheapest trees any table-lookup wave node could be at 16
-directions (see :func:`lookup_floor`): what Alg. 1 costs in SVM at the least.
+directions (see :func:`lookup_floor`): what Alg. 1 costs in SVM at the least.  The
+"OSL:" rows render with Cycles' Open Shading Language, the Wave Noise group in its
+OSL form (blender_addon/wave_osl.py), and Gabor under OSL for comparison.
 
     python bench/bench_node.py [--res 256] [--samples 4] [--repeat 2]
 """
@@ -28,13 +31,14 @@ from backend import Spectrum, WaveSettings  # noqa: E402
 from blender_addon.wave_nodes import build_wave_group  # noqa: E402
 
 
-def scene(res: int, samples: int):
+def scene(res: int, samples: int, osl: bool = False):
     """A Cycles scene: a 2 x 2 plane filling an orthographic camera's R x R frame, with an empty material
     -> (scene, material).  Also the scene of the EEVEE test (tests/blender_scripts/eevee_wave.py)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
     sc.cycles.device = "CPU"
+    sc.cycles.shading_system = osl  # Open Shading Language: every shader of the scene runs as OSL
     sc.cycles.samples = samples
     sc.cycles.use_denoising = False
     sc.render.resolution_x = sc.render.resolution_y = res
@@ -80,9 +84,10 @@ def texture(kind, **props):
     return make
 
 
-def wave(k):
+def wave(k, implementation="nodes"):
     def make(nt):
-        grp = build_wave_group(WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2, 6), directions=k, seed=1))
+        grp = build_wave_group(WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2, 6), directions=k, seed=1),
+                               implementation=implementation)
         n = nt.nodes.new("ShaderNodeGroup")
         n.node_tree = grp
         count = len(grp.nodes) + sum(len(g.node_tree.nodes) for g in grp.nodes if g.bl_idname == "ShaderNodeGroup")
@@ -156,28 +161,41 @@ def main():
     ap.add_argument("--samples", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=2)
     a = ap.parse_args()
-    cases = {
-        "Blender Noise detail 5": texture("ShaderNodeTexNoise", Detail=5.0, Scale=5.0),
-        "Blender Voronoi": texture("ShaderNodeTexVoronoi", Scale=5.0),
-        "Blender Gabor": texture("ShaderNodeTexGabor", Scale=5.0),
-        "Wave Noise 8 dirs": wave(8),
-        "Wave Noise 16 dirs": wave(16),
-        "Wave Noise 32 dirs": wave(32),
-        "floor 16: lookup only": lookup_floor(16, False),
-        "floor 16: 2 lookups+hash": lookup_floor(16, True),
-    }
+    # (name, tree maker, OSL shading system)
+    cases = [
+        ("Blender Noise detail 5", texture("ShaderNodeTexNoise", Detail=5.0, Scale=5.0), False),
+        ("Blender Voronoi", texture("ShaderNodeTexVoronoi", Scale=5.0), False),
+        ("Blender Gabor", texture("ShaderNodeTexGabor", Scale=5.0), False),
+        ("Wave Noise 8 dirs", wave(8), False),
+        ("Wave Noise 16 dirs", wave(16), False),
+        ("Wave Noise 32 dirs", wave(32), False),
+        ("floor 16: lookup only", lookup_floor(16, False), False),
+        ("floor 16: 2 lookups+hash", lookup_floor(16, True), False),
+        ("OSL: Blender Gabor", texture("ShaderNodeTexGabor", Scale=5.0), True),
+        ("OSL: Wave Noise 8 dirs", wave(8, "osl"), True),
+        ("OSL: Wave Noise 16 dirs", wave(16, "osl"), True),
+        ("OSL: Wave Noise 32 dirs", wave(32, "osl"), True),
+        ("OSL: Wave Noise 64 dirs", wave(64, "osl"), True),
+    ]
     res = {}
-    for name, make in cases.items():
-        sc, mat = scene(a.res, a.samples)
-        nodes = shade(mat, make)
-        bpy.ops.render.render()  # compile and warm up
-        best = min(_timed() for _ in range(a.repeat))
-        res[name] = dict(ns_per_pixel_sample=best / (a.res * a.res * a.samples) * 1e9, nodes=nodes, seconds=best)
+    for name, make, osl in cases:
+        times = {}
+        for spp in (a.samples, 2 * a.samples):
+            sc, mat = scene(a.res, spp, osl)
+            nodes = shade(mat, make)
+            bpy.ops.render.render()  # compile and warm up
+            times[spp] = min(_timed() for _ in range(a.repeat))
+        # per pixel-sample cost from the difference of S and 2S samples: scene set-up and shader
+        # compilation (OSL's JIT) are paid once per render and cancel out; reported apart as set-up
+        per = (times[2 * a.samples] - times[a.samples]) / (a.res * a.res * a.samples)
+        res[name] = dict(ns_per_pixel_sample=per * 1e9, nodes=nodes, osl=osl,
+                         setup_s=times[a.samples] - per * a.res * a.res * a.samples, seconds=times)
     ref = res["Blender Gabor"]["ns_per_pixel_sample"]
-    print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} samples")
-    print(f"  {'shader':24s} {'ns/px-sample':>12s} {'vs Gabor':>9s} {'nodes':>6s}")
+    print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
+    print(f"  {'shader':26s} {'ns/px-sample':>12s} {'vs Gabor':>9s} {'nodes':>6s} {'set-up s':>9s}")
     for name, r in res.items():
-        print(f"  {name:24s} {r['ns_per_pixel_sample']:12.1f} {r['ns_per_pixel_sample'] / ref:8.2f}x {r['nodes']:6d}")
+        print(f"  {name:26s} {r['ns_per_pixel_sample']:12.1f} {r['ns_per_pixel_sample'] / ref:8.2f}x {r['nodes']:6d}"
+              f" {r['setup_s']:9.2f}")
     os.makedirs(os.path.join(ROOT, "out", "bench"), exist_ok=True)
     with open(os.path.join(ROOT, "out", "bench", "node.json"), "w") as fh:
         json.dump(dict(res=a.res, samples=a.samples, results=res), fh, indent=1)

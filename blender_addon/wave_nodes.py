@@ -1,4 +1,4 @@
-"""The Wave Noise node: a node group built from Blender's own nodes (no OSL).
+"""The Wave Noise node: a node group built from Blender's own nodes, or one OSL script (:mod:`.wave_osl`).
 
 The group computes exactly the sum of :mod:`backend.wavenoise.wave` (Guehl et al. 2025,
 Eq. 6 and 9, Algorithm 1), node for node:
@@ -43,9 +43,11 @@ import numpy as np
 
 from ._deps import backend
 from .compat import id_property
+from .wave_constants import stratum_constants
 
-__all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json", "settings_from_json",
-           "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group", "clear_tree", "group_io"]
+__all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json",
+           "settings_from_json", "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group",
+           "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY", "tree_implementation"]
 
 _F = np.float32
 SETTINGS_KEY = "omninoise_wave_settings"
@@ -56,6 +58,17 @@ LEGACY_SETTINGS_KEY = "omninoise_wave"
 def tree_settings_json(tree) -> str | None:
     """The settings JSON stored on a Wave Noise (or Wave Cellular) tree, or None if it has none."""
     return id_property(tree, SETTINGS_KEY, LEGACY_SETTINGS_KEY)
+#: the two forms of the group: Blender's math nodes (every engine) or one OSL script (Cycles with OSL)
+IMPLEMENTATIONS = ("nodes", "osl")
+#: tree key holding the form a group was built in
+IMPLEMENTATION_KEY = "omninoise_wave_implementation"
+
+
+def tree_implementation(tree) -> str:
+    """The form ('nodes' or 'osl') a Wave Noise tree was built in; trees from before the OSL form are 'nodes'."""
+    return str(tree.get(IMPLEMENTATION_KEY, "nodes"))
+
+
 #: (name, socket type, default) of the group's inputs and outputs
 INPUTS = (("Vector", "NodeSocketVector", (0.0, 0.0, 0.0)), ("W", "NodeSocketFloat", 0.0),
           ("Scale", "NodeSocketFloat", 1.0), ("Time", "NodeSocketFloat", 0.0))
@@ -277,7 +290,7 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: tuple,
                    mode: str, consts: dict) -> bpy.types.NodeTree:
     """Sub-group for one stratum: Sum + amp (w0 T0 + w1 T1) as a vector (re, im, 0).
 
-    The stratum's constants (``consts``, from :func:`_stratum_constants`) are
+    The stratum's constants (``consts``, from :func:`stratum_constants`) are
     written into the nodes' sockets, not passed as group inputs: Cycles' SVM
     compiler would load every constant group input of every stratum onto its
     255-float stack before the first wave.  The position is offset by
@@ -363,35 +376,6 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: tuple,
 
 # -- the whole group ------------------------------------------------------------------
 
-def _stratum_constants(noise, k: int) -> dict:
-    dirs = noise.dirs
-    dom = dirs.domains[dirs.domain[k]]
-    if dom.kind != "cap":
-        raise backend.SettingError("example", "by-example noise is bake-only; the node supports caps and lobes")
-    dim = noise.dim
-    s = _F(dom.spread)
-    if dim == 4:
-        cap = _F(s - np.sin(s) * np.cos(s))
-    else:
-        cap = _F(_F(1.0) - np.cos(s))
-    v = -np.asarray(dom.axis, dtype=_F)
-    v[dim - 1] += 1.0
-    vv = float(np.dot(v, v))
-    scale = float(_F(2.0 / vv)) if vv >= 1e-12 else 0.0
-    sd = noise.slice_dirs[k]
-    pad = lambda a, fill=0.0: tuple(float(c) for c in (list(a[:3]) + [fill] * (3 - len(a[:3]))))  # noqa: E731
-    return {
-        "k": float(k), "Seed": float(noise.seed),
-        "Slice Dir": pad(sd), "Slice Dir W": float(sd[3]) if dim == 4 else 0.0,
-        "Slice Offset": float(noise.slice_offsets[k]),
-        "Box Lo": pad(dirs.lo[k]), "Box Size": pad(dirs.hi[k] - dirs.lo[k]),
-        "Spread": float(s), "Cap": float(cap),
-        "Mirror": pad(v), "Mirror W": float(v[3]) if dim == 4 else 0.0, "Mirror Scale": scale,
-        "Inv Period": float(_F(1.0 / noise.table.period)), "Amplitude": float(dirs.amp[k]),
-        "Table Size": int(noise.table.size),
-    }
-
-
 def clear_tree(tree: bpy.types.NodeTree) -> None:
     for n in list(tree.nodes):
         if n.bl_idname == "ShaderNodeGroup" or n.bl_idname == "GeometryNodeGroup":
@@ -438,12 +422,16 @@ def group_io(b: NodeBuilder) -> tuple:
 
 
 def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
-                     name: str = "Wave Noise") -> bpy.types.NodeTree:
+                     name: str = "Wave Noise", implementation: str = "nodes") -> bpy.types.NodeTree:
     """Build (or rebuild in place) the Wave Noise group for ``settings`` (a backend WaveSettings).
 
-    tree_type: 'ShaderNodeTree' or 'GeometryNodeTree'.  Returns the group tree;
-    its interface (INPUTS, OUTPUTS) is the same for every setting.
+    tree_type: 'ShaderNodeTree' or 'GeometryNodeTree'.  implementation: 'nodes' (Blender's
+    math nodes: every engine and device) or 'osl' (one compiled OSL script,
+    :mod:`.wave_osl`: Cycles with Open Shading Language only, shader trees only).
+    Returns the group tree; its interface (INPUTS, OUTPUTS) is the same for every setting and form.
     """
+    if implementation not in IMPLEMENTATIONS:
+        raise backend.SettingError("implementation", f"unknown {implementation!r}; choose nodes or osl")
     if settings.cellular != "none":
         raise backend.SettingError("cellular", "use the Wave Cellular node for cellular variants")
     if settings.example is not None or settings.transition_to is not None:
@@ -452,11 +440,18 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     table = noise.table
     if table.mode not in ("single", "axes"):
         raise backend.SettingError("anisotropy", f"table mode {table.mode!r} has no node form")
+    if implementation == "osl" and (tree.bl_idname if tree is not None else tree_type) != "ShaderNodeTree":
+        raise backend.SettingError("implementation",
+                                   "the OSL form is for shader trees; Geometry Nodes use the node form")
     if tree is None:
         tree = new_wave_tree(name, tree_type)
     else:
         clear_tree(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
+    tree[IMPLEMENTATION_KEY] = implementation
+    if implementation == "osl":
+        _build_osl(tree, noise)
+        return tree
     imgs = (ensure_table_image(table.values), ensure_table_image(table.values, slope=True))
     dim = noise.dim
     full = any(d.full for d in noise.dirs.domains)
@@ -470,7 +465,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     amps = noise.dirs.amp
     uniform = bool(np.all(amps == amps[0]))  # then one scale after the sum replaces 2 K multiplies
     for k in range(noise.dirs.count):
-        consts = _stratum_constants(noise, k)
+        consts = stratum_constants(noise, k)
         if uniform:
             consts["Amplitude"] = None
         node = b.new(group_kind)
@@ -490,3 +485,21 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     b.put(go.inputs["Modulus"], b.vmath("LENGTH", acc))
     b.put(go.inputs["Phase"], b.math("ARCTAN2", im, re))
     return tree
+
+
+def _build_osl(tree: bpy.types.NodeTree, noise) -> None:
+    """The OSL form: Vector x Scale, W x Scale and Time into one Script node (:func:`.wave_osl.script_node`)."""
+    from .wave_osl import script_node
+
+    b = NodeBuilder(tree)
+    gi, go, x, w = group_io(b)
+    try:
+        node = script_node(tree, noise, "Wave Noise (OSL)")
+    except backend.SettingError:
+        clear_tree(tree)
+        raise
+    tree.links.new(x, node.inputs["Position"])
+    tree.links.new(w, node.inputs["W"])
+    tree.links.new(gi.outputs["Time"], node.inputs["Time"])
+    for o in OUTPUTS:
+        tree.links.new(node.outputs[o], go.inputs[o])

@@ -4,16 +4,24 @@ The node an artist adds is a plain group node whose tree :mod:`.wave_nodes`
 builds; its settings live on the tree (``NodeTree.omninoise_wave``).  Editing a
 setting rebuilds the inner nodes in place: the interface never changes, so
 links to the node survive.  A .blend keeps rendering without the extension,
-because the group is made of Blender's own nodes and its tables are packed.
+because the group is made of Blender's own nodes and its tables are packed (or,
+in its OSL form, of one Script node whose text and bytecode are in the file).
+
+The form follows the scene by default (Implementation: Automatic): the OSL script
+where Cycles runs Open Shading Language, several times faster there; Blender's
+nodes everywhere else (EEVEE, Cycles' SVM on any device, Geometry Nodes).  Groups
+switch before each render, on file load, after depsgraph updates and when the
+engine or the OSL switch changes in the interface.
 """
 from __future__ import annotations
 
 import bpy
+from bpy.app.handlers import persistent
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
     PointerProperty, StringProperty
 
 from ._deps import backend
-from .wave_nodes import add_wave_node, build_wave_group, new_wave_tree
+from .wave_nodes import add_wave_node, build_wave_group, new_wave_tree, tree_implementation
 
 _SPECTRA = [(k, k.capitalize(), "") for k in ("gaussian", "bandpass", "fractal", "white", "blue", "brown", "twolevel")]
 _WAVEFORMS = [("gaussian", "Gaussian", "Random-phase waves (Gaussian noise)"),
@@ -22,24 +30,77 @@ _WAVEFORMS = [("gaussian", "Gaussian", "Random-phase waves (Gaussian noise)"),
 _ANISO = [("none", "Isotropic", "Directions over the whole (half) sphere"),
           ("lobes", "Lobe", "Directions within a cone around an axis (Fig. 5 right)"),
           ("axes", "Per Axis", "One band per axis, interpolated by direction (Fig. 5 left)")]
-#: most directions Cycles' shader stack holds, per dimension (tests/blender/test_wave_node.py)
+_IMPLEMENTATIONS = [
+    ("AUTO", "Automatic", "The OSL script where the scene renders with Cycles and Open Shading Language, "
+     "Blender's nodes everywhere else"),
+    ("NODES", "Nodes", "Blender's math nodes: Cycles on any device, EEVEE and Geometry Nodes"),
+    ("OSL", "OSL Script", "One compiled OSL script: several times faster, but only Cycles with Open Shading "
+     "Language renders it (elsewhere it is black)")]
+#: most directions Cycles' shader stack holds, per dimension (tests/blender/test_wave_node.py); OSL has no such limit
 MAX_DIRECTIONS = {2: 64, 3: 32, 4: 32}
 
 
-def _rebuild(self, context) -> None:
-    tree = self.id_data
-    if not self.is_wave or getattr(tree, "is_evaluated", False):
-        return
+def scene_runs_osl(scene) -> bool:
+    """True when ``scene`` renders with Cycles and its Open Shading Language switch is on."""
+    return (scene is not None and scene.render.engine == "CYCLES"
+            and bool(getattr(getattr(scene, "cycles", None), "shading_system", False)))
+
+
+def wanted_implementation(props, tree, scene) -> str:
+    """'nodes' or 'osl': the form a Wave Noise tree should be built in for ``scene``."""
+    if tree.bl_idname != "ShaderNodeTree" or props.implementation == "NODES":
+        return "nodes"
+    if props.implementation == "OSL":
+        return "osl"
+    from .wave_osl import osl_available
+
+    return "osl" if scene_runs_osl(scene) and osl_available() else "nodes"
+
+
+def rebuild_tree(props, scene) -> None:
+    """Rebuild the tree holding ``props`` from them; errors go to ``props.error`` (shown in the panel)."""
+    tree = props.id_data
     try:
-        if self.is_cellular:
+        if props.is_cellular:
             from .cellular_nodes import build_cellular_group
 
-            build_cellular_group(self.to_settings(), tree=tree)
+            build_cellular_group(props.to_settings(), tree=tree)
         else:
-            build_wave_group(self.to_settings(), tree=tree)
-        self.error = ""
+            form = wanted_implementation(props, tree, scene)
+            build_wave_group(props.to_settings(node=form == "nodes"), tree=tree, implementation=form)
+        props.error = ""
     except backend.SettingError as e:
-        self.error = str(e)
+        props.error = str(e)
+
+
+def _rebuild(self, context) -> None:
+    if not self.is_wave or getattr(self.id_data, "is_evaluated", False):
+        return
+    rebuild_tree(self, getattr(context, "scene", None))
+
+
+_last_scene_state = [None]
+
+
+@persistent
+def follow_render_settings(*_args) -> None:
+    """Automatic Wave Noise groups follow the scene: OSL form when Cycles runs OSL, nodes otherwise.
+
+    Runs before renders, after depsgraph updates and file loads, and when the render engine or
+    Cycles' Open Shading Language switch is changed in the interface (message bus); it only
+    compares two settings unless they changed."""
+    scene = getattr(bpy.context, "scene", None)
+    state = (scene.name, scene_runs_osl(scene)) if scene is not None else None
+    if state == _last_scene_state[0]:
+        return
+    _last_scene_state[0] = state
+    for tree in bpy.data.node_groups:
+        props = getattr(tree, "omninoise_wave", None)
+        if (props is None or not props.is_wave or props.is_cellular or props.implementation != "AUTO"
+                or tree.library is not None):
+            continue
+        if tree_implementation(tree) != wanted_implementation(props, tree, scene):
+            rebuild_tree(props, scene)
 
 
 class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
@@ -71,13 +132,14 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, min=0, max=(1 << 24) - 1, update=_rebuild)
     speed: FloatProperty(name="Speed", description="Wave speed for animation with the Time input (Eq. 9); "
                          "0 = static", default=0.0, soft_min=-10.0, soft_max=10.0, update=_rebuild)
+    implementation: EnumProperty(name="Implementation", items=_IMPLEMENTATIONS, default="AUTO", update=_rebuild)
 
     def to_settings(self, node: bool = True):
         """WaveSettings; ``node`` checks the live node's limits (bakes take any number of directions)."""
         dim = int(self.dimensions)
         if node and self.directions > MAX_DIRECTIONS[dim]:
-            raise backend.SettingError("directions", f"at most {MAX_DIRECTIONS[dim]} in {dim}D "
-                                       "(Cycles' shader stack); use a bake for more")
+            raise backend.SettingError("directions", f"at most {MAX_DIRECTIONS[dim]} in {dim}D (Cycles' shader "
+                                       "stack); use Cycles with Open Shading Language or a bake for more")
         sp = backend.Spectrum(self.spectrum, self.fmin, self.fmax, self.exponent)
         kw = {}
         if self.anisotropy == "lobes":
@@ -164,15 +226,17 @@ def new_cellular_node_tree(name: str, tree_type: str) -> bpy.types.NodeTree:
     return tree
 
 
-def new_wave_node_tree(name: str, tree_type: str) -> bpy.types.NodeTree:
-    """A Wave Noise group built from the default panel settings, its settings stored on it.
+def new_wave_node_tree(name: str, tree_type: str, scene=None) -> bpy.types.NodeTree:
+    """A Wave Noise group built from the default panel settings, its settings stored on it; in the
+    form ``scene`` (default: the context's) renders fastest (:func:`wanted_implementation`).
 
     Raises backend.SettingError (and leaves no tree behind) when the settings are invalid.
     """
     tree = new_wave_tree(name, tree_type)
     props = tree.omninoise_wave
     try:
-        build_wave_group(props.to_settings(), tree=tree)
+        form = wanted_implementation(props, tree, scene if scene is not None else getattr(bpy.context, "scene", None))
+        build_wave_group(props.to_settings(node=form == "nodes"), tree=tree, implementation=form)
     except backend.SettingError:
         bpy.data.node_groups.remove(tree)
         raise
@@ -217,6 +281,12 @@ def draw_wave_settings(layout, props) -> None:
         layout.prop(props, "cell_size")
     else:
         layout.prop(props, "speed")
+        if props.id_data.bl_idname == "ShaderNodeTree":
+            layout.prop(props, "implementation")
+            form = tree_implementation(props.id_data)
+            hint = ("OSL script (Cycles with Open Shading Language)" if form == "osl" else
+                    "Nodes (faster: Cycles > Open Shading Language)" if props.implementation == "AUTO" else "Nodes")
+            layout.label(text=f"In use: {hint}", icon="INFO")
     if props.error:
         layout.label(text=props.error, icon="ERROR")
 
@@ -224,6 +294,27 @@ def draw_wave_settings(layout, props) -> None:
 def _menu(self, context):
     self.layout.operator(OMNINOISE_OT_add_wave_noise.bl_idname, text="Wave Noise (OmniNoise)")
     self.layout.operator(OMNINOISE_OT_add_wave_cellular.bl_idname, text="Wave Cellular (OmniNoise)")
+
+
+def _HANDLERS():
+    h = bpy.app.handlers
+    return (h.render_pre, h.depsgraph_update_post, h.load_post)
+
+
+_MSGBUS_OWNER = object()
+
+
+@persistent
+def _subscribe(*_args) -> None:
+    """Message-bus subscriptions (cleared by every file load) to the settings the Automatic form follows.
+    Interface edits of Cycles' Python-defined settings do not always reach the depsgraph handlers."""
+    bpy.msgbus.clear_by_owner(_MSGBUS_OWNER)
+    keys = [(bpy.types.RenderSettings, "engine")]
+    cycles = getattr(bpy.types, "CyclesRenderSettings", None)
+    if cycles is not None:
+        keys.append((cycles, "shading_system"))
+    for key in keys:
+        bpy.msgbus.subscribe_rna(key=key, owner=_MSGBUS_OWNER, args=(), notify=follow_render_settings)
 
 
 MENUS = ("NODE_MT_category_shader_texture", "NODE_MT_category_GEO_TEXTURE")
@@ -234,6 +325,12 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.NodeTree.omninoise_wave = PointerProperty(type=OMNINOISE_PG_wave)
+    for handlers in _HANDLERS():
+        if follow_render_settings not in handlers:
+            handlers.append(follow_render_settings)
+    if _subscribe not in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.append(_subscribe)
+    _subscribe()
     for m in MENUS:
         menu = getattr(bpy.types, m, None)
         if menu is not None:
@@ -241,6 +338,13 @@ def register():
 
 
 def unregister():
+    for handlers in _HANDLERS():
+        if follow_render_settings in handlers:
+            handlers.remove(follow_render_settings)
+    if _subscribe in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_subscribe)
+    bpy.msgbus.clear_by_owner(_MSGBUS_OWNER)
+    _last_scene_state[0] = None
     for m in MENUS:
         menu = getattr(bpy.types, m, None)
         if menu is not None:

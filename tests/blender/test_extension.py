@@ -55,6 +55,10 @@ def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
     assert out["install"] == ["FINISHED"] and out["enabled"] and out["props"] and out["menu_op"]
     assert out["directions_default"] == 16 and out["directions_after_edit"] == 5
     assert "at most 32" in out["error"] and out["directions_after_error"] == 5
+    # the Automatic form follows the scene's shading system (OSL script / Blender's nodes)
+    want = ("osl", 1) if out["osl_available"] else ("nodes", 0)
+    assert (out["form_osl_scene"], out["scripts_osl_scene"]) == want
+    assert (out["form_svm_scene"], out["groups_svm_scene"]) == ("nodes", 5)
     assert out["cache_dir"].startswith(str(tmp_path))  # the user folder, not the extension's own
     assert not out["disabled_props"] and out["reenabled_props"]
     if not out["openvdb"]:  # the bpy 4.2 wheel: a one-line message instead of a volume

@@ -25,6 +25,22 @@ out["directions_after_edit"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tre
 tree.omninoise_wave.directions = 60  # above the 3D limit: a message, the old tree stays
 out["error"] = tree.omninoise_wave.error
 out["directions_after_error"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
+tree.omninoise_wave.directions = 5
+# an Automatic group follows the scene: the OSL script once Cycles runs OSL, nodes again after
+osl = importlib.import_module(MOD + ".blender_addon.wave_osl")
+out["osl_available"] = osl.osl_available()
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"
+scene.render.resolution_x = scene.render.resolution_y = 8
+scene.cycles.samples = 1
+scene.cycles.shading_system = True
+bpy.ops.render.render()  # the switch itself does not reach the depsgraph from Python: render_pre does it
+out["form_osl_scene"] = tree.get("omninoise_wave_implementation")
+out["scripts_osl_scene"] = sum(n.bl_idname == "ShaderNodeScript" for n in tree.nodes)
+scene.cycles.shading_system = False
+bpy.ops.render.render()
+out["form_svm_scene"] = tree.get("omninoise_wave_implementation")
+out["groups_svm_scene"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
 out["cache_dir"] = importlib.import_module(MOD + ".blender_addon.preferences").cache_dir()
 # a volume bake through the installed package (its relative backend/export imports, bundled openvdb)
 vdb = importlib.import_module(MOD + ".export.vdb")
