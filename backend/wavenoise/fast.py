@@ -151,69 +151,79 @@ def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
 # Grid rows: the same sum, walked along x.
 #
 # On a regular grid every row is a line x_j = x0 + j h.  Along it the slice
-# coordinate p = x . s_k + o_k and every wave coordinate are affine in x, so a
-# row splits, per stratum, into runs of one slice n; inside a run the slice
-# records are constant and the border weight depends on f = p - n alone.  Each
-# run splits again where u = (f - slpos) / 0.6 + 1/2 leaves [0, 1]: there one
-# weight is exactly 1 and the other 0, so a single table lookup suffices.  The
-# inner loops are branch-free and vectorise (AVX2/AVX-512 gathers).  Run
-# boundaries come from the affine form; a sample put in the neighbouring run by
-# rounding gets the same value to 1e-7, because u saturates at both ends of a
-# slice (slpos in [0.3, 0.7], ramp half-width 0.3).
+# coordinate p = x . s_k + o_k and every wave coordinate are affine in x.  Slice
+# n's border ramp towards n + 1, where u = (f - slpos) / 0.6 + 1/2 lies in
+# [0, 1], sits inside slice n (slpos in [0.3, 0.7], half-width 0.3); between two
+# ramps one slice is alone with weight exactly 1, so a single table lookup
+# suffices there.  Per stratum a row is therefore a sequence of segments in
+# slice order, pure(n), blend(n, n+1), pure(n+1), ..., whose ends come from the
+# affine form, and each slice's affine texel coordinate is computed once.  A
+# sample a rounding away from a segment end gets the same value to 1e-7 either
+# way, because the ramp saturates there.  The inner loops are branch-free and
+# the index loops vectorise.
 # ---------------------------------------------------------------------------
 
 if numba is not None:
 
-    # Each run is done in two loops over array views (a loop over range(a, b)
-    # with a non-zero start does not vectorise in numba): the first, branch-free
-    # and vectorised, turns positions into texel indices, fractions and weights;
-    # the second gathers table texels, which has to stay scalar.
+    # Each segment (samples o .. o+m-1 of the row) is done in loops indexed from 0: j into
+    # the scratch arrays, o + j into the row.  Indices are unsigned, so numba emits no
+    # negative-index wrap-around and the first loop, branch-free, vectorises (array views
+    # would cost reference counting per segment).  It turns positions into texel indices,
+    # fractions and weights; the second gathers table texels, which has to stay scalar.
 
     @numba.njit(cache=True, fastmath=False, inline="always")
-    def _texels(xs, a, b, fN, inv_N, I, T):
+    def _texels(xs, o, m, a, b, fN, inv_N, I, T):
         # texel coordinate tau = x a + b -> wrapped texel index I (padded table) and fraction T
-        for j in range(xs.shape[0]):
-            tau = xs[j] * a + b
+        for j in range(np.uint64(m)):
+            tau = xs[o + j] * a + b
             j0 = np.floor(tau)
             I[j] = np.int32(j0 - fN * np.floor(j0 * inv_N)) + np.int32(1)  # j0 mod N, exact below 2^24
             T[j] = tau - j0
 
     @numba.njit(cache=True, fastmath=False, inline="always")
-    def _gather(I, T, W, tab, out):
-        # out += W * lerp(tab[I], tab[I + 1], T)
+    def _gather(I, T, W, tab, out, o, m):
+        # out[o + j] += W[j] * lerp(tab[I], tab[I + 1], T)
         one = np.uint32(1)
-        for j in range(I.shape[0]):
+        for j in range(np.uint64(m)):
             i = np.uint32(I[j])
             v = tab[i]
-            out[j] += W[j] * (v + (tab[i + one] - v) * T[j])
+            out[o + j] += W[j] * (v + (tab[i + one] - v) * T[j])
 
     @numba.njit(cache=True, fastmath=False, inline="always")
-    def _pure(xs, a, b, amp, tre, tim, fN, inv_N, ore, oim, want_imag, I, T, W):
+    def _gather_amp(I, T, amp, tab, out, o, m):
+        # out[o + j] += amp * lerp(tab[I], tab[I + 1], T)
+        one = np.uint32(1)
+        for j in range(np.uint64(m)):
+            i = np.uint32(I[j])
+            v = tab[i]
+            out[o + j] += amp * (v + (tab[i + one] - v) * T[j])
+
+    @numba.njit(cache=True, fastmath=False, inline="always")
+    def _pure(xs, o, m, a, b, amp, tre, tim, fN, inv_N, ore, oim, want_imag, I, T):
         # one slice alone (its weight is exactly 1): amp * T(x a + b)
-        _texels(xs, a, b, fN, inv_N, I, T)
-        W[:] = amp
-        _gather(I, T, W, tre, ore)
+        _texels(xs, o, m, a, b, fN, inv_N, I, T)
+        _gather_amp(I, T, amp, tre, ore, o, m)
         if want_imag:
-            _gather(I, T, W, tim, oim)
+            _gather_amp(I, T, amp, tim, oim, o, m)
 
     @numba.njit(cache=True, fastmath=False, inline="always")
-    def _blend(xs, sx, q, fn, sp, a0, b0, a1, b1, amp, tre, tim, fN, inv_N, ore, oim, want_imag,
+    def _blend(xs, o, m, sx, q, fn, sp, a0, b0, a1, b1, amp, tre, tim, fN, inv_N, ore, oim, want_imag,
                I0, I1, T0, T1, W0, W1):
         # border ramp: amp * (cos(pi/2 s) T(x a0 + b0) + sin(pi/2 s) T(x a1 + b1))
         c = np.float32(0.5 / 0.3)
-        for j in range(xs.shape[0]):
-            u = ((xs[j] * sx + q) - fn - sp) * c + np.float32(0.5)
+        for j in range(np.uint64(m)):
+            u = ((xs[o + j] * sx + q) - fn - sp) * c + np.float32(0.5)
             u = min(max(u, np.float32(0.0)), np.float32(1.0))
             s = u * u * (np.float32(3.0) - np.float32(2.0) * u)
             W0[j] = amp * _cos_half_pi(s)
             W1[j] = amp * _cos_half_pi(np.float32(1.0) - s)
-        _texels(xs, a0, b0, fN, inv_N, I0, T0)
-        _texels(xs, a1, b1, fN, inv_N, I1, T1)
-        _gather(I0, T0, W0, tre, ore)
-        _gather(I1, T1, W1, tre, ore)
+        _texels(xs, o, m, a0, b0, fN, inv_N, I0, T0)
+        _texels(xs, o, m, a1, b1, fN, inv_N, I1, T1)
+        _gather(I0, T0, W0, tre, ore, o, m)
+        _gather(I1, T1, W1, tre, ore, o, m)
         if want_imag:
-            _gather(I0, T0, W0, tim, oim)
-            _gather(I1, T1, W1, tim, oim)
+            _gather(I0, T0, W0, tim, oim, o, m)
+            _gather(I1, T1, W1, tim, oim, o, m)
 
     @numba.njit(cache=True, fastmath=False, inline="always")
     def _row_affine(p, shift, inv_period, zeta, fN):
@@ -253,61 +263,81 @@ if numba is not None:
                     for d in range(1, D):
                         q += others[r, d - 1] * sdirs[k, d]
                     q = q + soffs[k]
-                    hs = h * np.float64(sx)
-                    amp = amps[k]
-                    ja = 0
-                    while ja < Nx:
-                        n = np.floor(xs[ja] * sx + q)
-                        # end of the run of slice n: estimate, then settle on the exact floor
-                        if hs > 0.0:
-                            jb = np.int64(np.ceil((np.float64(n) + 1.0 - q - np.float64(x0) * sx) / hs))
-                        elif hs < 0.0:
-                            jb = np.int64(np.ceil((np.float64(n) - q - np.float64(x0) * sx) / hs))
-                        else:
-                            jb = Nx
-                        jb = min(max(jb, ja + 1), Nx)
-                        while jb > ja + 1 and np.floor(xs[jb - 1] * sx + q) != n:
-                            jb -= 1
-                        while jb < Nx and np.floor(xs[jb] * sx + q) == n:
-                            jb += 1
-                        ri = np.int64(n - nmin[k])
-                        sp = slpos[k, ri]
-                        # wave coordinate of slices n, n+1 along the row: x * a + b
-                        a0 = omega[k, ri, 0] * (inv_period * fN)
-                        a1 = omega[k, ri + 1, 0] * (inv_period * fN)
-                        p0 = np.float32(0.0)
-                        p1 = np.float32(0.0)
-                        for d in range(1, D):
-                            p0 += others[r, d - 1] * omega[k, ri, d]
-                            p1 += others[r, d - 1] * omega[k, ri + 1, d]
-                        b0 = _row_affine(p0, shift, inv_period, zeta[k, ri], fN)
-                        b1 = _row_affine(p1, shift, inv_period, zeta[k, ri + 1], fN)
-                        # split where the border ramp starts and ends (f = sp -+ 0.3)
-                        if hs != 0.0:
-                            base = np.float64(n) - q - np.float64(x0) * sx
-                            ea = np.ceil((base + sp - 0.3) / hs)
-                            eb = np.ceil((base + sp + 0.3) / hs)
-                            if hs < 0.0:
-                                ea, eb = eb, ea
-                            ja_b = min(max(np.int64(ea), ja), jb)
-                            jb_b = min(max(np.int64(eb), ja_b), jb)
-                        else:
-                            ja_b, jb_b = ja, jb
-                        if hs > 0.0:
-                            lo_ab, hi_ab = (a0, b0), (a1, b1)
-                        else:
-                            lo_ab, hi_ab = (a1, b1), (a0, b0)
-                        for (u0, u1, ab) in ((ja, ja_b, lo_ab), (jb_b, jb, hi_ab)):
-                            if u1 > u0:
-                                m = u1 - u0
-                                _pure(xs[u0:u1], ab[0], ab[1], amp, tre, tim, fN, inv_N, ore[u0:u1],
-                                      oim[u0:u1] if want_imag else oim, want_imag, I0[:m], T0[:m], W0[:m])
-                        if jb_b > ja_b:
-                            m = jb_b - ja_b
-                            _blend(xs[ja_b:jb_b], sx, q, n, sp, a0, b0, a1, b1, amp, tre, tim, fN, inv_N,
-                                   ore[ja_b:jb_b], oim[ja_b:jb_b] if want_imag else oim, want_imag,
-                                   I0[:m], I1[:m], T0[:m], T1[:m], W0[:m], W1[:m])
-                        ja = jb
+                    _stratum_row(xs, x0, h, sx, q, k, r, others, amps[k], nmin, slpos, omega, zeta, tre, tim,
+                                 inv_period, shift, fN, inv_N, ore, oim, want_imag, I0, I1, T0, T1, W0, W1)
+
+    @numba.njit(cache=True, fastmath=False, inline="always")
+    def _slice_affine(k, r, ri, others, omega, zeta, shift, inv_period, fN):
+        # texel coordinate of slice record ri along the row: x * a + b
+        D = omega.shape[2]
+        p = np.float32(0.0)
+        for d in range(1, D):
+            p += others[r, d - 1] * omega[k, ri, d]
+        return omega[k, ri, 0] * (inv_period * fN), _row_affine(p, shift, inv_period, zeta[k, ri], fN)
+
+    @numba.njit(cache=True, fastmath=False, inline="always")
+    def _stratum_row(xs, x0, h, sx, q, k, r, others, amp, nmin, slpos, omega, zeta, tre, tim, inv_period, shift,
+                     fN, inv_N, ore, oim, want_imag, I0, I1, T0, T1, W0, W1):
+        """Stratum k's waves along one row, in segments ordered by slice.
+
+        Along the row p = x s_x + q is affine.  Slice m's border ramp towards m + 1 covers
+        p in [m + slpos_m - 0.3, m + slpos_m + 0.3], inside slice m; between two ramps
+        one slice is alone (weight exactly 1).  So the row is: pure(m), blend(m, m+1),
+        pure(m+1), blend(m+1, m+2), ... and every slice's affine texel coordinate
+        is computed once.  A sample a rounding away from a segment end gets the same
+        value to 1e-7 either way, because the ramp saturates there.
+        """
+        Nx = xs.shape[0]
+        hs = h * np.float64(sx)
+        if hs == 0.0 or Nx == 1:  # one slice coordinate for the whole row: the general ramp
+            n = np.floor(xs[0] * sx + q)
+            ri = np.int64(n - nmin[k])
+            a0, b0 = _slice_affine(k, r, ri, others, omega, zeta, shift, inv_period, fN)
+            a1, b1 = _slice_affine(k, r, ri + 1, others, omega, zeta, shift, inv_period, fN)
+            _blend(xs, np.uint64(0), Nx, sx, q, n, slpos[k, ri], a0, b0, a1, b1, amp, tre, tim, fN, inv_N, ore, oim,
+                   want_imag, I0, I1, T0, T1, W0, W1)
+            return
+        P0 = np.float64(x0) * np.float64(sx) + np.float64(q)
+        inv_hs = 1.0 / hs
+        pa = xs[0] * sx + q
+        pb = xs[Nx - 1] * sx + q
+        nlo = np.floor(min(pa, pb))
+        nhi = np.floor(max(pa, pb))
+        lo_ri = np.int64(nlo - nmin[k]) - 1  # record of slice nlo - 1 (records start one slice early)
+        hi_ri = np.int64(nhi - nmin[k])
+        up = hs > 0.0
+        cur = 0
+        # slices in the order the row meets them; (a, b) of the slice met last is carried over
+        m_ri = lo_ri if up else hi_ri + 1
+        am, bm = _slice_affine(k, r, m_ri, others, omega, zeta, shift, inv_period, fN)
+        count = hi_ri - lo_ri + 1
+        for step in range(count):
+            ri = lo_ri + step if up else hi_ri - step  # the ramp between records ri and ri + 1
+            n = nmin[k] + np.float32(ri)
+            sp = slpos[k, ri]
+            e_lo = np.float64(n) + np.float64(sp) - 0.3
+            e_hi = np.float64(n) + np.float64(sp) + 0.3
+            j_lo = min(max(np.int64(np.ceil((e_lo - P0) * inv_hs)), 0), Nx)
+            j_hi = min(max(np.int64(np.ceil((e_hi - P0) * inv_hs)), 0), Nx)
+            j_in, j_out = (j_lo, j_hi) if up else (j_hi, j_lo)
+            if up:
+                a_lo, b_lo = am, bm  # record ri, met before the ramp
+                a_hi, b_hi = _slice_affine(k, r, ri + 1, others, omega, zeta, shift, inv_period, fN)
+                an, bn = a_hi, b_hi
+            else:
+                a_hi, b_hi = am, bm  # record ri + 1, met before the ramp
+                a_lo, b_lo = _slice_affine(k, r, ri, others, omega, zeta, shift, inv_period, fN)
+                an, bn = a_lo, b_lo
+            if j_in > cur:  # the slice met before this ramp, alone
+                _pure(xs, np.uint64(cur), j_in - cur, am, bm, amp, tre, tim, fN, inv_N, ore, oim, want_imag, I0, T0)
+                cur = j_in
+            if j_out > cur:
+                _blend(xs, np.uint64(cur), j_out - cur, sx, q, n, sp, a_lo, b_lo, a_hi, b_hi, amp, tre, tim, fN,
+                       inv_N, ore, oim, want_imag, I0, I1, T0, T1, W0, W1)
+                cur = j_out
+            am, bm = an, bn
+        if cur < Nx:  # the last slice, alone to the row's end
+            _pure(xs, np.uint64(cur), Nx - cur, am, bm, amp, tre, tim, fN, inv_N, ore, oim, want_imag, I0, T0)
 
 
 class GridPlan:
