@@ -201,6 +201,10 @@ def main():
         for k, v in sorted(ns.items(), key=lambda kv: kv[1]):
             ratio = v / peer_ns[fastest] if fastest else float("nan")
             print(f"  {k:34s} {v:10.1f}  {ratio:6.2f}x")
+        for kind in ("blend", "pure"):
+            fl = ns.get(f"wave 16 floor, {kind} (AVX2 C)")
+            if fl:
+                print(f"  wave 16 dirs / floor ({kind}): {ns['wave 16 dirs'] / fl:.2f}x")
         results[f"{dim}D_{n}"] = ns
     if not a.quick:
         m = peak_memory_512()

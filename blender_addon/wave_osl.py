@@ -23,21 +23,17 @@ Blender-free, :func:`script_node` compiles it into a Script node.
 """
 from __future__ import annotations
 
-import glob
 import hashlib
 import os
-import sys
 
 import numpy as np
 
 from ._deps import backend
 from .wave_constants import stratum_constants
 
-__all__ = ["osl_source", "script_node", "osl_available", "SCRIPT_INPUTS"]
+__all__ = ["osl_source", "script_node", "osl_available"]
 
 _F = np.float32
-#: Script node inputs (the group feeds Position = Vector x Scale and W x Scale)
-SCRIPT_INPUTS = ("Position", "W", "Time")
 
 
 def _f(v) -> str:
@@ -190,31 +186,45 @@ def _direction_source(dim: int, full: bool, mirrored: bool) -> str:
 
 # -- Blender side ------------------------------------------------------------------
 
-def _oslquery_importable() -> bool:
-    """Cycles' script compiler imports ``oslquery``; Blender's own Python finds it, the bpy module's
-    bundled site-packages are not on sys.path by default."""
-    try:
-        import oslquery  # noqa: F401
-        return True
-    except ImportError:
-        pass
+#: the script's parameters as Script-node sockets: (name, socket type), inputs then outputs
+_SOCKETS_IN = (("Position", "NodeSocketVector"), ("W", "NodeSocketFloat"), ("Time", "NodeSocketFloat"))
+_SOCKETS_OUT = tuple((o, "NodeSocketFloat") for o in ("Value", "Imaginary", "Modulus", "Phase"))
+
+
+def _compiler():
+    """Cycles' OSL compiler (``_cycles.osl_compile(source_path, oso_path) -> bool``), or None."""
     import bpy
 
-    sys.path.extend(p for p in glob.glob(os.path.join(bpy.utils.resource_path("LOCAL"),
-                                                      "python", "lib", "python3*", "site-packages"))
-                    if p not in sys.path)
+    if not getattr(bpy.app.build_options, "cycles_osl", False):
+        return None
     try:
-        import oslquery  # noqa: F401,F811
-        return True
+        import _cycles
     except ImportError:
-        return False
+        return None
+    return getattr(_cycles, "osl_compile", None)
 
 
 def osl_available() -> bool:
     """True when this Blender can compile OSL scripts (Cycles built with OSL)."""
-    import bpy
+    return _compiler() is not None
 
-    return bool(getattr(bpy.app.build_options, "cycles_osl", False)) and _oslquery_importable()
+
+def _bytecode(code: str) -> str:
+    """Compile OSL source text with Cycles' compiler -> .oso bytecode text; SettingError when it fails."""
+    import tempfile
+
+    compile_osl = _compiler()
+    if compile_osl is None:
+        raise backend.SettingError("implementation", "this Blender cannot compile OSL scripts; use the node form")
+    with tempfile.TemporaryDirectory(prefix="omninoise_osl_") as d:
+        src, oso = os.path.join(d, "wave.osl"), os.path.join(d, "wave.oso")
+        with open(src, "w", encoding="utf-8") as fh:
+            fh.write(code)
+        if not compile_osl(src, oso) or not os.path.isfile(oso):
+            raise backend.SettingError("implementation", "the OSL script did not compile (Cycles' OSL compiler "
+                                       "refused it; the console has its message)")
+        with open(oso, encoding="utf-8") as fh:
+            return fh.read()
 
 
 def script_node(tree, noise, name: str):
@@ -222,13 +232,14 @@ def script_node(tree, noise, name: str):
 
     The script is an internal text datablock named by a hash of its source (shared between
     equal noises); its bytecode is stored in the node, so a saved .blend renders without
-    the extension.  Raises backend.SettingError if OSL is unavailable or compilation fails.
+    the extension.  The sockets are the script's known parameters, so Blender's OSL query
+    module (absent from some ``bpy`` builds) is not needed.  Raises backend.SettingError
+    if OSL is unavailable or compilation fails.
     """
     import bpy
 
-    if not osl_available():
-        raise backend.SettingError("implementation", "this Blender cannot compile OSL scripts; use the node form")
     code = osl_source(noise)
+    bytecode = _bytecode(code)
     digest = hashlib.sha256(code.encode()).hexdigest()[:12]
     text_name = f".OmniNoise wave {digest}.osl"
     text = bpy.data.texts.get(text_name)
@@ -239,12 +250,10 @@ def script_node(tree, noise, name: str):
     node.name = node.label = name
     node.mode = "INTERNAL"
     node.script = text
-    if not node.bytecode or any(s not in node.inputs for s in SCRIPT_INPUTS):
-        import cycles.osl
-
-        errors = []
-        cycles.osl.update_script_node(node, lambda kind, msg: errors.append(msg) if "ERROR" in kind else None)
-        if errors or not node.bytecode:
-            raise backend.SettingError("implementation", "the OSL script did not compile: "
-                                       + ("; ".join(errors) or "no bytecode"))
+    for sockets, specs in ((node.inputs, _SOCKETS_IN), (node.outputs, _SOCKETS_OUT)):
+        for nm, kind in specs:
+            if nm not in sockets:
+                sockets.new(type=kind, name=nm, identifier=nm)
+    node.bytecode = bytecode
+    node.bytecode_hash = hashlib.md5(bytecode.encode(), usedforsecurity=False).hexdigest()
     return node

@@ -13,7 +13,7 @@ from backend.errors import SettingError  # noqa: E402
 from backend.wavenoise.wave import select_output  # noqa: E402
 from blender_addon.wave_nodes import IMPLEMENTATION_KEY, build_wave_group, tree_implementation  # noqa: E402
 from blender_addon.wave_osl import osl_available, osl_source  # noqa: E402
-from tests.blender.test_wave_node import CASES, _bake, _engine, _plane_material  # noqa: E402
+from test_wave_node import CASES, _bake, _engine, _plane_material  # noqa: E402
 
 pytestmark = pytest.mark.skipif(not osl_available(), reason="this bpy has no OSL")
 

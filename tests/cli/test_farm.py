@@ -15,7 +15,7 @@ from cli.main import main  # noqa: E402
 from backend.jobs import run_job  # noqa: E402
 from export import read_volume  # noqa: E402
 from export.images import decode  # noqa: E402
-from tests.conftest import needs_openvdb  # noqa: E402
+from conftest import needs_openvdb  # noqa: E402
 
 JOB = """
 [[bake]]

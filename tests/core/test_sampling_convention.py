@@ -13,7 +13,7 @@ from cli.main import build_parser, main, settings_from_args
 from backend.grid import evaluate_grid
 from export import read_volume
 from export.images import read_image
-from tests.conftest import needs_openvdb
+from conftest import needs_openvdb
 
 ARGS = ["wave", "--directions", "8", "--fmin", "2", "--fmax", "6", "--seed", "4", "--extent", "2", "--quiet"]
 
