@@ -32,6 +32,7 @@ class TrainConfig:
     cutmix_p: float = 0.5
     offset_noise: float = 0.1
     emb_lambda: float = 0.02
+    min_snr_gamma: float = 0.0     # min-SNR-γ loss weighting (Hang et al. 2023), 5 in the paper; 0: plain MSE
     emb_dim: int = 32
     widths: tuple = (32, 64, 128)
     classes: tuple = field(default_factory=lambda: zoo.CLASS_NAMES)

@@ -9,6 +9,12 @@ spherical regulariser of the class embeddings (Sec. 3.1.1):
 noise), λ = 0.02, and r = √E the norm a standard normal E-vector has on
 average (E‖z‖² = E), so slerp between embeddings stays on the shell that the
 network saw.
+
+Min-SNR-γ weighting (Hang et al. 2023, "Efficient Diffusion Training via Min-SNR
+Weighting Strategy", Eq. 8 for ε-prediction): with SNR(t) = ᾱ_t / (1 - ᾱ_t), each
+sample's squared error is weighted by min(SNR(t), γ) / SNR(t), which caps the
+weight of the low-noise steps whose gradients conflict with the rest.  γ = 0
+turns it off (plain MSE, the paper's loss).
 """
 from __future__ import annotations
 
@@ -22,8 +28,12 @@ __all__ = ["Diffusion"]
 
 
 class Diffusion:
-    def __init__(self, T: int = T_DEFAULT, offset_noise: float = 0.1, emb_lambda: float = 0.02, device=None):
+    def __init__(self, T: int = T_DEFAULT, offset_noise: float = 0.1, emb_lambda: float = 0.02, device=None,
+                 min_snr_gamma: float = 0.0):
+        if min_snr_gamma < 0:
+            raise ValueError(f"min_snr_gamma must be >= 0 (0: off), got {min_snr_gamma}")
         self.T = T
+        self.min_snr_gamma = float(min_snr_gamma)
         self.offset = offset_noise
         self.emb_lambda = emb_lambda
         self.ab = torch.as_tensor(cosine_alphas_cumprod(T), dtype=torch.float32, device=device)
@@ -37,15 +47,28 @@ class Diffusion:
         a = self.ab.to(x0.device)[t].view(-1, 1, 1, 1)
         return a.sqrt() * x0 + (1.0 - a).sqrt() * eps
 
+    def snr_weight(self, t: torch.Tensor) -> torch.Tensor:
+        """Per-sample loss weight min(SNR(t), γ) / SNR(t) (Hang et al. 2023, Eq. 8); ones when γ = 0."""
+        if self.min_snr_gamma <= 0:
+            return torch.ones(t.shape, dtype=torch.float32, device=t.device)
+        a = self.ab.to(t.device)[t]
+        snr = a / (1.0 - a).clamp_min(1e-12)
+        return torch.clamp(snr, max=self.min_snr_gamma) / snr.clamp_min(1e-12)
+
     def embedding_penalty(self, emb: torch.Tensor) -> torch.Tensor:
         target = math.sqrt(emb.shape[1])
         return self.emb_lambda * ((emb.norm(dim=1) - target) ** 2).mean()
 
     def loss(self, model, x0: torch.Tensor, cond: torch.Tensor, generator=None) -> tuple:
-        """x0 float32 (B, 1, H, W) in [-1, 1], cond (B, E + P, H, W) -> (total, mse) scalars."""
+        """x0 float32 (B, 1, H, W) in [-1, 1], cond (B, E + P, H, W) -> (total, mse) scalars.
+
+        ``mse`` is the unweighted ε error (comparable across weightings); ``total`` carries the
+        min-SNR weights when γ > 0 and the embedding regulariser."""
         B = x0.shape[0]
         t = torch.randint(0, self.T, (B,), generator=generator, device=x0.device)
         eps = self.noise_like(x0, generator)
         pred = model(self.q_sample(x0, t, eps), t.to(torch.float32), cond)
-        mse = torch.mean((pred.float() - eps) ** 2)  # fp32 even under bf16 autocast
-        return mse + self.embedding_penalty(model.class_emb.weight), mse
+        per = torch.mean((pred.float() - eps) ** 2, dim=(1, 2, 3))  # fp32 even under bf16 autocast
+        mse = per.mean()
+        weighted = mse if self.min_snr_gamma <= 0 else (self.snr_weight(t) * per).mean()
+        return weighted + self.embedding_penalty(model.class_emb.weight), mse

@@ -118,7 +118,8 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
     for p_ in ema.parameters():
         p_.requires_grad_(False)
     opt = torch.optim.AdamW(model.parameters(), lr=cfg.lr, betas=cfg.betas, weight_decay=cfg.weight_decay)
-    diff = Diffusion(offset_noise=cfg.offset_noise, emb_lambda=cfg.emb_lambda, device=device)
+    diff = Diffusion(offset_noise=cfg.offset_noise, emb_lambda=cfg.emb_lambda, device=device,
+                     min_snr_gamma=cfg.min_snr_gamma)
     rng = np.random.default_rng(cfg.seed)
     gen = torch.Generator(device=device).manual_seed(cfg.seed)
     step = 0

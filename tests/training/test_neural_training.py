@@ -100,6 +100,30 @@ def test_loss_parts():
     assert d.embedding_penalty(e * 2) == pytest.approx(0.02 * 32, rel=1e-4)
 
 
+def test_min_snr_weights():
+    """Hang et al. 2023, Eq. 8 (ε-prediction): w(t) = min(SNR, γ) / SNR; 1 where SNR <= γ; off at γ = 0."""
+    from backend.neural.schedule import cosine_alphas_cumprod
+
+    ab = cosine_alphas_cumprod()
+    snr = ab / (1 - ab)
+    t = torch.tensor([0, 50, 200, 500, 999])
+    w = Diffusion(min_snr_gamma=5.0).snr_weight(t).numpy()
+    np.testing.assert_allclose(w, np.minimum(snr[t.numpy()], 5.0) / snr[t.numpy()], rtol=1e-3)  # float32 1 - ab
+    assert w[0] < 0.01 and w[-1] == pytest.approx(1.0)  # the first steps are damped, the noisy ones are not
+    assert torch.equal(Diffusion().snr_weight(t), torch.ones(5))
+    with pytest.raises(ValueError, match="min_snr_gamma"):
+        Diffusion(min_snr_gamma=-1.0)
+    # the reported mse stays the unweighted one, the total carries the weights
+    m = UNet(3, 2, emb_dim=4, widths=(8, 8, 8))
+    x0 = torch.zeros(4, 1, 16, 16)
+    cond = m.embed(torch.zeros(4, 16, 16, dtype=torch.long), torch.zeros(4, 2, 16, 16))
+    plain = Diffusion(emb_lambda=0.0).loss(m, x0, cond, torch.Generator().manual_seed(3))
+    snrw = Diffusion(emb_lambda=0.0, min_snr_gamma=5.0).loss(m, x0, cond, torch.Generator().manual_seed(3))
+    assert float(plain[1]) == pytest.approx(float(snrw[1]))
+    assert float(plain[0]) == pytest.approx(float(plain[1]))
+    assert float(snrw[0]) < float(snrw[1])
+
+
 def test_cutmix_pastes_other_classes_with_their_conditions():
     B, H = 6, 32
     imgs = torch.arange(B, dtype=torch.float32).view(B, 1, 1, 1).expand(B, 1, H, H).clone()
