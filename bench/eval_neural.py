@@ -34,6 +34,8 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=30, help="sampler steps")
     ap.add_argument("--sampler", default="ddim", help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py)")
     ap.add_argument("--spacing", help="timestep spacing: uniform, logsnr or karras (default: the sampler's own)")
+    ap.add_argument("--precision", default="fp32", help="the denoiser's arithmetic: fp32, int8 or auto "
+                                                         "(int8 needs the folder's int8 files, training/quantize_onnx.py)")
     ap.add_argument("--clf-steps", type=int, default=600)
     ap.add_argument("--classifier-cache", metavar="DIR",
                     help="keep the trained classifier here and reuse it (same classes, size, steps, threads)")
@@ -49,7 +51,7 @@ def main() -> int:
     ap.add_argument("--no-timing", action="store_true", help="skip the DDIM step timing (a busy machine)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
     a = ap.parse_args()
-    model = NeuralNoiseModel(a.model, threads=a.threads)
+    model = NeuralNoiseModel(a.model, threads=a.threads, precision=a.precision)
     classes = tuple(model.config["trained_classes"])
     if a.classes:
         classes = tuple(c.strip() for c in a.classes.split(","))
@@ -84,7 +86,7 @@ def _run(a, model, classes) -> int:
 
         res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing or DEFAULT_SPACING[a.sampler])
     res["model"] = dict(step=model.config["step"], sha256=model.fingerprint, n=a.n, steps=a.steps,
-                        classes=list(classes))
+                        classes=list(classes), precision=model.precision)
     print("| class | FD | acc | PSD err | low-frequency PSD err | coherence err (zoo) | response err (param) |")
     print("|---|---|---|---|---|---|---|")
     for name, r in res["classes"].items():

@@ -10,6 +10,7 @@ operators run to completion before returning.
 """
 from __future__ import annotations
 
+import importlib
 import os
 
 import bpy
@@ -21,7 +22,7 @@ from .tasks import TaskOperator
 from ._deps import backend
 from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
                            transfer_from_color_ramp, world_bounds)
-from .preferences import threads
+from .preferences import precision, threads
 from .wave_nodes import settings_from_json, tree_settings_json
 from .wave_ui import OMNINOISE_PG_wave, draw_wave_settings
 
@@ -179,7 +180,10 @@ class _BakeOperator(TaskOperator):
                 and obj.active_material.node_tree is not None:
             mat = obj.active_material
 
+        prec = precision()  # read on the main thread
+
         def work(progress, cancel):
+            importlib.import_module(f"{backend.__name__}.neural.precision").set_default_precision(prec)
             return backend.bake.run_bake(spec, progress, cancel)
 
         def done(result):
@@ -248,7 +252,10 @@ class OMNINOISE_OT_run_job(TaskOperator, bpy.types.Operator):
             return None
         keep_going, force = self.keep_going or p.keep_going, self.force or p.force
 
+        prec = precision()  # read on the main thread
+
         def work(progress, cancel):
+            importlib.import_module(f"{backend.__name__}.neural.precision").set_default_precision(prec)
             return backend.jobs.run_job(path, keep_going=keep_going, force=force, progress=progress, cancel=cancel)
 
         def done(outcomes):

@@ -24,7 +24,7 @@ from . import tasks
 from ._deps import backend
 from .bake_ui import draw_progress
 from .tasks import TaskOperator
-from .preferences import threads
+from .preferences import precision, threads
 
 __all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
 
@@ -47,11 +47,12 @@ SAMPLER_ITEMS = [("dpmpp_2m", "DPM-Solver++(2M)", "Second-order multistep: the f
 
 def model():
     """The shipped model, loaded on first use (never at register time), with onnxruntime on the
-    preferences' CPU threads (a changed preference loads sessions with the new count)."""
-    n = threads()
-    if _MODEL.get("threads") != n:
+    preferences' CPU threads and precision (a changed preference loads the model again)."""
+    key = (threads(), precision())
+    if _MODEL.get("key") != key:
         _MODEL.clear()
-        _MODEL.update(threads=n, m=_mod("neural.model").NeuralNoiseModel(_model_folder(), threads=n))
+        _MODEL.update(key=key, m=_mod("neural.model").NeuralNoiseModel(_model_folder(), threads=key[0],
+                                                                        precision=key[1]))
     return _MODEL["m"]
 
 

@@ -96,8 +96,16 @@ def _maybe_crash(path: str) -> None:
     os._exit(70)
 
 
-def run_file(job: str, bake: str, frame) -> dict:
+def _worker_precision(precision: str) -> None:
+    """The client's --precision on this worker (every worker of a farm runs the neural denoiser alike)."""
+    from backend.neural.precision import set_default_precision
+
+    set_default_precision(precision)
+
+
+def run_file(job: str, bake: str, frame, precision: str = "fp32") -> dict:
     """Worker: bake one file (whatever its state) -> :func:`file_record` of it."""
+    _worker_precision(precision)
     spec = _job_spec(job, bake)
     path = frame_path(spec.output, frame)
     _maybe_crash(path)
@@ -105,8 +113,9 @@ def run_file(job: str, bake: str, frame) -> dict:
     return file_record(bake_frame(spec, frame))
 
 
-def run_brick(job: str, bake: str, frame, z0: int, z1: int) -> dict:
+def run_brick(job: str, bake: str, frame, z0: int, z1: int, precision: str = "fp32") -> dict:
     """Worker: the grids of z = z0 .. z1 - 1 of a volume -> {grid name: float32 slab (z1 - z0, ny, nx[, 3])}."""
+    _worker_precision(precision)
     spec = _job_spec(job, bake)
     _maybe_crash(frame_path(spec.output, frame))
     return volume_channels(spec, evaluate_rows(spec.source, spec.grid, spec.frame_time(frame), z0, z1))
@@ -195,11 +204,12 @@ def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None 
 
 
 def run_farm(job: str, client, force: bool = False, only: list | None = None, brick_voxels: int | None = None,
-             retries: int = 2, progress=None, log=None, status=None) -> list:
+             retries: int = 2, progress=None, log=None, status=None, precision: str = "fp32") -> list:
     """Run a job file's bakes on ``client``'s cluster -> list of :class:`backend.jobs.JobOutcome` (one per bake).
 
     ``progress(fraction)`` (the core's contract) and ``status(done, total, bytes_moved, eta_seconds)`` after
-    every finished task.  Invalid bakes fail the
+    every finished task.  ``precision``: the neural denoiser's on every worker (see backend.neural.precision).
+    Invalid bakes fail the
     job before anything is sent (as one-machine runs do).  A failed task fails its output, named in the
     outcome; every other output is still written.
     """
@@ -218,9 +228,9 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
     futures = {}
     for t in tasks:
         if t.brick is None:
-            fut = client.submit(run_file, job, t.bake, t.frame, retries=retries, pure=False)
+            fut = client.submit(run_file, job, t.bake, t.frame, precision, retries=retries, pure=False)
         else:
-            fut = client.submit(run_brick, job, t.bake, t.frame, t.brick[0], t.brick[1], retries=retries,
+            fut = client.submit(run_brick, job, t.bake, t.frame, t.brick[0], t.brick[1], precision, retries=retries,
                                 pure=False)
         futures[fut] = t
     writers, bricks_done, failed, written = {}, {}, {}, {}

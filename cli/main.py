@@ -101,6 +101,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--keep-going", action="store_true", help="after a failed bake, carry on with the others")
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
     b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (default 0: all cores)")
+    b.add_argument("--precision", default="fp32", choices=("fp32", "int8"),
+                   help="neural noise denoiser arithmetic (default fp32; int8: faster draft on CPUs with VNNI)")
     b.add_argument("--quiet", action="store_true")
     farm = b.add_argument_group("farm (Dask distributed; pip install .[farm])")
     farm.add_argument("--workers", type=int, metavar="N", help="bake on a local cluster of N worker processes")
@@ -125,6 +127,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "
                         "else 512 px tiles; 0: never)")
     n.add_argument("--threads", type=int, default=0, help="CPU threads for onnxruntime (default 0: all cores)")
+    n.add_argument("--precision", default="fp32", choices=("fp32", "int8"),
+                   help="denoiser arithmetic (default fp32; int8: about 1.7x faster steps on CPUs with int8 dot "
+                        "products (VNNI), images slightly further from the reference)")
     n.add_argument("--seed", type=int, default=0)
     n.add_argument("--tileable", action="store_true", help="seamless tile (circular padding); size a multiple of 8")
     n.add_argument("--blend", metavar="MASK", help="grayscale mask image: white areas take --noise2 / --param2")
@@ -336,7 +341,7 @@ def _bake_on_farm(a: argparse.Namespace) -> int:
                 sys.stderr.flush()
 
         outcomes = farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
-                                 retries=a.retries, status=status)
+                                 retries=a.retries, status=status, precision=a.precision)
     finally:
         cluster = getattr(client, "cluster", None)
         client.close()
@@ -353,12 +358,15 @@ def _bake_on_farm(a: argparse.Namespace) -> int:
     return 1 if bad else 0
 
 
-def _set_threads(n: int) -> None:
+def _set_threads(n: int, precision: str = "fp32") -> None:
+    """The CLI's --threads and --precision as the defaults of every model the command loads."""
+    from backend.neural.precision import set_default_precision
     from backend.onnx_models import set_default_threads
 
     if n < 0:
         raise SettingError("--threads", f"must be >= 0 (0: all cores), got {n}")
     set_default_threads(n)
+    set_default_precision(precision)
 
 
 def run_bake_job(a: argparse.Namespace) -> int:
@@ -381,7 +389,7 @@ def run_bake_job(a: argparse.Namespace) -> int:
                   file=sys.stderr)
             return 2
         return 0
-    _set_threads(a.threads)
+    _set_threads(a.threads, a.precision)
     if a.workers is not None or a.cluster:
         return _bake_on_farm(a)
     now = {}      # the bake in progress: one bar per bake
@@ -500,7 +508,7 @@ def run_neural(a: argparse.Namespace) -> int:
     from backend.neural.generate import check_sampler
     from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
 
-    _set_threads(a.threads)
+    _set_threads(a.threads, a.precision)
     sampler = a.sampler or DEFAULT_SAMPLER
     steps = DEFAULT_STEPS if a.steps is None else a.steps
     check_sampler(sampler, steps, a.spacing, a.eta)
@@ -514,6 +522,8 @@ def run_neural(a: argparse.Namespace) -> int:
     try:
         model = NeuralNoiseModel(folder)
     except ModelError as exc:
+        if "int8" in str(exc):
+            raise SettingError("--precision", str(exc)) from None
         raise SettingError("--model", f"{exc}; train and export one (see models/README.md) or pass --model") from None
     if a.list:
         print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))

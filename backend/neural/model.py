@@ -7,15 +7,18 @@ the denoiser runs at every step) or one ``eps.onnx`` (``one-piece``, the form of
 older exports, still loaded).  Loading checks every file's sha256 against the
 JSON before onnxruntime sees it; sessions are created on first use.  The graphs'
 ``tile`` input switches every convolution between zero and circular padding
-(seamless tiles).
+(seamless tiles).  A split export may also hold int8 denoisers (``training/quantize_onnx.py``), run when
+``precision`` is int8 (:mod:`.precision`: a faster draft mode; float32 is the default).
 """
 from __future__ import annotations
 
+import os
 
 import numpy as np
 
 from ..errors import SettingError
 from ..onnx_models import ModelError, SessionCache, fingerprint, load_model_json, sha256_file
+from .precision import resolve as resolve_precision
 from .schedule import alphas_from_config
 
 __all__ = ["NeuralNoiseModel", "ModelError", "sha256_file"]
@@ -36,7 +39,7 @@ class NeuralNoiseModel:
     embedding    float32 (n_classes, E) class embeddings
     """
 
-    def __init__(self, folder: str, threads: int = 0):
+    def __init__(self, folder: str, threads: int = 0, precision: str | None = None):
         self.config = load_model_json(folder, "neural_noise.json")
         self.folder = folder
         self.classes = tuple(self.config["classes"])
@@ -61,9 +64,36 @@ class NeuralNoiseModel:
         except ValueError as exc:
             raise ModelError(f"{folder}: {exc}") from None
         self.threads = threads
+        int8 = self.config.get("int8") or {}
+        #: "fp32" or "int8": the denoiser's arithmetic (None: the default, see .precision)
+        self.precision = resolve_precision(precision)
+        if self.precision == "int8":
+            if self.form != "split":
+                raise ModelError(f"{folder}: int8 needs a split export (this one is {self.form})")
+            self._check_int8(folder, int8)
         # no CPU arena: at 1024² it kept 11.8 GB against 4.4 GB without, with steps no slower (bench_neural.py),
         # and inside Blender the arena would hold that memory after every bake
         self._sessions = SessionCache(folder, threads, arena=False)
+
+    @staticmethod
+    def _check_int8(folder: str, int8: dict) -> None:
+        """ModelError unless the folder's int8 denoisers exist and match their sha256 in the JSON."""
+        if not int8.get("files"):
+            raise ModelError(f"{folder}: no int8 denoisers (make them with python -m training.quantize_onnx {folder})")
+        for name, digest in int8["files"].items():
+            path = os.path.join(folder, name)
+            if not os.path.isfile(path):
+                raise ModelError(f"model file missing: {path}")
+            if sha256_file(path) != digest:
+                raise ModelError(f"{name}: sha256 does not match neural_noise.json (altered or damaged file)")
+
+    def denoiser_name(self, tileable: bool) -> str:
+        """The denoiser file a split export runs: per padding, and int8 when :attr:`precision` says so."""
+        files = self.config["files"]
+        name = "denoiser_tile.onnx" if tileable and "denoiser_tile.onnx" in files else "denoiser.onnx"
+        if self.precision == "int8":
+            name = self.config["int8"].get("of", {}).get(name, name)
+        return name
 
     def session(self, name: str | None = None):
         """The onnxruntime session of ``name`` (default: the ε-network of a one-piece export, the denoiser of a split one)."""
@@ -92,8 +122,7 @@ class NeuralNoiseModel:
 
             return eps
         # one denoiser per padding (no tile input), or an older export's one denoiser with a tile input
-        name = "denoiser_tile.onnx" if tileable and "denoiser_tile.onnx" in self.config["files"] else "denoiser.onnx"
-        sess = self.session(name)
+        sess = self.session(self.denoiser_name(tileable))
         extra = {"tile": tile} if "tile" in {i.name for i in sess.get_inputs()} else {}
         cache = {"cond": None, "maps": None}
 

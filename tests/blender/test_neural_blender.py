@@ -65,6 +65,26 @@ def test_bake_matches_the_runtime(scene, mode):
     np.testing.assert_array_equal(_pixels(p.name), got)  # same seed and settings: same image
 
 
+def test_int8_preference_bakes_with_the_int8_denoiser(scene, monkeypatch):
+    """The Neural Precision preference reloads the model with the shipped int8 denoisers; the bake equals the
+    runtime's int8 image and stays near the float32 one."""
+    from backend.neural.generate import generate
+
+    p = scene.omninoise_neural
+    assert neural_ui.model().precision == "fp32"  # the default
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
+    fp32 = _pixels(p.name)
+    monkeypatch.setattr(neural_ui, "precision", lambda: "int8")
+    m = neural_ui.model()
+    assert m.precision == "int8" and m.denoiser_name(False) == "denoiser_int8.onnx"
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
+    got = _pixels(p.name)
+    np.testing.assert_allclose(got, generate(m, neural_ui.build_conditioning(p, 32), seed=5, steps=3), atol=1e-6)
+    assert 0 < float(np.abs(got - fp32).mean()) < 0.05
+    monkeypatch.undo()
+    assert neural_ui.model().precision == "fp32"
+
+
 def test_painted_regions_carry_their_swatch(scene):
     """Left half spots, right half damascus: each side's conditioning is its swatch's."""
     p = scene.omninoise_neural

@@ -1,0 +1,56 @@
+"""Which arithmetic the neural noise denoiser runs in: float32 (the default), or the int8 export.
+
+The int8 denoisers (``training/quantize_onnx.py``) are a faster draft mode, not a free gain: on a CPU with
+int8 dot products (x86 VNNI) a 256² step took 0.217 s against 0.361 s in float32 (1.66x,
+``bench/neural_int8.py``), and without them int8 gains little (1.19x measured on an AVX2 CPU); but on the
+project's evaluation the images are measurably further from the zoo (median per-class FD 93 -> 98, 20 of 23
+classes higher; the model card has the table).  So float32 stays the default and int8 is opt-in.
+"""
+from __future__ import annotations
+
+import functools
+import platform
+
+from ..errors import SettingError
+
+__all__ = ["PRECISIONS", "int8_dot_products", "resolve", "set_default_precision", "default_precision"]
+
+PRECISIONS = ("fp32", "int8")
+_DEFAULT = {"precision": "fp32"}
+
+
+def _check(precision) -> str:
+    if precision not in PRECISIONS:
+        raise SettingError("precision", f"unknown precision {precision!r}; choose one of {', '.join(PRECISIONS)}")
+    return precision
+
+
+def set_default_precision(precision: str) -> None:
+    """The precision of models created without their own (the CLI's ``--precision``, the add-on's preference)."""
+    _DEFAULT["precision"] = _check(precision)
+
+
+def default_precision() -> str:
+    return _DEFAULT["precision"]
+
+
+@functools.lru_cache(maxsize=1)
+def int8_dot_products() -> bool:
+    """True on an x86 CPU whose flags (Linux /proc/cpuinfo) list AVX512-VNNI or AVX-VNNI, where int8 pays;
+    False where unknown.  Informational: benches and help texts say whether int8 is worth it here."""
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        return False
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("flags"):
+                    flags = set(line.split(":", 1)[1].split())
+                    return bool(flags & {"avx512_vnni", "avx_vnni"})
+    except OSError:
+        pass
+    return False
+
+
+def resolve(precision: str | None) -> str:
+    """"fp32" | "int8" | None (the default) -> the one used; SettingError for an unknown name."""
+    return _check(_DEFAULT["precision"] if precision is None else precision)
