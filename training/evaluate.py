@@ -142,6 +142,48 @@ def orientation_coherence(imgs: np.ndarray) -> np.ndarray:
     return np.where(tr > 1e-12, np.sqrt((jxx - jyy) ** 2 + 4 * jxy ** 2) / np.maximum(tr, 1e-12), 0.0)
 
 
+#: log-spaced radial frequency bins and value quantiles of :func:`look`
+LOOK_BINS, LOOK_QUANTILES = 24, 32
+
+
+def look(imgs: np.ndarray) -> dict:
+    """What a set of images (n, S, S) in [0, 1] looks like, for :func:`look_distance`: the shape of its
+    radially averaged power spectrum (log10 of the power in LOOK_BINS log-spaced bands from 1 to S/2 cycles
+    per image, normalised to total power 1, so contrast is left to the histogram) and its value histogram
+    (LOOK_QUANTILES quantiles of all pixels)."""
+    x = np.asarray(imgs, np.float64)
+    p = radial_psd(x)
+    k = np.arange(1, len(p) + 1)
+    edges = np.geomspace(1, len(p) + 1, LOOK_BINS + 1)
+    band = np.array([p[(k >= lo) & (k < hi)].sum() for lo, hi in zip(edges[:-1], edges[1:])])
+    spec = np.log10(band / max(band.sum(), 1e-20) + 1e-12)
+    q = np.quantile(x, (np.arange(LOOK_QUANTILES) + 0.5) / LOOK_QUANTILES)
+    return dict(spectrum=spec, histogram=q)
+
+
+def look_distance(a: dict, b: dict, scale=(1.0, 1.0)) -> float:
+    """Mean |Δ| of two :func:`look` spectra over ``scale[0]`` plus mean |Δ| of their quantiles over ``scale[1]``
+    (the scales put both terms in units of a typical distance between two zoo classes)."""
+    return float(np.abs(a["spectrum"] - b["spectrum"]).mean() / scale[0]
+                 + np.abs(a["histogram"] - b["histogram"]).mean() / scale[1])
+
+
+def look_scales(refs: dict) -> tuple:
+    """Median spectrum and histogram distances over all pairs of reference looks {class: look}."""
+    names = sorted(refs)
+    ds, dh = [], []
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            ds.append(np.abs(refs[a]["spectrum"] - refs[b]["spectrum"]).mean())
+            dh.append(np.abs(refs[a]["histogram"] - refs[b]["histogram"]).mean())
+    return float(np.median(ds)), float(np.median(dh))
+
+
+def nearest_looks(probe: dict, refs: dict, scale) -> list:
+    """[(class, distance), ...] of the reference looks sorted by distance from ``probe``."""
+    return sorted(((c, look_distance(probe, r, scale)) for c, r in refs.items()), key=lambda t: t[1])
+
+
 def _centroid(imgs):
     p = radial_psd(imgs)
     k = np.arange(1, len(p) + 1)

@@ -70,3 +70,37 @@ def test_classifier_stages_widen_the_receptive_field():
         rows = np.nonzero(g[0, 0].abs().sum(1).numpy())[0]
         assert rows.max() - rows.min() + 1 == expect, (rows.max() - rows.min() + 1)
     assert three.features(torch.rand(2, 1, 64, 64)).shape == (2, 128)
+
+
+def test_look_tells_spectra_and_histograms_apart_and_finds_the_nearest_class():
+    """look(): spectrum shape and value quantiles; nearest_looks ranks a new sample of each kind first,
+    a contrast change moves only the histogram term, and identical sets are at distance 0."""
+    from training.evaluate import look, look_distance, look_scales, nearest_looks
+
+    S = 64
+    yy, xx = np.mgrid[0:S, 0:S] / S
+
+    def kind(name, n, seed):
+        r = np.random.default_rng(seed)
+        if name == "white":
+            return r.random((n, S, S))
+        if name == "stripes":
+            ph = r.random(n)[:, None, None] * 6.283
+            return 0.5 + 0.5 * np.sin(2 * np.pi * 8 * xx[None] + ph)
+        f = np.fft.fft2(r.standard_normal((n, S, S)))  # smooth blobs: low-passed noise
+        k = np.hypot(*np.meshgrid(np.fft.fftfreq(S), np.fft.fftfreq(S), indexing="ij"))
+        img = np.real(np.fft.ifft2(f * np.exp(-(k / 0.04) ** 2)))
+        lo, hi = img.min(axis=(1, 2), keepdims=True), img.max(axis=(1, 2), keepdims=True)
+        return (img - lo) / (hi - lo)
+
+    refs = {k: look(kind(k, 4, 1)) for k in ("white", "stripes", "blobs")}
+    scale = look_scales(refs)
+    assert all(s > 0 for s in scale)
+    for k in refs:
+        ranked = nearest_looks(look(kind(k, 4, 2)), refs, scale)
+        assert ranked[0][0] == k and ranked[0][1] < 0.5 * ranked[1][1]
+    assert look_distance(refs["white"], refs["white"], scale) == 0.0
+    w = kind("white", 4, 1)
+    dimmer = look(0.25 + 0.5 * w)  # same spectrum shape, other contrast: only the histogram moves
+    np.testing.assert_allclose(dimmer["spectrum"], refs["white"]["spectrum"], atol=1e-9)
+    assert np.abs(dimmer["histogram"] - refs["white"]["histogram"]).mean() > 0.05
