@@ -11,7 +11,10 @@ import numpy as np
 
 from ._deps import backend
 
-__all__ = ["stratum_constants"]
+__all__ = ["stratum_constants", "OUTPUTS"]
+
+#: the Wave Noise outputs, in order, of both forms (node group and OSL script)
+OUTPUTS = ("Value", "Imaginary", "Modulus", "Phase")
 
 _F = np.float32
 

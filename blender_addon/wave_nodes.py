@@ -43,7 +43,7 @@ import numpy as np
 
 from ._deps import backend
 from .compat import id_property
-from .wave_constants import stratum_constants
+from .wave_constants import OUTPUTS, stratum_constants
 
 __all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json",
            "settings_from_json", "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group",
@@ -72,7 +72,6 @@ def tree_implementation(tree) -> str:
 #: (name, socket type, default) of the group's inputs and outputs
 INPUTS = (("Vector", "NodeSocketVector", (0.0, 0.0, 0.0)), ("W", "NodeSocketFloat", 0.0),
           ("Scale", "NodeSocketFloat", 1.0), ("Time", "NodeSocketFloat", 0.0))
-OUTPUTS = ("Value", "Imaginary", "Modulus", "Phase")
 STREAM = backend.wavenoise.wave.STREAM
 
 

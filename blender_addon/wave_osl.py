@@ -29,7 +29,7 @@ import os
 import numpy as np
 
 from ._deps import backend
-from .wave_constants import stratum_constants
+from .wave_constants import OUTPUTS, stratum_constants
 
 __all__ = ["osl_source", "script_node", "osl_available"]
 
@@ -188,7 +188,11 @@ def _direction_source(dim: int, full: bool, mirrored: bool) -> str:
 
 #: the script's parameters as Script-node sockets: (name, socket type), inputs then outputs
 _SOCKETS_IN = (("Position", "NodeSocketVector"), ("W", "NodeSocketFloat"), ("Time", "NodeSocketFloat"))
-_SOCKETS_OUT = tuple((o, "NodeSocketFloat") for o in ("Value", "Imaginary", "Modulus", "Phase"))
+_SOCKETS_OUT = tuple((o, "NodeSocketFloat") for o in OUTPUTS)
+#: compiled bytecode by sha256 of the source: compilation is deterministic, and an Automatic node is rebuilt
+#: (same source) every time the scene switches between OSL and the node form
+_BYTECODE: dict = {}
+_BYTECODE_KEEP = 16
 
 
 def _compiler():
@@ -210,7 +214,17 @@ def osl_available() -> bool:
 
 
 def _bytecode(code: str) -> str:
-    """Compile OSL source text with Cycles' compiler -> .oso bytecode text; SettingError when it fails."""
+    """Compile OSL source text with Cycles' compiler -> .oso bytecode text (cached by the source's sha256);
+    SettingError when it fails."""
+    key = hashlib.sha256(code.encode()).hexdigest()
+    if key not in _BYTECODE:
+        while len(_BYTECODE) >= _BYTECODE_KEEP:
+            _BYTECODE.pop(next(iter(_BYTECODE)))
+        _BYTECODE[key] = _compile(code)
+    return _BYTECODE[key]
+
+
+def _compile(code: str) -> str:
     import tempfile
 
     compile_osl = _compiler()

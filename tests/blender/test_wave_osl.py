@@ -129,3 +129,25 @@ def test_automatic_form_renders_in_both_shading_systems(tmp_path):
         assert forms == ["osl", "nodes", "osl"]
     finally:
         blender_addon.unregister()
+
+
+def test_rebuilds_reuse_the_compiled_bytecode(monkeypatch):
+    """Switching an Automatic node between forms rebuilds the script: the same source compiles once."""
+    from blender_addon import wave_osl
+
+    s, _ = CASES["3d"]
+    _osl_scene()
+    calls = []
+    real = wave_osl._compile
+    monkeypatch.setattr(wave_osl, "_compile", lambda code: calls.append(code) or real(code))
+    monkeypatch.setattr(wave_osl, "_BYTECODE", {})
+    grp = build_wave_group(s, "ShaderNodeTree", implementation="osl")
+    first = next(n for n in grp.nodes if n.bl_idname == "ShaderNodeScript").bytecode
+    build_wave_group(s, tree=grp, implementation="nodes")
+    build_wave_group(s, tree=grp, implementation="osl")
+    assert len(calls) == 1
+    assert next(n for n in grp.nodes if n.bl_idname == "ShaderNodeScript").bytecode == first
+    import dataclasses
+
+    build_wave_group(dataclasses.replace(s, seed=s.seed + 1), tree=grp, implementation="osl")
+    assert len(calls) == 2  # another noise: another source, compiled
