@@ -100,11 +100,56 @@ class NeuralNoiseModel:
         return self._sessions(name or ("denoiser.onnx" if self.form == "split" else "eps.onnx"))
 
     def encode(self, cond: np.ndarray, tileable: bool = False) -> dict:
-        """Split form: cond float32 (B, C, H, W) -> {m00: [1 + γ, β] of ResBlock 0, ...} for the denoiser."""
+        """Split form: cond float32 (B, C, H, W) -> {m00: [1 + γ, β] of ResBlock 0, ...} for the denoiser.
+
+        A spatially constant grid (one class, one parameter set: the common case) is encoded on a small
+        grid and expanded, with the same values: every map is a pointwise MLP, a nearest resize and two
+        3x3 convolutions of a constant, so it is constant except within EDGE px of each border, where it
+        depends only on the distance to that border (zero padding; with circular padding it is constant).
+        """
+        cond = np.ascontiguousarray(cond, _F)
+        small = self._small_grid(cond)
+        if small is not None:
+            return self._expand(self._encode(cond[:, :, :small, :small], tileable), cond.shape[-2:])
+        return self._encode(cond, tileable)
+
+    #: border frame (px, at every level) within which a constant grid's maps may vary; the maps' receptive
+    #: field reaches 2 px (two 3x3 convolutions), one more keeps a margin
+    EDGE = 3
+
+    def _encode(self, cond: np.ndarray, tileable: bool) -> dict:
         sess = self.session("encoder.onnx")
-        tile = _tile_flag(tileable)
         names = [o.name for o in sess.get_outputs()]
-        return dict(zip(names, sess.run(None, {"cond": np.ascontiguousarray(cond, _F), "tile": tile})))
+        return dict(zip(names, sess.run(None, {"cond": cond, "tile": _tile_flag(tileable)})))
+
+    def _small_grid(self, cond: np.ndarray):
+        """The side of the small grid that encodes ``cond`` exactly, or None (not constant, or small already)."""
+        levels = (self.config.get("blocks") or {}).get("levels")
+        if not levels:
+            return None
+        side = (2 * self.EDGE + 2) << max(levels)  # the coarsest level keeps an interior of 2 px
+        H, W = cond.shape[-2:]
+        if min(H, W) <= side or not np.array_equal(cond, np.broadcast_to(cond[:, :, :1, :1], cond.shape)):
+            return None
+        return side
+
+    def _expand(self, maps: dict, hw) -> dict:
+        """Maps of the small grid -> maps of an H x W grid: border rows and columns kept, the interior repeated."""
+        H, W = hw
+        levels = self.config["blocks"]["levels"]
+        e = self.EDGE
+        out = {}
+        for (name, m), lvl in zip(maps.items(), levels):
+            h, w = H >> lvl, W >> lvl
+            k = m.shape[-1]
+            o = np.empty(m.shape[:2] + (h, w), _F)
+            rows = ((slice(0, e), slice(0, e)), (slice(e, h - e), slice(e, e + 1)), (slice(h - e, h), slice(k - e, k)))
+            cols = ((slice(0, e), slice(0, e)), (slice(e, w - e), slice(e, e + 1)), (slice(w - e, w), slice(k - e, k)))
+            for ro, ri in rows:  # nine blocks: corners and edges copied, the interior (and edge runs) broadcast
+                for co, ci in cols:
+                    o[:, :, ro, co] = m[:, :, ri, ci]
+            out[name] = o
+        return out
 
     def eps_fn(self, tileable: bool = False):
         """model(x, t, cond) -> ε callable for the samplers of :mod:`backend.neural.sampler`.

@@ -323,3 +323,26 @@ def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(expor
     np.testing.assert_allclose(both[1:], one, atol=1e-4)
 
 
+
+
+def test_constant_grids_are_encoded_small_and_expanded_exactly(exported, monkeypatch):
+    """A one-class grid is encoded on a small grid and expanded: the maps equal the full encoder's (plain and
+    circular padding, non-square sizes); any other grid runs the full encoder."""
+    _, out = exported
+    m = NeuralNoiseModel(str(out))
+    side = (2 * m.EDGE + 2) << max(m.config["blocks"]["levels"])
+    for H, W in ((side + 8, side + 24), (side + 40, side + 8)):
+        cond = C.uniform(m, ("spots", {"scale": 6.0}), H, W)[None]
+        assert m._small_grid(cond) == side
+        for tile in (False, True):
+            full, fast = m._encode(np.ascontiguousarray(cond), tile), m.encode(cond, tile)
+            assert list(full) == list(fast)
+            for k in full:
+                assert fast[k].shape == full[k].shape and fast[k].dtype == np.float32
+                np.testing.assert_allclose(fast[k], full[k], atol=1e-6)
+    mixed = C.blend(m, ("spots", {}), ("perlin", {}), np.linspace(0, 1, side + 8)[None].repeat(side + 8, 0))[None]
+    assert m._small_grid(mixed) is None
+    small = C.uniform(m, ("spots", {}), side, side)[None]
+    assert m._small_grid(small) is None  # no smaller grid to encode
+    monkeypatch.setattr(m, "_expand", lambda *a: pytest.fail("a blend is not constant"))
+    m.encode(mixed)
