@@ -77,7 +77,8 @@ class _Encoder(torch.nn.Module):
         self.net = net
 
     def forward(self, cond, tile):
-        return tuple(self.net.encode(cond, tile))
+        # every block's maps as two outputs, 1 + γ and β: the denoiser then reads them without a Slice per step
+        return tuple(half for m in self.net.encode(cond, tile) for half in m.chunk(2, dim=1))
 
 
 class _Denoiser(torch.nn.Module):
@@ -88,7 +89,7 @@ class _Denoiser(torch.nn.Module):
         self.net, self.mode = net, mode
 
     def forward(self, x, t, *maps):
-        return self.net.denoise(x, t, list(maps), self.mode)
+        return self.net.denoise(x, t, [tuple(maps[i:i + 2]) for i in range(0, len(maps), 2)], self.mode)
 
 
 def share_weights(folder: str, graphs: list, weights: str) -> None:
@@ -137,18 +138,20 @@ def _export_split(model, out: str, size: int) -> dict:
     C = model.emb_dim + model.n_params
     cond, tile = torch.randn(1, C, size, size), torch.zeros(1)
     names = map_names(model)
+    tensors = [n + half for n in names for half in ("g", "b")]  # per block: 1 + γ ("m00g") and β ("m00b")
     hw = {0: "batch", 2: "height", 3: "width"}
-    map_axes = {n: {0: "batch", 2: f"h{n}", 3: f"w{n}"} for n in names}  # block k is at H / 2^level_k
-    onnx_export(_Encoder(model), (cond, tile), os.path.join(out, "encoder.onnx"), ["cond", "tile"], names,
+    map_axes = {n: {0: "batch", 2: f"h{n[:-1]}", 3: f"w{n[:-1]}"} for n in tensors}  # block k: H / 2^level_k
+    onnx_export(_Encoder(model), (cond, tile), os.path.join(out, "encoder.onnx"), ["cond", "tile"], tensors,
                 {"cond": hw, **map_axes})
     with torch.no_grad():
         maps = model.encode(cond, tile)
-    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), *maps)
+    args = (torch.randn(1, 1, size, size), torch.tensor([500.0]), *(h for m in maps for h in m.chunk(2, dim=1)))
     for name, mode in (("denoiser.onnx", None), ("denoiser_tile.onnx", "circular")):
-        onnx_export(_Denoiser(model, mode), args, os.path.join(out, name), ["x", "t"] + names, ["eps"],
+        onnx_export(_Denoiser(model, mode), args, os.path.join(out, name), ["x", "t"] + tensors, ["eps"],
                     {"x": hw, "t": {0: "batch"}, "eps": hw, **map_axes})
     share_weights(out, ["denoiser.onnx", "denoiser_tile.onnx"], "denoiser.weights")
-    return dict(names=names, channels=[int(m.shape[1]) for m in maps], levels=[lvl for _, lvl in model.blocks()])
+    return dict(names=names, tensors=tensors, channels=[int(m.shape[1]) for m in maps],
+                levels=[lvl for _, lvl in model.blocks()])
 
 
 def export_model(model, out: str, meta: dict, one_piece: bool = False) -> dict:

@@ -50,9 +50,9 @@ class Conv3(nn.Conv2d):
     def forward(self, x):
         if isinstance(self.tile, str):  # "circular": a graph for seamless tiles only (no blend with zeros)
             return super().forward(F.pad(x, (1, 1, 1, 1), mode="circular"))
+        if self.tile is None:  # the convolution's own zero padding: no separate Pad op in an exported graph
+            return F.conv2d(x, self.weight, self.bias, 1, 1)
         zero = F.pad(x, (1, 1, 1, 1))
-        if self.tile is None:
-            return super().forward(zero)
         wrap = F.pad(x, (1, 1, 1, 1), mode="circular")
         return super().forward(zero + (wrap - zero) * self.tile)
 
@@ -87,8 +87,9 @@ class SPADE(nn.Module):
 
     @staticmethod
     def apply(h, maps):
-        """h * (1 + γ) + β with ``maps`` from :meth:`maps`."""
-        g1, b = maps.chunk(2, dim=1)
+        """h * (1 + γ) + β with ``maps`` from :meth:`maps`, or the pair (1 + γ, β) already apart (an export's
+        denoiser takes them as two inputs, so no step slices them)."""
+        g1, b = maps if isinstance(maps, tuple) else maps.chunk(2, dim=1)
         return h * g1 + b
 
 

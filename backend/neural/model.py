@@ -110,7 +110,7 @@ class NeuralNoiseModel:
         cond = np.ascontiguousarray(cond, _F)
         small = self._small_grid(cond)
         if small is not None:
-            return self._expand(self._encode(cond[:, :, :small, :small], tileable), cond.shape[-2:])
+            return self._expand(self._encode(cond[:, :, :small, :small], tileable), cond.shape[-2:], small)
         return self._encode(cond, tileable)
 
     #: border frame (px, at every level) within which a constant grid's maps may vary; the maps' receptive
@@ -133,15 +133,16 @@ class NeuralNoiseModel:
             return None
         return side
 
-    def _expand(self, maps: dict, hw) -> dict:
-        """Maps of the small grid -> maps of an H x W grid: border rows and columns kept, the interior repeated."""
+    def _expand(self, maps: dict, hw, side: int) -> dict:
+        """Maps of the small side x side grid -> maps of an H x W grid: border frames kept, the interior repeated.
+        (A map side / 2^l px wide is at level l, whatever the export's names: one tensor per block, or two.)"""
         H, W = hw
-        levels = self.config["blocks"]["levels"]
         e = self.EDGE
         out = {}
-        for (name, m), lvl in zip(maps.items(), levels):
-            h, w = H >> lvl, W >> lvl
+        for name, m in maps.items():
             k = m.shape[-1]
+            lvl = (side // k).bit_length() - 1
+            h, w = H >> lvl, W >> lvl
             o = np.empty(m.shape[:2] + (h, w), _F)
             rows = ((slice(0, e), slice(0, e)), (slice(e, h - e), slice(e, e + 1)), (slice(h - e, h), slice(k - e, k)))
             cols = ((slice(0, e), slice(0, e)), (slice(e, w - e), slice(e, e + 1)), (slice(w - e, w), slice(k - e, k)))

@@ -346,3 +346,20 @@ def test_constant_grids_are_encoded_small_and_expanded_exactly(exported, monkeyp
     assert m._small_grid(small) is None  # no smaller grid to encode
     monkeypatch.setattr(m, "_expand", lambda *a: pytest.fail("a blend is not constant"))
     m.encode(mixed)
+
+
+def test_denoiser_graph_does_no_per_step_copies(exported):
+    """The per-step graph reads 1 + γ and β as inputs of their own (no Slice of the maps) and the plain denoiser
+    pads inside its convolutions (no Pad op): both were copies of full tensors at every step."""
+    import onnx
+
+    _, out = exported
+    doc = NeuralNoiseModel(str(out)).config["blocks"]
+    assert doc["tensors"][:2] == ["m00g", "m00b"] and len(doc["tensors"]) == 2 * len(doc["names"])
+    g = onnx.load(str(out / "denoiser.onnx"), load_external_data=False).graph
+    assert "Pad" not in [n.op_type for n in g.node]
+    assert [i.name for i in g.input] == ["x", "t"] + doc["tensors"]
+    for path in ("denoiser.onnx", "denoiser_tile.onnx"):  # the time embedding's tiny vectors are still sliced
+        nodes = onnx.load(str(out / path), load_external_data=False).graph.node
+        assert not [n.name for n in nodes if n.op_type == "Slice" and n.input[0] in doc["tensors"]]
+        assert sum(n.op_type == "Slice" for n in nodes) >= 2  # the check above looks at real Slice nodes
