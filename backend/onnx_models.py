@@ -6,7 +6,8 @@ import hashlib
 import json
 import os
 
-__all__ = ["ModelError", "sha256_file", "load_model_json", "fingerprint", "SessionCache", "set_default_threads"]
+__all__ = ["ModelError", "sha256_file", "load_model_json", "verify_files", "fingerprint", "SessionCache",
+           "set_default_threads"]
 
 _THREADS = {"default": 0}
 
@@ -43,13 +44,18 @@ def load_model_json(folder: str, json_name: str) -> dict:
     files = doc.get("files") if isinstance(doc, dict) else None
     if not isinstance(files, dict) or not files:
         raise ModelError(f"{path} lists no files with their sha256 ('files'): the model cannot be verified")
+    verify_files(folder, files, json_name)
+    return doc
+
+
+def verify_files(folder: str, files: dict, json_name: str) -> None:
+    """ModelError unless every ``files`` name (relative to ``folder``) exists with the sha256 ``json_name`` lists."""
     for name, digest in files.items():
         fp = os.path.join(folder, name)
         if not os.path.isfile(fp):
             raise ModelError(f"model file missing: {fp}")
         if sha256_file(fp) != digest:
             raise ModelError(f"{name}: sha256 does not match {json_name} (altered or damaged file)")
-    return doc
 
 
 def fingerprint(files: dict) -> str:

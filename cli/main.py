@@ -16,6 +16,7 @@ import numpy as np
 from export.images import ImageError
 from backend import limits
 from backend.errors import SettingError
+from backend.neural.precision import PRECISIONS
 from backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
 from backend.paths import neural_model
 from backend.wavenoise.settings import WaveSettings
@@ -101,7 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--keep-going", action="store_true", help="after a failed bake, carry on with the others")
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
     b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (default 0: all cores)")
-    b.add_argument("--precision", default="fp32", choices=("fp32", "int8"),
+    b.add_argument("--precision", default="fp32", choices=PRECISIONS,
                    help="neural noise denoiser arithmetic (default fp32; int8: faster draft on CPUs with VNNI)")
     b.add_argument("--quiet", action="store_true")
     farm = b.add_argument_group("farm (Dask distributed; pip install .[farm])")
@@ -127,7 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "
                         "else 512 px tiles; 0: never)")
     n.add_argument("--threads", type=int, default=0, help="CPU threads for onnxruntime (default 0: all cores)")
-    n.add_argument("--precision", default="fp32", choices=("fp32", "int8"),
+    n.add_argument("--precision", default="fp32", choices=PRECISIONS,
                    help="denoiser arithmetic (default fp32; int8: about 1.7x faster steps on CPUs with int8 dot "
                         "products (VNNI), images slightly further from the reference)")
     n.add_argument("--seed", type=int, default=0)

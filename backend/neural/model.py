@@ -12,12 +12,10 @@ JSON before onnxruntime sees it; sessions are created on first use.  The graphs'
 """
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from ..errors import SettingError
-from ..onnx_models import ModelError, SessionCache, fingerprint, load_model_json, sha256_file
+from ..onnx_models import ModelError, SessionCache, fingerprint, load_model_json, sha256_file, verify_files
 from .precision import resolve as resolve_precision
 from .schedule import alphas_from_config
 
@@ -80,12 +78,7 @@ class NeuralNoiseModel:
         """ModelError unless the folder's int8 denoisers exist and match their sha256 in the JSON."""
         if not int8.get("files"):
             raise ModelError(f"{folder}: no int8 denoisers (make them with python -m training.quantize_onnx {folder})")
-        for name, digest in int8["files"].items():
-            path = os.path.join(folder, name)
-            if not os.path.isfile(path):
-                raise ModelError(f"model file missing: {path}")
-            if sha256_file(path) != digest:
-                raise ModelError(f"{name}: sha256 does not match neural_noise.json (altered or damaged file)")
+        verify_files(folder, int8["files"], "neural_noise.json")
 
     def denoiser_name(self, tileable: bool) -> str:
         """The denoiser file a split export runs: per padding, and int8 when :attr:`precision` says so."""

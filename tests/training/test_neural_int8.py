@@ -14,26 +14,18 @@ from backend.neural import conditioning as C  # noqa: E402
 from backend.neural import precision as P  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
-from backend.onnx_models import fingerprint  # noqa: E402
-from training.export_onnx import export  # noqa: E402
 from training.quantize_onnx import INT8_FILES, calibration_feeds, quantize_folder  # noqa: E402
-from training.train import TrainConfig, train  # noqa: E402
-
-TINY = dict(size=16, batch=4, steps=3, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=3, precision="fp32",
-            sample_every=0, classes=("perlin", "spots", "cells_f1"))
+from test_neural_runtime import TINY, exported  # noqa: E402,F401  (the tiny split export, trained once)
 
 
 @pytest.fixture(scope="module")
-def folders(tmp_path_factory):
-    """A tiny trained split export, and a copy of it with int8 denoisers."""
-    run = tmp_path_factory.mktemp("run")
-    fp32 = tmp_path_factory.mktemp("fp32")
-    train(TrainConfig.from_dict(TINY), str(run), log=lambda s: None)
-    export(str(run), str(fp32))
+def folders(exported, tmp_path_factory):
+    """The tiny trained split export, and a copy of it with int8 denoisers."""
+    fp32 = str(exported[1])
     int8 = tmp_path_factory.mktemp("int8")
     shutil.copytree(fp32, int8, dirs_exist_ok=True)
     section = quantize_folder(str(int8), size=32, log=lambda s: None)
-    return str(fp32), str(int8), section
+    return fp32, str(int8), section
 
 
 @pytest.fixture
