@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: all setup demo test test-blender bench dist clean
+.PHONY: all setup kernel demo test test-blender bench dist clean
 
 all: test
 
@@ -16,9 +16,13 @@ $(STAMP): requirements.txt pyproject.toml
 	$(BIN)/python -m pip install -q --no-deps -e .
 	@touch $(STAMP)
 
-setup: $(STAMP)
+# the C row kernel of wave noise (optional: without a compiler the numba kernel runs); rebuilt when rows.c changes
+kernel: $(STAMP)
+	@$(BIN)/python tools/build_kernel.py
 
-demo: $(STAMP)
+setup: $(STAMP) kernel
+
+demo: $(STAMP) kernel
 	$(BIN)/python demo/showcase.py out/demo
 	$(BIN)/python demo/showcase_blend.py out/demo
 	$(BIN)/omninoise bake demo/volumes.toml
@@ -30,7 +34,7 @@ $(VENV)/.train: $(STAMP) requirements-train.txt
 	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt
 	@touch $@
 
-test: $(STAMP) $(VENV)/.train
+test: $(STAMP) $(VENV)/.train kernel
 	$(BIN)/python -m pytest -q
 
 # The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS and 4.5 LTS
@@ -51,7 +55,7 @@ BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy52
 	.venv-bpy52/bin/python -m pip install -q bpy==5.2.3 -r requirements-blender.txt
 	@touch $@
 
-test-blender: $(STAMP) $(addsuffix /.installed,$(BPY_VENVS))
+test-blender: $(STAMP) kernel $(addsuffix /.installed,$(BPY_VENVS))
 	$(BIN)/python tools/blender_versions.py $(BPY_VENVS)
 
 $(VENV)/.bench: $(STAMP) requirements-bench.txt
@@ -59,7 +63,7 @@ $(VENV)/.bench: $(STAMP) requirements-bench.txt
 	$(BIN)/python -m pip install -q --no-build-isolation -r requirements-bench.txt
 	@touch $@
 
-bench: $(VENV)/.bench
+bench: $(VENV)/.bench kernel
 	$(BIN)/python bench/bench_wave.py
 
 # installable extension zips (linux-x64, windows-x64, macos-arm64) in dist/, built and validated

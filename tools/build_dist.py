@@ -37,6 +37,9 @@ PLATFORMS = {  # Blender platform -> pip platform tag
 }
 RUNTIME = ("__init__.py", "blender_manifest.toml", "blender_addon", "backend", "export", "models")
 EXCLUDE_DIRS = {"__pycache__"}
+#: the C row kernel built for this machine (tools/build_kernel.py) is not a file of the platform-independent
+#: extension: installed extensions run the numpy path of wave noise, or numba where Blender's Python has it
+EXCLUDE_PREFIXES = ("_omni_rows.",)
 
 
 def blender_ext() -> str:
@@ -83,7 +86,8 @@ def stage(wheels: list[str]) -> str:
         src = os.path.join(ROOT, item)
         if os.path.isdir(src):
             shutil.copytree(src, os.path.join(dst, item),
-                            ignore=lambda d, names: [n for n in names if n in EXCLUDE_DIRS or n.endswith(".pyc")])
+                            ignore=lambda d, names: [n for n in names if n in EXCLUDE_DIRS or n.endswith(".pyc")
+                                                    or n.startswith(EXCLUDE_PREFIXES)])
         else:
             shutil.copy2(src, dst)
     names = []

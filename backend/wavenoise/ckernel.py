@@ -1,0 +1,139 @@
+"""The C row kernel (``rows.c``), loaded with ctypes when it has been built.
+
+``tools/build_kernel.py`` (run by ``make setup``) compiles ``rows.c`` next to this file as
+``_omni_rows.so`` (``.dylib`` on macOS, ``.dll`` on Windows).  Without it, or with
+OMNINOISE_NO_CKERNEL=1, :mod:`.fast` runs its numba row kernel, which stays the reference: both
+compute the same float32 operations in the same order (tested to be equal).  The call releases the
+GIL, so rows are split across Python threads.
+
+Arrays are those of :class:`backend.wavenoise.fast.GridPlan`; see ``rows.c`` for shapes.
+"""
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+__all__ = ["library_path", "available", "set_enabled", "vector", "padded", "rows"]
+
+_F = np.float32
+ABI = 1
+#: texels after the padded table so the 16-texel window loads of rows.c stay inside the arrays
+PAD = 16
+_SUFFIX = {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
+_lib = None
+_pool = None
+_enabled = not os.environ.get("OMNINOISE_NO_CKERNEL")
+
+
+def library_path() -> str:
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "_omni_rows" + _SUFFIX)
+
+
+def _load():
+    global _lib
+    if _lib is None:
+        _lib = False
+        path = library_path()
+        if not os.path.isfile(path):
+            return None
+        try:
+            lib = ctypes.CDLL(path)
+            if lib.omni_abi() != ABI:
+                return None
+        except (OSError, AttributeError):  # a library of another platform or an older build: numba runs
+            return None
+        f, i64, i32 = ctypes.POINTER(ctypes.c_float), ctypes.c_int64, ctypes.c_int
+        lib.omni_rows.argtypes = [f, i64, f, i64, i64, f, f, f, i64, i64, f, f, f, f, i64, f, f, f, f, i64,
+                                  ctypes.c_float, ctypes.c_float, i32, i32, f, f]
+        lib.omni_rows.restype = None
+        lib.omni_vector.restype = i32
+        _lib = lib
+    return _lib or None
+
+
+def available() -> bool:
+    """True when the kernel is built, loads, and is enabled (see :func:`set_enabled`)."""
+    return _enabled and _load() is not None
+
+
+def set_enabled(on: bool) -> bool:
+    """Switch the kernel on or off for grids planned from now on (the bench compares both); returns
+    the previous setting."""
+    global _enabled
+    before, _enabled = _enabled, bool(on)
+    return before
+
+
+def vector() -> bool:
+    """True where the loaded kernel runs its AVX2 loops (else its scalar ones)."""
+    lib = _load()
+    return bool(lib is not None and lib.omni_vector())
+
+
+def padded(table: np.ndarray) -> tuple:
+    """float32 (N + 2, 2) padded table (fast._padded_table) -> tre, tim, dre, dim: float32 (N + 2 + PAD)
+    values and forward differences T[i + 1] - T[i] (float32, as the reference computes them)."""
+    out = []
+    for c in range(2):
+        v = np.zeros(len(table) + PAD, _F)
+        v[:len(table)] = table[:, c]
+        d = np.zeros_like(v)
+        d[:len(table) - 1] = table[1:, c] - table[:-1, c]
+        out.append((v, d))
+    return out[0][0], out[1][0], out[0][1], out[1][1]
+
+
+def _threads() -> int:
+    numba = sys.modules.get("numba")  # numba's thread count when it runs (Blender and the CLI may set it)
+    if numba is not None:
+        return numba.get_num_threads()
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def _ptr(a: np.ndarray):
+    return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+
+
+def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_period, shift,
+         out_re, out_im=None, use_vector: bool = True) -> None:
+    """Fill out_re (and out_im) float32 (R, Nx), C-contiguous, like fast._rows_kernel.
+
+    tables: :func:`padded`'s four arrays.  Every array must be C-contiguous float32 (checked)."""
+    global _pool
+    lib = _load()
+    if lib is None:  # callers ask available() first (GridPlan)
+        raise RuntimeError("the C row kernel is not built (python tools/build_kernel.py)")
+    arrays = (xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, *tables, out_re)
+    if out_im is not None:
+        arrays += (out_im,)
+    for a in arrays:
+        if a.dtype != _F or not a.flags.c_contiguous:
+            raise ValueError("the C row kernel needs C-contiguous float32 arrays")
+    R, Nx = out_re.shape
+    K, D = sdirs.shape
+    if xs.shape != (Nx,) or others.shape != (R, D - 1) or (out_im is not None and out_im.shape != (R, Nx)):
+        raise ValueError(f"row kernel shapes: xs {xs.shape}, others {others.shape}, out {out_re.shape}")
+    S = slpos.shape[1]
+    N = len(tables[0]) - 2 - PAD
+    im = _ptr(out_im) if out_im is not None else None
+    vec = int(bool(use_vector) and lib.omni_vector())
+    args = (_ptr(sdirs), _ptr(soffs), _ptr(amps), K, D, _ptr(nmin), _ptr(slpos), _ptr(omega), _ptr(zeta), S,
+            *[_ptr(t) for t in tables], N, _F(inv_period), _F(shift), int(out_im is not None), vec)
+
+    def run(r0, r1):
+        lib.omni_rows(_ptr(xs), Nx, _ptr(others), r0, r1, *args, _ptr(out_re), im)
+
+    n = max(1, min(_threads(), R))
+    if n == 1:
+        return run(0, R)
+    if _pool is None or _pool._max_workers < n:
+        _pool = ThreadPoolExecutor(max(n, 2), thread_name_prefix="omninoise-rows")
+    # more pieces than threads, so a thread that got cheap rows takes another
+    pieces = min(R, 4 * n)
+    bounds = [R * i // pieces for i in range(pieces + 1)]
+    for f in [_pool.submit(run, a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]:
+        f.result()

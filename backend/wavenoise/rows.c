@@ -1,0 +1,475 @@
+/* Wave noise on grid rows: the compiled kernel of backend/wavenoise/fast.py (GridPlan.rows) in C.
+ *
+ * The same sum as the numba row kernel, which stays the reference (Guehl et al. 2025, Alg. 1): along a
+ * row, stratum k's slice coordinate p = x s_x + q is affine; slice n's wave is read from the complex
+ * table at the affine texel coordinate tau = x a_n + b_n and linearly interpolated (Eq. 8), and inside
+ * slice n's border ramp (half-width 0.3 around n + slpos_n) slices n and n + 1 are blended with the
+ * weights cos(pi/2 s) and cos(pi/2 (1 - s)).  Two ways along a row:
+ *
+ *   segment walk (stratum_row)  pure(n), blend(n, n+1), pure(n+1), ...: segment ends from the affine
+ *                               form in float64, a single table read where a slice is alone.  Numba's
+ *                               operations one for one (no fused multiply-adds): the same bits.  Used
+ *                               where slices are long (SEGMENT_WALK samples or more) and on CPUs
+ *                               without AVX2 (scalar loops).
+ *   blocks (stratum_blocks)     eight samples at a time, each lane finding its own slice and blending
+ *                               n and n + 1 with weights that are exactly (amp, 0) or (0, amp) outside
+ *                               the ramp: no per-segment bookkeeping, which dominates short slices
+ *                               (3D grids).  Texel coordinates as the reference; fused multiply-adds
+ *                               in the weights and sums: within 1e-6 of it.
+ *
+ * Table reads, which numba leaves scalar: the eight texels of one read usually lie within 16
+ * consecutive texels (the texel step per sample is small on a grid), so they come from two vector
+ * loads and a permute, elsewhere from a gather.  A lerp reads the value T[i] and the forward difference
+ * D[i] = T[i+1] - T[i] (the reference computes that difference in float32 too: same bits).
+ *
+ * Arrays (all C-contiguous, float32 unless said):
+ *   xs (Nx) ascending uniform row coordinates; others (R, D-1) the row's other coordinates;
+ *   sdirs (K, D), soffs (K), amps (K): strata; nmin (K), slpos (K, S), omega (K, S, D), zeta (K, S):
+ *   slice records (see fast._slice_records); tre, tim, dre, dim: (N + 2 + PAD) padded table values
+ *   and differences, texel i + 1 holds T[i mod N]; out_re, out_im (R, Nx).
+ *
+ * Build: tools/build_kernel.py (cc -O3 -ffp-contract=off -shared -fPIC; the AVX2 loops carry a target
+ * attribute and are chosen at run time, so the library runs on any x86-64 CPU, and elsewhere scalar).
+ * Loaded by ctypes; the call releases the GIL, so Python threads split the rows.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#if defined(__x86_64__) || defined(_M_X64)
+#define OMNI_X86 1
+#include <immintrin.h>
+#define AVX2 __attribute__((target("avx2,fma")))
+#endif
+
+#define OMNI_ABI 1
+#ifndef SEGMENT_WALK
+#define SEGMENT_WALK 128
+#endif
+
+typedef struct {
+  const float *xs;
+  const float *others, *sdirs, *soffs, *amps;
+  const float *nmin, *slpos, *omega, *zeta;
+  const float *tre, *tim, *dre, *dim;
+  float *out_re, *out_im;
+  int64_t Nx, K, D, S;
+  float fN, inv_N, inv_period, shift;
+  int want_imag, vector;
+} job_t;
+
+static inline void slice_affine(const job_t *J, int64_t k, int64_t r, int64_t ri, float *a, float *b);
+
+/* numba's float32 constants: the double rounded to float (a float literal could round differently) */
+#define C_HALF_PI ((float)1.5707963267948966)
+#define C_24 ((float)(1.0 / 24))
+#define C_720 ((float)(-1.0 / 720))
+#define C_40320 ((float)(1.0 / 40320))
+#define C_3628800 ((float)(-1.0 / 3628800))
+#define C_479001600 ((float)(1.0 / 479001600))
+
+/* cos(pi/2 s), s in [0, 1]: Taylor series of cos to x^12 (error < 5e-7), fast._cos_half_pi */
+static inline float cos_half_pi(float s) {
+  float x = C_HALF_PI * s, x2 = x * x;
+  return 1.0f + x2 * (-0.5f + x2 * (C_24 + x2 * (C_720 + x2 * (C_40320 + x2 * (C_3628800 + x2 * C_479001600)))));
+}
+
+/* texel coordinate -> padded texel index and fraction (fast._texels) */
+static inline int32_t texel(float tau, float fN, float inv_N, float *t) {
+  float j0 = floorf(tau);
+  *t = tau - j0;
+  return (int32_t)(j0 - fN * floorf(j0 * inv_N)) + 1;
+}
+
+static void pure_scalar(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore, float *oim) {
+  for (int64_t j = o; j < o + m; j++) {
+    float t;
+    int32_t i = texel(J->xs[j] * a + b, J->fN, J->inv_N, &t);
+    ore[j] += amp * (J->tre[i] + J->dre[i] * t);
+    if (J->want_imag) oim[j] += amp * (J->tim[i] + J->dim[i] * t);
+  }
+}
+
+static void blend_scalar(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0,
+                         float b0, float a1, float b1, float amp, float *ore, float *oim) {
+  const float c = (float)(0.5 / 0.3);
+  for (int64_t j = o; j < o + m; j++) {
+    float x = J->xs[j];
+    float u = ((x * sx + q) - fn - sp) * c + 0.5f;
+    u = fminf(fmaxf(u, 0.0f), 1.0f);
+    float s = u * u * (3.0f - 2.0f * u);
+    float w0 = amp * cos_half_pi(s), w1 = amp * cos_half_pi(1.0f - s), t0, t1;
+    int32_t i0 = texel(x * a0 + b0, J->fN, J->inv_N, &t0), i1 = texel(x * a1 + b1, J->fN, J->inv_N, &t1);
+    ore[j] += w0 * (J->tre[i0] + J->dre[i0] * t0);
+    ore[j] += w1 * (J->tre[i1] + J->dre[i1] * t1);
+    if (J->want_imag) {
+      oim[j] += w0 * (J->tim[i0] + J->dim[i0] * t0);
+      oim[j] += w1 * (J->tim[i1] + J->dim[i1] * t1);
+    }
+  }
+}
+
+#ifdef OMNI_X86
+/* lanes < m of eight samples (m < 8: the row's last ones) */
+AVX2 static inline __m256i lane_mask(int64_t m) {
+  return _mm256_cmpgt_epi32(_mm256_set1_epi32((int)m), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+}
+
+/* cos(pi/2 s) as cos_half_pi, Horner with fused multiply-adds (within 1 ulp of it) */
+AVX2 static inline __m256 cos_half_pi8(__m256 s) {
+  __m256 x = _mm256_mul_ps(_mm256_set1_ps(C_HALF_PI), s), x2 = _mm256_mul_ps(x, x);
+  __m256 p = _mm256_fmadd_ps(x2, _mm256_set1_ps(C_479001600), _mm256_set1_ps(C_3628800));
+  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(C_40320));
+  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(C_720));
+  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(C_24));
+  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(-0.5f));
+  return _mm256_fmadd_ps(x2, p, _mm256_set1_ps(1.0f));
+}
+
+/* Eight texels: from two loads and a permute where the lanes' texels lie within 16 consecutive ones
+ * (the texel step per sample is small on a grid), else a gather. */
+typedef struct { __m256i i, rel; __m256 hi; int base, win; } texels8;
+
+AVX2 static inline texels8 texels(__m256 tau, __m256 fN, __m256 inv_N, __m256 *t) {
+  texels8 T;
+  __m256 j0 = _mm256_floor_ps(tau);  /* texel() in eight lanes: the same operations */
+  *t = _mm256_sub_ps(tau, j0);
+  __m256 w = _mm256_sub_ps(j0, _mm256_mul_ps(fN, _mm256_floor_ps(_mm256_mul_ps(j0, inv_N))));
+  T.i = _mm256_add_epi32(_mm256_cvttps_epi32(w), _mm256_set1_epi32(1));
+  __m256i base = _mm256_min_epi32(_mm256_permutevar8x32_epi32(T.i, _mm256_setzero_si256()),
+                                  _mm256_permutevar8x32_epi32(T.i, _mm256_set1_epi32(7)));
+  T.rel = _mm256_sub_epi32(T.i, base);
+  __m256i bad = _mm256_or_si256(_mm256_cmpgt_epi32(T.rel, _mm256_set1_epi32(15)),
+                                _mm256_cmpgt_epi32(_mm256_setzero_si256(), T.rel));
+  T.win = _mm256_testz_si256(bad, bad);
+  T.base = _mm256_cvtsi256_si32(base);
+  T.hi = _mm256_castsi256_ps(_mm256_cmpgt_epi32(T.rel, _mm256_set1_epi32(7)));
+  return T;
+}
+
+AVX2 static inline __m256 fetch(const float *tab, const texels8 *T) {
+  if (T->win)
+    return _mm256_blendv_ps(_mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + T->base), T->rel),
+                            _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + T->base + 8), T->rel), T->hi);
+  return _mm256_i32gather_ps(tab, T->i, 4);
+}
+
+/* one record per lane: from registers when the row has at most eight records, else from memory */
+AVX2 static inline __m256 pick(const float *rec, __m256 reg, int regs, __m256i idx) {
+  return regs ? _mm256_permutevar8x32_ps(reg, idx) : _mm256_i32gather_ps(rec, idx, 4);
+}
+
+/* The segment walk's loops (stratum_row), eight samples at a time, with the reference's exact operations. */
+AVX2 static inline __m256 load_x(const float *xs, int64_t j, int64_t m) {
+  if (m >= 8) return _mm256_loadu_ps(xs + j);
+  __m256i k = lane_mask(m);
+  return _mm256_blendv_ps(_mm256_set1_ps(xs[j + m - 1]), _mm256_maskload_ps(xs + j, k), _mm256_castsi256_ps(k));
+}
+
+AVX2 static inline void add_out(float *out, int64_t j, int64_t m, __m256 v) {
+  if (m >= 8) {
+    _mm256_storeu_ps(out + j, _mm256_add_ps(_mm256_loadu_ps(out + j), v));
+  } else {
+    __m256i k = lane_mask(m);
+    _mm256_maskstore_ps(out + j, k, _mm256_add_ps(_mm256_maskload_ps(out + j, k), v));
+  }
+}
+
+AVX2 static inline __m256i texel8(__m256 tau, __m256 fN, __m256 inv_N, __m256 *t) {
+  __m256 j0 = _mm256_floor_ps(tau);
+  *t = _mm256_sub_ps(tau, j0);
+  __m256 w = _mm256_sub_ps(j0, _mm256_mul_ps(fN, _mm256_floor_ps(_mm256_mul_ps(j0, inv_N))));
+  return _mm256_add_epi32(_mm256_cvttps_epi32(w), _mm256_set1_epi32(1));
+}
+
+/* Where the eight texels lie within 16 consecutive ones: the window's start and each lane's place in it. */
+AVX2 static inline int window(__m256i i, __m256i *rel, int *base) {
+  int lo = _mm256_cvtsi256_si32(i), hi = _mm256_extract_epi32(i, 7);
+  *base = lo < hi ? lo : hi;
+  *rel = _mm256_sub_epi32(i, _mm256_set1_epi32(*base));
+  __m256i out = _mm256_or_si256(_mm256_cmpgt_epi32(*rel, _mm256_set1_epi32(15)),
+                                _mm256_cmpgt_epi32(_mm256_setzero_si256(), *rel));
+  return _mm256_testz_si256(out, out);
+}
+
+AVX2 static inline __m256 fetch_seg(const float *tab, __m256i i, int win, __m256i rel, int base) {
+  if (win) {
+    __m256 hi = _mm256_castsi256_ps(_mm256_cmpgt_epi32(rel, _mm256_set1_epi32(7)));
+    return _mm256_blendv_ps(_mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + base), rel),
+                            _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + base + 8), rel), hi);
+  }
+  return _mm256_i32gather_ps(tab, i, 4);
+}
+
+/* T(tau) and, if wanted, its imaginary part: value + difference * fraction */
+AVX2 static inline void lerp8(const job_t *J, __m256i i, __m256 t, __m256 *re, __m256 *im) {
+  __m256i rel;
+  int base, win = window(i, &rel, &base);
+  *re = _mm256_add_ps(fetch_seg(J->tre, i, win, rel, base), _mm256_mul_ps(fetch_seg(J->dre, i, win, rel, base), t));
+  if (J->want_imag)
+    *im = _mm256_add_ps(fetch_seg(J->tim, i, win, rel, base), _mm256_mul_ps(fetch_seg(J->dim, i, win, rel, base), t));
+}
+
+AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore,
+                           float *oim) {
+  const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vamp = _mm256_set1_ps(amp);
+  const __m256 fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
+  for (int64_t j = o; j < o + m; j += 8) {
+    int64_t n = o + m - j;
+    __m256 x = load_x(J->xs, j, n), t, re, im;
+    __m256i i = texel8(_mm256_add_ps(_mm256_mul_ps(x, va), vb), fN, inv_N, &t);
+    lerp8(J, i, t, &re, &im);
+    add_out(ore, j, n, _mm256_mul_ps(vamp, re));
+    if (J->want_imag) add_out(oim, j, n, _mm256_mul_ps(vamp, im));
+  }
+}
+
+AVX2 static inline __m256 cos_half_pi8_exact(__m256 s) {
+  __m256 x = _mm256_mul_ps(_mm256_set1_ps(C_HALF_PI), s), x2 = _mm256_mul_ps(x, x);
+  __m256 p = _mm256_add_ps(_mm256_set1_ps(C_3628800), _mm256_mul_ps(x2, _mm256_set1_ps(C_479001600)));
+  p = _mm256_add_ps(_mm256_set1_ps(C_40320), _mm256_mul_ps(x2, p));
+  p = _mm256_add_ps(_mm256_set1_ps(C_720), _mm256_mul_ps(x2, p));
+  p = _mm256_add_ps(_mm256_set1_ps(C_24), _mm256_mul_ps(x2, p));
+  p = _mm256_add_ps(_mm256_set1_ps(-0.5f), _mm256_mul_ps(x2, p));
+  return _mm256_add_ps(_mm256_set1_ps(1.0f), _mm256_mul_ps(x2, p));
+}
+
+AVX2 static void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0,
+                            float b0, float a1, float b1, float amp, float *ore, float *oim) {
+  const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vfn = _mm256_set1_ps(fn), vsp = _mm256_set1_ps(sp);
+  const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f);
+  const __m256 vamp = _mm256_set1_ps(amp), fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
+  const __m256 va0 = _mm256_set1_ps(a0), vb0 = _mm256_set1_ps(b0), va1 = _mm256_set1_ps(a1), vb1 = _mm256_set1_ps(b1);
+  for (int64_t j = o; j < o + m; j += 8) {
+    int64_t n = o + m - j;
+    __m256 x = load_x(J->xs, j, n), t0, t1, re0, im0, re1, im1;
+    __m256 u = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(x, vsx), vq), vfn), vsp);
+    u = _mm256_add_ps(_mm256_mul_ps(u, c), half);
+    /* min(max(u, 0), 1) as numba's: NaN cannot occur (finite coordinates) */
+    u = _mm256_min_ps(_mm256_max_ps(u, _mm256_setzero_ps()), one);
+    __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_set1_ps(2.0f), u)));
+    __m256 w0 = _mm256_mul_ps(vamp, cos_half_pi8_exact(s)), w1 = _mm256_mul_ps(vamp, cos_half_pi8_exact(_mm256_sub_ps(one, s)));
+    __m256i i0 = texel8(_mm256_add_ps(_mm256_mul_ps(x, va0), vb0), fN, inv_N, &t0);
+    __m256i i1 = texel8(_mm256_add_ps(_mm256_mul_ps(x, va1), vb1), fN, inv_N, &t1);
+    lerp8(J, i0, t0, &re0, &im0);
+    lerp8(J, i1, t1, &re1, &im1);
+    if (n >= 8) {  /* the reference adds slice n's term, then slice n + 1's */
+      __m256 r = _mm256_loadu_ps(ore + j);
+      r = _mm256_add_ps(r, _mm256_mul_ps(w0, re0));
+      _mm256_storeu_ps(ore + j, _mm256_add_ps(r, _mm256_mul_ps(w1, re1)));
+      if (J->want_imag) {
+        __m256 v = _mm256_loadu_ps(oim + j);
+        v = _mm256_add_ps(v, _mm256_mul_ps(w0, im0));
+        _mm256_storeu_ps(oim + j, _mm256_add_ps(v, _mm256_mul_ps(w1, im1)));
+      }
+    } else {
+      add_out(ore, j, n, _mm256_mul_ps(w0, re0));
+      add_out(ore, j, n, _mm256_mul_ps(w1, re1));
+      if (J->want_imag) {
+        add_out(oim, j, n, _mm256_mul_ps(w0, im0));
+        add_out(oim, j, n, _mm256_mul_ps(w1, im1));
+      }
+    }
+  }
+}
+
+/* Stratum k's waves along row r, eight samples at a time.  Every lane finds its slice n = floor(p) and
+ * blends slices n and n + 1 by n's border ramp (Alg. 1).  Before the ramp (u <= 0) the weights are exactly
+ * (amp, 0) and after it (u >= 1) exactly (0, amp), so a lane outside the ramp gets its single slice's
+ * amp T(tau) as in the reference's pure segments; what differs from the segment walk (stratum_row) is
+ * the rounding of the fused multiply-adds of the weights and the sums (< 1e-6), and a sample a rounding
+ * apart from a saturated ramp end.  Texel coordinates are computed exactly as the reference does.
+ * A, B, SP: scratch of at least (the row's records) + 9 floats each. */
+AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, int64_t r, float amp, float *ore,
+                                float *oim, float *A, float *B, float *SP) {
+  const int64_t Nx = J->Nx;
+  const float *xs = J->xs, *slp = J->slpos + k * J->S, nmk = J->nmin[k];
+  const int imag = J->want_imag;
+  float pa = xs[0] * sx + q, pb = xs[Nx - 1] * sx + q;
+  float nlo = floorf(pa < pb ? pa : pb), nhi = floorf(pa > pb ? pa : pb);
+  int64_t ri0 = (int64_t)(nlo - nmk), cnt = (int64_t)(nhi - nlo) + 2;  /* records of slices nlo .. nhi + 1 */
+  for (int64_t i = 0; i < cnt; i++) {
+    slice_affine(J, k, r, ri0 + i, &A[i], &B[i]);
+    SP[i] = slp[ri0 + i];
+  }
+  for (int64_t i = cnt; i < cnt + 9; i++) A[i] = B[i] = SP[i] = 0.0f;
+  const int regs = cnt <= 8;
+  const __m256 a0t = _mm256_loadu_ps(A), b0t = _mm256_loadu_ps(B), a1t = _mm256_loadu_ps(A + 1);
+  const __m256 b1t = _mm256_loadu_ps(B + 1), spt = _mm256_loadu_ps(SP);
+  const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vnlo = _mm256_set1_ps(nlo);
+  const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f);
+  const __m256 zero = _mm256_setzero_ps(), vamp = _mm256_set1_ps(amp);
+  const __m256 fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
+  for (int64_t j = 0; j < Nx; j += 8) {
+    int64_t m = Nx - j;
+    __m256i km = lane_mask(m < 8 ? m : 8);
+    __m256 x;
+    if (m >= 8) {
+      x = _mm256_loadu_ps(xs + j);
+    } else {  /* lanes past the row repeat its last sample: valid slices and texels */
+      x = _mm256_blendv_ps(_mm256_set1_ps(xs[Nx - 1]), _mm256_maskload_ps(xs + j, km), _mm256_castsi256_ps(km));
+    }
+    __m256 p = _mm256_add_ps(_mm256_mul_ps(x, vsx), vq), n = _mm256_floor_ps(p);
+    __m256i idx = _mm256_cvttps_epi32(_mm256_sub_ps(n, vnlo)), idx1 = _mm256_add_epi32(idx, _mm256_set1_epi32(1));
+    __m256 sp = pick(SP, spt, regs, idx);
+    __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_sub_ps(p, n), sp), c), half);
+    u = _mm256_min_ps(_mm256_max_ps(u, zero), one);
+    __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_set1_ps(2.0f), u)));
+    __m256 w0 = _mm256_andnot_ps(_mm256_cmp_ps(u, one, _CMP_GE_OQ), _mm256_mul_ps(vamp, cos_half_pi8(s)));
+    __m256 w1 = _mm256_andnot_ps(_mm256_cmp_ps(u, zero, _CMP_LE_OQ),
+                                 _mm256_mul_ps(vamp, cos_half_pi8(_mm256_sub_ps(one, s))));
+    __m256 tau0 = _mm256_add_ps(_mm256_mul_ps(x, pick(A, a0t, regs, idx)), pick(B, b0t, regs, idx));
+    __m256 tau1 = _mm256_add_ps(_mm256_mul_ps(x, regs ? _mm256_permutevar8x32_ps(a1t, idx) : pick(A, a1t, 0, idx1)),
+                                regs ? _mm256_permutevar8x32_ps(b1t, idx) : pick(B, b1t, 0, idx1));
+    __m256 t0, t1;
+    texels8 T0 = texels(tau0, fN, inv_N, &t0), T1 = texels(tau1, fN, inv_N, &t1);
+    __m256 l0 = _mm256_add_ps(fetch(J->tre, &T0), _mm256_mul_ps(fetch(J->dre, &T0), t0));
+    __m256 l1 = _mm256_add_ps(fetch(J->tre, &T1), _mm256_mul_ps(fetch(J->dre, &T1), t1));
+    __m256 acc = m >= 8 ? _mm256_loadu_ps(ore + j) : _mm256_maskload_ps(ore + j, km);
+    acc = _mm256_fmadd_ps(w1, l1, _mm256_fmadd_ps(w0, l0, acc));
+    if (m >= 8) _mm256_storeu_ps(ore + j, acc); else _mm256_maskstore_ps(ore + j, km, acc);
+    if (imag) {
+      l0 = _mm256_add_ps(fetch(J->tim, &T0), _mm256_mul_ps(fetch(J->dim, &T0), t0));
+      l1 = _mm256_add_ps(fetch(J->tim, &T1), _mm256_mul_ps(fetch(J->dim, &T1), t1));
+      acc = m >= 8 ? _mm256_loadu_ps(oim + j) : _mm256_maskload_ps(oim + j, km);
+      acc = _mm256_fmadd_ps(w1, l1, _mm256_fmadd_ps(w0, l0, acc));
+      if (m >= 8) _mm256_storeu_ps(oim + j, acc); else _mm256_maskstore_ps(oim + j, km, acc);
+    }
+  }
+}
+#endif
+
+static void pure(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore, float *oim) {
+#ifdef OMNI_X86
+  if (J->vector) return pure_avx2(J, o, m, a, b, amp, ore, oim);
+#endif
+  pure_scalar(J, o, m, a, b, amp, ore, oim);
+}
+
+static void blend(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0, float b0,
+                  float a1, float b1, float amp, float *ore, float *oim) {
+#ifdef OMNI_X86
+  if (J->vector) return blend_avx2(J, o, m, sx, q, fn, sp, a0, b0, a1, b1, amp, ore, oim);
+#endif
+  blend_scalar(J, o, m, sx, q, fn, sp, a0, b0, a1, b1, amp, ore, oim);
+}
+
+/* b of tau = x a + b, reduced mod N in float64 (fast._row_affine) */
+static inline float row_affine(float p, float shift, float inv_period, float zeta, float fN) {
+  double c = (((double)p - (double)shift) * (double)inv_period + (double)zeta) * (double)fN;
+  c = c - (double)fN * floor(c / (double)fN);
+  return (float)(c - 0.5);
+}
+
+/* slice record ri of stratum k on row r: a and b (fast._slice_affine) */
+static inline void slice_affine(const job_t *J, int64_t k, int64_t r, int64_t ri, float *a, float *b) {
+  const float *om = J->omega + (k * J->S + ri) * J->D, *oth = J->others + r * (J->D - 1);
+  float p = 0.0f;
+  for (int64_t d = 1; d < J->D; d++) p += oth[d - 1] * om[d];
+  *a = om[0] * (J->inv_period * J->fN);
+  *b = row_affine(p, J->shift, J->inv_period, J->zeta[k * J->S + ri], J->fN);
+}
+
+static inline int64_t clamp_index(double v, int64_t Nx) {
+  int64_t j = (int64_t)ceil(v);
+  return j < 0 ? 0 : (j > Nx ? Nx : j);
+}
+
+/* stratum k's waves along row r (fast._stratum_row) */
+static void stratum_row(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r, float amp,
+                        float *ore, float *oim) {
+  const int64_t Nx = J->Nx;
+  const float *xs = J->xs, *slp = J->slpos + k * J->S, nmk = J->nmin[k];
+  double hs = h * (double)sx;
+  if (hs == 0.0 || Nx == 1) {
+    float n = floorf(xs[0] * sx + q), a0, b0, a1, b1;
+    int64_t ri = (int64_t)(n - nmk);
+    slice_affine(J, k, r, ri, &a0, &b0);
+    slice_affine(J, k, r, ri + 1, &a1, &b1);
+    blend(J, 0, Nx, sx, q, n, slp[ri], a0, b0, a1, b1, amp, ore, oim);
+    return;
+  }
+  double P0 = (double)x0 * (double)sx + (double)q, inv_hs = 1.0 / hs;
+  float pa = xs[0] * sx + q, pb = xs[Nx - 1] * sx + q;
+  float nlo = floorf(pa < pb ? pa : pb), nhi = floorf(pa > pb ? pa : pb);
+  int64_t lo_ri = (int64_t)(nlo - nmk) - 1, hi_ri = (int64_t)(nhi - nmk);
+  int up = hs > 0.0;
+  int64_t cur = 0, count = hi_ri - lo_ri + 1;
+  float am, bm;
+  slice_affine(J, k, r, up ? lo_ri : hi_ri + 1, &am, &bm);
+  for (int64_t step = 0; step < count; step++) {
+    int64_t ri = up ? lo_ri + step : hi_ri - step;
+    float n = nmk + (float)ri, sp = slp[ri];
+    double e_lo = (double)n + (double)sp - 0.3, e_hi = (double)n + (double)sp + 0.3;
+    int64_t j_lo = clamp_index((e_lo - P0) * inv_hs, Nx), j_hi = clamp_index((e_hi - P0) * inv_hs, Nx);
+    int64_t j_in = up ? j_lo : j_hi, j_out = up ? j_hi : j_lo;
+    float a_lo, b_lo, a_hi, b_hi, an, bn;
+    if (up) {
+      a_lo = am, b_lo = bm;
+      slice_affine(J, k, r, ri + 1, &a_hi, &b_hi);
+      an = a_hi, bn = b_hi;
+    } else {
+      a_hi = am, b_hi = bm;
+      slice_affine(J, k, r, ri, &a_lo, &b_lo);
+      an = a_lo, bn = b_lo;
+    }
+    if (j_in > cur) {
+      pure(J, cur, j_in - cur, am, bm, amp, ore, oim);
+      cur = j_in;
+    }
+    if (j_out > cur) {
+      blend(J, cur, j_out - cur, sx, q, n, sp, a_lo, b_lo, a_hi, b_hi, amp, ore, oim);
+      cur = j_out;
+    }
+    am = an, bm = bn;
+  }
+  if (cur < Nx) pure(J, cur, Nx - cur, am, bm, amp, ore, oim);
+}
+
+int omni_abi(void) { return OMNI_ABI; }
+
+/* 1 where this CPU runs the AVX2 loops */
+int omni_vector(void) {
+#ifdef OMNI_X86
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+#else
+  return 0;
+#endif
+}
+
+/* Rows r0 .. r1 - 1 (fast._rows_kernel).  vector: use the AVX2 loops (only where omni_vector()). */
+void omni_rows(const float *xs, int64_t Nx, const float *others, int64_t r0, int64_t r1, const float *sdirs,
+               const float *soffs, const float *amps, int64_t K, int64_t D, const float *nmin, const float *slpos,
+               const float *omega, const float *zeta, int64_t S, const float *tre, const float *tim,
+               const float *dre, const float *dim, int64_t N, float inv_period, float shift, int want_imag,
+               int vector, float *out_re, float *out_im) {
+  job_t J = {xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tre, tim, dre, dim, out_re, out_im,
+             Nx, K, D, S, (float)N, 0.0f, inv_period, shift, want_imag, vector};
+  J.inv_N = 1.0f / J.fN;
+  float x0 = xs[0], *A = 0;
+#ifdef OMNI_X86
+  if (vector && !(A = malloc(3 * (S + 16) * sizeof(float)))) vector = J.vector = 0;  /* no memory: scalar */
+#endif
+  double h = Nx > 1 ? ((double)xs[Nx - 1] - (double)x0) / (double)(Nx - 1) : 1.0;
+  for (int64_t r = r0; r < r1; r++) {
+    float *ore = out_re + r * Nx, *oim = want_imag ? out_im + r * Nx : 0;
+    for (int64_t j = 0; j < Nx; j++) ore[j] = 0.0f;
+    if (want_imag)
+      for (int64_t j = 0; j < Nx; j++) oim[j] = 0.0f;
+    for (int64_t k = 0; k < K; k++) {
+      float q = 0.0f;
+      for (int64_t d = 1; d < D; d++) q += others[r * (D - 1) + d - 1] * sdirs[k * D + d];
+      q = q + soffs[k];
+#ifdef OMNI_X86
+      /* long slices (SEGMENT_WALK samples or more): the segment walk; else eight samples at a time */
+      if (vector && !(fabs(h * (double)sdirs[k * D]) * SEGMENT_WALK < 1.0)) {
+        stratum_blocks(&J, sdirs[k * D], q, k, r, amps[k], ore, oim, A, A + S + 16, A + 2 * (S + 16));
+        continue;
+      }
+#endif
+      stratum_row(&J, h, x0, sdirs[k * D], q, k, r, amps[k], ore, oim);
+    }
+  }
+  free(A);
+}

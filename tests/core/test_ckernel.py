@@ -1,0 +1,138 @@
+"""The C row kernel (backend/wavenoise/rows.c) against the numba row kernel, its reference."""
+import os
+import shutil
+import sys
+
+import numpy as np
+import pytest
+
+from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
+from backend.wavenoise import ckernel, fast
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+HAS_CC = any(shutil.which(c) for c in (os.environ.get("CC") or "cc", "gcc", "clang"))
+
+
+@pytest.fixture(scope="module", autouse=True)
+def built():
+    """The kernel as make setup builds it; built here if a compiler exists but the library does not."""
+    if not ckernel.available():
+        if not HAS_CC:
+            pytest.skip("no C compiler: the engine runs its numba kernel")
+        sys.path.insert(0, os.path.join(ROOT, "tools"))
+        import build_kernel
+        assert build_kernel.build(), "the C kernel failed to build"
+        ckernel._lib = None
+    assert ckernel.available()
+
+
+def _case(dim, extent, directions=12, speed=0.0, seed=5, spectrum=("bandpass", 3, 9)):
+    noise = compile_noise(WaveSettings(dim=dim, spectrum=Spectrum(*spectrum), directions=directions, seed=seed,
+                                       speed=speed))
+    return noise
+
+
+def _rows(noise, xs, others, time=0.4, mode="c", imag=True, threads=None):
+    """One set of rows by the C kernel (mode c / scalar) or the numba reference (mode numba)."""
+    lo = np.concatenate([[xs.min()], others.min(0)]).astype(np.float32)
+    hi = np.concatenate([[xs.max()], others.max(0)]).astype(np.float32)
+    plan = fast.grid_plan(noise, lo, hi, time)
+    re = np.empty((len(others), len(xs)), np.float32)
+    im = np.empty_like(re) if imag else None
+    if mode == "numba":
+        plan.ctables = None
+        plan.rows(xs, others, re, im)
+    else:
+        saved = ckernel._threads
+        if threads:
+            ckernel._threads = lambda: threads
+        try:
+            ckernel.rows(xs, others, noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, plan.nmin, plan.slpos,
+                         plan.omega, plan.zeta, plan.ctables, np.float32(1.0 / noise.table.period), plan.shift,
+                         re, im, use_vector=(mode == "c"))
+        finally:
+            ckernel._threads = saved
+    return re, im
+
+
+def _row_set(dim, nx, x0, x1, rows=23, spread=5.0, seed=0):
+    xs = np.linspace(x0, x1, nx).astype(np.float32)
+    others = np.random.default_rng(seed).uniform(-spread, spread, (rows, dim - 1)).astype(np.float32)
+    return xs, others
+
+
+needs_numba = pytest.mark.skipif(not fast.available(), reason="numba (the reference) not installed")
+
+
+@needs_numba
+@pytest.mark.parametrize("dim,nx,x0,x1,speed", [
+    (2, 203, -1.3, 3.7, 0.0),      # short slices: eight samples at a time, rows not a multiple of 8
+    (3, 128, 0.0, 4.0, 0.0),       # the bench's 3D row
+    (3, 37, 10.0, 11.0, 0.6),      # animated, far from the origin
+    (4, 16, -2.0, 2.0, 0.0),
+    (2, 1024, 0.0, 0.5, 0.0),      # long slices: the segment walk
+    (2, 300, -40.0, 40.0, 0.0),    # dozens of slices per row: records gathered, not permuted
+    (3, 1, 0.3, 0.3, 0.0),         # one sample per row
+    (2, 7, 0.0, 0.01, 0.0),        # fewer samples than one vector
+])
+def test_c_kernel_equals_numba(dim, nx, x0, x1, speed):
+    noise = _case(dim, x1 - x0, speed=speed)
+    xs, others = _row_set(dim, nx, x0, x1)
+    ref_re, ref_im = _rows(noise, xs, others, mode="numba")
+    for mode in ("c", "scalar"):
+        re, im = _rows(noise, xs, others, mode=mode)
+        for a, b in ((re, ref_re), (im, ref_im)):
+            d = np.abs(a - b).max()
+            # the segment walk and the scalar loops are numba's operations one for one; the blocks fuse
+            # the weights' multiply-adds (about 1 ulp); a wrong slice, weight or texel would differ by O(0.1)
+            assert d <= (0.0 if mode == "scalar" else 2e-6), (mode, d)
+    assert ref_re.std() > 0.1  # a real signal was compared
+    real_only, _ = _rows(noise, xs, others, mode="c", imag=False)
+    assert np.array_equal(real_only, _rows(noise, xs, others, mode="c")[0])
+
+
+@needs_numba
+def test_axis_aligned_direction_and_threads():
+    """A stratum whose slices do not change along the row (s_x = 0), and rows split over threads."""
+    noise = _case(3, 4.0, directions=8, seed=2)
+    noise.slice_dirs[0] = np.array([0.0, 0.6, 0.8], np.float32)  # p constant along x for stratum 0
+    xs, others = _row_set(3, 77, 0.0, 4.0, rows=41)
+    ref, _ = _rows(noise, xs, others, mode="numba")
+    one, _ = _rows(noise, xs, others, threads=1)
+    two, _ = _rows(noise, xs, others, threads=3)
+    assert np.array_equal(one, two)
+    assert np.abs(one - ref).max() <= 2e-6
+
+
+def test_grid_without_numba_uses_the_c_kernel(monkeypatch):
+    """Blender's Python has no numba: grids still get a plan, run by the C kernel, equal to numpy."""
+    noise = _case(3, 3.0)
+    monkeypatch.setattr(fast, "numba", None)
+    plan = fast.grid_plan(noise, np.zeros(3, np.float32), np.full(3, 3.0, np.float32), 0.4)
+    assert plan is not None and plan.ctables is not None
+    a = evaluate_grid(noise, 20, 3.0, "real", 0.4)
+    g = np.arange(20, dtype=np.float32) * np.float32(3.0 / 20)
+    z, y, x = np.meshgrid(g, g, g, indexing="ij")
+    pts = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)
+    b = noise.evaluate(pts, 0.4, accelerate=False).real.reshape(a.shape)
+    assert np.percentile(np.abs(a - b), 99) < 3e-4 and np.abs(a - b).max() < 1e-3
+
+
+def test_switch_off_and_bad_arrays():
+    noise = _case(2, 2.0)
+    before = ckernel.set_enabled(False)
+    try:
+        plan = fast.grid_plan(noise, np.zeros(2, np.float32), np.full(2, 2.0, np.float32), 0.0)
+        assert plan is None or plan.ctables is None  # numba's kernel (or numpy) runs
+    finally:
+        ckernel.set_enabled(before)
+    plan = fast.grid_plan(noise, np.zeros(2, np.float32), np.full(2, 2.0, np.float32), 0.0)
+    xs = np.linspace(0, 2, 16).astype(np.float32)
+    others = np.zeros((4, 1), np.float32)
+    out = np.empty((4, 32), np.float32)[:, ::2]  # not contiguous
+    with pytest.raises(ValueError, match="C-contiguous"):
+        ckernel.rows(xs, others, noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, plan.nmin, plan.slpos,
+                     plan.omega, plan.zeta, plan.ctables, np.float32(1.0), plan.shift, out)
+    with pytest.raises(ValueError, match="shapes"):
+        ckernel.rows(xs[:5], others, noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, plan.nmin, plan.slpos,
+                     plan.omega, plan.zeta, plan.ctables, np.float32(1.0), plan.shift, np.empty((4, 16), np.float32))
