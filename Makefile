@@ -67,8 +67,10 @@ bench: $(VENV)/.bench kernel
 	$(BIN)/python bench/bench_wave.py
 
 # installable extension zips (linux-x64, windows-x64, macos-arm64) in dist/, built and validated
-# with Blender's own extension builder from the bpy wheel
+# with Blender's own extension builder from the bpy wheel; Zig (PyPI's ziglang) cross-compiles the
+# C row kernel of wave noise for each platform
 dist: $(STAMP)
+	$(BIN)/python -m pip install -q ziglang==0.17.1
 	$(BIN)/python tools/build_dist.py --out dist
 
 clean:

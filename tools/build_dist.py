@@ -6,15 +6,19 @@
    linux-x64, windows-x64 and macos-arm64 into ``wheels/`` (kept between runs).
    One zip per platform carries both; Blender installs the wheels that match
    its own Python and the builder lists both versions in ``python_versions``.
+   With the ``ziglang`` package installed (``make dist`` installs it), also build the C row kernel of wave
+   noise for each platform (``tools/build_kernel.py``: Zig cross-compiles it) as the wheel
+   ``omninoise_rows``, so installed extensions bake wave noise with it instead of numpy.
 2. Stage the runtime files only (extension root, ``blender_addon``, ``backend``,
    ``export``; no tests, bench, demo or training code) into ``build/extension``
    and list the platforms and wheels in the staged manifest.
 3. Run ``blender_ext.py build --split-platforms`` from the ``bpy`` wheel (the
    same as ``blender --command extension build``), then ``validate`` each zip.
 
-Usage: python tools/build_dist.py [--out dist] [--no-wheels]
-(``--no-wheels`` builds one platform-independent zip without bundled wheels,
-which the tests install; the wheels are only needed by the neural features.)
+Usage: python tools/build_dist.py [--out dist] [--no-wheels [--kernel]]
+(``--no-wheels`` builds one zip without bundled wheels, which the tests install; the wheels are only needed
+by the neural features.  ``--kernel`` adds this machine's kernel wheel, built with its own C compiler, to
+that zip, for this machine's platform only.)
 """
 from __future__ import annotations
 
@@ -27,6 +31,9 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+
+import build_kernel  # noqa: E402
 PINS = {"onnxruntime": "1.31.1", "OpenEXR": "3.5.3"}
 #: the Pythons of the supported Blenders: 4.2 LTS-5.0 run 3.11, 5.1 and newer 3.13
 PYTHONS = ("3.11", "3.13")
@@ -73,12 +80,15 @@ def download_wheels() -> list[str]:
                 print(f"downloading wheels for {plat}, Python {py}", flush=True)
                 subprocess.run(cmd, check=True)
         for f in sorted(os.listdir(dest)):
-            if f.endswith(".whl") and not f.startswith("numpy-"):
+            if f.endswith(".whl") and not f.startswith(("numpy-", build_kernel.PACKAGE + "-")):
                 out.append(os.path.join(dest, f))
+        kernel = build_kernel.kernel_wheel(plat, os.path.join(ROOT, "build", "kernel", plat))
+        if kernel:
+            out.append(kernel)
     return out
 
 
-def stage(wheels: list[str]) -> str:
+def stage(wheels: list[str], platforms=tuple(PLATFORMS)) -> str:
     dst = os.path.join(ROOT, "build", "extension-nowheels" if not wheels else "extension")
     shutil.rmtree(dst, ignore_errors=True)
     os.makedirs(os.path.join(dst, "wheels"))
@@ -100,7 +110,7 @@ def stage(wheels: list[str]) -> str:
     text = open(man, encoding="utf-8").read()
     extra = ""
     if names:
-        extra = ("platforms = [" + ", ".join(f'"{p}"' for p in PLATFORMS) + "]\n"
+        extra = ("platforms = [" + ", ".join(f'"{p}"' for p in platforms) + "]\n"
                  "wheels = [\n" + "".join(f'  "./wheels/{n}",\n' for n in names) + "]\n")
     text = re.sub(r"(blender_version_min\s*=.*\n)", lambda m: m.group(1) + extra, text, count=1)
     open(man, "w", encoding="utf-8").write(text)
@@ -111,9 +121,19 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "dist"))
     ap.add_argument("--no-wheels", action="store_true", help="one zip without bundled wheels")
+    ap.add_argument("--kernel", action="store_true",
+                    help="with --no-wheels: add this machine's C kernel wheel (linux-x64 only)")
     a = ap.parse_args()
     tool = blender_ext()
-    src = stage([] if a.no_wheels else download_wheels())
+    if a.no_wheels and a.kernel:
+        if not sys.platform.startswith("linux"):
+            sys.exit("--kernel builds the linux-x64 kernel wheel with this machine's compiler: Linux only")
+        wheel = build_kernel.kernel_wheel("linux-x64", os.path.join(ROOT, "build", "kernel-native"), native=True)
+        if not wheel:
+            sys.exit("--kernel: the C kernel did not build (see above)")
+        src = stage([wheel], ("linux-x64",))
+    else:
+        src = stage([] if a.no_wheels else download_wheels())
     os.makedirs(a.out, exist_ok=True)
     split = [] if a.no_wheels else ["--split-platforms"]
     subprocess.run([sys.executable, tool, "build", "--source-dir", src, "--output-dir", a.out] + split, check=True)

@@ -1,7 +1,8 @@
 """The C row kernel (``rows.c``), loaded with ctypes when it has been built.
 
 ``tools/build_kernel.py`` (run by ``make setup``) compiles ``rows.c`` next to this file as
-``_omni_rows.so`` (``.dylib`` on macOS, ``.dll`` on Windows).  Without it, or with
+``_omni_rows.so`` (``.dylib`` on macOS, ``.dll`` on Windows); an installed extension has it from the
+``omninoise_rows`` wheel that ``make dist`` builds for each platform.  Without either, or with
 OMNINOISE_NO_CKERNEL=1, :mod:`.fast` runs its numba row kernel, which stays the reference: both
 compute the same float32 operations in the same order (tested to be equal).  The call releases the
 GIL, so rows are split across Python threads.
@@ -17,7 +18,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-__all__ = ["library_path", "available", "set_enabled", "vector", "padded", "rows"]
+__all__ = ["local_path", "library_path", "available", "set_enabled", "vector", "padded", "rows"]
 
 _F = np.float32
 ABI = 1
@@ -25,12 +26,24 @@ ABI = 1
 PAD = 16
 _SUFFIX = {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
 _lib = None
-_pool = None
 _enabled = not os.environ.get("OMNINOISE_NO_CKERNEL")
 
 
-def library_path() -> str:
+def local_path() -> str:
+    """Where tools/build_kernel.py builds the library for this machine (a development checkout)."""
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), "_omni_rows" + _SUFFIX)
+
+
+def library_path() -> str | None:
+    """The library to load: a local build, else the ``omninoise_rows`` wheel's (the extension's); or None."""
+    if os.path.isfile(local_path()):
+        return local_path()
+    try:
+        import omninoise_rows
+    except ImportError:
+        return None
+    path = getattr(omninoise_rows, "LIBRARY", None)
+    return path if path and os.path.isfile(path) else None
 
 
 def _load():
@@ -38,7 +51,7 @@ def _load():
     if _lib is None:
         _lib = False
         path = library_path()
-        if not os.path.isfile(path):
+        if path is None:
             return None
         try:
             lib = ctypes.CDLL(path)
@@ -103,7 +116,6 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
     """Fill out_re (and out_im) float32 (R, Nx), C-contiguous, like fast._rows_kernel.
 
     tables: :func:`padded`'s four arrays.  Every array must be C-contiguous float32 (checked)."""
-    global _pool
     lib = _load()
     if lib is None:  # callers ask available() first (GridPlan)
         raise RuntimeError("the C row kernel is not built (python tools/build_kernel.py)")
@@ -130,10 +142,10 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
     n = max(1, min(_threads(), R))
     if n == 1:
         return run(0, R)
-    if _pool is None or _pool._max_workers < n:
-        _pool = ThreadPoolExecutor(max(n, 2), thread_name_prefix="omninoise-rows")
-    # more pieces than threads, so a thread that got cheap rows takes another
+    # more pieces than threads, so a thread that got cheap rows takes another; threads live for one call
+    # (a slab of rows takes milliseconds, starting two threads microseconds), so none outlives a bake
     pieces = min(R, 4 * n)
     bounds = [R * i // pieces for i in range(pieces + 1)]
-    for f in [_pool.submit(run, a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]:
-        f.result()
+    with ThreadPoolExecutor(n, thread_name_prefix="omninoise-rows") as pool:
+        for f in [pool.submit(run, a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]:
+            f.result()

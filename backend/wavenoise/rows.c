@@ -38,11 +38,17 @@
 
 #if defined(__x86_64__) || defined(_M_X64)
 #define OMNI_X86 1
+#include <cpuid.h>
 #include <immintrin.h>
 #define AVX2 __attribute__((target("avx2,fma")))
 #endif
 
 #define OMNI_ABI 1
+#ifdef _WIN32
+#define OMNI_API __declspec(dllexport)
+#else
+#define OMNI_API __attribute__((visibility("default")))
+#endif
 #ifndef SEGMENT_WALK
 #define SEGMENT_WALK 128
 #endif
@@ -426,20 +432,26 @@ static void stratum_row(const job_t *J, double h, float x0, float sx, float q, i
   if (cur < Nx) pure(J, cur, Nx - cur, am, bm, amp, ore, oim);
 }
 
-int omni_abi(void) { return OMNI_ABI; }
+OMNI_API int omni_abi(void) { return OMNI_ABI; }
 
-/* 1 where this CPU runs the AVX2 loops */
-int omni_vector(void) {
+/* 1 where this CPU and its OS run the AVX2 + FMA loops: CPUID and XGETBV read directly (the compilers'
+ * __builtin_cpu_supports needs a runtime that cross-compiled libraries may lack) */
+OMNI_API int omni_vector(void) {
 #ifdef OMNI_X86
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
+  unsigned a, b, c, d, lo, hi;
+  if (!__get_cpuid(1, &a, &b, &c, &d)) return 0;
+  if (!((c >> 27) & 1) || !((c >> 28) & 1) || !((c >> 12) & 1)) return 0;  /* OSXSAVE, AVX, FMA */
+  __asm__ volatile("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0));
+  if ((lo & 6) != 6) return 0;  /* the OS saves the YMM registers */
+  if (!__get_cpuid_count(7, 0, &a, &b, &c, &d)) return 0;
+  return (b >> 5) & 1;  /* AVX2 */
 #else
   return 0;
 #endif
 }
 
 /* Rows r0 .. r1 - 1 (fast._rows_kernel).  vector: use the AVX2 loops (only where omni_vector()). */
-void omni_rows(const float *xs, int64_t Nx, const float *others, int64_t r0, int64_t r1, const float *sdirs,
+OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_t r0, int64_t r1, const float *sdirs,
                const float *soffs, const float *amps, int64_t K, int64_t D, const float *nmin, const float *slpos,
                const float *omega, const float *zeta, int64_t S, const float *tre, const float *tim,
                const float *dre, const float *dim, int64_t N, float inv_period, float shift, int want_imag,

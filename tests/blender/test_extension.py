@@ -1,6 +1,7 @@
 """Build the extension with Blender's builder, install it into temporary user folders, enable/disable."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -10,11 +11,15 @@ pytest.importorskip("bpy")
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
+#: the test zip carries this machine's C kernel wheel (build_dist.py --kernel) where it can be built
+KERNEL = sys.platform.startswith("linux") and bool(shutil.which(os.environ.get("CC") or "cc"))
+
+
 @pytest.fixture(scope="module")
 def built_zip(tmp_path_factory):
     out = tmp_path_factory.mktemp("dist")
     r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "build_dist.py"), "--no-wheels", "--out",
-                        str(out)], capture_output=True, text=True)
+                        str(out)] + (["--kernel"] if KERNEL else []), capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
     zips = [f for f in os.listdir(out) if f.endswith(".zip")]
     assert len(zips) == 1 and "valid" in r.stdout
@@ -29,7 +34,8 @@ def test_zip_holds_runtime_files_only(built_zip):
     assert "blender_addon/solid_ui.py" in names and "backend/solid/model.py" in names
     assert "models/solid/gravel_3d/decoder.onnx" in names and "models/solid/gravel_3d/solid.json" in names
     assert not [n for n in names if n.startswith(("tests/", "bench/", "demo/", "tools/", "training/"))
-                or "__pycache__" in n]
+                or "__pycache__" in n or "_omni_rows" in n]  # the kernel comes as a wheel, not this machine's build
+    assert bool([n for n in names if n.startswith("wheels/omninoise_rows-")]) == KERNEL
 
 
 def test_runtime_never_imports_torch():
@@ -60,6 +66,11 @@ def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
     assert (out["form_osl_scene"], out["scripts_osl_scene"]) == want
     assert (out["form_svm_scene"], out["groups_svm_scene"]) == ("nodes", 5)
     assert out["cache_dir"].startswith(str(tmp_path))  # the user folder, not the extension's own
+    # the installed extension found the kernel in the wheel Blender installed, and it computes the engine's noise
+    assert out["kernel_available"] == KERNEL
+    if KERNEL:
+        assert out["kernel_path"].startswith(str(tmp_path)) and "omninoise_rows" in out["kernel_path"]
+    assert out["kernel_vs_other"] < 1e-5 and out["kernel_signal"] > 0.1
     assert not out["disabled_props"] and out["reenabled_props"]
     if not out["openvdb"]:  # the bpy 4.2 wheel: a one-line message instead of a volume
         assert out["bake"] == ["ERROR"] and "OpenVDB Python module" in out["bake_error"]

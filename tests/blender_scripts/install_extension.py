@@ -49,6 +49,19 @@ try:
     out["openvdb"] = True
 except RuntimeError:  # the bpy 4.2 wheel: no OpenVDB module; the bake must say so in one line
     out["openvdb"] = False
+# the C row kernel from the extension's omninoise_rows wheel (zips built with --kernel), against the
+# engine's other path (numba where this Python has it, else numpy)
+ck = importlib.import_module(MOD + ".backend.wavenoise.ckernel")
+be = importlib.import_module(MOD + ".backend")
+out["kernel_path"] = ck.library_path()
+out["kernel_available"] = ck.available()
+noise = be.compile_noise(be.WaveSettings(dim=3, directions=8, seed=1))
+with_kernel = be.evaluate_grid(noise, 12, 2.0)
+ck.set_enabled(False)
+without = be.evaluate_grid(noise, 12, 2.0)
+ck.set_enabled(True)
+out["kernel_vs_other"] = float(abs(with_kernel - without).max())
+out["kernel_signal"] = float(without.std())
 bake = bpy.context.scene.omninoise_bake
 bake.bounds_mode = "CUSTOM"
 bake.volume_resolution = (8, 8, 8)

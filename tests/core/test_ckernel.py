@@ -136,3 +136,36 @@ def test_switch_off_and_bad_arrays():
     with pytest.raises(ValueError, match="shapes"):
         ckernel.rows(xs[:5], others, noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, plan.nmin, plan.slpos,
                      plan.omega, plan.zeta, plan.ctables, np.float32(1.0), plan.shift, np.empty((4, 16), np.float32))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the native kernel wheel is built on Linux")
+def test_kernel_wheel_installs_and_loads(tmp_path):
+    """The wheel make dist ships (here built with this machine's compiler): valid RECORD, and once installed
+    the runtime finds its library where no local build exists (an installed extension)."""
+    import base64
+    import hashlib
+    import subprocess
+    import zipfile
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    import build_kernel
+    wheel = build_kernel.kernel_wheel("linux-x64", str(tmp_path / "w"), native=True)
+    assert wheel and wheel.endswith("-py3-none-manylinux_2_17_x86_64.whl")
+    z = zipfile.ZipFile(wheel)
+    record = z.read([n for n in z.namelist() if n.endswith("RECORD")][0]).decode().splitlines()
+    for line in record:
+        name, digest, size = line.rsplit(",", 2)
+        if digest:
+            data = z.read(name)
+            want = "sha256=" + base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
+            assert digest == want and int(size) == len(data), name
+    target = tmp_path / "site"
+    r = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-index", "--target",
+                        str(target), wheel], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    code = ("import sys; from backend.wavenoise import ckernel; "
+            "ckernel.local_path = lambda: '/nonexistent/_omni_rows.so'; "
+            "print(ckernel.library_path()); print(ckernel.available())")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(target), ROOT]))
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=str(tmp_path))
+    path, ok = r.stdout.split()
+    assert path.startswith(str(target)) and ok == "True", r.stdout + r.stderr
