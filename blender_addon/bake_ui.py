@@ -35,6 +35,17 @@ _CELLULAR = [("none", "None", "Plain wave noise"), ("polytope", "Polytope", "Dis
              ("code", "Cell Code", "Random value per cell"), ("stit", "STIT", "Recursive STIT tessellation")]
 
 
+
+def _with_precision(fn):
+    """A worker function that runs ``fn(progress, cancel)`` with the preferences' neural precision, read
+    now (on the main thread: preferences are not read from worker threads)."""
+    prec = precision()
+
+    def work(progress, cancel):
+        importlib.import_module(f"{backend.__name__}.neural.precision").set_default_precision(prec)
+        return fn(progress, cancel)
+    return work
+
 def _apply_preset(self, context) -> None:
     node = ramp_node()
     tf = apply_preset(node.color_ramp, self.preset)
@@ -180,11 +191,7 @@ class _BakeOperator(TaskOperator):
                 and obj.active_material.node_tree is not None:
             mat = obj.active_material
 
-        prec = precision()  # read on the main thread
-
-        def work(progress, cancel):
-            importlib.import_module(f"{backend.__name__}.neural.precision").set_default_precision(prec)
-            return backend.bake.run_bake(spec, progress, cancel)
+        work = _with_precision(lambda progress, cancel: backend.bake.run_bake(spec, progress, cancel))
 
         def done(result):
             paths = [backend.bake.frame_path(spec.output, f) for f in spec.frame_list()]
@@ -252,11 +259,8 @@ class OMNINOISE_OT_run_job(TaskOperator, bpy.types.Operator):
             return None
         keep_going, force = self.keep_going or p.keep_going, self.force or p.force
 
-        prec = precision()  # read on the main thread
-
-        def work(progress, cancel):
-            importlib.import_module(f"{backend.__name__}.neural.precision").set_default_precision(prec)
-            return backend.jobs.run_job(path, keep_going=keep_going, force=force, progress=progress, cancel=cancel)
+        work = _with_precision(lambda progress, cancel: backend.jobs.run_job(
+            path, keep_going=keep_going, force=force, progress=progress, cancel=cancel))
 
         def done(outcomes):
             bad = [o for o in outcomes if o.status in ("invalid", "failed", "cancelled")]

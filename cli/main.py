@@ -503,7 +503,7 @@ def neural_request(a: argparse.Namespace, model):
 def run_neural(a: argparse.Namespace) -> int:
     import json
 
-    from backend.neural.model import ModelError, NeuralNoiseModel
+    from backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable
     from backend.neural.request import generate_request
 
     from backend.neural.generate import check_sampler
@@ -522,9 +522,9 @@ def run_neural(a: argparse.Namespace) -> int:
     folder = a.model or neural_model()
     try:
         model = NeuralNoiseModel(folder)
+    except PrecisionUnavailable as exc:
+        raise SettingError("--precision", str(exc)) from None
     except ModelError as exc:
-        if "int8" in str(exc):
-            raise SettingError("--precision", str(exc)) from None
         raise SettingError("--model", f"{exc}; train and export one (see models/README.md) or pass --model") from None
     if a.list:
         print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))

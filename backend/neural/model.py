@@ -19,9 +19,14 @@ from ..onnx_models import ModelError, SessionCache, fingerprint, load_model_json
 from .precision import resolve as resolve_precision
 from .schedule import alphas_from_config
 
-__all__ = ["NeuralNoiseModel", "ModelError", "sha256_file"]
+__all__ = ["NeuralNoiseModel", "ModelError", "PrecisionUnavailable", "sha256_file"]
 
 _F = np.float32
+
+
+class PrecisionUnavailable(ModelError):
+    """The model folder cannot run the requested precision (no int8 denoisers, or damaged ones); the
+    float32 model itself is fine."""
 
 
 def _tile_flag(tileable: bool) -> np.ndarray:
@@ -67,8 +72,13 @@ class NeuralNoiseModel:
         self.precision = resolve_precision(precision)
         if self.precision == "int8":
             if self.form != "split":
-                raise ModelError(f"{folder}: int8 needs a split export (this one is {self.form})")
-            self._check_int8(folder, int8)
+                raise PrecisionUnavailable(f"{folder}: int8 needs a split export (this one is {self.form})")
+            try:
+                self._check_int8(folder, int8)
+            except PrecisionUnavailable:
+                raise
+            except ModelError as exc:  # a damaged int8 file: the precision is what cannot run
+                raise PrecisionUnavailable(str(exc)) from None
         # no CPU arena: at 1024² it kept 11.8 GB against 4.4 GB without, with steps no slower (bench_neural.py),
         # and inside Blender the arena would hold that memory after every bake
         self._sessions = SessionCache(folder, threads, arena=False)
@@ -77,7 +87,7 @@ class NeuralNoiseModel:
     def _check_int8(folder: str, int8: dict) -> None:
         """ModelError unless the folder's int8 denoisers exist and match their sha256 in the JSON."""
         if not int8.get("files"):
-            raise ModelError(f"{folder}: no int8 denoisers (make them with python -m training.quantize_onnx {folder})")
+            raise PrecisionUnavailable(f"{folder}: no int8 denoisers (make them with python -m training.quantize_onnx {folder})")
         verify_files(folder, int8["files"], "neural_noise.json")
 
     def denoiser_name(self, tileable: bool) -> str:

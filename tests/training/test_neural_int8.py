@@ -13,9 +13,9 @@ from backend.errors import SettingError  # noqa: E402
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural import precision as P  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable  # noqa: E402
 from training.quantize_onnx import INT8_FILES, calibration_feeds, quantize_folder  # noqa: E402
-from test_neural_runtime import TINY, exported  # noqa: E402,F401  (the tiny split export, trained once)
+from tiny_run import TINY  # noqa: E402  (the export itself: the `exported` fixture of tests/training/conftest.py)
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +79,7 @@ def test_precision_choice(folders, default_precision):
     P.set_default_precision("int8")
     assert NeuralNoiseModel(int8).precision == "int8"  # None: the module default (the CLI's --precision)
     assert NeuralNoiseModel(int8, precision="fp32").precision == "fp32"
-    with pytest.raises(ModelError, match="quantize_onnx"):
+    with pytest.raises(PrecisionUnavailable, match="quantize_onnx"):
         NeuralNoiseModel(fp32)  # int8 asked for by default, but this folder has no int8 files
     with pytest.raises(SettingError, match="precision"):
         NeuralNoiseModel(int8, precision="int4")
@@ -113,8 +113,8 @@ def test_damaged_int8_file_is_refused(folders, tmp_path):
         fh.seek(100)
         fh.write(b"\xff\xfe")
     NeuralNoiseModel(str(bad), precision="fp32")  # fp32 never reads it
-    with pytest.raises(ModelError, match="denoiser_int8.onnx: sha256"):
-        NeuralNoiseModel(str(bad), precision="int8")
+    with pytest.raises(PrecisionUnavailable, match="denoiser_int8.onnx: sha256"):  # a ModelError the CLI
+        NeuralNoiseModel(str(bad), precision="int8")  # reports as --precision, not as a bad --model
     os.remove(bad / "denoiser_int8.onnx")
     with pytest.raises(ModelError, match="missing"):
         NeuralNoiseModel(str(bad), precision="int8")

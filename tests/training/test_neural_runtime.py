@@ -19,18 +19,7 @@ from training.export_onnx import export, reexport  # noqa: E402
 from training.train import TrainConfig, build_model, train  # noqa: E402
 from training.unet import set_circular  # noqa: E402
 
-TINY = dict(size=16, batch=4, steps=3, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=3, sample_every=0,
-            classes=("perlin", "spots", "cells_f1"))
-
-
-@pytest.fixture(scope="module")
-def exported(tmp_path_factory):
-    """A tiny trained run and its export in the default (split) form."""
-    run = tmp_path_factory.mktemp("run")
-    out = tmp_path_factory.mktemp("model")
-    train(TrainConfig.from_dict(TINY), str(run), log=lambda s: None)
-    export(str(run), str(out))
-    return run, out
+from tiny_run import TINY  # noqa: E402  (the run itself: the `exported` fixture of tests/training/conftest.py)
 
 
 @pytest.fixture(scope="module")
