@@ -8,6 +8,7 @@ The "wave 16 floor" rows (bench/lookup_floor.c, compiled with cc) are idealised
 hand-vectorised AVX2 rows, not an engine: "pure" does one table lerp per
 direction per sample and nothing else, a lower bound for any exact kernel;
 "blend" does the border ramp's two lerps and weights everywhere.
+"wave 16 dirs, numba kernel" is the same engine with the C row kernel switched off.
 Then streams a 512^3 grid and reports peak memory against the output's size.
 
 Run: make bench   (numbers: median of --repeat runs, wall clock, this machine)
@@ -29,7 +30,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
-from backend.wavenoise import fast  # noqa: E402
+from backend.wavenoise import ckernel, fast  # noqa: E402
 
 
 def timed(fn, repeat):
@@ -132,6 +133,12 @@ def wave_times(dim, n, repeat, dirs):
         s = WaveSettings(dim=dim, spectrum=Spectrum("fractal", 1.0, 16.0, 1.0), directions=k, seed=1)
         noise = compile_noise(s)
         out[f"wave {k} dirs"] = timed(lambda: evaluate_grid(noise, n, 4.0), repeat)
+        if k == 16 and ckernel.available() and fast.available():  # the same grids on numba's row kernel
+            before = ckernel.set_enabled(False)
+            try:
+                out["wave 16 dirs, numba kernel"] = timed(lambda: evaluate_grid(noise, n, 4.0), repeat)
+            finally:
+                ckernel.set_enabled(before)
     return out
 
 
@@ -181,7 +188,9 @@ def main():
     a = ap.parse_args()
     cases = [(2, 256), (3, 48)] if a.quick else [(2, 1024), (3, 128), (3, 256)]
     dirs = (8, 16) if a.quick else (8, 16, 32, 64)
-    print(f"wave noise engine: {'numba' if fast.available() else 'numpy'} path, {os.cpu_count()} cores")
+    engine = ("C kernel (" + ("AVX2" if ckernel.vector() else "scalar") + ")" if ckernel.available()
+              else "numba" if fast.available() else "numpy")
+    print(f"wave noise engine: {engine} grid rows, {os.cpu_count()} cores")
     results = {}
     floor = {} if a.quick else lookup_floor()
     for dim, n in cases:
@@ -201,6 +210,8 @@ def main():
         for k, v in sorted(ns.items(), key=lambda kv: kv[1]):
             ratio = v / peer_ns[fastest] if fastest else float("nan")
             print(f"  {k:34s} {v:10.1f}  {ratio:6.2f}x")
+        if "wave 16 dirs, numba kernel" in ns:
+            print(f"  wave 16 dirs: numba kernel / C kernel: {ns['wave 16 dirs, numba kernel'] / ns['wave 16 dirs']:.2f}x")
         for kind in ("blend", "pure"):
             fl = ns.get(f"wave 16 floor, {kind} (AVX2 C)")
             if fl:
