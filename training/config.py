@@ -35,6 +35,7 @@ class TrainConfig:
     min_snr_gamma: float = 0.0     # min-SNR-γ loss weighting (Hang et al. 2023), 5 in the paper; 0: plain MSE
     emb_dim: int = 32
     widths: tuple = (32, 64, 128)
+    deep: int = 0                  # levels of the zero-initialised deep branch at the bottleneck (.unet.DeepBranch)
     classes: tuple = field(default_factory=lambda: zoo.CLASS_NAMES)
     seeds_per_set: int = 4
     sets_per_class: int = 16384
@@ -60,8 +61,11 @@ class TrainConfig:
         bad = [c for c in d.get("classes", ()) if c not in zoo.CLASSES]
         if bad:
             raise ValueError(f"unknown class {bad[0]!r}")
-        if d.get("size", 64) % 8:
-            raise ValueError(f"size must be a multiple of 8, got {d['size']}")
+        levels = len(d.get("widths", (32, 64, 128))) + int(d.get("deep", 0))
+        if d.get("size", 64) % (1 << levels):
+            raise ValueError(f"size must be a multiple of {1 << levels} (2^levels of the U-Net), got {d['size']}")
+        if int(d.get("deep", 0)) < 0:
+            raise ValueError(f"deep must be >= 0, got {d['deep']}")
         if d.get("precision", "auto") not in PRECISIONS:
             raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {d['precision']!r}")
         if d.get("init_onnx") and not d.get("init_sha256"):

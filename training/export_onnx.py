@@ -164,7 +164,7 @@ def export_model(model, out: str, meta: dict, one_piece: bool = False) -> dict:
                classes=classes, params=params,
                class_params={k: v for k, v in zoo.describe().items() if k in classes}, emb_dim=model.emb_dim,
                class_embedding=model.class_emb.weight.detach().numpy().astype(float).round(7).tolist(),
-               multiple_of=8)
+               multiple_of=1 << model.levels())
     doc.update(meta)
     if one_piece:
         _export_one(model, os.path.join(out, "eps.onnx"), size)

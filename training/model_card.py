@@ -140,7 +140,8 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
         f"- **Data:** `training/zoo.py`, generated on the fly. Classes: {', '.join(meta['trained_classes'])}. "
         f"Halton parameter sets, {cfg['seeds_per_set']} seeds each, {cfg['size']}² px.",
         f"- **Config:** size {cfg['size']}, batch {cfg['batch']}, {cfg['steps']} steps, lr {cfg['lr']}, "
-        f"EMA {cfg['ema_decay']}, CutMix p {cfg['cutmix_p']}, widths {cfg['widths']}, embedding {cfg['emb_dim']}-D.",
+        f"EMA {cfg['ema_decay']}, CutMix p {cfg['cutmix_p']}, widths {cfg['widths']}"
+        + (f" with a {cfg['deep']}-level deep branch" if cfg.get("deep") else "") + f", embedding {cfg['emb_dim']}-D.",
         f"- **Hardware:** {hardware or hardware_line()}.",
         f"- **Steps:** {meta['step']}. **Wall time:** {wall:.1f} min.",
         f"- **Final training MSE** (mean of the last log window): {mse:.4f}. Wall time and loss are from {source}.",

@@ -48,7 +48,7 @@ def build_model(cfg: TrainConfig, state: dict | None = None) -> UNet:
     if state is not None:
         n_classes = state["class_emb.weight"].shape[0]
         n_params = state["cond_mlp.0.weight"].shape[1] - state["class_emb.weight"].shape[1]
-    return UNet(n_classes, n_params, emb_dim=cfg.emb_dim, widths=cfg.widths)
+    return UNet(n_classes, n_params, emb_dim=cfg.emb_dim, widths=cfg.widths, deep=cfg.deep)
 
 
 def model_names(model: UNet) -> tuple:

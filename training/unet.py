@@ -23,6 +23,12 @@ forward pass is two functions (one code path for training and both exports):
     ε    = denoise(x, t, maps, tile)   the rest of the network
 
 A sampler runs ``encode`` once per image and ``denoise`` at every step.
+
+``deep`` > 0 adds a deep branch at the bottleneck, between its two ResBlocks: ``deep`` further levels
+(downsample, two ResBlocks, upsample) whose output is added to the bottleneck through a zero-initialised
+convolution.  It doubles the network's reach per level (long-range structure: damascus bands, fibre runs)
+and, zero at initialisation, leaves a warm-started network's function exactly as it was, so a deeper
+model continues the shipped weights instead of starting over (issue 22).
 """
 from __future__ import annotations
 
@@ -113,10 +119,40 @@ class ResBlock(nn.Module):
         return h + self.skip(x)
 
 
+class DeepBranch(nn.Module):
+    """``depth`` more levels below the bottleneck (channels ``c``): downsample, ResBlock, [inner branch],
+    ResBlock, upsample, and a 3x3 convolution initialised to zero, so the branch adds nothing until trained."""
+
+    def __init__(self, c: int, depth: int):
+        super().__init__()
+        self.depth = depth
+        self.down = nn.Sequential(nn.PixelUnshuffle(2), nn.Conv2d(4 * c, c, 1))
+        self.res = nn.ModuleList([ResBlock(c, c), ResBlock(c, c)])
+        self.inner = DeepBranch(c, depth - 1) if depth > 1 else None
+        self.out = Conv3(c, c)
+        nn.init.zeros_(self.out.weight)
+        nn.init.zeros_(self.out.bias)
+
+    def blocks(self, level: int) -> list:
+        """(ResBlock, level) in the forward pass's order."""
+        inner = self.inner.blocks(level + 1) if self.inner is not None else []
+        return [(self.res[0], level)] + inner + [(self.res[1], level)]
+
+    def forward(self, h, temb, maps):
+        """h (B, c, H, W) -> what the branch adds to it; ``maps`` an iterator over the SPADE maps (shared with
+        the caller, so the branch takes its blocks' maps in :meth:`blocks` order)."""
+        g = self.res[0](self.down(h), temb, next(maps))
+        if self.inner is not None:
+            g = g + self.inner(g, temb, maps)
+        g = self.res[1](g, temb, next(maps))
+        return self.out(F.interpolate(g, scale_factor=2.0, mode="nearest"))
+
+
 class UNet(nn.Module):
     """ε-network; ``embed`` turns class-id and parameter maps into its conditioning grid."""
 
-    def __init__(self, n_classes: int, n_params: int, emb_dim: int = 32, widths=(32, 64, 128), feat: int = 128):
+    def __init__(self, n_classes: int, n_params: int, emb_dim: int = 32, widths=(32, 64, 128), feat: int = 128,
+                 deep: int = 0):
         super().__init__()
         self.n_classes, self.n_params, self.emb_dim, self.widths = n_classes, n_params, emb_dim, tuple(widths)
         self.circular = False
@@ -138,6 +174,8 @@ class UNet(nn.Module):
             c = cw
             self.downsample.append(nn.Sequential(nn.PixelUnshuffle(2), nn.Conv2d(4 * c, c, 1)))
         self.mid = nn.ModuleList([ResBlock(c, c), ResBlock(c, c)])
+        #: the deep branch's levels (nested DeepBranch modules), or None
+        self.deep = DeepBranch(c, deep) if deep > 0 else None
         self.up = nn.ModuleList()
         self.upsample = nn.ModuleList()
         for cw in reversed(w):
@@ -156,9 +194,15 @@ class UNet(nn.Module):
         """Every ResBlock with its downsampling level (resolution H / 2^level), in the order of the forward pass."""
         n = len(self.widths)
         out = [(blk, i) for i, blocks in enumerate(self.down) for blk in blocks]
-        out += [(blk, n) for blk in self.mid]
+        out += [(self.mid[0], n)]
+        out += self.deep.blocks(n + 1) if self.deep is not None else []
+        out += [(self.mid[1], n)]
         out += [(blk, n - 1 - j) for j, blocks in enumerate(self.up) for blk in blocks]
         return out + [(self.final, 0)]
+
+    def levels(self) -> int:
+        """Downsamplings from the input to the deepest block: H and W must be multiples of 2^levels."""
+        return len(self.widths) + (self.deep.depth if self.deep is not None else 0)
 
     def _set_tile(self, tile, like) -> None:
         """Every Conv3's padding for this pass: zeros (tile None or 0) or circular (1 or ``circular``); the
@@ -193,8 +237,10 @@ class UNet(nn.Module):
                 h = blk(h, temb, next(maps))
             skips.append(h)
             h = down(h)
-        for blk in self.mid:
-            h = blk(h, temb, next(maps))
+        h = self.mid[0](h, temb, next(maps))
+        if self.deep is not None:
+            h = h + self.deep(h, temb, maps)
+        h = self.mid[1](h, temb, next(maps))
         for blocks, up in zip(self.up, self.upsample):
             h = up(F.interpolate(h, scale_factor=2.0, mode="nearest"))
             h = torch.cat([h, skips.pop()], 1)

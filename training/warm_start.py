@@ -72,7 +72,8 @@ def warm_start(model: torch.nn.Module, weights: dict) -> None:
     """Copy ``weights`` (see :func:`exported_weights`) into ``model`` in place.
 
     Every parameter of the model must be found; only the class table and the
-    first MLP layer's input columns may be larger in the model than in the export.
+    first MLP layer's input columns may be larger in the model than in the export, and a deep branch
+    (``UNet(deep=...)``) may be new: it keeps its zero-output initialisation.
     ValueError names the first tensor that cannot be placed.
     """
     state = model.state_dict()
@@ -80,6 +81,8 @@ def warm_start(model: torch.nn.Module, weights: dict) -> None:
     with torch.no_grad():
         for name, dst in state.items():
             if name not in weights:
+                if name.startswith("deep.") and not any(k.startswith("deep.") for k in weights):
+                    continue  # a deep branch new to this run keeps its initialisation: zero output, same function
                 raise ValueError(f"init_onnx: the export has no tensor for {name}")
             src = torch.tensor(weights[name], dtype=dst.dtype)
             if name == "class_emb.weight" and src.shape[0] <= dst.shape[0] and src.shape[1] == dst.shape[1]:
@@ -106,6 +109,6 @@ def torch_from_export(folder: str):
 
     doc = load_model_json(folder, "neural_noise.json")
     cfg = TrainConfig.from_dict(doc["config"])
-    model = UNet(len(doc["classes"]), len(doc["params"]), emb_dim=cfg.emb_dim, widths=cfg.widths)
+    model = UNet(len(doc["classes"]), len(doc["params"]), emb_dim=cfg.emb_dim, widths=cfg.widths, deep=cfg.deep)
     warm_start(model, exported_weights(folder, fingerprint(doc["files"])))
     return model.eval()
