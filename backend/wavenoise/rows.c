@@ -181,39 +181,12 @@ AVX2 static inline void add_out(float *out, int64_t j, int64_t m, __m256 v) {
   }
 }
 
-AVX2 static inline __m256i texel8(__m256 tau, __m256 fN, __m256 inv_N, __m256 *t) {
-  __m256 j0 = _mm256_floor_ps(tau);
-  *t = _mm256_sub_ps(tau, j0);
-  __m256 w = _mm256_sub_ps(j0, _mm256_mul_ps(fN, _mm256_floor_ps(_mm256_mul_ps(j0, inv_N))));
-  return _mm256_add_epi32(_mm256_cvttps_epi32(w), _mm256_set1_epi32(1));
-}
-
-/* Where the eight texels lie within 16 consecutive ones: the window's start and each lane's place in it. */
-AVX2 static inline int window(__m256i i, __m256i *rel, int *base) {
-  int lo = _mm256_cvtsi256_si32(i), hi = _mm256_extract_epi32(i, 7);
-  *base = lo < hi ? lo : hi;
-  *rel = _mm256_sub_epi32(i, _mm256_set1_epi32(*base));
-  __m256i out = _mm256_or_si256(_mm256_cmpgt_epi32(*rel, _mm256_set1_epi32(15)),
-                                _mm256_cmpgt_epi32(_mm256_setzero_si256(), *rel));
-  return _mm256_testz_si256(out, out);
-}
-
-AVX2 static inline __m256 fetch_seg(const float *tab, __m256i i, int win, __m256i rel, int base) {
-  if (win) {
-    __m256 hi = _mm256_castsi256_ps(_mm256_cmpgt_epi32(rel, _mm256_set1_epi32(7)));
-    return _mm256_blendv_ps(_mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + base), rel),
-                            _mm256_permutevar8x32_ps(_mm256_loadu_ps(tab + base + 8), rel), hi);
-  }
-  return _mm256_i32gather_ps(tab, i, 4);
-}
-
-/* T(tau) and, if wanted, its imaginary part: value + difference * fraction */
-AVX2 static inline void lerp8(const job_t *J, __m256i i, __m256 t, __m256 *re, __m256 *im) {
-  __m256i rel;
-  int base, win = window(i, &rel, &base);
-  *re = _mm256_add_ps(fetch_seg(J->tre, i, win, rel, base), _mm256_mul_ps(fetch_seg(J->dre, i, win, rel, base), t));
-  if (J->want_imag)
-    *im = _mm256_add_ps(fetch_seg(J->tim, i, win, rel, base), _mm256_mul_ps(fetch_seg(J->dim, i, win, rel, base), t));
+/* T(tau) and, if wanted, its imaginary part: value + difference * fraction, the texels read by fetch() */
+AVX2 static inline void lerp8(const job_t *J, __m256 tau, __m256 fN, __m256 inv_N, __m256 *re, __m256 *im) {
+  __m256 t;
+  texels8 T = texels(tau, fN, inv_N, &t);
+  *re = _mm256_add_ps(fetch(J->tre, &T), _mm256_mul_ps(fetch(J->dre, &T), t));
+  if (J->want_imag) *im = _mm256_add_ps(fetch(J->tim, &T), _mm256_mul_ps(fetch(J->dim, &T), t));
 }
 
 AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore,
@@ -222,9 +195,8 @@ AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float 
   const __m256 fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
   for (int64_t j = o; j < o + m; j += 8) {
     int64_t n = o + m - j;
-    __m256 x = load_x(J->xs, j, n), t, re, im;
-    __m256i i = texel8(_mm256_add_ps(_mm256_mul_ps(x, va), vb), fN, inv_N, &t);
-    lerp8(J, i, t, &re, &im);
+    __m256 x = load_x(J->xs, j, n), re, im;
+    lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va), vb), fN, inv_N, &re, &im);
     add_out(ore, j, n, _mm256_mul_ps(vamp, re));
     if (J->want_imag) add_out(oim, j, n, _mm256_mul_ps(vamp, im));
   }
@@ -248,17 +220,15 @@ AVX2 static void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx, floa
   const __m256 va0 = _mm256_set1_ps(a0), vb0 = _mm256_set1_ps(b0), va1 = _mm256_set1_ps(a1), vb1 = _mm256_set1_ps(b1);
   for (int64_t j = o; j < o + m; j += 8) {
     int64_t n = o + m - j;
-    __m256 x = load_x(J->xs, j, n), t0, t1, re0, im0, re1, im1;
+    __m256 x = load_x(J->xs, j, n), re0, im0, re1, im1;
     __m256 u = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(x, vsx), vq), vfn), vsp);
     u = _mm256_add_ps(_mm256_mul_ps(u, c), half);
     /* min(max(u, 0), 1) as numba's: NaN cannot occur (finite coordinates) */
     u = _mm256_min_ps(_mm256_max_ps(u, _mm256_setzero_ps()), one);
     __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_set1_ps(2.0f), u)));
     __m256 w0 = _mm256_mul_ps(vamp, cos_half_pi8_exact(s)), w1 = _mm256_mul_ps(vamp, cos_half_pi8_exact(_mm256_sub_ps(one, s)));
-    __m256i i0 = texel8(_mm256_add_ps(_mm256_mul_ps(x, va0), vb0), fN, inv_N, &t0);
-    __m256i i1 = texel8(_mm256_add_ps(_mm256_mul_ps(x, va1), vb1), fN, inv_N, &t1);
-    lerp8(J, i0, t0, &re0, &im0);
-    lerp8(J, i1, t1, &re1, &im1);
+    lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va0), vb0), fN, inv_N, &re0, &im0);
+    lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va1), vb1), fN, inv_N, &re1, &im1);
     if (n >= 8) {  /* the reference adds slice n's term, then slice n + 1's */
       __m256 r = _mm256_loadu_ps(ore + j);
       r = _mm256_add_ps(r, _mm256_mul_ps(w0, re0));
@@ -327,18 +297,15 @@ AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, in
     __m256 tau0 = _mm256_add_ps(_mm256_mul_ps(x, pick(A, a0t, regs, idx)), pick(B, b0t, regs, idx));
     __m256 tau1 = _mm256_add_ps(_mm256_mul_ps(x, regs ? _mm256_permutevar8x32_ps(a1t, idx) : pick(A, a1t, 0, idx1)),
                                 regs ? _mm256_permutevar8x32_ps(b1t, idx) : pick(B, b1t, 0, idx1));
-    __m256 t0, t1;
-    texels8 T0 = texels(tau0, fN, inv_N, &t0), T1 = texels(tau1, fN, inv_N, &t1);
-    __m256 l0 = _mm256_add_ps(fetch(J->tre, &T0), _mm256_mul_ps(fetch(J->dre, &T0), t0));
-    __m256 l1 = _mm256_add_ps(fetch(J->tre, &T1), _mm256_mul_ps(fetch(J->dre, &T1), t1));
+    __m256 l0, l1, li0 = zero, li1 = zero;
+    lerp8(J, tau0, fN, inv_N, &l0, &li0);
+    lerp8(J, tau1, fN, inv_N, &l1, &li1);
     __m256 acc = m >= 8 ? _mm256_loadu_ps(ore + j) : _mm256_maskload_ps(ore + j, km);
     acc = _mm256_fmadd_ps(w1, l1, _mm256_fmadd_ps(w0, l0, acc));
     if (m >= 8) _mm256_storeu_ps(ore + j, acc); else _mm256_maskstore_ps(ore + j, km, acc);
     if (imag) {
-      l0 = _mm256_add_ps(fetch(J->tim, &T0), _mm256_mul_ps(fetch(J->dim, &T0), t0));
-      l1 = _mm256_add_ps(fetch(J->tim, &T1), _mm256_mul_ps(fetch(J->dim, &T1), t1));
       acc = m >= 8 ? _mm256_loadu_ps(oim + j) : _mm256_maskload_ps(oim + j, km);
-      acc = _mm256_fmadd_ps(w1, l1, _mm256_fmadd_ps(w0, l0, acc));
+      acc = _mm256_fmadd_ps(w1, li1, _mm256_fmadd_ps(w0, li0, acc));
       if (m >= 8) _mm256_storeu_ps(oim + j, acc); else _mm256_maskstore_ps(oim + j, km, acc);
     }
   }
