@@ -70,7 +70,10 @@ def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
     assert out["kernel_available"] == KERNEL
     if KERNEL:
         assert out["kernel_path"].startswith(str(tmp_path)) and "omninoise_rows" in out["kernel_path"]
-    assert out["kernel_vs_other"] < 1e-5 and out["kernel_signal"] > 0.1
+    # numba's row kernel is bit-equal to the C one (within 2e-6 in the block walk); numpy's point path
+    # computes coordinates by matmul, not along rows, and stays within test_ckernel's 1e-3 bound
+    assert out["kernel_vs_other"] < (1e-5 if out["other_path"] == "numba" else 1e-3), out["other_path"]
+    assert out["kernel_signal"] > 0.1
     assert not out["disabled_props"] and out["reenabled_props"]
     if not out["openvdb"]:  # the bpy 4.2 wheel: a one-line message instead of a volume
         assert out["bake"] == ["ERROR"] and "OpenVDB Python module" in out["bake_error"]

@@ -62,6 +62,7 @@ without = be.evaluate_grid(noise, 12, 2.0)
 ck.set_enabled(True)
 out["kernel_vs_other"] = float(abs(with_kernel - without).max())
 out["kernel_signal"] = float(without.std())
+out["other_path"] = "numba" if importlib.import_module(MOD + ".backend.wavenoise.fast").available() else "numpy"
 bake = bpy.context.scene.omninoise_bake
 bake.bounds_mode = "CUSTOM"
 bake.volume_resolution = (8, 8, 8)
