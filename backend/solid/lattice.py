@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["MASK32", "BITS", "MAX_CHANNELS", "lowbias32", "octave_seeds", "lattice_noise",
-           "lattice_noise_numpy", "fast_available"]
+           "lattice_noise_numpy", "fast_available", "check_points"]
 
 MASK32 = 0xFFFFFFFF
 BITS = 10                 #: bits per channel value
@@ -56,7 +56,7 @@ def octave_seeds(seed: int, octaves: int) -> np.ndarray:
     return np.array([lowbias32((base + (i + 1) * 0x9E3779B9) & MASK32) for i in range(octaves)], dtype=np.int64)
 
 
-def _check(points, transforms, channels):
+def check_points(points, transforms, channels):
     points = np.asarray(points)
     transforms = np.asarray(transforms, dtype=np.float32)
     if points.ndim != 2 or points.shape[1] not in (2, 3):
@@ -71,7 +71,7 @@ def _check(points, transforms, channels):
 
 def lattice_noise_numpy(points, transforms, seed: int, channels: int = 3) -> np.ndarray:
     """Reference numpy implementation of the octave noise n (see module doc): float32 (N, m*C)."""
-    points, transforms = _check(points, transforms, channels)
+    points, transforms = check_points(points, transforms, channels)
     N, D = points.shape
     m = transforms.shape[0]
     seeds = octave_seeds(seed, m)
@@ -155,7 +155,7 @@ def lattice_noise(points, transforms, seed: int, channels: int = 3) -> np.ndarra
     worker thread leaves Blender's UI responsive), else :func:`lattice_noise_numpy`;
     both give the same values to float32 rounding.
     """
-    points, transforms = _check(points, transforms, channels)
+    points, transforms = check_points(points, transforms, channels)
     if numba is None:
         return lattice_noise_numpy(points, transforms, seed, channels)
     out = np.empty((points.shape[0], transforms.shape[0] * channels), np.float32)

@@ -24,6 +24,7 @@ from ..errors import SettingError
 from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
+from .cellular import cellular_features
 from .lattice import lattice_noise
 
 __all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
@@ -135,6 +136,8 @@ class SolidTextureModel:
         self.colour_stats = int(c.get("colour_stats", 0))
         #: spectral models also append the exemplar's per-octave noise gains (``octaves`` values)
         self.spectral_gains = int(c.get("spectral_gains", 0))
+        #: the first ``cellular`` octaves also give the decoder Worley features (cellular.py); 0 in older models
+        self.cellular = int(c.get("cellular", 0))
         self.z_dim = int(c.get("z_dim", 8))
         self._session = SessionCache(folder, threads)
 
@@ -242,6 +245,8 @@ class SolidTextureModel:
                 if code.gains is None:
                     raise SettingError("code", f"model {self.name!r} needs the exemplar's spectral gains in its code")
                 noise *= np.repeat(np.asarray(code.gains, _F), self.channels)   # octave-major: i*C + c
+            if self.cellular:
+                noise = np.concatenate([noise, cellular_features(pts[a:b], T, seed, self.cellular)], axis=1)
             e = code.e if code.e.ndim == 1 else code.e[a:b]
             d = self.decode(noise, e)
             if self.colour_stats:

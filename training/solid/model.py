@@ -29,6 +29,8 @@ import math
 import torch
 from torch import nn
 
+from backend.solid.cellular import FEATURES as CELL_FEATURES
+from .cellular import cellular_features
 from .lattice import lattice_noise
 
 __all__ = ["colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
@@ -252,15 +254,18 @@ class SolidTexture(nn.Module):
 
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
                  mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
-                 colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False):
+                 colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False,
+                 cellular: int = 0):
         super().__init__()
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
         if colour not in ("sigmoid", "affine"):
             raise ValueError(f"colour must be 'sigmoid' or 'affine', got {colour!r}")
         self.dim, self.octaves, self.channels, self.code_dim, self.mode = dim, octaves, channels, code_dim, mode
-        self.colour = colour
-        self.decoder = Decoder(octaves * channels, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
+        if not 0 <= cellular <= octaves:
+            raise ValueError(f"cellular must be 0..{octaves} (octaves with Worley features), got {cellular}")
+        self.colour, self.cellular = colour, cellular
+        self.decoder = Decoder(octaves * channels + CELL_FEATURES * cellular, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
                                film=film)
         if mode == "single":
             self.code = nn.Parameter(torch.rand(code_dim) * 2.0 - 1.0)     # U(-1, 1) as the authors' code
@@ -279,11 +284,15 @@ class SolidTexture(nn.Module):
                stats: torch.Tensor | None = None, gains: torch.Tensor | None = None) -> torch.Tensor:
         """s(x | z) (Eq. 5): x (B, N, D), e (B, E), T (B, m, D, D), seeds int64 (B, m) -> RGB (B, N, 3);
         ``stats`` (B, 12): the exemplars' :func:`colour_stats` (``colour="affine"`` only); ``gains`` (B, m): the
-        exemplars' :func:`spectral_gains`, multiplying each octave's noise (``spectral`` models)."""
+        exemplars' :func:`spectral_gains`, multiplying each octave's noise (``spectral`` models).
+        The decoder reads the value noise (B, N, m C), then the first ``cellular`` octaves' Worley features
+        (B, N, 3 cellular; ``cellular.py``)."""
         n = lattice_noise(x, T, seeds, self.channels)
         if gains is not None:
             B, N, _ = n.shape
             n = (n.view(B, N, self.octaves, self.channels) * gains.view(B, 1, self.octaves, 1)).view(B, N, -1)
+        if self.cellular:
+            n = torch.cat([n, cellular_features(x, T, seeds, self.cellular)], dim=-1)
         out = self.decoder(n, e.unsqueeze(1))
         if self.colour == "affine":
             if stats is None:
