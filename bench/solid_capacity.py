@@ -4,8 +4,9 @@ Single-exemplar 2D models of structured photos (paving stones, brick courses), t
 Wasserstein loss by ``python -m training.solid.train --config C --out RUN``, one per decoder size, are
 rendered at the photo's smaller side (at most 256 px) for several seeds and compared with the photo they were fitted to (a capacity question:
 how near can the model get to its own exemplar, not generalisation) by the patch distance of
-``training/solid/photo_eval.py`` (x 1000, lower is better), beside random phase noise and a pixel shuffle
-of the same photo.
+``training/solid/photo_eval.py`` (x 1000, lower is better) and by the level-set morphology distance of
+``training/solid/morphology.py`` (region sizes, outlines, connectivity; lower is better), beside random
+phase noise and a pixel shuffle of the same photo.
 
     python bench/solid_capacity.py RUN [RUN ...] [--out docs/img/solid_capacity]
 
@@ -26,6 +27,7 @@ sys.path.insert(0, ROOT)
 
 from export.atomic import write_json  # noqa: E402
 from training.solid.model import colour_stats  # noqa: E402
+from training.solid.morphology import morphology_distance  # noqa: E402
 from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase  # noqa: E402
 from training.solid.train import SolidConfig, build_model, render, training_images  # noqa: E402
 
@@ -70,20 +72,23 @@ def main(argv=None) -> int:
         SIZE = min(MAX_SIZE, *ref.shape[:2])
         imgs = textures(cfg, model, photo, range(1, a.seeds + 1), SIZE)
         rng = np.random.default_rng(0)
+        rpn = [random_phase(ref, SIZE, rng) for _ in range(a.seeds)]
+        shuffled = [pixel_shuffle(ref, SIZE, rng) for _ in range(a.seeds)]
         name = os.path.basename(cfg.exemplars[0]).rsplit(".", 1)[0]
         row = dict(run=os.path.basename(run.rstrip("/")), photo=name, width=cfg.width, layers=cfg.layers,
                    octaves=cfg.octaves, params=int(state.get("n_params", 0)), steps=int(state["step"]),
                    train_minutes=round(state.get("elapsed", 0.0) / 60, 1),
                    model=round(patch_swd(imgs, ref), 1),
-                   random_phase=round(patch_swd([random_phase(ref, SIZE, rng) for _ in range(a.seeds)], ref), 1),
-                   pixel_shuffle=round(patch_swd([pixel_shuffle(ref, SIZE, rng) for _ in range(a.seeds)], ref), 1),
-                   size=SIZE)
+                   random_phase=round(patch_swd(rpn, ref), 1), pixel_shuffle=round(patch_swd(shuffled, ref), 1),
+                   morph=round(morphology_distance(imgs, ref), 3), morph_random_phase=round(morphology_distance(rpn, ref), 3),
+                   morph_pixel_shuffle=round(morphology_distance(shuffled, ref), 3),
+                   cellular=cfg.cellular, size=SIZE)
         rows.append(row)
         sheet.setdefault(name, dict(photo=ref[:SIZE, :SIZE], rpn=random_phase(ref, SIZE, np.random.default_rng(1)),
                                     runs=[], size=SIZE))
         sheet[name]["runs"].append(imgs[0])
-    cols = ["run", "photo", "size", "width", "layers", "params", "steps", "train_minutes", "model", "random_phase",
-            "pixel_shuffle"]
+    cols = ["run", "photo", "size", "width", "layers", "cellular", "params", "steps", "train_minutes", "model",
+            "random_phase", "pixel_shuffle", "morph", "morph_random_phase", "morph_pixel_shuffle"]
     print("| " + " | ".join(cols) + " |")
     print("|" + "---|" * len(cols))
     for r in rows:

@@ -24,6 +24,7 @@ from ..errors import SettingError
 from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
+from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
@@ -138,6 +139,8 @@ class SolidTextureModel:
         self.spectral_gains = int(c.get("spectral_gains", 0))
         #: the first ``cellular`` octaves also give the decoder Worley features (cellular.py); 0 in older models
         self.cellular = int(c.get("cellular", 0))
+        #: ... and brick features (brick.py)
+        self.bricks = int(c.get("bricks", 0))
         self.z_dim = int(c.get("z_dim", 8))
         self._session = SessionCache(folder, threads)
 
@@ -247,6 +250,8 @@ class SolidTextureModel:
                 noise *= np.repeat(np.asarray(code.gains, _F), self.channels)   # octave-major: i*C + c
             if self.cellular:
                 noise = np.concatenate([noise, cellular_features(pts[a:b], T, seed, self.cellular)], axis=1)
+            if self.bricks:
+                noise = np.concatenate([noise, brick_features(pts[a:b], T, seed, self.bricks)], axis=1)
             e = code.e if code.e.ndim == 1 else code.e[a:b]
             d = self.decode(noise, e)
             if self.colour_stats:

@@ -36,6 +36,8 @@ def test_config_errors_name_the_key():
         SolidConfig.from_dict({"dim": 4})
     with pytest.raises(ValueError, match="cellular must be 0..8"):
         SolidConfig.from_dict({"cellular": 9})
+    with pytest.raises(ValueError, match="bricks must be 0..4"):
+        SolidConfig.from_dict({"bricks": 5, "octaves": 4})
 
 
 def test_rotations_and_slices():
@@ -137,12 +139,13 @@ def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_
     assert ("| gravel | ours_3d: c continued, **not shipped** | 0.4 / 0.1 / 0.5 | 0.6 / 0.1 / 0.5 |" in text), text
 
 
-@pytest.mark.parametrize("dim,cellular", [(2, 0), (3, 0), (2, 3), (3, 2)])
-def test_single_export_runtime_matches_torch(tmp_path, dim, cellular):
-    run, state = _tiny(tmp_path, dim=dim, cellular=cellular)
+@pytest.mark.parametrize("dim,cellular,bricks", [(2, 0, 0), (3, 0, 0), (2, 3, 0), (3, 2, 2)])
+def test_single_export_runtime_matches_torch(tmp_path, dim, cellular, bricks):
+    run, state = _tiny(tmp_path, dim=dim, cellular=cellular, bricks=bricks)
     out = tmp_path / "model"
     doc = export(str(run), str(out))
     assert doc["mode"] == "single" and set(doc["files"]) == {"decoder.onnx"} and doc["cellular"] == cellular
+    assert doc["bricks"] == bricks
     rt = SolidTextureModel(str(out))
     code = rt.default_code()
     assert code.e.shape == (64,) and code.T.shape == (8, dim, dim)
@@ -155,7 +158,7 @@ def test_single_export_runtime_matches_torch(tmp_path, dim, cellular):
         ref = m.sample(torch.from_numpy(x), e, T, octave_seeds([7], 8)).numpy()[0]
     got = rt.evaluate(x[0], code, seed=7, chunk=700)
     assert got.dtype == np.float32 and got.shape == (3000, 3)
-    if cellular:   # float32 positions in torch: a point within ~1e-4 of a Voronoi border may pick the other cell
+    if cellular or bricks:   # float32 positions in torch: a point within ~1e-4 of a Voronoi border may pick the other cell
         assert (np.abs(got - ref).max(axis=1) < 2e-4).mean() > 0.995
     else:
         np.testing.assert_allclose(got, ref, atol=2e-4)

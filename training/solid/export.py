@@ -24,6 +24,7 @@ from torch import nn
 
 from backend._export import export as _ex
 from backend.onnx_models import sha256_file
+from backend.solid.brick import FEATURES as BRICK_FEATURES
 from backend.solid.cellular import FEATURES as CELL_FEATURES
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
@@ -82,7 +83,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
     model.load_state_dict(state["model"])
     model.eval()
     os.makedirs(out, exist_ok=True)
-    n_noise = cfg.octaves * cfg.channels + CELL_FEATURES * cfg.cellular
+    n_noise = cfg.octaves * cfg.channels + CELL_FEATURES * cfg.cellular + BRICK_FEATURES * cfg.bricks
     files = {}
     _onnx(SplitDecoder(model.decoder, n_noise), (torch.randn(16, n_noise), torch.randn(1, cfg.code_dim)),
           os.path.join(out, "decoder.onnx"), ["noise", "code"], ["rgb"],
@@ -94,7 +95,8 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                z_dim=cfg.z_dim, px_per_unit=cfg.px_per_unit, exemplar_scale=cfg.exemplar_scale,
                exemplars=list(cfg.exemplars), colour="sRGB", colour_model=cfg.colour,
                colour_stats=COLOUR_STATS if cfg.colour == "affine" else 0,
-               spectral_gains=cfg.octaves if cfg.spectral else 0, cellular=cfg.cellular, step=int(state["step"]),
+               spectral_gains=cfg.octaves if cfg.spectral else 0, cellular=cfg.cellular, bricks=cfg.bricks,
+               step=int(state["step"]),
                train_seconds=round(float(state.get("elapsed", 0.0)), 1), n_params=int(state["n_params"]),
                config=state["config"])
     with torch.no_grad():

@@ -29,7 +29,9 @@ import math
 import torch
 from torch import nn
 
+from backend.solid.brick import FEATURES as BRICK_FEATURES
 from backend.solid.cellular import FEATURES as CELL_FEATURES
+from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
@@ -255,17 +257,18 @@ class SolidTexture(nn.Module):
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
                  mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
                  colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False,
-                 cellular: int = 0):
+                 cellular: int = 0, bricks: int = 0):
         super().__init__()
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
         if colour not in ("sigmoid", "affine"):
             raise ValueError(f"colour must be 'sigmoid' or 'affine', got {colour!r}")
         self.dim, self.octaves, self.channels, self.code_dim, self.mode = dim, octaves, channels, code_dim, mode
-        if not 0 <= cellular <= octaves:
-            raise ValueError(f"cellular must be 0..{octaves} (octaves with Worley features), got {cellular}")
-        self.colour, self.cellular = colour, cellular
-        self.decoder = Decoder(octaves * channels + CELL_FEATURES * cellular, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
+        for key, k in (("cellular", cellular), ("bricks", bricks)):
+            if not 0 <= k <= octaves:
+                raise ValueError(f"{key} must be 0..{octaves} (octaves with {key} features), got {k}")
+        self.colour, self.cellular, self.bricks = colour, cellular, bricks
+        self.decoder = Decoder(octaves * channels + CELL_FEATURES * cellular + BRICK_FEATURES * bricks, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
                                film=film)
         if mode == "single":
             self.code = nn.Parameter(torch.rand(code_dim) * 2.0 - 1.0)     # U(-1, 1) as the authors' code
@@ -286,13 +289,15 @@ class SolidTexture(nn.Module):
         ``stats`` (B, 12): the exemplars' :func:`colour_stats` (``colour="affine"`` only); ``gains`` (B, m): the
         exemplars' :func:`spectral_gains`, multiplying each octave's noise (``spectral`` models).
         The decoder reads the value noise (B, N, m C), then the first ``cellular`` octaves' Worley features
-        (B, N, 3 cellular; ``cellular.py``)."""
+        (B, N, 3 cellular; ``cellular.py``), then the first ``bricks`` octaves' brick features (``brick.py``)."""
         n = lattice_noise(x, T, seeds, self.channels)
         if gains is not None:
             B, N, _ = n.shape
             n = (n.view(B, N, self.octaves, self.channels) * gains.view(B, 1, self.octaves, 1)).view(B, N, -1)
         if self.cellular:
             n = torch.cat([n, cellular_features(x, T, seeds, self.cellular)], dim=-1)
+        if self.bricks:
+            n = torch.cat([n, brick_features(x, T, seeds, self.bricks)], dim=-1)
         out = self.decoder(n, e.unsqueeze(1))
         if self.colour == "affine":
             if stats is None:

@@ -53,6 +53,7 @@ class SolidConfig:
     octaves: int = 8
     channels: int = 3               # noise values per octave (<= 3)
     cellular: int = 0               # the first this many octaves also give Worley features (cellular.py)
+    bricks: int = 0                 # ... and staggered-lattice (brick) features (brick.py)
     code_dim: int = 64              # |e|
     z_dim: int = 8                  # |z| (space mode)
     width: int = 128
@@ -104,8 +105,10 @@ class SolidConfig:
             raise ValueError(f"loss must be 'gram' or 'swd', got {cfg.loss!r}")
         if cfg.colour not in ("sigmoid", "affine"):
             raise ValueError(f"colour must be 'sigmoid' or 'affine', got {cfg.colour!r}")
-        if not 0 <= cfg.cellular <= cfg.octaves:
-            raise ValueError(f"cellular must be 0..{cfg.octaves} (octaves with Worley features), got {cfg.cellular}")
+        for key in ("cellular", "bricks"):
+            if not 0 <= getattr(cfg, key) <= cfg.octaves:
+                raise ValueError(f"{key} must be 0..{cfg.octaves} (octaves with {key} features), "
+                                 f"got {getattr(cfg, key)}")
         n_exemplars = len(ex.expand(cfg.exemplars))
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
@@ -138,7 +141,7 @@ def _seed_run(src: str, out: str) -> None:
 def build_model(cfg: SolidConfig) -> SolidTexture:
     return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
                         cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform, cfg.film,
-                        cfg.standardise, cfg.cellular)
+                        cfg.standardise, cfg.cellular, cfg.bricks)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
