@@ -82,13 +82,17 @@ def main(argv=None) -> int:
                    random_phase=round(patch_swd(rpn, ref), 1), pixel_shuffle=round(patch_swd(shuffled, ref), 1),
                    morph=round(morphology_distance(imgs, ref), 3), morph_random_phase=round(morphology_distance(rpn, ref), 3),
                    morph_pixel_shuffle=round(morphology_distance(shuffled, ref), 3),
+                   # the photo against itself: its right half against its left half (what "near" means)
+                   morph_photo_halves=round(morphology_distance(ref[:, ref.shape[1] // 2:],
+                                                                ref[:, :ref.shape[1] // 2]), 3),
                    cellular=cfg.cellular, size=SIZE)
         rows.append(row)
         sheet.setdefault(name, dict(photo=ref[:SIZE, :SIZE], rpn=random_phase(ref, SIZE, np.random.default_rng(1)),
                                     runs=[], size=SIZE))
         sheet[name]["runs"].append(imgs[0])
     cols = ["run", "photo", "size", "width", "layers", "cellular", "params", "steps", "train_minutes", "model",
-            "random_phase", "pixel_shuffle", "morph", "morph_random_phase", "morph_pixel_shuffle"]
+            "random_phase", "pixel_shuffle", "morph", "morph_random_phase", "morph_pixel_shuffle",
+            "morph_photo_halves"]
     print("| " + " | ".join(cols) + " |")
     print("|" + "---|" * len(cols))
     for r in rows:

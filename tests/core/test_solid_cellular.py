@@ -116,3 +116,16 @@ def test_torch_twin_matches_runtime(D):
     Tt = torch.from_numpy(T).requires_grad_(True)
     cellular_features(torch.from_numpy(x), Tt, octave_seeds([5, 9], 8), 4).square().sum().backward()
     assert torch.isfinite(Tt.grad).all() and Tt.grad[:4].abs().sum() > 0 and Tt.grad[4:].abs().sum() == 0
+
+
+@pytest.mark.parametrize("D", [2, 3])
+def test_compiled_equals_numpy(D):
+    from backend.solid.lattice import fast_available
+    if not fast_available():
+        pytest.skip("numba is not installed")
+    rng = np.random.default_rng(D)
+    x = rng.uniform(-100, 100, (5000, D))
+    T = rng.normal(size=(8, D, D)).astype(np.float32)
+    np.testing.assert_allclose(C.cellular_features(x, T, 3, 5), C.cellular_features_numpy(x, T, 3, 5), atol=1e-6)
+    np.testing.assert_allclose(C.cellular_features(REF_POINTS, REF_T, 7, 3),
+                               C.cellular_features_numpy(REF_POINTS, REF_T, 7, 3), atol=1e-6)
