@@ -265,3 +265,41 @@ def test_spectral_gains_twins_agree_and_follow_the_grain():
     np.testing.assert_allclose(gains_np(np.full((64, 64, 3), 0.3, np.float32)), 1.0, atol=1e-4)
     with pytest.raises(ValueError, match="spectral gains"):
         SolidConfig.from_dict(dict(mode="single", exemplars=["gravel"], spectral=True))
+
+
+def test_features_added_to_an_export_start_as_the_export(tmp_path):
+    """Cellular and brick features added to a model trained without them (init_onnx with new ``cellular``
+    and ``bricks``): their first-layer columns start at zero, so the grown model draws the export's texture
+    exactly, and the continued run trains them; features are not added to an export that has some."""
+    from backend.onnx_models import fingerprint
+    from training.solid.lattice import octave_seeds
+    from training.solid.warm_start import exported_weights, warm_start
+
+    photos = ex.photo_set("train")[:2]
+    cfg = dict(name="tiny_grow", mode="space", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=photos, colour="affine", loss="swd", transform="bounded",
+               swd_width=8, swd_levels=2, film=True, standardise=True, spectral=True)
+    state = train(SolidConfig.from_dict(cfg), str(tmp_path / "run"), log=lambda *_: None)
+    doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
+    sha = fingerprint(doc["files"])
+    old = build_model(SolidConfig.from_dict(cfg))
+    old.load_state_dict(state["model"])
+    grown = build_model(SolidConfig.from_dict(dict(cfg, cellular=2, bricks=1)))
+    warm_start(grown, exported_weights(str(tmp_path / "m"), sha), new_features=9)
+    pts = torch.from_numpy(np.random.default_rng(0).uniform(-3, 3, (1, 400, 3))).float()
+    z = torch.randn(1, 8)
+    stats, gains = torch.rand(1, 12), torch.rand(1, 8) + 0.5
+    with torch.no_grad():
+        e, T = old.translator(z)
+        a = old.sample(pts, e, T, octave_seeds([3], 8), stats, gains)
+        b = grown.sample(pts, e, T, octave_seeds([3], 8), stats, gains)
+    np.testing.assert_allclose(b.numpy(), a.numpy(), atol=1e-6)
+    grow = dict(cfg, cellular=2, bricks=1, steps=4, init_onnx=str(tmp_path / "m"), init_sha256=sha)
+    cont = train(SolidConfig.from_dict(grow), str(tmp_path / "cont"), log=lambda *_: None)
+    w = cont["model"]["decoder.net.0.weight"]
+    assert w.shape[1] == 8 * 3 + 9 + 64 and float(w[:, 24:33].abs().sum()) > 0     # the new columns trained
+    doc2 = export(str(tmp_path / "cont"), str(tmp_path / "m2"))
+    with pytest.raises(ValueError, match="features can be added only"):
+        train(SolidConfig.from_dict(dict(grow, cellular=3, init_onnx=str(tmp_path / "m2"),
+                                         init_sha256=fingerprint(doc2["files"]))), str(tmp_path / "c2"),
+              log=lambda *_: None)

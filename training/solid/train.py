@@ -39,6 +39,8 @@ from .lattice import octave_seeds
 from .model import SolidTexture, colour_stats, slice_points, spectral_gains
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
+from backend.solid.brick import FEATURES as BRICK_FEATURES
+from backend.solid.cellular import FEATURES as CELL_FEATURES
 from backend.onnx_models import load_model_json
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
@@ -213,7 +215,11 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     elif cfg.init_onnx:
         # the export's step and training time carry on, so the ledger and the cosine schedule continue
         model_json = load_model_json(cfg.init_onnx, "solid.json")
-        warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256))
+        had = CELL_FEATURES * int(model_json.get("cellular", 0)) + BRICK_FEATURES * int(model_json.get("bricks", 0))
+        new = CELL_FEATURES * cfg.cellular + BRICK_FEATURES * cfg.bricks - had
+        if had and new:
+            raise ValueError("init_onnx: features can be added only to an export without cellular or brick features")
+        warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256), new_features=new)
         step, elapsed = int(model_json.get("step", 0)), float(model_json.get("train_seconds", 0.0))
         first = step
         log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...) at step {step}")

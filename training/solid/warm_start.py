@@ -86,9 +86,14 @@ def exported_weights(folder: str, sha256: str) -> dict:
 _OPTIONAL = ("encoder.norms.4.weight", "encoder.norms.4.bias")
 
 
-def warm_start(model: torch.nn.Module, weights: dict) -> None:
+def warm_start(model: torch.nn.Module, weights: dict, new_features: int = 0) -> None:
     """Copy ``weights`` into ``model`` in place; every other tensor must be found with its shape
-    (ValueError names the first that is not)."""
+    (ValueError names the first that is not).
+
+    ``new_features``: the model's decoder reads this many more noise features than the export's
+    (cellular or brick features added to a model trained without them, appended after its value
+    noise): their columns of the first layer start at zero, so the model starts as the export
+    exactly and training learns to use them."""
     state = model.state_dict()
     with torch.no_grad():
         for name, dst in state.items():
@@ -97,6 +102,9 @@ def warm_start(model: torch.nn.Module, weights: dict) -> None:
                     continue
                 raise ValueError(f"init_onnx: the export has no tensor for {name}")
             src = torch.tensor(np.array(weights[name]), dtype=dst.dtype)
+            if name == "decoder.net.0.weight" and new_features:
+                n_old = src.shape[1] - model.code_dim
+                src = torch.cat([src[:, :n_old], src.new_zeros(src.shape[0], new_features), src[:, n_old:]], 1)
             if tuple(src.shape) != tuple(dst.shape):
                 raise ValueError(f"init_onnx: {name} has shape {tuple(src.shape)} in the export, "
                                  f"{tuple(dst.shape)} in the model")
