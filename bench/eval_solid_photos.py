@@ -11,6 +11,10 @@ Against the photo, per slice axis and pooled:
   beside the baselines built from the same photo (pixel shuffle, random phase
   noise, Perlin coloured by the photo's histogram) and ``photo_crop`` (a
   SIZE² crop of the photo itself: how far a real piece of it lies);
+- ``morph``: the level-set morphology distance of :mod:`training.solid.morphology`
+  (boundary length and Euler characteristic of quantile excursion sets: region
+  sizes, outlines, connectivity), lower is better, beside random phase noise's
+  (``morph_random_phase``) and a SIZE² crop of the photo's (``morph_photo_crop``);
 - ``colour``: mean colour error (mean over R, G, B of |difference of means|);
 - ``diversity``: mean absolute difference between two seeds' z slices;
 - ``axis_spread``: (max - min) / mean of the three axes' swd: 0 when x, y and z
@@ -35,6 +39,7 @@ import numpy as np  # noqa: E402
 from export.atomic import atomic_path, write_json  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
+from training.solid.morphology import morphology_distance  # noqa: E402
 
 SIZE = 128
 
@@ -102,6 +107,10 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
             r[name] = round(pe.patch_swd([fn(photo, SIZE, rng) for _ in range(seeds)], photo), 1)
             r[name + "_colour"] = round(pe.mean_colour_error(fn(photo, SIZE, rng), photo), 4)
         r["photo_crop"] = round(pe.patch_swd(photo[:SIZE, :SIZE], photo), 1)
+        r["morph"] = round(morphology_distance(pooled, photo), 3)
+        r["morph_random_phase"] = round(morphology_distance([pe.random_phase(photo, SIZE, rng) for _ in range(seeds)],
+                                                            photo), 3)
+        r["morph_photo_crop"] = round(morphology_distance(photo[:SIZE, :SIZE], photo), 3)
         r["seconds"] = round(seconds, 2)
         rows[os.path.basename(path)] = r
         print(os.path.basename(path), {k: r[k] for k in ("swd", "colour", "random_phase", "pixel_shuffle")},
@@ -124,7 +133,11 @@ def summary(rows: dict) -> dict:
                 beats_random_phase=int(sum(r["swd"] < r["random_phase"] for r in rows.values())),
                 median_colour=med("colour"), max_colour=round(float(max(r["colour"] for r in rows.values())), 4),
                 median_diversity=med("diversity"), median_axis_spread=med("axis_spread"),
-                median_seconds=med("seconds"), worst_swd=float(swd.max()))
+                median_seconds=med("seconds"), worst_swd=float(swd.max()),
+                **({} if "morph" not in next(iter(rows.values())) else dict(
+                    median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
+                    median_morph_photo_crop=med("morph_photo_crop"),
+                    beats_random_phase_morph=int(sum(r["morph"] < r["morph_random_phase"] for r in rows.values())))))
 
 
 def by_category(rows: dict) -> dict:

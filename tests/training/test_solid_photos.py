@@ -303,3 +303,26 @@ def test_features_added_to_an_export_start_as_the_export(tmp_path):
         train(SolidConfig.from_dict(dict(grow, cellular=3, init_onnx=str(tmp_path / "m2"),
                                          init_sha256=fingerprint(doc2["files"]))), str(tmp_path / "c2"),
               log=lambda *_: None)
+
+
+def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_path):
+    """bench/eval_solid_photos.py on a tiny space model and two held-out photos: every measure per photo, the
+    summary's medians, and the photo's own crop nearer to the photo than the pixel shuffle (patches) and random phase (morphology)."""
+    import importlib.util
+    import json
+
+    spec = importlib.util.spec_from_file_location("eval_solid_photos", os.path.join(ROOT, "bench", "eval_solid_photos.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    cfg = dict(name="tiny_eval", mode="space", dim=3, crop=64, batch=2, steps=1, width=16, log_every=1,
+               checkpoint_every=1, threads=1, exemplars=ex.photo_set("train")[:2], colour="affine", loss="swd",
+               transform="bounded", swd_width=8, swd_levels=2, cellular=1, bricks=1)
+    train(SolidConfig.from_dict(cfg), str(tmp_path / "run"), log=lambda *_: None)
+    export(str(tmp_path / "run"), str(tmp_path / "m"))
+    out = tmp_path / "eval.json"
+    assert mod.main(["--model", str(tmp_path / "m"), "--limit", "2", "-o", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["summary"]["photos"] == 2 and doc["summary"]["median_morph"] > 0
+    for r in doc["photos"].values():
+        assert r["photo_crop"] < r["pixel_shuffle"] and r["morph_photo_crop"] < r["morph_random_phase"]
+        assert set(r) >= {"swd", "morph", "morph_random_phase", "colour", "random_phase", "axis_spread"}
