@@ -134,6 +134,17 @@ def test_swd_loss_prefers_the_texture_to_its_shuffle():
     assert out.grad.abs().sum() > 0
 
 
+def test_sliced_features_levels_and_wide_filters():
+    """Each pyramid level gives the colour neighbourhoods and every filter that fits inside it: the default
+    (3, 7) filters on 128 px crops keep their 4 levels x 3 taps; a 31 px filter stops at the 32 px level
+    (needs k + 4) while the narrow taps go on."""
+    img = torch.rand(1, 3, 128, 128)
+    assert [t.shape[-1] for t in SlicedFeatures(width=4, kernels=(3, 7), levels=5)(img)] == \
+        [124, 126, 122, 60, 62, 58, 28, 30, 26, 12, 14, 10]
+    wide = SlicedFeatures(width=4, kernels=(3, 7, 31), levels=5)(img)
+    assert [t.shape[-1] for t in wide] == [124, 126, 122, 98, 60, 62, 58, 34, 28, 30, 26, 12, 14, 10]
+
+
 def test_photo_space_model_colour_path_export_and_refine(tmp_path):
     photos = ex.photo_set("train")[:2]
     cfg = dict(name="tiny_photo", mode="space", dim=3, crop=128, batch=2, steps=2, width=16, log_every=1,

@@ -54,11 +54,13 @@ class SlicedFeatures(nn.Module):
         for lvl in range(self.levels):
             if lvl:
                 x = F.avg_pool2d(x, 2)
-            if min(x.shape[-2:]) < max(self.kernels + (self.patch,)) + 4:
+            side = min(x.shape[-2:])
+            if side < max(self.patch, min(self.kernels)) + 4:
                 break
             taps.append(F.conv2d(x, self.patches))                          # 'valid': no border statistics
             for k in self.kernels:
-                taps.append(F.relu(F.conv2d(x, getattr(self, f"w{k}"), getattr(self, f"b{k}"))))
+                if side >= k + 4:         # a wide filter stops at the level where it no longer fits
+                    taps.append(F.relu(F.conv2d(x, getattr(self, f"w{k}"), getattr(self, f"b{k}"))))
         return taps
 
 
