@@ -99,7 +99,7 @@ def cellular_features_numpy(points, transforms, seed: int, octaves: int) -> np.n
 
 
 if numba is not None:
-    from .lattice import _lb32
+    from .lattice import lowbias32_jit
 
     @numba.njit(parallel=True, cache=True, nogil=True)
     def _cell_kernel(x, T, seeds, K, offs, out):
@@ -123,7 +123,7 @@ if numba is not None:
                 for o in range(offs.shape[0]):
                     h = seeds[i]
                     for a in range(D):
-                        h = _lb32((h + ((k[a] + offs[o, a]) & 0xFFFFFFFF)) & 0xFFFFFFFF)
+                        h = lowbias32_jit((h + ((k[a] + offs[o, a]) & 0xFFFFFFFF)) & 0xFFFFFFFF)
                     d2 = 0.0
                     for a in range(D):
                         j = ((h >> (10 * a)) & 1023) * (1.0 / 1024.0)
@@ -132,7 +132,7 @@ if numba is not None:
                     if d2 < f1:
                         f2 = f1
                         f1 = d2
-                        val = (_lb32(h) & 1023) * (2.0 / 1023.0) - 1.0
+                        val = (lowbias32_jit(h) & 1023) * (2.0 / 1023.0) - 1.0
                     elif d2 < f2:
                         f2 = d2
                 F1 = np.sqrt(f1)

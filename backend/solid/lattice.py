@@ -101,7 +101,7 @@ def lattice_noise_numpy(points, transforms, seed: int, channels: int = 3) -> np.
 
 if numba is not None:
     @numba.njit(cache=True, inline="always")
-    def _lb32(x):
+    def lowbias32_jit(x):
         x = x ^ (x >> 16)
         x = (x * 0x7FEB352D) & 0xFFFFFFFF
         x = x ^ (x >> 15)
@@ -136,7 +136,7 @@ if numba is not None:
                     wt = 1.0
                     for a in range(D):
                         bit = (corner >> a) & 1
-                        h = _lb32((h + ((k[a] + bit) & 0xFFFFFFFF)) & 0xFFFFFFFF)
+                        h = lowbias32_jit((h + ((k[a] + bit) & 0xFFFFFFFF)) & 0xFFFFFFFF)
                         wt *= w[a] if bit else 1.0 - w[a]
                     v0 += wt * ((h & 1023) * (2.0 / 1023.0) - 1.0)
                     v1 += wt * (((h >> 10) & 1023) * (2.0 / 1023.0) - 1.0)

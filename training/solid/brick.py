@@ -15,7 +15,7 @@ import torch
 
 from backend.solid.brick import BRICK_SALT, FEATURES
 from backend.solid.lattice import BITS, MASK32
-from .lattice import _lb32
+from .lattice import lowbias32_torch
 
 __all__ = ["brick_features"]
 
@@ -41,14 +41,14 @@ def brick_features(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, octave
     r = torch.floor(p[..., 1])
     ri = r.to(torch.int64)
     shift = 0.5 * (ri & 1).to(x.dtype)
-    s = _lb32((seeds[:, :octaves] ^ BRICK_SALT) & MASK32).view(B, octaves, 1)   # backend's brick_seeds
-    h = _lb32((s + (ri & MASK32)) & MASK32)
+    s = lowbias32_torch((seeds[:, :octaves] ^ BRICK_SALT) & MASK32).view(B, octaves, 1)   # backend's brick_seeds
+    h = lowbias32_torch((s + (ri & MASK32)) & MASK32)
     joint = None
     for a in range(D):
         if a == 1:
             continue
         q = p[..., a] + shift
-        h = _lb32((h + (torch.floor(q).to(torch.int64) & MASK32)) & MASK32)
+        h = lowbias32_torch((h + (torch.floor(q).to(torch.int64) & MASK32)) & MASK32)
         t = _tri(q)
         joint = t if joint is None else torch.minimum(joint, t)
     v = (h & _LEVELS).to(x.dtype) * (2.0 / _LEVELS) - 1.0

@@ -15,7 +15,7 @@ import torch
 
 from backend.solid.cellular import CELL_SALT, FEATURES, offsets
 from backend.solid.lattice import BITS, MASK32
-from .lattice import _lb32
+from .lattice import lowbias32_torch
 
 __all__ = ["cellular_features"]
 
@@ -36,19 +36,19 @@ def cellular_features(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, oct
     fl = torch.floor(p)
     f = p - fl
     k = fl.to(torch.int64)
-    s = _lb32((seeds[:, :octaves] ^ CELL_SALT) & MASK32).view(B, octaves, 1)   # backend's cell_seeds
+    s = lowbias32_torch((seeds[:, :octaves] ^ CELL_SALT) & MASK32).view(B, octaves, 1)   # backend's cell_seeds
     f1 = torch.full_like(f[..., 0], float("inf"))
     f2 = torch.full_like(f1, float("inf"))
     val = torch.zeros_like(f1)
     for off in offsets(D):
         h = s
         for d in range(D):
-            h = _lb32((h + ((k[..., d] + off[d]) & MASK32)) & MASK32)
+            h = lowbias32_torch((h + ((k[..., d] + off[d]) & MASK32)) & MASK32)
         d2 = 0.0
         for d in range(D):
             j = ((h >> (BITS * d)) & _LEVELS).to(x.dtype) * (1.0 / (_LEVELS + 1))
             d2 = d2 + (off[d] + j - f[..., d]) ** 2
-        v = (_lb32(h) & _LEVELS).to(x.dtype) * (2.0 / _LEVELS) - 1.0
+        v = (lowbias32_torch(h) & _LEVELS).to(x.dtype) * (2.0 / _LEVELS) - 1.0
         nearer = d2 < f1
         f2 = torch.where(nearer, f1, torch.minimum(f2, d2))
         f1 = torch.where(nearer, d2, f1)

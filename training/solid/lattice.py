@@ -14,12 +14,13 @@ import torch
 
 from backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
 
-__all__ = ["octave_seeds", "lattice_noise"]
+__all__ = ["octave_seeds", "lattice_noise", "lowbias32_torch"]
 
 _LEVELS = (1 << BITS) - 1
 
 
-def _lb32(x: torch.Tensor) -> torch.Tensor:
+def lowbias32_torch(x: torch.Tensor) -> torch.Tensor:
+    """``lowbias32`` of int64 tensors in [0, 2^32) (the runtime's hash, bit for bit)."""
     x = x ^ (x >> 16)
     x = (x * 0x7FEB352D) & MASK32
     x = x ^ (x >> 15)
@@ -53,7 +54,7 @@ def lattice_noise(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, channel
     ws = [None]
     for d in range(D):
         kd, wd = k[..., d], w1[..., d]
-        hs = [_lb32((h + ((kd + bit) & MASK32)) & MASK32) for h in hs for bit in (0, 1)]
+        hs = [lowbias32_torch((h + ((kd + bit) & MASK32)) & MASK32) for h in hs for bit in (0, 1)]
         ws = [(wd if bit else 1.0 - wd) if w is None else w * (wd if bit else 1.0 - wd) for w in ws for bit in (0, 1)]
     shifts = torch.arange(channels, device=x.device, dtype=torch.int64) * BITS
     out = x.new_zeros(B, m, N, channels)
