@@ -15,7 +15,7 @@ import torch
 
 from backend.solid.brick import BRICK_SALT, FEATURES
 from backend.solid.lattice import BITS, MASK32
-from .lattice import lowbias32_torch
+from .lattice import lowbias32_torch, octave_positions
 
 __all__ = ["brick_features"]
 
@@ -32,12 +32,7 @@ def brick_features(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, octave
     B, N, D = x.shape
     if octaves == 0:
         return x.new_zeros(B, N, 0)
-    m = T.shape[-3]
-    if T.dim() == 3:
-        T = T.unsqueeze(0).expand(B, m, D, D)
-    T = T[:, :octaves]
-    scale = (2.0 ** torch.arange(octaves, device=x.device, dtype=x.dtype)).view(1, octaves, 1, 1)
-    p = torch.einsum("bmij,bnj->bmni", T * scale, x)          # (B, K, N, D)
+    p = octave_positions(x, T, octaves)                        # (B, K, N, D)
     r = torch.floor(p[..., 1])
     ri = r.to(torch.int64)
     shift = 0.5 * (ri & 1).to(x.dtype)

@@ -15,7 +15,7 @@ import torch
 
 from backend.solid.cellular import CELL_SALT, FEATURES, offsets
 from backend.solid.lattice import BITS, MASK32
-from .lattice import lowbias32_torch
+from .lattice import lowbias32_torch, octave_positions
 
 __all__ = ["cellular_features"]
 
@@ -27,12 +27,7 @@ def cellular_features(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, oct
     B, N, D = x.shape
     if octaves == 0:
         return x.new_zeros(B, N, 0)
-    m = T.shape[-3]
-    if T.dim() == 3:
-        T = T.unsqueeze(0).expand(B, m, D, D)
-    T = T[:, :octaves]
-    scale = (2.0 ** torch.arange(octaves, device=x.device, dtype=x.dtype)).view(1, octaves, 1, 1)
-    p = torch.einsum("bmij,bnj->bmni", T * scale, x)          # (B, K, N, D)
+    p = octave_positions(x, T, octaves)                        # (B, K, N, D)
     fl = torch.floor(p)
     f = p - fl
     k = fl.to(torch.int64)

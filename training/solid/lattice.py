@@ -14,7 +14,7 @@ import torch
 
 from backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
 
-__all__ = ["octave_seeds", "lattice_noise", "lowbias32_torch"]
+__all__ = ["octave_seeds", "lattice_noise", "lowbias32_torch", "octave_positions"]
 
 _LEVELS = (1 << BITS) - 1
 
@@ -34,17 +34,23 @@ def octave_seeds(seeds, octaves: int, device=None) -> torch.Tensor:
     return torch.as_tensor(np.stack(rows), dtype=torch.int64, device=device)
 
 
+def octave_positions(x: torch.Tensor, T: torch.Tensor, octaves: int) -> torch.Tensor:
+    """The first ``octaves`` octaves' positions p[b, i, n] = 2^i T_i x_n (Eq. 5's argument): x (B, N, D),
+    T (m, D, D) or (B, m, D, D) -> (B, octaves, N, D)."""
+    B, N, D = x.shape
+    if T.dim() == 3:
+        T = T.unsqueeze(0).expand(B, T.shape[0], D, D)
+    scale = (2.0 ** torch.arange(octaves, device=x.device, dtype=x.dtype)).view(1, octaves, 1, 1)
+    return torch.einsum("bmij,bnj->bmni", T[:, :octaves] * scale, x)
+
+
 def lattice_noise(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, channels: int = 3) -> torch.Tensor:
     """Octave noise n_i = noise(T_i 2^(i-1) x | xi_i) (Eq. 5): (B, N, D) -> (B, N, m*C)."""
     if not 1 <= channels <= MAX_CHANNELS:
         raise ValueError(f"channels must be 1..{MAX_CHANNELS}")
     B, N, D = x.shape
     m = T.shape[-3]
-    if T.dim() == 3:
-        T = T.unsqueeze(0).expand(B, m, D, D)
-    scale = (2.0 ** torch.arange(m, device=x.device, dtype=x.dtype)).view(1, m, 1, 1)
-    # p[b, i, n, :] = 2^i T_i x_n
-    p = torch.einsum("bmij,bnj->bmni", T * scale, x)
+    p = octave_positions(x, T, m)
     fl = torch.floor(p)
     t = p - fl
     w1 = t * t * (3.0 - 2.0 * t)
