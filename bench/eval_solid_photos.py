@@ -134,10 +134,9 @@ def summary(rows: dict) -> dict:
                 median_colour=med("colour"), max_colour=round(float(max(r["colour"] for r in rows.values())), 4),
                 median_diversity=med("diversity"), median_axis_spread=med("axis_spread"),
                 median_seconds=med("seconds"), worst_swd=float(swd.max()),
-                **({} if "morph" not in next(iter(rows.values())) else dict(
-                    median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
-                    median_morph_photo_crop=med("morph_photo_crop"),
-                    beats_random_phase_morph=int(sum(r["morph"] < r["morph_random_phase"] for r in rows.values())))))
+                median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
+                median_morph_photo_crop=med("morph_photo_crop"),
+                beats_random_phase_morph=int(sum(r["morph"] < r["morph_random_phase"] for r in rows.values())))
 
 
 def by_category(rows: dict) -> dict:

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lattice import BITS, MASK32, check_points, lowbias32, octave_seeds
+from .lattice import BITS, MASK32, check_feature_octaves, lowbias32, octave_position, salted_seeds
 
 __all__ = ["FEATURES", "BRICK_SALT", "brick_seeds", "brick_features"]
 
@@ -40,7 +40,7 @@ _LEVELS = (1 << BITS) - 1
 
 def brick_seeds(seed: int, octaves: int) -> np.ndarray:
     """Per-octave seeds of the brick lattices: int64 (octaves,)."""
-    return lowbias32((octave_seeds(seed, octaves) ^ BRICK_SALT) & MASK32)
+    return salted_seeds(seed, octaves, BRICK_SALT)
 
 
 def _tri(t: np.ndarray) -> np.ndarray:
@@ -51,16 +51,14 @@ def _tri(t: np.ndarray) -> np.ndarray:
 
 def brick_features(points, transforms, seed: int, octaves: int) -> np.ndarray:
     """Brick features of the first ``octaves`` octaves (see module doc): float32 (N, 3 octaves)."""
-    points, transforms = check_points(points, transforms, 1)
+    points, transforms = check_feature_octaves(points, transforms, octaves, "brick")
     N, D = points.shape
-    if not 0 <= octaves <= transforms.shape[0]:
-        raise ValueError(f"brick octaves must be 0..{transforms.shape[0]}, got {octaves}")
     seeds = brick_seeds(seed, transforms.shape[0])
     x = points.astype(np.float64)
     out = np.empty((N, FEATURES * octaves), np.float32)
     others = [a for a in range(D) if a != 1]
     for i in range(octaves):
-        p = (x @ transforms[i].astype(np.float64).T) * float(2 ** i)
+        p = octave_position(x, transforms, i)
         r = np.floor(p[:, 1])
         shift = 0.5 * (r.astype(np.int64) & 1)
         h = lowbias32((seeds[i] + (r.astype(np.int64) & MASK32)) & MASK32)

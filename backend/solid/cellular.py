@@ -37,7 +37,7 @@ import itertools
 
 import numpy as np
 
-from .lattice import BITS, MASK32, check_points, lowbias32, numba, octave_seeds
+from .lattice import BITS, MASK32, check_feature_octaves, lowbias32, numba, octave_position, salted_seeds
 
 __all__ = ["FEATURES", "CELL_SALT", "cell_seeds", "cellular_features", "cellular_features_numpy"]
 
@@ -48,7 +48,7 @@ _LEVELS = (1 << BITS) - 1
 
 def cell_seeds(seed: int, octaves: int) -> np.ndarray:
     """Per-octave seeds of the feature-point lattices: int64 (octaves,)."""
-    return lowbias32((octave_seeds(seed, octaves) ^ CELL_SALT) & MASK32)
+    return salted_seeds(seed, octaves, CELL_SALT)
 
 
 def offsets(dim: int) -> list:
@@ -56,22 +56,15 @@ def offsets(dim: int) -> list:
     return list(itertools.product((-1, 0, 1), repeat=dim))
 
 
-def _inputs(points, transforms, octaves):
-    points, transforms = check_points(points, transforms, 1)
-    if not 0 <= octaves <= transforms.shape[0]:
-        raise ValueError(f"cellular octaves must be 0..{transforms.shape[0]}, got {octaves}")
-    return points, transforms
-
-
 def cellular_features_numpy(points, transforms, seed: int, octaves: int) -> np.ndarray:
     """Reference numpy implementation of the features (see module doc): float32 (N, 3 octaves)."""
-    points, transforms = _inputs(points, transforms, octaves)
+    points, transforms = check_feature_octaves(points, transforms, octaves, "cellular")
     N, D = points.shape
     seeds = cell_seeds(seed, transforms.shape[0])
     x = points.astype(np.float64)
     out = np.empty((N, FEATURES * octaves), np.float32)
     for i in range(octaves):
-        p = (x @ transforms[i].astype(np.float64).T) * float(2 ** i)
+        p = octave_position(x, transforms, i)
         fl = np.floor(p)
         f = p - fl
         k = fl.astype(np.int64)
@@ -99,7 +92,7 @@ def cellular_features_numpy(points, transforms, seed: int, octaves: int) -> np.n
 
 
 if numba is not None:
-    from .lattice import lowbias32_jit
+    from .lattice import lowbias32_jit, octave_coord
 
     @numba.njit(parallel=True, cache=True, nogil=True)
     def _cell_kernel(x, T, seeds, K, offs, out):
@@ -108,12 +101,8 @@ if numba is not None:
             p = np.empty(3)
             k = np.empty(3, np.int64)
             for i in range(K):
-                s = 1 << i
                 for a in range(D):
-                    acc = 0.0
-                    for b in range(D):
-                        acc += np.float64(T[i, a, b]) * x[n, b]
-                    pa = acc * s
+                    pa = octave_coord(T, x, n, i, a)
                     fa = np.floor(pa)
                     p[a] = pa - fa
                     k[a] = np.int64(fa)
@@ -147,7 +136,7 @@ def cellular_features(points, transforms, seed: int, octaves: int) -> np.ndarray
     The compiled kernel when numba is importable (it releases the GIL), else
     :func:`cellular_features_numpy`; both give the same values to float32 rounding.
     """
-    points, transforms = _inputs(points, transforms, octaves)
+    points, transforms = check_feature_octaves(points, transforms, octaves, "cellular")
     if numba is None:
         return cellular_features_numpy(points, transforms, seed, octaves)
     out = np.empty((points.shape[0], FEATURES * octaves), np.float32)

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MASK32", "BITS", "MAX_CHANNELS", "lowbias32", "octave_seeds", "lattice_noise",
-           "lattice_noise_numpy", "fast_available", "check_points"]
+__all__ = ["MASK32", "BITS", "MAX_CHANNELS", "lowbias32", "octave_seeds", "salted_seeds", "lattice_noise",
+           "lattice_noise_numpy", "fast_available", "check_points", "check_feature_octaves", "octave_position"]
 
 MASK32 = 0xFFFFFFFF
 BITS = 10                 #: bits per channel value
@@ -56,6 +56,12 @@ def octave_seeds(seed: int, octaves: int) -> np.ndarray:
     return np.array([lowbias32((base + (i + 1) * 0x9E3779B9) & MASK32) for i in range(octaves)], dtype=np.int64)
 
 
+def salted_seeds(seed: int, octaves: int, salt: int) -> np.ndarray:
+    """Per-octave seeds of another hash stream (cellular, brick features): int64 (octaves,),
+    lowbias32(xi_i ^ salt), so each stream is independent of the value noise's."""
+    return lowbias32((octave_seeds(seed, octaves) ^ salt) & MASK32)
+
+
 def check_points(points, transforms, channels):
     points = np.asarray(points)
     transforms = np.asarray(transforms, dtype=np.float32)
@@ -69,6 +75,19 @@ def check_points(points, transforms, channels):
     return points, transforms
 
 
+def check_feature_octaves(points, transforms, octaves: int, family: str):
+    """:func:`check_points` for a feature family read at the first ``octaves`` octaves; ValueError names the family."""
+    points, transforms = check_points(points, transforms, 1)
+    if not 0 <= octaves <= transforms.shape[0]:
+        raise ValueError(f"{family} octaves must be 0..{transforms.shape[0]}, got {octaves}")
+    return points, transforms
+
+
+def octave_position(x: np.ndarray, transforms: np.ndarray, i: int) -> np.ndarray:
+    """p = T_i 2^(i-1) x (Eq. 5; octave index i from 0 here): x float64 (N, D) -> float64 (N, D)."""
+    return (x @ transforms[i].astype(np.float64).T) * float(2 ** i)
+
+
 def lattice_noise_numpy(points, transforms, seed: int, channels: int = 3) -> np.ndarray:
     """Reference numpy implementation of the octave noise n (see module doc): float32 (N, m*C)."""
     points, transforms = check_points(points, transforms, channels)
@@ -78,8 +97,7 @@ def lattice_noise_numpy(points, transforms, seed: int, channels: int = 3) -> np.
     x = points.astype(np.float64)
     out = np.empty((N, m * channels), np.float32)
     for i in range(m):
-        # p = T_i 2^(i-1) x (Eq. 5; octave index i from 0 here)
-        p = (x @ transforms[i].astype(np.float64).T) * float(2 ** i)
+        p = octave_position(x, transforms, i)
         fl = np.floor(p)
         t = p - fl
         w1 = t * t * (3.0 - 2.0 * t)
@@ -108,24 +126,26 @@ if numba is not None:
         x = (x * 0x846CA68B) & 0xFFFFFFFF
         return x ^ (x >> 16)
 
+    @numba.njit(cache=True, inline="always")
+    def octave_coord(T, x, n, i, a):
+        """Coordinate a of 2^i T_i x_n in float64, as :func:`octave_position` computes it."""
+        acc = 0.0
+        for b in range(x.shape[1]):
+            acc += np.float64(T[i, a, b]) * x[n, b]
+        return acc * (1 << i)
+
     @numba.njit(parallel=True, cache=True, nogil=True)
     def _noise_kernel(x, T, seeds, C, out):
         N, D = x.shape
         m = T.shape[0]
         for n in numba.prange(N):
-            p = np.empty(3)
             w = np.empty(3)
             k = np.empty(3, np.int64)
             for i in range(m):
-                s = 1 << i
                 for a in range(D):
-                    acc = 0.0
-                    for b in range(D):
-                        acc += np.float64(T[i, a, b]) * x[n, b]
-                    pa = acc * s
+                    pa = octave_coord(T, x, n, i, a)
                     f = np.floor(pa)
                     t = pa - f
-                    p[a] = pa
                     w[a] = t * t * (3.0 - 2.0 * t)
                     k[a] = np.int64(f)
                 v0 = 0.0

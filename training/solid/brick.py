@@ -15,7 +15,7 @@ import torch
 
 from backend.solid.brick import BRICK_SALT, FEATURES
 from backend.solid.lattice import BITS, MASK32
-from .lattice import lowbias32_torch, octave_positions
+from .lattice import lowbias32_torch, octave_positions, salted_seeds
 
 __all__ = ["brick_features"]
 
@@ -36,7 +36,7 @@ def brick_features(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, octave
     r = torch.floor(p[..., 1])
     ri = r.to(torch.int64)
     shift = 0.5 * (ri & 1).to(x.dtype)
-    s = lowbias32_torch((seeds[:, :octaves] ^ BRICK_SALT) & MASK32).view(B, octaves, 1)   # backend's brick_seeds
+    s = salted_seeds(seeds, octaves, BRICK_SALT)                   # backend's brick_seeds
     h = lowbias32_torch((s + (ri & MASK32)) & MASK32)
     joint = None
     for a in range(D):

@@ -15,7 +15,7 @@ import torch
 
 from backend.solid.cellular import CELL_SALT, FEATURES, offsets
 from backend.solid.lattice import BITS, MASK32
-from .lattice import lowbias32_torch, octave_positions
+from .lattice import lowbias32_torch, octave_positions, salted_seeds
 
 __all__ = ["cellular_features"]
 
@@ -31,7 +31,7 @@ def cellular_features(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, oct
     fl = torch.floor(p)
     f = p - fl
     k = fl.to(torch.int64)
-    s = lowbias32_torch((seeds[:, :octaves] ^ CELL_SALT) & MASK32).view(B, octaves, 1)   # backend's cell_seeds
+    s = salted_seeds(seeds, octaves, CELL_SALT)                   # backend's cell_seeds
     f1 = torch.full_like(f[..., 0], float("inf"))
     f2 = torch.full_like(f1, float("inf"))
     val = torch.zeros_like(f1)

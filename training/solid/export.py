@@ -24,8 +24,6 @@ from torch import nn
 
 from backend._export import export as _ex
 from backend.onnx_models import sha256_file
-from backend.solid.brick import FEATURES as BRICK_FEATURES
-from backend.solid.cellular import FEATURES as CELL_FEATURES
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
 from .model import COLOUR_STATS, colour_stats, spectral_gains
@@ -83,7 +81,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
     model.load_state_dict(state["model"])
     model.eval()
     os.makedirs(out, exist_ok=True)
-    n_noise = cfg.octaves * cfg.channels + CELL_FEATURES * cfg.cellular + BRICK_FEATURES * cfg.bricks
+    n_noise = model.n_noise
     files = {}
     _onnx(SplitDecoder(model.decoder, n_noise), (torch.randn(16, n_noise), torch.randn(1, cfg.code_dim)),
           os.path.join(out, "decoder.onnx"), ["noise", "code"], ["rgb"],

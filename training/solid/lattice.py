@@ -14,7 +14,7 @@ import torch
 
 from backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
 
-__all__ = ["octave_seeds", "lattice_noise", "lowbias32_torch", "octave_positions"]
+__all__ = ["octave_seeds", "salted_seeds", "lattice_noise", "lowbias32_torch", "octave_positions"]
 
 _LEVELS = (1 << BITS) - 1
 
@@ -32,6 +32,12 @@ def octave_seeds(seeds, octaves: int, device=None) -> torch.Tensor:
     """Per-sample user seeds (B,) -> int64 (B, octaves), as the runtime's ``octave_seeds``."""
     rows = [_np_octave_seeds(int(s), octaves) for s in np.asarray(seeds).reshape(-1)]
     return torch.as_tensor(np.stack(rows), dtype=torch.int64, device=device)
+
+
+def salted_seeds(seeds: torch.Tensor, octaves: int, salt: int) -> torch.Tensor:
+    """The first ``octaves`` of another hash stream's seeds from the octave seeds (B, m) -> (B, octaves, 1),
+    as the runtime's ``salted_seeds``."""
+    return lowbias32_torch((seeds[:, :octaves] ^ salt) & MASK32).unsqueeze(-1)
 
 
 def octave_positions(x: torch.Tensor, T: torch.Tensor, octaves: int) -> torch.Tensor:

@@ -35,7 +35,12 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
-__all__ = ["colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
+__all__ = ["shape_features", "colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
+
+
+def shape_features(cellular: int, bricks: int) -> int:
+    """How many values the cellular and brick octaves add to the decoder's input (after the value noise)."""
+    return CELL_FEATURES * cellular + BRICK_FEATURES * bricks
 
 
 def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
@@ -268,7 +273,9 @@ class SolidTexture(nn.Module):
             if not 0 <= k <= octaves:
                 raise ValueError(f"{key} must be 0..{octaves} (octaves with {key} features), got {k}")
         self.colour, self.cellular, self.bricks = colour, cellular, bricks
-        self.decoder = Decoder(octaves * channels + CELL_FEATURES * cellular + BRICK_FEATURES * bricks, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
+        #: decoder inputs: value noise (octaves x channels), then the shape features
+        self.n_noise = octaves * channels + shape_features(cellular, bricks)
+        self.decoder = Decoder(self.n_noise, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
                                film=film)
         if mode == "single":
             self.code = nn.Parameter(torch.rand(code_dim) * 2.0 - 1.0)     # U(-1, 1) as the authors' code

@@ -36,11 +36,9 @@ from ..config import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import SolidTexture, colour_stats, slice_points, spectral_gains
+from .model import SolidTexture, colour_stats, shape_features, slice_points, spectral_gains
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
-from backend.solid.brick import FEATURES as BRICK_FEATURES
-from backend.solid.cellular import FEATURES as CELL_FEATURES
 from backend.onnx_models import load_model_json
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
@@ -215,8 +213,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     elif cfg.init_onnx:
         # the export's step and training time carry on, so the ledger and the cosine schedule continue
         model_json = load_model_json(cfg.init_onnx, "solid.json")
-        had = CELL_FEATURES * int(model_json.get("cellular", 0)) + BRICK_FEATURES * int(model_json.get("bricks", 0))
-        new = CELL_FEATURES * cfg.cellular + BRICK_FEATURES * cfg.bricks - had
+        had = shape_features(int(model_json.get("cellular", 0)), int(model_json.get("bricks", 0)))
+        new = shape_features(cfg.cellular, cfg.bricks) - had
         if had and new:
             raise ValueError("init_onnx: features can be added only to an export without cellular or brick features")
         warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256), new_features=new)
