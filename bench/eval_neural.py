@@ -33,7 +33,7 @@ def main() -> int:
     ap.add_argument("--n", type=int, default=32, help="samples per class")
     ap.add_argument("--steps", type=int, default=30, help="sampler steps")
     ap.add_argument("--sampler", default="ddim", help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py)")
-    ap.add_argument("--spacing", help="timestep spacing: uniform, logsnr or karras (default: the sampler's own)")
+    ap.add_argument("--spacing", help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own)")
     ap.add_argument("--precision", default="fp32", help="the denoiser's arithmetic: fp32, int8 or auto "
                                                          "(int8 needs the folder's int8 files, training/quantize_onnx.py)")
     ap.add_argument("--clf-steps", type=int, default=600)

@@ -122,7 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--sampler", default=None, help="ddim, dpmpp_2m or heun (default: dpmpp_2m)")
     n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 15)")
     n.add_argument("--spacing", default=None,
-                   help="timestep spacing: uniform, logsnr or karras (default: logsnr for dpmpp_2m, else uniform)")
+                   help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own, see README)")
     n.add_argument("--eta", type=float, default=0.0, help="ddim only: step noise, 0 (deterministic) .. 1 (DDPM)")
     n.add_argument("--tile", type=int, default=None,
                    help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "

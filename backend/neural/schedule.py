@@ -32,7 +32,14 @@ def ddim_timesteps(steps: int, T: int = T_DEFAULT) -> np.ndarray:
     return np.unique(np.linspace(0, T - 1, steps).round().astype(np.int64))[::-1].copy()
 
 
-SPACINGS = ("uniform", "logsnr", "karras")
+SPACINGS = ("uniform", "logsnr", "karras", "truncated")
+
+#: the λ interval the "truncated" grid spends its evaluations on after the first (at t = T - 1): below
+#: λ = -3.5 (SNR e^-7) the data prediction hardly changes, so one first-order step crosses it; above
+#: λ = 3.5 (σ/α = 0.03, a quarter of an 8-bit level's worth of noise after the final denoising) the
+#: last evaluation's data prediction is the image.  Chosen by the distance to the converged ODE solution
+#: (README, "Sampling"; scratch-free: bench/neural_solver_error.py)
+TRUNCATED_LAMBDA = (-3.5, 3.5)
 
 
 def timesteps(steps: int, alphas_cumprod: np.ndarray, spacing: str = "uniform", rho: float = 7.0) -> np.ndarray:
@@ -41,6 +48,9 @@ def timesteps(steps: int, alphas_cumprod: np.ndarray, spacing: str = "uniform", 
     uniform  even in t (DDIM's sub-sequence, :func:`ddim_timesteps`)
     logsnr   even in λ = log(α / σ) = ½ log(ᾱ / (1 - ᾱ)) (Lu et al. 2022's recommendation for few steps)
     karras   s_i = (s_max^{1/ρ} + i/(n-1) (s_min^{1/ρ} - s_max^{1/ρ}))^ρ in s = σ / α (Karras et al. 2022, Eq. 5)
+    truncated  T-1 first, then steps - 1 targets even in λ over TRUNCATED_LAMBDA; it ends at λ = 3.5,
+             not at t = 0, and every timestep is a distinct evaluation (on the cosine schedule the λ grids
+             above merge targets near T - 1: "logsnr" gives 13 timesteps for 15)
     Each continuous target is rounded to the discrete timestep nearest in λ.
     """
     ab = np.asarray(alphas_cumprod, np.float64)
@@ -52,6 +62,12 @@ def timesteps(steps: int, alphas_cumprod: np.ndarray, spacing: str = "uniform", 
     lam = 0.5 * np.log(ab / (1.0 - ab))  # increasing as t decreases
     if steps == 1:
         return np.array([T - 1], np.int64)
+    if spacing == "truncated":
+        lo, hi = max(TRUNCATED_LAMBDA[0], lam[-1]), min(TRUNCATED_LAMBDA[1], lam[0])
+        target = np.concatenate([[lam[-1]], np.linspace(lo, hi, steps - 1)])
+        ts = _nearest(lam, target)
+        ts[0] = T - 1
+        return np.unique(ts)[::-1].copy()
     if spacing == "logsnr":
         target = np.linspace(lam[-1], lam[0], steps)
     elif spacing == "karras":
@@ -60,13 +76,18 @@ def timesteps(steps: int, alphas_cumprod: np.ndarray, spacing: str = "uniform", 
         target = -np.log((s_max ** (1 / rho) + r * (s_min ** (1 / rho) - s_max ** (1 / rho))) ** rho)
     else:
         raise ValueError(f"unknown spacing {spacing!r}; choose one of {', '.join(SPACINGS)}")
-    # lam is decreasing in t: search on the reversed (increasing) array
-    idx = np.clip(np.searchsorted(lam[::-1], target), 1, T - 1)
-    lo, hi = lam[::-1][idx - 1], lam[::-1][idx]
-    idx = np.where(np.abs(target - lo) <= np.abs(target - hi), idx - 1, idx)
-    ts = (T - 1 - idx).astype(np.int64)
+    ts = _nearest(lam, target)
     ts[0], ts[-1] = T - 1, 0
     return np.unique(ts)[::-1].copy()
+
+
+def _nearest(lam: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The timestep nearest in λ to each target: int64 like ``target`` (``lam`` decreasing in t)."""
+    T = len(lam)
+    idx = np.clip(np.searchsorted(lam[::-1], target), 1, T - 1)  # search the reversed (increasing) array
+    lo, hi = lam[::-1][idx - 1], lam[::-1][idx]
+    idx = np.where(np.abs(target - lo) <= np.abs(target - hi), idx - 1, idx)
+    return (T - 1 - idx).astype(np.int64)
 
 
 def alphas_from_config(schedule: dict) -> np.ndarray:
