@@ -75,7 +75,7 @@ def main() -> int:
         d = {n: float(np.abs(sample(name, eps, x_T[n], conds[n], steps, spacing=spacing) - ref[n]).mean())
              for n in classes}
         v = np.array(list(d.values()))
-        ev = len_evals(model, name, steps, spacing)
+        ev = evaluations(name, steps, spacing, model.alphas_cumprod)
         print(f"{name:12s} {steps:5d} {spacing:10s} {ev:5d} {v.mean():7.4f} {np.median(v):7.4f} {v.max():7.4f}  "
               f"{max(d, key=d.get)}", flush=True)
         results[f"{name}:{steps}:{spacing}"] = dict(evaluations=ev, mean=float(v.mean()), median=float(np.median(v)),
@@ -85,13 +85,6 @@ def main() -> int:
             json.dump(dict(size=S, batch=B, ref_steps=a.ref_steps, model=model.fingerprint, results=results), f,
                       indent=1)
     return 0
-
-
-def len_evals(model, name: str, steps: int, spacing: str) -> int:
-    """Model evaluations the sampler makes (grids may merge timesteps that round together)."""
-    from backend.neural.schedule import timesteps
-    n = len(timesteps(steps, model.alphas_cumprod, spacing))
-    return evaluations(name, n)
 
 
 if __name__ == "__main__":

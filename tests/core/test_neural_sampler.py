@@ -134,6 +134,8 @@ def test_truncated_grid_spends_every_evaluation_between_its_lambda_bounds():
             dl = np.diff(lam[ts[1:]])
             assert np.abs(dl / dl.mean() - 1).max() < 0.15, n  # timesteps are whole: λ rounds
     assert len(timesteps(15, AB, "logsnr")) == 13  # what the truncated grid avoids
+    assert evaluations("dpmpp_2m", 15, "logsnr") == 13 and evaluations("dpmpp_2m", 10, "truncated") == 10
+    assert evaluations("heun", 10, "truncated") == 18
     # on Gaussian data it converges to the exact solution up to its ends' bias (the data prediction at
     # λ = 3.5 instead of t = 0, and one step across λ < -3.5), and at 10 evaluations it is nearer than DDIM 30
     e = [err("dpmpp_2m", n, spacing="truncated") for n in (5, 10, 40)]
