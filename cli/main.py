@@ -120,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
     n.add_argument("--size", type=int, default=256, help="output side in pixels")
     n.add_argument("--sampler", default=None, help="ddim, dpmpp_2m or heun (default: dpmpp_2m)")
-    n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 15)")
+    n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 10)")
     n.add_argument("--spacing", default=None,
                    help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own, see README)")
     n.add_argument("--eta", type=float, default=0.0, help="ddim only: step noise, 0 (deterministic) .. 1 (DDPM)")
