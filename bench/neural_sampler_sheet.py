@@ -19,7 +19,7 @@ sys.path.insert(0, ROOT)
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS  # noqa: E402
+from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, write_png  # noqa: E402
 
@@ -64,7 +64,7 @@ def main() -> int:
     sheet = np.concatenate([np.concatenate([r, np.ones((gap, r.shape[1]), np.float32)]) for r in rows])[:-gap]
     write_png(a.out, preview_8bit(sheet, 0.0, 1.0))
     write_json(os.path.splitext(a.out)[0] + ".json", dict(
-        rows=labels, size=S, left="ddim 30", right=f"{DEFAULT_SAMPLER} {DEFAULT_STEPS}",
+        rows=labels, size=S, left="ddim 30", right=f"{DEFAULT_SAMPLER} {DEFAULT_STEPS} {DEFAULT_SPACING[DEFAULT_SAMPLER]}",
         seconds={k: round(v, 1) for k, v in times.items()}, model=model.fingerprint))
     print(f"{a.out}: left DDIM 30 ({times['ddim']:.0f} s), right {DEFAULT_SAMPLER} {DEFAULT_STEPS} "
           f"({times[DEFAULT_SAMPLER]:.0f} s)")
