@@ -26,6 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.model import NeuralNoiseModel  # noqa: E402
 from backend.neural.sampler import evaluations, initial_noise, sample  # noqa: E402
+from export.atomic import write_json  # noqa: E402
 
 
 def parse(spec: str) -> tuple:
@@ -81,9 +82,7 @@ def main() -> int:
         results[f"{name}:{steps}:{spacing}"] = dict(evaluations=ev, mean=float(v.mean()), median=float(np.median(v)),
                                                      max=float(v.max()), classes=d)
     if a.out:
-        with open(a.out, "w") as f:
-            json.dump(dict(size=S, batch=B, ref_steps=a.ref_steps, model=model.fingerprint, results=results), f,
-                      indent=1)
+        write_json(a.out, dict(size=S, batch=B, ref_steps=a.ref_steps, model=model.fingerprint, results=results))
     return 0
 
 
