@@ -48,8 +48,9 @@ def _worker(a) -> dict:
     x = np.random.default_rng(0).standard_normal((1, 1, S, S)).astype(np.float32)
     t = np.array([500.0], np.float32)
     tile = auto_tile(S, S) if m.form == "split" else 0
-    out = dict(size=S, form=m.form, sampler=a.sampler, steps=a.steps, evaluations=evaluations(a.sampler, a.steps, DEFAULT_SPACING[a.sampler], m.alphas_cumprod),
-               tile=tile, load_s=round(time.perf_counter() - t0, 3))
+    n_eval = evaluations(a.sampler, a.steps, DEFAULT_SPACING[a.sampler], m.alphas_cumprod)
+    out = dict(size=S, form=m.form, sampler=a.sampler, steps=a.steps, evaluations=n_eval, tile=tile,
+               load_s=round(time.perf_counter() - t0, 3))
     if tile:
         f, count, cache = image_eps(m, cond[None], False, tile)  # generate()'s tiles and map cache
         t1 = time.perf_counter()

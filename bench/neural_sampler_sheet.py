@@ -64,7 +64,8 @@ def main() -> int:
     sheet = np.concatenate([np.concatenate([r, np.ones((gap, r.shape[1]), np.float32)]) for r in rows])[:-gap]
     write_png(a.out, preview_8bit(sheet, 0.0, 1.0))
     write_json(os.path.splitext(a.out)[0] + ".json", dict(
-        rows=labels, size=S, left="ddim 30", right=f"{DEFAULT_SAMPLER} {DEFAULT_STEPS} {DEFAULT_SPACING[DEFAULT_SAMPLER]}",
+        rows=labels, size=S, left="ddim 30",
+        right=f"{DEFAULT_SAMPLER} {DEFAULT_STEPS} {DEFAULT_SPACING[DEFAULT_SAMPLER]}",
         seconds={k: round(v, 1) for k, v in times.items()}, model=model.fingerprint))
     print(f"{a.out}: left DDIM 30 ({times['ddim']:.0f} s), right {DEFAULT_SAMPLER} {DEFAULT_STEPS} "
           f"({times[DEFAULT_SAMPLER]:.0f} s)")

@@ -65,9 +65,7 @@ def timesteps(steps: int, alphas_cumprod: np.ndarray, spacing: str = "uniform", 
     if spacing == "truncated":
         lo, hi = max(TRUNCATED_LAMBDA[0], lam[-1]), min(TRUNCATED_LAMBDA[1], lam[0])
         target = np.concatenate([[lam[-1]], np.linspace(lo, hi, steps - 1)])
-        ts = _nearest(lam, target)
-        ts[0] = T - 1
-        return np.unique(ts)[::-1].copy()
+        return np.unique(_nearest(lam, target))[::-1].copy()  # target[0] = λ(T-1) rounds to T-1 exactly
     if spacing == "logsnr":
         target = np.linspace(lam[-1], lam[0], steps)
     elif spacing == "karras":

@@ -15,7 +15,8 @@ from backend.errors import SettingError
 from backend.neural.generate import check_sampler
 from backend.neural.sampler import (DEFAULT_SAMPLER, DEFAULT_STEPS, SAMPLERS, ddim_sample, evaluations,
                                     initial_noise, sample, step_noise_rng)
-from backend.neural.schedule import TRUNCATED_LAMBDA, alphas_from_config, cosine_alphas_cumprod, ddim_timesteps, timesteps
+from backend.neural.schedule import (TRUNCATED_LAMBDA, alphas_from_config, cosine_alphas_cumprod, ddim_timesteps,
+                                     timesteps)
 
 AB = cosine_alphas_cumprod(1000)
 S_DATA = 0.5
@@ -120,6 +121,8 @@ def test_timestep_grids():
     assert np.abs(dl[4:] / dl[4:].mean() - 1).max() < 0.1
     with pytest.raises(ValueError, match="unknown spacing"):
         timesteps(5, AB, "geometric")
+    with pytest.raises(ValueError, match="steps must lie"):
+        timesteps(0, AB, "logsnr")
 
 
 def test_truncated_grid_spends_every_evaluation_between_its_lambda_bounds():
@@ -141,8 +144,6 @@ def test_truncated_grid_spends_every_evaluation_between_its_lambda_bounds():
     e = [err("dpmpp_2m", n, spacing="truncated") for n in (5, 10, 40)]
     assert e[0] > e[1] > e[2] and e[2] < 2e-3, e
     assert e[1] < err("ddim", 30), e
-    with pytest.raises(ValueError, match="steps must lie"):
-        timesteps(0, AB, "logsnr")
 
 
 def test_schedule_is_read_from_the_model_json():
