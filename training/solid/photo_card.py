@@ -31,7 +31,10 @@ ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase no
         ("photos where it beats random phase", "beats_random_phase"),
         ("median mean-colour error ↓ (target ≤ 0.03)", "median_colour"), ("worst mean-colour error", "max_colour"),
         ("median diversity between seeds", "median_diversity"), ("median axis spread (x/y/z) ↓", "median_axis_spread"),
-        ("median seconds: encode + six 128² slices", "median_seconds"))
+        ("median seconds: encode + six 128² slices", "median_seconds"),
+        ("median morphology distance ↓", "median_morph"), ("… random phase noise", "median_morph_random_phase"),
+        ("… a crop of the photo itself", "median_morph_photo_crop"),
+        ("photos where it beats random phase on morphology", "beats_random_phase_morph"))
 
 
 def run_facts(run: str) -> dict:
@@ -93,7 +96,10 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
             "within one image."] if cfg.get("film") else []),
          "- **Loss:** sliced Wasserstein distance (Heitz et al. 2021) of random multi-scale features (5 x 5 colour "
          f"neighbourhoods and {cfg['swd_width']} zero-mean ReLU filters of sizes {cfg['swd_kernels']} on "
-         f"{cfg['swd_levels']} pyramid levels) plus the sliced colour-histogram term (weight {cfg['hist_weight']}).",
+         f"{cfg['swd_levels']} pyramid levels) plus the sliced colour-histogram term (weight {cfg['hist_weight']})"
+         + (f" plus the power-spectrum band term (weight {cfg['spectrum_weight']}; `training/solid/spectrum.py`: "
+            "log shares of the luminance's power in 8 log-spaced rings x 4 orientations, each slice against "
+            "its crop)." if cfg.get("spectrum_weight") else "."),
          "- **Bounded octave transforms:** T_i = R_i e^{c_i} (I + S_i), S_i symmetric with eigenvalues within "
          "±0.6: stretch up to 4:1, never singular. The previous space model's transforms had singular values "
          "down to 0.0, i.e. noise extruded along a line: the diagonal streaks in all its output.", "",

@@ -10,8 +10,9 @@ Every step (Sec. 3, Fig. 5): random crops of the exemplar(s) -> the sampler at
 pixel centres of random 2D slices of the D-dimensional domain (axis-aligned
 and, with probability ``oblique``, rotated planes in 3D), fresh seeds xi and
 a random offset per slice -> style loss (Gram matrices of fixed random
-multi-scale features + colour histogram, :mod:`.features`) -> Adam with a
-cosine learning-rate decay.
+multi-scale features + colour histogram, :mod:`.features`, or sliced Wasserstein
+distances of such features, :mod:`.swd`; optionally the power spectrum's band
+shares, :mod:`.spectrum`) -> Adam with a cosine learning-rate decay.
 
 ``RUN/ckpt.pt`` is written atomically every ``checkpoint_every`` steps (a run
 resumes from it), ``RUN/log.jsonl`` has one line per ``log_every`` steps.
@@ -37,6 +38,7 @@ from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
 from .model import SolidTexture, colour_stats, shape_features, slice_points, spectral_gains
+from .spectrum import spectrum_loss
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from backend.onnx_models import load_model_json
@@ -79,6 +81,7 @@ class SolidConfig:
     swd_width: int = 32             # swd: random filters per size and pyramid level
     swd_kernels: tuple = (3, 7)     # swd: filter sizes
     swd_levels: int = 5             # swd: pyramid levels
+    spectrum_weight: float = 0.0    # weight of the power-spectrum band term (spectrum.py); 0: off
     seed: int = 0
     log_every: int = 25
     checkpoint_every: int = 250
@@ -112,6 +115,8 @@ class SolidConfig:
         n_exemplars = len(ex.expand(cfg.exemplars))
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
+        if not (math.isfinite(cfg.spectrum_weight) and cfg.spectrum_weight >= 0):
+            raise ValueError(f"spectrum_weight must be a number >= 0, got {cfg.spectrum_weight!r}")
         if cfg.init_onnx and not cfg.init_sha256:
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         if cfg.init_onnx and cfg.init_from:
@@ -167,9 +172,13 @@ def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, 
     """The config's style loss of rendered images against reference crops (both (B, 3, S, S))."""
     per_sample = cfg.mode == "space"
     if cfg.loss == "gram":
-        return style_loss(feats, img, ref, cfg.hist_weight, per_sample=per_sample)
-    return swd_loss(feats, img, ref, per_sample=per_sample, generator=gen) + \
-        cfg.hist_weight * histogram_loss(img, ref, per_sample=per_sample)
+        loss = style_loss(feats, img, ref, cfg.hist_weight, per_sample=per_sample)
+    else:
+        loss = swd_loss(feats, img, ref, per_sample=per_sample, generator=gen) + \
+            cfg.hist_weight * histogram_loss(img, ref, per_sample=per_sample)
+    if cfg.spectrum_weight:
+        loss = loss + cfg.spectrum_weight * spectrum_loss(img, ref, per_sample=per_sample)
+    return loss
 
 
 def loss_features(cfg: SolidConfig):
