@@ -15,6 +15,10 @@ Against the photo, per slice axis and pooled:
   (boundary length and Euler characteristic of quantile excursion sets: region
   sizes, outlines, connectivity), lower is better, beside random phase noise's
   (``morph_random_phase``) and a SIZE² crop of the photo's (``morph_photo_crop``);
+- ``spectrum``: the power-spectrum band distance of :mod:`training.solid.spectrum` (log shares of the
+  luminance's power in log-spaced rings x orientations; speckle, blob size, grain direction), mean over
+  the slices against a SIZE² crop of the photo, lower is better, beside random phase noise's
+  (``spectrum_random_phase``), which keeps the photo's Fourier modulus;
 - ``colour``: mean colour error (mean over R, G, B of |difference of means|);
 - ``diversity``: mean absolute difference between two seeds' z slices;
 - ``axis_spread``: (max - min) / mean of the three axes' swd: 0 when x, y and z
@@ -87,6 +91,19 @@ def cube(model: SolidTextureModel, code, seed: int = 0, n: int = 96, out: int = 
     return img
 
 
+def spectrum_distance(images: list, photo: np.ndarray) -> float:
+    """Mean over ``images`` (h, w, 3) of :func:`training.solid.spectrum.spectrum_loss` against the photo's
+    top-left crop of the same size."""
+    import torch
+
+    from training.solid.spectrum import spectrum_loss
+
+    def t(a):
+        return torch.from_numpy(np.ascontiguousarray(a, np.float32)).permute(2, 0, 1)[None]
+
+    return float(np.mean([spectrum_loss(t(im), t(photo[:im.shape[0], :im.shape[1]])).item() for im in images]))
+
+
 def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None) -> dict:
     rows = {}
     for path in files:
@@ -111,6 +128,9 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         r["morph_random_phase"] = round(morphology_distance([pe.random_phase(photo, SIZE, rng) for _ in range(seeds)],
                                                             photo), 3)
         r["morph_photo_crop"] = round(morphology_distance(photo[:SIZE, :SIZE], photo), 3)
+        r["spectrum"] = round(spectrum_distance(pooled, photo), 3)
+        r["spectrum_random_phase"] = round(spectrum_distance([pe.random_phase(photo, SIZE, rng) for _ in range(seeds)],
+                                                             photo), 3)
         r["seconds"] = round(seconds, 2)
         rows[os.path.basename(path)] = r
         print(os.path.basename(path), {k: r[k] for k in ("swd", "colour", "random_phase", "pixel_shuffle")},
@@ -136,7 +156,8 @@ def summary(rows: dict) -> dict:
                 median_seconds=med("seconds"), worst_swd=float(swd.max()),
                 median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
                 median_morph_photo_crop=med("morph_photo_crop"),
-                beats_random_phase_morph=int(sum(r["morph"] < r["morph_random_phase"] for r in rows.values())))
+                beats_random_phase_morph=int(sum(r["morph"] < r["morph_random_phase"] for r in rows.values())),
+                median_spectrum=med("spectrum"), median_spectrum_random_phase=med("spectrum_random_phase"))
 
 
 def by_category(rows: dict) -> dict:

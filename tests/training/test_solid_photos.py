@@ -336,4 +336,7 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
     assert doc["summary"]["photos"] == 2 and doc["summary"]["median_morph"] > 0
     for r in doc["photos"].values():
         assert r["photo_crop"] < r["pixel_shuffle"] and r["morph_photo_crop"] < r["morph_random_phase"]
-        assert set(r) >= {"swd", "morph", "morph_random_phase", "colour", "random_phase", "axis_spread"}
+        assert set(r) >= {"swd", "morph", "morph_random_phase", "colour", "random_phase", "axis_spread", "spectrum",
+                          "spectrum_random_phase"}
+        assert r["spectrum"] > 0 and r["spectrum_random_phase"] > 0
+    assert doc["summary"]["median_spectrum"] > 0

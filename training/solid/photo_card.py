@@ -34,7 +34,9 @@ ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase no
         ("median seconds: encode + six 128² slices", "median_seconds"),
         ("median morphology distance ↓", "median_morph"), ("… random phase noise", "median_morph_random_phase"),
         ("… a crop of the photo itself", "median_morph_photo_crop"),
-        ("photos where it beats random phase on morphology", "beats_random_phase_morph"))
+        ("photos where it beats random phase on morphology", "beats_random_phase_morph"),
+        ("median power-spectrum band distance ↓", "median_spectrum"),
+        ("… random phase noise", "median_spectrum_random_phase"))
 
 
 def run_facts(run: str) -> dict:
