@@ -71,12 +71,14 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
+         *([f"# starts from the export {cfg['init_onnx']} (sha256 {cfg['init_sha256'][:12]}...): the model this one replaced"]
+           if cfg.get("init_onnx") else []),
          f"python -m training.solid.train --config {config} --out runs/solid/{cfg['name']}",
          f"python -m training.solid.export runs/solid/{cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
          f"{f['seconds'] / 60:.1f} min wall on {hardware_line().split(',')[0]}, {cfg['threads']} "
-         f"threads, fp32 (no native bf16 on this CPU)"
+         f"threads, fp32"
          + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
             " (read from the export; the run folder and its loss log were not kept).")
          + (f" Stopped at step {step} of its {cfg['steps']}-step cosine schedule (the session's time; "
