@@ -3,10 +3,11 @@ import math
 
 import numpy as np
 import pytest
-import torch
 
-from training.solid.spectrum import band_index, band_shares, spectrum_loss
-from training.solid.train import SolidConfig, loss_features, texture_loss
+torch = pytest.importorskip("torch")
+
+from training.solid.spectrum import band_index, band_shares, spectrum_loss  # noqa: E402
+from training.solid.train import SolidConfig, loss_features, texture_loss  # noqa: E402
 
 
 def _smooth_noise(seed: int, size: int = 96, sigma: float = 3.0) -> torch.Tensor:
