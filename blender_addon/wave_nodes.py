@@ -11,10 +11,9 @@ Eq. 6 and 9, Algorithm 1), node for node:
   Newton steps for psi), Householder-rotated onto the lobe axis;
 * the wave (x . omega - v t) / L + zeta read from the complex table with the
   engine's linear interpolation (texel centres at (i + 1/2) / N), done in nodes:
-  two float images packed into the .blend, T (R = real, G = imaginary) and its
-  forward difference dT[i] = T[i+1] - T[i], are read at texel j0's centre with
-  Closest interpolation and Repeat extension, and T + t dT is one vector
-  multiply-add.  A Linear Image Texture would not do: EEVEE samples it with
+  one float RGBA image packed into the .blend holds T (R = real, G = imaginary) and its
+  forward difference dT[i] = T[i+1] - T[i] (B, A); it is read once at texel j0's centre with
+  Closest interpolation and Repeat extension, and T + t dT is two multiply-adds.  A Linear Image Texture would not do: EEVEE samples it with
   mipmaps and anisotropic filtering, and the table coordinate jumps at every
   slice border and table wrap, where the screen-space derivative then picks a
   blurred mip level (measured: correlation 0.81 with the engine at 48 px);
@@ -88,19 +87,22 @@ def settings_from_json(text: str):
 
 # -- the table as a packed float image ---------------------------------------------
 
-def ensure_table_image(values: np.ndarray, slope: bool = False) -> bpy.types.Image:
+def ensure_table_image(values: np.ndarray, slope: bool = False, packed: bool = False) -> bpy.types.Image:
     """A packed float image of a complex table: complex64 (rows, N) -> N x rows image.
 
     slope False: R = re T, G = im T.  slope True: R, G = re, im of the forward
     difference dT[i] = T[(i + 1) mod N] - T[i] (float32, as the engine's lerp
-    computes it).  Images are shared by content (the name carries a hash of the
-    values), so identical tables are stored once per .blend.
+    computes it).  packed True: both in one RGBA texel, R, G = re, im T and B, A = re, im dT, so one
+    image read gives all a lerp needs (what the node group uses: 1.16x faster in Cycles SVM at 16
+    directions than two reads, the same values to 2.4e-7).  Images are shared by content (the name carries
+    a hash of the values), so identical tables are stored once per .blend.
     """
     values = np.ascontiguousarray(values, np.complex64)
     rows, size = values.shape
+    diff = (np.roll(values, -1, axis=1) - values).astype(np.complex64)
     if slope:
-        values = (np.roll(values, -1, axis=1) - values).astype(np.complex64)
-    kind = "slope" if slope else "table"
+        values = diff
+    kind = "packed" if packed else "slope" if slope else "table"
     name = f"OmniNoise {kind} " + hashlib.sha256(values.tobytes()).hexdigest()[:12]
     img = bpy.data.images.get(name)
     if img is not None and tuple(img.size) == (size, rows):
@@ -113,6 +115,9 @@ def ensure_table_image(values: np.ndarray, slope: bool = False) -> bpy.types.Ima
     px[..., 0] = values.real
     px[..., 1] = values.imag
     px[..., 3] = 1.0
+    if packed:
+        px[..., 2] = diff.real
+        px[..., 3] = diff.imag
     img.pixels.foreach_set(px.ravel())
     img.pack()
     return img
@@ -193,15 +198,16 @@ class NodeBuilder:
         for the whole shader."""
         return self.vmath("DOT_PRODUCT", color, tuple(np.eye(3)[c]))
 
-    def image(self, img: bpy.types.Image, vector):
-        """Unfiltered (Closest), repeating image lookup -> colour socket (r, g, b) read as a vector."""
+    def image(self, img: bpy.types.Image, vector, alpha: bool = False):
+        """Unfiltered (Closest), repeating image lookup -> colour socket (r, g, b) read as a vector, and with
+        ``alpha`` the alpha socket too (one lookup)."""
         if self.geo:
             node = self.new("GeometryNodeImageTexture", interpolation="Closest", extension="REPEAT")
             node.inputs["Image"].default_value = img
         else:
             node = self.new("ShaderNodeTexImage", interpolation="Closest", extension="REPEAT", image=img)
         self.put(node.inputs["Vector"], vector)
-        return node.outputs["Color"]
+        return (node.outputs["Color"], node.outputs["Alpha"]) if alpha else node.outputs["Color"]
 
     def texel(self, coord, size: int):
         """Texel j0 = floor(coord N) of an N-texel row, for a coordinate already shifted by -1/(2N):
@@ -211,9 +217,13 @@ class NodeBuilder:
         j0 = self.math("FLOOR", v)
         return self.math("SUBTRACT", v, j0), self.math("MULTIPLY_ADD", j0, float(_F(1.0 / size)), float(_F(0.5 / size)))
 
-    def lerp(self, imgs: tuple, t, where):
-        """Linear interpolation T + t dT from the (table, slope) images read at ``where`` -> vector (re, im, 0)."""
-        return self.vmath("MULTIPLY_ADD", self.image(imgs[1], where), t, c=self.image(imgs[0], where))
+    def lerp(self, img, t, where):
+        """Linear interpolation T + t dT from the packed image (R, G = T; B, A = dT; :func:`ensure_table_image`)
+        read once at ``where`` -> vector (re, im, 0)."""
+        color, alpha = self.image(img, where, alpha=True)
+        rgb = self.separate(color)
+        return self.combine(self.math("MULTIPLY_ADD", rgb[2], t, rgb[0]), self.math("MULTIPLY_ADD", alpha, t, rgb[1]),
+                            0.0)
 
 
 def new_group(name: str, tree_type: str, inputs, outputs) -> bpy.types.NodeTree:
@@ -285,7 +295,7 @@ def _direction(b: NodeBuilder, u, dim: int, full: bool, g) -> tuple:
     return vec, w
 
 
-def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: tuple, rows: int,
+def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: bpy.types.Image, rows: int,
                    mode: str, consts: dict) -> bpy.types.NodeTree:
     """Sub-group for one stratum: Sum + amp (w0 T0 + w1 T1) as a vector (re, im, 0).
 
@@ -305,10 +315,10 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: tuple,
     return tree
 
 
-def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: tuple, rows: int, mode: str, consts: dict):
+def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: bpy.types.Image, rows: int, mode: str, consts: dict):
     """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket.
 
-    imgs: the (table, slope) images of :func:`ensure_table_image`; Shift carries
+    imgs: the packed table image of :func:`ensure_table_image`; Shift carries
     v t + L / (2 N), so the coordinate below is already half a texel early.
 
     Per slice one White Noise node gives (zeta, jitter 0, jitter 1) (backend.wavenoise.wave
@@ -451,7 +461,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     if implementation == "osl":
         _build_osl(tree, noise)
         return tree
-    imgs = (ensure_table_image(table.values), ensure_table_image(table.values, slope=True))
+    imgs = ensure_table_image(table.values, packed=True)
     dim = noise.dim
     full = any(d.full for d in noise.dirs.domains)
     b = NodeBuilder(tree)

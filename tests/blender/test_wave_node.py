@@ -187,9 +187,13 @@ def test_table_image_is_float_and_survives_save(tmp_path):
     s, _ = CASES["2d"]
     grp = build_wave_group(s, "ShaderNodeTree")
     grp.use_fake_user = True
-    img = next(i for i in bpy.data.images if i.name.startswith("OmniNoise table"))
+    img = next(i for i in bpy.data.images if i.name.startswith("OmniNoise packed"))
     assert img.packed_file is not None and not img.use_half_precision and img.is_float
     ref = np.array(img.pixels[:], np.float32)
+    # one texel holds what a lerp needs: R, G = T[j] and B, A = T[j + 1] - T[j] (negative alpha kept)
+    px = ref.reshape(img.size[1], img.size[0], 4)
+    assert np.allclose(px[:, :, 2:], np.roll(px[:, :, :2], -1, axis=1) - px[:, :, :2], atol=1e-6)
+    assert px[..., 3].min() < 0
     name = img.name
     path = str(tmp_path / "t.blend")
     bpy.ops.wm.save_as_mainfile(filepath=path)
