@@ -11,9 +11,10 @@ Eq. 6 and 9, Algorithm 1), node for node:
   Newton steps for psi), Householder-rotated onto the lobe axis;
 * the wave (x . omega - v t) / L + zeta read from the complex table with the
   engine's linear interpolation (texel centres at (i + 1/2) / N), done in nodes:
-  one float RGBA image packed into the .blend holds T (R = real, G = imaginary) and its
-  forward difference dT[i] = T[i+1] - T[i] (B, A); it is read once at texel j0's centre with
-  Closest interpolation and Repeat extension, and T + t dT is two multiply-adds.  A Linear Image Texture would not do: EEVEE samples it with
+  one float RGBA image packed into the .blend holds T (R = real, G = imaginary)
+  and its forward difference dT[i] = T[i+1] - T[i] (B, A); it is read once at
+  texel j0's centre with Closest interpolation and Repeat extension, and T + t dT
+  is two multiply-adds.  A Linear Image Texture would not do: EEVEE samples it with
   mipmaps and anisotropic filtering, and the table coordinate jumps at every
   slice border and table wrap, where the screen-space derivative then picks a
   blurred mip level (measured: correlation 0.81 with the engine at 48 px);
@@ -87,23 +88,18 @@ def settings_from_json(text: str):
 
 # -- the table as a packed float image ---------------------------------------------
 
-def ensure_table_image(values: np.ndarray, slope: bool = False, packed: bool = False) -> bpy.types.Image:
-    """A packed float image of a complex table: complex64 (rows, N) -> N x rows image.
+def ensure_table_image(values: np.ndarray) -> bpy.types.Image:
+    """A packed float image of a complex table: complex64 (rows, N) -> N x rows RGBA image.
 
-    slope False: R = re T, G = im T.  slope True: R, G = re, im of the forward
-    difference dT[i] = T[(i + 1) mod N] - T[i] (float32, as the engine's lerp
-    computes it).  packed True: both in one RGBA texel, R, G = re, im T and B, A = re, im dT, so one
-    image read gives all a lerp needs (what the node group uses: 1.16x faster in Cycles SVM at 16
-    directions than two reads, the same values to 2.4e-7).  Images are shared by content (the name carries
-    a hash of the values), so identical tables are stored once per .blend.
+    One texel holds all a lerp needs: R, G = re, im T[i] and B, A = re, im of the forward
+    difference dT[i] = T[(i + 1) mod N] - T[i] (float32, as the engine's lerp computes it), so
+    the node group reads the table once per lerp (1.16x faster in Cycles SVM at 16 directions
+    than two images of T and dT, the same values to 2.4e-7).  Images are shared by content (the
+    name carries a hash of the values), so identical tables are stored once per .blend.
     """
     values = np.ascontiguousarray(values, np.complex64)
     rows, size = values.shape
-    diff = (np.roll(values, -1, axis=1) - values).astype(np.complex64)
-    if slope:
-        values = diff
-    kind = "packed" if packed else "slope" if slope else "table"
-    name = f"OmniNoise {kind} " + hashlib.sha256(values.tobytes()).hexdigest()[:12]
+    name = "OmniNoise packed " + hashlib.sha256(values.tobytes()).hexdigest()[:12]
     img = bpy.data.images.get(name)
     if img is not None and tuple(img.size) == (size, rows):
         return img
@@ -111,13 +107,8 @@ def ensure_table_image(values: np.ndarray, slope: bool = False, packed: bool = F
     img.colorspace_settings.name = "Non-Color"
     img.alpha_mode = "CHANNEL_PACKED"
     img.use_half_precision = False  # Cycles would otherwise sample a half-float copy (5e-4 error)
-    px = np.zeros((rows, size, 4), _F)
-    px[..., 0] = values.real
-    px[..., 1] = values.imag
-    px[..., 3] = 1.0
-    if packed:
-        px[..., 2] = diff.real
-        px[..., 3] = diff.imag
+    diff = (np.roll(values, -1, axis=1) - values).astype(np.complex64)
+    px = np.stack([values.real, values.imag, diff.real, diff.imag], axis=-1).astype(_F)
     img.pixels.foreach_set(px.ravel())
     img.pack()
     return img
@@ -295,7 +286,7 @@ def _direction(b: NodeBuilder, u, dim: int, full: bool, g) -> tuple:
     return vec, w
 
 
-def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: bpy.types.Image, rows: int,
+def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.types.Image, rows: int,
                    mode: str, consts: dict) -> bpy.types.NodeTree:
     """Sub-group for one stratum: Sum + amp (w0 T0 + w1 T1) as a vector (re, im, 0).
 
@@ -310,15 +301,15 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, imgs: bpy.ty
     b = NodeBuilder(tree)
     gi = b.new("NodeGroupInput")
     go = b.new("NodeGroupOutput")
-    b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, imgs, rows,
+    b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, img, rows,
                                            mode, consts))
     return tree
 
 
-def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: bpy.types.Image, rows: int, mode: str, consts: dict):
+def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, img: bpy.types.Image, rows: int, mode: str, consts: dict):
     """Nodes of one stratum added through ``b``; ins: sockets Sum, Position, W, Shift -> new Sum socket.
 
-    imgs: the packed table image of :func:`ensure_table_image`; Shift carries
+    img: the packed table image of :func:`ensure_table_image`; Shift carries
     v t + L / (2 N), so the coordinate below is already half a texel early.
 
     Per slice one White Noise node gives (zeta, jitter 0, jitter 1) (backend.wavenoise.wave
@@ -360,13 +351,13 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, imgs: bpy.ty
         coord = b.math("MULTIPLY_ADD", b.math("SUBTRACT", dot, g["Shift"]), g["Inv Period"], zeta)
         t, centre = b.texel(coord, g["Table Size"])
         if mode == "single":  # a one-row image: a float Vector (c, c, c) reads T(c)
-            waves.append(b.lerp(imgs, t, centre))
+            waves.append(b.lerp(img, t, centre))
         else:  # per-axis tables, interpolated by omega_a^2 (Fig. 5 left)
             comps = b.separate(omega)
             acc = None
             for a in range(rows):
                 wa = om_w if a == 3 else comps[a]
-                ta = b.vmath("SCALE", b.lerp(imgs, t, b.combine(centre, (a + 0.5) / rows, 0.0)),
+                ta = b.vmath("SCALE", b.lerp(img, t, b.combine(centre, (a + 0.5) / rows, 0.0)),
                              scale=b.math("MULTIPLY", wa, wa))
                 acc = ta if acc is None else b.vmath("ADD", acc, ta)
             waves.append(acc)
@@ -461,7 +452,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     if implementation == "osl":
         _build_osl(tree, noise)
         return tree
-    imgs = ensure_table_image(table.values, packed=True)
+    img = ensure_table_image(table.values)
     dim = noise.dim
     full = any(d.full for d in noise.dirs.domains)
     b = NodeBuilder(tree)
@@ -478,7 +469,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
         if uniform:
             consts["Amplitude"] = None
         node = b.new(group_kind)
-        node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, imgs,
+        node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
                                         table.values.shape[0], table.mode, consts)
         node.label = f"Direction {k + 1}"
         b.put(node.inputs["Sum"], acc)

@@ -62,13 +62,10 @@ def band_shares(img: torch.Tensor, radial: int = 8, angular: int = 4) -> torch.T
     y = y - y.mean(dim=(1, 2), keepdim=True)
     win = torch.outer(torch.hann_window(H, periodic=False, dtype=img.dtype, device=img.device),
                       torch.hann_window(W, periodic=False, dtype=img.dtype, device=img.device))
-    P = torch.fft.rfft2(y * win).abs() ** 2                     # (B, H, W // 2 + 1)
-    # the rfft2 keeps half the plane: coefficients 1 .. ceil(W/2)-1 stand for two (k and -k) of the full one
-    P = P.clone()
-    if W % 2 == 0:
-        P[:, :, 1:-1] *= 2.0
-    else:
-        P[:, :, 1:] *= 2.0
+    # the rfft2 keeps half the plane: columns 1 .. ceil(W/2)-1 stand for two (k and -k) of the full one
+    twice = torch.ones(W // 2 + 1, dtype=img.dtype, device=img.device)
+    twice[1:(W + 1) // 2] = 2.0
+    P = torch.fft.rfft2(y * win).abs() ** 2 * twice              # (B, H, W // 2 + 1)
     idx = band_index(H, W, radial, angular).to(img.device)
     keep = idx >= 0
     n = radial * angular
