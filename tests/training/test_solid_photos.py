@@ -340,3 +340,48 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
                           "spectrum_random_phase"}
         assert r["spectrum"] > 0 and r["spectrum_random_phase"] > 0
     assert doc["summary"]["median_spectrum"] > 0
+
+
+def test_min_spacing_caps_every_octave_lattice_in_training_and_in_the_export(tmp_path):
+    """``min_spacing``: no octave's lattice is finer than that many exemplar pixels, whatever the translator
+    asks for (largest singular value of T_i <= (px_per_unit / 2^i) / min_spacing), in torch and in the
+    exported translator the runtime reads; octaves coarse enough are not touched; bad values are refused."""
+    from backend.onnx_models import fingerprint
+    from training.solid.model import bounded_transform, max_scales, random_rotations
+    from training.solid.warm_start import exported_weights, warm_start
+
+    np.testing.assert_allclose(max_scales(4, 16.0, 2.0).numpy(), [8.0, 4.0, 2.0, 1.0])
+    R = random_rotations(4, 3)
+    raw = torch.randn(64, 4, 10) * 5.0                      # every stretch and scale pushed to its bound
+    free = torch.linalg.svdvals(bounded_transform(raw, R)).amax(-1)
+    capped = torch.linalg.svdvals(bounded_transform(raw, R, max_scales(4, 16.0, 8.0))).amax(-1)   # caps 2, 1, .5, .25
+    assert float(free.max()) > 2.0                                                                # the bound alone
+    assert bool((capped <= torch.tensor([2.0, 1.0, 0.5, 0.25]) + 1e-5).all())
+    np.testing.assert_allclose(capped[:, 0].numpy(), torch.minimum(free[:, 0], torch.tensor(2.0)).numpy(), rtol=0.35)
+    loose = torch.linalg.svdvals(bounded_transform(raw, R, max_scales(4, 16.0, 0.1))).amax(-1)     # caps >= 20
+    np.testing.assert_allclose(loose.numpy(), free.numpy(), rtol=1e-6)
+
+    photos = ex.photo_set("train")[:2]
+    cfg = dict(name="tiny_spacing", mode="space", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=photos, colour="affine", loss="swd", transform="bounded",
+               swd_width=8, swd_levels=2, px_per_unit=32.0, octaves=4, min_spacing=8.0)
+    train(SolidConfig.from_dict(cfg), str(tmp_path / "run"), log=lambda *_: None)
+    doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
+    rt = SolidTextureModel(str(tmp_path / "m"))
+    for path in photos:
+        T = np.asarray(rt.translate(rt.encode(ex.load_image(path).permute(1, 2, 0).numpy())).T)
+        top = np.linalg.svd(T, compute_uv=False).max(-1)
+        assert (top <= np.array([4.0, 2.0, 1.0, 0.5]) + 1e-5).all() and top[3] > 0.45, top
+    # an export made without the cap continues with it (the cap is config, not a weight)
+    plain = dict(cfg, min_spacing=0.0, name="tiny_plain")
+    train(SolidConfig.from_dict(plain), str(tmp_path / "run0"), log=lambda *_: None)
+    doc0 = export(str(tmp_path / "run0"), str(tmp_path / "m0"))
+    m = build_model(SolidConfig.from_dict(cfg))
+    warm_start(m, exported_weights(str(tmp_path / "m0"), fingerprint(doc0["files"])))
+    assert "translator.max_scale" not in m.state_dict()
+    for bad, msg in ((-1.0, "min_spacing must be"), (float("nan"), "min_spacing must be")):
+        with pytest.raises(ValueError, match=msg):
+            SolidConfig.from_dict(dict(cfg, min_spacing=bad))
+    with pytest.raises(ValueError, match="needs mode 'space' and transform 'bounded'"):
+        SolidConfig.from_dict(dict(cfg, transform="free"))
+    assert doc["config"]["min_spacing"] == 8.0

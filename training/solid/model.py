@@ -35,7 +35,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
-__all__ = ["shape_features", "colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
+__all__ = ["shape_features", "colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
 
 
 def shape_features(cellular: int, bricks: int) -> int:
@@ -207,23 +207,44 @@ MAX_STRETCH = 0.6
 MAX_LOG_SCALE = 0.5
 
 
-def bounded_transform(raw: torch.Tensor, R: torch.Tensor) -> torch.Tensor:
+def bounded_transform(raw: torch.Tensor, R: torch.Tensor, max_scale: torch.Tensor | None = None) -> torch.Tensor:
     """T_i = R_i exp(c_i) (I + S_i) from raw (B, m, D*D + 1): S_i = sym(M_i) scaled so its Frobenius norm
     (a bound on every eigenvalue) stays <= MAX_STRETCH, c_i = MAX_LOG_SCALE tanh(raw_i[-1]).
 
     Singular values of T_i then lie in [0.4, 1.6] x e^+-0.5: anisotropic (grain, layers) up to a ratio of 4,
     but never the near-singular T of the free parametrisation, whose zero singular values extruded the
     noise along one direction (the diagonal streaks of the first space model: its T_i had singular values
-    down to 0.0)."""
+    down to 0.0).
+
+    ``max_scale`` (m,): a cap on each T_i's largest singular value, exp(c_i) (1 + ||S_i||_F) <= max_scale_i
+    (exp(c_i) is lowered where it would pass it), so octave i's lattice is never finer than the spacing the
+    cap was made for (:func:`max_scales`)."""
     B, m, _ = raw.shape
     D = R.shape[-1]
     M = raw[..., :D * D].view(B, m, D, D)
     S = 0.5 * (M + M.transpose(-1, -2))
     n = S.flatten(2).norm(dim=2).view(B, m, 1, 1)
-    S = S * (MAX_STRETCH * torch.tanh(n) / n.clamp_min(1e-6))
+    stretch = MAX_STRETCH * torch.tanh(n)                  # ||S_i||_F after scaling, >= its largest |eigenvalue|
+    S = S * (stretch / n.clamp_min(1e-6))
     c = torch.exp(MAX_LOG_SCALE * torch.tanh(raw[..., D * D:])).view(B, m, 1, 1)
+    if max_scale is not None:
+        c = torch.minimum(c, max_scale.view(1, m, 1, 1) / (1.0 + stretch))
     eye = torch.eye(D, dtype=raw.dtype, device=raw.device)
     return R @ ((eye + S) * c)
+
+
+def max_scales(octaves: int, px_per_unit: float, min_spacing: float) -> torch.Tensor:
+    """Per-octave caps on the transforms' largest singular value, (octaves,) float32: octave i's lattice
+    spacing is px_per_unit / 2^i exemplar pixels (Eq. 5), divided by its transform's largest singular value,
+    so a cap of (px_per_unit / 2^i) / min_spacing keeps every lattice at least ``min_spacing`` px apart.
+
+    Value noise on a lattice finer than 2 px is white at the pixel scale: an octave at 1 px (octave 8 of
+    128 px/unit), which the first photo models also stretched 2.6x finer, gave the speckle their slices
+    show (the finest spectrum ring 1.4x the photo's).  Coarse octaves' caps exceed the bounded range and
+    change nothing."""
+    if not (math.isfinite(min_spacing) and min_spacing > 0):
+        raise ValueError(f"min_spacing must be a number > 0 (px), got {min_spacing!r}")
+    return torch.tensor([px_per_unit / 2 ** i / min_spacing for i in range(octaves)], dtype=torch.float32)
 
 
 class Translator(nn.Module):
@@ -231,10 +252,12 @@ class Translator(nn.Module):
     by 1: the first models), or ``bounded`` (:func:`bounded_transform`)."""
 
     def __init__(self, z_dim: int, code_dim: int, octaves: int, dim: int, width: int = 128, seed: int = 0,
-                 transform: str = "free"):
+                 transform: str = "free", max_scale: torch.Tensor | None = None):
         super().__init__()
         if transform not in ("free", "bounded"):
             raise ValueError(f"transform must be 'free' or 'bounded', got {transform!r}")
+        if max_scale is not None and (transform != "bounded" or tuple(max_scale.shape) != (octaves,)):
+            raise ValueError("max_scale needs the bounded transform and one cap per octave")
         self.code_dim, self.octaves, self.dim, self.transform = code_dim, octaves, dim, transform
         per = dim * dim + (transform == "bounded")
         self.net = nn.Sequential(nn.Linear(z_dim, width), nn.ReLU(), nn.Linear(width, width), nn.ReLU(),
@@ -243,12 +266,15 @@ class Translator(nn.Module):
             self.net[-1].weight[code_dim:].mul_(0.1)   # from the first step (a x0.1 code part left e nearly
             self.net[-1].bias.zero_()                  # constant and the encoder unused: every code one texture)
         self.register_buffer("R", random_rotations(octaves, dim, seed))
+        # not in the state dict: made from the config (min_spacing), so exports without it still load
+        self.register_buffer("max_scale", max_scale, persistent=False)
 
     def forward(self, z: torch.Tensor):
         out = self.net(z)
         e = out[:, :self.code_dim]
         if self.transform == "bounded":
-            return e, bounded_transform(out[:, self.code_dim:].view(z.shape[0], self.octaves, -1), self.R)
+            return e, bounded_transform(out[:, self.code_dim:].view(z.shape[0], self.octaves, -1), self.R,
+                                        self.max_scale)
         # bounded: an unbounded Delta let a space run grow every T_i to ~100x (all octaves at the pixel
         # scale: fine grain of one average colour for every exemplar)
         delta = torch.tanh(out[:, self.code_dim:]).view(-1, self.octaves, self.dim, self.dim)
@@ -262,7 +288,7 @@ class SolidTexture(nn.Module):
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
                  mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
                  colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False,
-                 cellular: int = 0, bricks: int = 0):
+                 cellular: int = 0, bricks: int = 0, max_scale: torch.Tensor | None = None):
         super().__init__()
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
@@ -282,7 +308,8 @@ class SolidTexture(nn.Module):
             self.T = nn.Parameter(random_rotations(octaves, dim, seed).clone())
         else:
             self.encoder = Encoder(z_dim, standardise=standardise)
-            self.translator = Translator(z_dim, code_dim, octaves, dim, seed=seed, transform=transform)
+            self.translator = Translator(z_dim, code_dim, octaves, dim, seed=seed, transform=transform,
+                                         max_scale=max_scale)
 
     def codes(self, exemplars: torch.Tensor | None = None, batch: int = 1):
         """(e (B, E), T (B, m, D, D)) for a batch: the single-mode parameters, or h(g(exemplars))."""

@@ -37,7 +37,7 @@ from ..config import check_config_keys
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import SolidTexture, colour_stats, shape_features, slice_points, spectral_gains
+from .model import SolidTexture, colour_stats, max_scales, shape_features, slice_points, spectral_gains
 from .spectrum import spectrum_loss
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
@@ -82,6 +82,7 @@ class SolidConfig:
     swd_kernels: tuple = (3, 7)     # swd: filter sizes
     swd_levels: int = 5             # swd: pyramid levels
     spectrum_weight: float = 0.0    # weight of the power-spectrum band term (spectrum.py); 0: off
+    min_spacing: float = 0.0        # bounded space models: no octave's lattice finer than this many px (model.max_scales); 0: off
     seed: int = 0
     log_every: int = 25
     checkpoint_every: int = 250
@@ -117,6 +118,11 @@ class SolidConfig:
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
         if not (math.isfinite(cfg.spectrum_weight) and cfg.spectrum_weight >= 0):
             raise ValueError(f"spectrum_weight must be a number >= 0, got {cfg.spectrum_weight!r}")
+        if cfg.min_spacing:
+            if not (math.isfinite(cfg.min_spacing) and cfg.min_spacing > 0):
+                raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
+            if cfg.mode != "space" or cfg.transform != "bounded":
+                raise ValueError("min_spacing caps the bounded transforms: it needs mode 'space' and transform 'bounded'")
         if cfg.init_onnx and not cfg.init_sha256:
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         if cfg.init_onnx and cfg.init_from:
@@ -146,7 +152,8 @@ def _seed_run(src: str, out: str) -> None:
 def build_model(cfg: SolidConfig) -> SolidTexture:
     return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
                         cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform, cfg.film,
-                        cfg.standardise, cfg.cellular, cfg.bricks)
+                        cfg.standardise, cfg.cellular, cfg.bricks,
+                        max_scales(cfg.octaves, cfg.px_per_unit, cfg.min_spacing) if cfg.min_spacing else None)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
