@@ -182,6 +182,10 @@ def local_client(workers: int, memory_limit: str = "auto"):
     """A local cluster of ``workers`` processes (one thread each) listening on 127.0.0.1 only -> Client."""
     from distributed import Client, LocalCluster
 
+    from cli import hugepages
+
+    # the workers are new processes: they start with huge pages for large neural images (cli/hugepages.py)
+    os.environ.update(hugepages.environment(os.environ))
     cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
                            dashboard_address="127.0.0.1:0", memory_limit=memory_limit,
                            silence_logs=logging.ERROR)

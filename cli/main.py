@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from export.images import ImageError
+from cli import hugepages
 from backend import limits
 from backend.errors import SettingError
 from backend.neural.precision import PRECISIONS
@@ -761,6 +762,11 @@ def run_transfer(a: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
     a = ap.parse_args(argv)
+    if argv is None and hugepages.wanted(a.command, getattr(a, "size", 0) or 0, os.environ):
+        try:   # a large neural image: the same command again, with huge pages (cli/hugepages.py)
+            hugepages.reexec()
+        except OSError:
+            pass
     try:
         if a.command == "wave":
             return run_wave(a)
