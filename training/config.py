@@ -30,6 +30,11 @@ class TrainConfig:
     grad_clip: float = 1.0
     ema_decay: float = 0.999
     cutmix_p: float = 0.5
+    # Mirror training images at random (the stages before the orientation stage did, p = 0.5 per axis). Off: a
+    # mirror turns damascus's fixed band direction and the orientation of gabor, gabor_texture, fibers and phasor
+    # into its reflection while the conditioning still says the original, so the model learned "this direction
+    # or its mirror image" and at 256² drew both in patches.
+    flips: bool = False
     offset_noise: float = 0.1
     emb_lambda: float = 0.02
     min_snr_gamma: float = 0.0     # min-SNR-γ loss weighting (Hang et al. 2023), 5 in the paper; 0: plain MSE

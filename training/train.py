@@ -1,7 +1,7 @@
 """Train the neural noise model: ``python -m training.train --config CONFIG.json --out RUN``.
 
 Data is generated on the fly by :mod:`.zoo` (no files), on the CPU or the GPU.
-Every step: a zoo batch -> CutMix (p = 0.5) -> random flips -> ε-prediction loss
+Every step: a zoo batch -> CutMix (p = 0.5) -> (random flips, ``flips``) -> ε-prediction loss
 with offset noise and the spherical embedding penalty -> AdamW (lr 8e-5,
 β = (0.9, 0.99), weight decay 0.01), gradient clipping at 1, EMA of the weights.
 ``RUN/ckpt.pt`` is written atomically every ``checkpoint_every`` steps and a
@@ -49,6 +49,17 @@ def build_model(cfg: TrainConfig, state: dict | None = None) -> UNet:
         n_classes = state["class_emb.weight"].shape[0]
         n_params = state["cond_mlp.0.weight"].shape[1] - state["class_emb.weight"].shape[1]
     return UNet(n_classes, n_params, emb_dim=cfg.emb_dim, widths=cfg.widths, deep=cfg.deep)
+
+
+def random_mirror(imgs, idm, pm, rng: np.random.Generator):
+    """Mirror the whole batch left-right and up-down, each with p = 0.5: images (B, 1, H, W), class maps (B, H, W),
+    parameter maps (B, P, H, W).  Only with ``TrainConfig.flips``: a mirror reflects an oriented class's direction
+    (damascus's bands, a gabor, fibers or phasor orientation θ -> π - θ) while its conditioning keeps θ."""
+    if rng.random() < 0.5:
+        imgs, idm, pm = imgs.flip(-1), idm.flip(-1), pm.flip(-1)
+    if rng.random() < 0.5:
+        imgs, idm, pm = imgs.flip(-2), idm.flip(-2), pm.flip(-2)
+    return imgs, idm, pm
 
 
 def model_names(model: UNet) -> tuple:
@@ -142,10 +153,8 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
         imgs, ids, conds = sampler.batch(cfg.batch)
         idm, pm = _conditions(ids, conds[:, : model.n_params], cfg.size)  # older runs: a prefix of the slots
         imgs, idm, pm = cutmix(imgs, idm, pm, rng, p=cfg.cutmix_p)
-        if rng.random() < 0.5:
-            imgs, idm, pm = imgs.flip(-1), idm.flip(-1), pm.flip(-1)
-        if rng.random() < 0.5:
-            imgs, idm, pm = imgs.flip(-2), idm.flip(-2), pm.flip(-2)
+        if cfg.flips:
+            imgs, idm, pm = random_mirror(imgs, idm, pm, rng)
         x0 = (imgs * 2.0 - 1.0).to(device).contiguous(memory_format=fmt)
         model.train()
         with autocast(precision, device):

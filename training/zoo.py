@@ -155,7 +155,7 @@ def _fibers(x, y, s, p, n):
     white = ops.hash_unit(ix, iy, s.view(-1, 1, 1), 5) - 0.5
     sc = _u(p, "scale") / REF_PX  # cycles per pixel across fibres
     L = _u(p, "length")
-    theta = ops.hash_unit(torch.zeros_like(s), torch.zeros_like(s), s, 9).view(-1, 1, 1) * math.pi
+    theta = _u(p, "orientation")  # a parameter, not drawn from the seed: see _ORIENTATION
 
     def resp(fx, fy):
         u = fx * torch.cos(theta) + fy * torch.sin(theta)   # along the fibres' normal
@@ -218,7 +218,7 @@ def _phasor(x, y, s, p, n):
     white = ops.hash_unit(ix, iy, s.view(-1, 1, 1), 17) - 0.5
     F = _u(p, "frequency") / REF_PX
     spread = _u(p, "spread") * (math.pi / 2) + 0.05
-    th = ops.hash_unit(torch.zeros_like(s), torch.zeros_like(s), s, 19).view(-1, 1, 1) * 2 * math.pi
+    th = _u(p, "orientation")  # [0, pi) is every phasor: th + pi draws the same image negated
     fy = torch.fft.fftfreq(H, device=x.device).view(1, H, 1)
     fx = torch.fft.fftfreq(W, device=x.device).view(1, 1, W)
     r = torch.sqrt(fx ** 2 + fy ** 2)
@@ -316,6 +316,12 @@ def _wave_engine(kind: str):
     return gen
 
 
+#: The direction of fibres and of phasor noise's waves (radians, modulo pi).  It was once drawn from each image's
+#: seed: a hidden variable that one whole image shares, which a network of finite reach cannot agree on across a
+#: 256-px image (each region picked its own direction).  As a parameter it reaches every pixel through the
+#: conditioning, and the artist sets it.
+_ORIENTATION = Param("orientation", 0.0, math.pi, "radians, modulo pi")
+
 _CLASSES = [
     NoiseClass("cells_f1", "worley", (Param("scale", 4, 20, "cells per 128 px"), Param("jitter", 0.2, 1.0, "cell jitter")),
                _cells_f1, "Worley F1 distance (Substance 'cells 1')"),
@@ -338,7 +344,8 @@ _CLASSES = [
                _liquid, "domain-warped fBm (Substance 'liquid')"),
     NoiseClass("spots", "threshold", (Param("scale", 2, 16, "cells per 128 px"), Param("coverage", 0.2, 0.8, "white fraction")),
                _spots, "black-and-white spots (Substance 'bnw spots')"),
-    NoiseClass("fibers", "filtered", (Param("scale", 6, 24, "fibres per 128 px"), Param("length", 1.0, 8.0, "elongation")),
+    NoiseClass("fibers", "filtered", (Param("scale", 6, 24, "fibres per 128 px"), Param("length", 1.0, 8.0, "elongation"),
+                                      _ORIENTATION),
                _fibers, "messy oriented fibres (Substance 'messy fibers')"),
     NoiseClass("galvanic", "grunge", (Param("scale", 2, 8, "cells per 128 px"), Param("contrast", 0.0, 1.0, "ridge sharpness")),
                _galvanic, "ridged fBm over cracked cells (Substance 'grunge galvanic')"),
@@ -352,7 +359,8 @@ _CLASSES = [
     NoiseClass("gabor", "gabor", (Param("frequency", 0.02, 0.08, "cycles per px"), Param("bandwidth", 0.01, 0.35, "kernel a, 1/px"),
                                   Param("orientation", 0.0, 2 * math.pi, "radians")),
                _gabor, "Gabor noise (Lagae et al. 2009; the paper's Appendix B, Table 3)"),
-    NoiseClass("phasor", "gabor", (Param("frequency", 4, 16, "cycles per 128 px"), Param("spread", 0.0, 1.0, "angle spread")),
+    NoiseClass("phasor", "gabor", (Param("frequency", 4, 16, "cycles per 128 px"), Param("spread", 0.0, 1.0, "angle spread"),
+                                   _ORIENTATION),
                _phasor, "phasor noise (Tricard et al. 2019; Appendix B)"),
     NoiseClass("noise", "blender", (Param("Scale", 1, 10, "per 128 px"), Param("Detail", 0, 8, "octaves"),
                                     Param("Roughness", 0.3, 0.8, ""), Param("Distortion", 0.0, 2.0, "")),
@@ -376,7 +384,12 @@ _CLASSES = [
 #: append-only: a class's index and each parameter's slot are part of every trained model
 CLASSES = {c.name: c for c in _CLASSES}
 CLASS_NAMES = tuple(c.name for c in _CLASSES)
-PARAM_NAMES = tuple(dict.fromkeys(p.name for c in _CLASSES for p in c.params))
+#: append-only as well: a name keeps the slot it was given when it first appeared (fibres and phasor took up
+#: gabor's "orientation" later, so the order is written out rather than derived from the class list)
+PARAM_NAMES = ("scale", "jitter", "distortion", "blur", "roughness", "detail", "coverage", "length", "contrast",
+               "frequency", "bandwidth", "orientation", "spread", "Scale", "Detail", "Roughness", "Distortion",
+               "Randomness", "split", "Frequency", "Anisotropy", "Orientation")
+assert {p.name for c in _CLASSES for p in c.params} == set(PARAM_NAMES), "a new parameter name is appended here"
 
 
 def generate(name: str, params: dict, seeds: torch.Tensor, size: int, device=None) -> torch.Tensor:

@@ -172,6 +172,32 @@ def test_training_runs_logs_and_resumes_identically(tmp_path):
     assert [r["step"] for r in log] == [1, 2, 3, 4] and all(np.isfinite(r["mse"]) for r in log)
 
 
+def test_mirrors_contradict_oriented_conditioning_so_training_does_not_mirror(monkeypatch, tmp_path):
+    """A left-right mirror turns a gabor of orientation θ into one of π - θ while its conditioning still says θ
+    (and damascus's fixed bands into their reflection): the model then learns 'θ or its mirror' and draws both in
+    patches.  So training does not mirror unless a config asks for it (the stages that did say so)."""
+    from training import train as T
+
+    def direction(img):
+        gy, gx = np.gradient(img.astype(np.float64))
+        return float(np.degrees(0.5 * np.arctan2(2 * np.mean(gx * gy), np.mean(gx * gx) - np.mean(gy * gy))) % 180)
+
+    p = dict(zoo.default_params("gabor"), orientation=math.radians(30), bandwidth=0.02)
+    img = zoo.generate("gabor", p, torch.arange(1), 128)
+    assert abs(direction(img[0].numpy()) - 30) < 8
+    mirrored, _, _ = T.random_mirror(img[:, None], torch.zeros(1, 128, 128), torch.zeros(1, 2, 128, 128),
+                                     type("R", (), {"random": staticmethod(iter([0.0, 0.9]).__next__)})())
+    assert abs(direction(mirrored[0, 0].numpy()) - 150) < 8  # the conditioning would still say 30°
+
+    assert TrainConfig().flips is False
+    calls = []
+    monkeypatch.setattr(T, "random_mirror", lambda *a: calls.append(1) or a[:3])
+    train(TrainConfig.from_dict(dict(TINY, steps=2)), str(tmp_path / "a"), log=lambda s: None)
+    assert calls == []
+    train(TrainConfig.from_dict(dict(TINY, steps=2, flips=True)), str(tmp_path / "b"), log=lambda s: None)
+    assert len(calls) == 2
+
+
 def test_config_errors():
     with pytest.raises(ValueError, match="unknown config key 'lr_rate'"):
         TrainConfig.from_dict({"lr_rate": 1})

@@ -102,3 +102,35 @@ def test_zoo_cli(tmp_path, capsys):
                       (["--noise", "spots", "--param", "size=2"], "no parameter 'size'")]:
         assert main(["zoo", *args, "-o", out]) == 2
         assert msg in capsys.readouterr().err
+
+
+def _gradient_direction(img: np.ndarray) -> float:
+    """The dominant gradient direction of an image (structure tensor), degrees modulo 180."""
+    gy, gx = np.gradient(img.astype(np.float64))
+    jxx, jxy, jyy = np.mean(gx * gx), np.mean(gx * gy), np.mean(gy * gy)
+    return float(np.degrees(0.5 * np.arctan2(2 * jxy, jxx - jyy)) % 180.0)
+
+
+@pytest.mark.parametrize("name, extra", [("fibers", {"scale": 12.0, "length": 6.0}),
+                                         ("phasor", {"frequency": 8.0, "spread": 0.1})])
+def test_orientation_is_a_parameter_every_seed_follows(name, extra):
+    """Fibres and phasor waves once took their direction from the seed: a variable hidden from the model that a
+    whole image shares. Now the parameter sets it, for every seed, so the conditioning carries it."""
+    assert zoo.CLASSES[name].param("orientation").hi == pytest.approx(np.pi)
+    for deg in (0.0, 30.0, 90.0, 135.0):
+        imgs = zoo.generate(name, dict(extra, orientation=np.radians(deg)), torch.arange(3) + 40, 128).numpy()
+        for img in imgs:
+            err = abs((_gradient_direction(img) - deg + 90.0) % 180.0 - 90.0)
+            assert err < 8.0, (name, deg, _gradient_direction(img))  # a random direction: uniform over ±90
+    c = zoo.condition_vector(name, dict(extra, orientation=np.pi / 4))
+    assert c[0, zoo.PARAM_NAMES.index("orientation")] == pytest.approx(0.25)
+
+
+def test_parameter_slots_and_class_ids_are_append_only():
+    """A trained model's conditioning slots are fixed: the zoo's names start with every shipped model's."""
+    from backend.onnx_models import load_model_json
+    from backend.paths import neural_model
+
+    doc = load_model_json(neural_model(), "neural_noise.json")
+    assert zoo.PARAM_NAMES[: len(doc["params"])] == tuple(doc["params"])
+    assert zoo.CLASS_NAMES[: len(doc["classes"])] == tuple(doc["classes"])
