@@ -41,7 +41,7 @@ def main() -> int:
     import torch
 
     from training import zoo
-    from training.evaluate import orientation_coherence, psd_error
+    from training.evaluate import known_params, orientation_coherence, psd_error
 
     classes = [c.strip() for c in a.classes.split(",") if c.strip()]
     labels = a.label or [os.path.basename(os.path.normpath(m)) for m in a.model]
@@ -58,7 +58,7 @@ def main() -> int:
         imgs = [real[0]]
         for label, m in zip(labels, models):
             t = time.perf_counter()
-            img = generate(m, C.uniform(m, (name, params), S, S), seed=a.seed)
+            img = generate(m, C.uniform(m, (name, known_params(m, name, params)), S, S), seed=a.seed)
             row[label] = dict(coherence=round(float(orientation_coherence(img[None])[0]), 3),
                               psd_low=round(psd_error(img[None], real, low=True), 3),
                               psd=round(psd_error(img[None], real), 3), seconds=round(time.perf_counter() - t, 2))

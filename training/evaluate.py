@@ -36,7 +36,7 @@ import torch.nn.functional as F
 
 from . import zoo
 
-__all__ = ["Classifier", "train_classifier", "cached_classifier", "frechet", "radial_psd", "psd_error",
+__all__ = ["Classifier", "train_classifier", "cached_classifier", "known_params", "frechet", "radial_psd", "psd_error",
            "orientation_coherence", "evaluate"]
 
 
@@ -190,6 +190,14 @@ def _centroid(imgs):
     return float((p * k).sum() / p.sum())
 
 
+def known_params(model, name: str, params: dict) -> dict:
+    """The zoo parameters of ``name`` that ``model`` was trained with: a model exported before a class gained a
+    parameter (fibers' and phasor's orientation) is not told it and draws its own, which the zoo's images then
+    measure."""
+    own = {p["name"] for p in model.class_params[name]["params"]}
+    return {k: v for k, v in params.items() if k in own}
+
+
 def cached_classifier(classes, size: int, steps: int, cache: str | None = None, log=None, stages: int = 2,
                       threads: int | None = None):
     """:func:`train_classifier`, or the one saved in folder ``cache`` for the same classes, size, steps
@@ -256,7 +264,7 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
     eps_fn = model.eps_fn(False)
 
     def sample(spec, count, seed0):
-        cond = np.repeat(C.uniform(model, spec, S, S)[None], count, 0)
+        cond = np.repeat(C.uniform(model, (spec[0], known_params(model, *spec)), S, S)[None], count, 0)
         x = _sample(sampler, eps_fn, initial_noise(seed0, (count, 1, S, S)), cond, steps,
                     alphas_cumprod=model.alphas_cumprod, spacing=spacing)
         return (x[:, 0] + 1) * 0.5
@@ -270,8 +278,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
         sets = rng.integers(0, 16384, size=n)
         params = zoo.sample_params(name, sets)
         real = zoo.generate(name, params, torch.arange(n) + 77_000, S).numpy()
-        cond = np.stack([C.uniform(model, (name, {k: float(v[i]) for k, v in params.items()}), S, S)
-                         for i in range(n)])
+        cond = np.stack([C.uniform(model, (name, known_params(model, name, {k: float(v[i]) for k, v in params.items()})),
+                                   S, S) for i in range(n)])
         x0 = np.concatenate([initial_noise(1000 + i, (1, 1, S, S)) for i in range(n)])
         gen = (_sample(sampler, eps_fn, x0, cond, steps, alphas_cumprod=model.alphas_cumprod,
                        spacing=spacing)[:, 0] + 1) * 0.5

@@ -104,3 +104,21 @@ def test_look_tells_spectra_and_histograms_apart_and_finds_the_nearest_class():
     dimmer = look(0.25 + 0.5 * w)  # same spectrum shape, other contrast: only the histogram moves
     np.testing.assert_allclose(dimmer["spectrum"], refs["white"]["spectrum"], atol=1e-9)
     assert np.abs(dimmer["histogram"] - refs["white"]["histogram"]).mean() > 0.05
+
+
+def test_known_params_keeps_what_the_model_was_trained_with():
+    """An export made before fibers gained 'orientation' is evaluated without it (it draws its own); a model
+    that has it is told it."""
+    from backend.neural.model import NeuralNoiseModel
+    from backend.paths import neural_model
+    from training import zoo
+    from training.evaluate import known_params
+
+    model = NeuralNoiseModel(neural_model())
+    params = zoo.default_params("fibers")
+    assert "orientation" in params
+    own = {p["name"] for p in model.class_params["fibers"]["params"]}
+    assert known_params(model, "fibers", params) == {k: v for k, v in params.items() if k in own}
+    assert set(known_params(model, "perlin", zoo.default_params("perlin"))) == {"scale"}
+    model.class_params = dict(model.class_params, fibers=dict(params=[{"name": "scale"}, {"name": "orientation"}]))
+    assert set(known_params(model, "fibers", params)) == {"scale", "orientation"}
