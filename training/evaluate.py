@@ -218,7 +218,9 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
     import json
     import os
 
-    key = dict(classes=list(classes), size=size, steps=steps, threads=torch.get_num_threads())
+    key = dict(classes=list(classes), size=size, steps=steps, threads=torch.get_num_threads(),
+               # the zoo's classes and parameters: a classifier of the zoo before a change is another instrument
+               zoo=hashlib.sha256(json.dumps(zoo.describe(), sort_keys=True).encode()).hexdigest()[:16])
     if stages != 2:
         key["stages"] = stages  # the 2-stage key is unchanged, so classifiers cached before stay valid
     key = json.dumps(key)

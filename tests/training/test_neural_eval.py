@@ -122,3 +122,20 @@ def test_known_params_keeps_what_the_model_was_trained_with():
     assert set(known_params(model, "perlin", zoo.default_params("perlin"))) == {"scale"}
     model.class_params = dict(model.class_params, fibers=dict(params=[{"name": "scale"}, {"name": "orientation"}]))
     assert set(known_params(model, "fibers", params)) == {"scale", "orientation"}
+
+
+def test_cached_classifier_is_keyed_by_the_zoo(tmp_path, monkeypatch):
+    """A classifier trained on the zoo before a class changed is another instrument: the cache does not reuse it."""
+    from training import evaluate as E
+
+    calls = []
+    real = E.train_classifier
+    monkeypatch.setattr(E, "train_classifier", lambda *a, **k: calls.append(1) or real(*a, **k))
+    E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)
+    E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)
+    assert len(calls) == 1 and len(list(tmp_path.glob("classifier_*.pt"))) == 1
+    described = E.zoo.describe()
+    described["perlin"]["params"][0]["max"] = 99
+    monkeypatch.setattr(E.zoo, "describe", lambda: described)
+    E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)
+    assert len(calls) == 2 and len(list(tmp_path.glob("classifier_*.pt"))) == 2
