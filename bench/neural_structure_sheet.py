@@ -37,6 +37,7 @@ def main() -> int:
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--zoo-seeds", type=int, default=8, help="zoo images per class for the spectrum reference")
+    ap.add_argument("--threads", type=int, default=0, help="onnxruntime threads (0: its default, every core)")
     a = ap.parse_args()
     import torch
 
@@ -47,7 +48,7 @@ def main() -> int:
     labels = a.label or [os.path.basename(os.path.normpath(m)) for m in a.model]
     if len(labels) != len(a.model):
         ap.error("give one --label per --model")
-    models = [NeuralNoiseModel(m) for m in a.model]
+    models = [NeuralNoiseModel(m, threads=a.threads) for m in a.model]
     S, gap = a.size, 4
     sheet = np.ones((len(classes) * (S + gap), (1 + len(models)) * (S + gap)), np.float32)
     report = dict(size=S, seed=a.seed, models=dict(zip(labels, a.model)), classes={})
