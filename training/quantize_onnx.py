@@ -6,7 +6,7 @@ weights' fingerprint, are untouched; the runtime uses the int8 files only where 
 ``precision: auto``, on CPUs with int8 dot products, see :mod:`backend.neural.precision`).
 
 Method: onnxruntime's static quantization in QDQ form, the convolutions only (where the FLOPs are): int8
-weights per output channel, uint8 activations with one range per tensor (MinMax) calibrated on real
+weights per output channel, uint8 activations with one range per tensor (the 99.999th percentile) calibrated on real
 denoiser inputs: x_t = √ᾱ x₀ + √(1-ᾱ) ε (DDPM's forward process, Ho et al. 2020 Eq. 4) of zoo images x₀
 of every class at noise levels spread over the sampler's range, with the encoder's maps of that class.
 The first convolution (it reads x_t itself) and the output convolution stay float32: both are tiny and
@@ -62,10 +62,16 @@ def _edge_convs(proto) -> list:
     return [n.name for n in proto.graph.node if n.op_type == "Conv" and (set(n.input) & ins or set(n.output) & outs)]
 
 
+#: activation ranges clip the calibration values' extreme 0.001 % (November 2026): on the orientation-stage weights,
+#: five classes at 128², mean |int8 - float32| 0.0121 against 0.0153 with MinMax ranges (99.99: 0.0122)
+CALIB_PERCENTILE = 99.999
+
+
 def quantize_folder(folder: str, size: int = 64, seed: int = 0, log=print) -> dict:
     """Write the int8 denoisers of split export ``folder``; returns the JSON's ``int8`` section."""
     import onnx
-    from onnxruntime.quantization import CalibrationDataReader, QuantFormat, QuantType, quantize_static
+    from onnxruntime.quantization import (CalibrationDataReader, CalibrationMethod, QuantFormat, QuantType,
+                                          quantize_static)
 
     model = NeuralNoiseModel(folder)
     if model.form != "split":
@@ -93,11 +99,13 @@ def quantize_folder(folder: str, size: int = 64, seed: int = 0, log=print) -> di
             with _ex.atomic_path(os.path.join(folder, int8)) as dst:
                 quantize_static(src, dst, Reader(), quant_format=QuantFormat.QDQ, op_types_to_quantize=["Conv"],
                                 activation_type=QuantType.QUInt8, weight_type=QuantType.QInt8, per_channel=True,
-                                nodes_to_exclude=_edge_convs(proto))
+                                nodes_to_exclude=_edge_convs(proto), calibrate_method=CalibrationMethod.Percentile,
+                                extra_options={"CalibPercentile": CALIB_PERCENTILE})
         files[int8] = sha256_file(os.path.join(folder, int8))
         log(f"{int8}: {len(feeds)} calibration inputs at {size}²")
     section = dict(files=files, of=INT8_FILES, method="onnxruntime static QDQ, Conv only, int8 weights per channel, "
-                   "uint8 activations (MinMax), first and output convolutions float32",
+                   f"uint8 activations (percentile {CALIB_PERCENTILE} of the calibration values), first and output "
+                   "convolutions float32",
                    calibration=dict(size=size, seed=seed, timesteps=list(CALIB_T),
                                     classes=list(model.config["trained_classes"])))
     path = os.path.join(folder, "neural_noise.json")
