@@ -37,7 +37,7 @@ import torch.nn.functional as F
 from . import zoo
 
 __all__ = ["Classifier", "train_classifier", "cached_classifier", "known_params", "frechet", "radial_psd", "psd_error",
-           "orientation_coherence", "evaluate"]
+           "orientation_coherence", "gradient_direction", "evaluate"]
 
 
 class Classifier(nn.Module):
@@ -126,6 +126,21 @@ def psd_error(gen: np.ndarray, real: np.ndarray, low: bool = False) -> float:
     return float(d[: max(2, gen.shape[-1] // 8)].mean() if low else d.mean())
 
 
+def _structure_tensor(imgs: np.ndarray):
+    """J = mean(∇I ∇Iᵀ) over each image (n, S, S), central differences -> Jxx, Jyy, Jxy float64 (n,)."""
+    x = np.asarray(imgs, np.float64)
+    gy = 0.5 * (x[:, 2:, 1:-1] - x[:, :-2, 1:-1])
+    gx = 0.5 * (x[:, 1:-1, 2:] - x[:, 1:-1, :-2])
+    return (gx * gx).mean((1, 2)), (gy * gy).mean((1, 2)), (gx * gy).mean((1, 2))
+
+
+def gradient_direction(imgs: np.ndarray) -> np.ndarray:
+    """The dominant gradient direction of images (n, S, S) -> (n,) degrees in [0, 180), 0 along +x (array
+    columns), 90 along the rows: the structure tensor's leading eigenvector, ½ atan2(2 Jxy, Jxx - Jyy)."""
+    jxx, jyy, jxy = _structure_tensor(imgs)
+    return np.degrees(0.5 * np.arctan2(2 * jxy, jxx - jyy)) % 180.0
+
+
 def orientation_coherence(imgs: np.ndarray) -> np.ndarray:
     """Global orientation coherence of images (n, S, S) -> (n,) in [0, 1].
 
@@ -134,10 +149,7 @@ def orientation_coherence(imgs: np.ndarray) -> np.ndarray:
     1987): 1 when every gradient in the image is parallel (straight bands), 0 for isotropic texture.
     Flat images give 0.
     """
-    x = np.asarray(imgs, np.float64)
-    gy = 0.5 * (x[:, 2:, 1:-1] - x[:, :-2, 1:-1])
-    gx = 0.5 * (x[:, 1:-1, 2:] - x[:, 1:-1, :-2])
-    jxx, jyy, jxy = (gx * gx).mean((1, 2)), (gy * gy).mean((1, 2)), (gx * gy).mean((1, 2))
+    jxx, jyy, jxy = _structure_tensor(imgs)
     tr = jxx + jyy
     return np.where(tr > 1e-12, np.sqrt((jxx - jyy) ** 2 + 4 * jxy ** 2) / np.maximum(tr, 1e-12), 0.0)
 

@@ -139,3 +139,15 @@ def test_cached_classifier_is_keyed_by_the_zoo(tmp_path, monkeypatch):
     monkeypatch.setattr(E.zoo, "describe", lambda: described)
     E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)
     assert len(calls) == 2 and len(list(tmp_path.glob("classifier_*.pt"))) == 2
+
+
+def test_gradient_direction_of_bands():
+    """Bands whose gradient points at angle a (0 along +x, the array's columns) give a, modulo 180."""
+    from training.evaluate import gradient_direction
+
+    y, x = np.mgrid[0:96, 0:96].astype(np.float64)
+    for deg in (0, 30, 90, 150):
+        a = np.radians(deg)
+        img = np.cos(2 * np.pi * 0.07 * (x * np.cos(a) + y * np.sin(a)))
+        got = gradient_direction(img[None])[0]
+        assert abs((got - deg + 90) % 180 - 90) < 1.0, (deg, got)

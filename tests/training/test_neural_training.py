@@ -177,17 +177,14 @@ def test_mirrors_contradict_oriented_conditioning_so_training_does_not_mirror(mo
     (and damascus's fixed bands into their reflection): the model then learns 'θ or its mirror' and draws both in
     patches.  So training does not mirror unless a config asks for it (the stages that did say so)."""
     from training import train as T
-
-    def direction(img):
-        gy, gx = np.gradient(img.astype(np.float64))
-        return float(np.degrees(0.5 * np.arctan2(2 * np.mean(gx * gy), np.mean(gx * gx) - np.mean(gy * gy))) % 180)
+    from training.evaluate import gradient_direction
 
     p = dict(zoo.default_params("gabor"), orientation=math.radians(30), bandwidth=0.02)
     img = zoo.generate("gabor", p, torch.arange(1), 128)
-    assert abs(direction(img[0].numpy()) - 30) < 8
+    assert abs(gradient_direction(img.numpy())[0] - 30) < 8
     mirrored, _, _ = T.random_mirror(img[:, None], torch.zeros(1, 128, 128), torch.zeros(1, 2, 128, 128),
                                      type("R", (), {"random": staticmethod(iter([0.0, 0.9]).__next__)})())
-    assert abs(direction(mirrored[0, 0].numpy()) - 150) < 8  # the conditioning would still say 30°
+    assert abs(gradient_direction(mirrored[:, 0].numpy())[0] - 150) < 8  # the conditioning would still say 30°
 
     assert TrainConfig().flips is False
     calls = []
