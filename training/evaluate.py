@@ -234,7 +234,7 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
                # the zoo's classes and parameters: a classifier of the zoo before a change is another instrument
                zoo=hashlib.sha256(json.dumps(zoo.describe(), sort_keys=True).encode()).hexdigest()[:16])
     if stages != 2:
-        key["stages"] = stages  # the 2-stage key is unchanged, so classifiers cached before stay valid
+        key["stages"] = stages  # only where it is not 2, the default the key was first written without
     key = json.dumps(key)
     path = os.path.join(cache, "classifier_" + hashlib.sha256(key.encode()).hexdigest()[:16] + ".pt")
     if os.path.isfile(path):
@@ -292,8 +292,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
         sets = rng.integers(0, 16384, size=n)
         params = zoo.sample_params(name, sets)
         real = zoo.generate(name, params, torch.arange(n) + 77_000, S).numpy()
-        cond = np.stack([C.uniform(model, (name, known_params(model, name, {k: float(v[i]) for k, v in params.items()})),
-                                   S, S) for i in range(n)])
+        specs = [(name, known_params(model, name, {k: float(v[i]) for k, v in params.items()})) for i in range(n)]
+        cond = np.stack([C.uniform(model, spec, S, S) for spec in specs])
         x0 = np.concatenate([initial_noise(1000 + i, (1, 1, S, S)) for i in range(n)])
         gen = (_sample(sampler, eps_fn, x0, cond, steps, alphas_cumprod=model.alphas_cumprod,
                        spacing=spacing)[:, 0] + 1) * 0.5
