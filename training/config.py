@@ -38,10 +38,14 @@ class TrainConfig:
     offset_noise: float = 0.1
     emb_lambda: float = 0.02
     min_snr_gamma: float = 0.0     # min-SNR-γ loss weighting (Hang et al. 2023), 5 in the paper; 0: plain MSE
+    low_snr_weight: float = 1.0    # weight min(1/ᾱ_t, W) on the noisiest steps (.diffusion); 1: plain MSE
     emb_dim: int = 32
     widths: tuple = (32, 64, 128)
     deep: int = 0                  # levels of the zero-initialised deep branch at the bottleneck (.unet.DeepBranch)
     classes: tuple = field(default_factory=lambda: zoo.CLASS_NAMES)
+    # Per-class sampling weights {name: weight} (1 where absent): a class of weight 2 fills twice the share of the
+    # batches. Empty: equal shares. (The oriented classes, whose direction parameter the model must learn to follow.)
+    class_weights: dict = field(default_factory=dict)
     seeds_per_set: int = 4
     sets_per_class: int = 16384
     seed: int = 0
@@ -66,6 +70,10 @@ class TrainConfig:
         bad = [c for c in d.get("classes", ()) if c not in zoo.CLASSES]
         if bad:
             raise ValueError(f"unknown class {bad[0]!r}")
+        if "class_weights" in d:
+            if not isinstance(d["class_weights"], dict):
+                raise ValueError(f"class_weights must map class names to weights, got {d['class_weights']!r}")
+            zoo.class_probabilities(d.get("classes", zoo.CLASS_NAMES), d["class_weights"])
         levels = len(d.get("widths", (32, 64, 128))) + int(d.get("deep", 0))
         if d.get("size", 64) % (1 << levels):
             raise ValueError(f"size must be a multiple of {1 << levels} (2^levels of the U-Net), got {d['size']}")

@@ -130,7 +130,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
         p_.requires_grad_(False)
     opt = torch.optim.AdamW(model.parameters(), lr=cfg.lr, betas=cfg.betas, weight_decay=cfg.weight_decay)
     diff = Diffusion(offset_noise=cfg.offset_noise, emb_lambda=cfg.emb_lambda, device=device,
-                     min_snr_gamma=cfg.min_snr_gamma)
+                     min_snr_gamma=cfg.min_snr_gamma, low_snr_weight=cfg.low_snr_weight)
     rng = np.random.default_rng(cfg.seed)
     gen = torch.Generator(device=device).manual_seed(cfg.seed)
     step = 0
@@ -146,7 +146,8 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
     with open(os.path.join(out, "config.json"), "w", encoding="utf-8") as fh:
         json.dump(asdict(cfg), fh, indent=2)
     del state
-    sampler = zoo.ZooSampler(cfg.size, cfg.classes, cfg.seeds_per_set, cfg.sets_per_class, rng=rng, device=device)
+    sampler = zoo.ZooSampler(cfg.size, cfg.classes, cfg.seeds_per_set, cfg.sets_per_class, rng=rng, device=device,
+                             class_weights=cfg.class_weights)
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     t0, last, losses = time.time(), {}, []
     while step < end:

@@ -453,6 +453,18 @@ def condition_vector(name: str, params: dict) -> torch.Tensor:
     return out
 
 
+def class_probabilities(classes, weights: dict) -> np.ndarray:
+    """float64 (n,) shares of ``classes`` drawn with ``weights`` (name -> weight > 0, 1 where absent).
+    ValueError naming a weighted class that is not among ``classes``, or a weight that is not positive."""
+    for name, w in weights.items():
+        if name not in classes:
+            raise ValueError(f"class_weights names {name!r}, which is not among the trained classes")
+        if not (isinstance(w, (int, float)) and not isinstance(w, bool) and w > 0 and math.isfinite(w)):
+            raise ValueError(f"class_weights[{name!r}] must be a positive number, got {w!r}")
+    w = np.array([float(weights.get(c, 1.0)) for c in classes])
+    return w / w.sum()
+
+
 class ZooSampler:
     """On-the-fly training batches: Halton parameter sets, ``seeds_per_set`` seeds each.
 
@@ -460,13 +472,19 @@ class ZooSampler:
     """
 
     def __init__(self, size: int, classes=CLASS_NAMES, seeds_per_set: int = 4, sets_per_class: int = 16384,
-                 rng: np.random.Generator | None = None, device=None):
+                 rng: np.random.Generator | None = None, device=None, class_weights: dict | None = None):
         self.size, self.classes, self.device = size, tuple(classes), device
         self.seeds_per_set, self.sets = seeds_per_set, sets_per_class
         self.rng = rng if rng is not None else np.random.default_rng(0)
+        #: probability of each class per image: ``class_weights`` (name -> weight, 1 where absent), normalised;
+        #: None for equal shares (drawn as before, so older runs resume on the same batches)
+        self.p = class_probabilities(self.classes, class_weights) if class_weights else None
 
     def batch(self, b: int):
-        cls_idx = self.rng.integers(0, len(self.classes), size=b)
+        if self.p is None:
+            cls_idx = self.rng.integers(0, len(self.classes), size=b)
+        else:
+            cls_idx = self.rng.choice(len(self.classes), size=b, p=self.p)
         sample = self.rng.integers(0, self.sets * self.seeds_per_set, size=b)
         imgs = torch.empty(b, 1, self.size, self.size)
         conds = torch.zeros(b, len(PARAM_NAMES))

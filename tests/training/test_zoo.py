@@ -90,6 +90,31 @@ def test_sampler_batches():
     assert torch.equal(imgs, again[0]) and torch.equal(cond, again[2])
 
 
+def test_sampler_class_weights():
+    classes = ("perlin", "spots", "gabor")
+    np.testing.assert_allclose(zoo.class_probabilities(classes, {"gabor": 2}), [0.25, 0.25, 0.5])
+    s = zoo.ZooSampler(16, classes=classes, rng=np.random.default_rng(5), class_weights={"perlin": 6})
+    _, ids, _ = s.batch(160)
+    share = float((ids == zoo.CLASS_NAMES.index("perlin")).float().mean())
+    assert 0.62 < share < 0.88  # 0.75 expected; equal weights give 1/3
+    assert zoo.ZooSampler(16, classes=classes).p is None  # no weights: the draw of older runs
+    with pytest.raises(ValueError, match="'clouds', which is not among"):
+        zoo.class_probabilities(classes, {"clouds": 2})
+    with pytest.raises(ValueError, match=r"class_weights\['gabor'\] must be a positive number"):
+        zoo.class_probabilities(classes, {"gabor": 0})
+
+
+def test_config_class_weights():
+    from training.config import TrainConfig
+
+    cfg = TrainConfig.from_dict({"class_weights": {"fibers": 2.0}})
+    assert cfg.class_weights == {"fibers": 2.0}
+    with pytest.raises(ValueError, match="not among the trained classes"):
+        TrainConfig.from_dict({"classes": ["perlin"], "class_weights": {"fibers": 2.0}})
+    with pytest.raises(ValueError, match="must map class names"):
+        TrainConfig.from_dict({"class_weights": [2.0]})
+
+
 def test_zoo_cli(tmp_path, capsys):
     out = str(tmp_path / "z.npy")
     assert main(["zoo", "--noise", "spots", "--param", "coverage=0.7", "--size", "48", "--seed", "3", "-o", out]) == 0
