@@ -124,6 +124,29 @@ def test_min_snr_weights():
     assert float(snrw[0]) < float(snrw[1])
 
 
+def test_low_snr_weights():
+    """min(1/ᾱ_t, W): the ε error turned into the v error (1 + 1/SNR = 1/ᾱ), capped at W; about 1 on the clean
+    steps, W on the noisiest; combined with min-SNR-γ by product; off at W = 1."""
+    from backend.neural.schedule import cosine_alphas_cumprod
+
+    ab = cosine_alphas_cumprod()
+    t = torch.tensor([0, 300, 700, 900, 999])
+    w = Diffusion(low_snr_weight=10.0).snr_weight(t).numpy()
+    np.testing.assert_allclose(w, np.minimum(1.0 / ab[t.numpy()], 10.0), rtol=1e-4)
+    assert w[0] == pytest.approx(1.0, abs=1e-3) and w[-1] == pytest.approx(10.0) and 1.0 < w[2] < w[3] <= 10.0
+    assert torch.equal(Diffusion(low_snr_weight=1.0).snr_weight(t), torch.ones(5))
+    both = Diffusion(min_snr_gamma=5.0, low_snr_weight=10.0).snr_weight(t)
+    assert torch.allclose(both, Diffusion(min_snr_gamma=5.0).snr_weight(t) * Diffusion(low_snr_weight=10.0).snr_weight(t))
+    with pytest.raises(ValueError, match="low_snr_weight must be >= 1"):
+        Diffusion(low_snr_weight=0.5)
+    m = UNet(3, 2, emb_dim=4, widths=(8, 8, 8))
+    x0 = torch.zeros(4, 1, 16, 16)
+    cond = m.embed(torch.zeros(4, 16, 16, dtype=torch.long), torch.zeros(4, 2, 16, 16))
+    plain = Diffusion(emb_lambda=0.0).loss(m, x0, cond, torch.Generator().manual_seed(3))
+    low = Diffusion(emb_lambda=0.0, low_snr_weight=10.0).loss(m, x0, cond, torch.Generator().manual_seed(3))
+    assert float(plain[1]) == pytest.approx(float(low[1])) and float(low[0]) > float(low[1])
+
+
 def test_cutmix_pastes_other_classes_with_their_conditions():
     B, H = 6, 32
     imgs = torch.arange(B, dtype=torch.float32).view(B, 1, 1, 1).expand(B, 1, H, H).clone()
