@@ -92,6 +92,11 @@ def _run(a, model, classes) -> int:
     for name, r in res["classes"].items():
         print(f"| {name} | {r['fd']} | {r['acc']} | {r['psd']} | {r.get('psd_low', '—')} | "
               f"{r.get('coherence', '—')} ({r.get('coherence_zoo', '—')}) | {r['response']} ({r['param']}) |")
+    oriented = {n: r for n, r in res["classes"].items() if "direction_error" in r}
+    if oriented:
+        print("\n| class | direction error, degrees (zoo's own spread; 45 = ignores the parameter) |\n|---|---|")
+        for name, r in oriented.items():
+            print(f"| {name} ({r['direction_param']}) | {r['direction_error']} ({r['direction_error_zoo']}) |")
     print(f"\nzoo accuracy of the classifier: {res['zoo_accuracy']}")
     print(f"seam ratio: tileable {res['seam_tileable']}, plain {res['seam_plain']}; blend locality {res['locality']}")
     t = res.get("timing")

@@ -15,6 +15,10 @@ instrument is trained here too: a small CNN classifier on the zoo.  Per class:
                 Granlund 1987) measured over the whole image: 1 when all gradients are parallel
                 (damascus bands, aligned fibres), 0 when isotropic; a model that keeps local
                 texture but loses the long-range orientation scores near 0 where the zoo is near 1
+    direction_error   for classes with a direction parameter (ORIENTED): the mean angle (degrees)
+                between the dominant gradient direction of generated images and of the zoo's at
+                0/45/90/135 degrees: 0 when the model follows the parameter, about 45 when it
+                draws a direction of its own
 
 and overall:
 
@@ -27,6 +31,7 @@ Run: ``python bench/eval_neural.py --model models/neural_noise`` (see that scrip
 """
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -37,7 +42,7 @@ import torch.nn.functional as F
 from . import zoo
 
 __all__ = ["Classifier", "train_classifier", "cached_classifier", "known_params", "frechet", "radial_psd", "psd_error",
-           "orientation_coherence", "gradient_direction", "evaluate"]
+           "orientation_coherence", "gradient_direction", "angle_difference", "direction_error", "ORIENTED", "evaluate"]
 
 
 class Classifier(nn.Module):
@@ -202,6 +207,41 @@ def _centroid(imgs):
     return float((p * k).sum() / p.sum())
 
 
+#: classes whose parameter sets a direction: (that parameter, settings that make the direction unambiguous)
+ORIENTED = {"fibers": ("orientation", {}), "phasor": ("orientation", {"spread": 0.2}),
+            "gabor": ("orientation", {"bandwidth": 0.05}), "gabor_texture": ("Orientation", {"Anisotropy": 1.0})}
+#: the directions (degrees) at which :func:`direction_error` asks for each oriented class
+DIRECTIONS = (0.0, 45.0, 90.0, 135.0)
+
+
+def angle_difference(a, b) -> np.ndarray:
+    """|a - b| between directions in degrees modulo 180 -> values in [0, 90]; 45 on average for unrelated ones."""
+    d = np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64)) % 180.0
+    return np.minimum(d, 180.0 - d)
+
+
+def direction_error(model, name: str, sample, size: int, seeds: int = 4) -> dict:
+    """Does the model draw the direction its parameter asks for?  For each direction of :data:`DIRECTIONS`
+    (class ``name`` of :data:`ORIENTED`, its other parameters at mid-range but for the listed settings) ``seeds``
+    images from ``sample(spec, count, seed0)`` -> (count, S, S) are compared with the zoo's images of the same
+    settings: the mean :func:`angle_difference` of their dominant gradient directions (degrees; 0 follows the
+    parameter, about 45 ignores it) and the same between the zoo's seeds and their mean direction (its own
+    spread)."""
+    pname, extra = ORIENTED[name]
+    errs, zoo_spread = [], []
+    for deg in DIRECTIONS:
+        params = dict(zoo.default_params(name), **extra, **{pname: math.radians(deg)})
+        real = zoo.generate(name, {k: np.full(seeds, v) for k, v in params.items()}, torch.arange(seeds) + 31_000,
+                            size).numpy()
+        gen = sample((name, params), seeds, 4000)
+        dz, dg = gradient_direction(real), gradient_direction(gen)
+        ref = float(np.degrees(0.5 * np.angle(np.exp(2j * np.radians(dz)).mean())) % 180.0)  # the zoo's mean
+        errs.append(angle_difference(dg, ref))
+        zoo_spread.append(angle_difference(dz, ref))
+    return dict(direction_error=round(float(np.mean(errs)), 1), direction_error_zoo=round(float(np.mean(zoo_spread)), 1),
+                direction_param=pname)
+
+
 def known_params(model, name: str, params: dict) -> dict:
     """The zoo parameters of ``name`` that ``model`` was trained with: a model exported before a class gained a
     parameter (fibers' and phasor's orientation) is not told it and draws its own, which the zoo's images then
@@ -310,6 +350,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
             coherence=round(abs(float(orientation_coherence(gen).mean() - orientation_coherence(real).mean())), 3),
             coherence_zoo=round(float(orientation_coherence(real).mean()), 3),
             response=round(abs((mr[1] / mr[0]) / (zr[1] / zr[0]) - 1.0), 3), param=p0.name)
+        if name in ORIENTED and ORIENTED[name][0] in {p["name"] for p in model.class_params[name]["params"]}:
+            rows[name].update(direction_error(model, name, sample, S))
         log(f"{name}: {rows[name]}")
     # tileable seams
     tile = generate(model, C.uniform(model, (classes[0], {}), S * 2, S * 2), seed=5, steps=steps, tileable=True)

@@ -297,12 +297,16 @@ def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(expor
 
     _, out = exported
     m = NeuralNoiseModel(str(out))
-    res = evaluate(m, ("perlin", "spots"), n=3, steps=2, clf_steps=3, log=lambda s: None, size=24,
+    res = evaluate(m, ("perlin", "spots", "fibers"), n=3, steps=2, clf_steps=3, log=lambda s: None, size=24,
                    classifier_cache=str(tmp_path), clf_stages=3, clf_threads=1)
     assert res["size"] == 24 and res["classifier"] == dict(steps=3, stages=3, threads=1)
     for r in res["classes"].values():
         assert set(r) >= {"fd", "acc", "psd", "psd_low", "coherence", "coherence_zoo", "response"}
         assert 0.0 <= r["coherence"] <= 1.0 and np.isfinite(r["psd_low"])
+    # the oriented class alone is asked for directions, on its own parameter
+    assert [n for n, r in res["classes"].items() if "direction_error" in r] == ["fibers"]
+    assert res["classes"]["fibers"]["direction_param"] == "orientation"
+    assert 0.0 <= res["classes"]["fibers"]["direction_error"] <= 90.0
     assert list(tmp_path.glob("classifier_*.pt"))  # the 3-stage instrument is cached for the next model
     eps = m.eps_fn(False)
     cond = np.stack([C.uniform(m, ("spots", {"scale": v}), 24, 24) for v in (4.0, 9.0)])
