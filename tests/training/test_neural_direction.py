@@ -1,5 +1,7 @@
-"""bench/neural_direction_sheet.py on the committed tiny model: a row per oriented class, the zoo's column follows
-the asked direction, every model gets a direction and an error per asked direction."""
+"""The direction benches on the committed tiny model. bench/neural_direction_sheet.py: a row per oriented class, the
+zoo's column follows the asked direction, every model gets a direction and an error per asked direction.
+bench/neural_direction_gain.py: the ideal gain of knowing the direction grows from the noisy end, and a model's
+errors with the right and the turned direction are measured on the same noise."""
 import json
 import os
 import subprocess
@@ -34,3 +36,21 @@ def test_direction_sheet_measures_each_asked_direction(tmp_path):
     assert Image.open(out).size == (4 * (2 * (64 + 4) + 8), 4 * (64 + 4))
     bad = subprocess.run(cmd + ["--label", "extra"], capture_output=True, text=True, cwd=ROOT)
     assert bad.returncode != 0 and "one --label per --model" in bad.stderr
+
+
+def test_direction_gain_bench(tmp_path):
+    out = tmp_path / "gain.json"
+    tiny = os.path.join(ROOT, "tests", "data", "tiny_neural")
+    cmd = [sys.executable, os.path.join(ROOT, "bench", "neural_direction_gain.py"), "--model", tiny, "--size", "32",
+           "--n", "6", "--threads", "1", "-o", str(out)]
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr[-2000:]
+    rep = json.loads(out.read_text())
+    ideal = rep["ideal"]
+    assert [row["t"] for row in ideal] == sorted((row["t"] for row in ideal), reverse=True)
+    gains = [row["mixture"] / row["known"] - 1 for row in ideal]
+    assert all(g >= -1e-9 for g in gains) and gains[-1] > gains[0] and gains[-1] > 0.1  # the known direction helps more
+    rows = rep["models"][tiny]
+    assert len(rows) == len(ideal) and all(row["right"] > 0 and row["turned"] > 0 for row in rows)
+    bad = subprocess.run(cmd[:-2] + ["--noise", "perlin"], capture_output=True, text=True, cwd=ROOT)
+    assert bad.returncode != 0 and "--noise must be one of" in bad.stderr
