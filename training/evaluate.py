@@ -220,7 +220,7 @@ def angle_difference(a, b) -> np.ndarray:
     return np.minimum(d, 180.0 - d)
 
 
-def direction_error(model, name: str, sample, size: int, seeds: int = 4) -> dict:
+def direction_error(name: str, sample, size: int, seeds: int = 4) -> dict:
     """Does the model draw the direction its parameter asks for?  For each direction of :data:`DIRECTIONS`
     (class ``name`` of :data:`ORIENTED`, its other parameters at mid-range but for the listed settings) ``seeds``
     images from ``sample(spec, count, seed0)`` -> (count, S, S) are compared with the zoo's images of the same
@@ -351,7 +351,7 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
             coherence_zoo=round(float(orientation_coherence(real).mean()), 3),
             response=round(abs((mr[1] / mr[0]) / (zr[1] / zr[0]) - 1.0), 3), param=p0.name)
         if name in ORIENTED and ORIENTED[name][0] in {p["name"] for p in model.class_params[name]["params"]}:
-            rows[name].update(direction_error(model, name, sample, S))
+            rows[name].update(direction_error(name, sample, S))
         log(f"{name}: {rows[name]}")
     # tileable seams
     tile = generate(model, C.uniform(model, (classes[0], {}), S * 2, S * 2), seed=5, steps=steps, tileable=True)

@@ -174,10 +174,10 @@ def test_direction_error_tells_a_model_that_follows_the_parameter_from_one_that_
     def ignores(spec, count, seed0):
         return np.repeat(bands[None], count, 0)
 
-    good = direction_error(None, "fibers", follows, S)
+    good = direction_error("fibers", follows, S)
     assert good["direction_param"] == "orientation"
     assert good["direction_error"] < 10 and good["direction_error_zoo"] < 10, good
-    bad = direction_error(None, "fibers", ignores, S)
+    bad = direction_error("fibers", ignores, S)
     assert 35 < bad["direction_error"] < 55, bad
-    assert direction_error(None, "gabor_texture", follows, S)["direction_param"] == "Orientation"
+    assert direction_error("gabor_texture", follows, S)["direction_param"] == "Orientation"
     np.testing.assert_allclose(angle_difference([10, 170, 0, 90], [170, 10, 135, 0]), [20, 20, 45, 90])
