@@ -34,13 +34,10 @@ def ideal_gain(name: str, size: int, n: int, timesteps=TIMESTEPS) -> list:
 
     from backend.neural.schedule import cosine_alphas_cumprod
     from training import zoo
-    from training.evaluate import ORIENTED
-
-    pname, extra = ORIENTED[name]
+    from training.evaluate import oriented_params
 
     def power(theta):
-        p = {k: np.full(n, v) for k, v in dict(zoo.default_params(name), **extra).items()}
-        p[pname] = np.full(n, theta)
+        p = {k: np.full(n, v) for k, v in oriented_params(name, theta).items()}
         x = zoo.generate(name, p, torch.arange(n) + 900, size).numpy() * 2 - 1
         return (np.abs(np.fft.fft2(x) / size) ** 2).mean(0)  # per-pixel power at each frequency
 
@@ -62,16 +59,15 @@ def model_gain(folder: str, name: str, size: int, n: int, timesteps=TIMESTEPS) -
 
     from training import zoo
     from training.diffusion import Diffusion
-    from training.evaluate import ORIENTED
+    from training.evaluate import ORIENTED, oriented_params
     from training.warm_start import torch_from_export
 
-    pname, extra = ORIENTED[name]
+    pname = ORIENTED[name][0]
     spec = next(p for p in zoo.CLASSES[name].params if p.name == pname)
     period = np.pi  # every oriented class repeats its images after a half turn
     rng = np.random.default_rng(0)
     theta = rng.uniform(0, period, n)
-    params = {k: np.full(n, v) for k, v in dict(zoo.default_params(name), **extra).items()}
-    params[pname] = theta
+    params = {k: np.full(n, v) for k, v in oriented_params(name, theta).items()}
     wrong = dict(params, **{pname: np.mod(theta + period / 2, period)})
     assert spec.lo <= wrong[pname].min() and wrong[pname].max() <= spec.hi
     x0 = zoo.generate(name, params, torch.arange(n) + 500, size)[:, None] * 2 - 1

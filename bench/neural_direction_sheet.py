@@ -38,7 +38,8 @@ def main() -> int:
     import torch
 
     from training import zoo
-    from training.evaluate import DIRECTIONS, ORIENTED, angle_difference, gradient_direction, known_params
+    from training.evaluate import (DIRECTIONS, ORIENTED, angle_difference, gradient_direction, known_params,
+                                   oriented_params)
 
     labels = a.label or [os.path.basename(os.path.normpath(m)) for m in a.model]
     if len(labels) != len(a.model):
@@ -47,10 +48,10 @@ def main() -> int:
     S, gap, group = a.size, 4, 1 + len(models)
     sheet = np.ones((len(ORIENTED) * (S + gap), len(DIRECTIONS) * (group * (S + gap) + 2 * gap)), np.float32)
     report = dict(size=S, seed=a.seed, directions=list(DIRECTIONS), models=dict(zip(labels, a.model)), classes={})
-    for r, (name, (pname, extra)) in enumerate(ORIENTED.items()):
+    for r, name in enumerate(ORIENTED):
         row = {label: dict(direction=[], error=[]) for label in ["zoo"] + labels}
         for j, deg in enumerate(DIRECTIONS):
-            params = dict(zoo.default_params(name), **extra, **{pname: math.radians(deg)})
+            params = oriented_params(name, math.radians(deg))
             real = zoo.generate(name, params, torch.tensor([a.seed]), S).numpy()[0]
             imgs = [real] + [generate(m, C.uniform(m, (name, known_params(m, name, params)), S, S), seed=a.seed)
                              for m in models]
@@ -64,7 +65,7 @@ def main() -> int:
                 sheet[r * (S + gap): r * (S + gap) + S, x0: x0 + S] = np.clip(img, 0, 1)
         for label in labels:
             row[label]["mean_error"] = round(float(np.mean(row[label]["error"])), 1)
-        report["classes"][name] = dict(row, param=pname)
+        report["classes"][name] = dict(row, param=ORIENTED[name][0])
         print(name, {k: v["direction"] for k, v in row.items()}, file=sys.stderr)
     write_png(a.out, (sheet * 255 + 0.5).astype(np.uint8))
     write_json(os.path.splitext(a.out)[0] + ".json", dict(report, columns=["zoo"] + labels))

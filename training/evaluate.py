@@ -42,7 +42,8 @@ import torch.nn.functional as F
 from . import zoo
 
 __all__ = ["Classifier", "train_classifier", "cached_classifier", "known_params", "frechet", "radial_psd", "psd_error",
-           "orientation_coherence", "gradient_direction", "angle_difference", "direction_error", "ORIENTED", "evaluate"]
+           "orientation_coherence", "gradient_direction", "angle_difference", "direction_error", "oriented_params", "ORIENTED",
+           "evaluate"]
 
 
 class Classifier(nn.Module):
@@ -214,6 +215,13 @@ ORIENTED = {"fibers": ("orientation", {}), "phasor": ("orientation", {"spread": 
 DIRECTIONS = (0.0, 45.0, 90.0, 135.0)
 
 
+def oriented_params(name: str, theta) -> dict:
+    """The settings at which class ``name`` of :data:`ORIENTED` is asked for direction ``theta`` (radians, a number
+    or an array): its other parameters at mid-range, but for the listed settings that make the direction clear."""
+    pname, extra = ORIENTED[name]
+    return dict(zoo.default_params(name), **extra, **{pname: theta})
+
+
 def angle_difference(a, b) -> np.ndarray:
     """|a - b| between directions in degrees modulo 180 -> values in [0, 90]; 45 on average for unrelated ones."""
     d = np.abs(np.asarray(a, np.float64) - np.asarray(b, np.float64)) % 180.0
@@ -227,10 +235,9 @@ def direction_error(name: str, sample, size: int, seeds: int = 4) -> dict:
     settings: the mean :func:`angle_difference` of their dominant gradient directions (degrees; 0 follows the
     parameter, about 45 ignores it) and the same between the zoo's seeds and their mean direction (its own
     spread)."""
-    pname, extra = ORIENTED[name]
     errs, zoo_spread = [], []
     for deg in DIRECTIONS:
-        params = dict(zoo.default_params(name), **extra, **{pname: math.radians(deg)})
+        params = oriented_params(name, math.radians(deg))
         real = zoo.generate(name, {k: np.full(seeds, v) for k, v in params.items()}, torch.arange(seeds) + 31_000,
                             size).numpy()
         gen = sample((name, params), seeds, 4000)
@@ -239,7 +246,7 @@ def direction_error(name: str, sample, size: int, seeds: int = 4) -> dict:
         errs.append(angle_difference(dg, ref))
         zoo_spread.append(angle_difference(dz, ref))
     return dict(direction_error=round(float(np.mean(errs)), 1), direction_error_zoo=round(float(np.mean(zoo_spread)), 1),
-                direction_param=pname)
+                direction_param=ORIENTED[name][0])
 
 
 def known_params(model, name: str, params: dict) -> dict:
