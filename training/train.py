@@ -105,13 +105,15 @@ def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0
     return (x0[:, 0] + 1.0) * 0.5
 
 
-def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print) -> dict:
-    """Train (or resume) into folder ``out``; stops after ``max_steps`` more steps if given. Returns the last log."""
+def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print, max_seconds: float | None = None) -> dict:
+    """Train (or resume) into folder ``out``; stops after ``max_steps`` more steps if given, or at the first step
+    that ends ``max_seconds`` of wall time after the loop began (a lent GPU's lease), with a checkpoint either way.
+    Returns the last log."""
     with cpu_threads(cfg.threads):
-        return _train(cfg, out, max_steps, log)
+        return _train(cfg, out, max_steps, log, max_seconds)
 
 
-def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
+def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: float | None = None) -> dict:
     os.makedirs(out, exist_ok=True)
     device = _device(cfg.device)
     torch.manual_seed(cfg.seed)
@@ -169,6 +171,8 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log) -> dict:
                 pe.lerp_(pm_, 1.0 - cfg.ema_decay)
         step += 1
         losses.append(float(mse.detach()))
+        if max_seconds is not None and time.time() - t0 >= max_seconds:
+            end = step  # out of wall time: log and checkpoint this step, then stop
         if step % cfg.log_every == 0 or step == end:
             last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss.detach()), seconds=round(time.time() - t0, 2),
                         precision=precision, threads=torch.get_num_threads(),
@@ -199,15 +203,18 @@ def main(argv=None) -> int:
     ap.add_argument("--config", required=True, help="JSON config (see TrainConfig)")
     ap.add_argument("--out", required=True, help="run folder: checkpoint, log, samples")
     ap.add_argument("--max-steps", type=int, help="stop after this many more steps (resume later)")
+    ap.add_argument("--max-seconds", type=float, help="stop, with a checkpoint, once this much wall time has passed")
     a = ap.parse_args(argv)
     try:
+        if a.max_seconds is not None and not a.max_seconds > 0:
+            raise ValueError(f"--max-seconds must be > 0, got {a.max_seconds:g}")
         cfg = load_config(a.config)
         if cfg.init_onnx and not os.path.isfile(os.path.join(a.out, "ckpt.pt")):
             exported_weights(cfg.init_onnx, cfg.init_sha256)  # a bad start fails here, in one line
     except (OSError, ValueError, ModelError) as exc:
         print(f"train: error: {exc}", file=sys.stderr)
         return 2
-    train(cfg, a.out, a.max_steps)
+    train(cfg, a.out, a.max_steps, max_seconds=a.max_seconds)
     return 0
 
 

@@ -195,6 +195,20 @@ def test_training_runs_logs_and_resumes_identically(tmp_path):
     assert [r["step"] for r in log] == [1, 2, 3, 4] and all(np.isfinite(r["mse"]) for r in log)
 
 
+def test_wall_time_budget_stops_with_a_checkpoint_and_resumes(tmp_path):
+    """--max-seconds (a lent GPU's lease): the run stops after its first step past the budget, checkpointed and
+    logged, and resumes from there."""
+    from training.train import main
+
+    cfg = TrainConfig.from_dict(dict(TINY, steps=50))
+    last = train(cfg, str(tmp_path / "a"), log=lambda s: None, max_seconds=1e-9)
+    state = torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)
+    assert last["step"] == state["step"] == 1
+    train(cfg, str(tmp_path / "a"), max_steps=2, log=lambda s: None)
+    assert torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)["step"] == 3
+    assert main(["--config", "x.json", "--out", str(tmp_path / "c"), "--max-seconds", "0"]) == 2
+
+
 def test_mirrors_contradict_oriented_conditioning_so_training_does_not_mirror(monkeypatch, tmp_path):
     """A left-right mirror turns a gabor of orientation θ into one of π - θ while its conditioning still says θ
     (and damascus's fixed bands into their reflection): the model then learns 'θ or its mirror' and draws both in

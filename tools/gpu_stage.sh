@@ -1,0 +1,24 @@
+#!/bin/bash
+# One lent-GPU training stage in one call (device tool): train CONFIG for SECONDS of wall time from its init_onnx,
+# then write the EMA weights (two halves, each under the 16 MiB a returned file may have), the log and the config
+# into OUT_DIR. Locally: tools/gpu_export.py turns them back into a run folder that training.export_onnx reads.
+#   tools/gpu_stage.sh CONFIG SECONDS OUT_DIR [PYTHON]
+set -u
+cfg=$1; secs=$2; out=$3; py=${4:-python3}
+export PYTHONUNBUFFERED=1
+run=$(mktemp -d)
+nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null
+$py -c "import torch, numpy, numba; print('torch', torch.__version__, 'cuda', torch.cuda.is_available(), 'numpy', numpy.__version__, 'numba', numba.__version__)"
+$py -m training.train --config "$cfg" --out "$run" --max-seconds "$secs" 2>&1 | tee "$out/train.log"
+$py - "$run" "$out" <<'PY'
+import json, os, shutil, sys, torch
+run, out = sys.argv[1:]
+st = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
+keys = list(st["ema"])
+half = len(keys) // 2
+for name, ks in (("ema_a.pt", keys[:half]), ("ema_b.pt", keys[half:])):
+    torch.save({k: st["ema"][k].float().contiguous() for k in ks}, os.path.join(out, name))
+json.dump(dict(step=st["step"], config=st["config"]), open(os.path.join(out, "stage.json"), "w"), indent=1)
+shutil.copy(os.path.join(run, "log.jsonl"), os.path.join(out, "log.jsonl"))
+print("saved step", st["step"], sorted(os.listdir(out)))
+PY
