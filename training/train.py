@@ -38,6 +38,10 @@ from backend.onnx_models import ModelError
 __all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names", "check_config_keys"]
 
 
+#: a run stops (keeping its last checkpoint) after this many consecutive steps with a non-finite loss or gradient
+MAX_SKIPPED_IN_A_ROW = 20
+
+
 def build_model(cfg: TrainConfig, state: dict | None = None) -> UNet:
     """A fresh UNet for the current zoo, or one shaped like a checkpoint's weights (``state``).
 
@@ -152,6 +156,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
                              class_weights=cfg.class_weights)
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     t0, last, losses = time.time(), {}, []
+    skipped, in_a_row = 0, 0  # steps skipped for a non-finite loss or gradient (see below)
     while step < end:
         imgs, ids, conds = sampler.batch(cfg.batch)
         idm, pm = _conditions(ids, conds[:, : model.n_params], cfg.size)  # older runs: a prefix of the slots
@@ -163,8 +168,22 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
         with autocast(precision, device):
             loss, mse = diff.loss(model, x0, model.embed(idm.to(device), pm.to(device)).contiguous(memory_format=fmt), gen)
         opt.zero_grad(set_to_none=True)
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
+        finite = bool(torch.isfinite(loss))
+        if finite:
+            loss.backward()
+            finite = bool(torch.isfinite(torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)))
+        if not finite:
+            # One non-finite batch (a NaN pixel, an overflow) would turn every weight into NaN through the clipped
+            # update and the EMA after it (a 128² GPU stage did, at step ~1000). Skip the update instead; stop,
+            # keeping the last checkpoint, when it keeps happening.
+            skipped, in_a_row = skipped + 1, in_a_row + 1
+            names = sorted({zoo.CLASS_NAMES[i] for i in ids.tolist()})
+            log(f"step {step + 1}: non-finite loss or gradient, update skipped (classes in the batch: {', '.join(names)})")
+            if in_a_row >= MAX_SKIPPED_IN_A_ROW:
+                raise RuntimeError(f"training diverged: {in_a_row} steps in a row with a non-finite loss or gradient "
+                                   f"at step {step + 1}; the checkpoint in {out} is the last good one")
+            continue
+        in_a_row = 0
         opt.step()
         with torch.no_grad():
             for pe, pm_ in zip(ema.parameters(), model.parameters()):
@@ -175,7 +194,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
             end = step  # out of wall time: log and checkpoint this step, then stop
         if step % cfg.log_every == 0 or step == end:
             last = dict(step=step, mse=float(np.mean(losses)), loss=float(loss.detach()), seconds=round(time.time() - t0, 2),
-                        precision=precision, threads=torch.get_num_threads(),
+                        precision=precision, threads=torch.get_num_threads(), skipped=skipped,
                         emb_norm=float(model.class_emb.weight.detach().norm(dim=1).mean()))
             losses = []
             with open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8") as fh:
@@ -214,7 +233,11 @@ def main(argv=None) -> int:
     except (OSError, ValueError, ModelError) as exc:
         print(f"train: error: {exc}", file=sys.stderr)
         return 2
-    train(cfg, a.out, a.max_steps, max_seconds=a.max_seconds)
+    try:
+        train(cfg, a.out, a.max_steps, max_seconds=a.max_seconds)
+    except RuntimeError as exc:  # diverged: the message names the step and the checkpoint kept
+        print(f"train: error: {exc}", file=sys.stderr)
+        return 1
     return 0
 
 

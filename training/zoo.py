@@ -168,7 +168,9 @@ def _fibers(x, y, s, p, n):
 
 def _galvanic(x, y, s, p, n):
     sc = _u(p, "scale")
-    ridged = 1.0 - ops.fbm(x * sc, y * sc, s, 5, torch.full_like(sc.view(-1), 0.55)).abs() * 2.0
+    # clamped at 0: where |fbm| > 0.5 the ridge went negative and its fractional power below was NaN (one
+    # 128² image in about 2700, enough to turn a GPU stage's weights into NaN at step ~1000)
+    ridged = (1.0 - ops.fbm(x * sc, y * sc, s, 5, torch.full_like(sc.view(-1), 0.55)).abs() * 2.0).clamp(min=0.0)
     f1, f2, _ = ops.worley(x * sc * 2, y * sc * 2, s, torch.ones_like(sc.view(-1)), salt=40)
     return ridged ** (1.0 + 4.0 * _u(p, "contrast")) * (0.6 + 0.4 * torch.tanh(8 * (f2 - f1)))
 

@@ -209,6 +209,49 @@ def test_wall_time_budget_stops_with_a_checkpoint_and_resumes(tmp_path):
     assert main(["--config", "x.json", "--out", str(tmp_path / "c"), "--max-seconds", "0"]) == 2
 
 
+def _nan_batches(monkeypatch, bad_calls):
+    """Make the zoo sampler's calls number ``bad_calls`` (0-based) return a NaN image first in the batch."""
+    real = zoo.ZooSampler.batch
+    calls = []
+
+    def batch(self, b):
+        imgs, ids, conds = real(self, b)
+        if len(calls) in bad_calls:
+            imgs[0] = float("nan")  # the whole image: CutMix may paste over part of it
+        calls.append(1)
+        return imgs, ids, conds
+
+    monkeypatch.setattr(zoo.ZooSampler, "batch", batch)
+
+
+def test_a_non_finite_batch_is_skipped_not_learned(monkeypatch, tmp_path):
+    """One NaN pixel used to turn every weight NaN through the clipped update (a GPU stage did at step ~1000):
+    the update is skipped, counted in the log, and the weights stay finite."""
+    _nan_batches(monkeypatch, {1})
+    msgs = []
+    cfg = TrainConfig.from_dict(dict(TINY, steps=3))
+    last = train(cfg, str(tmp_path / "a"), log=msgs.append)
+    state = torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)
+    assert state["step"] == 3 and last["skipped"] == 1
+    assert all(torch.isfinite(v).all() for k in ("model", "ema") for v in state[k].values() if v.is_floating_point())
+    assert any("non-finite" in m and "update skipped" in m for m in msgs)
+
+
+def test_a_run_that_keeps_diverging_stops_and_keeps_its_last_checkpoint(monkeypatch, tmp_path):
+    from training import train as train_mod
+
+    cfg = TrainConfig.from_dict(dict(TINY, steps=10))
+    train(cfg, str(tmp_path / "a"), max_steps=2, log=lambda s: None)
+    before = torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)
+    _nan_batches(monkeypatch, set(range(1000)))
+    with pytest.raises(RuntimeError, match="diverged: 20 steps in a row"):
+        train(cfg, str(tmp_path / "a"), log=lambda s: None)
+    after = torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)
+    assert after["step"] == before["step"] == 2 and train_mod.MAX_SKIPPED_IN_A_ROW == 20
+    for k in before["model"]:
+        assert torch.equal(before["model"][k], after["model"][k]), k
+
+
 def test_mirrors_contradict_oriented_conditioning_so_training_does_not_mirror(monkeypatch, tmp_path):
     """A left-right mirror turns a gabor of orientation θ into one of π - θ while its conditioning still says θ
     (and damascus's fixed bands into their reflection): the model then learns 'θ or its mirror' and draws both in

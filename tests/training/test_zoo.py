@@ -153,3 +153,11 @@ def test_parameter_slots_and_class_ids_are_append_only():
     doc = load_model_json(neural_model(), "neural_noise.json")
     assert zoo.PARAM_NAMES[: len(doc["params"])] == tuple(doc["params"])
     assert zoo.CLASS_NAMES[: len(doc["classes"])] == tuple(doc["classes"])
+
+
+def test_galvanic_has_no_nan_where_its_ridge_noise_is_strongest():
+    """The sample that turned a 128² GPU stage's weights into NaN (seed and parameters from the replayed data
+    stream, step 980): |fbm| > 0.5 made the ridge negative and its fractional power NaN."""
+    p = {"scale": torch.tensor([4.338623046875]), "contrast": torch.tensor([0.5051059289742417])}
+    img = zoo.generate("galvanic", p, torch.tensor([110020244]), 128)
+    assert torch.isfinite(img).all() and float(img.min()) >= 0.0 and float(img.max()) <= 1.0
