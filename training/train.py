@@ -26,7 +26,7 @@ import numpy as np
 import torch
 
 from . import zoo
-from .cutmix import cutmix
+from .cutmix import cutmix_sources, mix_by_sources
 from .diffusion import Diffusion
 from .config import TrainConfig, check_config_keys, load_config  # noqa: F401  (re-exported)
 from .precision import autocast, resolve
@@ -159,14 +159,15 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
     skipped, in_a_row = 0, 0  # steps skipped for a non-finite loss or gradient (see below)
     while step < end:
         imgs, ids, conds = sampler.batch(cfg.batch)
-        idm, pm = _conditions(ids, conds[:, : model.n_params], cfg.size)  # older runs: a prefix of the slots
-        imgs, idm, pm = cutmix(imgs, idm, pm, rng, p=cfg.cutmix_p)
+        src = cutmix_sources(ids, cfg.size, cfg.size, rng, p=cfg.cutmix_p).to(device)
+        # mixed on the training device; older runs' models read a prefix of the parameter slots
+        imgs, idm, pm = mix_by_sources(imgs, ids, conds[:, : model.n_params], src)
         if cfg.flips:
             imgs, idm, pm = random_mirror(imgs, idm, pm, rng)
-        x0 = (imgs * 2.0 - 1.0).to(device).contiguous(memory_format=fmt)
+        x0 = (imgs * 2.0 - 1.0).contiguous(memory_format=fmt)
         model.train()
         with autocast(precision, device):
-            loss, mse = diff.loss(model, x0, model.embed(idm.to(device), pm.to(device)).contiguous(memory_format=fmt), gen)
+            loss, mse = diff.loss(model, x0, model.embed(idm, pm).contiguous(memory_format=fmt), gen)
         opt.zero_grad(set_to_none=True)
         finite = bool(torch.isfinite(loss))
         if finite:

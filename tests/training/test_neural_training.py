@@ -164,6 +164,53 @@ def test_cutmix_pastes_other_classes_with_their_conditions():
     assert torch.equal(same[0], imgs) and torch.equal(same[1], ids)
 
 
+def _cutmix_in_place(images, ids, params, rng, p):
+    """The in-place form CutMix had before source maps (the reference for the equality below)."""
+    from training.cutmix import rotated_box_mask
+
+    src = (images, ids, params)
+    images, ids, params = images.clone(), ids.clone(), params.clone()
+    B, _, H, W = images.shape
+    base = ids[:, 0, 0].clone()
+    for b in range(B):
+        if rng.random() >= p:
+            continue
+        donors = np.nonzero((base != base[b]).numpy())[0]
+        if len(donors) == 0:
+            continue
+        for _ in range(int(rng.integers(1, 5))):
+            d = int(rng.choice(donors))
+            w, h = float(rng.uniform(0.25, 0.75)) * W, float(rng.uniform(0.25, 0.75)) * H
+            m = rotated_box_mask(H, W, float(rng.uniform(0, W)), float(rng.uniform(0, H)), w, h,
+                                 float(rng.uniform(0, math.pi)))
+            images[b, :, m] = src[0][d, :, m]
+            ids[b, m] = src[1][d, m]
+            params[b][:, m] = src[2][d][:, m]
+    return images, ids, params
+
+
+def test_cutmix_by_source_map_equals_pasting_in_place_and_keeps_the_data_stream():
+    """Training now draws a source map and gathers on its device (no (B, P, H, W) maps built on the CPU): the same
+    mixed batch, bit for bit, as pasting in place, and the same draws from the run's generator after it."""
+    from training.cutmix import cutmix_sources, mix_by_sources
+    from training.train import _conditions
+
+    B, H, P = 12, 24, 3
+    g = torch.Generator().manual_seed(0)
+    imgs = torch.rand(B, 1, H, H, generator=g)
+    ids = torch.tensor([0, 1, 2, 0, 1, 2, 3, 3, 0, 1, 2, 5])
+    conds = torch.rand(B, P, generator=g)
+    idm, pm = _conditions(ids, conds, H)
+    ra, rb = np.random.default_rng(4), np.random.default_rng(4)
+    want = _cutmix_in_place(imgs, idm, pm, ra, p=0.7)
+    got = mix_by_sources(imgs, ids, conds, cutmix_sources(ids, H, H, rb, p=0.7))
+    again = cutmix(imgs, idm, pm, np.random.default_rng(4), p=0.7)
+    for w, x, y in zip(want, got, again):
+        assert torch.equal(w, x) and torch.equal(w, y)
+    assert not torch.equal(want[0], imgs)  # something was mixed
+    assert ra.random() == rb.random()
+
+
 def test_training_overfits_a_fixed_batch():
     torch.manual_seed(0)
     m = UNet(3, 2, emb_dim=4, widths=(8, 16, 16))
