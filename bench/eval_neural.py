@@ -28,6 +28,9 @@ def main() -> int:
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
     ap.add_argument("--classes", help="comma-separated classes to evaluate (default: the model's trained classes); "
                                       "two models compare only on the same classes, with the same instrument")
+    ap.add_argument("--only", help="comma-separated classes to report, measured with the classifier of every "
+                                   "evaluated class (--classes): a larger n for a few classes on the same instrument; "
+                                   "no seam or locality figures")
     ap.add_argument("--threads", type=int, default=0, help="CPU threads for torch and numba (0: their defaults); "
                                                            "the classifier is reproducible for a fixed count")
     ap.add_argument("--n", type=int, default=32, help="samples per class")
@@ -59,6 +62,14 @@ def main() -> int:
         if bad:
             print(f"eval_neural: error: {a.model} was not trained on {bad[0]!r}", file=sys.stderr)
             return 2
+    only = None
+    if a.only:
+        only = tuple(c.strip() for c in a.only.split(","))
+        bad = [c for c in only if c not in classes]
+        if bad:
+            print(f"eval_neural: error: --only {bad[0]!r} is not among the evaluated classes", file=sys.stderr)
+            return 2
+    a.only = only
     if a.timing_only and a.no_timing:
         print("eval_neural: error: --timing-only and --no-timing exclude each other", file=sys.stderr)
         return 2
@@ -78,7 +89,7 @@ def _run(a, model, classes) -> int:
     else:
         res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr),
                        sampler=a.sampler, spacing=a.spacing, classifier_cache=a.classifier_cache,
-                       size=a.eval_size, clf_stages=a.clf_stages, clf_threads=a.clf_threads)
+                       size=a.eval_size, clf_stages=a.clf_stages, clf_threads=a.clf_threads, only=a.only)
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
     if not a.timing_only:
@@ -87,6 +98,8 @@ def _run(a, model, classes) -> int:
         res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing or DEFAULT_SPACING[a.sampler])
     res["model"] = dict(step=model.config["step"], sha256=model.fingerprint, n=a.n, steps=a.steps,
                         classes=list(classes), precision=model.precision)
+    if a.only:
+        res["model"]["only"] = list(a.only)
     print("| class | FD | acc | PSD err | low-frequency PSD err | coherence err (zoo) | response err (param) |")
     print("|---|---|---|---|---|---|---|")
     for name, r in res["classes"].items():

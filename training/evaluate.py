@@ -257,6 +257,14 @@ def known_params(model, name: str, params: dict) -> dict:
     return {k: v for k, v in params.items() if k in own}
 
 
+def _images_description() -> dict:
+    """:func:`zoo.describe` without what does not change the zoo's images (a parameter's conditioning period)."""
+    out = zoo.describe()
+    for c in out.values():
+        c["params"] = [{k: v for k, v in p.items() if k != "period"} for p in c["params"]]
+    return out
+
+
 def cached_classifier(classes, size: int, steps: int, cache: str | None = None, log=None, stages: int = 2,
                       threads: int | None = None):
     """:func:`train_classifier`, or the one saved in folder ``cache`` for the same classes, size, steps
@@ -278,8 +286,9 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
     import os
 
     key = dict(classes=list(classes), size=size, steps=steps, threads=torch.get_num_threads(),
-               # the zoo's classes and parameters: a classifier of the zoo before a change is another instrument
-               zoo=hashlib.sha256(json.dumps(zoo.describe(), sort_keys=True).encode()).hexdigest()[:16])
+               # the zoo's classes and parameters: a classifier of the zoo before a change is another instrument;
+               # a parameter's period is left out: it changes the conditioning, not the images a classifier sees
+               zoo=hashlib.sha256(json.dumps(_images_description(), sort_keys=True).encode()).hexdigest()[:16])
     if stages != 2:
         key["stages"] = stages  # only where it is not 2, the default the key was first written without
     key = json.dumps(key)
@@ -300,11 +309,14 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
 
 def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print,
              sampler: str = "ddim", spacing: str | None = None, classifier_cache: str | None = None,
-             size: int | None = None, clf_stages: int = 2, clf_threads: int | None = None) -> dict:
+             size: int | None = None, clf_stages: int = 2, clf_threads: int | None = None,
+             only: tuple | None = None) -> dict:
     """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`),
     sampled by ``sampler`` with ``steps`` timesteps (the same seeds for every sampler) at ``size``² px
     (default: the model's training size; two models compare only at one size, with one classifier).
-    The n samples of a class are generated as one batch, each from its own seed as before."""
+    The n samples of a class are generated as one batch, each from its own seed as before.
+    ``only``: rows for these of ``classes`` alone, measured by the classifier of all ``classes`` (the same
+    instrument, the same samples as a full run with this n) and without the seam and locality measures (None)."""
     from backend.neural import conditioning as C
     from backend.neural.generate import generate as _generate
     from backend.neural.sampler import initial_noise, sample as _sample
@@ -337,6 +349,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
 
     for name in classes:
         sets = rng.integers(0, 16384, size=n)
+        if only is not None and name not in only:
+            continue  # its draw is made all the same: the classes after it get the samples of a full run
         params = zoo.sample_params(name, sets)
         real = zoo.generate(name, params, torch.arange(n) + 77_000, S).numpy()
         specs = [(name, known_params(model, name, {k: float(v[i]) for k, v in params.items()})) for i in range(n)]
@@ -360,6 +374,9 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
         if name in ORIENTED and ORIENTED[name][0] in {p["name"] for p in model.class_params[name]["params"]}:
             rows[name].update(direction_error(name, sample, S))
         log(f"{name}: {rows[name]}")
+    if only is not None:
+        return dict(classes=rows, size=S, classifier=dict(steps=clf_steps, stages=clf_stages, threads=clf_threads),
+                    zoo_accuracy=round(zoo_acc, 3), seam_tileable=None, seam_plain=None, locality=None)
     # tileable seams
     tile = generate(model, C.uniform(model, (classes[0], {}), S * 2, S * 2), seed=5, steps=steps, tileable=True)
     plain = generate(model, C.uniform(model, (classes[0], {}), S * 2, S * 2), seed=5, steps=steps, tileable=False)

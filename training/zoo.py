@@ -40,9 +40,19 @@ class Param:
     hi: float
     unit: str
     integer: bool = False
+    #: > 0: the images repeat every ``period`` of this parameter (an orientation of a kernel that is symmetric under
+    #: a half turn: pi), and the conditioning carries ((v - lo) mod period) / period, so that one turn of the network's
+    #: input is one turn of the pattern; 0: the range maps linearly onto [0, 1]
+    period: float = 0.0
 
     def to_unit(self, v):
         return (v - self.lo) / (self.hi - self.lo)
+
+    def condition(self, v: torch.Tensor) -> torch.Tensor:
+        """Physical values (B,) -> the conditioning's [0, 1] values (B,) (see ``period``)."""
+        if self.period > 0:
+            return torch.remainder(v - self.lo, self.period) / self.period
+        return ((v - self.lo) / (self.hi - self.lo)).clamp(0.0, 1.0)
 
     def from_unit(self, u):
         v = self.lo + u * (self.hi - self.lo)
@@ -359,7 +369,7 @@ _CLASSES = [
                                        Param("distortion", 0.2, 2.0, "warp")),
                _damascus, "warped stripes (Substance 'grunge damas')"),
     NoiseClass("gabor", "gabor", (Param("frequency", 0.02, 0.08, "cycles per px"), Param("bandwidth", 0.01, 0.35, "kernel a, 1/px"),
-                                  Param("orientation", 0.0, 2 * math.pi, "radians")),
+                                  Param("orientation", 0.0, 2 * math.pi, "radians", period=math.pi)),
                _gabor, "Gabor noise (Lagae et al. 2009; the paper's Appendix B, Table 3)"),
     NoiseClass("phasor", "gabor", (Param("frequency", 4, 16, "cycles per 128 px"), Param("spread", 0.0, 1.0, "angle spread"),
                                    _ORIENTATION),
@@ -451,7 +461,7 @@ def condition_vector(name: str, params: dict) -> torch.Tensor:
     out = torch.zeros(first.shape[0], len(PARAM_NAMES))
     for spec in cls.params:
         v = torch.as_tensor(params[spec.name], dtype=torch.float32).view(-1)
-        out[:, PARAM_NAMES.index(spec.name)] = ((v - spec.lo) / (spec.hi - spec.lo)).clamp(0.0, 1.0)
+        out[:, PARAM_NAMES.index(spec.name)] = spec.condition(v)
     return out
 
 
@@ -533,6 +543,11 @@ def parse_params(name: str, items: list) -> dict:
 
 def describe() -> dict:
     """Classes and their parameters as plain JSON types."""
-    return {c.name: dict(family=c.family, doc=c.doc, params=[dict(name=p.name, min=p.lo, max=p.hi, unit=p.unit,
-                                                                   integer=p.integer) for p in c.params])
-            for c in _CLASSES}
+    return {c.name: dict(family=c.family, doc=c.doc, params=[_describe_param(p) for p in c.params]) for c in _CLASSES}
+
+
+def _describe_param(p: Param) -> dict:
+    d = dict(name=p.name, min=p.lo, max=p.hi, unit=p.unit, integer=p.integer)
+    if p.period > 0:  # only then: a model exported before periods existed keeps its JSON, and the runtime its mapping
+        d["period"] = p.period
+    return d

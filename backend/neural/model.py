@@ -193,7 +193,9 @@ class NeuralNoiseModel:
         """Physical parameter values of class ``name`` -> float32 (P,) normalised vector (zeros elsewhere).
 
         Missing parameters take the middle of their range; unknown names or values
-        outside the range raise SettingError naming them.
+        outside the range raise SettingError naming them.  A parameter with a ``period`` in the
+        model's JSON (an orientation whose images repeat every half turn) maps to
+        ((v - min) mod period) / period, as the zoo conditioned it in training.
         """
         self.class_id(name)
         spec = {p["name"]: p for p in self.class_params[name]["params"]}
@@ -206,5 +208,7 @@ class NeuralNoiseModel:
             v = float(values.get(pname, 0.5 * (p["min"] + p["max"])))
             if not p["min"] <= v <= p["max"]:
                 raise SettingError("param", f"{pname}={v:g} is outside [{p['min']:g}, {p['max']:g}] ({p['unit']})")
-            vec[self.params.index(pname)] = (v - p["min"]) / (p["max"] - p["min"])
+            period = p.get("period", 0.0)  # the pattern repeats every period: the input turns once per period
+            vec[self.params.index(pname)] = (((v - p["min"]) % period) / period if period > 0
+                                             else (v - p["min"]) / (p["max"] - p["min"]))
         return vec

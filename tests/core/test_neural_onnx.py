@@ -358,3 +358,23 @@ steps = 2
     job.write_text(inline.replace('latent = "slerp"', 'latent = "slerp"\nblend = "mask.png"'))
     (_, bad), = load_job(str(job))
     assert "source.keys: keyframes set the classes of the whole image; leave out blend" in str(bad)
+
+
+def test_a_periodic_parameter_maps_one_turn_of_its_pattern_to_one_turn_of_the_input(tiny):
+    """gabor's orientation spans 0-2π but its images repeat every π (a cosine kernel): a model whose JSON gives the
+    period gets ((v - min) mod period) / period, as the zoo conditioned it; a JSON without one keeps the range."""
+    import copy
+    import math
+
+    m = NeuralNoiseModel(tiny)
+    slot = m.params.index("orientation")
+    assert "period" not in {k for p in m.class_params["gabor"]["params"] for k in p}
+    assert m.param_vector("gabor", {"orientation": math.pi})[slot] == pytest.approx(0.5)  # the range: 0-2π
+    m.class_params = copy.deepcopy(m.class_params)
+    for p in m.class_params["gabor"]["params"]:
+        if p["name"] == "orientation":
+            p["period"] = math.pi
+    for v, want in ((0.0, 0.0), (math.pi / 2, 0.5), (math.pi + 0.3, 0.3 / math.pi), (2 * math.pi, 0.0)):
+        assert m.param_vector("gabor", {"orientation": v})[slot] == pytest.approx(want, abs=1e-6)
+    with pytest.raises(SettingError, match="outside"):
+        m.param_vector("gabor", {"orientation": 7.0})

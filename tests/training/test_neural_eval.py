@@ -135,6 +135,10 @@ def test_cached_classifier_is_keyed_by_the_zoo(tmp_path, monkeypatch):
     E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)
     assert len(calls) == 1 and len(list(tmp_path.glob("classifier_*.pt"))) == 1
     described = E.zoo.describe()
+    described["perlin"]["params"][0]["period"] = 0.5  # conditioning only: the same images, the same instrument
+    monkeypatch.setattr(E.zoo, "describe", lambda: described)
+    E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)
+    assert len(calls) == 1
     described["perlin"]["params"][0]["max"] = 99
     monkeypatch.setattr(E.zoo, "describe", lambda: described)
     E.cached_classifier(("perlin", "spots"), 16, 2, str(tmp_path), stages=2, threads=1)

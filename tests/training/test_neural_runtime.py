@@ -314,6 +314,11 @@ def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(expor
     both = sample("dpmpp_2m", eps, x0, cond, 3, alphas_cumprod=m.alphas_cumprod)
     one = sample("dpmpp_2m", eps, x0[1:], cond[1:].copy(), 3, alphas_cumprod=m.alphas_cumprod)
     np.testing.assert_allclose(both[1:], one, atol=1e-4)
+    # --only: the rows of a full run for those classes (same classifier and samples), without seams or locality
+    part = evaluate(m, ("perlin", "spots", "fibers"), n=3, steps=2, clf_steps=3, log=lambda s: None, size=24,
+                    classifier_cache=str(tmp_path), clf_stages=3, clf_threads=1, only=("spots",))
+    assert list(part["classes"]) == ["spots"] and part["classes"]["spots"] == res["classes"]["spots"]
+    assert part["locality"] is None and part["seam_tileable"] is None
 
 
 

@@ -1,5 +1,6 @@
 """The neural-noise training zoo: classes, parameters, Halton sets, conditioning, CLI."""
 import json
+import math
 
 import numpy as np
 import pytest
@@ -161,3 +162,18 @@ def test_galvanic_has_no_nan_where_its_ridge_noise_is_strongest():
     p = {"scale": torch.tensor([4.338623046875]), "contrast": torch.tensor([0.5051059289742417])}
     img = zoo.generate("galvanic", p, torch.tensor([110020244]), 128)
     assert torch.isfinite(img).all() and float(img.min()) >= 0.0 and float(img.max()) <= 1.0
+
+
+def test_gabor_orientation_is_conditioned_modulo_its_half_turn_period():
+    """gabor's images are the same at θ and θ + π (its kernel is a cosine): the conditioning gives both the same
+    input, turning once per π like fibres and phasor, and the exported description carries the period."""
+    p = {"frequency": torch.tensor([0.05, 0.05]), "bandwidth": torch.tensor([0.1, 0.1]),
+         "orientation": torch.tensor([0.7, 0.7 + math.pi])}
+    img = zoo.generate("gabor", p, torch.tensor([5, 5]), 64)
+    assert torch.allclose(img[0], img[1], atol=1e-5)
+    c = zoo.condition_vector("gabor", p)[:, zoo.PARAM_NAMES.index("orientation")]
+    assert torch.allclose(c, torch.tensor([0.7 / math.pi] * 2), atol=1e-6)
+    spec = {q["name"]: q for q in zoo.describe()["gabor"]["params"]}
+    assert spec["orientation"]["period"] == pytest.approx(math.pi) and "period" not in spec["frequency"]
+    fib = zoo.condition_vector("fibers", {**zoo.default_params("fibers"), "orientation": torch.tensor([2.0])})
+    assert float(fib[0, zoo.PARAM_NAMES.index("orientation")]) == pytest.approx(2.0 / math.pi, abs=1e-6)
