@@ -55,6 +55,7 @@ class TrainConfig:
     sample_every: int = 5000
     sample_steps: int = 20
     threads: int = 0               # CPU threads for torch and numba (0: their defaults), see .threads
+    workers: int = 0               # processes that make the batches ahead of the loop (.batches; 0: the loop does)
     init_onnx: str = ""            # a fresh run starts from this export's weights (see .warm_start) ...
     init_sha256: str = ""          # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
     precision: str = "auto"        # auto | fp32 | bf16: bf16 autocast where the CPU/GPU computes bf16 natively (.precision)
@@ -81,6 +82,8 @@ class TrainConfig:
             raise ValueError(f"deep must be >= 0, got {d['deep']}")
         if d.get("precision", "auto") not in PRECISIONS:
             raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {d['precision']!r}")
+        if not isinstance(d.get("workers", 0), int) or d.get("workers", 0) < 0:
+            raise ValueError(f"workers must be an integer >= 0, got {d['workers']!r}")
         if d.get("init_onnx") and not d.get("init_sha256"):
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         return cls(**d)

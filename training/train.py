@@ -26,6 +26,7 @@ import numpy as np
 import torch
 
 from . import zoo
+from .batches import worker_batches
 from .cutmix import cutmix_sources, mix_by_sources
 from .diffusion import Diffusion
 from .config import TrainConfig, check_config_keys, load_config  # noqa: F401  (re-exported)
@@ -157,9 +158,14 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     t0, last, losses = time.time(), {}, []
     skipped, in_a_row = 0, 0  # steps skipped for a non-finite loss or gradient (see below)
+    batches = worker_batches(cfg, step, end, pin=device.type == "cuda") if cfg.workers else None
     while step < end:
-        imgs, ids, conds = sampler.batch(cfg.batch)
-        src = cutmix_sources(ids, cfg.size, cfg.size, rng, p=cfg.cutmix_p).to(device)
+        if batches is not None:  # made ahead by worker processes, batch k from its own generator (.batches)
+            imgs, ids, conds, src = next(batches)
+            src = src.to(device, non_blocking=True)
+        else:
+            imgs, ids, conds = sampler.batch(cfg.batch)
+            src = cutmix_sources(ids, cfg.size, cfg.size, rng, p=cfg.cutmix_p).to(device)
         # mixed on the training device; older runs' models read a prefix of the parameter slots
         imgs, idm, pm = mix_by_sources(imgs, ids, conds[:, : model.n_params], src)
         if cfg.flips:
