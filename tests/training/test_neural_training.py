@@ -228,8 +228,8 @@ def test_training_overfits_a_fixed_batch():
     assert losses[-1] < 0.5 * losses[0], (losses[0], losses[-1])
 
 
-def test_training_runs_logs_and_resumes_identically(tmp_path):
-    cfg = TrainConfig.from_dict(dict(TINY, steps=4))
+def _stopped_and_resumed_equals_uninterrupted(cfg, tmp_path):
+    """Train 2 of cfg's 4 steps into a/, resume to 4; train 4 at once into b/; the weights agree."""
     train(cfg, str(tmp_path / "a"), max_steps=2, log=lambda s: None)
     train(cfg, str(tmp_path / "a"), log=lambda s: None)
     train(cfg, str(tmp_path / "b"), log=lambda s: None)
@@ -238,6 +238,11 @@ def test_training_runs_logs_and_resumes_identically(tmp_path):
     assert a["step"] == b["step"] == 4
     for k in a["model"]:
         assert torch.allclose(a["model"][k], b["model"][k], atol=1e-6), k
+
+
+def test_training_runs_logs_and_resumes_identically(tmp_path):
+    cfg = TrainConfig.from_dict(dict(TINY, steps=4))
+    _stopped_and_resumed_equals_uninterrupted(cfg, tmp_path)
     log = [json.loads(line) for line in (tmp_path / "b" / "log.jsonl").read_text().splitlines()]
     assert [r["step"] for r in log] == [1, 2, 3, 4] and all(np.isfinite(r["mse"]) for r in log)
 
@@ -311,14 +316,7 @@ def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically
         for u, v, w in zip(x, y, batch_at(cfg, k + 1)):
             assert torch.equal(u, v) and torch.equal(u, w)
     assert not torch.equal(a[0][0], a[1][0])
-    train(cfg, str(tmp_path / "a"), max_steps=2, log=lambda s: None)
-    train(cfg, str(tmp_path / "a"), log=lambda s: None)
-    train(cfg, str(tmp_path / "b"), log=lambda s: None)
-    sa = torch.load(tmp_path / "a" / "ckpt.pt", weights_only=False)
-    sb = torch.load(tmp_path / "b" / "ckpt.pt", weights_only=False)
-    assert sa["step"] == sb["step"] == 4
-    for k in sa["model"]:
-        assert torch.allclose(sa["model"][k], sb["model"][k], atol=1e-6), k
+    _stopped_and_resumed_equals_uninterrupted(cfg, tmp_path)
     with pytest.raises(ValueError, match="workers must be an integer >= 0"):
         TrainConfig.from_dict(dict(TINY, workers=-1))
 
