@@ -26,10 +26,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from backend.solid.cellular import cellular_features_numpy
 from backend.solid.lattice import lattice_noise
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
-           "BASELINES"]
+           "colour_by_rank", "voronoi_pavement", "BASELINES"]
 
 _K = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
 
@@ -118,11 +119,30 @@ def perlin_hist(photo: np.ndarray, size: int, rng: np.random.Generator, octaves:
     pts = np.stack([uu.ravel(), vv.ravel()], 1) + rng.uniform(0, 1000, 2)
     T = np.stack([np.eye(2, dtype=np.float32)] * octaves)
     n = lattice_noise(pts, T, int(rng.integers(0, 2 ** 31 - 1)), 1)
-    f = (n * (0.5 ** np.arange(octaves))).sum(1)
+    return colour_by_rank((n * (0.5 ** np.arange(octaves))).sum(1).reshape(size, size), photo)
+
+
+def colour_by_rank(field: np.ndarray, photo: np.ndarray) -> np.ndarray:
+    """A scalar field (H, W) coloured by rank through the photo's pixels sorted by mean value: (H, W, 3) float32
+    with the photo's colour histogram and the field's arrangement."""
+    f = np.asarray(field).ravel()
     flat = np.asarray(photo, np.float32).reshape(-1, 3)
     cols = flat[np.argsort(flat.mean(1), kind="stable")]
-    idx = (np.argsort(np.argsort(f)) * (cols.shape[0] / f.shape[0])).astype(int)
-    return cols[np.clip(idx, 0, cols.shape[0] - 1)].reshape(size, size, 3)
+    idx = (np.argsort(np.argsort(f, kind="stable")) * (cols.shape[0] / f.shape[0])).astype(int)
+    return cols[np.clip(idx, 0, cols.shape[0] - 1)].reshape(*np.shape(field), 3)
+
+
+def voronoi_pavement(size: int, cell: float, rng: np.random.Generator, joint: float = 2.0,
+                     noise: float = 0.01) -> np.ndarray:
+    """A synthetic stone pavement (size, size) float32 in [0, 1], a probe for structure measures: Voronoi cells
+    of about ``cell`` px (Worley features, :mod:`backend.solid.cellular`), one grey per stone, dark joints where
+    F2 - F1 < ``joint`` px, plus Gaussian pixel noise."""
+    u = (np.arange(size) + 0.5) / cell
+    vv, uu = np.meshgrid(u, u, indexing="ij")
+    pts = np.stack([uu.ravel(), vv.ravel()], 1) + rng.uniform(0, 1000, 2)
+    f = cellular_features_numpy(pts, np.eye(2, dtype=np.float32)[None], int(rng.integers(0, 2 ** 31 - 1)), 1)
+    grey = np.where((f[:, 1] + 1) / 2 * cell < joint, 0.12, 0.45 + 0.25 * f[:, 2])
+    return np.clip(grey.reshape(size, size) + noise * rng.standard_normal((size, size)), 0, 1).astype(np.float32)
 
 
 BASELINES = {"pixel_shuffle": pixel_shuffle, "random_phase": random_phase, "perlin_hist": perlin_hist}

@@ -34,23 +34,25 @@ __all__ = ["SlicedFeatures", "sliced_w2", "swd_loss"]
 class SlicedFeatures(nn.Module):
     """Fixed random multi-scale features; forward gives a list of feature maps (B, C_t, H_t, W_t), one per tap."""
 
-    def __init__(self, seed: int = 0, levels: int = 5, patch: int = 5, width: int = 64, kernels=(3, 7, 11)):
+    def __init__(self, seed: int = 0, levels: int = 5, patch: int = 5, width: int = 64, kernels=(3, 7, 11),
+                 channels: int = 3):
         super().__init__()
         g = torch.Generator().manual_seed(seed)
         self.levels, self.patch, self.kernels = levels, patch, tuple(kernels)
         for k in self.kernels:
-            filt = torch.randn(width, 3, k, k, generator=g)
+            filt = torch.randn(width, channels, k, k, generator=g)
             filt = filt - filt.mean(dim=(1, 2, 3), keepdim=True)          # zero mean: structure, not colour
             filt = filt / filt.flatten(1).norm(dim=1).view(-1, 1, 1, 1)
             self.register_buffer(f"w{k}", filt)
             self.register_buffer(f"b{k}", (torch.rand(width, generator=g) - 0.5) * 0.2)
         # the k x k colour neighbourhood as a feature vector: an identity filter bank
-        eye = torch.eye(3 * patch * patch).view(3 * patch * patch, 3, patch, patch)
+        eye = torch.eye(channels * patch * patch).view(channels * patch * patch, channels, patch, patch)
         self.register_buffer("patches", eye)
 
-    def forward(self, img: torch.Tensor) -> list:
+    def forward(self, img: torch.Tensor, centred: bool = False) -> list:
+        """Taps of ``img`` (B, channels, H, W): values in [0, 1], or with ``centred`` already zero-centred."""
         taps = []
-        x = (img - 0.5) * 2.0
+        x = img if centred else (img - 0.5) * 2.0
         for lvl in range(self.levels):
             if lvl:
                 x = F.avg_pool2d(x, 2)

@@ -12,7 +12,8 @@ and, with probability ``oblique``, rotated planes in 3D), fresh seeds xi and
 a random offset per slice -> style loss (Gram matrices of fixed random
 multi-scale features + colour histogram, :mod:`.features`, or sliced Wasserstein
 distances of such features, :mod:`.swd`; optionally the power spectrum's band
-shares, :mod:`.spectrum`) -> Adam with a cosine learning-rate decay.
+shares, :mod:`.spectrum`, and the level-set morphology, :mod:`.soft_morphology`)
+-> Adam with a cosine learning-rate decay.
 
 ``RUN/ckpt.pt`` is written atomically every ``checkpoint_every`` steps (a run
 resumes from it), ``RUN/log.jsonl`` has one line per ``log_every`` steps.
@@ -38,6 +39,7 @@ from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
 from .model import SolidTexture, colour_stats, max_scales, shape_features, slice_points, spectral_gains
+from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
@@ -82,6 +84,7 @@ class SolidConfig:
     swd_kernels: tuple = (3, 7)     # swd: filter sizes
     swd_levels: int = 5             # swd: pyramid levels
     spectrum_weight: float = 0.0    # weight of the power-spectrum band term (spectrum.py); 0: off
+    morphology_weight: float = 0.0  # weight of the soft level-set morphology term (soft_morphology.py); 0: off
     min_spacing: float = 0.0        # bounded space models: no octave's lattice finer than this many px (model.max_scales); 0: off
     seed: int = 0
     log_every: int = 25
@@ -116,8 +119,9 @@ class SolidConfig:
         n_exemplars = len(ex.expand(cfg.exemplars))
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
-        if not (math.isfinite(cfg.spectrum_weight) and cfg.spectrum_weight >= 0):
-            raise ValueError(f"spectrum_weight must be a number >= 0, got {cfg.spectrum_weight!r}")
+        for key in ("spectrum_weight", "morphology_weight"):
+            if not (math.isfinite(getattr(cfg, key)) and getattr(cfg, key) >= 0):
+                raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
         if cfg.min_spacing:
             if not (math.isfinite(cfg.min_spacing) and cfg.min_spacing > 0):
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
@@ -185,6 +189,8 @@ def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, 
             cfg.hist_weight * histogram_loss(img, ref, per_sample=per_sample)
     if cfg.spectrum_weight:
         loss = loss + cfg.spectrum_weight * spectrum_loss(img, ref, per_sample=per_sample)
+    if cfg.morphology_weight:
+        loss = loss + cfg.morphology_weight * soft_morphology_loss(img, ref, per_sample=per_sample)
     return loss
 
 
