@@ -36,6 +36,7 @@ def main() -> int:
     ap.add_argument("--n", type=int, default=32, help="samples per class")
     ap.add_argument("--steps", type=int, default=30, help="sampler steps")
     ap.add_argument("--sampler", default="ddim", help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py)")
+    ap.add_argument("--eta", type=float, default=0.0, help="step noise of ddim or dpmpp_2m (0: deterministic)")
     ap.add_argument("--spacing", help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own)")
     ap.add_argument("--precision", default="fp32", help="the denoiser's arithmetic: fp32, int8 or auto "
                                                          "(int8 needs the folder's int8 files, training/quantize_onnx.py)")
@@ -89,13 +90,15 @@ def _run(a, model, classes) -> int:
     else:
         res = evaluate(model, classes, a.n, a.steps, a.clf_steps, log=lambda s: print(s, file=sys.stderr),
                        sampler=a.sampler, spacing=a.spacing, classifier_cache=a.classifier_cache,
-                       size=a.eval_size, clf_stages=a.clf_stages, clf_threads=a.clf_threads, only=a.only)
+                       size=a.eval_size, clf_stages=a.clf_stages, clf_threads=a.clf_threads, only=a.only, eta=a.eta)
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
     if not a.timing_only:
         from backend.neural.sampler import DEFAULT_SPACING
 
         res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing or DEFAULT_SPACING[a.sampler])
+        if a.eta:
+            res["sampler"]["eta"] = a.eta
     res["model"] = dict(step=model.config["step"], sha256=model.fingerprint, n=a.n, steps=a.steps,
                         classes=list(classes), precision=model.precision)
     if a.only:

@@ -124,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 10)")
     n.add_argument("--spacing", default=None,
                    help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own, see README)")
-    n.add_argument("--eta", type=float, default=0.0, help="ddim only: step noise, 0 (deterministic) .. 1 (DDPM)")
+    n.add_argument("--eta", type=float, default=0.0, help="ddim or dpmpp_2m: step noise, 0 (deterministic) .. 1 (DDPM; the SDE solver)")
     n.add_argument("--tile", type=int, default=None,
                    help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "
                         "else 512 px tiles; 0: never)")

@@ -310,23 +310,27 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
 def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600, log=print,
              sampler: str = "ddim", spacing: str | None = None, classifier_cache: str | None = None,
              size: int | None = None, clf_stages: int = 2, clf_threads: int | None = None,
-             only: tuple | None = None) -> dict:
+             only: tuple | None = None, eta: float = 0.0) -> dict:
     """The table above for an exported model (a :class:`backend.neural.model.NeuralNoiseModel`),
     sampled by ``sampler`` with ``steps`` timesteps (the same seeds for every sampler) at ``size``² px
     (default: the model's training size; two models compare only at one size, with one classifier).
     The n samples of a class are generated as one batch, each from its own seed as before.
     ``only``: rows for these of ``classes`` alone, measured by the classifier of all ``classes`` (the same
-    instrument, the same samples as a full run with this n) and without the seam and locality measures (None)."""
+    instrument, the same samples as a full run with this n) and without the seam and locality measures (None).
+    ``eta`` > 0: the sampler's stochastic form; every batch's step noise starts from one seed."""
     from backend.neural import conditioning as C
     from backend.neural.generate import generate as _generate
-    from backend.neural.sampler import initial_noise, sample as _sample
+    from backend.neural.sampler import initial_noise, sample as _sample_ode, step_noise_rng
 
     from backend.neural.sampler import DEFAULT_SPACING
 
     spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
 
     def generate(*args, **kw):
-        return _generate(*args, sampler=sampler, spacing=spacing, **kw)
+        return _generate(*args, sampler=sampler, spacing=spacing, eta=eta, **kw)
+
+    def _sample(*args, **kw):
+        return _sample_ode(*args, **kw, **(dict(eta=eta, rng=step_noise_rng(0)) if eta else {}))
 
     S = int(size or model.config["train_size"])
     clf, zoo_acc = cached_classifier(classes, S, clf_steps, classifier_cache, log=log, stages=clf_stages,

@@ -66,8 +66,8 @@ def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: flo
         raise SettingError("spacing", f"unknown spacing {spacing!r}; choose one of {', '.join(SPACINGS)}")
     if not (np.isfinite(eta) and 0.0 <= eta <= 1.0):
         raise SettingError("eta", f"must lie in [0, 1], got {eta!r}")
-    if eta and sampler != "ddim":
-        raise SettingError("eta", f"eta > 0 is a DDIM setting; {sampler} is deterministic")
+    if eta and sampler not in ("ddim", "dpmpp_2m"):
+        raise SettingError("eta", f"eta > 0 is a DDIM or DPM-Solver++(2M) setting; {sampler} is deterministic")
 
 
 def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS, tileable: bool = False,

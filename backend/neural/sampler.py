@@ -110,8 +110,18 @@ def ddim_sample(model: Callable, x_T: np.ndarray, cond: np.ndarray, steps: int =
 
 def dpmpp_2m_sample(model: Callable, x_T: np.ndarray, cond: np.ndarray, steps: int = 12, T: int = T_DEFAULT,
                     callback: Callable[[int, int, np.ndarray], None] | None = None, clip: bool = True,
-                    alphas_cumprod: np.ndarray | None = None, spacing: str = "uniform") -> np.ndarray:
-    """DPM-Solver++(2M): x_T (B, 1, H, W) -> x̂₀ float32 with ``steps`` evaluations."""
+                    alphas_cumprod: np.ndarray | None = None, spacing: str = "uniform", eta: float = 0.0,
+                    rng: np.random.Generator | None = None) -> np.ndarray:
+    """DPM-Solver++(2M): x_T (B, 1, H, W) -> x̂₀ float32 with ``steps`` evaluations.
+
+    η > 0 is the SDE form (Lu et al. 2022, "DPM-Solver++", Sec. 5; k-diffusion's ``sample_dpmpp_2m_sde``,
+    midpoint correction), written for the VP process with h = λ_s - λ_t:
+
+        x_s = (σ_s / σ_t) e^{-η h} x_t + α_s (1 - e^{-(1+η) h}) (D + (D - D_prev) / (2 r)) + σ_s √(1 - e^{-2 η h}) z
+
+    with r = h_prev / h and z ~ N(0, I) from ``rng``; η = 0 is the ODE solver exactly."""
+    if eta and rng is None:
+        raise ValueError("DPM-Solver++(2M) with eta > 0 needs an rng for its step noise")
     ab, ts = _grid(steps, T, alphas_cumprod, spacing)
     f = _Counter(model, cond, len(ts), callback)
     alpha, sigma = np.sqrt(ab), np.sqrt(1.0 - ab)
@@ -130,7 +140,11 @@ def dpmpp_2m_sample(model: Callable, x_T: np.ndarray, cond: np.ndarray, steps: i
         else:
             r = h_prev / h
             dbar = (1.0 + 0.5 / r) * d - (0.5 / r) * d_prev
-        x = ((sigma[s] / sigma[t]) * x - alpha[s] * np.expm1(-h) * dbar).astype(_F)
+        if eta:
+            x = ((sigma[s] / sigma[t]) * np.exp(-eta * h) * x - alpha[s] * np.expm1(-(1.0 + eta) * h) * dbar
+                 + sigma[s] * np.sqrt(-np.expm1(-2.0 * eta * h)) * rng.standard_normal(x.shape)).astype(_F)
+        else:
+            x = ((sigma[s] / sigma[t]) * x - alpha[s] * np.expm1(-h) * dbar).astype(_F)
         d_prev, h_prev = d, h
     return d
 

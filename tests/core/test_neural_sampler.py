@@ -34,6 +34,7 @@ def exact_x0(xT):
 
 XT = initial_noise(0, (1, 1, 4, 4))
 GOLDEN_TRUNCATED = [-0.19401, -0.47059, -0.29755, -0.29755, 0.35382, 0.64798]
+GOLDEN_SDE = [0.19192, -0.31235, -0.12665, -0.24243, 0.55771, 0.581]
 
 
 def err(name, steps, **kw):
@@ -157,8 +158,38 @@ def test_sampler_settings_are_checked_in_one_place():
     check_sampler(DEFAULT_SAMPLER, DEFAULT_STEPS)
     for args, msg in [(("euler_a", 10), "unknown sampler 'euler_a'"), (("ddim", 0), "steps"),
                       (("ddim", 2.5), "steps"), (("heun", 1), "at least 2"), (("ddim", 10, "zigzag"), "spacing"),
-                      (("ddim", 10, "uniform", float("nan")), "eta"), (("dpmpp_2m", 10, "uniform", 0.5), "DDIM setting")]:
+                      (("ddim", 10, "uniform", float("nan")), "eta"), (("heun", 10, "uniform", 0.5), "DPM-Solver")]:
         with pytest.raises(SettingError, match=msg):
             check_sampler(*args)
     with pytest.raises(ValueError, match="unknown sampler"):
         sample("euler_a", gaussian_eps, XT, None, 4)
+
+
+def test_dpmpp_2m_sde_eta_zero_is_the_ode_solver_and_eta_one_samples_the_data_distribution():
+    from backend.neural.sampler import dpmpp_2m_sample
+
+    ode = dpmpp_2m_sample(gaussian_eps, XT, None, 10, clip=False, spacing="truncated")
+    np.testing.assert_array_equal(ode, dpmpp_2m_sample(gaussian_eps, XT, None, 10, clip=False, spacing="truncated",
+                                                       eta=0.0, rng=step_noise_rng(1)))
+    a = dpmpp_2m_sample(gaussian_eps, XT, None, 10, clip=False, spacing="truncated", eta=1.0, rng=step_noise_rng(3))
+    b = dpmpp_2m_sample(gaussian_eps, XT, None, 10, clip=False, spacing="truncated", eta=1.0, rng=step_noise_rng(3))
+    np.testing.assert_array_equal(a, b)
+    assert np.abs(a - ode).max() > 1e-3
+    with pytest.raises(ValueError, match="needs an rng"):
+        dpmpp_2m_sample(gaussian_eps, XT, None, 10, eta=0.5)
+    # golden values (one fixed input and step noise), computed after the distribution check below passed
+    x = initial_noise(7, (1, 1, 2, 3))
+    got = sample("dpmpp_2m", gaussian_eps, x, None, 10, clip=False, spacing="truncated", eta=1.0,
+                 rng=step_noise_rng(5)).ravel()
+    np.testing.assert_allclose(got, GOLDEN_SDE, atol=2e-5)
+    # the SDE forgets x_T and draws from the data: N(0, s²) per pixel, shrunk by the last prediction
+    # (α₀ s² / √(α₀² s² + σ₀²) at the grid's last λ); x_T's correlation with the output falls far below the ODE's 1
+    many = initial_noise(11, (1, 1, 128, 128))
+    for steps in (10, 50):
+        out = dpmpp_2m_sample(gaussian_eps, many, None, steps, clip=False, spacing="truncated", eta=1.0,
+                              rng=step_noise_rng(2))
+        assert abs(out.std() - S_DATA) < 0.02, (steps, out.std())
+        assert abs(np.corrcoef(out.ravel(), many.ravel())[0, 1]) < 0.5
+    assert check_sampler("dpmpp_2m", 10, eta=1.0) is None
+    with pytest.raises(SettingError, match="eta"):
+        check_sampler("heun", 10, eta=0.5)
