@@ -124,7 +124,9 @@ def build_parser() -> argparse.ArgumentParser:
     n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 10)")
     n.add_argument("--spacing", default=None,
                    help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own, see README)")
-    n.add_argument("--eta", type=float, default=0.0, help="ddim or dpmpp_2m: step noise, 0 (deterministic) .. 1 (DDPM; the SDE solver)")
+    n.add_argument("--eta", type=float, default=None,
+                   help="ddim or dpmpp_2m: step noise, 0 (deterministic) .. 1 (DDPM; the SDE solver); "
+                        "default 0.3 for dpmpp_2m, 0 for ddim; animation is always 0")
     n.add_argument("--tile", type=int, default=None,
                    help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "
                         "else 512 px tiles; 0: never)")
@@ -585,7 +587,7 @@ def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile
     n = last - first + 1
     bar = _Bar(a.quiet, "frames ")
     frames = animate(model, keys, (first, last), a.size, a.size, latent=a.latent, speed=a.drift, steps=steps,
-                     sampler=sampler, spacing=a.spacing, tileable=a.tileable, tile=tile)
+                     sampler=sampler, spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=tile)
     for i, (f, img) in enumerate(frames):
         path = frame_path(a.out, f)
         if ext == ".png":

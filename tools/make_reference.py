@@ -67,7 +67,7 @@ def neural_values(folder: str) -> np.ndarray:
 
     m = NeuralNoiseModel(folder, threads=1)
     # the sampler pinned (not the default), so the values follow the weights alone
-    return generate(m, C.uniform(m, (m.classes[0], {}), 16, 16), seed=1, steps=2, sampler="dpmpp_2m",
+    return generate(m, C.uniform(m, (m.classes[0], {}), 16, 16), seed=1, steps=2, sampler="dpmpp_2m", eta=0.0,
                     spacing="logsnr")
 
 

@@ -197,6 +197,9 @@ def frame_image(model, keys: list, frame: float, H: int, W: int, latent: str = "
                 **generate_kw) -> np.ndarray:
     """One frame (any real frame number) of a keyframed sequence: float32 (H, W); the one path of
     :func:`animate` and of animated bakes (``backend.sources.NeuralSource``)."""
+    if generate_kw.get("eta"):
+        raise SettingError("--eta", "animation needs a deterministic sampler (eta = 0): step noise flickers")
+    generate_kw["eta"] = 0.0       # whatever the sampler's default: every frame follows its latent
     k = model.multiple_of
     shape = (-(-H // k) * k, -(-W // k) * k)
     return generate(model, frame_cond(model, keys, frame, H, W), x_T=frame_latent(keys, frame, shape, latent, speed),

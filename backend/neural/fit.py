@@ -179,7 +179,8 @@ class FitResult:
         class is given)."""
         name = max(self.classes, key=self.classes.get)
         flags = " ".join(f"--param {k}={v:.4g}" for k, v in self.params[name].items())
-        return f"omninoise neural --noise {name} {flags} --seed {self.seed}".replace("  ", " ")
+        # the seed was chosen on the deterministic sampler's images: the command keeps it deterministic
+        return f"omninoise neural --noise {name} {flags} --seed {self.seed} --eta 0".replace("  ", " ")
 
 
 def _physical(model, name: str, u: np.ndarray) -> dict:

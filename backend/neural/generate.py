@@ -19,7 +19,8 @@ from typing import Callable
 import numpy as np
 
 from ..errors import SettingError
-from .sampler import DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, step_noise_rng
+from .sampler import (DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample,
+                      step_noise_rng)
 from .schedule import SPACINGS, alphas_from_config
 
 __all__ = ["generate", "check_sampler", "image_eps", "auto_tile", "AUTO_WHOLE", "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES"]
@@ -54,8 +55,8 @@ def image_eps(model, cond: np.ndarray, tileable: bool, tile: int, overlap: int =
     return tiled_eps(model, cond, tile, overlap, tileable, cache), count, cache
 
 
-def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: float = 0.0) -> None:
-    """SettingError naming the first bad sampler setting (spacing None: the sampler's default)."""
+def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: float | None = 0.0) -> None:
+    """SettingError naming the first bad sampler setting (spacing and eta None: the sampler's defaults)."""
     if sampler not in SAMPLERS:
         raise SettingError("sampler", f"unknown sampler {sampler!r}; choose one of {', '.join(SAMPLERS)}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 1 <= steps <= 1000:
@@ -64,6 +65,8 @@ def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: flo
         raise SettingError("steps", "heun needs at least 2 steps")
     if spacing is not None and spacing not in SPACINGS:
         raise SettingError("spacing", f"unknown spacing {spacing!r}; choose one of {', '.join(SPACINGS)}")
+    if eta is None:
+        return
     if not (np.isfinite(eta) and 0.0 <= eta <= 1.0):
         raise SettingError("eta", f"must lie in [0, 1], got {eta!r}")
     if eta and sampler not in ("ddim", "dpmpp_2m"):
@@ -72,7 +75,7 @@ def check_sampler(sampler: str, steps: int, spacing: str | None = None, eta: flo
 
 def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS, tileable: bool = False,
              callback: Callable[[int, int, np.ndarray], None] | None = None, sampler: str = DEFAULT_SAMPLER,
-             spacing: str | None = None, eta: float = 0.0, tile: int | None = None,
+             spacing: str | None = None, eta: float | None = None, tile: int | None = None,
              overlap: int = DEFAULT_OVERLAP, x_T: np.ndarray | None = None) -> np.ndarray:
     """cond float32 (E + P, H, W) -> image float32 (H, W) in [0, 1].
 
@@ -80,7 +83,8 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
     (default: ``initial_noise(seed)``); animation passes latents that move smoothly between frames.
 
     ``steps`` timesteps of ``sampler`` (see :data:`backend.neural.sampler.SAMPLERS`) on the
-    model's own schedule (its JSON), spaced by ``spacing`` (None: the sampler's DEFAULT_SPACING);
+    model's own schedule (its JSON), spaced by ``spacing`` (None: the sampler's DEFAULT_SPACING), with step
+    noise ``eta`` (None: the sampler's DEFAULT_ETA; the noise is drawn from ``step_noise_rng(seed)``);
     callback(i, n, x̂₀) after each of the n model evaluations.
     Sides above ``tile`` px are denoised in tiles overlapping by ``overlap`` px (0: never tile;
     None: :func:`auto_tile`).
@@ -92,6 +96,7 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
         raise SettingError("conditioning", f"expected {want} channels, got {C}")
     check_sampler(sampler, steps, spacing, eta)
     spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
+    eta = DEFAULT_ETA[sampler] if eta is None else eta
     k = model.multiple_of
     if tileable and (H % k or W % k):
         raise SettingError("size", f"tileable output needs sides that are multiples of {k}, got {W}x{H}")

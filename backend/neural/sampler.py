@@ -189,6 +189,11 @@ SAMPLERS: dict = {
 #: the previous default, 15 timesteps even in log-SNR, made 13 evaluations, four of them below λ = -4.5
 DEFAULT_SAMPLER = "dpmpp_2m"
 DEFAULT_STEPS = 10
+#: the step noise η each sampler uses unless told (None in the front ends): the SDE form of DPM-Solver++(2M) with
+#: η = 0.3, chosen by measurement (README, "Sampling"): on the 64² instrument, 23 classes, the same 10 evaluations
+#: give median per-class FD 45.5 against 56.0 for the ODE (η = 0) and 76.4 for DDIM 30, and cells_distorted, which
+#: the ODE needs 30 evaluations for, comes within 20 % of DDIM 30 (n = 128); DDIM and Heun stay deterministic
+DEFAULT_ETA = {"ddim": 0.0, "dpmpp_2m": 0.3, "heun": 0.0}
 #: the timestep spacing each sampler uses unless told: the truncated λ grid for DPM-Solver++, uniform t for
 #: DDIM (the images of earlier versions) and Heun (it overshoots on λ grids' long first intervals)
 DEFAULT_SPACING = {"ddim": "uniform", "dpmpp_2m": "truncated", "heun": "uniform"}

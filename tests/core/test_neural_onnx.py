@@ -265,17 +265,21 @@ def test_animation_hits_its_keyframes_and_moves_smoothly_between_them(tiny, tmp_
     assert [k.frame for k in keys] == [1, 7] and keys[0].params == {"scale": 4.0}
     frames = dict(animate(m, keys, (0, 8), 16, 16, latent="fixed", steps=4))
     assert sorted(frames) == list(range(0, 9))
-    # keyframes: the plain image of the key's spec from the first key's seed
+    # keyframes: the plain image of the key's spec from the first key's seed, made with the deterministic
+    # sampler (animation always is; a still's default has step noise)
     np.testing.assert_array_equal(frames[1], generate(m, C.uniform(m, ("perlin", {"scale": 4.0}), 16, 16), seed=2,
-                                                       steps=4))
-    np.testing.assert_array_equal(frames[7], generate(m, C.uniform(m, ("cells_f1", {}), 16, 16), seed=2, steps=4))
+                                                       steps=4, eta=0.0))
+    np.testing.assert_array_equal(frames[7], generate(m, C.uniform(m, ("cells_f1", {}), 16, 16), seed=2, steps=4,
+                                                      eta=0.0))
+    assert np.abs(frames[1] - generate(m, C.uniform(m, ("perlin", {"scale": 4.0}), 16, 16), seed=2,
+                                       steps=4)).max() > 1e-3
     np.testing.assert_array_equal(frames[0], frames[1])  # held before the first key and after the last
     np.testing.assert_array_equal(frames[8], frames[7])
     # halfway: the conditioning is the w = 1/2 blend
     half = frame_cond(m, keys, 4, 16, 16)
     np.testing.assert_allclose(half, C.blend(m, keys[0].spec, keys[1].spec, np.full((16, 16), 0.5)), atol=1e-6)
     seq = [frames[f] for f in range(1, 8)]
-    other = generate(m, C.uniform(m, ("perlin", {"scale": 4.0}), 16, 16), seed=77, steps=4)
+    other = generate(m, C.uniform(m, ("perlin", {"scale": 4.0}), 16, 16), seed=77, steps=4, eta=0.0)
     coh = temporal_coherence(seq, float(np.abs(other - frames[1]).mean()))
     assert coh["step_over_independent"] < 0.5, coh  # far from flicker
     # latents: slerp goes from one key's seed to the other's, keeping the norm; drift circles
