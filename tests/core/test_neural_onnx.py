@@ -58,6 +58,19 @@ def test_tiled_generation(tiny):
             generate(model, cond, steps=2, tile=tile, overlap=overlap)
 
 
+def test_the_default_step_noise_is_seeded_and_shared_by_tiles(tiny):
+    """The default sampler's step noise (η = 0.3) comes from the seed: the same seed gives the same bytes, the
+    default equals an explicit η = 0.3 and differs from η = 0, and a tile covering the image is the one piece."""
+    model = NeuralNoiseModel(str(tiny))
+    cond = C.uniform(model, ("perlin", {}), 64, 64)
+    a = generate(model, cond, seed=5, steps=4)
+    np.testing.assert_array_equal(a, generate(model, cond, seed=5, steps=4))
+    np.testing.assert_array_equal(a, generate(model, cond, seed=5, steps=4, eta=0.3))
+    np.testing.assert_array_equal(a, generate(model, cond, seed=5, steps=4, tile=64, overlap=16))
+    assert np.abs(a - generate(model, cond, seed=5, steps=4, eta=0.0)).max() > 1e-3
+    assert np.abs(a - generate(model, cond, seed=6, steps=4)).max() > 1e-3
+
+
 def test_tileable_sampling_wraps(tiny):
     out = tiny
     model = NeuralNoiseModel(str(out))

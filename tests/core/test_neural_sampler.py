@@ -193,3 +193,14 @@ def test_dpmpp_2m_sde_eta_zero_is_the_ode_solver_and_eta_one_samples_the_data_di
     assert check_sampler("dpmpp_2m", 10, eta=1.0) is None
     with pytest.raises(SettingError, match="eta"):
         check_sampler("heun", 10, eta=0.5)
+
+
+def test_requests_name_the_step_noise_they_are_made_with():
+    from backend.neural.request import NeuralRequest
+    from backend.neural.sampler import DEFAULT_ETA
+
+    assert DEFAULT_ETA == {"ddim": 0.0, "dpmpp_2m": 0.3, "heun": 0.0} and set(DEFAULT_ETA) == set(SAMPLERS)
+    r = NeuralRequest("uniform", [("perlin", {})], 16, 16)
+    assert r.eta is None and r.key()["eta"] == 0.3
+    assert NeuralRequest("uniform", [("perlin", {})], 16, 16, sampler="ddim").key()["eta"] == 0.0
+    assert NeuralRequest("uniform", [("perlin", {})], 16, 16, eta=0.0).key()["eta"] == 0.0
