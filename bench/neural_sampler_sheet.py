@@ -1,8 +1,9 @@
-"""Side-by-side sheet of two samplers on the same seeds: `python bench/neural_sampler_sheet.py OUT.png`.
+"""Side-by-side sheet of samplers on the same seeds: `python bench/neural_sampler_sheet.py OUT.png [--size S]`.
 
-Each row is one conditioning (a class at its default parameters, or a mask, four-corner or painted blend);
-the left image is DDIM with 30 steps (the sampler before DPM-Solver++), the right one the runtime's default
-sampler and step count, from the same x_T.  Writes OUT.png and OUT.json (settings and seconds).
+Each row is one conditioning (a class at its default parameters, or a mask, four-corner or painted blend).
+Columns, all from the same x_T: DDIM with 30 steps (the sampler before DPM-Solver++); the runtime's default
+sampler and step count without step noise (η = 0); the runtime's default (its DEFAULT_ETA).  Writes OUT.png and
+OUT.json (settings and seconds).
 """
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ sys.path.insert(0, ROOT)
 from backend.neural import conditioning as C  # noqa: E402
 from backend.neural.generate import generate  # noqa: E402
 from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS  # noqa: E402
+from backend.neural.sampler import DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, write_png  # noqa: E402
 
@@ -51,24 +52,24 @@ def main() -> int:
     a = ap.parse_args()
     model = NeuralNoiseModel(a.model, threads=a.threads)
     S, gap = a.size, 4
-    rows, times, labels = [], {"ddim": 0.0, DEFAULT_SAMPLER: 0.0}, []
+    columns = (("ddim 30", dict(steps=30, sampler="ddim")),
+               (f"{DEFAULT_SAMPLER} {DEFAULT_STEPS} eta 0", dict(eta=0.0)),
+               (f"{DEFAULT_SAMPLER} {DEFAULT_STEPS} eta {DEFAULT_ETA[DEFAULT_SAMPLER]:g} (default)", {}))
+    rows, times, labels = [], {c: 0.0 for c, _ in columns}, []
     for i, (label, cond) in enumerate(conditions(model, S)):
         labels.append(label)
-        t0 = time.perf_counter()
-        ref = generate(model, cond, seed=100 + i, steps=30, sampler="ddim")
-        t1 = time.perf_counter()
-        new = generate(model, cond, seed=100 + i)
-        times["ddim"] += t1 - t0
-        times[DEFAULT_SAMPLER] += time.perf_counter() - t1
-        rows.append(np.concatenate([ref, np.ones((S, gap), np.float32), new], 1))
+        row = []
+        for name, kw in columns:
+            t0 = time.perf_counter()
+            row += [generate(model, cond, seed=100 + i, **kw), np.ones((S, gap), np.float32)]
+            times[name] += time.perf_counter() - t0
+        rows.append(np.concatenate(row[:-1], 1))
     sheet = np.concatenate([np.concatenate([r, np.ones((gap, r.shape[1]), np.float32)]) for r in rows])[:-gap]
     write_png(a.out, preview_8bit(sheet, 0.0, 1.0))
     write_json(os.path.splitext(a.out)[0] + ".json", dict(
-        rows=labels, size=S, left="ddim 30",
-        right=f"{DEFAULT_SAMPLER} {DEFAULT_STEPS} {DEFAULT_SPACING[DEFAULT_SAMPLER]}",
+        rows=labels, size=S, columns=[c for c, _ in columns], spacing=DEFAULT_SPACING[DEFAULT_SAMPLER],
         seconds={k: round(v, 1) for k, v in times.items()}, model=model.fingerprint))
-    print(f"{a.out}: left DDIM 30 ({times['ddim']:.0f} s), right {DEFAULT_SAMPLER} {DEFAULT_STEPS} "
-          f"({times[DEFAULT_SAMPLER]:.0f} s)")
+    print(f"{a.out}: " + ", ".join(f"{k} ({v:.0f} s)" for k, v in times.items()))
     return 0
 
 

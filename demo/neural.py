@@ -23,7 +23,7 @@ from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, write_png  # noqa: E402
 
-STEPS = DEFAULT_STEPS  # the runtime's default sampler (DPM-Solver++(2M), log-SNR spacing) and step count
+STEPS = DEFAULT_STEPS  # the runtime's default sampler (DPM-Solver++(2M), truncated grid, step noise 0.3) and step count
 PER_ROW = 8  # tiles per row of the sheet; the classes wrap onto as many rows as they need
 
 
