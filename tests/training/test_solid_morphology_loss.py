@@ -1,13 +1,14 @@
 """The arrangement features and the soft level-set morphology term of the solid-texture loss (issue 20)."""
 import numpy as np
 import pytest
-import torch
 
-from training.solid.arrangement import ArrangementFeatures, gaussianise, luminance
-from training.solid.morphology import morphology_distance
-from training.solid.photo_eval import voronoi_pavement
-from training.solid.soft_morphology import soft_curves, soft_functionals, soft_morphology_loss
-from training.solid.train import SolidConfig, texture_loss
+torch = pytest.importorskip("torch")
+
+from training.solid.arrangement import ArrangementFeatures, gaussianise, luminance  # noqa: E402
+from training.solid.morphology import morphology_distance  # noqa: E402
+from training.solid.photo_eval import voronoi_pavement  # noqa: E402
+from training.solid.soft_morphology import soft_curves, soft_functionals, soft_morphology_loss  # noqa: E402
+from training.solid.train import SolidConfig, loss_features, texture_loss  # noqa: E402
 
 torch.set_num_threads(2)
 
@@ -103,7 +104,6 @@ def test_config_weight_enters_the_training_loss_and_bad_weights_are_refused():
     img, ref = _t(_speckle(64, rng)), _t(voronoi_pavement(64, 12, rng))
     base = dict(mode="single", exemplars=["gravel"], loss="swd", swd_width=4, swd_levels=3)
     off, on = SolidConfig.from_dict(base), SolidConfig.from_dict({**base, "morphology_weight": 0.5})
-    from training.solid.train import loss_features
     feats = loss_features(off)
     l0 = texture_loss(off, feats, img, ref, torch.Generator().manual_seed(0)).item()
     l1 = texture_loss(on, feats, img, ref, torch.Generator().manual_seed(0)).item()
