@@ -35,7 +35,7 @@ import torch  # noqa: E402
 
 from backend.solid.model import SolidTextureModel  # noqa: E402
 from export.atomic import write_json  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
+from training.solid import exemplars as ex, photo_eval as pe  # noqa: E402
 from training.solid.arrangement import ArrangementFeatures  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
 from training.solid.soft_morphology import soft_morphology_loss  # noqa: E402
@@ -46,13 +46,6 @@ SIZE = 128
 DEFAULT = ("train/paving__alpine_arctic_paving_stones_01.jpg", "val/paving__sahara_paving_stones_01.jpg",
            "val/brick__beige_bricks.jpg", "val/rock__alpine_cliff_b.jpg",
            "val/gravel__temp_dirt_gravel_plants.jpg")
-
-
-def read(path: str) -> np.ndarray:
-    from PIL import Image
-
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"), np.float32) / 255.0
 
 
 def crops(photo: np.ndarray, n: int, rng: np.random.Generator) -> list:
@@ -112,7 +105,7 @@ def main(argv=None) -> int:
     table = {}
     for name in a.photos:
         path = name if os.path.isfile(name) else os.path.join(ROOT, "data", "photos", name)
-        photo = read(path)
+        photo = ex.load_image(path).permute(1, 2, 0).numpy()
         rng = np.random.default_rng(0)
         rows = {k: score(photo, ims, cfg, feats, arr, a.draws, rng)
                 for k, ims in candidates(photo, model, a.cell, rng).items()}

@@ -320,7 +320,7 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
     ``eta`` > 0: the sampler's stochastic form; every batch's step noise starts from one seed."""
     from backend.neural import conditioning as C
     from backend.neural.generate import generate as _generate
-    from backend.neural.sampler import initial_noise, sample as _sample_ode, step_noise_rng
+    from backend.neural.sampler import initial_noise, sample as _run_sampler, step_noise_rng
 
     from backend.neural.sampler import DEFAULT_SPACING
 
@@ -329,8 +329,8 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
     def generate(*args, **kw):
         return _generate(*args, sampler=sampler, spacing=spacing, eta=eta, **kw)
 
-    def _sample(*args, **kw):
-        return _sample_ode(*args, **kw, **(dict(eta=eta, rng=step_noise_rng(0)) if eta else {}))
+    def _sample(*args, **kw):  # the sampler, with its step noise seeded when eta > 0
+        return _run_sampler(*args, **kw, **(dict(eta=eta, rng=step_noise_rng(0)) if eta else {}))
 
     S = int(size or model.config["train_size"])
     clf, zoo_acc = cached_classifier(classes, S, clf_steps, classifier_cache, log=log, stages=clf_stages,

@@ -179,8 +179,6 @@ def animate(model, keys: list, frames: tuple, H: int, W: int, latent: str = "fix
     first, last = int(frames[0]), int(frames[1])
     if last < first:
         raise SettingError("--frames", f"expected FIRST LAST with LAST >= FIRST, got {first} {last}")
-    if generate_kw.get("eta"):
-        raise SettingError("--eta", "animation needs a deterministic sampler (eta = 0): step noise flickers")
     for k in keys:
         model.param_vector(*k.spec)  # unknown classes or parameters fail before the first frame
     if latent == "drift" and not np.isfinite(speed):

@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import SettingError
-from .sampler import (DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample,
+from .sampler import (DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, sampler_eta,
                       step_noise_rng)
 from .schedule import SPACINGS, alphas_from_config
 
@@ -96,7 +96,7 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
         raise SettingError("conditioning", f"expected {want} channels, got {C}")
     check_sampler(sampler, steps, spacing, eta)
     spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
-    eta = DEFAULT_ETA[sampler] if eta is None else eta
+    eta = sampler_eta(sampler, eta)
     k = model.multiple_of
     if tileable and (H % k or W % k):
         raise SettingError("size", f"tileable output needs sides that are multiples of {k}, got {W}x{H}")

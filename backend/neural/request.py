@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import SettingError
 from . import conditioning as C
-from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 
 __all__ = ["LAYOUTS", "NeuralRequest", "generate_request", "regions_from_colours", "region_key", "regions_from_map"]
 
@@ -122,17 +122,11 @@ class NeuralRequest:
         present = sorted(int(i) for i in np.unique(self.regions))
         return C.painted(model, self.regions, {i: self.specs[i] for i in present}, self.transition, self.sharpness)
 
-    def resolved_eta(self) -> float:
-        """The step noise the request is generated with (None: the sampler's default)."""
-        from .sampler import DEFAULT_ETA
-
-        return DEFAULT_ETA.get(self.sampler, 0.0) if self.eta is None else self.eta
-
     def key(self) -> dict:
         """A JSON summary: every setting, maps by sha256 (equal keys: equal images)."""
         d = dict(layout=self.layout, specs=[[n, dict(sorted(p.items()))] for n, p in self.specs], width=self.width,
                  height=self.height, seed=self.seed, steps=self.steps, sampler=self.sampler, spacing=self.spacing,
-                 eta=self.resolved_eta(), tileable=self.tileable)
+                 eta=sampler_eta(self.sampler, self.eta), tileable=self.tileable)
         if self.layout in ("blend", "painted"):
             d.update(transition=self.transition, sharpness=self.sharpness)
             arr = self.mask if self.layout == "blend" else self.regions

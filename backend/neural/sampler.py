@@ -35,8 +35,8 @@ import numpy as np
 
 from .schedule import T_DEFAULT, cosine_alphas_cumprod, timesteps
 
-__all__ = ["SAMPLERS", "DEFAULT_SAMPLER", "DEFAULT_STEPS", "DEFAULT_SPACING", "evaluations", "sample", "ddim_step",
-           "ddim_sample", "dpmpp_2m_sample", "heun_sample", "initial_noise"]
+__all__ = ["SAMPLERS", "DEFAULT_SAMPLER", "DEFAULT_STEPS", "DEFAULT_SPACING", "DEFAULT_ETA", "sampler_eta", "evaluations",
+           "sample", "ddim_step", "ddim_sample", "dpmpp_2m_sample", "heun_sample", "initial_noise"]
 
 _F = np.float32
 
@@ -194,6 +194,14 @@ DEFAULT_STEPS = 10
 #: give median per-class FD 45.5 against 56.0 for the ODE (η = 0) and 76.4 for DDIM 30, and cells_distorted, which
 #: the ODE needs 30 evaluations for, comes within 20 % of DDIM 30 (n = 128); DDIM and Heun stay deterministic
 DEFAULT_ETA = {"ddim": 0.0, "dpmpp_2m": 0.3, "heun": 0.0}
+
+
+def sampler_eta(sampler: str, eta: float | None) -> float:
+    """The step noise ``sampler`` runs with: ``eta``, or with None the sampler's DEFAULT_ETA (0 for a name that
+    is not a sampler: :func:`backend.neural.generate.check_sampler` refuses those)."""
+    return DEFAULT_ETA.get(sampler, 0.0) if eta is None else eta
+
+
 #: the timestep spacing each sampler uses unless told: the truncated λ grid for DPM-Solver++, uniform t for
 #: DDIM (the images of earlier versions) and Heun (it overshoots on λ grids' long first intervals)
 DEFAULT_SPACING = {"ddim": "uniform", "dpmpp_2m": "truncated", "heun": "uniform"}
