@@ -89,7 +89,50 @@ class _Denoiser(torch.nn.Module):
         self.net, self.mode = net, mode
 
     def forward(self, x, t, *maps):
-        return self.net.denoise(x, t, [tuple(maps[i:i + 2]) for i in range(0, len(maps), 2)], self.mode)
+        # the folded form (GroupNorm affine and time modulation per channel, strided downsampling: see
+        # training.unet): the same function in fewer passes over the feature maps
+        return self.net.denoise(x, t, [tuple(maps[i:i + 2]) for i in range(0, len(maps), 2)], self.mode, fold=True)
+
+
+def drop_identity_arithmetic(path: str) -> int:
+    """Remove from the ONNX graph at ``path`` every Mul by a constant 1 and Add of a constant 0 that cannot change
+    its other operand's shape (a one-element constant of no higher rank): the TorchScript exporter writes such a
+    pair after every affine-free instance norm, two passes over a feature map that do nothing.  Returns how many."""
+    import onnx
+    from onnx import numpy_helper
+
+    from backend._export import export
+
+    model = onnx.load(path)
+    graph = model.graph
+    rank = {v.name: len(v.type.tensor_type.shape.dim)
+            for v in list(onnx.shape_inference.infer_shapes(model).graph.value_info) + list(graph.input)}
+    const = {n.output[0]: numpy_helper.to_array(n.attribute[0].t) for n in graph.node
+             if n.op_type == "Constant" and n.attribute and n.attribute[0].name == "value"}
+    const.update({i.name: numpy_helper.to_array(i) for i in graph.initializer})
+    outputs = {o.name for o in graph.output}
+    neutral = {"Mul": 1.0, "Add": 0.0}
+    rename, keep = {}, []
+    for node in graph.node:
+        node.input[:] = [rename.get(i, i) for i in node.input]
+        if node.op_type in neutral and node.output[0] not in outputs and len(node.input) == 2:
+            for c, other in (node.input, node.input[::-1]):
+                v = const.get(c)
+                if (v is not None and v.size == 1 and float(v.reshape(())) == neutral[node.op_type]
+                        and v.ndim <= rank.get(other, -1)):
+                    rename[node.output[0]] = other
+                    break
+            else:
+                keep.append(node)
+            continue
+        keep.append(node)
+    used = {i for n in keep for i in n.input} | outputs
+    keep = [n for n in keep if n.op_type != "Constant" or n.output[0] in used]
+    del graph.node[:]
+    graph.node.extend(keep)
+    with export.atomic_path(path) as tmp:
+        onnx.save(model, tmp)
+    return len(rename)
 
 
 def share_weights(folder: str, graphs: list, weights: str) -> None:
@@ -149,6 +192,7 @@ def _export_split(model, out: str, size: int) -> dict:
     for name, mode in (("denoiser.onnx", None), ("denoiser_tile.onnx", "circular")):
         onnx_export(_Denoiser(model, mode), args, os.path.join(out, name), ["x", "t"] + tensors, ["eps"],
                     {"x": hw, "t": {0: "batch"}, "eps": hw, **map_axes})
+        drop_identity_arithmetic(os.path.join(out, name))
     share_weights(out, ["denoiser.onnx", "denoiser_tile.onnx"], "denoiser.weights")
     return dict(names=names, tensors=tensors, channels=[int(m.shape[1]) for m in maps],
                 levels=[lvl for _, lvl in model.blocks()])

@@ -24,6 +24,13 @@ forward pass is two functions (one code path for training and both exports):
 
 A sampler runs ``encode`` once per image and ``denoise`` at every step.
 
+``denoise(..., fold=True)`` is the same function in fewer full-resolution operations, for the exported
+denoiser (issue 21): GroupNorm's affine (w, b) and the time modulation fold into one scale and shift per
+channel, h = norm(conv(x)) * w(1 + γ₁) + (b(1 + γ₁) + β₁), computed on (B, C) vectors instead of four passes
+over the feature map; and each downsampling (pixel unshuffle, then a 1x1 convolution of the 4C channels) is
+the 2x2 stride-2 convolution with the same weights, K[o, c, i, j] = W[o, 4c + 2i + j], without the unshuffle's
+transpose.  Only the rounding differs.
+
 ``deep`` > 0 adds a deep branch at the bottleneck, between its two ResBlocks: ``deep`` further levels
 (downsample, two ResBlocks, upsample) whose output is added to the bottleneck through a zero-initialised
 convolution.  It doubles the network's reach per level (long-range structure: damascus bands, fibre runs)
@@ -99,9 +106,26 @@ class SPADE(nn.Module):
         return h * g1 + b
 
 
+class Downsample(nn.Sequential):
+    """Pixel unshuffle by 2, then a 1x1 convolution (4C -> C); folded (see the module doc), one 2x2 stride-2 convolution."""
+
+    def __init__(self, c: int):
+        super().__init__(nn.PixelUnshuffle(2), nn.Conv2d(4 * c, c, 1))
+        self.fold = False
+
+    def forward(self, x):
+        if not self.fold:
+            return super().forward(x)
+        conv = self[1]
+        # PixelUnshuffle's channel 4c + 2i + j holds pixel (2y + i, 2x + j) of channel c
+        k = conv.weight.reshape(conv.out_channels, conv.in_channels // 4, 2, 2)
+        return F.conv2d(x, k, conv.bias, stride=2)
+
+
 class ResBlock(nn.Module):
     def __init__(self, cin: int, cout: int, tdim: int = 128, groups: int = 8):
         super().__init__()
+        self.fold = False  # see the module doc: set by UNet.denoise(fold=True)
         self.conv1 = Conv3(cin, cout)
         self.norm1 = nn.GroupNorm(groups, cout)
         self.time = nn.Linear(tdim, 2 * cout)
@@ -113,7 +137,14 @@ class ResBlock(nn.Module):
     def forward(self, x, temb, maps):
         """block 1: conv -> GroupNorm -> x(1+γ₁)+β₁ (time) -> x(1+γ₂)+β₂ (SPADE maps) -> SiLU; block 2 plain."""
         g, b = self.time(F.silu(temb)).chunk(2, dim=1)
-        h = self.norm1(self.conv1(x)) * (1.0 + g[:, :, None, None]) + b[:, :, None, None]
+        if self.fold:  # GroupNorm's affine and the time modulation as one (B, C) scale and shift
+            n = self.norm1
+            scale, shift = n.weight * (1.0 + g), n.bias * (1.0 + g) + b
+            # no affine: the export's drop_identity_arithmetic removes the multiply by ones and add of zeros
+            # that the exporter writes for it
+            h = F.group_norm(self.conv1(x), n.num_groups, eps=n.eps) * scale[:, :, None, None] + shift[:, :, None, None]
+        else:
+            h = self.norm1(self.conv1(x)) * (1.0 + g[:, :, None, None]) + b[:, :, None, None]
         h = F.silu(SPADE.apply(h, maps))
         h = F.silu(self.norm2(self.conv2(h)))
         return h + self.skip(x)
@@ -126,7 +157,7 @@ class DeepBranch(nn.Module):
     def __init__(self, c: int, depth: int):
         super().__init__()
         self.depth = depth
-        self.down = nn.Sequential(nn.PixelUnshuffle(2), nn.Conv2d(4 * c, c, 1))
+        self.down = Downsample(c)
         self.res = nn.ModuleList([ResBlock(c, c), ResBlock(c, c)])
         self.inner = DeepBranch(c, depth - 1) if depth > 1 else None
         self.out = Conv3(c, c)
@@ -172,7 +203,7 @@ class UNet(nn.Module):
             self.down.append(blocks)
             skips.append(cw)
             c = cw
-            self.downsample.append(nn.Sequential(nn.PixelUnshuffle(2), nn.Conv2d(4 * c, c, 1)))
+            self.downsample.append(Downsample(c))
         self.mid = nn.ModuleList([ResBlock(c, c), ResBlock(c, c)])
         #: the deep branch's levels (nested DeepBranch modules), or None
         self.deep = DeepBranch(c, deep) if deep > 0 else None
@@ -224,9 +255,12 @@ class UNet(nn.Module):
                 levels[lvl] = feat if lvl == 0 else F.interpolate(feat, size=(H >> lvl, W >> lvl), mode="nearest")
         return [blk.spade.maps(levels[lvl]) for blk, lvl in self.blocks()]
 
-    def denoise(self, x, t, maps, tile=None):
-        """ε from x (B, 1, H, W), t (B,) and :meth:`encode`'s maps."""
+    def denoise(self, x, t, maps, tile=None, fold: bool = False):
+        """ε from x (B, 1, H, W), t (B,) and :meth:`encode`'s maps; ``fold`` the export's form (module doc)."""
         self._set_tile(tile, x)
+        for m in self.modules():
+            if isinstance(m, (ResBlock, Downsample)):
+                m.fold = fold
         maps = iter(maps)
         temb = self.temb(t)
         h = self.init(x)

@@ -9,6 +9,8 @@ export (the zoo is append-only, see :mod:`.zoo`):
 - GroupNorm affines, which the exporter stores as anonymous ``onnx::Mul_N`` /
   ``onnx::Add_N`` initialisers, are named by their node's scope
   (``/down.0.0/norm1/Mul`` -> ``down.0.0.norm1.weight``);
+- a folded export's 2x2 stride-2 downsampling kernels (see :mod:`.unet`) go back to the 1x1
+  convolution over unshuffled channels they were made from;
 - the class embedding comes from the JSON's ``class_embedding`` table;
 - a grown class table keeps its fresh N(0, 1) rows (the spherical prior of
   Sec. 3.1.1) for the new classes; a grown parameter vector gets zero input
@@ -42,11 +44,16 @@ def _graph_weights(path: str) -> dict:
     affine = {"Mul": "weight", "Add": "bias"}
     for node in graph.node:
         scope, _, op = node.name.rpartition("/")
+        name = scope.strip("/").removeprefix("net/").replace("/", ".")
+        anon = [i for i in node.input if i in inits and i.startswith("onnx::")]
         if op in affine and "/norm" in scope:
-            anon = [i for i in node.input if i in inits and i.startswith("onnx::")]
             if len(anon) == 1:
-                name = scope.strip("/").removeprefix("net/").replace("/", ".")
                 out[name + "." + affine[op]] = inits[anon[0]].reshape(-1)
+        elif node.op_type == "Conv" and len(anon) == 1 and inits[anon[0]].shape[2:] == (2, 2):
+            # a folded downsampling (training.unet.Downsample): the 2x2 stride-2 kernel is the 1x1
+            # convolution's weight over the unshuffled channels, K[o, c, i, j] = W[o, 4c + 2i + j]
+            k = inits[anon[0]]
+            out[name + ".1.weight"] = k.reshape(k.shape[0], -1, 1, 1)
     return out
 
 

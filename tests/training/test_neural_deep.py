@@ -85,3 +85,28 @@ def test_config_checks_size_against_depth():
     with pytest.raises(ValueError, match="deep must be"):
         TrainConfig.from_dict(dict(TINY, deep=-1))
     assert UNet(3, 2, widths=(8, 16, 16), deep=2).levels() == 5
+
+
+@pytest.mark.parametrize("deep", [0, 1])
+def test_the_exports_folded_denoiser_is_the_same_function(exported, deep):
+    """denoise(fold=True) (per-channel scale and shift, strided downsampling: the exported form) equals the
+    training form within float rounding, plain and circular, with and without a deep branch whose weights
+    are nonzero; and a training pass after it runs the unfolded form again."""
+    _, out = exported
+    m = _deep_from(out, deep) if deep else torch_from_export(str(out))
+    torch.manual_seed(3)
+    with torch.no_grad():
+        for p in m.parameters():  # GroupNorm affines away from (1, 0), a live deep branch
+            p.add_(0.05 * torch.randn_like(p))
+    rng = np.random.default_rng(2)
+    side = 1 << m.levels()
+    x = torch.from_numpy(rng.standard_normal((2, 1, 2 * side, 3 * side)).astype(np.float32))
+    t = torch.tensor([5.0, 800.0])
+    cond = torch.from_numpy(rng.standard_normal((2, m.emb_dim + m.n_params, 2 * side, 3 * side)).astype(np.float32))
+    with torch.no_grad():
+        for tile in (None, "circular"):
+            maps = m.encode(cond, tile)
+            plain = m.denoise(x, t, maps, tile)
+            folded = m.denoise(x, t, maps, tile, fold=True)
+            assert (plain - folded).abs().max() < 1e-5 and plain.abs().max() > 0.1
+            assert torch.equal(m.denoise(x, t, maps, tile), plain)  # fold is per call, not sticky

@@ -361,3 +361,56 @@ def test_denoiser_graph_does_no_per_step_copies(exported):
         nodes = onnx.load(str(out / path), load_external_data=False).graph.node
         assert not [n.name for n in nodes if n.op_type == "Slice" and n.input[0] in doc["tensors"]]
         assert sum(n.op_type == "Slice" for n in nodes) >= 2  # the check above looks at real Slice nodes
+
+
+def test_exported_denoiser_is_folded(exported):
+    """The per-step graphs are the folded form (training.unet): no transpose of a pixel unshuffle, and no
+    multiply by one or add of zero (what the exporter writes for a norm without an affine); torch rebuilt from
+    the export has the unfolded 1x1 downsampling weights back."""
+    import onnx
+    from onnx import numpy_helper
+
+    _, out = exported
+    for path in ("denoiser.onnx", "denoiser_tile.onnx"):
+        g = onnx.load(str(out / path), load_external_data=False).graph
+        ops = [n.op_type for n in g.node]
+        assert "Transpose" not in ops and ops.count("Conv") >= 3
+        consts = {n.output[0]: numpy_helper.to_array(n.attribute[0].t) for n in g.node if n.op_type == "Constant"}
+        for n in g.node:
+            if n.op_type in ("Mul", "Add"):
+                for i in n.input:
+                    v = consts.get(i)
+                    assert v is None or v.size != 1 or float(v.reshape(())) != (n.op_type == "Mul"), n.name
+    from training.warm_start import torch_from_export
+
+    m = torch_from_export(str(out))
+    assert tuple(m.downsample[0][1].weight.shape[2:]) == (1, 1)
+
+
+def test_drop_identity_arithmetic_keeps_what_changes_values_or_shapes(tmp_path):
+    """Mul by 1 and Add of 0 go; a multiply by 2 stays, and so does a multiply by a one of higher rank
+    than the other operand (it broadcasts the shape up); the function is unchanged."""
+    import onnx
+    import onnxruntime as ort
+    from onnx import TensorProto, helper
+
+    from training.export_onnx import drop_identity_arithmetic
+
+    def const(name, value, shape):
+        return helper.make_node("Constant", [], [name], value=helper.make_tensor(name + "_v", TensorProto.FLOAT, shape,
+                                                                                [value] * int(np.prod(shape))))
+    nodes = [const("one", 1.0, [1, 1, 1]), const("zero", 0.0, [1]), const("two", 2.0, [1]),
+             const("one5", 1.0, [1, 1, 1, 1, 1]),
+             helper.make_node("Mul", ["x", "one"], ["a"]), helper.make_node("Add", ["zero", "a"], ["b"]),
+             helper.make_node("Mul", ["b", "two"], ["c"]), helper.make_node("Mul", ["c", "one5"], ["y"])]
+    graph = helper.make_graph(nodes, "g", [helper.make_tensor_value_info("x", TensorProto.FLOAT, [1, 2, 3, 4])],
+                              [helper.make_tensor_value_info("y", TensorProto.FLOAT, None)])
+    path = str(tmp_path / "g.onnx")
+    onnx.save(helper.make_model(graph, opset_imports=[helper.make_opsetid("", 17)], ir_version=8), path)
+    x = np.random.default_rng(0).standard_normal((1, 2, 3, 4)).astype(np.float32)
+    before = ort.InferenceSession(path, providers=["CPUExecutionProvider"]).run(None, {"x": x})[0]
+    assert drop_identity_arithmetic(path) == 2
+    ops = [n.op_type for n in onnx.load(path).graph.node]
+    assert ops.count("Mul") == 2 and "Add" not in ops and ops.count("Constant") == 2
+    after = ort.InferenceSession(path, providers=["CPUExecutionProvider"]).run(None, {"x": x})[0]
+    assert after.shape == before.shape == (1, 1, 2, 3, 4) and np.array_equal(after, before)
