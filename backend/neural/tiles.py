@@ -83,7 +83,9 @@ def tiled_eps(model, cond: np.ndarray, tile: int, overlap: int, wrap: bool, cach
             edges = (H > th,) * 2 + (W > tw,) * 2
         else:
             edges = (y0 > 0, y0 + th < H, x0 > 0, x0 + tw < W)
-        sub = np.ascontiguousarray(cond[:, :, ys][:, :, :, xs])
+        # with kept maps a tile keeps its conditioning too (the maps are cached by the array's identity, and take
+        # 12x its bytes); without, it is cut out again at each step, so no copy of the grid stays per tile
+        sub = np.ascontiguousarray(cond[:, :, ys][:, :, :, xs]) if cache_maps else None
         tiles.append((ys, xs, feather(th, tw, overlap, edges), sub, model.eps_fn(False) if cache_maps else None))
     norm = np.zeros((H, W), _F)
     for ys, xs, w, _, _ in tiles:  # a tile is at most the image: its indices are distinct, so += is safe
@@ -93,7 +95,8 @@ def tiled_eps(model, cond: np.ndarray, tile: int, overlap: int, wrap: bool, cach
         out = np.zeros_like(x, dtype=_F)
         for ys, xs, w, sub, fn in tiles:
             f = fn if fn is not None else model.eps_fn(False)
-            e = f(np.ascontiguousarray(x[:, :, ys][:, :, :, xs]), t, sub)
+            c = sub if sub is not None else np.ascontiguousarray(cond[:, :, ys][:, :, :, xs])
+            e = f(np.ascontiguousarray(x[:, :, ys][:, :, :, xs]), t, c)
             out[:, :, ys[:, None], xs[None, :]] += w * e
         return out / norm
 
