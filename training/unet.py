@@ -125,7 +125,7 @@ class Downsample(nn.Sequential):
 class ResBlock(nn.Module):
     def __init__(self, cin: int, cout: int, tdim: int = 128, groups: int = 8):
         super().__init__()
-        self.fold = False  # see the module doc: set by UNet.denoise(fold=True)
+        self.fold = False  # see the module doc: set for each pass by UNet._set_pass
         self.conv1 = Conv3(cin, cout)
         self.norm1 = nn.GroupNorm(groups, cout)
         self.time = nn.Linear(tdim, 2 * cout)
@@ -235,18 +235,21 @@ class UNet(nn.Module):
         """Downsamplings from the input to the deepest block: H and W must be multiples of 2^levels."""
         return len(self.widths) + (self.deep.depth if self.deep is not None else 0)
 
-    def _set_tile(self, tile, like) -> None:
-        """Every Conv3's padding for this pass: zeros (tile None or 0) or circular (1 or ``circular``); the
-        string "circular" pads circularly without the zero branch (the export's tileable-only graph)."""
+    def _set_pass(self, tile, like, fold: bool = False) -> None:
+        """Set up this pass, in one walk over the modules: every Conv3's padding, zeros (tile None or 0) or
+        circular (1 or ``circular``; the string "circular" pads circularly without the zero branch: the export's
+        tileable-only graph); and whether ResBlocks and downsamplings run folded (module doc)."""
         if tile is None and self.circular:
             tile = torch.ones(1, device=like.device)
         for m in self.modules():
             if isinstance(m, Conv3):
                 m.tile = tile if tile is None or isinstance(tile, str) else tile.reshape(()).to(like.dtype)
+            elif isinstance(m, (ResBlock, Downsample)):
+                m.fold = fold
 
     def encode(self, cond, tile=None) -> list:
         """cond (B, E + P, H, W) -> [maps of each ResBlock in :meth:`blocks` order] (see SPADE.maps)."""
-        self._set_tile(tile, cond)
+        self._set_pass(tile, cond)
         feat = self.cond_mlp(cond)
         H, W = cond.shape[-2:]
         levels = {}
@@ -257,10 +260,7 @@ class UNet(nn.Module):
 
     def denoise(self, x, t, maps, tile=None, fold: bool = False):
         """ε from x (B, 1, H, W), t (B,) and :meth:`encode`'s maps; ``fold`` the export's form (module doc)."""
-        self._set_tile(tile, x)
-        for m in self.modules():
-            if isinstance(m, (ResBlock, Downsample)):
-                m.fold = fold
+        self._set_pass(tile, x, fold)
         maps = iter(maps)
         temb = self.temb(t)
         h = self.init(x)

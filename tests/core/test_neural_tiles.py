@@ -36,7 +36,6 @@ def test_automatic_tiling():
     assert auto_tile(AUTO_WHOLE, AUTO_WHOLE) == 0 and auto_tile(AUTO_WHOLE + 8, 64) == AUTO_TILE
 
 
-
 def _peak_of_tiled_image(side: int, tile: int) -> int:
     """Peak resident bytes of a process that makes one side x side image in tiles (one evaluation of the shipped
     model, the tiles' encoder maps not kept: MAP_CACHE_BYTES 0), and checks the image."""
