@@ -19,7 +19,7 @@ from torch.utils.data import DataLoader, IterableDataset, get_worker_info
 from . import zoo
 from .cutmix import cutmix_sources
 
-__all__ = ["batch_at", "worker_batches"]
+__all__ = ["batch_at", "worker_batches", "worker_loader"]
 
 
 def batch_at(cfg, k: int) -> tuple:
@@ -54,7 +54,22 @@ def _one_thread(_):
         pass
 
 
+# Seconds the loop waits for the next batch before it stops with an error instead of waiting for ever.  A 128²
+# batch of 64 took the H200 machine's training loop 0.58 s in all; a worker that makes nothing for 2 minutes is stuck.
+BATCH_TIMEOUT_S = 120
+
+
 def worker_batches(cfg, start: int, end: int, pin: bool = False):
-    """An iterator over batches ``start`` .. ``end - 1`` made by ``cfg.workers`` processes."""
-    return iter(DataLoader(_Stream(cfg, start, end), batch_size=None, num_workers=cfg.workers,
-                           worker_init_fn=_one_thread, prefetch_factor=4, pin_memory=pin))
+    """An iterator over batches ``start`` .. ``end - 1`` made by ``cfg.workers`` processes.
+
+    The workers are *spawned*, not forked.  On a lent H200 forked workers deadlocked before their first batch (0 % CPU,
+    each stopped inside a torch op of the zoo): the training process had already started CUDA's and torch's threads,
+    and a fork copies their held locks but not the threads that would release them.  A spawned worker starts a fresh
+    interpreter and imports what it needs (a few seconds, once per run)."""
+    return iter(worker_loader(cfg, start, end, pin))
+
+
+def worker_loader(cfg, start: int, end: int, pin: bool = False) -> DataLoader:
+    """The loader behind :func:`worker_batches`."""
+    return DataLoader(_Stream(cfg, start, end), batch_size=None, num_workers=cfg.workers, worker_init_fn=_one_thread,
+                      prefetch_factor=4, pin_memory=pin, multiprocessing_context="spawn", timeout=BATCH_TIMEOUT_S)

@@ -307,7 +307,7 @@ def test_a_run_that_keeps_diverging_stops_and_keeps_its_last_checkpoint(monkeypa
 def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically(tmp_path):
     """workers > 0 (a GPU that outruns one core's zoo): batch k comes from default_rng([seed, k]) in a worker
     process, so one worker or two give the same batches in the same order, and a stopped run resumes exactly."""
-    from training.batches import batch_at, worker_batches
+    from training.batches import batch_at, worker_batches, worker_loader
 
     cfg = TrainConfig.from_dict(dict(TINY, steps=4, workers=2))
     one = TrainConfig.from_dict(dict(TINY, steps=4, workers=1))
@@ -316,9 +316,28 @@ def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically
         for u, v, w in zip(x, y, batch_at(cfg, k + 1)):
             assert torch.equal(u, v) and torch.equal(u, w)
     assert not torch.equal(a[0][0], a[1][0])
+    # spawned, not forked (forked workers deadlocked on a lent H200), and a stuck worker ends the run with an error
+    loader = worker_loader(cfg, 0, 1)
+    assert loader.multiprocessing_context.get_start_method() == "spawn" and 0 < loader.timeout <= 600
     _stopped_and_resumed_equals_uninterrupted(cfg, tmp_path)
     with pytest.raises(ValueError, match="workers must be an integer >= 0"):
         TrainConfig.from_dict(dict(TINY, workers=-1))
+
+
+def test_a_stuck_data_worker_ends_the_run_with_a_one_line_error(monkeypatch, tmp_path):
+    """The loader's timeout turns a worker that makes nothing (a lent GPU's lease running out on a hang) into an
+    error naming the workers and the way out, with nothing written as if it had trained."""
+    from training import train as T
+
+    def stuck(cfg, start, end, pin=False):
+        raise RuntimeError(f"DataLoader timed out after {T.BATCH_TIMEOUT_S} seconds")
+        yield  # a generator, as the real one
+
+    monkeypatch.setattr(T, "worker_batches", stuck)
+    cfg = TrainConfig.from_dict(dict(TINY, steps=2, workers=2))
+    with pytest.raises(RuntimeError, match=r"data workers made no batch in \d+ s at step 1 \(workers=2\); set workers to 0"):
+        T.train(cfg, str(tmp_path / "r"), log=lambda s: None)
+    assert not (tmp_path / "r" / "ckpt.pt").exists()
 
 
 def test_mirrors_contradict_oriented_conditioning_so_training_does_not_mirror(monkeypatch, tmp_path):
