@@ -191,16 +191,19 @@ def main(argv=None) -> int:
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
     ap.add_argument("--limit", type=int, default=0, help="only every k-th photo so that about N are evaluated")
     ap.add_argument("--seeds", type=int, default=2)
+    ap.add_argument("--split", default="val", choices=("val", "train"),
+                    help="val (default): the held-out photos every reported figure uses; train: the photos the "
+                         "model was trained on, to tell overfitting from a loss that leads away from the photos")
     ap.add_argument("--sheet", help="write a picture of (up to 8) photos and their textures")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_photos.json"))
     a = ap.parse_args(argv)
     model = SolidTextureModel(a.model)
-    files = photos()
+    files = photos(a.split)
     if a.limit:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     sheet = [] if a.sheet else None
     rows = evaluate(model, files, a.seeds, sheet)
-    doc = dict(model=a.model, model_sha=model.config["files"], size=SIZE, seeds=a.seeds, summary=summary(rows),
+    doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds, summary=summary(rows),
                by_category=by_category(rows), photos=rows)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)

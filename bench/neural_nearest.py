@@ -54,6 +54,8 @@ def main() -> int:
     ap.add_argument("--n", type=int, default=2, help="generated images per class")
     ap.add_argument("--zoo-n", type=int, default=8, help="zoo images per class (two halves)")
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--floor", type=float, default=0.0,
+                    help="count spectrum bands under this share of the power as equal (training.evaluate.look)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_nearest.json"))
     a = ap.parse_args()
     from training import zoo
@@ -70,13 +72,13 @@ def main() -> int:
     else:
         classes = list(zoo.CLASS_NAMES)
     halves = zoo_halves(classes, a.size, a.zoo_n)
-    refs = {c: look(h[1]) for c, h in halves.items()}
+    refs = {c: look(h[1], a.floor) for c, h in halves.items()}
     scale = look_scales(refs)
-    report = dict(size=a.size, n=a.n, zoo_n=a.zoo_n, scale=dict(spectrum=scale[0], histogram=scale[1]),
+    report = dict(size=a.size, n=a.n, zoo_n=a.zoo_n, floor=a.floor, scale=dict(spectrum=scale[0], histogram=scale[1]),
                   zoo={}, models={})
     dups = {}
     for c in classes:
-        ranked = nearest_looks(look(halves[c][0]), refs, scale)
+        ranked = nearest_looks(look(halves[c][0], a.floor), refs, scale)
         own = dict(ranked)[c]
         dups[c] = [(o, d) for o, d in ranked if o != c and d <= own]
         other = next((o, d) for o, d in ranked if o != c)
@@ -91,7 +93,7 @@ def main() -> int:
         rows, t0 = {}, time.perf_counter()
         for c in classes:
             imgs = np.stack([generate(m, C.uniform(m, (c, {}), a.size, a.size), seed=11 + i) for i in range(a.n)])
-            ranked = nearest_looks(look(imgs), refs, scale)
+            ranked = nearest_looks(look(imgs, a.floor), refs, scale)
             ok = {c} | {o for o, _ in dups[c]}
             rows[c] = dict(nearest=[[o, round(d, 3)] for o, d in ranked[:3]], own=round(dict(ranked)[c], 3),
                            passes=ranked[0][0] in ok)

@@ -164,17 +164,21 @@ def orientation_coherence(imgs: np.ndarray) -> np.ndarray:
 LOOK_BINS, LOOK_QUANTILES = 24, 32
 
 
-def look(imgs: np.ndarray) -> dict:
+def look(imgs: np.ndarray, floor: float = 0.0) -> dict:
     """What a set of images (n, S, S) in [0, 1] looks like, for :func:`look_distance`: the shape of its
     radially averaged power spectrum (log10 of the power in LOOK_BINS log-spaced bands from 1 to S/2 cycles
     per image, normalised to total power 1, so contrast is left to the histogram) and its value histogram
-    (LOOK_QUANTILES quantiles of all pixels)."""
+    (LOOK_QUANTILES quantiles of all pixels).
+
+    ``floor`` > 0 raises every band's share to at least ``floor`` before the log: bands holding less of the power
+    than that (1e-4: an amplitude under 1 % of the image's standard deviation) then count as equal, whereas on the
+    plain log scale a band at 1e-7 and one at 1e-5 of the power differ as much as 10 % and 0.1 %."""
     x = np.asarray(imgs, np.float64)
     p = radial_psd(x)
     k = np.arange(1, len(p) + 1)
     edges = np.geomspace(1, len(p) + 1, LOOK_BINS + 1)
     band = np.array([p[(k >= lo) & (k < hi)].sum() for lo, hi in zip(edges[:-1], edges[1:])])
-    spec = np.log10(band / max(band.sum(), 1e-20) + 1e-12)
+    spec = np.log10(np.maximum(band / max(band.sum(), 1e-20), floor) + 1e-12)
     q = np.quantile(x, (np.arange(LOOK_QUANTILES) + 0.5) / LOOK_QUANTILES)
     return dict(spectrum=spec, histogram=q)
 

@@ -105,6 +105,15 @@ def test_look_tells_spectra_and_histograms_apart_and_finds_the_nearest_class():
     np.testing.assert_allclose(dimmer["spectrum"], refs["white"]["spectrum"], atol=1e-9)
     assert np.abs(dimmer["histogram"] - refs["white"]["histogram"]).mean() > 0.05
 
+    # a faint grain (1e-3 amplitude, about 4e-5 of the blobs' power in the top bands) moves the plain log spectrum
+    # a lot and the floored one not at all; a real change of shape (blobs against white) moves both
+    b = kind("blobs", 4, 1)
+    grain = b + 1e-3 * np.random.default_rng(3).standard_normal(b.shape)
+    plain = np.abs(look(grain)["spectrum"] - look(b)["spectrum"]).max()
+    floored = np.abs(look(grain, 1e-4)["spectrum"] - look(b, 1e-4)["spectrum"]).max()
+    assert plain > 1.0 and floored < 0.05, (plain, floored)
+    assert np.abs(look(w, 1e-4)["spectrum"] - look(b, 1e-4)["spectrum"]).mean() > 0.3
+
 
 def test_known_params_keeps_what_the_model_was_trained_with():
     """An export made before fibers gained 'orientation' is evaluated without it (it draws its own); a model
