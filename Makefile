@@ -38,9 +38,9 @@ test: $(STAMP) $(VENV)/.train kernel
 	$(BIN)/python -m pytest -q
 
 # The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS and 4.5 LTS
-# (Python 3.11) and 5.2 (Python 3.13; Blender 5.1+ runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
+# (Python 3.11), 5.1 and 5.2 (Python 3.13; Blender 5.1+ runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
 PY313 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.13*/bin/python3.13) $(shell command -v python3.13))
-BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy52
+BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy51 .venv-bpy52
 .venv-bpy42/.installed: requirements-blender.txt
 	$(PY) -m venv .venv-bpy42
 	.venv-bpy42/bin/python -m pip install -q bpy==4.2.23 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
@@ -48,6 +48,11 @@ BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy52
 .venv-bpy45/.installed: requirements-blender.txt
 	$(PY) -m venv .venv-bpy45
 	.venv-bpy45/bin/python -m pip install -q bpy==4.5.15 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
+	@touch $@
+.venv-bpy51/.installed: requirements-blender.txt
+	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.1 (set PY313=...)"; exit 2; }
+	$(PY313) -m venv .venv-bpy51
+	.venv-bpy51/bin/python -m pip install -q bpy==5.1.2 -r requirements-blender.txt
 	@touch $@
 .venv-bpy52/.installed: requirements-blender.txt
 	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.2 (set PY313=...)"; exit 2; }
