@@ -3,6 +3,9 @@
 # then write the EMA weights (two halves, each under the 16 MiB a returned file may have), the log and the config
 # into OUT_DIR. Locally: tools/gpu_export.py turns them back into a run folder that training.export_onnx reads.
 #   tools/gpu_stage.sh CONFIG SECONDS OUT_DIR [PYTHON]
+# With EVAL_CLF=DIR (a carried classifier cache, runs/clf) the stage is also exported and evaluated there on every
+# core, by the model card's instrument command (6000-step classifier, 64², 32 per class, the default sampler), into
+# OUT_DIR/eval.json, so one call brings back an evaluated candidate.
 set -u
 cfg=$1; secs=$2; out=$3; py=${4:-python3}
 export PYTHONUNBUFFERED=1
@@ -32,3 +35,11 @@ json.dump(dict(step=st["step"], config=st["config"]), open(os.path.join(out, "st
 shutil.copy(os.path.join(run, "log.jsonl"), os.path.join(out, "log.jsonl"))
 print("saved step", st["step"], sorted(os.listdir(out)))
 PY
+if [ -n "${EVAL_CLF:-}" ]; then
+    exp=$(mktemp -d)
+    $py tools/gpu_export.py "$out" "$exp/run" && $py -m training.export_onnx "$exp/run" "$exp/model" > "$out/export.log" 2>&1 \
+      && $py bench/eval_neural.py --model "$exp/model" --eval-size 64 --clf-stages 3 --clf-steps 6000 --clf-threads 2 \
+           --n "${EVAL_N:-32}" --threads "$(nproc)" --classifier-cache "$EVAL_CLF" --sampler dpmpp_2m --steps 10 --spacing truncated \
+           --eta 0.3 --no-timing -o "$out/eval.json" > "$out/eval.log" 2>&1
+    tail -3 "$out/eval.log"
+fi
