@@ -203,8 +203,8 @@ def main(argv=None) -> int:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     sheet = [] if a.sheet else None
     rows = evaluate(model, files, a.seeds, sheet)
-    doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds, summary=summary(rows),
-               by_category=by_category(rows), photos=rows)
+    doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
+               summary=summary(rows), by_category=by_category(rows), photos=rows)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
     if sheet:

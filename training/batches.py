@@ -65,8 +65,18 @@ def worker_batches(cfg, start: int, end: int, pin: bool = False):
     The workers are *spawned*, not forked.  On a lent H200 forked workers deadlocked before their first batch (0 % CPU,
     each stopped inside a torch op of the zoo): the training process had already started CUDA's and torch's threads,
     and a fork copies their held locks but not the threads that would release them.  A spawned worker starts a fresh
-    interpreter and imports what it needs (a few seconds, once per run)."""
-    return iter(worker_loader(cfg, start, end, pin))
+    interpreter and imports what it needs (a few seconds, once per run).  A batch that does not come within
+    :data:`BATCH_TIMEOUT_S` ends the iteration with a one-line RuntimeError naming the step and the way out."""
+    k = start
+    try:
+        for item in worker_loader(cfg, start, end, pin):
+            yield item
+            k += 1
+    except RuntimeError as e:
+        if "timed out" not in str(e):  # DataLoader's own words for its timeout
+            raise
+        raise RuntimeError(f"data workers made no batch in {BATCH_TIMEOUT_S} s at step {k + 1} "
+                           f"(workers={cfg.workers}); set workers to 0 to make batches in the loop") from e
 
 
 def worker_loader(cfg, start: int, end: int, pin: bool = False) -> DataLoader:

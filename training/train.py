@@ -26,7 +26,7 @@ import numpy as np
 import torch
 
 from . import zoo
-from .batches import BATCH_TIMEOUT_S, worker_batches
+from .batches import worker_batches
 from .cutmix import cutmix_sources, mix_by_sources
 from .diffusion import Diffusion
 from .config import TrainConfig, check_config_keys, load_config  # noqa: F401  (re-exported)
@@ -161,13 +161,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
     batches = worker_batches(cfg, step, end, pin=device.type == "cuda") if cfg.workers else None
     while step < end:
         if batches is not None:  # made ahead by worker processes, batch k from its own generator (.batches)
-            try:
-                imgs, ids, conds, src = next(batches)
-            except RuntimeError as e:
-                if "timed out" not in str(e):
-                    raise
-                raise RuntimeError(f"data workers made no batch in {BATCH_TIMEOUT_S} s at step {step + 1} "
-                                   f"(workers={cfg.workers}); set workers to 0 to make batches in the loop") from e
+            imgs, ids, conds, src = next(batches)
             src = src.to(device, non_blocking=True)
         else:
             imgs, ids, conds = sampler.batch(cfg.batch)

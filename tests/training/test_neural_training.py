@@ -327,15 +327,16 @@ def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically
 def test_a_stuck_data_worker_ends_the_run_with_a_one_line_error(monkeypatch, tmp_path):
     """The loader's timeout turns a worker that makes nothing (a lent GPU's lease running out on a hang) into an
     error naming the workers and the way out, with nothing written as if it had trained."""
+    from training import batches as B
     from training import train as T
 
-    def stuck(cfg, start, end, pin=False):
-        raise RuntimeError(f"DataLoader timed out after {T.BATCH_TIMEOUT_S} seconds")
-        yield  # a generator, as the real one
+    def stuck(cfg, start, end, pin=False):  # what DataLoader raises when no batch comes within its timeout
+        raise RuntimeError(f"DataLoader timed out after {B.BATCH_TIMEOUT_S} seconds")
 
-    monkeypatch.setattr(T, "worker_batches", stuck)
+    monkeypatch.setattr(B, "worker_loader", stuck)
     cfg = TrainConfig.from_dict(dict(TINY, steps=2, workers=2))
-    with pytest.raises(RuntimeError, match=r"data workers made no batch in \d+ s at step 1 \(workers=2\); set workers to 0"):
+    with pytest.raises(RuntimeError,
+                       match=r"data workers made no batch in \d+ s at step 1 \(workers=2\); set workers to 0"):
         T.train(cfg, str(tmp_path / "r"), log=lambda s: None)
     assert not (tmp_path / "r" / "ckpt.pt").exists()
 
