@@ -25,6 +25,12 @@ __all__ = ["Cancelled", "evaluate_grid", "evaluate_box", "grid_shape", "evaluate
 
 _F = np.float32
 ProgressFn = Callable[[float], None]
+#: samples per slab (progress and cancel are checked between slabs) where points are evaluated in numpy or numba:
+#: bounds the (rows, row, dim) coordinate temporaries
+POINT_CHUNK = 1 << 18
+#: samples per slab where the compiled row kernel fills rows in place (grid_plan): about 25 ms of work on two
+#: cores, so progress stays smooth while each slab's thread start and tail (about 1 ms) stay small beside it
+PLAN_CHUNK = 1 << 20
 
 
 class Cancelled(RuntimeError):
@@ -46,12 +52,13 @@ def evaluate_points(noise, x: np.ndarray, output: str, time: float = 0.0, cellul
 def evaluate_grid(noise: WaveNoise | CellularNoise, size: int, extent: float, output: str = "real",
                   time: float = 0.0, cellular: str = "none", out: np.ndarray | None = None,
                   progress: ProgressFn | None = None, cancel: Callable[[], bool] | None = None,
-                  chunk: int = 1 << 18, origin: tuple | None = None) -> np.ndarray:
+                  chunk: int | None = None, origin: tuple | None = None) -> np.ndarray:
     """Evaluate on an N^d grid (d = min(dim, 3)) -> float32 array of :func:`grid_shape`.
 
     time     animation time (2D+t, 3D+t) or the W coordinate (4D)
     progress called with the finished fraction after each slab
     cancel   polled between slabs; returning True raises :class:`Cancelled`
+    chunk    samples per slab (None: :data:`PLAN_CHUNK` on the row kernel, else :data:`POINT_CHUNK`)
     """
     dim = noise.dim
     if size < 1:
@@ -69,7 +76,7 @@ def evaluate_grid(noise: WaveNoise | CellularNoise, size: int, extent: float, ou
 def evaluate_box(noise: WaveNoise | CellularNoise, shape: tuple, lo, step, output: str = "real",
                  time: float = 0.0, cellular: str = "none", out: np.ndarray | None = None,
                  progress: ProgressFn | None = None, cancel: Callable[[], bool] | None = None,
-                 chunk: int = 1 << 18, start: tuple | None = None) -> np.ndarray:
+                 chunk: int | None = None, start: tuple | None = None) -> np.ndarray:
     """Evaluate on a box grid -> float32 array of ``shape``.
 
     shape  (ny, nx) or (nz, ny, nx); rank <= min(noise.dim, 3)
@@ -102,7 +109,6 @@ def evaluate_box(noise: WaveNoise | CellularNoise, shape: tuple, lo, step, outpu
     axes = [np.arange(first[a], first[a] + shape[rank - 1 - a], dtype=_F) * _F(steps[a]) for a in range(rank)]
     row = shape[-1]
     rows_total = int(np.prod(shape[:-1]))
-    rows_per = max(1, chunk // row)
     flat = out.reshape(rows_total, row)
     plan = None
     if isinstance(noise, WaveNoise) and output in OUTPUTS:
@@ -110,6 +116,9 @@ def evaluate_box(noise: WaveNoise | CellularNoise, shape: tuple, lo, step, outpu
         for a in range(rank):
             hi[a] += axes[a][-1]
         plan = fast.grid_plan(noise, base, hi, time)
+    if chunk is None:
+        chunk = PLAN_CHUNK if plan is not None else POINT_CHUNK
+    rows_per = max(1, chunk // row)
     for r0 in range(0, rows_total, rows_per):
         if cancel is not None and cancel():
             raise Cancelled("cancelled")

@@ -75,13 +75,8 @@ def _slice_records(noise, lo: np.ndarray, hi: np.ndarray):
     span = int(np.max(np.floor(pmax) - nmin)) + 3
     if span > MAX_RECORDS:
         return None
-    K, D = sd.shape
-    slpos = np.empty((K, span), _F)
-    omega = np.empty((K, span, D), _F)
-    zeta = np.empty((K, span), _F)
-    for k in range(K):
-        m = (nmin[k] + np.arange(span, dtype=_F)).astype(_F) + _F(0.0)
-        slpos[k], omega[k], zeta[k] = noise.slice_records(k, m)
+    m = (nmin[:, None] + np.arange(span, dtype=_F)).astype(_F) + _F(0.0)
+    slpos, omega, zeta = noise.strata_records(m)
     return nmin, slpos, omega, zeta
 
 

@@ -146,6 +146,29 @@ class WaveNoise:
         omega = map_directions(u, self.dirs.domains[self.dirs.domain[k]])
         return slpos, omega, zeta
 
+    def strata_records(self, m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`slice_records` of every stratum at once: slice ids m float32 (K, M), row k for stratum k ->
+        border positions (K, M), directions (K, M, D), offsets zeta (K, M); the same values, one hash per
+        array instead of one per stratum (a grid's plan hashes all its slices here)."""
+        m = np.asarray(m, _F)
+        K = self.dirs.count
+        kk = np.arange(K, dtype=_F)[:, None]
+        s = self.seed
+        a, b = _F(STREAM["slice_a"]), _F(STREAM["slice_b"])
+        zeta = white_color4(kk, m, a, s, 0)
+        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * border_fraction(zeta)
+        jit = [white_color4(kk, m, a, s, 1 + c) for c in range(min(self.dim - 1, 2))]
+        if self.dim == 4:
+            jit.append(white_color4(kk, m, b, s, 0))
+        u = np.stack(jit, -1)
+        u = self.dirs.lo[:, None, :] + (self.dirs.hi - self.dirs.lo)[:, None, :] * u
+        omega = np.empty(m.shape + (self.dim,), _F)
+        for d, dom in enumerate(self.dirs.domains):
+            ks = np.flatnonzero(self.dirs.domain == d)
+            if len(ks):
+                omega[ks] = map_directions(u[ks].reshape(-1, self.dim - 1), dom).reshape(len(ks), m.shape[1], -1)
+        return slpos, omega, zeta
+
     def _lookup(self, values: np.ndarray, omega: np.ndarray, coord: np.ndarray) -> np.ndarray:
         mode = self.table.mode
         if mode == "single":

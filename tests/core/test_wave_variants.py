@@ -190,3 +190,30 @@ def test_cancel_stops_evaluation():
 
     with pytest.raises(Cancelled):
         evaluate_grid(noise, 256, 4.0, chunk=256, cancel=cancel)
+
+
+def _by_example_3d():
+    ex = img(WaveSettings(dim=2, spectrum=Spectrum("bandpass", 6, 10), directions=16, seed=9), size=64)
+    return WaveSettings(dim=3, directions=12, seed=10, example=ex, example_extent=4.0, example_plane="xz")
+
+
+@pytest.mark.parametrize("make", [
+    lambda: WaveSettings(dim=2, directions=16, seed=3),
+    lambda: WaveSettings(dim=3, directions=16, seed=4),
+    lambda: WaveSettings(dim=4, directions=9, seed=5),
+    lambda: WaveSettings(dim=3, directions=8, seed=6, speed=0.7),
+    lambda: WaveSettings(dim=3, directions=10, seed=7, anisotropy="lobes",
+                         lobes=(((1.0, 0.0, 0.0), 1.0), ((0.0, 0.6, 0.8), 0.5)), spread=15.0),
+    _by_example_3d,
+], ids=["2d", "3d", "4d", "3d+t", "3d-lobes", "3d-by-example"])
+def test_strata_records_equal_per_stratum_records(make):
+    """A grid plan hashes every stratum's slices in one call (strata_records): the same bits as
+    slice_records stratum by stratum, for every kind of direction domain."""
+    noise = compile_noise(make())
+    K = noise.dirs.count
+    m = (np.float32(-7.0) + np.arange(40, dtype=np.float32))[None, :] + np.arange(K, dtype=np.float32)[:, None] * 3
+    m = m.astype(np.float32)
+    slpos, omega, zeta = noise.strata_records(m)
+    for k in range(K):
+        s, o, z = noise.slice_records(k, m[k])
+        assert np.array_equal(slpos[k], s) and np.array_equal(omega[k], o) and np.array_equal(zeta[k], z), k
