@@ -133,14 +133,7 @@ class WaveNoise:
         which are independent of zeta's coarse value (2^20 levels) and cost two math nodes
         instead of a second hash.  4D reads jitter 2 from B = White Noise (k, m, b, seed).
         """
-        kk, s = _F(k), self.seed
-        a, b = _F(STREAM["slice_a"]), _F(STREAM["slice_b"])
-        zeta = white_color4(kk, m, a, s, 0)
-        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * border_fraction(zeta)
-        jit = [white_color4(kk, m, a, s, 1 + c) for c in range(min(self.dim - 1, 2))]
-        if self.dim == 4:
-            jit.append(white_color4(kk, m, b, s, 0))
-        u = np.stack(jit, 1)
+        slpos, zeta, u = self._slice_hashes(_F(k), m)
         lo, hi = self.dirs.lo[k], self.dirs.hi[k]
         u = lo + (hi - lo) * u
         omega = map_directions(u, self.dirs.domains[self.dirs.domain[k]])
@@ -151,16 +144,7 @@ class WaveNoise:
         border positions (K, M), directions (K, M, D), offsets zeta (K, M); the same values, one hash per
         array instead of one per stratum (a grid's plan hashes all its slices here)."""
         m = np.asarray(m, _F)
-        K = self.dirs.count
-        kk = np.arange(K, dtype=_F)[:, None]
-        s = self.seed
-        a, b = _F(STREAM["slice_a"]), _F(STREAM["slice_b"])
-        zeta = white_color4(kk, m, a, s, 0)
-        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * border_fraction(zeta)
-        jit = [white_color4(kk, m, a, s, 1 + c) for c in range(min(self.dim - 1, 2))]
-        if self.dim == 4:
-            jit.append(white_color4(kk, m, b, s, 0))
-        u = np.stack(jit, -1)
+        slpos, zeta, u = self._slice_hashes(np.arange(self.dirs.count, dtype=_F)[:, None], m)
         u = self.dirs.lo[:, None, :] + (self.dirs.hi - self.dirs.lo)[:, None, :] * u
         omega = np.empty(m.shape + (self.dim,), _F)
         for d, dom in enumerate(self.dirs.domains):
@@ -168,6 +152,18 @@ class WaveNoise:
             if len(ks):
                 omega[ks] = map_directions(u[ks].reshape(-1, self.dim - 1), dom).reshape(len(ks), m.shape[1], -1)
         return slpos, omega, zeta
+
+    def _slice_hashes(self, kk, m):
+        """Border positions, offsets zeta and direction jitters (..., D - 1) in [0, 1) of slices m of strata kk
+        (float32, broadcast together)."""
+        s = self.seed
+        a, b = _F(STREAM["slice_a"]), _F(STREAM["slice_b"])
+        zeta = white_color4(kk, m, a, s, 0)
+        slpos = _F(SLPOS_MIN) + _F(SLPOS_RANGE) * border_fraction(zeta)
+        jit = [white_color4(kk, m, a, s, 1 + c) for c in range(min(self.dim - 1, 2))]
+        if self.dim == 4:
+            jit.append(white_color4(kk, m, b, s, 0))
+        return slpos, zeta, np.stack(jit, -1)
 
     def _lookup(self, values: np.ndarray, omega: np.ndarray, coord: np.ndarray) -> np.ndarray:
         mode = self.table.mode
