@@ -7,7 +7,8 @@ evaluated through bpy Geometry Nodes.  Prints ratios wave / fastest peer.
 The "wave 16 floor" rows (bench/lookup_floor.c, compiled with cc) are idealised
 hand-vectorised AVX2 rows, not an engine: "pure" does one table lerp per
 direction per sample and nothing else, a lower bound for any exact kernel;
-"blend" does the border ramp's two lerps and weights everywhere.
+"blend" does the border ramp's two lerps and weights everywhere; each the faster
+of its two table-read forms (register windows or gathers), as the engine picks.
 "wave 16 dirs, numba kernel" is the same engine with the C row kernel switched off.
 Then streams a 512^3 grid and reports peak memory against the output's size.
 
@@ -217,6 +218,11 @@ def main():
             if fl:
                 print(f"  wave 16 dirs / floor ({kind}): {ns['wave 16 dirs'] / fl:.2f}x")
         results[f"{dim}D_{n}"] = ns
+    if ckernel.available():
+        print(f"\nC kernel table reads: {ckernel.fetch_mode()} (the faster form on this CPU, timed by the first grid)")
+        results["fetch_mode"] = ckernel.fetch_mode()
+    if floor:
+        results["floor"] = floor
     if not a.quick:
         m = peak_memory_512()
         print(f"\n512^3 grid, 8 dirs: output {m['output_mib']:.0f} MiB, process peak {m['peak_mib']:.0f} MiB "

@@ -8,6 +8,12 @@ long slices and on CPUs without AVX2, within 2e-6 on short slices (see rows.c; t
 GIL, so rows are split across Python threads.
 
 Arrays are those of :class:`backend.wavenoise.fast.GridPlan`; see ``rows.c`` for shapes.
+
+Table reads in the AVX2 loops come in two forms that read the same texels (so give the same bits): "window"
+(two vector loads and a permute where eight texels lie within 16, else a gather) and "gather" (always a
+gather).  Which is faster depends on the CPU: gathers are cheap on Intel's Sapphire Rapids and dear on CPUs
+whose microcode slows them.  The first large call of a process times both on its own first rows (rows it had to
+compute anyway) and keeps the faster (:func:`fetch_mode`); OMNINOISE_FETCH=window|gather sets it instead.
 """
 from __future__ import annotations
 
@@ -15,10 +21,11 @@ import ctypes
 import os
 import sys
 import threading
+import time
 
 import numpy as np
 
-__all__ = ["local_path", "library_path", "available", "set_enabled", "vector", "padded", "rows"]
+__all__ = ["local_path", "library_path", "available", "set_enabled", "vector", "fetch_mode", "padded", "rows"]
 
 _F = np.float32
 ABI = 1
@@ -27,6 +34,12 @@ PAD = 16
 _SUFFIX = {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
 _lib = None
 _enabled = not os.environ.get("OMNINOISE_NO_CKERNEL")
+#: omni_rows' vector argument per table-read form
+FETCH_MODES = {"window": 1, "gather": 2}
+#: the form this process uses: from OMNINOISE_FETCH, else None until the first large call has timed both
+_fetch = os.environ.get("OMNINOISE_FETCH") or None
+#: a call times both forms when it has at least this many samples (and 16 rows), on its first quarter
+CALIBRATE_SAMPLES = 1 << 16
 
 
 def local_path() -> str:
@@ -87,6 +100,14 @@ def vector() -> bool:
     return bool(lib is not None and lib.omni_vector())
 
 
+def fetch_mode() -> str | None:
+    """The table-read form the AVX2 loops use in this process ("window" or "gather"), or None while no call has
+    been large enough to time them.  OMNINOISE_FETCH with another value is an error, named here."""
+    if _fetch is not None and _fetch not in FETCH_MODES:
+        raise ValueError(f"OMNINOISE_FETCH must be one of {', '.join(FETCH_MODES)}, got {_fetch!r}")
+    return _fetch
+
+
 def padded(table: np.ndarray) -> tuple:
     """float32 (N + 2, 2) padded table (fast._padded_table) -> tre, tim, dre, dim: float32 (N + 2 + PAD)
     values and forward differences T[i + 1] - T[i] (float32, as the reference computes them)."""
@@ -132,20 +153,26 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
     S = slpos.shape[1]
     N = len(tables[0]) - 2 - PAD
     im = _ptr(out_im) if out_im is not None else None
-    vec = int(bool(use_vector) and lib.omni_vector())
+    vec = bool(use_vector) and lib.omni_vector()
     args = (_ptr(sdirs), _ptr(soffs), _ptr(amps), K, D, _ptr(nmin), _ptr(slpos), _ptr(omega), _ptr(zeta), S,
-            *[_ptr(t) for t in tables], N, _F(inv_period), _F(shift), int(out_im is not None), vec)
+            *[_ptr(t) for t in tables], N, _F(inv_period), _F(shift), int(out_im is not None))
 
-    def run(r0, r1):
-        lib.omni_rows(_ptr(xs), Nx, _ptr(others), r0, r1, *args, _ptr(out_re), im)
+    def run(r0, r1, mode=None):
+        m = FETCH_MODES[mode or fetch_mode() or "window"] if vec else 0  # undecided (a small call): windows
+        lib.omni_rows(_ptr(xs), Nx, _ptr(others), r0, r1, *args, m, _ptr(out_re), im)
 
-    n = max(1, min(_threads(), R))
+    first = 0
+    if vec and fetch_mode() is None and R >= 16 and R * Nx >= CALIBRATE_SAMPLES:
+        first = _calibrate(run, R)
+    n = max(1, min(_threads(), R - first))
+    if first == R:
+        return
     if n == 1:
-        return run(0, R)
+        return run(first, R)
     # more pieces than threads, so a thread that got cheap rows takes another.  The calling thread works too,
     # beside n - 1 helpers that live for this call only (none outlives a bake; starting one takes about 0.3 ms)
-    pieces = min(R, 4 * n)
-    bounds = [R * i // pieces for i in range(pieces + 1)]
+    pieces = min(R - first, 4 * n)
+    bounds = [first + (R - first) * i // pieces for i in range(pieces + 1)]
     todo = iter([(a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a])
     lock, errors = threading.Lock(), []
 
@@ -168,3 +195,19 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
         h.join()
     if errors:
         raise errors[0]
+
+
+def _calibrate(run, R: int) -> int:
+    """Time both table-read forms on the call's first rows (computed for real, one thread), keep the faster for
+    this process; returns how many rows are done.  Each form does two pieces of about 1/16 of the rows,
+    interleaved, and its faster piece counts."""
+    global _fetch
+    step = max(1, R // 16)
+    best, row = {}, 0
+    for mode in ("window", "gather", "window", "gather"):
+        t = time.perf_counter()
+        run(row, row + step, mode)
+        best[mode] = min(best.get(mode, float("inf")), time.perf_counter() - t)
+        row += step
+    _fetch = min(best, key=best.get)
+    return row

@@ -18,10 +18,11 @@
  *                               (3D grids).  Texel coordinates as the reference; fused multiply-adds
  *                               in the weights and sums: within 1e-6 of it.
  *
- * Table reads, which numba leaves scalar: the eight texels of one read usually lie within 16
- * consecutive texels (the texel step per sample is small on a grid), so they come from two vector
- * loads and a permute, elsewhere from a gather.  A lerp reads the value T[i] and the forward difference
- * D[i] = T[i+1] - T[i] (the reference computes that difference in float32 too: same bits).
+ * Table reads, which numba leaves scalar, in one of two ways (the same texels, so the same bits; the
+ * caller picks the faster on its CPU, see ckernel.py): "window", where the eight texels of one read lie
+ * within 16 consecutive texels (usually: the texel step per sample is small on a grid) two vector loads
+ * and a permute, elsewhere a gather; or "gather", an AVX2 gather always.  A lerp reads the value T[i] and
+ * the forward difference D[i] = T[i+1] - T[i] (the reference computes that difference in float32 too).
  *
  * Arrays (all C-contiguous, float32 unless said):
  *   xs (Nx) ascending uniform row coordinates; others (R, D-1) the row's other coordinates;
@@ -65,7 +66,7 @@ typedef struct {
   float *out_re, *out_im;
   int64_t Nx, K, D, S;
   float fN, inv_N, inv_period, shift;
-  int want_imag, vector;
+  int want_imag, vector, gather;
 } job_t;
 
 static inline void slice_affine(const job_t *J, int64_t k, int64_t r, int64_t ri, float *a, float *b);
@@ -136,16 +137,21 @@ AVX2 static inline __m256 cos_half_pi8(__m256 s) {
   return _mm256_fmadd_ps(x2, p, _mm256_set1_ps(1.0f));
 }
 
-/* Eight texels: from two loads and a permute where the lanes' texels lie within 16 consecutive ones
- * (the texel step per sample is small on a grid), else a gather. */
+/* Eight texels: with ``gather`` 0, from two loads and a permute where the lanes' texels lie within 16
+ * consecutive ones (the texel step per sample is small on a grid), else a gather; with ``gather`` 1 a
+ * gather always (faster on CPUs with fast gathers, such as Intel's Sapphire Rapids). */
 typedef struct { __m256i i, rel; __m256 hi; int base, win; } texels8;
 
-AVX2 static inline texels8 texels(__m256 tau, __m256 fN, __m256 inv_N, __m256 *t) {
+AVX2 static inline texels8 texels(__m256 tau, __m256 fN, __m256 inv_N, __m256 *t, int gather) {
   texels8 T;
   __m256 j0 = _mm256_floor_ps(tau);  /* texel() in eight lanes: the same operations */
   *t = _mm256_sub_ps(tau, j0);
   __m256 w = _mm256_sub_ps(j0, _mm256_mul_ps(fN, _mm256_floor_ps(_mm256_mul_ps(j0, inv_N))));
   T.i = _mm256_add_epi32(_mm256_cvttps_epi32(w), _mm256_set1_epi32(1));
+  if (gather) {
+    T.rel = T.i, T.hi = _mm256_setzero_ps(), T.base = 0, T.win = 0;
+    return T;
+  }
   __m256i base = _mm256_min_epi32(_mm256_permutevar8x32_epi32(T.i, _mm256_setzero_si256()),
                                   _mm256_permutevar8x32_epi32(T.i, _mm256_set1_epi32(7)));
   T.rel = _mm256_sub_epi32(T.i, base);
@@ -188,7 +194,7 @@ AVX2 static inline void add_out(float *out, int64_t j, int64_t m, __m256 v) {
 /* T(tau) and, if wanted, its imaginary part: value + difference * fraction, the texels read by fetch() */
 AVX2 static inline void lerp8(const job_t *J, __m256 tau, __m256 fN, __m256 inv_N, __m256 *re, __m256 *im) {
   __m256 t;
-  texels8 T = texels(tau, fN, inv_N, &t);
+  texels8 T = texels(tau, fN, inv_N, &t, J->gather);
   *re = _mm256_add_ps(fetch(J->tre, &T), _mm256_mul_ps(fetch(J->dre, &T), t));
   if (J->want_imag) *im = _mm256_add_ps(fetch(J->tim, &T), _mm256_mul_ps(fetch(J->dim, &T), t));
 }
@@ -409,18 +415,19 @@ OMNI_API int omni_vector(void) {
 #endif
 }
 
-/* Rows r0 .. r1 - 1 (fast._rows_kernel).  vector: use the AVX2 loops (only where omni_vector()). */
+/* Rows r0 .. r1 - 1 (fast._rows_kernel).  vector: 0 the scalar loops; 1 the AVX2 loops with windowed table
+ * reads, 2 with gathered ones (1 and 2 only where omni_vector()). */
 OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_t r0, int64_t r1, const float *sdirs,
                const float *soffs, const float *amps, int64_t K, int64_t D, const float *nmin, const float *slpos,
                const float *omega, const float *zeta, int64_t S, const float *tre, const float *tim,
                const float *dre, const float *dim, int64_t N, float inv_period, float shift, int want_imag,
                int vector, float *out_re, float *out_im) {
   job_t J = {xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tre, tim, dre, dim, out_re, out_im,
-             Nx, K, D, S, (float)N, 0.0f, inv_period, shift, want_imag, vector};
+             Nx, K, D, S, (float)N, 0.0f, inv_period, shift, want_imag, vector != 0, vector == 2};
   J.inv_N = 1.0f / J.fN;
   float x0 = xs[0], *A = 0;
 #ifdef OMNI_X86
-  if (vector && !(A = malloc(3 * (S + 16) * sizeof(float)))) vector = J.vector = 0;  /* no memory: scalar */
+  if (vector && !(A = malloc(3 * (S + 16) * sizeof(float)))) vector = J.vector = J.gather = 0;  /* no memory */
 #endif
   double h = Nx > 1 ? ((double)xs[Nx - 1] - (double)x0) / (double)(Nx - 1) : 1.0;
   for (int64_t r = r0; r < r1; r++) {

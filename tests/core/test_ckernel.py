@@ -169,3 +169,42 @@ def test_kernel_wheel_installs_and_loads(tmp_path):
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=str(tmp_path))
     path, ok = r.stdout.split()
     assert path.startswith(str(target)) and ok == "True", r.stdout + r.stderr
+
+
+@needs_numba
+@pytest.mark.parametrize("dim,nx,x0,x1", [(3, 128, 0.0, 4.0), (2, 1024, 0.0, 0.5), (2, 300, -40.0, 40.0)])
+def test_fetch_modes_give_the_same_bits(monkeypatch, dim, nx, x0, x1):
+    """The AVX2 loops read the table through register windows or through gathers; both read the same texels."""
+    if not ckernel.vector():
+        pytest.skip("no AVX2 on this CPU: the scalar loops run")
+    noise = _case(dim, x1 - x0)
+    xs, others = _row_set(dim, nx, x0, x1, rows=40)
+    out = {}
+    for mode in ckernel.FETCH_MODES:
+        monkeypatch.setattr(ckernel, "_fetch", mode)
+        out[mode] = _rows(noise, xs, others, threads=2)
+    assert np.array_equal(out["window"][0], out["gather"][0]) and np.array_equal(out["window"][1], out["gather"][1])
+    assert out["window"][0].std() > 0.1
+
+
+def test_first_large_call_picks_a_fetch_mode(monkeypatch):
+    """A process's first call with enough samples times both read forms on its own rows and keeps one; the rows
+    it computed while timing are the same as those of a call that did not time (same bits)."""
+    if not ckernel.vector():
+        pytest.skip("no AVX2 on this CPU: the scalar loops run")
+    noise = _case(3, 4.0)
+    xs, others = _row_set(3, 128, 0.0, 4.0, rows=ckernel.CALIBRATE_SAMPLES // 128 + 16)
+    monkeypatch.setattr(ckernel, "_fetch", None)
+    timed = _rows(noise, xs, others, threads=2)
+    assert ckernel.fetch_mode() in ckernel.FETCH_MODES
+    monkeypatch.setattr(ckernel, "_fetch", "window")
+    assert np.array_equal(timed[0], _rows(noise, xs, others, threads=2)[0])
+    monkeypatch.setattr(ckernel, "_fetch", None)  # too small to time: the default form, nothing chosen
+    small = _rows(noise, xs[:8], others[:3], threads=2)
+    assert ckernel.fetch_mode() is None and np.isfinite(small[0]).all()
+
+
+def test_bad_fetch_mode_is_named(monkeypatch):
+    monkeypatch.setattr(ckernel, "_fetch", "fast")
+    with pytest.raises(ValueError, match="OMNINOISE_FETCH must be one of window, gather, got 'fast'"):
+        ckernel.fetch_mode()
