@@ -4,7 +4,7 @@ Compiles ``backend/wavenoise/rows.c`` with the system C compiler (``$CC``, else 
 ``backend/wavenoise/_omni_rows.so`` (atomic write), which :mod:`backend.wavenoise.ckernel` loads.  No
 compiler, or a failed build, is not an error: the engine then runs its numba kernel (the reference) and
 this prints why.  ``-ffp-contract=off`` keeps every multiply and add apart, as numba computes them, so
-both kernels give the same bits; the AVX2 loops are compiled with a target attribute and chosen at run
+the scalar loops give numba's bits (the AVX2 loops fuse only where they say so, within 2e-6); the AVX2 loops are compiled with a target attribute and chosen at run
 time, so the library runs on any x86-64 CPU.  An up-to-date library (newer than ``rows.c``) is kept unless
 ``--force``; ``--check`` exits 1 when no library could be built.
 
