@@ -163,10 +163,8 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
 
     first = 0
     if vec and fetch_mode() is None and R >= 16 and R * Nx >= CALIBRATE_SAMPLES:
-        first = _calibrate(run, R)
+        first = _calibrate(run, R)  # a quarter of the rows at most
     n = max(1, min(_threads(), R - first))
-    if first == R:
-        return
     if n == 1:
         return run(first, R)
     # more pieces than threads, so a thread that got cheap rows takes another.  The calling thread works too,
