@@ -4,7 +4,11 @@ Issue 22 asks that every class's generated images at 256² be nearer, by spectru
 images of that class than to those of any other class, except classes that are near-duplicates in the zoo
 itself.  This prints and writes (``-o``, JSON) both halves of that test with the measure of
 ``training/evaluate.py`` (:func:`look`: the shape of the radial power spectrum in 24 log-spaced bands and 32
-value quantiles; distances in units of the median distance between two zoo classes):
+value quantiles; distances in units of the median distance between two zoo classes).  The spectrum is taken of
+each image's periodic component (Moisan 2011, :func:`training.evaluate.periodic_component`): five zoo classes
+tile (gaussian, fibers, gabor, phasor, gabor_texture) and a model's images do not, and the jumps at the borders
+of an image that does not tile spread about 1e-4 of its power into every top band, more than a smooth class
+holds there:
 
 - **the zoo against itself**: per class, zoo images split in two halves (seeds alternate); half A of class c
   is compared with half B of every class.  Classes c' at least as near to A_c as c's own half B are

@@ -105,14 +105,50 @@ def test_look_tells_spectra_and_histograms_apart_and_finds_the_nearest_class():
     np.testing.assert_allclose(dimmer["spectrum"], refs["white"]["spectrum"], atol=1e-9)
     assert np.abs(dimmer["histogram"] - refs["white"]["histogram"]).mean() > 0.05
 
-    # a faint grain (1e-3 amplitude, about 4e-5 of the blobs' power in the top bands) moves the plain log spectrum
-    # a lot and the floored one not at all; a real change of shape (blobs against white) moves both
+    # a faint grain (1e-2 amplitude, about 2e-5 of the blobs' power in each top band) moves the plain log spectrum
+    # a lot and the floored one hardly; a real change of shape (blobs against white) moves both
     b = kind("blobs", 4, 1)
-    grain = b + 1e-3 * np.random.default_rng(3).standard_normal(b.shape)
+    grain = b + 1e-2 * np.random.default_rng(3).standard_normal(b.shape)
     plain = np.abs(look(grain)["spectrum"] - look(b)["spectrum"]).max()
     floored = np.abs(look(grain, 1e-4)["spectrum"] - look(b, 1e-4)["spectrum"]).max()
     assert plain > 1.0 and floored < 0.05, (plain, floored)
     assert np.abs(look(w, 1e-4)["spectrum"] - look(b, 1e-4)["spectrum"]).mean() > 0.3
+
+
+def test_periodic_component_solves_moisans_equation_and_removes_the_border_cross():
+    """u = p + s (Moisan 2011): the discrete periodic Laplacian of s is the boundary image v, s has mean 0; a crop
+    of a smooth tiling field, which jumps at its borders, gets its top-band power back down near the field's own,
+    and look() then puts the crop beside the whole field (it did not: the crop's border cross looked like grain)."""
+    from training.evaluate import look, periodic_component, radial_psd
+
+    r = np.random.default_rng(5)
+    S = 256
+    k = np.hypot(*np.meshgrid(np.fft.fftfreq(S), np.fft.fftfreq(S), indexing="ij"))
+    field = np.real(np.fft.ifft2(np.fft.fft2(r.standard_normal((4, S, S))) * np.exp(-(k / 0.02) ** 2)))
+    field = 0.5 + 0.15 * field / field.std()
+    u = field[:, 37:101, 90:154]  # 64² crops: they do not tile
+    p = periodic_component(u)
+    s_ = u - p
+    lap = sum(np.roll(s_, sh, axis=ax) for sh in (1, -1) for ax in (1, 2)) - 4 * s_
+    v = np.zeros_like(u)
+    v[:, 0, :] += u[:, -1, :] - u[:, 0, :]
+    v[:, -1, :] -= u[:, -1, :] - u[:, 0, :]
+    v[:, :, 0] += u[:, :, -1] - u[:, :, 0]
+    v[:, :, -1] -= u[:, :, -1] - u[:, :, 0]
+    np.testing.assert_allclose(lap, v, atol=1e-9)
+    np.testing.assert_allclose(s_.mean(axis=(1, 2)), 0, atol=1e-12)
+
+    def top(imgs):  # share of the power in the top quarter of the radial spectrum
+        q = radial_psd(imgs)
+        return q[3 * len(q) // 4:].sum() / q.sum()
+
+    whole = field[:, ::4, ::4]  # the field at the crops' scale would be finer; compare with the crops' own content:
+    assert top(u) > 100 * top(p), (top(u), top(p))  # the border cross dominated the raw crops' top bands
+    assert top(p) < 3e-5, top(p)
+    assert top(field) < 1e-6 and whole.shape == (4, 64, 64)
+    crop2 = field[:, 150:214, 10:74]
+    d_pc = np.abs(look(u)["spectrum"] - look(crop2)["spectrum"]).mean()
+    assert d_pc < 0.2, d_pc
 
 
 def test_known_params_keeps_what_the_model_was_trained_with():
