@@ -12,7 +12,9 @@ the photo by
   one-channel features of each image's rank-Gaussianised luminance);
 - ``soft_morph``: the differentiable morphology term (:mod:`training.solid.soft_morphology`);
 - ``patch``: the evaluation's patch distance (:func:`training.solid.photo_eval.patch_swd`, x 1000);
-- ``morph``: the level-set morphology distance (:mod:`training.solid.morphology`).
+- ``morph``: the level-set morphology distance (:mod:`training.solid.morphology`);
+- ``structure`` (with ``--structure NET``): the sliced Wasserstein distance of the learned structure features
+  (:mod:`training.solid.structure_features`, a network trained to tell photo crops from their random-phase twins).
 
 Candidates: other crops of the photo; a Voronoi pavement (cells of ``--cell`` px, dark 2 px joints, one
 shade per stone, pixel noise 0.01) with its own greys and with the photo's colours by rank; speckle (the
@@ -37,6 +39,7 @@ from backend.solid.model import SolidTextureModel  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from training.solid import exemplars as ex, photo_eval as pe  # noqa: E402
 from training.solid.arrangement import ArrangementFeatures  # noqa: E402
+from training.solid.structure_features import StructureFeatures, load_structure_net  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
 from training.solid.soft_morphology import soft_morphology_loss  # noqa: E402
 from training.solid.swd import swd_loss  # noqa: E402
@@ -73,18 +76,22 @@ def candidates(photo: np.ndarray, model: SolidTextureModel, cell: float, rng: np
     }
 
 
-def score(photo: np.ndarray, images: list, cfg, feats, arr, draws: int, rng: np.random.Generator) -> dict:
+def score(photo: np.ndarray, images: list, cfg, feats, arr, draws: int, rng: np.random.Generator,
+          structure=None) -> dict:
     t = lambda ims: torch.from_numpy(np.stack(ims)).permute(0, 3, 1, 2).contiguous()  # noqa: E731
     out = t(images)
     g = torch.Generator().manual_seed(0)
-    train, arrangement, soft = [], [], []
+    train, arrangement, soft, struct = [], [], [], []
     with torch.no_grad():
         for _ in range(draws):
             ref = t(crops(photo, 4, rng))
             train.append(texture_loss(cfg, feats, out, ref, g).item())
             arrangement.append(swd_loss(arr, out, ref, per_sample=True, generator=g).item())
             soft.append(soft_morphology_loss(out, ref, per_sample=True).item())
-    return dict(train=float(np.mean(train)), arrangement=float(np.mean(arrangement)), soft_morph=float(np.mean(soft)),
+            if structure is not None:
+                struct.append(swd_loss(structure, out, ref, per_sample=True, generator=g).item())
+    extra = dict(structure=float(np.mean(struct))) if struct else {}
+    return dict(**extra, train=float(np.mean(train)), arrangement=float(np.mean(arrangement)), soft_morph=float(np.mean(soft)),
                 patch=float(pe.patch_swd(images, photo)), morph=float(np.mean([morphology_distance(i, photo)
                                                                                 for i in images])))
 
@@ -96,25 +103,28 @@ def main(argv=None) -> int:
     ap.add_argument("--config", default=os.path.join(ROOT, "configs", "solid", "photo_space_3d.json"))
     ap.add_argument("--cell", type=float, default=28.0, help="pavement cell size, px")
     ap.add_argument("--draws", type=int, default=6)
+    ap.add_argument("--structure", help="a trained structure network (training.solid.structure_features) to score too")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_arrangement.json"))
     a = ap.parse_args(argv)
     torch.set_num_threads(2)
     cfg = load_config(a.config)
     feats, arr = loss_features(cfg), ArrangementFeatures()
+    structure = StructureFeatures(load_structure_net(a.structure)) if a.structure else None
     model = SolidTextureModel(a.model)
     table = {}
     for name in a.photos:
         path = name if os.path.isfile(name) else os.path.join(ROOT, "data", "photos", name)
         photo = ex.load_image(path).permute(1, 2, 0).numpy()
         rng = np.random.default_rng(0)
-        rows = {k: score(photo, ims, cfg, feats, arr, a.draws, rng)
+        rows = {k: score(photo, ims, cfg, feats, arr, a.draws, rng, structure)
                 for k, ims in candidates(photo, model, a.cell, rng).items()}
         table[os.path.basename(path)] = rows
         print(os.path.basename(path))
-        print(f"  {'candidate':24s} {'train':>8s} {'arrange':>8s} {'soft_mo':>8s} {'patch':>8s} {'morph':>6s}")
+        print(f"  {'candidate':24s} {'train':>8s} {'arrange':>8s} {'soft_mo':>8s} {'patch':>8s} {'morph':>6s}"
+              + (f" {'struct':>8s}" if structure is not None else ""))
         for k, r in rows.items():
             print(f"  {k:24s} {r['train']:8.4f} {r['arrangement']:8.4f} {r['soft_morph']:8.3f} {r['patch']:8.1f} "
-                  f"{r['morph']:6.2f}")
+                  f"{r['morph']:6.2f}" + (f" {r['structure']:8.4f}" if structure is not None else ""))
     write_json(a.out, table)
     return 0
 

@@ -9,9 +9,9 @@ as in multi-scale texture synthesis) against the training loss of
 multi-scale features + colour histogram) and, for comparison, the earlier
 Gram loss.  If the loss sees structure, the optimised image shows the photo's
 stones, grains and bricks; a loss that only sees colour and spectrum gives
-blotches.  The sheet: photo | Gram loss | sliced Wasserstein loss, one row per
-photo; the patch distance of :mod:`training.solid.photo_eval` for
-each is printed and written beside the sheet (JSON).
+blotches.  The sheet: photo | Gram loss | sliced Wasserstein loss [| the same plus the learned structure term
+of :mod:`training.solid.structure_features`, with ``--structure NET``], one row per photo; the patch distance of
+:mod:`training.solid.photo_eval` for each is printed and written beside the sheet (JSON).
 """
 from __future__ import annotations
 
@@ -61,6 +61,10 @@ def main(argv=None) -> int:
     ap.add_argument("--photos", default=",".join(DEFAULT_PHOTOS), help="categories (first held-out photo of each)")
     ap.add_argument("--config", default=os.path.join(ROOT, "configs", "solid", "photo_space_3d.json"))
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--structure", help="a trained structure network (training.solid.structure_features): adds the "
+                                        "column 'structure', the sliced Wasserstein loss plus its learned structure term")
+    ap.add_argument("--structure-weight", type=float, default=0.2)
+    ap.add_argument("--no-gram", action="store_true", help="leave out the Gram-loss column")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "img", "solid_loss_sheet.png"))
     a = ap.parse_args(argv)
     if a.threads:
@@ -68,7 +72,11 @@ def main(argv=None) -> int:
     from PIL import Image
 
     swd_cfg = load_config(a.config)
-    gram_cfg = SolidConfig.from_dict({**{k: v for k, v in vars(swd_cfg).items()}, "loss": "gram"})
+    columns = [] if a.no_gram else [("gram", SolidConfig.from_dict({**vars(swd_cfg), "loss": "gram"}))]
+    columns.append(("swd", swd_cfg))
+    if a.structure:
+        columns.append(("structure", SolidConfig.from_dict({**vars(swd_cfg), "structure_net": a.structure,
+                                                            "structure_weight": a.structure_weight})))
     val = ex.photo_set("val")
     rows, results = [], {}
     for cat in a.photos.split(","):
@@ -79,7 +87,7 @@ def main(argv=None) -> int:
         ref = ex.load_image(path).unsqueeze(0)
         photo = ref[0].permute(1, 2, 0).numpy()
         row, res = [ref[..., :a.size, :a.size]], {}
-        for name, cfg in (("gram", gram_cfg), ("swd", swd_cfg)):
+        for name, cfg in columns:
             t = time.time()
             out = optimise(cfg, ref, a.size, a.steps)
             res[name] = round(pe.patch_swd(out[0].permute(1, 2, 0).numpy(), photo), 1)
@@ -92,7 +100,10 @@ def main(argv=None) -> int:
     sheet = (torch.cat(rows, dim=2)[0].permute(1, 2, 0).numpy() * 255.0 + 0.5).astype(np.uint8)
     with atomic_path(a.out) as tmp:
         Image.fromarray(sheet).save(tmp, format="PNG")
-    write_json(os.path.splitext(a.out)[0] + ".json", dict(steps=a.steps, size=a.size, config=a.config, photos=results))
+    write_json(os.path.splitext(a.out)[0] + ".json", dict(steps=a.steps, size=a.size, config=a.config,
+                                                          columns=[n for n, _ in columns], structure=a.structure,
+                                                          structure_weight=a.structure_weight if a.structure else None,
+                                                          photos=results))
     print(a.out)
     return 0
 

@@ -41,6 +41,7 @@ from .lattice import octave_seeds
 from .model import SolidTexture, colour_stats, max_scales, shape_features, slice_points, spectral_gains
 from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
+from .structure_features import StructureFeatures, load_structure_net
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from backend.onnx_models import load_model_json
@@ -85,6 +86,8 @@ class SolidConfig:
     swd_levels: int = 5             # swd: pyramid levels
     spectrum_weight: float = 0.0    # weight of the power-spectrum band term (spectrum.py); 0: off
     morphology_weight: float = 0.0  # weight of the soft level-set morphology term (soft_morphology.py); 0: off
+    structure_weight: float = 0.0   # weight of the learned structure term (structure_features.py); 0: off
+    structure_net: str = ""         # ... the trained structure network it reads (a file of train_structure_net)
     min_spacing: float = 0.0        # bounded space models: no octave's lattice finer than this many px (model.max_scales); 0: off
     seed: int = 0
     log_every: int = 25
@@ -119,9 +122,12 @@ class SolidConfig:
         n_exemplars = len(ex.expand(cfg.exemplars))
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
-        for key in ("spectrum_weight", "morphology_weight"):
+        for key in ("spectrum_weight", "morphology_weight", "structure_weight"):
             if not (math.isfinite(getattr(cfg, key)) and getattr(cfg, key) >= 0):
                 raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
+        if cfg.structure_weight and not os.path.isfile(cfg.structure_net):
+            raise ValueError(f"structure_weight needs structure_net, a trained structure network file; "
+                             f"{cfg.structure_net!r} is not one")
         if cfg.min_spacing:
             if not (math.isfinite(cfg.min_spacing) and cfg.min_spacing > 0):
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
@@ -191,7 +197,21 @@ def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, 
         loss = loss + cfg.spectrum_weight * spectrum_loss(img, ref, per_sample=per_sample)
     if cfg.morphology_weight:
         loss = loss + cfg.morphology_weight * soft_morphology_loss(img, ref, per_sample=per_sample)
+    if cfg.structure_weight:
+        loss = loss + cfg.structure_weight * swd_loss(structure_features(cfg.structure_net), img, ref,
+                                                      per_sample=per_sample, generator=gen)
     return loss
+
+
+_STRUCTURE: dict = {}
+
+
+def structure_features(path: str) -> StructureFeatures:
+    """The frozen structure features of a trained network file, loaded once per process."""
+    key = os.path.abspath(path)
+    if key not in _STRUCTURE:
+        _STRUCTURE[key] = StructureFeatures(load_structure_net(key))
+    return _STRUCTURE[key]
 
 
 def loss_features(cfg: SolidConfig):
