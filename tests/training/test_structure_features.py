@@ -64,6 +64,10 @@ def test_the_training_loss_takes_the_structure_term_only_with_a_network(tmp_path
     with pytest.raises(ValueError, match="structure_weight"):
         SolidConfig.from_dict({**base, "structure_weight": -1.0})
     path = tmp_path / "net.pt"
+    missing = SolidConfig.from_dict({**base, "structure_weight": 0.5, "structure_net": str(tmp_path / "none.pt")})
+    with pytest.raises(ValueError, match="no trained structure network"):  # configs parse; the loss needs the file
+        texture_loss(missing, loss_features(missing), torch.rand(1, 3, 32, 32), torch.rand(1, 3, 32, 32),
+                     torch.Generator().manual_seed(0))
     torch.save(dict(weights=StructureNet(4).state_dict(), record=dict(width=4)), path)
     plain = SolidConfig.from_dict(base)
     with_term = SolidConfig.from_dict({**base, "structure_weight": 0.5, "structure_net": str(path)})

@@ -125,9 +125,9 @@ class SolidConfig:
         for key in ("spectrum_weight", "morphology_weight", "structure_weight"):
             if not (math.isfinite(getattr(cfg, key)) and getattr(cfg, key) >= 0):
                 raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
-        if cfg.structure_weight and not os.path.isfile(cfg.structure_net):
-            raise ValueError(f"structure_weight needs structure_net, a trained structure network file; "
-                             f"{cfg.structure_net!r} is not one")
+        if cfg.structure_weight and not cfg.structure_net:
+            raise ValueError("structure_weight needs structure_net, the file of a trained structure network "
+                             "(python -m training.solid.structure_features --out FILE)")
         if cfg.min_spacing:
             if not (math.isfinite(cfg.min_spacing) and cfg.min_spacing > 0):
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
@@ -209,6 +209,9 @@ _STRUCTURE: dict = {}
 def structure_features(path: str) -> StructureFeatures:
     """The frozen structure features of a trained network file, loaded once per process."""
     key = os.path.abspath(path)
+    if key not in _STRUCTURE and not os.path.isfile(key):
+        raise ValueError(f"structure_net: no trained structure network at {path!r} "
+                         f"(make one: python -m training.solid.structure_features --out {path})")
     if key not in _STRUCTURE:
         _STRUCTURE[key] = StructureFeatures(load_structure_net(key))
     return _STRUCTURE[key]
@@ -263,6 +266,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         step, elapsed = int(model_json.get("step", 0)), float(model_json.get("train_seconds", 0.0))
         first = step
         log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...) at step {step}")
+    if cfg.structure_weight:
+        structure_features(cfg.structure_net)  # a missing network fails here, before the first step
     images = training_images(cfg)
     augment = cfg.dim == 3 if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
