@@ -142,10 +142,9 @@ def test_periodic_component_solves_moisans_equation_and_removes_the_border_cross
         q = radial_psd(imgs)
         return q[3 * len(q) // 4:].sum() / q.sum()
 
-    whole = field[:, ::4, ::4]  # the field at the crops' scale would be finer; compare with the crops' own content:
     assert top(u) > 100 * top(p), (top(u), top(p))  # the border cross dominated the raw crops' top bands
     assert top(p) < 3e-5, top(p)
-    assert top(field) < 1e-6 and whole.shape == (4, 64, 64)
+    assert top(field) < 1e-6
     crop2 = field[:, 150:214, 10:74]
     d_pc = np.abs(look(u)["spectrum"] - look(crop2)["spectrum"]).mean()
     assert d_pc < 0.2, d_pc

@@ -209,10 +209,10 @@ _STRUCTURE: dict = {}
 def structure_features(path: str) -> StructureFeatures:
     """The frozen structure features of a trained network file, loaded once per process."""
     key = os.path.abspath(path)
-    if key not in _STRUCTURE and not os.path.isfile(key):
-        raise ValueError(f"structure_net: no trained structure network at {path!r} "
-                         f"(make one: python -m training.solid.structure_features --out {path})")
     if key not in _STRUCTURE:
+        if not os.path.isfile(key):
+            raise ValueError(f"structure_net: no trained structure network at {path!r} "
+                             f"(make one: python -m training.solid.structure_features --out {path})")
         _STRUCTURE[key] = StructureFeatures(load_structure_net(key))
     return _STRUCTURE[key]
 
