@@ -4,8 +4,8 @@
 ``_omni_rows.so`` (``.dylib`` on macOS, ``.dll`` on Windows); an installed extension has it from the
 ``omninoise_rows`` wheel that ``make dist`` builds for each platform.  Without either, or with
 OMNINOISE_NO_CKERNEL=1, :mod:`.fast` runs its numba row kernel, which stays the reference: equal bits on
-CPUs without AVX2 (the scalar loops), within 2e-6 with the AVX2 loops, which fuse the ramp's weights and sums (see
-rows.c; tested).  The call releases the GIL, so rows are split across Python threads.
+CPUs without AVX2 (the scalar loops), within 2e-6 with the AVX2 loops, which fuse the lerps and the ramp's weights
+and sums and take the weights' cosine from a shorter polynomial (see rows.c; tested).  The call releases the GIL, so rows are split across Python threads.
 
 Arrays are those of :class:`backend.wavenoise.fast.GridPlan`; see ``rows.c`` for shapes.
 

@@ -11,12 +11,19 @@
  *                               where slices are long (SEGMENT_WALK, 48 samples or more) and on CPUs
  *                               without AVX2.  The scalar loops are numba's operations one for one (no
  *                               fused multiply-adds): the same bits.  The AVX2 loops compute texel
- *                               coordinates the same way and fuse the ramp's weights and sums.
+ *                               coordinates the same way and fuse the lerps, the ramp's weights and
+ *                               sums.
  *   blocks (stratum_blocks)     eight samples at a time, each lane finding its own slice and blending
  *                               n and n + 1 with weights that are exactly (amp, 0) or (0, amp) outside
  *                               the ramp: no per-segment bookkeeping, which dominates short slices
  *                               (3D grids).  Texel coordinates as the reference; fused multiply-adds
- *                               in the weights and sums: within 1e-6 of it.
+ *                               in the lerps, weights and sums, and the weights' cosine from a shorter
+ *                               (minimax) polynomial: within 1e-6 of it.
+ *
+ * The AVX2 loops count operations (issue 27: each one saved was measurable on a 3D grid): a power-of-two
+ * table size wraps texel indices with an integer and, the tables are addressed from their texel 1, the
+ * amplitude multiplies the blended sum once, and the walk's bookkeeping is compiled for AVX2 too (its
+ * float64 floor and ceil become single instructions).
  *
  * Table reads, which numba leaves scalar, in one of two ways (the same texels, so the same bits; the
  * caller picks the faster on its CPU, see ckernel.py): "window", where the eight texels of one read lie
@@ -66,7 +73,7 @@ typedef struct {
   float *out_re, *out_im;
   int64_t Nx, K, D, S;
   float fN, inv_N, inv_period, shift;
-  int want_imag, vector, gather;
+  int want_imag, vector, gather, pow2;
 } job_t;
 
 static inline void slice_affine(const job_t *J, int64_t k, int64_t r, int64_t ri, float *a, float *b);
@@ -126,15 +133,20 @@ AVX2 static inline __m256i lane_mask(int64_t m) {
   return _mm256_cmpgt_epi32(_mm256_set1_epi32((int)m), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
 }
 
-/* cos(pi/2 s) as cos_half_pi, Horner with fused multiply-adds (within 1 ulp of it) */
+/* cos(pi/2 s), s in [0, 1], as an even polynomial 1 + y (c1 + y (c2 + y (c3 + y c4))) in y = s^2 with
+ * minimax coefficients (fitted by Lawson's iteration on 20001 Chebyshev points; the constant exactly 1, so
+ * a weight before the ramp is exactly amp): error 5.3e-8 against cos, about float32's rounding, where
+ * cos_half_pi's Taylor series takes three operations more */
+#define CM1 (-1.23369888e+00f)
+#define CM2 (2.53653209e-01f)
+#define CM3 (-2.08139667e-02f)
+#define CM4 (8.59690055e-04f)
 AVX2 static inline __m256 cos_half_pi8(__m256 s) {
-  __m256 x = _mm256_mul_ps(_mm256_set1_ps(C_HALF_PI), s), x2 = _mm256_mul_ps(x, x);
-  __m256 p = _mm256_fmadd_ps(x2, _mm256_set1_ps(C_479001600), _mm256_set1_ps(C_3628800));
-  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(C_40320));
-  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(C_720));
-  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(C_24));
-  p = _mm256_fmadd_ps(x2, p, _mm256_set1_ps(-0.5f));
-  return _mm256_fmadd_ps(x2, p, _mm256_set1_ps(1.0f));
+  __m256 y = _mm256_mul_ps(s, s);
+  __m256 p = _mm256_fmadd_ps(y, _mm256_set1_ps(CM4), _mm256_set1_ps(CM3));
+  p = _mm256_fmadd_ps(y, p, _mm256_set1_ps(CM2));
+  p = _mm256_fmadd_ps(y, p, _mm256_set1_ps(CM1));
+  return _mm256_fmadd_ps(y, p, _mm256_set1_ps(1.0f));
 }
 
 /* Eight texels: with ``gather`` 0, from two loads and a permute where the lanes' texels lie within 16
@@ -142,13 +154,16 @@ AVX2 static inline __m256 cos_half_pi8(__m256 s) {
  * gather always (faster on CPUs with fast gathers, such as Intel's Sapphire Rapids). */
 typedef struct { __m256i i, rel; __m256 hi; int base, win; } texels8;
 
-AVX2 static inline texels8 texels(__m256 tau, __m256 fN, __m256 inv_N, __m256 *t, int gather) {
+AVX2 static inline texels8 texels(const job_t *J, __m256 tau, __m256 fN, __m256 inv_N, __m256 *t) {
   texels8 T;
-  __m256 j0 = _mm256_floor_ps(tau);  /* texel() in eight lanes: the same operations */
+  __m256 j0 = _mm256_floor_ps(tau);  /* texel() in eight lanes: the same texel, less the padding's + 1 */
   *t = _mm256_sub_ps(tau, j0);
-  __m256 w = _mm256_sub_ps(j0, _mm256_mul_ps(fN, _mm256_floor_ps(_mm256_mul_ps(j0, inv_N))));
-  T.i = _mm256_add_epi32(_mm256_cvttps_epi32(w), _mm256_set1_epi32(1));
-  if (gather) {
+  if (J->pow2) {  /* j0 mod N for N = 2^k (|j0| < 2^24): an integer and gives what texel()'s floats give */
+    T.i = _mm256_and_si256(_mm256_cvttps_epi32(j0), _mm256_set1_epi32(J->pow2 - 1));
+  } else {
+    T.i = _mm256_cvttps_epi32(_mm256_sub_ps(j0, _mm256_mul_ps(fN, _mm256_floor_ps(_mm256_mul_ps(j0, inv_N)))));
+  }
+  if (J->gather) {
     T.rel = T.i, T.hi = _mm256_setzero_ps(), T.base = 0, T.win = 0;
     return T;
   }
@@ -194,9 +209,9 @@ AVX2 static inline void add_out(float *out, int64_t j, int64_t m, __m256 v) {
 /* T(tau) and, if wanted, its imaginary part: value + difference * fraction, the texels read by fetch() */
 AVX2 static inline void lerp8(const job_t *J, __m256 tau, __m256 fN, __m256 inv_N, __m256 *re, __m256 *im) {
   __m256 t;
-  texels8 T = texels(tau, fN, inv_N, &t, J->gather);
-  *re = _mm256_add_ps(fetch(J->tre, &T), _mm256_mul_ps(fetch(J->dre, &T), t));
-  if (J->want_imag) *im = _mm256_add_ps(fetch(J->tim, &T), _mm256_mul_ps(fetch(J->dim, &T), t));
+  texels8 T = texels(J, tau, fN, inv_N, &t);  /* indices from the tables' texel 1: T[0] */
+  *re = _mm256_fmadd_ps(fetch(J->dre + 1, &T), t, fetch(J->tre + 1, &T));
+  if (J->want_imag) *im = _mm256_fmadd_ps(fetch(J->dim + 1, &T), t, fetch(J->tim + 1, &T));
 }
 
 AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore,
@@ -217,32 +232,32 @@ AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float 
  * 1e-6 of the reference, tested). */
 AVX2 static void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0,
                             float b0, float a1, float b1, float amp, float *ore, float *oim) {
-  const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vfn = _mm256_set1_ps(fn), vsp = _mm256_set1_ps(sp);
-  const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f);
+  const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vfn = _mm256_set1_ps(fn);
+  const __m256 voff = _mm256_set1_ps(0.5f - sp * (float)(0.5 / 0.3));
+  const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), one = _mm256_set1_ps(1.0f);
   const __m256 two = _mm256_set1_ps(2.0f), three = _mm256_set1_ps(3.0f);
   const __m256 vamp = _mm256_set1_ps(amp), fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
   const __m256 va0 = _mm256_set1_ps(a0), vb0 = _mm256_set1_ps(b0), va1 = _mm256_set1_ps(a1), vb1 = _mm256_set1_ps(b1);
   for (int64_t j = o; j < o + m; j += 8) {
     int64_t n = o + m - j;
     __m256 x = load_x(J->xs, j, n), re0, im0, re1, im1;
-    __m256 u = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(x, vsx), vq), vfn), vsp);
-    u = _mm256_fmadd_ps(u, c, half);
+    __m256 u = _mm256_fmadd_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(x, vsx), vq), vfn), c, voff);
     /* min(max(u, 0), 1) as numba's: NaN cannot occur (finite coordinates) */
     u = _mm256_min_ps(_mm256_max_ps(u, _mm256_setzero_ps()), one);
     __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_fnmadd_ps(two, u, three));
-    __m256 w0 = _mm256_mul_ps(vamp, cos_half_pi8(s)), w1 = _mm256_mul_ps(vamp, cos_half_pi8(_mm256_sub_ps(one, s)));
+    __m256 w0 = cos_half_pi8(s), w1 = cos_half_pi8(_mm256_sub_ps(one, s));
     lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va0), vb0), fN, inv_N, &re0, &im0);
     lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va1), vb1), fN, inv_N, &re1, &im1);
     if (n >= 8) {  /* slice n's term, then slice n + 1's, as the reference adds them */
-      _mm256_storeu_ps(ore + j, _mm256_fmadd_ps(w1, re1, _mm256_fmadd_ps(w0, re0, _mm256_loadu_ps(ore + j))));
+      _mm256_storeu_ps(ore + j, _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, re1, _mm256_mul_ps(w0, re0)), _mm256_loadu_ps(ore + j)));
       if (J->want_imag)
-        _mm256_storeu_ps(oim + j, _mm256_fmadd_ps(w1, im1, _mm256_fmadd_ps(w0, im0, _mm256_loadu_ps(oim + j))));
+        _mm256_storeu_ps(oim + j, _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, im1, _mm256_mul_ps(w0, im0)), _mm256_loadu_ps(oim + j)));
     } else {
       __m256i k = lane_mask(n);
-      _mm256_maskstore_ps(ore + j, k, _mm256_fmadd_ps(w1, re1, _mm256_fmadd_ps(w0, re0, _mm256_maskload_ps(ore + j, k))));
+      _mm256_maskstore_ps(ore + j, k, _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, re1, _mm256_mul_ps(w0, re0)), _mm256_maskload_ps(ore + j, k)));
       if (J->want_imag)
         _mm256_maskstore_ps(oim + j, k,
-                            _mm256_fmadd_ps(w1, im1, _mm256_fmadd_ps(w0, im0, _mm256_maskload_ps(oim + j, k))));
+                            _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, im1, _mm256_mul_ps(w0, im0)), _mm256_maskload_ps(oim + j, k)));
     }
   }
 }
@@ -264,14 +279,14 @@ AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, in
   int64_t ri0 = (int64_t)(nlo - nmk), cnt = (int64_t)(nhi - nlo) + 2;  /* records of slices nlo .. nhi + 1 */
   for (int64_t i = 0; i < cnt; i++) {
     slice_affine(J, k, r, ri0 + i, &A[i], &B[i]);
-    SP[i] = slp[ri0 + i];
+    SP[i] = 0.5f - slp[ri0 + i] * (float)(0.5 / 0.3);
   }
   for (int64_t i = cnt; i < cnt + 9; i++) A[i] = B[i] = SP[i] = 0.0f;
   const int regs = cnt <= 8;
   const __m256 a0t = _mm256_loadu_ps(A), b0t = _mm256_loadu_ps(B), a1t = _mm256_loadu_ps(A + 1);
   const __m256 b1t = _mm256_loadu_ps(B + 1), spt = _mm256_loadu_ps(SP);
   const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vnlo = _mm256_set1_ps(nlo);
-  const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f);
+  const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), one = _mm256_set1_ps(1.0f);
   const __m256 zero = _mm256_setzero_ps(), vamp = _mm256_set1_ps(amp);
   const __m256 fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
   for (int64_t j = 0; j < Nx; j += 8) {
@@ -286,12 +301,11 @@ AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, in
     __m256 p = _mm256_add_ps(_mm256_mul_ps(x, vsx), vq), n = _mm256_floor_ps(p);
     __m256i idx = _mm256_cvttps_epi32(_mm256_sub_ps(n, vnlo)), idx1 = _mm256_add_epi32(idx, _mm256_set1_epi32(1));
     __m256 sp = pick(SP, spt, regs, idx);
-    __m256 u = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_sub_ps(p, n), sp), c), half);
+    __m256 u = _mm256_fmadd_ps(_mm256_sub_ps(p, n), c, sp);
     u = _mm256_min_ps(_mm256_max_ps(u, zero), one);
-    __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_set1_ps(2.0f), u)));
-    __m256 w0 = _mm256_andnot_ps(_mm256_cmp_ps(u, one, _CMP_GE_OQ), _mm256_mul_ps(vamp, cos_half_pi8(s)));
-    __m256 w1 = _mm256_andnot_ps(_mm256_cmp_ps(u, zero, _CMP_LE_OQ),
-                                 _mm256_mul_ps(vamp, cos_half_pi8(_mm256_sub_ps(one, s))));
+    __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_fnmadd_ps(_mm256_set1_ps(2.0f), u, _mm256_set1_ps(3.0f)));
+    __m256 w0 = _mm256_andnot_ps(_mm256_cmp_ps(u, one, _CMP_GE_OQ), cos_half_pi8(s));
+    __m256 w1 = _mm256_andnot_ps(_mm256_cmp_ps(u, zero, _CMP_LE_OQ), cos_half_pi8(_mm256_sub_ps(one, s)));
     __m256 tau0 = _mm256_add_ps(_mm256_mul_ps(x, pick(A, a0t, regs, idx)), pick(B, b0t, regs, idx));
     __m256 tau1 = _mm256_add_ps(_mm256_mul_ps(x, regs ? _mm256_permutevar8x32_ps(a1t, idx) : pick(A, a1t, 0, idx1)),
                                 regs ? _mm256_permutevar8x32_ps(b1t, idx) : pick(B, b1t, 0, idx1));
@@ -299,11 +313,11 @@ AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, in
     lerp8(J, tau0, fN, inv_N, &l0, &li0);
     lerp8(J, tau1, fN, inv_N, &l1, &li1);
     __m256 acc = m >= 8 ? _mm256_loadu_ps(ore + j) : _mm256_maskload_ps(ore + j, km);
-    acc = _mm256_fmadd_ps(w1, l1, _mm256_fmadd_ps(w0, l0, acc));
+    acc = _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, l1, _mm256_mul_ps(w0, l0)), acc);
     if (m >= 8) _mm256_storeu_ps(ore + j, acc); else _mm256_maskstore_ps(ore + j, km, acc);
     if (imag) {
       acc = m >= 8 ? _mm256_loadu_ps(oim + j) : _mm256_maskload_ps(oim + j, km);
-      acc = _mm256_fmadd_ps(w1, li1, _mm256_fmadd_ps(w0, li0, acc));
+      acc = _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, li1, _mm256_mul_ps(w0, li0)), acc);
       if (m >= 8) _mm256_storeu_ps(oim + j, acc); else _mm256_maskstore_ps(oim + j, km, acc);
     }
   }
@@ -347,7 +361,7 @@ static inline int64_t clamp_index(double v, int64_t Nx) {
 }
 
 /* stratum k's waves along row r (fast._stratum_row) */
-static void stratum_row(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r, float amp,
+static inline __attribute__((always_inline)) void stratum_row_(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r, float amp,
                         float *ore, float *oim) {
   const int64_t Nx = J->Nx;
   const float *xs = J->xs, *slp = J->slpos + k * J->S, nmk = J->nmin[k];
@@ -397,6 +411,14 @@ static void stratum_row(const job_t *J, double h, float x0, float sx, float q, i
   if (cur < Nx) pure(J, cur, Nx - cur, am, bm, amp, ore, oim);
 }
 
+static void stratum_row(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r, float amp,
+                        float *ore, float *oim) { stratum_row_(J, h, x0, sx, q, k, r, amp, ore, oim); }
+#ifdef OMNI_X86
+/* the same walk compiled for AVX2 CPUs: its float64 floor and ceil become single instructions */
+AVX2 static void stratum_row_avx2(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r,
+                                  float amp, float *ore, float *oim) { stratum_row_(J, h, x0, sx, q, k, r, amp, ore, oim); }
+#endif
+
 OMNI_API int omni_abi(void) { return OMNI_ABI; }
 
 /* 1 where this CPU and its OS run the AVX2 + FMA loops: CPUID and XGETBV read directly (the compilers'
@@ -423,7 +445,8 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
                const float *dre, const float *dim, int64_t N, float inv_period, float shift, int want_imag,
                int vector, float *out_re, float *out_im) {
   job_t J = {xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tre, tim, dre, dim, out_re, out_im,
-             Nx, K, D, S, (float)N, 0.0f, inv_period, shift, want_imag, vector != 0, vector == 2};
+             Nx, K, D, S, (float)N, 0.0f, inv_period, shift, want_imag, vector != 0, vector == 2, 0};
+  J.pow2 = N > 0 && (N & (N - 1)) == 0 ? (int)N : 0;
   J.inv_N = 1.0f / J.fN;
   float x0 = xs[0], *A = 0;
 #ifdef OMNI_X86
@@ -443,6 +466,10 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
       /* long slices (SEGMENT_WALK samples or more): the segment walk; else eight samples at a time */
       if (vector && !(fabs(h * (double)sdirs[k * D]) * SEGMENT_WALK < 1.0)) {
         stratum_blocks(&J, sdirs[k * D], q, k, r, amps[k], ore, oim, A, A + S + 16, A + 2 * (S + 16));
+        continue;
+      }
+      if (vector) {
+        stratum_row_avx2(&J, h, x0, sdirs[k * D], q, k, r, amps[k], ore, oim);
         continue;
       }
 #endif

@@ -26,9 +26,10 @@ def built():
     assert ckernel.available()
 
 
-def _case(dim, extent, directions=12, speed=0.0, seed=5, spectrum=("bandpass", 3, 9)):
+def _case(dim, extent, directions=12, speed=0.0, seed=5, spectrum=("bandpass", 3, 9), table_size=None):
+    extra = {} if table_size is None else {"table_size": table_size}
     noise = compile_noise(WaveSettings(dim=dim, spectrum=Spectrum(*spectrum), directions=directions, seed=seed,
-                                       speed=speed))
+                                       speed=speed, **extra))
     return noise
 
 
@@ -89,6 +90,20 @@ def test_c_kernel_equals_numba(dim, nx, x0, x1, speed):
     assert ref_re.std() > 0.1  # a real signal was compared
     real_only, _ = _rows(noise, xs, others, mode="c", imag=False)
     assert np.array_equal(real_only, _rows(noise, xs, others, mode="c")[0])
+
+
+@needs_numba
+@pytest.mark.parametrize("table_size", [1000, 4096, 640])
+def test_table_sizes_wrap_alike(table_size):
+    """The AVX2 loops wrap texel indices with an integer and where the table size is a power of two, with
+    numba's float operations elsewhere: both against the reference, on short (blocks) and long (walk) slices."""
+    for dim, nx, x0, x1 in ((3, 128, -3.0, 4.0), (2, 1024, 0.0, 0.5)):
+        noise = _case(dim, x1 - x0, table_size=table_size)
+        xs, others = _row_set(dim, nx, x0, x1, rows=17, spread=30.0)
+        ref_re, ref_im = _rows(noise, xs, others, mode="numba")
+        re, im = _rows(noise, xs, others)
+        assert np.abs(re - ref_re).max() <= 2e-6 and np.abs(im - ref_im).max() <= 2e-6, table_size
+        assert ref_re.std() > 0.1
 
 
 @needs_numba
