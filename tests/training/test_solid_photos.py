@@ -199,6 +199,26 @@ def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
         photo_card.run_facts(str(tmp_path))
 
 
+def test_photo_card_lists_every_stage_of_a_continued_run(tmp_path):
+    """A model trained over stages (a later config continues the earlier run with init_from) gets one training
+    command per stage in its card, oldest first, with the first stage's starting export."""
+    from training.solid import photo_card
+
+    first = tmp_path / "a_3d.json"
+    first.write_text(json.dumps({"name": "a", "init_onnx": "models/solid/space", "init_sha256": "ab" * 32}))
+    second = tmp_path / "b_3d.json"
+    second.write_text(json.dumps({"name": "b", "init_from": "runs/solid/a"}))
+    lines = photo_card.stage_commands([str(first), str(second)])
+    assert lines == ["# starts from the export models/solid/space (sha256 abababababab...): the model this one replaced",
+                     f"python -m training.solid.train --config {first} --out runs/solid/a",
+                     "# continues runs/solid/a (the stage above)",
+                     f"python -m training.solid.train --config {second} --out runs/solid/b"]
+    space = os.path.join(ROOT, "models", "solid", "space")
+    summary = dict(summary=dict(photos=87))
+    text = photo_card.section(space, summary, summary, True, config=[str(first), str(second)])
+    assert text.index("--out runs/solid/a") < text.index("--out runs/solid/b") < text.index("training.solid.export")
+
+
 @pytest.mark.parametrize("film", [False, True])
 def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
     """A run continued from an export (init_onnx) starts from the very weights that were exported: the rebuilt

@@ -58,10 +58,32 @@ def run_facts(run: str) -> dict:
     raise SystemExit(f"photo_card: error: {run} has neither ckpt.pt (a run) nor solid.json (an export)")
 
 
+def stage_commands(configs) -> list:
+    """The shell lines that train a model through its stages: one ``training.solid.train`` per config (oldest
+    first; a later one continues the earlier run through ``init_from``), the first stage's starting export as a
+    comment.  A config file that is not there is named by its path alone (its stage's run folder is then
+    ``runs/solid/`` + the file's stem less ``_3d``)."""
+    lines = []
+    for i, path in enumerate(configs):
+        try:
+            cfg = read_json(path)
+        except (OSError, ValueError):
+            cfg = {"name": os.path.splitext(os.path.basename(path))[0].removesuffix("_3d")}
+        if i == 0 and cfg.get("init_onnx"):
+            lines.append(f"# starts from the export {cfg['init_onnx']} (sha256 {cfg['init_sha256'][:12]}...): "
+                         "the model this one replaced")
+        elif i and cfg.get("init_from"):
+            lines.append(f"# continues {cfg['init_from']} (the stage above)")
+        lines.append(f"python -m training.solid.train --config {path} --out runs/solid/{cfg['name']}")
+    return lines
+
+
 def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "previous space model",
-            ledger: tuple = (), config: str = "configs/solid/photo_space_3d.json") -> str:
+            ledger: tuple = (), config="configs/solid/photo_space_3d.json") -> str:
+    """``config``: the run's config path, or the paths of its stages oldest first (see :func:`stage_commands`)."""
     f = run_facts(run)
     cfg, step = f["config"], f["step"]
+    configs = (config,) if isinstance(config, str) else tuple(config)
     n_photos = len([n for n in os.listdir(os.path.join("data", "photos", "train"))]) if os.path.isdir(
         os.path.join("data", "photos", "train")) else "?"
     ps, ns = prev["summary"], new["summary"]
@@ -71,9 +93,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
-         *([f"# starts from the export {cfg['init_onnx']} (sha256 {cfg['init_sha256'][:12]}...): the model this one replaced"]
-           if cfg.get("init_onnx") else []),
-         f"python -m training.solid.train --config {config} --out runs/solid/{cfg['name']}",
+         *stage_commands(configs),
          f"python -m training.solid.export runs/solid/{cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
@@ -132,11 +152,12 @@ def main(argv=None) -> int:
     ap.add_argument("--prev-label", default="previous space model", help="the column header of --prev")
     ap.add_argument("--ledger", help="a JSON list of rows (stage, steps, wall time, swd, ratio, beats, colour, "
                                      "shipped) for the ledger table")
-    ap.add_argument("--config", default="configs/solid/photo_space_3d.json", help="the run's config (for the command)")
+    ap.add_argument("--config", action="append", help="the run's config (for the command); repeated for a run "
+                                                      "continued over stages, oldest first")
     ap.add_argument("-o", "--out", default=os.path.join("models", "solid", "MODEL_CARD.md"))
     a = ap.parse_args(argv)
     text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped, a.prev_label,
-                   tuple(read_json(a.ledger)) if a.ledger else (), a.config)
+                   tuple(read_json(a.ledger)) if a.ledger else (), a.config or ["configs/solid/photo_space_3d.json"])
     with open(a.out, encoding="utf-8") as fh:
         card = fh.read()
     if BEGIN in card and END in card:
