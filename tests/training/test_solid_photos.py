@@ -207,10 +207,14 @@ def test_photo_card_lists_every_stage_of_a_continued_run(tmp_path):
     first = tmp_path / "a_3d.json"
     first.write_text(json.dumps({"name": "a", "init_onnx": "models/solid/space", "init_sha256": "ab" * 32}))
     second = tmp_path / "b_3d.json"
-    second.write_text(json.dumps({"name": "b", "init_from": "runs/solid/a"}))
-    lines = photo_card.stage_commands([str(first), str(second)])
+    second.write_text(json.dumps({"name": "b", "init_from": "runs/solid/a", "structure_weight": 0.2,
+                                  "structure_net": "runs/net.pt"}))
+    lines = photo_card.stage_commands([str(first), str(second), str(second)])
     assert lines == ["# starts from the export models/solid/space (sha256 abababababab...): the model this one replaced",
                      f"python -m training.solid.train --config {first} --out runs/solid/a",
+                     "# continues runs/solid/a (the stage above)",
+                     "python -m training.solid.structure_features --out runs/net.pt   # the structure term's network",
+                     f"python -m training.solid.train --config {second} --out runs/solid/b",
                      "# continues runs/solid/a (the stage above)",
                      f"python -m training.solid.train --config {second} --out runs/solid/b"]
     space = os.path.join(ROOT, "models", "solid", "space")

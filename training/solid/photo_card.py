@@ -61,8 +61,9 @@ def run_facts(run: str) -> dict:
 def stage_commands(configs) -> list:
     """The shell lines that train a model through its stages: one ``training.solid.train`` per config (oldest
     first; a later one continues the earlier run through ``init_from``), the first stage's starting export as a
-    comment.  A config file that is not there is named by its path alone (its stage's run folder is then
-    ``runs/solid/`` + the file's stem less ``_3d``)."""
+    comment, and the training of a stage's structure network before its first use.  A config file that is not
+    there is named by its path alone (its stage's run folder is then ``runs/solid/`` + the file's stem less
+    ``_3d``)."""
     lines = []
     for i, path in enumerate(configs):
         try:
@@ -74,6 +75,9 @@ def stage_commands(configs) -> list:
                          "the model this one replaced")
         elif i and cfg.get("init_from"):
             lines.append(f"# continues {cfg['init_from']} (the stage above)")
+        net = cfg.get("structure_net")
+        if net and cfg.get("structure_weight") and not any(net in line for line in lines):
+            lines.append(f"python -m training.solid.structure_features --out {net}   # the structure term's network")
         lines.append(f"python -m training.solid.train --config {path} --out runs/solid/{cfg['name']}")
     return lines
 
@@ -123,7 +127,10 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          f"{cfg['swd_levels']} pyramid levels) plus the sliced colour-histogram term (weight {cfg['hist_weight']})"
          + (f" plus the power-spectrum band term (weight {cfg['spectrum_weight']}; `training/solid/spectrum.py`: "
             "log shares of the luminance's power in 8 log-spaced rings x 4 orientations, each slice against "
-            "its crop)." if cfg.get("spectrum_weight") else "."),
+            "its crop)" if cfg.get("spectrum_weight") else "")
+         + (f" plus the learned structure term (weight {cfg['structure_weight']}: the sliced Wasserstein distance "
+            "of the features of a small network trained on the photo set to tell photo crops from their "
+            "random-phase twins; `training/solid/structure_features.py`)." if cfg.get("structure_weight") else "."),
          "- **Bounded octave transforms:** T_i = R_i e^{c_i} (I + S_i), S_i symmetric with eigenvalues within "
          "±0.6: stretch up to 4:1, never singular. The previous space model's transforms had singular values "
          "down to 0.0, i.e. noise extruded along a line: the diagonal streaks in all its output.", "",
