@@ -219,6 +219,11 @@ def test_photo_card_lists_every_stage_of_a_continued_run(tmp_path):
                      f"python -m training.solid.train --config {second} --out runs/solid/b"]
     space = os.path.join(ROOT, "models", "solid", "space")
     summary = dict(summary=dict(photos=87))
+    third = tmp_path / "c_3d.json"
+    third.write_text(json.dumps({"name": "c", "init_onnx": "models/solid/space", "init_sha256": "cd" * 32}))
+    assert photo_card.stage_commands([str(first), str(third)])[2:] == [
+        "python -m training.solid.export runs/solid/a models/solid/space   # sha256 cdcdcdcdcdcd..., which the next "
+        "stage starts from", f"python -m training.solid.train --config {third} --out runs/solid/c"]
     text = photo_card.section(space, summary, summary, True, config=[str(first), str(second)])
     assert text.index("--out runs/solid/a") < text.index("--out runs/solid/b") < text.index("training.solid.export")
 

@@ -60,11 +60,12 @@ def run_facts(run: str) -> dict:
 
 def stage_commands(configs) -> list:
     """The shell lines that train a model through its stages: one ``training.solid.train`` per config (oldest
-    first; a later one continues the earlier run through ``init_from``), the first stage's starting export as a
+    first; a later one continues the earlier run through ``init_from``, or starts from its export through
+    ``init_onnx``, exported first), the first stage's starting export as a
     comment, and the training of a stage's structure network before its first use.  A config file that is not
     there is named by its path alone (its stage's run folder is then ``runs/solid/`` + the file's stem less
     ``_3d``)."""
-    lines = []
+    lines, prev = [], None
     for i, path in enumerate(configs):
         try:
             cfg = read_json(path)
@@ -75,10 +76,14 @@ def stage_commands(configs) -> list:
                          "the model this one replaced")
         elif i and cfg.get("init_from"):
             lines.append(f"# continues {cfg['init_from']} (the stage above)")
+        elif i and cfg.get("init_onnx"):  # starts from the stage above's export
+            lines.append(f"python -m training.solid.export runs/solid/{prev} {cfg['init_onnx']}   # sha256 "
+                         f"{cfg.get('init_sha256', '?')[:12]}..., which the next stage starts from")
         net = cfg.get("structure_net")
         if net and cfg.get("structure_weight") and not any(net in line for line in lines):
             lines.append(f"python -m training.solid.structure_features --out {net}   # the structure term's network")
         lines.append(f"python -m training.solid.train --config {path} --out runs/solid/{cfg['name']}")
+        prev = cfg["name"]
     return lines
 
 
