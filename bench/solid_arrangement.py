@@ -39,11 +39,10 @@ from backend.solid.model import SolidTextureModel  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from training.solid import exemplars as ex, photo_eval as pe  # noqa: E402
 from training.solid.arrangement import ArrangementFeatures  # noqa: E402
-from training.solid.structure_features import StructureFeatures, load_structure_net  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
 from training.solid.soft_morphology import soft_morphology_loss  # noqa: E402
 from training.solid.swd import swd_loss  # noqa: E402
-from training.solid.train import load_config, loss_features, texture_loss  # noqa: E402
+from training.solid.train import load_config, loss_features, structure_features, texture_loss  # noqa: E402
 
 SIZE = 128
 DEFAULT = ("train/paving__alpine_arctic_paving_stones_01.jpg", "val/paving__sahara_paving_stones_01.jpg",
@@ -109,7 +108,7 @@ def main(argv=None) -> int:
     torch.set_num_threads(2)
     cfg = load_config(a.config)
     feats, arr = loss_features(cfg), ArrangementFeatures()
-    structure = StructureFeatures(load_structure_net(a.structure)) if a.structure else None
+    structure = structure_features(a.structure) if a.structure else None
     model = SolidTextureModel(a.model)
     table = {}
     for name in a.photos:

@@ -149,6 +149,10 @@ AVX2 static inline __m256 cos_half_pi8(__m256 s) {
   return _mm256_fmadd_ps(y, p, _mm256_set1_ps(1.0f));
 }
 
+/* The border ramp's position u = (p - n - sp) c + 1/2 (c = 1/(2 * 0.3)) as (p - n) c + ramp_offset(sp): the offset
+ * of slice n's ramp centre sp, once per slice record instead of once per sample */
+static inline float ramp_offset(float sp) { return 0.5f - sp * (float)(0.5 / 0.3); }
+
 /* Eight texels: with ``gather`` 0, from two loads and a permute where the lanes' texels lie within 16
  * consecutive ones (the texel step per sample is small on a grid), else a gather; with ``gather`` 1 a
  * gather always (faster on CPUs with fast gathers, such as Intel's Sapphire Rapids). */
@@ -233,7 +237,7 @@ AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float 
 AVX2 static void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0,
                             float b0, float a1, float b1, float amp, float *ore, float *oim) {
   const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vfn = _mm256_set1_ps(fn);
-  const __m256 voff = _mm256_set1_ps(0.5f - sp * (float)(0.5 / 0.3));
+  const __m256 voff = _mm256_set1_ps(ramp_offset(sp));
   const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), one = _mm256_set1_ps(1.0f);
   const __m256 two = _mm256_set1_ps(2.0f), three = _mm256_set1_ps(3.0f);
   const __m256 vamp = _mm256_set1_ps(amp), fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
@@ -279,7 +283,7 @@ AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, in
   int64_t ri0 = (int64_t)(nlo - nmk), cnt = (int64_t)(nhi - nlo) + 2;  /* records of slices nlo .. nhi + 1 */
   for (int64_t i = 0; i < cnt; i++) {
     slice_affine(J, k, r, ri0 + i, &A[i], &B[i]);
-    SP[i] = 0.5f - slp[ri0 + i] * (float)(0.5 / 0.3);
+    SP[i] = ramp_offset(slp[ri0 + i]);
   }
   for (int64_t i = cnt; i < cnt + 9; i++) A[i] = B[i] = SP[i] = 0.0f;
   const int regs = cnt <= 8;

@@ -22,6 +22,8 @@ from backend._export import export as _ex
 from ..model_card import hardware_line, read_json
 
 BEGIN, END = "<!-- photo-space:begin -->", "<!-- photo-space:end -->"
+#: the run's config when none is given
+DEFAULT_CONFIG = "configs/solid/photo_space_3d.json"
 
 ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase noise, same photos", "median_random_phase"),
         ("… pixel shuffle", "median_pixel_shuffle"), ("… Perlin with the photo's histogram", "median_perlin_hist"),
@@ -88,7 +90,7 @@ def stage_commands(configs) -> list:
 
 
 def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "previous space model",
-            ledger: tuple = (), config="configs/solid/photo_space_3d.json") -> str:
+            ledger: tuple = (), config=DEFAULT_CONFIG) -> str:
     """``config``: the run's config path, or the paths of its stages oldest first (see :func:`stage_commands`)."""
     f = run_facts(run)
     cfg, step = f["config"], f["step"]
@@ -169,7 +171,7 @@ def main(argv=None) -> int:
     ap.add_argument("-o", "--out", default=os.path.join("models", "solid", "MODEL_CARD.md"))
     a = ap.parse_args(argv)
     text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped, a.prev_label,
-                   tuple(read_json(a.ledger)) if a.ledger else (), a.config or ["configs/solid/photo_space_3d.json"])
+                   tuple(read_json(a.ledger)) if a.ledger else (), a.config or [DEFAULT_CONFIG])
     with open(a.out, encoding="utf-8") as fh:
         card = fh.read()
     if BEGIN in card and END in card:
