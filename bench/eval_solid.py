@@ -61,7 +61,8 @@ def quality(n: int, models_dir: str = MODELS) -> dict:
                 methods["ours_2d"] = np.stack([m.evaluate(_plane(EVAL_SIZE, ppu, i), code, i).reshape(EVAL_SIZE, EVAL_SIZE, 3)
                                                for i in range(n)])
             else:
-                methods["ours_3d"] = slices_3d(lambda p, i: m.evaluate(p, code, i), n, EVAL_SIZE, ppu)
+                methods["ours_3d"] = slices_3d(lambda p, i: m.evaluate(p, code, i), n, EVAL_SIZE, ppu,
+                                               fixed_axis=m.config.get("config", {}).get("fixed_axis", ""))
         if space is not None and name in space.codes and not space.colour_stats:
             held = ex.heldout_region(name).permute(1, 2, 0).numpy()
             code = space.translate(space.encode(held))
@@ -130,12 +131,14 @@ def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
         with torch.no_grad():
             e, T = tm.codes(batch=1)
             seeds = octave_seeds([0], tm.octaves)
+            # a photo model's colour (mu, L): the export's, as the runtime reads it
+            stats = torch.tensor([m.config["colour_code"]], dtype=torch.float32) if m.colour_stats else None
             x = torch.from_numpy(pts.astype(np.float32))
-            tm.sample(x[None, :chunk], e, T, seeds)
+            tm.sample(x[None, :chunk], e, T, seeds, stats)
             t = time.perf_counter()
             out = np.empty((len(pts), 3), np.float32)
             for a in range(0, len(pts), chunk):
-                out[a:a + chunk] = tm.sample(x[None, a:a + chunk], e, T, seeds)[0].numpy()
+                out[a:a + chunk] = tm.sample(x[None, a:a + chunk], e, T, seeds, stats)[0].numpy()
     sec = time.perf_counter() - t
     return dict(engine=engine, dim=dim, size=size, points=len(pts), seconds=round(sec, 3),
                 points_per_s=round(len(pts) / sec), peak_mib=_peak_mib(),
@@ -160,7 +163,7 @@ def main() -> int:
     ap.add_argument("--speed", action="store_true", help="also time onnxruntime against torch")
     ap.add_argument("--only-speed", action="store_true")
     ap.add_argument("--model", default="rust_3d", help="model timed by --speed")
-    ap.add_argument("--run", default=os.path.join(ROOT, "runs", "solid", "rust_3d_long"),
+    ap.add_argument("--run", default=os.path.join(ROOT, "runs", "solid", "rust_3d"),
                     help="its training run (torch loads the same weights from ckpt.pt)")
     ap.add_argument("--speed-one", choices=("onnxruntime", "torch"), help=argparse.SUPPRESS)
     ap.add_argument("--dim", type=int, default=3, help=argparse.SUPPRESS)

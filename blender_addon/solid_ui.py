@@ -67,8 +67,8 @@ def load_model(name: str):
 def _catalogue() -> list:
     """(identifier, label, description) of every shipped texture: single 3D models, then space exemplars."""
     models = _models()
-    items = [(f"single:{name}", m.config["exemplars"][0].replace("_", " ").title(),
-              f"Fitted to the {m.config['exemplars'][0]} exemplar ({name})")
+    items = [(f"single:{name}", m.exemplar_label.replace("_", " ").title(),
+              f"Fitted to the exemplar {os.path.basename(m.config['exemplars'][0])} ({name})")
              for name, m in models.items() if m.mode == "single" and m.dim == 3]
     items += [(f"space:{name}:{ex}", f"{ex.replace('_', ' ').title()} (space)",
                f"The {ex} exemplar's code in the texture space {name}")

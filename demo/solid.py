@@ -41,11 +41,14 @@ def slices_sheet(out: str, size: int = 160) -> list:
         if m.mode != "single" or m.dim != 3:
             continue
         ex = m.config["exemplars"][0]
-        img = read_rgb(os.path.join(EXEMPLARS, f"{ex}.png"))
+        # a shipped exemplar by name (data/exemplars/NAME.png) or a photo of the photo set by its path
+        path = os.path.join(EXEMPLARS, f"{ex}.png") if os.path.isfile(os.path.join(EXEMPLARS, f"{ex}.png")) \
+            else os.path.join(ROOT, ex)
+        img = read_rgb(path)
         step = max(1, round(1.0 / m.config["exemplar_scale"]))
         exemplar = img[::step, ::step][:size, :size]
         code = m.default_code()
-        scale = m.config["exemplar_scale"]
+        scale = 1.0 / step   # the slices at the resolution the exemplar is shown at
         cells = [exemplar] + [m.image(size, code, 0, scale=scale, axis=a, offset=(1.3, 2.1, 0.7)) for a in "zyx"]
         frame = np.linalg.qr(np.random.default_rng(4).normal(size=(3, 3)))[0]
         pts = plane_points(size, m.px_per_unit * scale) @ frame[:, :2].T + 3.0

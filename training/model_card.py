@@ -51,7 +51,8 @@ def read_json(path: str | None):
         return json.load(fh)
 
 
-def hardware_line() -> str:
+def cpu_name() -> str:
+    """The CPU's model name (/proc/cpuinfo), else what platform knows."""
     cpu = platform.processor() or platform.machine()
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as fh:
@@ -60,7 +61,11 @@ def hardware_line() -> str:
             cpu = names[0]
     except OSError:
         pass
-    return f"{cpu}, {os.cpu_count()} cores visible, 1 training thread"
+    return cpu
+
+
+def hardware_line() -> str:
+    return f"{cpu_name()}, {os.cpu_count()} cores visible, 1 training thread"
 
 
 def _table(ev: dict) -> str:

@@ -142,13 +142,26 @@ class SolidTextureModel:
         #: ... and brick features (brick.py)
         self.bricks = int(c.get("bricks", 0))
         self.z_dim = int(c.get("z_dim", 8))
+        if self.mode == "single" and self.colour_stats and len(c.get("colour_code", ())) != self.colour_stats:
+            raise ModelError(f"model {self.name!r} draws in its exemplar's colours but its solid.json has no "
+                             f"colour_code of {self.colour_stats} values (mu and L): re-export it")
         self._session = SessionCache(folder, threads)
+
+    @property
+    def exemplar_label(self) -> str:
+        """The first exemplar's short name: a shipped exemplar's ('gravel') or a photo-set file's category
+        ('wood' for ``data/photos/train/wood__oldwood.jpg``)."""
+        return os.path.splitext(os.path.basename(self.config["exemplars"][0]))[0].split("__", 1)[0]
 
     # -- codes ----------------------------------------------------------------------------------
     def default_code(self) -> TextureCode:
         """The single-mode texture, or the space model's first training exemplar."""
         if self.mode == "single":
-            return TextureCode(np.asarray(self.config["code"], _F), np.asarray(self.config["T"], _F))
+            e, T = np.asarray(self.config["code"], _F), np.asarray(self.config["T"], _F)
+            if not self.colour_stats:
+                return TextureCode(e, T)
+            c = np.asarray(self.config["colour_code"], _F)
+            return TextureCode(e, T, c[:3].copy(), c[3:12].reshape(3, 3).copy())
         return self.translate(next(iter(self.codes.values())))
 
     def encode(self, image: np.ndarray) -> np.ndarray:

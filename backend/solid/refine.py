@@ -155,7 +155,7 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
     if refine < 0:
         raise SettingError(name("refine"), f"must be >= 0, got {refine}")
     if model.mode == "single":  # an exemplar may only name the model's own texture
-        own = {model.name} | {str(e) for e in model.config.get("exemplars", [])}
+        own = {model.name, model.exemplar_label} | {str(e) for e in model.config.get("exemplars", [])}
         other = exemplar is not None and (not isinstance(exemplar, str) or exemplar not in own)
         for key, bad, why in (("exemplar", other, "another exemplar"),
                               ("to", to, "interpolation"), ("refine", refine, "refining")):

@@ -82,7 +82,9 @@ def test_uv_image_bake_is_the_texture_at_each_texels_surface_point(scene):
 
 
 def test_cube_seams_agree(scene):
-    """Texels on both sides of a cube edge (two UV islands) read nearly the same 3D points."""
+    """Texels on both sides of a cube edge (two UV islands) agree as well as the texture itself does between
+    their 3D points (no seam: the baked colours differ across the edge no more than the runtime's at the same
+    points; a texture with fine grain differs over the texel's width anyway)."""
     bpy.ops.mesh.primitive_cube_add(size=2.0)
     p = scene.omninoise_solid
     p.size, p.scale = 256, 0.25
@@ -100,10 +102,13 @@ def test_cube_seams_agree(scene):
     zb = pts[near2][:, 2]
     ca, cb = img[near], img[near2]
     # colours as a function of z along the edge, interpolated: the two faces agree
+    m = _model()
+    ra, rb = (m.evaluate(q * 0.25, m.default_code(), seed=3) for q in (pts[near], pts[near2]))
     order = np.argsort(zb)
     for c in range(3):
-        interp = np.interp(za, zb[order], cb[order, c])
-        assert np.abs(interp - ca[:, c]).mean() < 0.06
+        baked = np.abs(np.interp(za, zb[order], cb[order, c]) - ca[:, c]).mean()
+        texture = np.abs(np.interp(za, zb[order], rb[order, c]) - ra[:, c]).mean()
+        assert baked < texture + 0.01 and baked < 0.15
 
 
 def test_color_attribute_bake(scene):

@@ -46,3 +46,21 @@ def test_slices_cover_axes_and_oblique_planes():
     assert out.shape == (4, 8, 8, 3)
     const = [int((p.std(0) < 1e-9).sum()) for p in seen]
     assert const == [1, 1, 1, 0]      # three axis-aligned slices, then an oblique one
+
+
+def test_slices_of_a_fixed_axis_model_run_through_its_axis():
+    """fixed_axis 'rows': every slice is vertical (z varies down the image, z constant along a row); 'columns':
+    x runs along every row, constant down a column."""
+    for axis, along_row, down_col in (("rows", None, 2), ("columns", 0, None)):
+        seen = []
+
+        def evaluate(p, i):
+            seen.append(p.reshape(8, 8, 3))
+            return np.zeros((len(p), 3), np.float32)
+
+        slices_3d(evaluate, 6, 8, 8.0, fixed_axis=axis)
+        for p in seen:
+            if down_col is not None:
+                assert np.allclose(p[:, :, 2].std(1), 0) and p[0, 0, 2] > p[-1, 0, 2]   # rows level, top up
+            if along_row is not None:
+                assert np.allclose(np.diff(p[:, :, 0], axis=1), 1 / 8.0) and np.allclose(p[:, :, 0].std(0), 0)

@@ -55,6 +55,33 @@ def test_rotations_and_slices():
     assert x2.shape == (2, 64, 2) and float(x2.abs().max()) < 4.0
 
 
+def test_fixed_axis_slices_keep_the_photo_direction_on_one_axis():
+    """fixed_axis 'columns': image columns step along +x in every slice, the plane turning about x (all angles
+    seen); 'rows': image rows step down -z, the plane turning about z. Configs refuse it with rotated crops."""
+    g = torch.Generator().manual_seed(3)
+    size, ppu = 8, 8.0
+    for axis, col_step, row_step_axis in (("columns", (1, 0, 0), 0), ("rows", None, 2)):
+        x = slice_points(64, size, ppu, 3, 0.0, 5.0, g, fixed_axis=axis).view(64, size, size, 3)
+        du = (x[:, 0, 1] - x[:, 0, 0]) * ppu          # one image column to the right
+        dv = (x[:, 1, 0] - x[:, 0, 0]) * ppu          # one image row down
+        np.testing.assert_allclose(du.norm(dim=1).numpy(), 1.0, atol=1e-5)
+        np.testing.assert_allclose((du * dv).sum(1).numpy(), 0.0, atol=1e-5)   # orthonormal frames
+        if col_step is not None:
+            np.testing.assert_allclose(du.numpy(), np.broadcast_to(col_step, (64, 3)), atol=1e-5)
+            angles = torch.atan2(dv[:, 2], dv[:, 1])
+        else:
+            np.testing.assert_allclose(dv.numpy(), np.broadcast_to((0, 0, -1), (64, 3)), atol=1e-5)
+            angles = torch.atan2(du[:, 1], du[:, 0])
+        # the plane turns all the way about the axis: every quadrant of angles is drawn
+        assert len(set((torch.floor(angles / (np.pi / 2)) % 4).int().tolist())) == 4
+    with pytest.raises(ValueError, match="fixed_axis"):
+        slice_points(1, 4, 4.0, 3, 0.0, 1.0, g, fixed_axis="diagonal")
+    with pytest.raises(ValueError, match="augment false"):
+        SolidConfig.from_dict({"fixed_axis": "columns", "augment": True})
+    with pytest.raises(ValueError, match="dim 3"):
+        SolidConfig.from_dict({"fixed_axis": "rows", "dim": 2})
+
+
 def test_features_see_structure_and_colour():
     f = RandomFeatures(seed=0)
     rng = torch.Generator().manual_seed(0)
@@ -129,7 +156,7 @@ def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_
     (cfgs / "c_long.json").write_text(json.dumps(dict(long, init_from="runs/c")))
     export(str(tmp_path / "runs" / "c_long"), str(tmp_path / "models" / "c"))
     text = card(str(tmp_path / "models"), str(tmp_path / "runs"), None, str(cfgs))
-    assert "| c | single | 2D | gravel | 1.0 | `c.json` → `c_long.json` | 7 |" in text, text
+    assert "| c | single | 2D | gravel | 1.0 | gram | `c.json` → `c_long.json` | 7 |" in text, text
     # a continued run that lost to the shipped model is listed beside it, marked as not shipped
     row = lambda v: {"gravel": {"ours_3d": dict(style=v, psd=0.1, diversity=1.0, success=0.5)}}  # noqa: E731
     for name, v in (("prev", 0.4), ("cand", 0.6), ("now", 0.4)):
@@ -260,3 +287,51 @@ def test_refinement_never_worsens_and_moves_a_wrong_start(tmp_path):
     fine = np.tile(np.sin(np.arange(64) * 2.4)[None, :, None] * 0.3 + 0.5, (64, 1, 3))
     assert stats_distance(s0, texture_stats(fine)) > 0.1                               # finer
     assert stats_distance(s0, texture_stats(base.copy())) == 0.0
+
+
+def test_spectral_aspect_and_the_initial_stretch_follow_the_grain():
+    """Stripes that run horizontally (grain along the rows) have aspect < 1, standing ones > 1, a noise about 1;
+    init_stretch lengthens features along the fixed axis by it, never shortens them, and starts the run so."""
+    from training.solid.model import spectral_aspect
+    from training.solid.train import initial_stretch
+
+    g = torch.Generator().manual_seed(0)
+    noise = torch.rand(1, 64, 64, generator=g)
+    blur = torch.nn.functional.avg_pool2d(noise[None], (1, 9), stride=1, padding=(0, 4))[0]   # smeared along rows
+    lying = blur.expand(3, -1, -1)
+    standing = lying.transpose(1, 2)
+    assert spectral_aspect(lying) < 0.5 < 2.0 < spectral_aspect(standing)
+    assert 0.8 < spectral_aspect(noise.expand(3, -1, -1)) < 1.25
+    assert initial_stretch(lying, "columns") == pytest.approx(spectral_aspect(lying))
+    assert initial_stretch(lying, "rows") == 1.0 and initial_stretch(standing, "columns") == 1.0
+    with pytest.raises(ValueError, match="init_stretch"):
+        SolidConfig.from_dict({"init_stretch": True})
+
+
+def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
+    """axis_rotations keep the fixed axis on the lattice's second (brick-row) axis and are rotations; a fresh
+    single model with fixed_axis starts from them, its column of the axis scaled by the initial stretch."""
+    from training.solid.model import axis_rotations
+    from training.solid import exemplars as ex
+
+    for axis, k in (("columns", 0), ("rows", 2)):
+        T = axis_rotations(8, axis, seed=2)
+        e = torch.zeros(3)
+        e[k] = 1.0
+        np.testing.assert_allclose((T @ e).numpy(), np.broadcast_to([0.0, 1.0, 0.0], (8, 3)), atol=1e-6)
+        np.testing.assert_allclose((T @ T.transpose(1, 2)).numpy(), np.broadcast_to(np.eye(3), (8, 3, 3)), atol=1e-6)
+        np.testing.assert_allclose(torch.det(T).numpy(), 1.0, atol=1e-5)
+        assert len({round(float(t[0, (k + 1) % 3]), 4) for t in T}) == 8     # each octave turned its own way
+    photo = ex.photo_set("train")[0]
+    cfg = dict(name="tiny_axis", mode="single", dim=3, crop=32, batch=1, steps=0, width=8, threads=1,
+               exemplars=[photo], colour="affine", loss="swd", swd_width=4, swd_levels=1, augment=False,
+               fixed_axis="rows", init_stretch=True, checkpoint_every=1)
+    from training.solid.train import initial_stretch, training_images
+    c = SolidConfig.from_dict(cfg)
+    logs = []
+    train(SolidConfig.from_dict(dict(cfg, steps=1, lr=0.0, lr_min=0.0)), str(tmp_path / "run"), log=logs.append)
+    state = torch.load(tmp_path / "run" / "ckpt.pt", weights_only=False)
+    want = axis_rotations(8, "rows", 0)
+    want[:, :, 2] *= initial_stretch(training_images(c)[0], "rows")
+    np.testing.assert_allclose(state["model"]["T"].numpy(), want.numpy(), atol=1e-6)   # lr 0: the start itself
+    assert any("stretched along the rows axis" in s for s in logs)

@@ -414,3 +414,54 @@ def test_min_spacing_caps_every_octave_lattice_in_training_and_in_the_export(tmp
     with pytest.raises(ValueError, match="needs mode 'space' and transform 'bounded'"):
         SolidConfig.from_dict(dict(cfg, transform="free"))
     assert doc["config"]["min_spacing"] == 8.0
+
+
+def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
+    """A single-exemplar photo model (``hold_out``): training crops only the left three quarters, the export
+    carries the photo's colour (mu, L) so the runtime draws in it without an encoder, and
+    bench/eval_solid_singles.py measures it on the right quarter beside random phase, the shuffle and a space model."""
+    import importlib.util
+
+    photo_path = os.path.relpath(ex.photo_set("train")[0], ROOT)
+    img = ex.exemplar(os.path.join(ROOT, photo_path))
+    cfg = dict(name="tiny_single", mode="single", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=[os.path.join(ROOT, photo_path)], colour="affine",
+               loss="swd", swd_width=8, swd_levels=2, hold_out=True)
+    c = SolidConfig.from_dict(cfg)
+    from training.solid.train import training_images
+    (region,) = training_images(c)
+    assert region.shape[2] == img.shape[2] * 3 // 4          # the right quarter never reaches training
+    assert training_images(SolidConfig.from_dict({**cfg, "hold_out": False}))[0].shape[2] == img.shape[2]
+    with pytest.raises(ValueError, match="hold_out"):
+        SolidConfig.from_dict({**cfg, "mode": "space", "exemplars": ex.photo_set("train")[:2]})
+    train(c, str(tmp_path / "run"), log=lambda *_: None)
+    doc = export(str(tmp_path / "run"), str(tmp_path / "models" / "tiny_single"))
+    np.testing.assert_allclose(doc["colour_code"], colour_stats(region.permute(1, 2, 0).numpy()), atol=1e-5)
+    assert doc["hardware"].endswith("1 threads, fp32")        # where it trained travels with the export
+    rt = SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
+    code = rt.default_code()
+    np.testing.assert_allclose(code.mu, doc["colour_code"][:3], atol=1e-6)
+    pic = rt.image(32, code, seed=0, axis="x")
+    assert pic.shape == (32, 32, 3) and 0.0 <= pic.min() and pic.max() <= 1.0
+    assert rt.exemplar_label == os.path.basename(photo_path).split("__")[0]
+    # an export without the colour it draws in is refused when loaded, with a one-line reason
+    broken = dict(json.loads((tmp_path / "models" / "tiny_single" / "solid.json").read_text()))
+    del broken["colour_code"]
+    (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(broken))
+    from backend.onnx_models import ModelError
+    with pytest.raises(ModelError, match="colour_code"):
+        SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
+    (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(doc))
+    # the held-out evaluation: every measure, against the shipped space model given the same training pixels
+    spec = importlib.util.spec_from_file_location("eval_solid_singles",
+                                                  os.path.join(ROOT, "bench", "eval_solid_singles.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = tmp_path / "singles.json"
+    assert mod.main(["--models", str(tmp_path / "models"), "--space", os.path.join(ROOT, "models", "solid", "space"),
+                     "--prev", str(tmp_path / "models"), "-o", str(out), "--sheet", str(tmp_path / "s.png")]) == 0
+    r = json.loads(out.read_text())["rows"]["tiny_single"]
+    assert set(r) >= {"swd", "space", "random_phase", "pixel_shuffle", "photo_crop", "colour", "morph", "previous"}
+    assert r["previous"] == r["swd"]          # the "previous" model here is the model itself: the same figures
+    assert r["photo_crop"] < r["pixel_shuffle"] and r["photo_crop"] < r["swd"]   # a 2-step model is far from the photo
+    assert (tmp_path / "s.png").stat().st_size > 1000

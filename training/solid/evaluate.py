@@ -79,14 +79,21 @@ def _metrics(samples: torch.Tensor, refs: torch.Tensor, feats: RandomFeatures) -
     return dict(style=round(style, 4), psd=round(psd, 4), diversity=round(float(np.mean(d)), 4))
 
 
-def slices_3d(evaluate, n: int, size: int, px_per_unit: float, seed: int = 0) -> np.ndarray:
+def slices_3d(evaluate, n: int, size: int, px_per_unit: float, seed: int = 0, fixed_axis: str = "") -> np.ndarray:
     """n slices (axis-aligned xy/xz/yz in turn, every 4th oblique) of a 3D texture through random
-    points, sample i with seed i: evaluate(points (N, 3), seed) -> (N, 3).  Returns (n, size, size, 3)."""
+    points, sample i with seed i: evaluate(points (N, 3), seed) -> (N, 3).  Returns (n, size, size, 3).
+    ``fixed_axis`` ("columns" or "rows", a model trained so): the planes it was trained on instead, through
+    that axis at random angles about it, the image's horizontal along x ("columns") or its vertical along z."""
     rng = np.random.default_rng(seed)
     plane = plane_points(size, px_per_unit)
     out = []
     for i in range(n):
-        if i % 4 == 3:
+        if fixed_axis:
+            t = rng.uniform(0.0, 2.0 * np.pi)
+            c, s = np.cos(t), np.sin(t)
+            frame = np.array([[1.0, 0.0], [0.0, c], [0.0, s]]) if fixed_axis == "columns" else \
+                np.array([[c, 0.0], [s, 0.0], [0.0, 1.0]])
+        elif i % 4 == 3:
             q, r = np.linalg.qr(rng.normal(size=(3, 3)))
             frame = q * np.sign(np.diag(r))
         else:
@@ -150,7 +157,7 @@ def evaluate_exemplar(name: str, region_scale: float, methods: dict, n: int = 8,
                              align_corners=False)[0].clamp(0, 1)
 
     held = rescale(ex.heldout_region(name))
-    train_region = rescale(ex.train_region(ex.exemplar(name), name))
+    train_region = rescale(ex.train_region(ex.exemplar(name), name, hold_out=True))   # never the held-out pixels
     refs = _crops(held, 16, size, seed=99)
     feats = RandomFeatures(**METRIC_FEATURES)
     res = {}

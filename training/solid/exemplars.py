@@ -130,9 +130,11 @@ def exemplar(name: str, data_dir: str | None = None) -> torch.Tensor:
     raise ValueError(f"unknown exemplar {name!r}: not a file and not one of {', '.join(PHOTOS + PROCEDURAL)}")
 
 
-def train_region(img: torch.Tensor, name: str) -> torch.Tensor:
-    """The part of a shipped photo that training may crop (all but the right quarter); other images whole."""
-    return img[:, :, : img.shape[2] * 3 // 4] if name in PHOTOS else img
+def train_region(img: torch.Tensor, name: str, hold_out: bool = False) -> torch.Tensor:
+    """The part of an exemplar that training may crop: all but the right quarter of a shipped photo, or of
+    any photo when ``hold_out`` (a single-exemplar model's own held-out pixels, :func:`heldout_region`);
+    other images whole."""
+    return img[:, :, : img.shape[2] * 3 // 4] if name in PHOTOS or (hold_out and name not in PROCEDURAL) else img
 
 
 def heldout_region(name: str, data_dir: str | None = None) -> torch.Tensor:

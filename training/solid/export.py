@@ -96,12 +96,16 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                spectral_gains=cfg.octaves if cfg.spectral else 0, cellular=cfg.cellular, bricks=cfg.bricks,
                step=int(state["step"]),
                train_seconds=round(float(state.get("elapsed", 0.0)), 1), n_params=int(state["n_params"]),
+               hardware=str(state.get("hardware", "")),
                config=state["config"])
     with torch.no_grad():
         if cfg.mode == "single":
             e, T = model.codes(batch=1)
             doc["code"] = e[0].numpy().astype(float).round(7).tolist()
             doc["T"] = T[0].numpy().astype(float).round(7).tolist()
+            if cfg.colour == "affine":   # the exemplar's colour (mu, L), as training rendered it
+                doc["colour_code"] = colour_stats(training_images(cfg)[0].unsqueeze(0))[0].numpy() \
+                    .astype(float).round(7).tolist()
         else:
             _onnx(model.encoder, (torch.rand(1, 3, ENCODER_SIZE, ENCODER_SIZE),), os.path.join(out, "encoder.onnx"),
                   ["exemplar"], ["z"], {"exemplar": {0: "batch"}, "z": {0: "batch"}})

@@ -35,7 +35,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
-__all__ = ["shape_features", "colour_stats", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "slice_points"]
+__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "axis_rotations", "slice_points"]
 
 
 def shape_features(cellular: int, bricks: int) -> int:
@@ -53,6 +53,28 @@ def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
         if torch.det(q) < 0:
             q[:, 0] = -q[:, 0]
         out.append(q)
+    return torch.stack(out).to(torch.float32)
+
+
+def axis_rotations(octaves: int, fixed_axis: str, seed: int = 0) -> torch.Tensor:
+    """Transforms (octaves, 3, 3) float32 that keep a direction of space on the lattice's second axis (the
+    brick lattice's rows, :mod:`backend.solid.brick`) and turn the plane across it by a seeded uniform angle
+    per octave: "columns" keeps x, "rows" keeps z (det +1).  A single-exemplar model trained with
+    ``fixed_axis`` starts from these, so its lattices start aligned with the photo's direction."""
+    g = torch.Generator().manual_seed(seed)
+    axis = {"columns": 0, "rows": 2}[fixed_axis]
+    a, b = [k for k in range(3) if k != axis]
+    out = []
+    for _ in range(octaves):
+        t = float(torch.rand(1, generator=g)) * 2.0 * math.pi
+        c, s = math.cos(t), math.sin(t)
+        T = torch.zeros(3, 3, dtype=torch.float64)
+        T[0, a], T[0, b] = c, s          # p_0: a direction across the axis
+        T[1, axis] = 1.0                 # p_1: along the axis
+        T[2, a], T[2, b] = s, -c         # p_2: the other direction across it
+        if torch.det(T) < 0:
+            T[2] = -T[2]
+        out.append(T)
     return torch.stack(out).to(torch.float32)
 
 
@@ -93,6 +115,22 @@ def spectral_gains(img: torch.Tensor, octaves: int = 8, px_per_unit: float = 128
         g = c
     e = torch.stack([energy[L] for L in levels], dim=1) + 1e-12
     return torch.sqrt(octaves * e / e.sum(dim=1, keepdim=True)).clamp(*GAIN_RANGE)
+
+
+def spectral_aspect(img: torch.Tensor) -> float:
+    """How much longer an exemplar's features run across than down: (3, H, W) -> sqrt(E[f_x²] / E[f_y²]), the
+    spread of horizontal over vertical frequencies in the luminance's power spectrum (Hann window, mean
+    removed).  1 for an isotropic texture; < 1 when features run horizontally (grain along the rows), > 1 when
+    they run vertically (planks standing up)."""
+    y = img.double().mean(0)
+    y = y - y.mean()
+    H, W = y.shape
+    win = torch.outer(torch.hann_window(H, periodic=False, dtype=torch.float64),
+                      torch.hann_window(W, periodic=False, dtype=torch.float64))
+    P = torch.fft.fft2(y * win).abs() ** 2
+    fy = torch.fft.fftfreq(H, dtype=torch.float64).view(-1, 1)
+    fx = torch.fft.fftfreq(W, dtype=torch.float64).view(1, -1)
+    return float(torch.sqrt((P * fx ** 2).sum() / (P * fy ** 2).sum().clamp_min(1e-30)))
 
 
 def colour_stats(img: torch.Tensor, eps: float = 1e-4) -> torch.Tensor:
@@ -344,13 +382,20 @@ class SolidTexture(nn.Module):
 
 
 def slice_points(batch: int, size: int, px_per_unit: float, dim: int, oblique: float, extent: float,
-                 generator: torch.Generator) -> torch.Tensor:
+                 generator: torch.Generator, fixed_axis: str = "") -> torch.Tensor:
     """Pixel-centre positions of random 2D slices of the D-dimensional domain (Fig. 5): (B, size*size, D).
 
     2D: the plane itself, shifted by a random offset (orientation kept: the
     exemplar's orientation is the texture's).  3D: planes through a random
     point, axis-aligned (a random axis permutation) or, with probability
     ``oblique``, randomly rotated.
+
+    ``fixed_axis`` (3D) keeps one image axis on one axis of space, for materials with a direction (Kopf et al.
+    2007 give such solids one exemplar per view; here one view constrains every plane through the axis):
+    "columns": the image's horizontal runs along x (wood grain: every plane containing x, rotated about it
+    by a uniform angle, shows the photo; planes across x, the end grain, are left free); "rows": the
+    image's vertical runs along -z (a brick wall: every vertical plane shows the courses, the top of the
+    photo up).
     """
     u = (torch.arange(size, dtype=torch.float32) + 0.5) / px_per_unit
     vv, uu = torch.meshgrid(u, u, indexing="ij")
@@ -358,9 +403,20 @@ def slice_points(batch: int, size: int, px_per_unit: float, dim: int, oblique: f
     off = (torch.rand(batch, 1, dim, generator=generator) * 2.0 - 1.0) * extent
     if dim == 2:
         return plane.unsqueeze(0) + off
+    if fixed_axis not in ("", "columns", "rows"):
+        raise ValueError(f"fixed_axis must be '', 'columns' or 'rows', got {fixed_axis!r}")
     frames = []
     for _ in range(batch):
-        if torch.rand(1, generator=generator).item() < oblique:
+        if fixed_axis:
+            t = float(torch.rand(1, generator=generator)) * 2.0 * math.pi
+            c, s_ = math.cos(t), math.sin(t)
+            if fixed_axis == "columns":     # u = x; v turns about x
+                a, b = [1.0, 0.0, 0.0], [0.0, c, s_]
+            else:                           # v = z (image up is +z); u turns about z
+                a, b = [c, s_, 0.0], [0.0, 0.0, 1.0]
+            n = torch.linalg.cross(torch.tensor(a), torch.tensor(b))
+            frames.append(torch.stack([torch.tensor(a), torch.tensor(b), n], dim=1))
+        elif torch.rand(1, generator=generator).item() < oblique:
             q, r = torch.linalg.qr(torch.randn(3, 3, generator=generator))
             frames.append(q * torch.sign(torch.diagonal(r)).unsqueeze(0))
         else:

@@ -12,11 +12,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 
-from ..model_card import hardware_line, read_json, wall_seconds
+from ..model_card import read_json, wall_seconds
 
-__all__ = ["card"]
+__all__ = ["card", "loss_label", "singles_section", "keep_other_sections"]
 
 
 def _final_loss(log: str, window: int = 10) -> float:
@@ -27,24 +28,55 @@ def _final_loss(log: str, window: int = 10) -> float:
     return round(rows[mid] if len(rows) % 2 else 0.5 * (rows[mid - 1] + rows[mid]), 4)
 
 
+def loss_label(cfg: dict) -> str:
+    """The training loss of a config, short: 'swd + spectrum 0.2 + structure 0.2' (colour model appended)."""
+    parts = [cfg.get("loss", "gram")]
+    for key, label in (("spectrum_weight", "spectrum"), ("morphology_weight", "morphology"),
+                       ("structure_weight", "structure")):
+        if cfg.get(key):
+            parts.append(f"{label} {cfg[key]:g}")
+    extra = [f"{cfg['cellular']} cellular octaves" if cfg.get("cellular") else "",
+             f"{cfg['bricks']} brick octaves" if cfg.get("bricks") else "",
+             "colour affine" if cfg.get("colour") == "affine" else "",
+             f"fixed_axis {cfg['fixed_axis']}" if cfg.get("fixed_axis") else ""]
+    return ", ".join([" + ".join(parts)] + [e for e in extra if e])
+
+
 def _config_index(configs: str) -> dict:
-    """{config name: (file name, config)} of the JSON configs in folder ``configs``."""
+    """{config name: [(path relative to ``configs``, config), ...]} of the JSON configs under folder ``configs``
+    (subfolders included: a retrained model's config may share its name with the one it replaced)."""
     index = {}
-    if os.path.isdir(configs):
-        for fn in sorted(os.listdir(configs)):
+    for folder, _, files in sorted(os.walk(configs)) if os.path.isdir(configs) else ():
+        for fn in sorted(files):
             if fn.endswith(".json"):
-                cfg = read_json(os.path.join(configs, fn))
-                index.setdefault(cfg.get("name"), (fn, cfg))
+                cfg = read_json(os.path.join(folder, fn))
+                if isinstance(cfg, dict) and "name" in cfg:
+                    index.setdefault(cfg["name"], []).append((os.path.relpath(os.path.join(folder, fn), configs), cfg))
     return index
+
+
+def _same(a, b) -> bool:
+    return json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+
+
+def _find_config(cfg: dict, index: dict):
+    """(file, config) of the config file ``cfg`` (a run's full config) was made from: among the files of its
+    name, the one whose every key agrees with it; else the first; (NAME.json, None) when none is named so."""
+    found = index.get(cfg.get("name"), [])
+    for fn, c in found:
+        if all(_same(cfg.get(k), v) for k, v in c.items()):
+            return fn, c
+    return found[0] if found else (f"{cfg.get('name')}.json", None)
 
 
 def _config_files(cfg: dict, index: dict) -> list:
     """The config files a model was trained with, in order: its init_from chain, then its own."""
     chain, cur = [], cfg
     while cur is not None and len(chain) < 8:
-        chain.insert(0, index.get(cur.get("name"), (f"{cur.get('name')}.json", None))[0])
+        fn, _ = _find_config(cur, index)
+        chain.insert(0, fn)
         parent = os.path.basename(cur.get("init_from", "").rstrip("/"))
-        cur = index[parent][1] if parent in index else None
+        cur = index[parent][0][1] if parent in index else None
     return chain
 
 
@@ -77,8 +109,62 @@ def _cell(r: dict) -> str:
     return f"{r['style']} / {r['psd']} / {r['success']}"
 
 
+#: the headings card() writes; every other section of an existing card is kept as it is (keep_other_sections)
+GENERATED = ("# Neural solid texture models", "## How they were made", "## Models", "## Against the models they replaced",
+             "## Evaluation (", "## Speed and memory", "## Limits", "## Single-exemplar photo models")
+
+
+def keep_other_sections(existing: str, generated: str) -> str:
+    """``generated`` followed by the sections of ``existing`` (split at '## ' headings) that card() does not
+    write: sections other tools (photo_card) or people wrote survive a regenerated card, in their order."""
+    # a section starts at its heading, or at a marker line (<!-- ...:begin -->) right above it
+    parts = re.split(r"(?<!-->)\n(?=(?:<!--[^\n]*-->\n)?## )", "\n" + existing)
+    kept = [p.strip("\n") for p in parts[1:]
+            if not re.sub(r"^<!--[^\n]*-->\n", "", p).startswith(GENERATED)]
+    return generated.rstrip("\n") + "\n\n" + "\n\n".join(kept) + "\n" if kept else generated
+
+
+def singles_section(path: str, manifest: str = os.path.join("data", "photos", "manifest.json")) -> list:
+    """Lines of the card's section on single-exemplar photo models, from ``bench/eval_solid_singles.py``'s JSON."""
+    doc = read_json(path)
+    files = {}
+    if os.path.isfile(manifest):
+        files = {os.path.join("data", "photos", p["file"]): p for p in read_json(manifest)["photos"]}
+    rows, s = doc["rows"], doc["summary"]
+    L = ["## Single-exemplar photo models (issue 20)", "",
+         "Each fitted to one photo of the photo set's training split, never seeing its right quarter; measured "
+         "on that quarter (`python bench/eval_solid_singles.py --prev OLD_MODELS --sheet docs/img/solid_singles.png`, "
+         "2 seeds of 128² images; 3D: x, y and z slices pooled, or the two slices through a `fixed_axis`). Patch "
+         "distance: sliced Wasserstein distance of 7 × 7 Laplacian-pyramid neighbourhoods (× 1000, lower is "
+         "better). Beside it, what an artist could make from the same three quarters instead: the shipped space "
+         "model given them, random phase noise and the pixel shuffle; the model of the same name it replaced "
+         "(fitted to another exemplar); and a 128² crop of the three quarters themselves (the photo against its "
+         "own other part). A model replaces the previous one when it is closer to the held-out quarter than that "
+         "model and than the pixel shuffle (unless the photo's own crop is not either: a photo whose quarter "
+         "differs from the rest), with colour error at most 0.03. **Licence of the weights:** that of the photo "
+         "(CC-BY-SA-3.0 for a CC-BY-SA photo).", "",
+         "| model | photo (licence) | patch distance ↓ | space model | random phase | pixel shuffle | previous model "
+         "| photo's crop | colour error | morphology (space / random phase) |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for name, r in sorted(rows.items()):
+        m = files.get(os.path.normpath(r["photo"]), {})
+        lic = f" ({m['licence']})" if m else ""
+        L.append(f"| {name} | {os.path.basename(r['photo'])}{lic} | **{r['swd']}** | {r.get('space', '—')} | "
+                 f"{r['random_phase']} | {r['pixel_shuffle']} | {r.get('previous', '—')} | {r['photo_crop']} | "
+                 f"{r['colour']} | "
+                 f"{r['morph']} ({r.get('morph_space', '—')} / {r['morph_random_phase']}) |")
+    b = s["beats"]
+    L += ["", f"Over the {s['models']} models: median patch distance {s['median_swd']} (space model "
+          f"{s['median_space']}, random phase {s['median_random_phase']}); lower than the space model's on "
+          f"{b['space']}, random phase's on {b['random_phase']}, the pixel shuffle's on {b['pixel_shuffle']} and "
+          f"the previous model's on {b.get('previous', 0)}; "
+          f"median colour error {s['median_colour']} (worst {s['worst_colour']}).", "",
+          "![Photo (held-out quarter framed), model seeds 0 and 1, space model, random phase, the model it replaced]"
+          "(../../docs/img/solid_singles.png)", ""]
+    return L
+
+
 def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/solid",
-         previous_eval: str | None = None, rejected: dict | None = None) -> str:
+         previous_eval: str | None = None, rejected: dict | None = None, singles: str | None = None) -> str:
     """``rejected``: {model name: path of the evaluation JSON of its continued run}, shown, not shipped."""
     docs = {}
     for name in sorted(os.listdir(models)):
@@ -94,42 +180,68 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "Solid textures after Henzler, Mitra and Ritschel, \"Learning a Neural 3D Texture Space from 2D "
          "Exemplars\" (CVPR 2020), trained by this project's code (`training/solid/`) on CPU.", "",
          "## How they were made", "", "```sh",
-         "# one model per config; configs/solid/NAME.json names its exemplar, dimension and schedule",
-         "python -m training.solid.train --config configs/solid/NAME.json --out runs/solid/NAME",
+         "# one model per config (the table's configs column; configs/solid/ holds them): exemplar, dimension, schedule",
+         "python -m training.solid.structure_features --out runs/structnet/net_cmd.pt   # models with a structure term",
+         "python -m training.solid.train --config configs/solid/photo_singles/NAME.json --out runs/solid/NAME",
          "python -m training.solid.export runs/solid/NAME models/solid/NAME",
          "python bench/eval_solid.py --speed",
-         "python -m training.solid.model_card -o models/solid/MODEL_CARD.md", "```", "",
-         "- **Exemplars:** the CC0 photographs brick, grass and gravel from scikit-image's data "
-         "(`data/exemplars/README.md`; training never crops their right quarter) and the procedural classes "
-         "wood, marble, rust and granite of `training/solid/exemplars.py` (seed 0 trains, seed 1 is held out).",
+         "python bench/eval_solid_singles.py --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/img/solid_singles.json",
+         "python -m training.solid.model_card --singles docs/img/solid_singles.json -o models/solid/MODEL_CARD.md",
+         "```", "",
+         "- **Exemplars:** the single-exemplar models named by a photo were each fitted to one colour photo of "
+         "the photo set's training split (`data/photos/`: package, licence, author and sha256 per file in its "
+         "`manifest.json`, attribution in `ATTRIBUTION.md`); with `hold_out` training never crops its right "
+         "quarter, which `bench/eval_solid_singles.py` measures on. Older models name the CC0 photographs brick, "
+         "grass and gravel of scikit-image (`data/exemplars/README.md`, right quarter held out as well) or a "
+         "procedural class of `training/solid/exemplars.py` (seed 0 trains, seed 1 is held out). The space model "
+         "is trained on the whole training split (\"Photo texture space\" below).",
          "- **Model** (Sec. 3-4, Eq. 5): 8 octaves of lattice value noise, 3 values per lattice point, octave i "
          "read at T_i 2^(i-1) x; decoder MLP of four 128-wide ReLU layers over [noise (24), e (64)] to RGB "
          "(sigmoid, sRGB values). Single mode learns e, T and the decoder; the space model learns an "
          "instance-normalised encoder (128 px patch -> z, 8-D), a translator h(z) -> (e, T) and the decoder jointly.",
-         "- **Loss:** no pretrained VGG can be downloaded here, so the Gram matrices are those of a fixed random "
-         "two-layer network (32 5x5 and 64 3x3 zero-mean filters, four pyramid levels; Ustyuzhaninov et al. 2017 "
-         "showed random multi-scale filters suffice for Gram-based synthesis), plus a sliced Wasserstein term on "
-         "the joint RGB distribution (10 colour directions), weight 10.",
+         "- **Loss** (the table's `loss` column; no pretrained VGG can be downloaded here): `gram`: the Gram "
+         "matrices of a fixed random two-layer network (32 5x5 and 64 3x3 zero-mean filters, four pyramid levels; "
+         "Ustyuzhaninov et al. 2017) plus a sliced Wasserstein term on the joint RGB distribution (10 colour "
+         "directions), weight 10; `swd`: the sliced Wasserstein distance (Heitz et al. 2021) of random multi-scale "
+         "features plus the same colour term; `+ spectrum w`: the power-spectrum band term "
+         "(`training/solid/spectrum.py`); `+ structure w`: the learned structure term "
+         "(`training/solid/structure_features.py`, \"Learned structure features\" below). Colour `affine`: the "
+         "decoder's output is mapped through the exemplar's mean and colour Cholesky factor (rgb = mu + L d), so "
+         "the mean colour is the photo's by construction.",
          "- **3D from 2D:** each step renders 128² slices through random points of 3D space, axis-aligned "
          "(random axis permutation) or, half the time, randomly rotated; every slice must match the exemplar's "
-         "statistics. Exemplar crops are randomly rotated/flipped for 3D models.",
-         f"- **Hardware:** {hardware_line()}; one torch thread per run, two or three runs sharing the two cores "
-         "(wall times include that sharing).",
+         "statistics. Exemplar crops are randomly rotated/flipped for 3D models. Models trained with "
+         "`fixed_axis` (the table's loss column names it) keep the photo's direction instead: `rows` puts the "
+         "photo's vertical on z, and every vertical plane, at a uniform angle about z, must look like the "
+         "unrotated photo (brick courses level, planks standing); `columns` puts its horizontal on x. Their "
+         "lattices start turned about that axis only (`model.axis_rotations`), and with `init_stretch` their "
+         "features start as much longer along it as the photo's power spectrum says (`model.spectral_aspect`). "
+         "The planes across the axis (end grain) are not trained.",
+         "- **Hardware:** beside each wall time where the export records it (training writes it into the "
+         "checkpoint); the models without it were trained on an Intel Xeon with 2 cores visible, one torch thread "
+         "per run, two or three runs sharing the two cores (wall times include that sharing).",
          "- **gravel_3d** was trained before the decoder's He initialisation became the default; its config "
          "names `decoder_init = \"torch\"`, which reproduces it. Every other model uses He initialisation.", "",
          "## Models", "",
          "Final loss: the median of the last ten logged batch losses.", "",
-         "| model | mode | dim | exemplars | scale | configs | steps | wall time | final loss | sha256 (decoder.onnx) |",
-         "|---|---|---|---|---|---|---|---|---|---|"]
+         "| model | mode | dim | exemplars | scale | loss | configs | steps | wall time | final loss | sha256 (decoder.onnx) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|"]
     continued, index = [], _config_index(configs)
     for name, d in docs.items():
         log = os.path.join(runs, d["name"], "log.jsonl")
-        wall = f"{wall_seconds(log) / 60:.1f} min" if os.path.isfile(log) else "n/a"
+        if os.path.isfile(log):
+            wall = f"{wall_seconds(log) / 60:.1f} min"
+        else:     # the run folder is gone (another machine): the export keeps the training time
+            wall = f"{float(d['train_seconds']) / 60:.1f} min" if d.get("train_seconds") else "n/a"
+        if d.get("hardware"):
+            wall += f" ({d['hardware']})"
         loss = _final_loss(log) if os.path.isfile(log) else "n/a"
-        chain = _config_files(d.get("config", {"name": d["name"]}), index)
+        cfg = d.get("config", {"name": d["name"]})
+        chain = _config_files(cfg, index)
         if len(chain) > 1:
             continued.append(name)
-        L.append(f"| {name} | {d['mode']} | {d['dim']}D | {', '.join(d['exemplars'])} | {d['exemplar_scale']} | "
+        exemplars = ", ".join(os.path.basename(e) for e in d["exemplars"])
+        L.append(f"| {name} | {d['mode']} | {d['dim']}D | {exemplars} | {d['exemplar_scale']} | {loss_label(cfg)} | "
                  f"{' → '.join(f'`{c}`' for c in chain)} | {d['step']} | {wall} | {loss} | "
                  f"`{d['files']['decoder.onnx'][:16]}…` |")
     if continued:
@@ -140,7 +252,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
               "`python -m training.solid.train --config configs/solid/NAME_long.json "
               "--out runs/solid/NAME_long` after the first run."]
     L += ["", "Full sha256 of every file: each model's `solid.json` (`files`); the runtime refuses a file whose "
-          "hash differs. Configs: `configs/solid/<model>.json` (the space model: `space_3d.json`).", ""]
+          "hash differs. Configs: the configs column, under `configs/solid/`.", ""]
     q = ev.get("quality")
     if q and previous_eval and os.path.isfile(previous_eval) and continued:
         prev = read_json(previous_eval).get("quality", {})
@@ -163,7 +275,8 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
               "| exemplar | method | style error ↓ | PSD error ↓ | diversity ↑ | success ↑ |", "|---|---|---|---|---|---|"]
         for name, rows in q.items():
             for meth, r in rows.items():
-                L.append(f"| {name} | {meth} | {r['style']} | {r['psd']} | {r['diversity']} | {r['success']} |")
+                L.append(f"| {os.path.basename(name)} | {meth} | {r['style']} | {r['psd']} | {r['diversity']} | "
+                         f"{r['success']} |")
         L.append("")
     sp = ev.get("speed")
     if sp:
@@ -175,21 +288,23 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
             L.append(f"| {'×'.join([str(r['size'])] * r['dim'])} | {r['engine']} | {r['points_per_s']:,} | "
                      f"{r['seconds']} | {r['peak_mib']} |")
         L.append("")
+    if singles:
+        L += singles_section(singles)
     L += ["## Limits", "",
-          "- The point-wise MLP over value noise reproduces stochastic, stationary textures (granite, gravel-like "
-          "speckle, rust, marble clouds) far better than structured ones: bricks come out as blotches, not "
-          "courses, as the paper's own results and its Table 1 note for non-stochastic appearance.",
-          "- The photographs are greyscale; the models still output RGB.",
-          "- The texture-space model needed three fixes before it conditioned on its input at all, each found by "
-          "looking at its output during training: its encoder first averaged instance-normalised maps (every "
-          "exemplar got the same code; it now reads the per-channel statistics the normalisation removes), its "
-          "translator's unbounded transforms grew ~100x (now bounded by tanh), and a x0.1-scaled code output left "
-          "the decoder ignoring e (now full scale, with distinct exemplars in every batch). Continued from 1500 to "
-          "5000 steps it generalises much better to held-out pixels (mean style error 7.18 -> 2.88), but brick and "
-          "marble remain far from their exemplars: it separates colours and coarse character more than structure.",
-          "- Longer training does not always help: the continued wood_3d lost to the shipped one on both errors, "
-          "and the continued rust_3d and granite_3d gained little, although their training losses fell; the "
-          "independent evaluation network, not the training loss, decides what ships.",
+          "- The point-wise MLP over noise octaves reproduces stochastic, stationary textures (gravel, grass, "
+          "rust, granite) far better than structured ones: the brick model draws the photo's colours as speckle "
+          "with faint level bands, not courses with joints; the marble model draws no veins; the wood model draws "
+          "grain along its axis but no plank seams. Random phase noise and the texture-space model beat it on "
+          "the brick photo, the space model narrowly on the marble photo (\"Single-exemplar photo models\").",
+          "- A `fixed_axis` model matches its photo on the planes through its axis only; across the axis (a "
+          "horizontal cut through the wood model, for example) it draws untrained blotches.",
+          "- The texture-space model first needed three fixes before it conditioned on its input at all (its "
+          "encoder averaged instance-normalised maps; its translator's unbounded transforms grew ~100x, now "
+          "bounded by tanh; a x0.1-scaled code left the decoder ignoring e); see \"Photo texture space\" for "
+          "how far it generalises to held-out photos.",
+          "- Longer training does not always help: continued runs of earlier models lost or gained little "
+          "although their training losses fell; the held-out evaluation, not the training loss, decides what "
+          "ships.",
           "- Trained on two CPU cores for minutes per model: a GPU run with more steps and a larger batch would "
           "lower the style error further.", ""]
     return "\n".join(L)
@@ -204,10 +319,14 @@ def main(argv=None) -> int:
     ap.add_argument("--previous-eval", help="evaluation JSON of the models that retrained ones replaced")
     ap.add_argument("--rejected", nargs="*", default=[], metavar="MODEL=EVAL_JSON",
                     help="continued runs that did not beat the shipped model, with their evaluation")
+    ap.add_argument("--singles", help="JSON of bench/eval_solid_singles.py (the photo single-exemplar models)")
     ap.add_argument("-o", "--out", default="models/solid/MODEL_CARD.md")
     a = ap.parse_args(argv)
     rejected = dict(r.split("=", 1) for r in a.rejected)
-    text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected)
+    text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected, a.singles)
+    if os.path.isfile(a.out):      # sections other tools wrote (the photo space model's, ...) are kept
+        with open(a.out, encoding="utf-8") as fh:
+            text = keep_other_sections(fh.read(), text)
     from backend._export import export
 
     export.write_text(a.out, text)

@@ -99,7 +99,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
         os.path.join("data", "photos", "train")) else "?"
     ps, ns = prev["summary"], new["summary"]
     L = [BEGIN, "## Photo texture space (issue 20)", "",
-         f"**{'Shipped as `space`; the tables above that name `space` describe the seven-exemplar model it replaced' if shipped else 'Candidate, not shipped'}.** Trained on the photo set "
+         f"**{'Shipped as `space`; its row in the Models table above; the Gram evaluation does not score it (colour from the photo: see its own figures below)' if shipped else 'Candidate, not shipped'}.** Trained on the photo set "
          f"(`data/photos/train`, {n_photos} colour photographs from Debian's 0ad-data, ufoai-textures and "
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",

@@ -35,10 +35,12 @@ import torch
 from backend._export import export as _ex
 from ..threads import cpu_threads
 from ..config import check_config_keys
+from ..model_card import cpu_name
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import SolidTexture, colour_stats, max_scales, shape_features, slice_points, spectral_gains
+from .model import (SolidTexture, axis_rotations, colour_stats, max_scales, shape_features, slice_points, spectral_aspect,
+                    spectral_gains)
 from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
 from .structure_features import StructureFeatures, load_structure_net
@@ -98,6 +100,12 @@ class SolidConfig:
     init_onnx: str = ""             # or an export folder to continue (its weights; Adam's moments start afresh) ...
     init_sha256: str = ""           # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
     warmup: int = 0                 # steps of linear learning-rate warm-up from where this run starts
+    fixed_axis: str = ""            # 3D: "columns" (image horizontal along x: wood grain) or "rows" (image vertical
+                                    # along z: brick courses) slices only through that axis (model.slice_points)
+    init_stretch: bool = False      # single mode with fixed_axis: the transforms start scaled along that axis by
+                                    # the exemplar's spectral aspect (model.spectral_aspect; grain starts long)
+    hold_out: bool = False          # single mode: train on a photo's left three quarters only (its right quarter
+                                    # is the held-out part bench/eval_solid_singles.py measures on)
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -137,9 +145,28 @@ class SolidConfig:
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         if cfg.init_onnx and cfg.init_from:
             raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
+        if cfg.fixed_axis not in ("", "columns", "rows"):
+            raise ValueError(f"fixed_axis must be '', 'columns' or 'rows', got {cfg.fixed_axis!r}")
+        if cfg.fixed_axis and (cfg.dim != 3 or cfg.augment):
+            raise ValueError("fixed_axis keeps the photo's orientation on an axis of 3D space: it needs dim 3 and "
+                             "augment false (rotated crops would turn the grain)")
+        if cfg.init_stretch and not (cfg.mode == "single" and cfg.fixed_axis):
+            raise ValueError("init_stretch scales the transforms along the fixed axis: it needs mode 'single' and "
+                             "fixed_axis")
+        if cfg.hold_out and cfg.mode != "single":
+            raise ValueError("hold_out keeps a quarter of the one exemplar for evaluation: it needs mode 'single' "
+                             "(space models hold out whole photos: photos:val)")
         if cfg.mode == "single" and n_exemplars != 1:
             raise ValueError(f"single mode takes exactly one exemplar, got {n_exemplars}")
         return cfg
+
+
+def initial_stretch(img: torch.Tensor, fixed_axis: str) -> float:
+    """The scale in [1/16, 1] that ``init_stretch`` gives the transforms along the fixed axis: the exemplar's
+    feature length along the image axis that lies on it, relative to across (:func:`.model.spectral_aspect`)
+    - "columns": the image's horizontal; "rows": its vertical.  Features are only ever lengthened."""
+    a = spectral_aspect(img)
+    return float(min(1.0, max(1.0 / 16.0, a if fixed_axis == "columns" else 1.0 / a)))
 
 
 def load_config(path: str) -> SolidConfig:
@@ -175,7 +202,8 @@ def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
 
 def training_images(cfg: SolidConfig) -> list:
     """The training regions of the config's exemplars, resampled: list of (3, H, W)."""
-    return [_resample(ex.train_region(ex.exemplar(n), n), cfg.exemplar_scale) for n in ex.expand(cfg.exemplars)]
+    return [_resample(ex.train_region(ex.exemplar(n), n, cfg.hold_out), cfg.exemplar_scale)
+            for n in ex.expand(cfg.exemplars)]
 
 
 def render(model: SolidTexture, e: torch.Tensor, T: torch.Tensor, x: torch.Tensor, seeds, size: int,
@@ -242,6 +270,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     feats = loss_features(cfg)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
+    prev_hardware = ""
     first = 0              # the step this run's optimiser started at (warm-up counts from it)
     ckpt_path = os.path.join(out, "ckpt.pt")
     if cfg.init_from and not os.path.isfile(ckpt_path):
@@ -254,6 +283,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         step, elapsed = state["step"], state.get("elapsed", 0.0)
         gen.set_state(state["gen"])
         first = state.get("first_step", 0)
+        prev_hardware = state.get("hardware", "")
         log(f"resumed at step {step}")
     elif cfg.init_onnx:
         # the export's step and training time carry on, so the ledger and the cosine schedule continue
@@ -265,17 +295,28 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256), new_features=new)
         step, elapsed = int(model_json.get("step", 0)), float(model_json.get("train_seconds", 0.0))
         first = step
+        prev_hardware = str(model_json.get("hardware", ""))
         log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...) at step {step}")
     if cfg.structure_weight:
         structure_features(cfg.structure_net)  # a missing network fails here, before the first step
     images = training_images(cfg)
-    augment = cfg.dim == 3 if cfg.augment is None else cfg.augment
+    if cfg.mode == "single" and cfg.fixed_axis and step == 0:
+        with torch.no_grad():   # lattices start aligned with the photo's direction (model.axis_rotations)
+            model.T.copy_(axis_rotations(cfg.octaves, cfg.fixed_axis, cfg.seed))
+            if cfg.init_stretch:   # octave i reads T_i x: scaling T's column of the axis stretches features along it
+                stretch = initial_stretch(images[0], cfg.fixed_axis)
+                model.T[:, :, 0 if cfg.fixed_axis == "columns" else 2] *= stretch
+                log(f"transforms start stretched along the {cfg.fixed_axis} axis by {1 / stretch:.2f}")
+    augment = (cfg.dim == 3 and not cfg.fixed_axis) if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     logf = open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8")
     t0 = time.time() - elapsed
     # single mode: one exemplar, so one colour statistic for the whole run
     single_stats = colour_stats(images[0].unsqueeze(0)).expand(cfg.batch, -1) if cfg.mode == "single" else None
     state = None
+    # where training ran: this stretch's CPU, after those of the stretches it resumes (recorded in the export)
+    here = f"{cpu_name()}, {cfg.threads or torch.get_num_threads()} threads, fp32"
+    hardware = prev_hardware if here in prev_hardware.split("; ") else "; ".join(filter(None, [prev_hardware, here]))
     while step < end:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / cfg.steps))
         if cfg.warmup:     # fresh Adam moments (a run continued from an export) start with small steps
@@ -294,7 +335,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             e, T = model.codes(ref)
             stats = colour_stats(ref)
             gains = spectral_gains(ref, cfg.octaves, cfg.px_per_unit) if cfg.spectral else None
-        x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen)
+        x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen, cfg.fixed_axis)
         seeds = torch.randint(0, 2 ** 31 - 1, (cfg.batch,), generator=gen).numpy()
         img = render(model, e, T, x, seeds, cfg.crop, stats if cfg.colour == "affine" else None, gains)
         loss = texture_loss(cfg, feats, img, ref, gen)
@@ -311,7 +352,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         if step % cfg.checkpoint_every == 0 or step == end:
             state = dict(config=asdict(cfg), model=model.state_dict(), opt=opt.state_dict(), step=step,
                          elapsed=time.time() - t0, gen=gen.get_state(), n_params=model.n_params(),
-                         first_step=first)
+                         first_step=first, hardware=hardware)
             _save(ckpt_path, state)
     logf.close()
     if state is None:

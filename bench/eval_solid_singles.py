@@ -1,0 +1,169 @@
+"""Single-exemplar solid textures fitted to photos, measured on pixels they never saw:
+`python bench/eval_solid_singles.py [--models DIR] [--prev DIR] [-o JSON] [--sheet PNG]`.
+
+A single-exemplar model trained with ``hold_out`` saw only its photo's left three quarters
+(``training.solid.exemplars.train_region``); the right quarter (H x W/4) is the reference here.  For each
+such model, with 2 seeds of 128² images (3D models: x, y and z slices pooled, or for a model trained with
+``fixed_axis`` the two slices through that axis; 2D: the plane):
+
+- ``swd``: the patch distance of ``training.solid.photo_eval.patch_swd`` (7 x 7 neighbourhoods of a Laplacian
+  pyramid, x 1000; lower is better) to the held-out strip;
+- the same for what an artist could make instead from the pixels the model saw (the training region):
+  random phase noise (``random_phase``), the pixel shuffle (``pixel_shuffle``) and the shipped space model
+  given that region (``space``: encode, translate, slices); ``photo_crop``: a 128² crop of the training region
+  itself (the floor: the photo against its own other part);
+- ``colour``: mean colour error against the strip; ``morph``: the level-set morphology distance
+  (training/solid/morphology.py), with random phase noise's beside it.
+
+``--prev DIR`` adds the previously shipped models of the same names (``previous``: fitted to other exemplars,
+scored on the same strip) and their picture.  Writes JSON (default out/bench/solid_singles.json) and, with ``--sheet``, a PNG: photo
+(held-out quarter framed) | model seed 0 | seed 1 | space model | random phase | previous model.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+import numpy as np  # noqa: E402
+
+from export.atomic import atomic_path, write_json  # noqa: E402
+from backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models  # noqa: E402
+from training.solid import photo_eval as pe  # noqa: E402
+from training.solid.morphology import morphology_distance  # noqa: E402
+
+SIZE = 128
+SEEDS = 2
+
+
+def read(path: str) -> np.ndarray:
+    from PIL import Image
+
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"), np.float32) / 255.0
+
+
+def split_photo(photo: np.ndarray) -> tuple:
+    """(training region, held-out strip) of a photo (H, W, 3): its left three quarters and the rest."""
+    cut = photo.shape[1] * 3 // 4
+    return photo[:, :cut], photo[:, cut:]
+
+
+#: the slices (normal to these axes) through a fixed axis: the planes a ``fixed_axis`` model is trained on
+THROUGH_AXIS = {"rows": "xy", "columns": "yz"}
+
+
+def images(model: SolidTextureModel, code, seeds: int = SEEDS) -> list:
+    """The model's 128² images: x, y and z slices per seed (3D) or the plane per seed (2D).  A model trained
+    with ``fixed_axis`` shows its photo on the planes through that axis only (the end grain across it is free):
+    those two slices."""
+    offsets = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
+    fixed = model.config.get("config", {}).get("fixed_axis", "")
+    axes = THROUGH_AXIS.get(fixed, "xyz") if model.dim == 3 else "z"
+    return [model.image(SIZE, code, seed=s, axis=a, offset=offsets[a]) for s in range(seeds) for a in axes]
+
+
+def evaluate_model(model: SolidTextureModel, space: SolidTextureModel | None, seeds: int = SEEDS,
+                   previous: SolidTextureModel | None = None) -> tuple:
+    """(figures dict, pictures dict) of one single-exemplar photo model on its held-out strip; ``previous``:
+    the model it replaces (fitted to another exemplar), scored on the same strip."""
+    photo = read(os.path.join(ROOT, model.config["exemplars"][0]))
+    train, held = split_photo(photo)
+    rng = np.random.default_rng(0)
+    pics = {"photo": photo, "model": images(model, model.default_code(), seeds)}
+    pics["random_phase"] = [pe.random_phase(train, SIZE, rng) for _ in range(seeds)]
+    pics["pixel_shuffle"] = [pe.pixel_shuffle(train, SIZE, rng) for _ in range(seeds)]
+    if space is not None:
+        pics["space"] = images(space, space.translate(space.encode(train)), seeds)
+    if previous is not None:
+        pics["previous"] = images(previous, previous.default_code(), seeds)
+    r = {"photo": model.config["exemplars"][0], "dim": model.dim}
+    for k in ("model", "space", "random_phase", "pixel_shuffle", "previous"):
+        if k in pics:
+            r["swd" if k == "model" else k] = round(pe.patch_swd(pics[k], held), 1)
+    r["photo_crop"] = round(pe.patch_swd(train[:SIZE, :SIZE], held), 1)
+    r["colour"] = round(float(np.mean([pe.mean_colour_error(im, held) for im in pics["model"]])), 4)
+    for k in ("space", "previous"):
+        if k in pics:
+            r[k + "_colour"] = round(float(np.mean([pe.mean_colour_error(im, held) for im in pics[k]])), 4)
+    r["morph"] = round(morphology_distance(pics["model"], held), 3)
+    r["morph_random_phase"] = round(morphology_distance(pics["random_phase"], held), 3)
+    if "space" in pics:
+        r["morph_space"] = round(morphology_distance(pics["space"], held), 3)
+    return r, pics
+
+
+def write_sheet(rows: list, path: str, size: int = 128) -> None:
+    """One row per model: photo (held-out quarter framed in white) | seed 0 | seed 1 | space | random phase | previous."""
+    from PIL import Image, ImageDraw
+
+    def tile(a):
+        return Image.fromarray((np.clip(a, 0, 1) * 255 + 0.5).astype(np.uint8)).resize((size, size))
+
+    sheet = Image.new("RGB", (6 * size, len(rows) * size), (255, 255, 255))
+    for i, (pics, prev) in enumerate(rows):
+        per_seed = len(pics["model"]) // SEEDS
+        cells = [pics["photo"], pics["model"][0], pics["model"][per_seed], pics.get("space", [None])[0],
+                 pics["random_phase"][0], prev]
+        for j, c in enumerate(cells):
+            if c is not None:
+                sheet.paste(tile(c), (j * size, i * size))
+        d = ImageDraw.Draw(sheet)
+        d.rectangle([size * 3 // 4, i * size, size - 1, (i + 1) * size - 1], outline=(255, 255, 255))
+    with atomic_path(path) as tmp:
+        sheet.save(tmp, format="PNG")
+
+
+def summary(rows: dict) -> dict:
+    def med(k):
+        v = [r[k] for r in rows.values() if k in r]
+        return round(float(np.median(v)), 3) if v else None
+
+    beats = {k: sum(r["swd"] < r[k] for r in rows.values() if k in r)
+             for k in ("space", "random_phase", "pixel_shuffle", "previous")}
+    return dict(models=len(rows), median_swd=med("swd"), median_space=med("space"),
+                median_random_phase=med("random_phase"), median_colour=med("colour"),
+                worst_colour=max((r["colour"] for r in rows.values()), default=None),
+                beats=beats)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python bench/eval_solid_singles.py", description=__doc__.split("\n")[0])
+    ap.add_argument("--models", default=SHIPPED_MODELS, help="folder of solid models (default: the shipped ones)")
+    ap.add_argument("--space", default=None, help="space model folder (default: the models folder's 'space')")
+    ap.add_argument("--prev", default=None, help="folder of the previous models of the same names")
+    ap.add_argument("--only", default="", help="comma-separated model names")
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_singles.json"))
+    ap.add_argument("--sheet", default=None, help="write the picture here (PNG)")
+    a = ap.parse_args(argv)
+    models = load_models(a.models)
+    space_dir = a.space or os.path.join(a.models, "space")
+    space = SolidTextureModel(space_dir) if os.path.isfile(os.path.join(space_dir, "solid.json")) else None
+    only = [s for s in a.only.split(",") if s]
+    rows, sheet = {}, []
+    for name, m in sorted(models.items()):
+        if m.mode != "single" or not m.config.get("config", {}).get("hold_out") or (only and name not in only):
+            continue
+        prev = None
+        if a.prev and os.path.isfile(os.path.join(a.prev, name, "solid.json")):
+            prev = SolidTextureModel(os.path.join(a.prev, name))
+        r, pics = evaluate_model(m, space, previous=prev)
+        rows[name] = r
+        print(name, {k: r[k] for k in ("swd", "space", "random_phase", "pixel_shuffle", "previous", "photo_crop",
+                                       "colour") if k in r}, flush=True)
+        sheet.append((pics, pics["previous"][-1] if "previous" in pics else None))
+    if not rows:
+        raise SystemExit(f"eval_solid_singles: no single-exemplar model trained with hold_out in {a.models}")
+    doc = dict(rows=rows, summary=summary(rows))
+    write_json(a.out, doc)
+    print(doc["summary"])
+    if a.sheet:
+        write_sheet(sheet, a.sheet)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
