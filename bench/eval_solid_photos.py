@@ -61,7 +61,7 @@ def read(path: str) -> np.ndarray:
 
 
 def slice_image(model: SolidTextureModel, code, axis: str, seed: int, size: int = SIZE) -> np.ndarray:
-    off = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}[axis]
+    off = pe.SLICE_OFFSETS[axis]
     return model.image(size, code, seed=seed, axis=axis, offset=off)
 
 

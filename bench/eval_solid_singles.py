@@ -31,19 +31,13 @@ sys.path.insert(0, ROOT)
 import numpy as np  # noqa: E402
 
 from export.atomic import atomic_path, write_json  # noqa: E402
+from export.images import read_rgb  # noqa: E402
 from backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
 
 SIZE = 128
 SEEDS = 2
-
-
-def read(path: str) -> np.ndarray:
-    from PIL import Image
-
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"), np.float32) / 255.0
 
 
 def split_photo(photo: np.ndarray) -> tuple:
@@ -60,17 +54,16 @@ def images(model: SolidTextureModel, code, seeds: int = SEEDS) -> list:
     """The model's 128² images: x, y and z slices per seed (3D) or the plane per seed (2D).  A model trained
     with ``fixed_axis`` shows its photo on the planes through that axis only (the end grain across it is free):
     those two slices."""
-    offsets = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
     fixed = model.config.get("config", {}).get("fixed_axis", "")
     axes = THROUGH_AXIS.get(fixed, "xyz") if model.dim == 3 else "z"
-    return [model.image(SIZE, code, seed=s, axis=a, offset=offsets[a]) for s in range(seeds) for a in axes]
+    return [model.image(SIZE, code, seed=s, axis=a, offset=pe.SLICE_OFFSETS[a]) for s in range(seeds) for a in axes]
 
 
 def evaluate_model(model: SolidTextureModel, space: SolidTextureModel | None, seeds: int = SEEDS,
                    previous: SolidTextureModel | None = None) -> tuple:
     """(figures dict, pictures dict) of one single-exemplar photo model on its held-out strip; ``previous``:
     the model it replaces (fitted to another exemplar), scored on the same strip."""
-    photo = read(os.path.join(ROOT, model.config["exemplars"][0]))
+    photo = read_rgb(os.path.join(ROOT, model.config["exemplars"][0]))
     train, held = split_photo(photo)
     rng = np.random.default_rng(0)
     pics = {"photo": photo, "model": images(model, model.default_code(), seeds)}

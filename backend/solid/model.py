@@ -28,7 +28,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
-__all__ = ["SolidTextureModel", "TextureCode", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
+__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
@@ -76,6 +76,17 @@ class TextureCode:
     mu: np.ndarray | None = None
     L: np.ndarray | None = None
     gains: np.ndarray | None = None
+
+
+def exemplar_category(name: str) -> str:
+    """An exemplar's short name: a shipped exemplar's own ('gravel') or a photo-set file's category, the part of
+    its name before '__' ('wood' for ``data/photos/train/wood__oldwood.jpg``)."""
+    return os.path.splitext(os.path.basename(name))[0].split("__", 1)[0]
+
+
+def _colour(c: np.ndarray) -> tuple:
+    """(mu (3,), L (3, 3)) of a photo model's 12 colour statistics [mu, L row-major] (:func:`colour_stats`)."""
+    return c[:3].copy(), c[3:12].reshape(3, 3).copy()
 
 
 def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
@@ -149,9 +160,8 @@ class SolidTextureModel:
 
     @property
     def exemplar_label(self) -> str:
-        """The first exemplar's short name: a shipped exemplar's ('gravel') or a photo-set file's category
-        ('wood' for ``data/photos/train/wood__oldwood.jpg``)."""
-        return os.path.splitext(os.path.basename(self.config["exemplars"][0]))[0].split("__", 1)[0]
+        """The first exemplar's short name (:func:`exemplar_category`)."""
+        return exemplar_category(self.config["exemplars"][0])
 
     # -- codes ----------------------------------------------------------------------------------
     def default_code(self) -> TextureCode:
@@ -160,8 +170,7 @@ class SolidTextureModel:
             e, T = np.asarray(self.config["code"], _F), np.asarray(self.config["T"], _F)
             if not self.colour_stats:
                 return TextureCode(e, T)
-            c = np.asarray(self.config["colour_code"], _F)
-            return TextureCode(e, T, c[:3].copy(), c[3:12].reshape(3, 3).copy())
+            return TextureCode(e, T, *_colour(np.asarray(self.config["colour_code"], _F)))
         return self.translate(next(iter(self.codes.values())))
 
     def encode(self, image: np.ndarray) -> np.ndarray:
@@ -213,7 +222,7 @@ class SolidTextureModel:
             return TextureCode(e[0].astype(_F), T[0].astype(_F))
         c = z[self.z_dim:self.z_dim + self.colour_stats]
         gains = z[self.z_dim + self.colour_stats:].copy() if self.spectral_gains else None
-        return TextureCode(e[0].astype(_F), T[0].astype(_F), c[:3].copy(), c[3:12].reshape(3, 3).copy(), gains)
+        return TextureCode(e[0].astype(_F), T[0].astype(_F), *_colour(c), gains)
 
     def code(self, exemplar: str | None = None) -> TextureCode:
         """A named training exemplar's code (space models), or the default code."""

@@ -35,6 +35,7 @@ from backend.solid.lattice import lattice_noise
 from backend.solid.model import plane_points
 from . import exemplars as ex
 from .features import RandomFeatures, gram_loss, histogram_loss
+from .model import axis_frame
 
 __all__ = ["METRIC_FEATURES", "evaluate_exemplar", "slices_3d", "baselines", "EVAL_SIZE"]
 
@@ -89,10 +90,7 @@ def slices_3d(evaluate, n: int, size: int, px_per_unit: float, seed: int = 0, fi
     out = []
     for i in range(n):
         if fixed_axis:
-            t = rng.uniform(0.0, 2.0 * np.pi)
-            c, s = np.cos(t), np.sin(t)
-            frame = np.array([[1.0, 0.0], [0.0, c], [0.0, s]]) if fixed_axis == "columns" else \
-                np.array([[c, 0.0], [s, 0.0], [0.0, 1.0]])
+            frame = np.array(axis_frame(fixed_axis, rng.uniform(0.0, 2.0 * np.pi))).T   # columns u, v
         elif i % 4 == 3:
             q, r = np.linalg.qr(rng.normal(size=(3, 3)))
             frame = q * np.sign(np.diag(r))

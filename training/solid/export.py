@@ -24,6 +24,7 @@ from torch import nn
 
 from backend._export import export as _ex
 from backend.onnx_models import sha256_file
+from backend.solid.model import exemplar_category
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
 from .model import COLOUR_STATS, colour_stats, spectral_gains
@@ -117,11 +118,9 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
             # (photo models: one named code per category, its first training photo; z gets the photo's colour)
             codes = {}
             for name, img in zip(ex.expand(cfg.exemplars), training_images(cfg)):
-                key = os.path.splitext(os.path.basename(name))[0]
-                if "__" in key:
-                    key = key.split("__", 1)[0]
-                    if key in codes:
-                        continue
+                key = exemplar_category(name)
+                if key in codes:      # photo models: a category's first training photo names it
+                    continue
                 crops = img.unfold(1, ENCODER_SIZE, ENCODER_SIZE // 2).unfold(2, ENCODER_SIZE, ENCODER_SIZE // 2)
                 crops = crops.permute(1, 2, 0, 3, 4).reshape(-1, 3, ENCODER_SIZE, ENCODER_SIZE)
                 z = model.encoder(crops).mean(0)

@@ -35,7 +35,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
-__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "axis_rotations", "slice_points"]
+__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
 
 
 def shape_features(cellular: int, bricks: int) -> int:
@@ -56,13 +56,30 @@ def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
     return torch.stack(out).to(torch.float32)
 
 
+#: ``fixed_axis`` -> the axis of space the photo's direction lies on: "columns" (its horizontal) on x, "rows"
+#: (its vertical) on z
+FIXED_AXES = {"columns": 0, "rows": 2}
+
+
+def check_fixed_axis(fixed_axis: str) -> None:
+    if fixed_axis and fixed_axis not in FIXED_AXES:
+        raise ValueError(f"fixed_axis must be '', 'columns' or 'rows', got {fixed_axis!r}")
+
+
+def axis_frame(fixed_axis: str, t: float) -> list:
+    """The image axes (u, v) in space, [u (3,), v (3,)] as lists, of the plane through the fixed axis turned by
+    angle t about it: "columns": u = x, v = (0, cos t, sin t); "rows": u = (cos t, sin t, 0), v = z (image up)."""
+    c, s = math.cos(t), math.sin(t)
+    return [[1.0, 0.0, 0.0], [0.0, c, s]] if fixed_axis == "columns" else [[c, s, 0.0], [0.0, 0.0, 1.0]]
+
+
 def axis_rotations(octaves: int, fixed_axis: str, seed: int = 0) -> torch.Tensor:
     """Transforms (octaves, 3, 3) float32 that keep a direction of space on the lattice's second axis (the
     brick lattice's rows, :mod:`backend.solid.brick`) and turn the plane across it by a seeded uniform angle
     per octave: "columns" keeps x, "rows" keeps z (det +1).  A single-exemplar model trained with
     ``fixed_axis`` starts from these, so its lattices start aligned with the photo's direction."""
     g = torch.Generator().manual_seed(seed)
-    axis = {"columns": 0, "rows": 2}[fixed_axis]
+    axis = FIXED_AXES[fixed_axis]
     a, b = [k for k in range(3) if k != axis]
     out = []
     for _ in range(octaves):
@@ -403,19 +420,13 @@ def slice_points(batch: int, size: int, px_per_unit: float, dim: int, oblique: f
     off = (torch.rand(batch, 1, dim, generator=generator) * 2.0 - 1.0) * extent
     if dim == 2:
         return plane.unsqueeze(0) + off
-    if fixed_axis not in ("", "columns", "rows"):
-        raise ValueError(f"fixed_axis must be '', 'columns' or 'rows', got {fixed_axis!r}")
+    check_fixed_axis(fixed_axis)
     frames = []
     for _ in range(batch):
         if fixed_axis:
             t = float(torch.rand(1, generator=generator)) * 2.0 * math.pi
-            c, s_ = math.cos(t), math.sin(t)
-            if fixed_axis == "columns":     # u = x; v turns about x
-                a, b = [1.0, 0.0, 0.0], [0.0, c, s_]
-            else:                           # v = z (image up is +z); u turns about z
-                a, b = [c, s_, 0.0], [0.0, 0.0, 1.0]
-            n = torch.linalg.cross(torch.tensor(a), torch.tensor(b))
-            frames.append(torch.stack([torch.tensor(a), torch.tensor(b), n], dim=1))
+            u, v = (torch.tensor(w) for w in axis_frame(fixed_axis, t))
+            frames.append(torch.stack([u, v, torch.linalg.cross(u, v)], dim=1))
         elif torch.rand(1, generator=generator).item() < oblique:
             q, r = torch.linalg.qr(torch.randn(3, 3, generator=generator))
             frames.append(q * torch.sign(torch.diagonal(r)).unsqueeze(0))

@@ -30,7 +30,10 @@ from backend.solid.cellular import cellular_features_numpy
 from backend.solid.lattice import lattice_noise
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
-           "colour_by_rank", "voronoi_pavement", "BASELINES"]
+           "colour_by_rank", "voronoi_pavement", "BASELINES", "SLICE_OFFSETS"]
+
+#: where the held-out evaluations cut a 3D texture: a slice normal to each axis through these points (units)
+SLICE_OFFSETS = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
 
 _K = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
 

@@ -39,8 +39,8 @@ from ..model_card import cpu_name
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import (SolidTexture, axis_rotations, colour_stats, max_scales, shape_features, slice_points, spectral_aspect,
-                    spectral_gains)
+from .model import (FIXED_AXES, SolidTexture, axis_rotations, check_fixed_axis, colour_stats, max_scales,
+                    shape_features, slice_points, spectral_aspect, spectral_gains)
 from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
 from .structure_features import StructureFeatures, load_structure_net
@@ -145,8 +145,7 @@ class SolidConfig:
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         if cfg.init_onnx and cfg.init_from:
             raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
-        if cfg.fixed_axis not in ("", "columns", "rows"):
-            raise ValueError(f"fixed_axis must be '', 'columns' or 'rows', got {cfg.fixed_axis!r}")
+        check_fixed_axis(cfg.fixed_axis)
         if cfg.fixed_axis and (cfg.dim != 3 or cfg.augment):
             raise ValueError("fixed_axis keeps the photo's orientation on an axis of 3D space: it needs dim 3 and "
                              "augment false (rotated crops would turn the grain)")
@@ -305,7 +304,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             model.T.copy_(axis_rotations(cfg.octaves, cfg.fixed_axis, cfg.seed))
             if cfg.init_stretch:   # octave i reads T_i x: scaling T's column of the axis stretches features along it
                 stretch = initial_stretch(images[0], cfg.fixed_axis)
-                model.T[:, :, 0 if cfg.fixed_axis == "columns" else 2] *= stretch
+                model.T[:, :, FIXED_AXES[cfg.fixed_axis]] *= stretch
                 log(f"transforms start stretched along the {cfg.fixed_axis} axis by {1 / stretch:.2f}")
     augment = (cfg.dim == 3 and not cfg.fixed_axis) if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
