@@ -8,17 +8,17 @@
  *
  *   segment walk (stratum_row)  pure(n), blend(n, n+1), pure(n+1), ...: segment ends from the affine
  *                               form in float64, a single table read where a slice is alone.  Used
- *                               where slices are long (SEGMENT_WALK, 48 samples or more) and on CPUs
+ *                               where slices have SEGMENT_WALK (16) samples or more and on CPUs
  *                               without AVX2.  The scalar loops are numba's operations one for one (no
  *                               fused multiply-adds): the same bits.  The AVX2 loops compute texel
- *                               coordinates the same way and fuse the lerps, the ramp's weights and
- *                               sums.
+ *                               coordinates the same way, fuse the lerps, the ramp's weights and
+ *                               sums, and write a stratum's terms into a scratch row (pure_avx2).
  *   blocks (stratum_blocks)     eight samples at a time, each lane finding its own slice and blending
  *                               n and n + 1 with weights that are exactly (amp, 0) or (0, amp) outside
- *                               the ramp: no per-segment bookkeeping, which dominates short slices
- *                               (3D grids).  Texel coordinates as the reference; fused multiply-adds
- *                               in the lerps, weights and sums, and the weights' cosine from a shorter
- *                               (minimax) polynomial: within 1e-6 of it.
+ *                               the ramp: no per-segment bookkeeping, which dominates very short
+ *                               slices (small grids).  Texel coordinates as the reference; fused
+ *                               multiply-adds in the lerps, weights and sums, and the weights' cosine
+ *                               from a shorter (minimax) polynomial: within 1e-6 of it.
  *
  * The AVX2 loops count operations (issue 27: each one saved was measurable on a 3D grid): a power-of-two
  * table size wraps texel indices with an integer and, the tables are addressed from their texel 1, the
@@ -58,11 +58,13 @@
 #else
 #define OMNI_API __attribute__((visibility("default")))
 #endif
-/* Slices of at least this many samples take the segment walk, shorter ones the blocks.  With the walk's fused
- * blend, 48 was fastest of 32, 48, 64 and 128 on the bench's grids (Sapphire Rapids, 2 threads, November 26,
- * 2026: 3D 256³ 23.3 -> 18.6 ns per sample, 3D 128³ 26.3 -> 24.7, 2D 1024² 15.1 -> 14.7; medians of 3). */
+/* Slices of at least this many samples take the segment walk, shorter ones the blocks.  Since the walk writes
+ * scratch rows (pure_avx2), 16 was as fast as any of 0, 8, 16 and 24 at 3D 128³ and 64³ and faster than 48
+ * (128³: 11.6 against 14.2-14.7 ns per sample, and 16.7 against 18.4 with gathered table reads), while at 32³
+ * (slices of 6 to 9 samples) the blocks were faster than the walk (AMD EPYC, 2 threads, November 26, 2026).
+ * It was 48 when the walk added into the output in place (Sapphire Rapids). */
 #ifndef SEGMENT_WALK
-#define SEGMENT_WALK 48
+#define SEGMENT_WALK 16
 #endif
 
 typedef struct {
@@ -194,13 +196,7 @@ AVX2 static inline __m256 pick(const float *rec, __m256 reg, int regs, __m256i i
   return regs ? _mm256_permutevar8x32_ps(reg, idx) : _mm256_i32gather_ps(rec, idx, 4);
 }
 
-/* The segment walk's loops (stratum_row), eight samples at a time. */
-AVX2 static inline __m256 load_x(const float *xs, int64_t j, int64_t m) {
-  if (m >= 8) return _mm256_loadu_ps(xs + j);
-  __m256i k = lane_mask(m);
-  return _mm256_blendv_ps(_mm256_set1_ps(xs[j + m - 1]), _mm256_maskload_ps(xs + j, k), _mm256_castsi256_ps(k));
-}
-
+/* out[j .. j + m) += the first m lanes of v (m < 8: the row's last samples) */
 AVX2 static inline void add_out(float *out, int64_t j, int64_t m, __m256 v) {
   if (m >= 8) {
     _mm256_storeu_ps(out + j, _mm256_add_ps(_mm256_loadu_ps(out + j), v));
@@ -218,24 +214,33 @@ AVX2 static inline void lerp8(const job_t *J, __m256 tau, __m256 fN, __m256 inv_
   if (J->want_imag) *im = _mm256_fmadd_ps(fetch(J->dim + 1, &T), t, fetch(J->tim + 1, &T));
 }
 
-AVX2 static void pure_avx2(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore,
-                           float *oim) {
+/* The segment walk's loops (stratum_row_avx2), eight samples at a time.  They write a stratum's terms into a
+ * scratch row (Nx + 8 floats) with full-width stores and no loads: a segment's last, partial block writes past
+ * the segment's end, and the next segment (the walk goes left to right) overwrites those lanes; the row's
+ * coordinates are padded (omni_rows), so every load is a full one too.  The scratch row is added to the output
+ * row one stratum later (omni_rows), when its stores have left the store buffer.  The earlier loops added into
+ * the output row segment by segment with masked loads and stores at the segments' ends, and each segment's
+ * first block loaded what the previous segment's last masked store had just written, partly: a load the CPU
+ * cannot forward from a store, so it waited for the store to complete (issue 27: 3D 128³ 14.7 -> 11.7 ns per
+ * sample with the inlined loops and padded coordinates, AMD EPYC, 2 threads).  Texel coordinates and the ramp's
+ * position p = x s_x + q exactly as the reference computes them; the lerps, the ramp's weights and sums with
+ * fused multiply-adds, the amplitude applied once (within 2e-6 of the reference, tested). */
+AVX2 static inline __attribute__((always_inline)) void pure_avx2(const job_t *J, int64_t o, int64_t m, float a,
+                                                                 float b, float amp, float *sre, float *sim) {
   const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vamp = _mm256_set1_ps(amp);
   const __m256 fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
   for (int64_t j = o; j < o + m; j += 8) {
-    int64_t n = o + m - j;
-    __m256 x = load_x(J->xs, j, n), re, im;
+    __m256 x = _mm256_loadu_ps(J->xs + j), re, im;  /* the padded coordinates (omni_rows) */
     lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va), vb), fN, inv_N, &re, &im);
-    add_out(ore, j, n, _mm256_mul_ps(vamp, re));
-    if (J->want_imag) add_out(oim, j, n, _mm256_mul_ps(vamp, im));
+    _mm256_storeu_ps(sre + j, _mm256_mul_ps(vamp, re));
+    if (J->want_imag) _mm256_storeu_ps(sim + j, _mm256_mul_ps(vamp, im));
   }
 }
 
-/* A blend segment, eight samples at a time: texel coordinates and the ramp's position p = x s_x + q exactly as
- * the reference computes them, the ramp, weights and sums with fused multiply-adds (as stratum_blocks; within
- * 1e-6 of the reference, tested). */
-AVX2 static void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0,
-                            float b0, float a1, float b1, float amp, float *ore, float *oim) {
+AVX2 static inline __attribute__((always_inline)) void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx,
+                                                                  float q, float fn, float sp, float a0, float b0,
+                                                                  float a1, float b1, float amp, float *sre,
+                                                                  float *sim) {
   const __m256 vsx = _mm256_set1_ps(sx), vq = _mm256_set1_ps(q), vfn = _mm256_set1_ps(fn);
   const __m256 voff = _mm256_set1_ps(ramp_offset(sp));
   const __m256 c = _mm256_set1_ps((float)(0.5 / 0.3)), one = _mm256_set1_ps(1.0f);
@@ -243,27 +248,34 @@ AVX2 static void blend_avx2(const job_t *J, int64_t o, int64_t m, float sx, floa
   const __m256 vamp = _mm256_set1_ps(amp), fN = _mm256_set1_ps(J->fN), inv_N = _mm256_set1_ps(J->inv_N);
   const __m256 va0 = _mm256_set1_ps(a0), vb0 = _mm256_set1_ps(b0), va1 = _mm256_set1_ps(a1), vb1 = _mm256_set1_ps(b1);
   for (int64_t j = o; j < o + m; j += 8) {
-    int64_t n = o + m - j;
-    __m256 x = load_x(J->xs, j, n), re0, im0, re1, im1;
+    __m256 x = _mm256_loadu_ps(J->xs + j), re0, im0, re1, im1;
     __m256 u = _mm256_fmadd_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(x, vsx), vq), vfn), c, voff);
-    /* min(max(u, 0), 1) as numba's: NaN cannot occur (finite coordinates) */
     u = _mm256_min_ps(_mm256_max_ps(u, _mm256_setzero_ps()), one);
     __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_fnmadd_ps(two, u, three));
     __m256 w0 = cos_half_pi8(s), w1 = cos_half_pi8(_mm256_sub_ps(one, s));
     lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va0), vb0), fN, inv_N, &re0, &im0);
     lerp8(J, _mm256_add_ps(_mm256_mul_ps(x, va1), vb1), fN, inv_N, &re1, &im1);
-    if (n >= 8) {  /* slice n's term, then slice n + 1's, as the reference adds them */
-      _mm256_storeu_ps(ore + j, _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, re1, _mm256_mul_ps(w0, re0)), _mm256_loadu_ps(ore + j)));
-      if (J->want_imag)
-        _mm256_storeu_ps(oim + j, _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, im1, _mm256_mul_ps(w0, im0)), _mm256_loadu_ps(oim + j)));
-    } else {
-      __m256i k = lane_mask(n);
-      _mm256_maskstore_ps(ore + j, k, _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, re1, _mm256_mul_ps(w0, re0)), _mm256_maskload_ps(ore + j, k)));
-      if (J->want_imag)
-        _mm256_maskstore_ps(oim + j, k,
-                            _mm256_fmadd_ps(vamp, _mm256_fmadd_ps(w1, im1, _mm256_mul_ps(w0, im0)), _mm256_maskload_ps(oim + j, k)));
-    }
+    _mm256_storeu_ps(sre + j, _mm256_mul_ps(vamp, _mm256_fmadd_ps(w1, re1, _mm256_mul_ps(w0, re0))));
+    if (J->want_imag)
+      _mm256_storeu_ps(sim + j, _mm256_mul_ps(vamp, _mm256_fmadd_ps(w1, im1, _mm256_mul_ps(w0, im0))));
   }
+}
+
+/* out row (Nx) += scratch row */
+AVX2 static void walk_add(int64_t Nx, const float *sc, float *out) {
+  int64_t j = 0;
+  for (; j + 8 <= Nx; j += 8)
+    _mm256_storeu_ps(out + j, _mm256_add_ps(_mm256_loadu_ps(out + j), _mm256_loadu_ps(sc + j)));
+  if (j < Nx) add_out(out, j, Nx - j, _mm256_loadu_ps(sc + j));
+}
+
+/* adds a walked stratum's scratch rows (re at pend, im at pend + Nx + 8) to the output row, if any; returns NULL */
+AVX2 static float *add_pending(const job_t *J, float *pend, float *ore, float *oim) {
+  if (pend) {
+    walk_add(J->Nx, pend, ore);
+    if (J->want_imag) walk_add(J->Nx, pend + J->Nx + 8, oim);
+  }
+  return 0;
 }
 
 /* Stratum k's waves along row r, eight samples at a time.  Every lane finds its slice n = floor(p) and
@@ -328,21 +340,6 @@ AVX2 static void stratum_blocks(const job_t *J, float sx, float q, int64_t k, in
 }
 #endif
 
-static void pure(const job_t *J, int64_t o, int64_t m, float a, float b, float amp, float *ore, float *oim) {
-#ifdef OMNI_X86
-  if (J->vector) return pure_avx2(J, o, m, a, b, amp, ore, oim);
-#endif
-  pure_scalar(J, o, m, a, b, amp, ore, oim);
-}
-
-static void blend(const job_t *J, int64_t o, int64_t m, float sx, float q, float fn, float sp, float a0, float b0,
-                  float a1, float b1, float amp, float *ore, float *oim) {
-#ifdef OMNI_X86
-  if (J->vector) return blend_avx2(J, o, m, sx, q, fn, sp, a0, b0, a1, b1, amp, ore, oim);
-#endif
-  blend_scalar(J, o, m, sx, q, fn, sp, a0, b0, a1, b1, amp, ore, oim);
-}
-
 /* b of tau = x a + b, reduced mod N in float64 (fast._row_affine) */
 static inline float row_affine(float p, float shift, float inv_period, float zeta, float fN) {
   double c = (((double)p - (double)shift) * (double)inv_period + (double)zeta) * (double)fN;
@@ -364,9 +361,15 @@ static inline int64_t clamp_index(double v, int64_t Nx) {
   return j < 0 ? 0 : (j > Nx ? Nx : j);
 }
 
-/* stratum k's waves along row r (fast._stratum_row) */
-static inline __attribute__((always_inline)) void stratum_row_(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r, float amp,
-                        float *ore, float *oim) {
+typedef void (*pure_fn)(const job_t *, int64_t, int64_t, float, float, float, float *, float *);
+typedef void (*blend_fn)(const job_t *, int64_t, int64_t, float, float, float, float, float, float, float, float,
+                         float, float *, float *);
+
+/* stratum k's waves along row r (fast._stratum_row), its segments by pure_seg and blend_seg: the scalar loops,
+ * which add into ore, oim, or the AVX2 ones, which write scratch rows there */
+static inline __attribute__((always_inline)) void stratum_row_(const job_t *J, double h, float x0, float sx, float q,
+                                                               int64_t k, int64_t r, float amp, float *ore,
+                                                               float *oim, pure_fn pure_seg, blend_fn blend_seg) {
   const int64_t Nx = J->Nx;
   const float *xs = J->xs, *slp = J->slpos + k * J->S, nmk = J->nmin[k];
   double hs = h * (double)sx;
@@ -375,7 +378,7 @@ static inline __attribute__((always_inline)) void stratum_row_(const job_t *J, d
     int64_t ri = (int64_t)(n - nmk);
     slice_affine(J, k, r, ri, &a0, &b0);
     slice_affine(J, k, r, ri + 1, &a1, &b1);
-    blend(J, 0, Nx, sx, q, n, slp[ri], a0, b0, a1, b1, amp, ore, oim);
+    blend_seg(J, 0, Nx, sx, q, n, slp[ri], a0, b0, a1, b1, amp, ore, oim);
     return;
   }
   double P0 = (double)x0 * (double)sx + (double)q, inv_hs = 1.0 / hs;
@@ -403,24 +406,27 @@ static inline __attribute__((always_inline)) void stratum_row_(const job_t *J, d
       an = a_lo, bn = b_lo;
     }
     if (j_in > cur) {
-      pure(J, cur, j_in - cur, am, bm, amp, ore, oim);
+      pure_seg(J, cur, j_in - cur, am, bm, amp, ore, oim);
       cur = j_in;
     }
     if (j_out > cur) {
-      blend(J, cur, j_out - cur, sx, q, n, sp, a_lo, b_lo, a_hi, b_hi, amp, ore, oim);
+      blend_seg(J, cur, j_out - cur, sx, q, n, sp, a_lo, b_lo, a_hi, b_hi, amp, ore, oim);
       cur = j_out;
     }
     am = an, bm = bn;
   }
-  if (cur < Nx) pure(J, cur, Nx - cur, am, bm, amp, ore, oim);
+  if (cur < Nx) pure_seg(J, cur, Nx - cur, am, bm, amp, ore, oim);
 }
 
 static void stratum_row(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r, float amp,
-                        float *ore, float *oim) { stratum_row_(J, h, x0, sx, q, k, r, amp, ore, oim); }
+                        float *ore, float *oim) { stratum_row_(J, h, x0, sx, q, k, r, amp, ore, oim, pure_scalar, blend_scalar); }
 #ifdef OMNI_X86
-/* the same walk compiled for AVX2 CPUs: its float64 floor and ceil become single instructions */
+/* the same walk compiled for AVX2 CPUs (its float64 floor and ceil become single instructions), writing the
+ * stratum's terms into the scratch rows sre, sim (Nx + 8 floats each; see pure_avx2) */
 AVX2 static void stratum_row_avx2(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r,
-                                  float amp, float *ore, float *oim) { stratum_row_(J, h, x0, sx, q, k, r, amp, ore, oim); }
+                                  float amp, float *ore, float *oim, float *sre, float *sim) {
+  stratum_row_(J, h, x0, sx, q, k, r, amp, sre, sim, pure_avx2, blend_avx2);
+}
 #endif
 
 OMNI_API int omni_abi(void) { return OMNI_ABI; }
@@ -453,15 +459,25 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
   J.pow2 = N > 0 && (N & (N - 1)) == 0 ? (int)N : 0;
   J.inv_N = 1.0f / J.fN;
   float x0 = xs[0], *A = 0;
+  /* scratch: the blocks' records (3 (S + 16)), two pairs of scratch rows for the walk's terms (re, im) and the
+   * padded row coordinates (Nx + 8 each) */
+  const int64_t W = Nx + 8;
 #ifdef OMNI_X86
-  if (vector && !(A = malloc(3 * (S + 16) * sizeof(float)))) vector = J.vector = J.gather = 0;  /* no memory */
+  if (vector && !(A = malloc((3 * (S + 16) + 5 * W) * sizeof(float)))) vector = J.vector = J.gather = 0;  /* no memory */
 #endif
   double h = Nx > 1 ? ((double)xs[Nx - 1] - (double)x0) / (double)(Nx - 1) : 1.0;
+  float *scratch = A ? A + 3 * (S + 16) : 0;
+  if (vector && scratch) {  /* the row's coordinates padded with its last one: the walk's blocks load eight */
+    float *xp = scratch + 4 * W;
+    for (int64_t j = 0; j < W; j++) xp[j] = xs[j < Nx ? j : Nx - 1];
+    J.xs = xp;
+  }
   for (int64_t r = r0; r < r1; r++) {
     float *ore = out_re + r * Nx, *oim = want_imag ? out_im + r * Nx : 0;
     for (int64_t j = 0; j < Nx; j++) ore[j] = 0.0f;
     if (want_imag)
       for (int64_t j = 0; j < Nx; j++) oim[j] = 0.0f;
+    float *pend = 0;  /* the last walked stratum's scratch rows, added after the next stratum (strata in order) */
     for (int64_t k = 0; k < K; k++) {
       float q = 0.0f;
       for (int64_t d = 1; d < D; d++) q += others[r * (D - 1) + d - 1] * sdirs[k * D + d];
@@ -469,16 +485,23 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
 #ifdef OMNI_X86
       /* long slices (SEGMENT_WALK samples or more): the segment walk; else eight samples at a time */
       if (vector && !(fabs(h * (double)sdirs[k * D]) * SEGMENT_WALK < 1.0)) {
+        pend = add_pending(&J, pend, ore, oim);
         stratum_blocks(&J, sdirs[k * D], q, k, r, amps[k], ore, oim, A, A + S + 16, A + 2 * (S + 16));
         continue;
       }
       if (vector) {
-        stratum_row_avx2(&J, h, x0, sdirs[k * D], q, k, r, amps[k], ore, oim);
+        float *sc = pend == scratch ? scratch + 2 * W : scratch;  /* the pair not pending */
+        stratum_row_avx2(&J, h, x0, sdirs[k * D], q, k, r, amps[k], ore, oim, sc, sc + W);
+        add_pending(&J, pend, ore, oim);
+        pend = sc;
         continue;
       }
 #endif
       stratum_row(&J, h, x0, sdirs[k * D], q, k, r, amps[k], ore, oim);
     }
+#ifdef OMNI_X86
+    add_pending(&J, pend, ore, oim);
+#endif
   }
   free(A);
 }

@@ -67,8 +67,9 @@ needs_numba = pytest.mark.skipif(not fast.available(), reason="numba (the refere
 
 @needs_numba
 @pytest.mark.parametrize("dim,nx,x0,x1,speed", [
-    (2, 203, -1.3, 3.7, 0.0),      # short slices: eight samples at a time, rows not a multiple of 8
+    (2, 203, -1.3, 3.7, 0.0),      # slices of 38 samples and more: the walk, rows not a multiple of 8
     (3, 128, 0.0, 4.0, 0.0),       # the bench's 3D row
+    (3, 101, 0.0, 6.5, 0.0),       # slices of 15 to 50 samples: blocks and walk in one row set
     (3, 37, 10.0, 11.0, 0.6),      # animated, far from the origin
     (4, 16, -2.0, 2.0, 0.0),
     (2, 1024, 0.0, 0.5, 0.0),      # long slices: the segment walk
