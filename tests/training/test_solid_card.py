@@ -45,6 +45,9 @@ def test_loss_label_and_config_file_of_a_retrained_model(tmp_path):
         "swd + spectrum 0.2 + structure 0.2, colour affine"
     assert mc.loss_label({"loss": "swd", "bricks": 3, "fixed_axis": "rows"}) == "swd, 3 brick octaves, fixed_axis rows"
     assert mc.loss_label({}) == "gram"
+    assert mc.loss_label({"loss": "swd", "hist_weight": 30.0, "bricks": 3, "noise_ramp": 400}) == \
+        "swd + colour 30, 3 brick octaves, value noise ramped in over 400 steps"
+    assert mc.loss_label({"loss": "swd", "hist_weight": 10.0}) == "swd"
     # two config files share a name (the model and the one it replaced): the run's own config picks its file
     (tmp_path / "sub").mkdir()
     old = {"name": "wood_3d", "exemplars": ["wood"], "steps": 1500}

@@ -335,3 +335,42 @@ def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
     want[:, :, 2] *= initial_stretch(training_images(c)[0], "rows")
     np.testing.assert_allclose(state["model"]["T"].numpy(), want.numpy(), atol=1e-6)   # lr 0: the start itself
     assert any("stretched along the rows axis" in s for s in logs)
+
+
+def test_noise_ramp_lets_the_shape_features_draw_first(tmp_path, monkeypatch):
+    """noise_ramp: the value noise enters single-mode training with a gain (step + 1) / ramp, capped at 1, so the
+    first steps' images are a function of the shape features alone; bad settings are named."""
+    import training.solid.train as tr
+
+    with pytest.raises(ValueError, match="noise_ramp needs shape features"):
+        SolidConfig.from_dict({"noise_ramp": 5, "steps": 10})
+    with pytest.raises(ValueError, match="noise_ramp must be a whole number"):
+        SolidConfig.from_dict({"noise_ramp": 10, "steps": 10, "bricks": 1})
+    with pytest.raises(ValueError, match="mode 'single'"):
+        SolidConfig.from_dict({"noise_ramp": 5, "steps": 10, "bricks": 1, "mode": "space",
+                               "exemplars": ["gravel", "grass"]})
+    cfg = SolidConfig.from_dict({"noise_ramp": 4, "steps": 10, "bricks": 1})
+    assert [tr.noise_gain(cfg, s) for s in range(5)] == [0.25, 0.5, 0.75, 1.0, 1.0]
+    assert tr.noise_gain(SolidConfig.from_dict({}), 0) == 1.0
+
+    seen, render = [], tr.render
+
+    def spy(model, e, T, x, seeds, size, stats=None, gains=None):
+        seen.append(None if gains is None else gains.unique().tolist())
+        if gains is not None and len(seen) == 1:   # at gain 0 the decoder's value-noise weights no longer matter
+            w = model.decoder.net[0].weight
+            n_value = model.octaves * model.channels
+            with torch.no_grad():
+                for g in (0.0, 1.0):
+                    before = render(model, e, T, x, seeds, size, stats, gains * 0.0 + g)
+                    w[:, :n_value] += 0.5
+                    after = render(model, e, T, x, seeds, size, stats, gains * 0.0 + g)
+                    w[:, :n_value] -= 0.5
+                    assert torch.allclose(before, after) == (g == 0.0), g
+        return render(model, e, T, x, seeds, size, stats, gains)
+
+    monkeypatch.setattr(tr, "render", spy)
+    _tiny(tmp_path, steps=5, bricks=1, noise_ramp=3)
+    assert seen[2:] == [None, None, None]
+    np.testing.assert_allclose([g[0] for g in seen[:2]], [1 / 3, 2 / 3], rtol=1e-6)
+    assert all(len(g) == 1 for g in seen[:2])

@@ -106,6 +106,9 @@ class SolidConfig:
                                     # the exemplar's spectral aspect (model.spectral_aspect; grain starts long)
     hold_out: bool = False          # single mode: train on a photo's left three quarters only (its right quarter
                                     # is the held-out part bench/eval_solid_singles.py measures on)
+    noise_ramp: int = 0             # the value noise enters the decoder with a gain rising from 0 to 1 over the
+                                    # run's first noise_ramp steps, so the shape features (cellular, bricks) draw
+                                    # alone at first and the decoder learns to read them (noise_gain); 0: off
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -136,6 +139,13 @@ class SolidConfig:
         if cfg.structure_weight and not cfg.structure_net:
             raise ValueError("structure_weight needs structure_net, the file of a trained structure network "
                              "(python -m training.solid.structure_features --out FILE)")
+        if cfg.noise_ramp:
+            if not (isinstance(cfg.noise_ramp, int) and 0 < cfg.noise_ramp < cfg.steps):
+                raise ValueError(f"noise_ramp must be a whole number of steps in 1 .. steps - 1, got {cfg.noise_ramp!r}")
+            if not (cfg.cellular or cfg.bricks):
+                raise ValueError("noise_ramp needs shape features (cellular or bricks) to draw while the noise is off")
+            if cfg.mode != "single":
+                raise ValueError("noise_ramp is for single-exemplar models (mode 'single')")
         if cfg.min_spacing:
             if not (math.isfinite(cfg.min_spacing) and cfg.min_spacing > 0):
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
@@ -203,6 +213,11 @@ def training_images(cfg: SolidConfig) -> list:
     """The training regions of the config's exemplars, resampled: list of (3, H, W)."""
     return [_resample(ex.train_region(ex.exemplar(n), n, cfg.hold_out), cfg.exemplar_scale)
             for n in ex.expand(cfg.exemplars)]
+
+
+def noise_gain(cfg: SolidConfig, step: int) -> float:
+    """The value noise's gain at a step: (step + 1) / noise_ramp up to 1 (1 without a ramp)."""
+    return min(1.0, (step + 1) / cfg.noise_ramp) if cfg.noise_ramp else 1.0
 
 
 def render(model: SolidTexture, e: torch.Tensor, T: torch.Tensor, x: torch.Tensor, seeds, size: int,
@@ -326,6 +341,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
             e, T = model.codes(batch=cfg.batch)
             stats, gains = single_stats, None
+            if noise_gain(cfg, step) < 1.0:   # the octaves' noise times the ramp's gain (model.sample's gains)
+                gains = torch.full((cfg.batch, cfg.octaves), noise_gain(cfg, step))
         else:
             # distinct exemplars within a batch (while there are enough): each step contrasts textures
             pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
