@@ -78,8 +78,9 @@ def test_fixed_axis_slices_keep_the_photo_direction_on_one_axis():
         slice_points(1, 4, 4.0, 3, 0.0, 1.0, g, fixed_axis="diagonal")
     with pytest.raises(ValueError, match="augment false"):
         SolidConfig.from_dict({"fixed_axis": "columns", "augment": True})
-    with pytest.raises(ValueError, match="dim 3"):
-        SolidConfig.from_dict({"fixed_axis": "rows", "dim": 2})
+    with pytest.raises(ValueError, match="mode 'single'"):
+        SolidConfig.from_dict({"fixed_axis": "rows", "dim": 2, "mode": "space", "exemplars": ["gravel", "grass"]})
+    assert SolidConfig.from_dict({"fixed_axis": "rows", "dim": 2}).fixed_axis == "rows"
 
 
 def test_features_see_structure_and_colour():
@@ -322,6 +323,14 @@ def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
         np.testing.assert_allclose((T @ T.transpose(1, 2)).numpy(), np.broadcast_to(np.eye(3), (8, 3, 3)), atol=1e-6)
         np.testing.assert_allclose(torch.det(T).numpy(), 1.0, atol=1e-5)
         assert len({round(float(t[0, (k + 1) % 3]), 4) for t in T}) == 8     # each octave turned its own way
+    # 2D: the plane is the photo's; "rows" keeps the lattices' rows on its rows (p_1 = y), "columns" on its
+    # columns (p_1 = x), every octave alike
+    for axis, k in (("rows", 1), ("columns", 0)):
+        T = axis_rotations(8, axis, seed=2, dim=2)
+        e = torch.zeros(2)
+        e[k] = 1.0
+        np.testing.assert_allclose((T @ e).numpy(), np.broadcast_to([0.0, 1.0], (8, 2)), atol=1e-7)
+        np.testing.assert_allclose(torch.det(T).numpy(), 1.0, atol=1e-6)
     photo = ex.photo_set("train")[0]
     cfg = dict(name="tiny_axis", mode="single", dim=3, crop=32, batch=1, steps=0, width=8, threads=1,
                exemplars=[photo], colour="affine", loss="swd", swd_width=4, swd_levels=1, augment=False,
@@ -335,6 +344,12 @@ def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
     want[:, :, 2] *= initial_stretch(training_images(c)[0], "rows")
     np.testing.assert_allclose(state["model"]["T"].numpy(), want.numpy(), atol=1e-6)   # lr 0: the start itself
     assert any("stretched along the rows axis" in s for s in logs)
+    train(SolidConfig.from_dict(dict(cfg, dim=2, steps=1, lr=0.0, lr_min=0.0)), str(tmp_path / "run2"),
+          log=lambda *_: None)
+    T2 = torch.load(tmp_path / "run2" / "ckpt.pt", weights_only=False)["model"]["T"]
+    want2 = torch.eye(2).expand(8, 2, 2).clone()
+    want2[:, :, 1] *= initial_stretch(training_images(c)[0], "rows")   # the photo's vertical is y in 2D
+    np.testing.assert_allclose(T2.numpy(), want2.numpy(), atol=1e-6)
 
 
 def test_noise_ramp_lets_the_shape_features_draw_first(tmp_path, monkeypatch):

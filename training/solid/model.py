@@ -35,7 +35,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
 
-__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
+__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
 
 
 def shape_features(cellular: int, bricks: int) -> int:
@@ -59,6 +59,13 @@ def random_rotations(octaves: int, dim: int, seed: int = 0) -> torch.Tensor:
 #: ``fixed_axis`` -> the axis of space the photo's direction lies on: "columns" (its horizontal) on x, "rows"
 #: (its vertical) on z
 FIXED_AXES = {"columns": 0, "rows": 2}
+#: the same in a 2D model, whose plane is the photo's: its horizontal is x, its vertical y
+FIXED_AXES_2D = {"columns": 0, "rows": 1}
+
+
+def fixed_axis_index(fixed_axis: str, dim: int) -> int:
+    """The coordinate (0 .. dim - 1) that ``fixed_axis`` puts the photo's direction on."""
+    return (FIXED_AXES_2D if dim == 2 else FIXED_AXES)[fixed_axis]
 
 
 def check_fixed_axis(fixed_axis: str) -> None:
@@ -73,11 +80,18 @@ def axis_frame(fixed_axis: str, t: float) -> list:
     return [[1.0, 0.0, 0.0], [0.0, c, s]] if fixed_axis == "columns" else [[c, s, 0.0], [0.0, 0.0, 1.0]]
 
 
-def axis_rotations(octaves: int, fixed_axis: str, seed: int = 0) -> torch.Tensor:
-    """Transforms (octaves, 3, 3) float32 that keep a direction of space on the lattice's second axis (the
+def axis_rotations(octaves: int, fixed_axis: str, seed: int = 0, dim: int = 3) -> torch.Tensor:
+    """Transforms (octaves, dim, dim) float32 that keep a direction of space on the lattice's second axis (the
     brick lattice's rows, :mod:`backend.solid.brick`) and turn the plane across it by a seeded uniform angle
     per octave: "columns" keeps x, "rows" keeps z (det +1).  A single-exemplar model trained with
-    ``fixed_axis`` starts from these, so its lattices start aligned with the photo's direction."""
+    ``fixed_axis`` starts from these, so its lattices start aligned with the photo's direction.
+
+    In 2D the plane is the photo's own and is never turned (``slice_points``), so there is nothing to turn
+    about the axis: "rows" is the identity (the lattice's rows run along the photo's rows, p_1 = y) and
+    "columns" the quarter turn with p_1 = x, for every octave."""
+    if dim == 2:
+        T = torch.eye(2) if fixed_axis == "rows" else torch.tensor([[0.0, -1.0], [1.0, 0.0]])
+        return T.expand(octaves, 2, 2).clone()
     g = torch.Generator().manual_seed(seed)
     axis = FIXED_AXES[fixed_axis]
     a, b = [k for k in range(3) if k != axis]

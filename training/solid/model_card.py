@@ -195,8 +195,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "- **Exemplars:** the single-exemplar models named by a photo were each fitted to one colour photo of "
          "the photo set's training split (`data/photos/`: package, licence, author and sha256 per file in its "
          "`manifest.json`, attribution in `ATTRIBUTION.md`); with `hold_out` training never crops its right "
-         "quarter, which `bench/eval_solid_singles.py` measures on. Older models name the CC0 photographs brick, "
-         "grass and gravel of scikit-image (`data/exemplars/README.md`, right quarter held out as well) or a "
+         "quarter, which `bench/eval_solid_singles.py` measures on. The one older model, granite_3d, names a "
          "procedural class of `training/solid/exemplars.py` (seed 0 trains, seed 1 is held out). The space model "
          "is trained on the whole training split (\"Photo texture space\" below).",
          "- **Model** (Sec. 3-4, Eq. 5): 8 octaves of lattice value noise, 3 values per lattice point, octave i "
@@ -220,7 +219,8 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "unrotated photo (brick courses level, planks standing); `columns` puts its horizontal on x. Their "
          "lattices start turned about that axis only (`model.axis_rotations`), and with `init_stretch` their "
          "features start as much longer along it as the photo's power spectrum says (`model.spectral_aspect`). "
-         "The planes across the axis (end grain) are not trained.",
+         "The planes across the axis (end grain) are not trained. A 2D model's plane is the photo's own; there "
+         "`fixed_axis` only starts the lattices' rows along the photo's rows (`rows`) or columns (`columns`).",
          "- **Hardware:** beside each wall time where the export records it (training writes it into the "
          "checkpoint); the models without it were trained on an Intel Xeon with 2 cores visible, one torch thread "
          "per run, two or three runs sharing the two cores (wall times include that sharing).",

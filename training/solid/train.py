@@ -39,7 +39,7 @@ from ..model_card import cpu_name
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import (FIXED_AXES, SolidTexture, axis_rotations, check_fixed_axis, colour_stats, max_scales,
+from .model import (SolidTexture, fixed_axis_index, axis_rotations, check_fixed_axis, colour_stats, max_scales,
                     shape_features, slice_points, spectral_aspect, spectral_gains)
 from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
@@ -101,7 +101,8 @@ class SolidConfig:
     init_sha256: str = ""           # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
     warmup: int = 0                 # steps of linear learning-rate warm-up from where this run starts
     fixed_axis: str = ""            # 3D: "columns" (image horizontal along x: wood grain) or "rows" (image vertical
-                                    # along z: brick courses) slices only through that axis (model.slice_points)
+                                    # along z: brick courses) slices only through that axis (model.slice_points);
+                                    # 2D single: the lattices start with their rows along the photo's rows or columns
     init_stretch: bool = False      # single mode with fixed_axis: the transforms start scaled along that axis by
                                     # the exemplar's spectral aspect (model.spectral_aspect; grain starts long)
     hold_out: bool = False          # single mode: train on a photo's left three quarters only (its right quarter
@@ -156,9 +157,12 @@ class SolidConfig:
         if cfg.init_onnx and cfg.init_from:
             raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
         check_fixed_axis(cfg.fixed_axis)
-        if cfg.fixed_axis and (cfg.dim != 3 or cfg.augment):
-            raise ValueError("fixed_axis keeps the photo's orientation on an axis of 3D space: it needs dim 3 and "
-                             "augment false (rotated crops would turn the grain)")
+        if cfg.fixed_axis and cfg.augment:
+            raise ValueError("fixed_axis keeps the photo's orientation on an axis: it needs augment false (rotated "
+                             "crops would turn the grain)")
+        if cfg.fixed_axis and cfg.dim == 2 and cfg.mode != "single":
+            raise ValueError("in 2D, fixed_axis sets where a single model's lattices start (model.axis_rotations): "
+                             "it needs mode 'single' (a 2D plane is the photo's own, never turned)")
         if cfg.init_stretch and not (cfg.mode == "single" and cfg.fixed_axis):
             raise ValueError("init_stretch scales the transforms along the fixed axis: it needs mode 'single' and "
                              "fixed_axis")
@@ -316,10 +320,10 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     images = training_images(cfg)
     if cfg.mode == "single" and cfg.fixed_axis and step == 0:
         with torch.no_grad():   # lattices start aligned with the photo's direction (model.axis_rotations)
-            model.T.copy_(axis_rotations(cfg.octaves, cfg.fixed_axis, cfg.seed))
+            model.T.copy_(axis_rotations(cfg.octaves, cfg.fixed_axis, cfg.seed, cfg.dim))
             if cfg.init_stretch:   # octave i reads T_i x: scaling T's column of the axis stretches features along it
                 stretch = initial_stretch(images[0], cfg.fixed_axis)
-                model.T[:, :, FIXED_AXES[cfg.fixed_axis]] *= stretch
+                model.T[:, :, fixed_axis_index(cfg.fixed_axis, cfg.dim)] *= stretch
                 log(f"transforms start stretched along the {cfg.fixed_axis} axis by {1 / stretch:.2f}")
     augment = (cfg.dim == 3 and not cfg.fixed_axis) if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
