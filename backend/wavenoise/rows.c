@@ -250,6 +250,7 @@ AVX2 static inline __attribute__((always_inline)) void blend_avx2(const job_t *J
   for (int64_t j = o; j < o + m; j += 8) {
     __m256 x = _mm256_loadu_ps(J->xs + j), re0, im0, re1, im1;
     __m256 u = _mm256_fmadd_ps(_mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(x, vsx), vq), vfn), c, voff);
+    /* min(max(u, 0), 1) as numba's: NaN cannot occur (finite coordinates) */
     u = _mm256_min_ps(_mm256_max_ps(u, _mm256_setzero_ps()), one);
     __m256 s = _mm256_mul_ps(_mm256_mul_ps(u, u), _mm256_fnmadd_ps(two, u, three));
     __m256 w0 = cos_half_pi8(s), w1 = cos_half_pi8(_mm256_sub_ps(one, s));
@@ -424,7 +425,7 @@ static void stratum_row(const job_t *J, double h, float x0, float sx, float q, i
 /* the same walk compiled for AVX2 CPUs (its float64 floor and ceil become single instructions), writing the
  * stratum's terms into the scratch rows sre, sim (Nx + 8 floats each; see pure_avx2) */
 AVX2 static void stratum_row_avx2(const job_t *J, double h, float x0, float sx, float q, int64_t k, int64_t r,
-                                  float amp, float *ore, float *oim, float *sre, float *sim) {
+                                  float amp, float *sre, float *sim) {
   stratum_row_(J, h, x0, sx, q, k, r, amp, sre, sim, pure_avx2, blend_avx2);
 }
 #endif
@@ -491,7 +492,7 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
       }
       if (vector) {
         float *sc = pend == scratch ? scratch + 2 * W : scratch;  /* the pair not pending */
-        stratum_row_avx2(&J, h, x0, sdirs[k * D], q, k, r, amps[k], ore, oim, sc, sc + W);
+        stratum_row_avx2(&J, h, x0, sdirs[k * D], q, k, r, amps[k], sc, sc + W);
         add_pending(&J, pend, ore, oim);
         pend = sc;
         continue;

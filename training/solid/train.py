@@ -345,8 +345,9 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
             ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
             e, T = model.codes(batch=cfg.batch)
             stats, gains = single_stats, None
-            if noise_gain(cfg, step) < 1.0:   # the octaves' noise times the ramp's gain (model.sample's gains)
-                gains = torch.full((cfg.batch, cfg.octaves), noise_gain(cfg, step))
+            gain = noise_gain(cfg, step)
+            if gain < 1.0:   # the octaves' noise times the ramp's gain (model.sample's gains)
+                gains = torch.full((cfg.batch, cfg.octaves), gain)
         else:
             # distinct exemplars within a batch (while there are enough): each step contrasts textures
             pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
