@@ -361,9 +361,6 @@ def test_noise_ramp_lets_the_shape_features_draw_first(tmp_path, monkeypatch):
         SolidConfig.from_dict({"noise_ramp": 5, "steps": 10})
     with pytest.raises(ValueError, match="noise_ramp must be a whole number"):
         SolidConfig.from_dict({"noise_ramp": 10, "steps": 10, "bricks": 1})
-    with pytest.raises(ValueError, match="mode 'single'"):
-        SolidConfig.from_dict({"noise_ramp": 5, "steps": 10, "bricks": 1, "mode": "space",
-                               "exemplars": ["gravel", "grass"]})
     cfg = SolidConfig.from_dict({"noise_ramp": 4, "steps": 10, "bricks": 1})
     assert [tr.noise_gain(cfg, s) for s in range(5)] == [0.25, 0.5, 0.75, 1.0, 1.0]
     assert tr.noise_gain(SolidConfig.from_dict({}), 0) == 1.0
@@ -389,3 +386,73 @@ def test_noise_ramp_lets_the_shape_features_draw_first(tmp_path, monkeypatch):
     assert seen[2:] == [None, None, None]
     np.testing.assert_allclose([g[0] for g in seen[:2]], [1 / 3, 2 / 3], rtol=1e-6)
     assert all(len(g) == 1 for g in seen[:2])
+
+
+def test_noise_ramp_in_space_mode_scales_the_spectral_gains(tmp_path, monkeypatch):
+    """A space model's ramp multiplies each photo's measured spectral gains (model.spectral_gains) by the ramp's
+    gain, so the ratios between octaves stay the photo's while the noise fades in."""
+    import training.solid.train as tr
+    from training.solid.model import spectral_gains
+
+    seen, render = [], tr.render
+
+    def spy(model, e, T, x, seeds, size, stats=None, gains=None):
+        seen.append(gains.clone())
+        return render(model, e, T, x, seeds, size, stats, gains)
+
+    measured, real = [], spectral_gains
+
+    def spy_gains(img, octaves=8, px_per_unit=128.0):
+        measured.append(real(img, octaves, px_per_unit))
+        return measured[-1]
+
+    monkeypatch.setattr(tr, "render", spy)
+    monkeypatch.setattr(tr, "spectral_gains", spy_gains)
+    _tiny(tmp_path, mode="space", steps=4, crop=64, cellular=1, noise_ramp=2, colour="affine", spectral=True)
+    assert len(seen) == len(measured) == 4
+    for step, (g, m) in enumerate(zip(seen, measured)):
+        torch.testing.assert_close(g, m * min(1.0, (step + 1) / 2))
+
+
+def test_budget_fits_the_schedule_to_the_time_there_is(tmp_path, monkeypatch):
+    """--budget-seconds: after steps 10 to 40 of a stretch the run's steps become what the rest of the budget holds
+    at the measured rate, the noise ramp keeps its share of the schedule, and the checkpoint records both."""
+    import training.solid.train as tr
+
+    cfg = SolidConfig.from_dict({"steps": 1000, "noise_ramp": 200, "bricks": 1})
+    fitted = tr.fit_schedule(cfg, 40, 0.5, 100.0)
+    assert (fitted.steps, fitted.noise_ramp) == (240, 48)
+    assert tr.fit_schedule(cfg, 40, 0.5, -3.0).steps == 41          # past the budget: one more step
+    assert tr.fit_schedule(SolidConfig.from_dict({"steps": 10}), 0, 0.1, 100.0).noise_ramp == 0
+    with pytest.raises(ValueError, match="seconds per step must be a positive number"):
+        tr.fit_schedule(cfg, 40, 0.0, 100.0)
+
+    clock, render = [0.0], tr.render
+
+    def step_of_two_seconds(*args, **kw):                # a clock that moves 2 s per rendered step
+        clock[0] += 2.0
+        return render(*args, **kw)
+
+    monkeypatch.setattr(tr, "render", step_of_two_seconds)
+    monkeypatch.setattr(tr.time, "time", lambda: clock[0])
+    run = tmp_path / "budget"
+    cfg = SolidConfig.from_dict(dict(crop=16, batch=1, steps=1000, width=16, log_every=1000, checkpoint_every=1000,
+                                     threads=1, exemplars=["gravel"], dim=2, bricks=1, noise_ramp=500))
+    state = train(cfg, str(run), log=lambda *_: None, budget_seconds=1000.0)
+    # at step 40, 80 s gone at 2 s per step: the 920 s left hold 460 steps
+    assert state["step"] == state["config"]["steps"] == 500
+    assert state["config"]["noise_ramp"] == 250
+    with pytest.raises(ValueError, match="budget_seconds must be a positive number"):
+        train(cfg, str(run), budget_seconds=0.0)
+
+
+def test_device_is_checked(tmp_path, capsys):
+    import training.solid.train as tr
+
+    with pytest.raises(ValueError, match="device must be 'cpu', 'cuda' or 'cuda:N', got 'gpu'"):
+        SolidConfig.from_dict({"device": "gpu"})
+    SolidConfig.from_dict({"device": "cuda:1"})
+    if not torch.cuda.is_available():
+        assert tr.main(["--config", "configs/solid/gravel_3d.json", "--out", str(tmp_path / "r"),
+                        "--set", 'device="cuda"', "--set", "steps=2"]) == 2
+        assert "torch sees no CUDA device here" in capsys.readouterr().err

@@ -169,7 +169,7 @@ def colour_stats(img: torch.Tensor, eps: float = 1e-4) -> torch.Tensor:
     x = img.flatten(2)                                   # (B, 3, P)
     mu = x.mean(2)
     xc = x - mu.unsqueeze(2)
-    cov = xc @ xc.transpose(1, 2) / x.shape[2] + eps * torch.eye(3, dtype=img.dtype)
+    cov = xc @ xc.transpose(1, 2) / x.shape[2] + eps * torch.eye(3, dtype=img.dtype, device=img.device)
     L = torch.linalg.cholesky(cov)
     return torch.cat([mu, L.flatten(1)], dim=1)
 

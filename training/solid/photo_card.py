@@ -19,7 +19,7 @@ import re
 import sys
 
 from backend._export import export as _ex
-from ..model_card import hardware_line, read_json
+from ..model_card import read_json
 
 BEGIN, END = "<!-- photo-space:begin -->", "<!-- photo-space:end -->"
 #: the run's config when none is given
@@ -42,8 +42,9 @@ ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase no
 
 
 def run_facts(run: str) -> dict:
-    """Steps, config, wall seconds, final loss and last learning rate of a run folder (``ckpt.pt`` and
-    ``log.jsonl``) or, when the run folder is gone, of its export (``solid.json``: no loss or learning rate)."""
+    """Steps, config, wall seconds, hardware (each stretch's, oldest first), final loss and last learning rate
+    of a run folder (``ckpt.pt`` and ``log.jsonl``) or, when the run folder is gone, of its export
+    (``solid.json``: no loss or learning rate)."""
     if os.path.isfile(os.path.join(run, "ckpt.pt")):
         import torch
 
@@ -52,11 +53,12 @@ def run_facts(run: str) -> dict:
             log = [json.loads(line) for line in fh if line.strip()]
         last = sorted(r["loss"] for r in log[-10:])
         return dict(step=int(state["step"]), config=state["config"], seconds=float(state.get("elapsed", 0)),
-                    loss=last[len(last) // 2] if last else None, lr=log[-1].get("lr") if log else None)
+                    loss=last[len(last) // 2] if last else None, lr=log[-1].get("lr") if log else None,
+                    hardware=str(state.get("hardware", "")))
     if os.path.isfile(os.path.join(run, "solid.json")):
         meta = read_json(os.path.join(run, "solid.json"))
         return dict(step=int(meta["step"]), config=meta["config"], seconds=float(meta.get("train_seconds", 0)),
-                    loss=None, lr=None)
+                    loss=None, lr=None, hardware=str(meta.get("hardware", "")))
     raise SystemExit(f"photo_card: error: {run} has neither ckpt.pt (a run) nor solid.json (an export)")
 
 
@@ -108,8 +110,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          f"python -m training.solid.export runs/solid/{cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
-         f"{f['seconds'] / 60:.1f} min wall on {hardware_line().split(',')[0]}, {cfg['threads']} "
-         f"threads, fp32"
+         f"{f['seconds'] / 60:.1f} min wall in all stages, on {f['hardware'] or 'hardware not recorded'}"
          + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
             " (read from the export; the run folder and its loss log were not kept).")
          + (f" Stopped at step {step} of its {cfg['steps']}-step cosine schedule (the session's time; "

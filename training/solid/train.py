@@ -28,7 +28,7 @@ import os
 import shutil
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import torch
 
@@ -48,7 +48,7 @@ from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from backend.onnx_models import load_model_json
 
-__all__ = ["SolidConfig", "load_config", "build_model", "train", "render"]
+__all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain"]
 
 
 @dataclass
@@ -95,7 +95,8 @@ class SolidConfig:
     log_every: int = 25
     checkpoint_every: int = 250
     threads: int = 0                # CPU threads for torch and numba (0: their defaults)
-    device: str = "cpu"
+    device: str = "cpu"             # "cpu" or "cuda" / "cuda:N" (model, loss and crops there; the random draws
+                                    # stay on the CPU's generator, so a run's data is the same on any device)
     init_from: str = ""             # a run folder to continue (its ckpt.pt and log.jsonl seed a new run)
     init_onnx: str = ""             # or an export folder to continue (its weights; Adam's moments start afresh) ...
     init_sha256: str = ""           # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
@@ -109,7 +110,8 @@ class SolidConfig:
                                     # is the held-out part bench/eval_solid_singles.py measures on)
     noise_ramp: int = 0             # the value noise enters the decoder with a gain rising from 0 to 1 over the
                                     # run's first noise_ramp steps, so the shape features (cellular, bricks) draw
-                                    # alone at first and the decoder learns to read them (noise_gain); 0: off
+                                    # alone at first and the decoder learns to read them (noise_gain); 0: off.
+                                    # Space models: the ramp multiplies the spectral gains
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -145,8 +147,6 @@ class SolidConfig:
                 raise ValueError(f"noise_ramp must be a whole number of steps in 1 .. steps - 1, got {cfg.noise_ramp!r}")
             if not (cfg.cellular or cfg.bricks):
                 raise ValueError("noise_ramp needs shape features (cellular or bricks) to draw while the noise is off")
-            if cfg.mode != "single":
-                raise ValueError("noise_ramp is for single-exemplar models (mode 'single')")
         if cfg.min_spacing:
             if not (math.isfinite(cfg.min_spacing) and cfg.min_spacing > 0):
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
@@ -157,6 +157,9 @@ class SolidConfig:
         if cfg.init_onnx and cfg.init_from:
             raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
         check_fixed_axis(cfg.fixed_axis)
+        if not (cfg.device == "cpu" or cfg.device == "cuda" or
+                (cfg.device.startswith("cuda:") and cfg.device[5:].isdigit())):
+            raise ValueError(f"device must be 'cpu', 'cuda' or 'cuda:N', got {cfg.device!r}")
         if cfg.fixed_axis and cfg.augment:
             raise ValueError("fixed_axis keeps the photo's orientation on an axis: it needs augment false (rotated "
                              "crops would turn the grain)")
@@ -244,7 +247,7 @@ def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, 
     if cfg.morphology_weight:
         loss = loss + cfg.morphology_weight * soft_morphology_loss(img, ref, per_sample=per_sample)
     if cfg.structure_weight:
-        loss = loss + cfg.structure_weight * swd_loss(structure_features(cfg.structure_net), img, ref,
+        loss = loss + cfg.structure_weight * swd_loss(structure_features(cfg.structure_net, img.device), img, ref,
                                                       per_sample=per_sample, generator=gen)
     return loss
 
@@ -252,14 +255,14 @@ def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, 
 _STRUCTURE: dict = {}
 
 
-def structure_features(path: str) -> StructureFeatures:
-    """The frozen structure features of a trained network file, loaded once per process."""
-    key = os.path.abspath(path)
+def structure_features(path: str, device: str = "cpu") -> StructureFeatures:
+    """The frozen structure features of a trained network file, loaded once per process and device."""
+    key = (os.path.abspath(path), str(device))
     if key not in _STRUCTURE:
-        if not os.path.isfile(key):
+        if not os.path.isfile(key[0]):
             raise ValueError(f"structure_net: no trained structure network at {path!r} "
                              f"(make one: python -m training.solid.structure_features --out {path})")
-        _STRUCTURE[key] = StructureFeatures(load_structure_net(key))
+        _STRUCTURE[key] = StructureFeatures(load_structure_net(key[0])).to(device)
     return _STRUCTURE[key]
 
 
@@ -274,18 +277,58 @@ def _save(path: str, obj) -> None:
         torch.save(obj, tmp)
 
 
-def train(cfg: SolidConfig, out: str, max_steps: int | None = None, log=print) -> dict:
-    """Train (or resume) into folder ``out``; returns the final checkpoint dict."""
+def fit_schedule(cfg: SolidConfig, step: int, seconds_per_step: float, seconds_left: float) -> SolidConfig:
+    """The config with its schedule scaled to end when a time budget does: ``steps`` becomes ``step`` plus as
+    many steps as ``seconds_left`` holds at the measured rate, and ``noise_ramp`` keeps its share of the
+    schedule (the cosine and the ramp then run their whole course in the time there is)."""
+    if not (seconds_per_step > 0 and math.isfinite(seconds_per_step)):
+        raise ValueError(f"fit_schedule: seconds per step must be a positive number, got {seconds_per_step!r}")
+    steps = step + max(1, int(max(0.0, seconds_left) / seconds_per_step))
+    ramp = 0
+    if cfg.noise_ramp:
+        ramp = max(1, min(steps - 1, round(cfg.noise_ramp * steps / cfg.steps)))
+    return replace(cfg, steps=steps, noise_ramp=ramp)
+
+
+def train_device(name: str) -> torch.device:
+    """The torch device of a config's ``device``, or a one-line error when it is not there."""
+    dev = torch.device(name)
+    if dev.type == "cuda" and not torch.cuda.is_available():
+        raise ValueError(f"device {name!r}: torch sees no CUDA device here (train with device 'cpu')")
+    return dev
+
+
+def hardware_here(cfg: SolidConfig, dev: torch.device) -> str:
+    """Where a stretch of training runs, for the model card: the GPU or the CPU and its threads, precision."""
+    if dev.type == "cuda":
+        conv = "TF32 convolutions" if torch.backends.cudnn.allow_tf32 else "fp32 convolutions"
+        return f"{torch.cuda.get_device_name(dev)}, fp32 ({conv})"
+    return f"{cpu_name()}, {cfg.threads or torch.get_num_threads()} threads, fp32"
+
+
+def train(cfg: SolidConfig, out: str, max_steps: int | None = None, log=print,
+          budget_seconds: float | None = None) -> dict:
+    """Train (or resume) into folder ``out``; returns the final checkpoint dict.
+
+    ``budget_seconds``: the run's schedule (``steps``, ``noise_ramp``) is fitted to end after this many seconds
+    of training (:func:`fit_schedule`, from the rate of steps 10 to 40 of this stretch); the fitted config is
+    the one its checkpoint records."""
+    if budget_seconds is not None and not (budget_seconds > 0 and math.isfinite(budget_seconds)):
+        raise ValueError(f"budget_seconds must be a positive number, got {budget_seconds!r}")
     with cpu_threads(cfg.threads):
-        return _train(cfg, out, max_steps, log)
+        return _train(cfg, out, max_steps, log, budget_seconds)
 
 
-def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
+_FIT_FROM, _FIT_TO = 10, 40     # the steps of a stretch whose rate fits a budget (after the device warms up)
+
+
+def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_seconds: float | None = None) -> dict:
+    dev = train_device(cfg.device)
     os.makedirs(out, exist_ok=True)
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed + 1)
     model = build_model(cfg)
-    feats = loss_features(cfg)
+    feats = loss_features(cfg).to(dev)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
     prev_hardware = ""
@@ -313,10 +356,16 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256), new_features=new)
         step, elapsed = int(model_json.get("step", 0)), float(model_json.get("train_seconds", 0.0))
         first = step
-        prev_hardware = str(model_json.get("hardware", ""))
+        prev_hardware = str(model_json.get("hardware", "")) or (f"steps 0-{step}: not recorded in the export"
+                                                                 if step else "")
         log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...) at step {step}")
     if cfg.structure_weight:
-        structure_features(cfg.structure_net)  # a missing network fails here, before the first step
+        structure_features(cfg.structure_net, dev)  # a missing network fails here, before the first step
+    model.to(dev)
+    for st in opt.state.values():    # a resumed optimiser's moments follow their parameters
+        for k, v in st.items():
+            if torch.is_tensor(v) and k != "step":
+                st[k] = v.to(dev)
     images = training_images(cfg)
     if cfg.mode == "single" and cfg.fixed_axis and step == 0:
         with torch.no_grad():   # lattices start aligned with the photo's direction (model.axis_rotations)
@@ -330,11 +379,13 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
     logf = open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8")
     t0 = time.time() - elapsed
     # single mode: one exemplar, so one colour statistic for the whole run
-    single_stats = colour_stats(images[0].unsqueeze(0)).expand(cfg.batch, -1) if cfg.mode == "single" else None
+    single_stats = colour_stats(images[0].unsqueeze(0)).expand(cfg.batch, -1).to(dev) if cfg.mode == "single" \
+        else None
     state = None
-    # where training ran: this stretch's CPU, after those of the stretches it resumes (recorded in the export)
-    here = f"{cpu_name()}, {cfg.threads or torch.get_num_threads()} threads, fp32"
+    # where training ran: this stretch's device, after those of the stretches it resumes (recorded in the export)
+    here = hardware_here(cfg, dev)
     hardware = prev_hardware if here in prev_hardware.split("; ") else "; ".join(filter(None, [prev_hardware, here]))
+    start, t_loop, t_fit = step, time.time(), 0.0
     while step < end:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / cfg.steps))
         if cfg.warmup:     # fresh Adam moments (a run continued from an export) start with small steps
@@ -342,21 +393,22 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         for g in opt.param_groups:
             g["lr"] = lr
         if cfg.mode == "single":
-            ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment)
+            ref = ex.random_crops(images[0], cfg.batch, cfg.crop, gen, augment).to(dev)
             e, T = model.codes(batch=cfg.batch)
             stats, gains = single_stats, None
-            gain = noise_gain(cfg, step)
-            if gain < 1.0:   # the octaves' noise times the ramp's gain (model.sample's gains)
-                gains = torch.full((cfg.batch, cfg.octaves), gain)
         else:
             # distinct exemplars within a batch (while there are enough): each step contrasts textures
             pick = torch.randperm(len(images), generator=gen).tolist() * (cfg.batch // len(images) + 1)
             pick = pick[:cfg.batch]
-            ref = torch.cat([ex.random_crops(images[k], 1, cfg.crop, gen, augment) for k in pick])
+            ref = torch.cat([ex.random_crops(images[k], 1, cfg.crop, gen, augment) for k in pick]).to(dev)
             e, T = model.codes(ref)
             stats = colour_stats(ref)
             gains = spectral_gains(ref, cfg.octaves, cfg.px_per_unit) if cfg.spectral else None
-        x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen, cfg.fixed_axis)
+        gain = noise_gain(cfg, step)
+        if gain < 1.0:   # the octaves' noise times the ramp's gain (model.sample's gains)
+            gains = torch.full((cfg.batch, cfg.octaves), gain, device=dev) if gains is None else gains * gain
+        x = slice_points(cfg.batch, cfg.crop, cfg.px_per_unit, cfg.dim, cfg.oblique, cfg.extent, gen,
+                         cfg.fixed_axis).to(dev)
         seeds = torch.randint(0, 2 ** 31 - 1, (cfg.batch,), generator=gen).numpy()
         img = render(model, e, T, x, seeds, cfg.crop, stats if cfg.colour == "affine" else None, gains)
         loss = texture_loss(cfg, feats, img, ref, gen)
@@ -365,6 +417,17 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log) -> dict:
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
         opt.step()
         step += 1
+        if budget_seconds is not None and step in (start + _FIT_FROM, start + _FIT_TO):
+            if dev.type == "cuda":
+                torch.cuda.synchronize(dev)     # the rate of finished steps, not of queued kernels
+            t_fit = time.time() if step == start + _FIT_FROM else t_fit
+        if budget_seconds is not None and step == start + _FIT_TO:
+            now = time.time()
+            before = cfg.steps
+            cfg = fit_schedule(cfg, step, (now - t_fit) / (_FIT_TO - _FIT_FROM), budget_seconds - (now - t_loop))
+            end = cfg.steps if max_steps is None else min(cfg.steps, start + max_steps)
+            log(f"schedule fitted to {budget_seconds:.0f} s: steps {before} -> {cfg.steps}"
+                + (f", noise_ramp {cfg.noise_ramp}" if cfg.noise_ramp else ""))
         if step % cfg.log_every == 0 or step == end:
             rec = dict(step=step, loss=round(loss.item(), 5), lr=lr, seconds=round(time.time() - t0, 1))
             logf.write(json.dumps(rec) + "\n")
@@ -386,6 +449,9 @@ def main(argv=None) -> int:
     ap.add_argument("--config", required=True, help="JSON config (keys: SolidConfig)")
     ap.add_argument("--out", required=True, help="run folder (ckpt.pt, log.jsonl)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=JSON", help="override a config key")
+    ap.add_argument("--budget-seconds", type=float, default=None, metavar="S",
+                    help="fit the schedule (steps, noise_ramp) to end after S seconds of training; the fitted "
+                         "steps are logged and kept in the checkpoint (resume with --set steps=N)")
     a = ap.parse_args(argv)
     with open(a.config, encoding="utf-8") as fh:
         d = json.load(fh)
@@ -397,7 +463,11 @@ def main(argv=None) -> int:
     except (ValueError, TypeError) as err:
         print(f"solid train: error: {err}", file=sys.stderr)
         return 2
-    train(cfg, a.out)
+    try:
+        train(cfg, a.out, budget_seconds=a.budget_seconds)
+    except ValueError as err:
+        print(f"solid train: error: {err}", file=sys.stderr)
+        return 2
     return 0
 
 

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Trains several solid-texture configs side by side on one GPU, each with its schedule fitted to a time
+# budget (python -m training.solid.train --budget-seconds), and leaves for each run its checkpoint without
+# the optimiser's moments (RUN.pt: config, model, step, hardware; export it with
+# python -m training.solid.export) and one archive of the logs in OUTDIR.
+#
+#   tools/gpu_solid_campaign.sh BUDGET_SECONDS OUTDIR CONFIG.json [CONFIG.json ...]
+#
+# PYTHON (default python3) runs training; EXTRA_SET adds --set KEY=JSON to every run, several separated by ';'
+# (a CPU rehearsal: EXTRA_SET='device="cpu";batch=2;crop=64').  Each run's log is runs/solid/NAME.log; the script polls them every POLL seconds.
+set -u
+if [ $# -lt 3 ]; then
+    echo "usage: tools/gpu_solid_campaign.sh BUDGET_SECONDS OUTDIR CONFIG.json [CONFIG.json ...]" >&2
+    exit 2
+fi
+budget=$1; out=$2; shift 2
+py=${PYTHON:-python3}
+poll=${POLL:-60}
+mkdir -p "$out" runs/solid
+command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader
+names=(); pids=()
+for cfg in "$@"; do
+    name=$(basename "$cfg" .json)
+    args=(-m training.solid.train --config "$cfg" --out "runs/solid/$name" --budget-seconds "$budget")
+    IFS=';' read -r -a extra <<<"${EXTRA_SET:-}"
+    for kv in "${extra[@]}"; do args+=(--set "$kv"); done
+    PYTHONUNBUFFERED=1 "$py" "${args[@]}" >"runs/solid/$name.log" 2>&1 &
+    pids+=($!); names+=("$name")
+done
+while :; do
+    alive=0
+    for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=$((alive + 1)); done
+    date +%T
+    command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=utilization.gpu,memory.used --format=csv,noheader
+    for n in "${names[@]}"; do echo "  $n: $(tail -n 1 "runs/solid/$n.log")"; done
+    [ "$alive" -eq 0 ] && break
+    sleep "$poll"
+done
+status=0
+for i in "${!pids[@]}"; do
+    wait "${pids[$i]}" || { echo "${names[$i]} failed:"; tail -n 20 "runs/solid/${names[$i]}.log"; status=1; }
+done
+for n in "${names[@]}"; do
+    [ -f "runs/solid/$n/ckpt.pt" ] || continue
+    "$py" - "runs/solid/$n/ckpt.pt" "$out/$n.pt" <<'PY'
+import sys, torch
+state = torch.load(sys.argv[1], map_location="cpu", weights_only=False)
+state.pop("opt", None)
+torch.save(state, sys.argv[2])
+print(sys.argv[2], "step", state["step"], "of", state["config"]["steps"], "-", state["hardware"])
+PY
+    grep -h "schedule fitted" "runs/solid/$n.log" | sed "s/^/  $n: /"
+done
+tar czf "$out/logs.tar.gz" $(for n in "${names[@]}"; do echo "runs/solid/$n.log"; [ -f "runs/solid/$n/log.jsonl" ] && echo "runs/solid/$n/log.jsonl"; done)
+exit $status
