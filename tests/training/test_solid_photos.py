@@ -190,7 +190,8 @@ def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
     prev = dict(summary=dict(photos=87, median_swd=300.0, ratio_to_random_phase=2.5, beats_pixel_shuffle=70))
     new = dict(summary=dict(photos=87, median_swd=210.0, ratio_to_random_phase=1.9, beats_pixel_shuffle=77))
     text = photo_card.section(space, prev, new, True, "older", (("a stage", 5, "1 min", 1.0, 2.0, "3", "4", "no"),))
-    assert f"**Run:** {meta['step']} steps of batch {meta['config']['batch']}" in text
+    last = "the last stage at " if meta["config"].get("init_onnx") or meta["config"].get("init_from") else ""
+    assert f"**Run:** {meta['step']} steps, {last}batch {meta['config']['batch']}" in text
     hardware = meta.get("hardware") or "hardware not recorded"
     assert f"{meta['train_seconds'] / 60:.1f} min wall in all stages, on {hardware}" in text
     assert "| median patch distance (swd) ↓ | 300.0 | 210.0 |" in text

@@ -41,6 +41,11 @@ ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase no
         ("… random phase noise", "median_spectrum_random_phase"))
 
 
+def _continued(cfg: dict) -> bool:
+    """Whether a run's config continues an earlier stage (from its run folder or its export)."""
+    return bool(cfg.get("init_onnx") or cfg.get("init_from"))
+
+
 def run_facts(run: str) -> dict:
     """Steps, config, wall seconds, hardware (each stretch's, oldest first), final loss and last learning rate
     of a run folder (``ckpt.pt`` and ``log.jsonl``) or, when the run folder is gone, of its export
@@ -54,11 +59,12 @@ def run_facts(run: str) -> dict:
         last = sorted(r["loss"] for r in log[-10:])
         return dict(step=int(state["step"]), config=state["config"], seconds=float(state.get("elapsed", 0)),
                     loss=last[len(last) // 2] if last else None, lr=log[-1].get("lr") if log else None,
-                    hardware=str(state.get("hardware", "")))
+                    hardware=str(state.get("hardware", "")),
+                    stages=bool(state.get("first_step") or _continued(state["config"])))
     if os.path.isfile(os.path.join(run, "solid.json")):
         meta = read_json(os.path.join(run, "solid.json"))
         return dict(step=int(meta["step"]), config=meta["config"], seconds=float(meta.get("train_seconds", 0)),
-                    loss=None, lr=None, hardware=str(meta.get("hardware", "")))
+                    loss=None, lr=None, hardware=str(meta.get("hardware", "")), stages=_continued(meta["config"]))
     raise SystemExit(f"photo_card: error: {run} has neither ckpt.pt (a run) nor solid.json (an export)")
 
 
@@ -109,7 +115,8 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          *stage_commands(configs),
          f"python -m training.solid.export runs/solid/{cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
-         f"- **Run:** {step} steps of batch {cfg['batch']} ({cfg['crop']}² crops and slices), "
+         f"- **Run:** {step} steps, {'the last stage at ' if f['stages'] else ''}batch {cfg['batch']} "
+         f"({cfg['crop']}² crops and slices), "
          f"{f['seconds'] / 60:.1f} min wall in all stages, on {f['hardware'] or 'hardware not recorded'}"
          + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
             " (read from the export; the run folder and its loss log were not kept).")
