@@ -456,3 +456,37 @@ def test_device_is_checked(tmp_path, capsys):
         assert tr.main(["--config", "configs/solid/gravel_3d.json", "--out", str(tmp_path / "r"),
                         "--set", 'device="cuda"', "--set", "steps=2"]) == 2
         assert "torch sees no CUDA device here" in capsys.readouterr().err
+
+
+def test_average_of_checkpoints_is_their_mean_and_exports(tmp_path):
+    """training.solid.average (stochastic weight averaging): every float tensor is the mean of the runs' tensors,
+    the last run gives config and step, the sources are named, a run of another shape is refused in one line, and
+    the average exports and is read by the card (no loss log of its own)."""
+    from training.solid import average, photo_card
+
+    run_a, state_a = _tiny(tmp_path, steps=2)
+    run_b = tmp_path / "run_b"
+    state_b = train(SolidConfig.from_dict(dict(state_a["config"], steps=4, init_from=str(run_a))), str(run_b),
+                    log=lambda *_: None)
+    assert state_b["step"] == 4
+    out = tmp_path / "avg"
+    assert average.main(["--out", str(out), str(run_a), str(run_b)]) == 0
+    avg = torch.load(out / "ckpt.pt", map_location="cpu", weights_only=False)
+    for k, v in avg["model"].items():
+        if v.is_floating_point():
+            torch.testing.assert_close(v, (state_a["model"][k] + state_b["model"][k]) / 2)
+    assert not torch.equal(state_a["model"]["decoder.net.0.weight"], state_b["model"]["decoder.net.0.weight"])
+    assert avg["step"] == 4 and "opt" not in avg
+    assert avg["averaged_from"] == [dict(run=str(run_a), step=2), dict(run=str(run_b), step=4)]
+    facts = photo_card.run_facts(str(out))
+    assert facts["averaged"] == [2, 4] and facts["loss"] is None
+    export(str(out), str(tmp_path / "avg_export"))
+    m = SolidTextureModel(str(tmp_path / "avg_export"))
+    assert m.config["step"] == 4
+
+    other, _ = _tiny(tmp_path, dim=2, steps=1)
+    with pytest.raises(ValueError, match="is not the architecture of"):
+        average.average_checkpoints([str(run_a), str(other)])
+    with pytest.raises(ValueError, match="at least two run folders"):
+        average.average_checkpoints([str(run_a)])
+    assert average.main(["--out", str(tmp_path / "x"), str(run_a), str(tmp_path / "missing")]) == 2

@@ -54,17 +54,22 @@ def run_facts(run: str) -> dict:
         import torch
 
         state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
-        with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
-            log = [json.loads(line) for line in fh if line.strip()]
+        log = []    # an averaged checkpoint (average.py) has no loss log of its own
+        if os.path.isfile(os.path.join(run, "log.jsonl")):
+            with open(os.path.join(run, "log.jsonl"), encoding="utf-8") as fh:
+                log = [json.loads(line) for line in fh if line.strip()]
         last = sorted(r["loss"] for r in log[-10:])
         return dict(step=int(state["step"]), config=state["config"], seconds=float(state.get("elapsed", 0)),
                     loss=last[len(last) // 2] if last else None, lr=log[-1].get("lr") if log else None,
                     hardware=str(state.get("hardware", "")),
-                    stages=bool(state.get("first_step") or _continued(state["config"])))
+                    stages=bool(state.get("first_step") or _continued(state["config"])),
+                    averaged=[int(a["step"]) for a in state.get("averaged_from", [])],
+                    averaged_runs=[str(a["run"]) for a in state.get("averaged_from", [])])
     if os.path.isfile(os.path.join(run, "solid.json")):
         meta = read_json(os.path.join(run, "solid.json"))
         return dict(step=int(meta["step"]), config=meta["config"], seconds=float(meta.get("train_seconds", 0)),
-                    loss=None, lr=None, hardware=str(meta.get("hardware", "")), stages=_continued(meta["config"]))
+                    loss=None, lr=None, hardware=str(meta.get("hardware", "")), stages=_continued(meta["config"]),
+                    averaged=[], averaged_runs=[])
     raise SystemExit(f"photo_card: error: {run} has neither ckpt.pt (a run) nor solid.json (an export)")
 
 
@@ -113,12 +118,16 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
          *stage_commands(configs),
-         f"python -m training.solid.export runs/solid/{cfg['name']} models/solid/space",
+         *([f"python -m training.solid.average --out {run} {' '.join(f['averaged_runs'])}   # the mean of "
+            "their weights"] if f["averaged"] else []),
+         f"python -m training.solid.export {run if f['averaged'] else 'runs/solid/' + cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps, {'the last stage at ' if f['stages'] else ''}batch {cfg['batch']} "
          f"({cfg['crop']}² crops and slices), "
          f"{f['seconds'] / 60:.1f} min wall in all stages, on {f['hardware'] or 'hardware not recorded'}"
          + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
+            f"; the mean of its weights at steps {' and '.join(map(str, f['averaged']))} (stochastic weight "
+            "averaging, Izmailov et al. 2018: `python -m training.solid.average`)." if f["averaged"] else
             " (read from the export; the run folder and its loss log were not kept).")
          + (f" Stopped at step {step} of its {cfg['steps']}-step cosine schedule (the session's time; "
             f"learning rate {f['lr']:.2g} at the end); `--out` the same folder resumes it."

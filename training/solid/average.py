@@ -1,0 +1,84 @@
+"""Average the weights of checkpoints along one run's trajectory (stochastic weight averaging).
+
+    python -m training.solid.average --out RUN SRC [SRC ...]
+
+Izmailov et al. ("Averaging Weights Leads to Wider Optima and Better
+Generalization", UAI 2018) average the weights a run passes through late in
+training, at a constant or cyclic learning rate: w_SWA = (1/n) sum_i w_i
+(their Eq. 2, with equal weights).  The points lie in one basin, so their
+mean is a model too, and usually a better one than any single point: the SGD
+iterates bounce around the basin's centre.
+
+SRC: run folders (``ckpt.pt``) of one architecture, the later stages of one
+trajectory (a run and the runs continued from it).  Every floating-point
+tensor of the models' state dicts is averaged; integer buffers are taken from
+the last SRC.  The result ``RUN/ckpt.pt`` takes the config, step, training
+time and hardware of the last SRC (the latest point), names its sources in
+``averaged_from`` (folder and step), holds no optimiser state (continue it
+from its export with ``init_onnx``), and exports like any run
+(``python -m training.solid.export RUN OUT``).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+import torch
+
+from backend._export import export as _ex
+
+__all__ = ["average_checkpoints", "main"]
+
+
+def _load(run: str) -> dict:
+    path = os.path.join(run, "ckpt.pt")
+    if not os.path.isfile(path):
+        raise ValueError(f"average: no checkpoint {path}")
+    return torch.load(path, map_location="cpu", weights_only=False)
+
+
+def average_checkpoints(runs: list) -> dict:
+    """The checkpoint whose model is the mean of the runs' models (see the module doc); the runs' order is
+    oldest first, and the last gives the config, step and the rest."""
+    if len(runs) < 2:
+        raise ValueError(f"average: give at least two run folders, got {len(runs)}")
+    states = [_load(r) for r in runs]
+    models = [s["model"] for s in states]
+    keys = list(models[-1])
+    for run, m in zip(runs, models):
+        if list(m) != keys or any(m[k].shape != models[-1][k].shape for k in keys):
+            raise ValueError(f"average: {run} is not the architecture of {runs[-1]} (its tensors differ in "
+                             "names or shapes)")
+    mean = {}
+    for k in keys:
+        last = models[-1][k]
+        if last.is_floating_point():
+            mean[k] = (sum(m[k].double() for m in models) / len(models)).to(last.dtype)
+        else:
+            mean[k] = last.clone()
+    out = {k: v for k, v in states[-1].items() if k != "opt"}
+    out["model"] = mean
+    out["averaged_from"] = [dict(run=r, step=int(s["step"])) for r, s in zip(runs, states)]
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.solid.average", description=__doc__.split("\n")[0])
+    ap.add_argument("--out", required=True, help="the run folder to write (ckpt.pt)")
+    ap.add_argument("runs", nargs="+", help="run folders (ckpt.pt), oldest first")
+    a = ap.parse_args(argv)
+    try:
+        state = average_checkpoints(a.runs)
+    except ValueError as err:
+        print(f"solid average: error: {err}", file=sys.stderr)
+        return 2
+    os.makedirs(a.out, exist_ok=True)
+    with _ex.atomic_path(os.path.join(a.out, "ckpt.pt")) as tmp:
+        torch.save(state, tmp)
+    print(f"{a.out}: the mean of " + ", ".join(f"{s['run']} (step {s['step']})" for s in state["averaged_from"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
