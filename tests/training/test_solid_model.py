@@ -490,3 +490,32 @@ def test_average_of_checkpoints_is_their_mean_and_exports(tmp_path):
     with pytest.raises(ValueError, match="at least two run folders"):
         average.average_checkpoints([str(run_a)])
     assert average.main(["--out", str(tmp_path / "x"), str(run_a), str(tmp_path / "missing")]) == 2
+
+
+def test_gpu_campaign_script_trains_configs_side_by_side(tmp_path):
+    """tools/gpu_solid_campaign.sh, rehearsed on the CPU (EXTRA_SET): each config trains to the schedule fitted to
+    the budget and comes back as NAME.pt without the optimiser's moments, the logs as one archive; a config that
+    fails makes the script fail and is named."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tarfile
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    cfg = dict(name="camp_a", crop=16, batch=1, steps=100000, width=16, log_every=100000, checkpoint_every=100000,
+               exemplars=["gravel"], dim=2, device="cuda")
+    (tmp_path / "camp_a.json").write_text(json.dumps(cfg))
+    (tmp_path / "camp_bad.json").write_text(json.dumps(dict(cfg, name="camp_bad", octave=3)))
+    env = dict(os.environ, PYTHON=sys.executable, POLL="1", EXTRA_SET='device="cpu";threads=1',
+               PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    r = subprocess.run(["bash", os.path.join(root, "tools", "gpu_solid_campaign.sh"), "3", "out", "camp_a.json",
+                        "camp_bad.json"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "camp_bad failed:" in r.stdout and "unknown config key 'octave'" in r.stdout
+    state = torch.load(tmp_path / "out" / "camp_a.pt", map_location="cpu", weights_only=False)
+    assert "opt" not in state and 40 < state["step"] == state["config"]["steps"] < 100000
+    assert state["config"]["device"] == "cpu"
+    with tarfile.open(tmp_path / "out" / "logs.tar.gz") as tar:
+        names = set(tar.getnames())
+    assert {"runs/solid/camp_a.log", "runs/solid/camp_a/log.jsonl", "runs/solid/camp_bad.log"} <= names
