@@ -6,6 +6,9 @@
 #
 #   tools/gpu_solid_campaign.sh BUDGET_SECONDS OUTDIR CONFIG.json [CONFIG.json ...]
 #
+# SWA_FROM=STEP: each run that keeps weight snapshots (snapshot_every in its config) also comes back as
+# NAME_swa.pt, the mean of its snapshots from that step on (python -m training.solid.average --snapshots); the
+# tool brings back at most 8 files, so at most 3 runs with SWA_FROM.
 # PYTHON (default python3) runs training; EXTRA_SET adds --set KEY=JSON to every run, several separated by ';'
 # (a CPU rehearsal: EXTRA_SET='device="cpu";batch=2;crop=64').  Each run's log is runs/solid/NAME.log; the script polls them every POLL seconds.
 set -u
@@ -50,6 +53,10 @@ torch.save(state, sys.argv[2])
 print(sys.argv[2], "step", state["step"], "of", state["config"]["steps"], "-", state["hardware"])
 PY
     grep -h "schedule fitted" "runs/solid/$n.log" | sed "s/^/  $n: /"
+    if [ -n "${SWA_FROM:-}" ] && [ -d "runs/solid/$n/snapshots" ]; then
+        "$py" -m training.solid.average --out "runs/solid/${n}_swa" --snapshots "runs/solid/$n" --from "$SWA_FROM" \
+            && cp "runs/solid/${n}_swa/ckpt.pt" "$out/${n}_swa.pt" || status=1
+    fi
 done
 tar czf "$out/logs.tar.gz" $(for n in "${names[@]}"; do echo "runs/solid/$n.log"; [ -f "runs/solid/$n/log.jsonl" ] && echo "runs/solid/$n/log.jsonl"; done)
 exit $status

@@ -487,7 +487,7 @@ def test_average_of_checkpoints_is_their_mean_and_exports(tmp_path):
     other, _ = _tiny(tmp_path, dim=2, steps=1)
     with pytest.raises(ValueError, match="is not the architecture of"):
         average.average_checkpoints([str(run_a), str(other)])
-    with pytest.raises(ValueError, match="at least two run folders"):
+    with pytest.raises(ValueError, match="at least two run folders or snapshots"):
         average.average_checkpoints([str(run_a)])
     assert average.main(["--out", str(tmp_path / "x"), str(run_a), str(tmp_path / "missing")]) == 2
 
@@ -504,10 +504,10 @@ def test_gpu_campaign_script_trains_configs_side_by_side(tmp_path):
 
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     cfg = dict(name="camp_a", crop=16, batch=1, steps=100000, width=16, log_every=100000, checkpoint_every=100000,
-               exemplars=["gravel"], dim=2, device="cuda")
+               exemplars=["gravel"], dim=2, device="cuda", snapshot_every=10)
     (tmp_path / "camp_a.json").write_text(json.dumps(cfg))
     (tmp_path / "camp_bad.json").write_text(json.dumps(dict(cfg, name="camp_bad", octave=3)))
-    env = dict(os.environ, PYTHON=sys.executable, POLL="1", EXTRA_SET='device="cpu";threads=1',
+    env = dict(os.environ, PYTHON=sys.executable, POLL="1", EXTRA_SET='device="cpu";threads=1', SWA_FROM="20",
                PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
     r = subprocess.run(["bash", os.path.join(root, "tools", "gpu_solid_campaign.sh"), "3", "out", "camp_a.json",
                         "camp_bad.json"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
@@ -516,6 +516,39 @@ def test_gpu_campaign_script_trains_configs_side_by_side(tmp_path):
     state = torch.load(tmp_path / "out" / "camp_a.pt", map_location="cpu", weights_only=False)
     assert "opt" not in state and 40 < state["step"] == state["config"]["steps"] < 100000
     assert state["config"]["device"] == "cpu"
+    swa = torch.load(tmp_path / "out" / "camp_a_swa.pt", map_location="cpu", weights_only=False)
+    assert swa["step"] == state["step"] and swa["averaged_from"][0]["step"] == 20
+    assert not (tmp_path / "out" / "camp_bad_swa.pt").exists()
     with tarfile.open(tmp_path / "out" / "logs.tar.gz") as tar:
         names = set(tar.getnames())
     assert {"runs/solid/camp_a.log", "runs/solid/camp_a/log.jsonl", "runs/solid/camp_bad.log"} <= names
+
+
+def test_snapshots_are_kept_and_averaged(tmp_path):
+    """snapshot_every keeps the weights every N steps and at the end in RUN/snapshots; average --snapshots RUN
+    --from STEP is the mean of those from STEP on, with the run's config; bad settings are named."""
+    import os
+
+    from training.solid import average
+    from training.solid.train import snapshot_path
+
+    with pytest.raises(ValueError, match="snapshot_every must be a whole number"):
+        SolidConfig.from_dict({"snapshot_every": -1})
+    run, state = _tiny(tmp_path, steps=5, snapshot_every=2)
+    snaps = sorted(os.listdir(run / "snapshots"))
+    assert snaps == ["step_0000002.pt", "step_0000004.pt", "step_0000005.pt"]
+    last = torch.load(snapshot_path(str(run), 5), map_location="cpu", weights_only=False)
+    for k, v in state["model"].items():
+        torch.testing.assert_close(last["model"][k], v)
+    out = tmp_path / "swa"
+    assert average.main(["--out", str(out), "--snapshots", str(run), "--from", "3"]) == 0
+    avg = torch.load(out / "ckpt.pt", map_location="cpu", weights_only=False)
+    s4 = torch.load(snapshot_path(str(run), 4), map_location="cpu", weights_only=False)
+    w = "decoder.net.0.weight"
+    torch.testing.assert_close(avg["model"][w], (s4["model"][w] + last["model"][w]) / 2)
+    assert avg["step"] == 5 and avg["config"] == state["config"]
+    assert [a["step"] for a in avg["averaged_from"]] == [4, 5]
+    with pytest.raises(ValueError, match="no weight snapshots from step 9 on"):
+        average.snapshots(str(run), 9)
+    with pytest.raises(ValueError, match="snapshots alone hold no config"):
+        average.average_checkpoints([snapshot_path(str(run), 4), snapshot_path(str(run), 5)])

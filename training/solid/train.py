@@ -48,7 +48,8 @@ from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from backend.onnx_models import load_model_json
 
-__all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain"]
+__all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain",
+           "snapshot_path"]
 
 
 @dataclass
@@ -94,6 +95,9 @@ class SolidConfig:
     seed: int = 0
     log_every: int = 25
     checkpoint_every: int = 250
+    snapshot_every: int = 0         # also keep the model's weights every this many steps and at the end in
+                                    # RUN/snapshots/ (weight averaging: python -m training.solid.average
+                                    # --snapshots RUN); 0: off
     threads: int = 0                # CPU threads for torch and numba (0: their defaults)
     device: str = "cpu"             # "cpu" or "cuda" / "cuda:N" (model, loss and crops there; the random draws
                                     # stay on the CPU's generator, so a run's data is the same on any device)
@@ -152,6 +156,8 @@ class SolidConfig:
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
             if cfg.mode != "space" or cfg.transform != "bounded":
                 raise ValueError("min_spacing caps the bounded transforms: it needs mode 'space' and transform 'bounded'")
+        if not (isinstance(cfg.snapshot_every, int) and cfg.snapshot_every >= 0):
+            raise ValueError(f"snapshot_every must be a whole number of steps >= 0, got {cfg.snapshot_every!r}")
         if cfg.init_onnx and not cfg.init_sha256:
             raise ValueError("init_onnx needs init_sha256 (the fingerprint of the weights the run starts from)")
         if cfg.init_onnx and cfg.init_from:
@@ -270,6 +276,11 @@ def loss_features(cfg: SolidConfig):
     if cfg.loss == "gram":
         return RandomFeatures(seed=0)
     return SlicedFeatures(seed=0, levels=cfg.swd_levels, width=cfg.swd_width, kernels=cfg.swd_kernels)
+
+
+def snapshot_path(run: str, step: int) -> str:
+    """Where a run keeps its weights of a step (``snapshot_every``): RUN/snapshots/step_NNNNNNN.pt."""
+    return os.path.join(run, "snapshots", f"step_{step:07d}.pt")
 
 
 def _save(path: str, obj) -> None:
@@ -433,6 +444,10 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
             logf.write(json.dumps(rec) + "\n")
             logf.flush()
             log(f"step {step}/{cfg.steps} loss {loss.item():.4f} ({rec['seconds']:.0f} s)")
+        if cfg.snapshot_every and (step % cfg.snapshot_every == 0 or step == end):
+            os.makedirs(os.path.dirname(snapshot_path(out, step)), exist_ok=True)
+            _save(snapshot_path(out, step), dict(model={k: v.detach().cpu() for k, v in model.state_dict().items()},
+                                                 step=step))
         if step % cfg.checkpoint_every == 0 or step == end:
             state = dict(config=asdict(cfg), model=model.state_dict(), opt=opt.state_dict(), step=step,
                          elapsed=time.time() - t0, gen=gen.get_state(), n_params=model.n_params(),
