@@ -10,7 +10,8 @@
 # NAME_swa.pt, the mean of its snapshots from that step on (python -m training.solid.average --snapshots); the
 # tool brings back at most 8 files, so at most 3 runs with SWA_FROM.
 # PYTHON (default python3) runs training; EXTRA_SET adds --set KEY=JSON to every run, several separated by ';'
-# (a CPU rehearsal: EXTRA_SET='device="cpu";batch=2;crop=64').  Each run's log is runs/solid/NAME.log; the script polls them every POLL seconds.
+# (a CPU rehearsal: EXTRA_SET='device="cpu";batch=2;crop=64').  Each run's log is runs/solid/NAME.log; the
+# script polls them every POLL seconds.
 set -u
 if [ $# -lt 3 ]; then
     echo "usage: tools/gpu_solid_campaign.sh BUDGET_SECONDS OUTDIR CONFIG.json [CONFIG.json ...]" >&2
@@ -21,11 +22,11 @@ py=${PYTHON:-python3}
 poll=${POLL:-60}
 mkdir -p "$out" runs/solid
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader
+IFS=';' read -r -a extra <<<"${EXTRA_SET:-}"
 names=(); pids=()
 for cfg in "$@"; do
     name=$(basename "$cfg" .json)
     args=(-m training.solid.train --config "$cfg" --out "runs/solid/$name" --budget-seconds "$budget")
-    IFS=';' read -r -a extra <<<"${EXTRA_SET:-}"
     for kv in "${extra[@]}"; do args+=(--set "$kv"); done
     PYTHONUNBUFFERED=1 "$py" "${args[@]}" >"runs/solid/$name.log" 2>&1 &
     pids+=($!); names+=("$name")

@@ -338,7 +338,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
     os.makedirs(out, exist_ok=True)
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed + 1)
-    model = build_model(cfg)
+    model = build_model(cfg).to(dev)    # before the optimiser: a resumed one's moments load onto its parameters
     feats = loss_features(cfg).to(dev)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
@@ -372,11 +372,6 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
         log(f"started from {cfg.init_onnx} ({cfg.init_sha256[:12]}...) at step {step}")
     if cfg.structure_weight:
         structure_features(cfg.structure_net, dev)  # a missing network fails here, before the first step
-    model.to(dev)
-    for st in opt.state.values():    # a resumed optimiser's moments follow their parameters
-        for k, v in st.items():
-            if torch.is_tensor(v) and k != "step":
-                st[k] = v.to(dev)
     images = training_images(cfg)
     if cfg.mode == "single" and cfg.fixed_axis and step == 0:
         with torch.no_grad():   # lattices start aligned with the photo's direction (model.axis_rotations)
@@ -431,14 +426,15 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
         if budget_seconds is not None and step in (start + _FIT_FROM, start + _FIT_TO):
             if dev.type == "cuda":
                 torch.cuda.synchronize(dev)     # the rate of finished steps, not of queued kernels
-            t_fit = time.time() if step == start + _FIT_FROM else t_fit
-        if budget_seconds is not None and step == start + _FIT_TO:
             now = time.time()
-            before = cfg.steps
-            cfg = fit_schedule(cfg, step, (now - t_fit) / (_FIT_TO - _FIT_FROM), budget_seconds - (now - t_loop))
-            end = cfg.steps if max_steps is None else min(cfg.steps, start + max_steps)
-            log(f"schedule fitted to {budget_seconds:.0f} s: steps {before} -> {cfg.steps}"
-                + (f", noise_ramp {cfg.noise_ramp}" if cfg.noise_ramp else ""))
+            if step == start + _FIT_FROM:
+                t_fit = now
+            else:
+                before = cfg.steps
+                cfg = fit_schedule(cfg, step, (now - t_fit) / (_FIT_TO - _FIT_FROM), budget_seconds - (now - t_loop))
+                end = cfg.steps if max_steps is None else min(cfg.steps, start + max_steps)
+                log(f"schedule fitted to {budget_seconds:.0f} s: steps {before} -> {cfg.steps}"
+                    + (f", noise_ramp {cfg.noise_ramp}" if cfg.noise_ramp else ""))
         if step % cfg.log_every == 0 or step == end:
             rec = dict(step=step, loss=round(loss.item(), 5), lr=lr, seconds=round(time.time() - t0, 1))
             logf.write(json.dumps(rec) + "\n")
