@@ -27,6 +27,7 @@ from ..paths import solid_models
 from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
+from .waves import wave_features
 
 __all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
 
@@ -152,6 +153,10 @@ class SolidTextureModel:
         self.cellular = int(c.get("cellular", 0))
         #: ... and brick features (brick.py)
         self.bricks = int(c.get("bricks", 0))
+        #: a single-photo model's periodic components (waves.py: rows f_x, f_y, phi, a); none in older models
+        self.waves = np.asarray(c.get("waves", []), np.float64).reshape(-1, 4)
+        if len(self.waves) and (self.mode != "single" or self.dim != 2):
+            raise ModelError(f"model {self.name!r} has waves, which only single 2D models can have")
         self.z_dim = int(c.get("z_dim", 8))
         if self.mode == "single" and self.colour_stats and len(c.get("colour_code", ())) != self.colour_stats:
             raise ModelError(f"model {self.name!r} draws in its exemplar's colours but its solid.json has no "
@@ -274,6 +279,8 @@ class SolidTextureModel:
                 noise = np.concatenate([noise, cellular_features(pts[a:b], T, seed, self.cellular)], axis=1)
             if self.bricks:
                 noise = np.concatenate([noise, brick_features(pts[a:b], T, seed, self.bricks)], axis=1)
+            if len(self.waves):
+                noise = np.concatenate([noise, wave_features(pts[a:b], self.waves)], axis=1)
             e = code.e if code.e.ndim == 1 else code.e[a:b]
             d = self.decode(noise, e)
             if self.colour_stats:

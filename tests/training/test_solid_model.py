@@ -1,5 +1,7 @@
 """Neural solid textures: training steps, ONNX export, and the torch-free runtime against torch."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -8,14 +10,16 @@ from backend.grid import Cancelled
 torch = pytest.importorskip("torch")
 
 from backend.errors import SettingError  # noqa: E402
-from backend.onnx_models import ModelError  # noqa: E402
+from backend.onnx_models import ModelError, fingerprint  # noqa: E402
 from backend.solid.model import SolidTextureModel, TextureCode  # noqa: E402
+from backend.solid.waves import wave_features as wave_features_np  # noqa: E402
 from training.solid import exemplars as ex  # noqa: E402
 from training.solid.export import export  # noqa: E402
 from training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
 from training.solid.lattice import octave_seeds  # noqa: E402
 from training.solid.model import random_rotations, slice_points  # noqa: E402
-from training.solid.train import SolidConfig, build_model, train  # noqa: E402
+from training.solid.train import SolidConfig, build_model, train, training_images  # noqa: E402
+from training.solid.waves import photo_waves, wave_features  # noqa: E402
 
 
 def _tiny(tmp_path, mode="single", dim=3, steps=4, **kw):
@@ -38,6 +42,34 @@ def test_config_errors_name_the_key():
         SolidConfig.from_dict({"cellular": 9})
     with pytest.raises(ValueError, match="bricks must be 0..4"):
         SolidConfig.from_dict({"bricks": 5, "octaves": 4})
+    for bad in ({"waves": 4, "dim": 3}, {"waves": 4, "dim": 2, "mode": "space", "exemplars": ["gravel", "grass"]},
+                {"waves": -1, "dim": 2}, {"waves": 2.5, "dim": 2}):
+        with pytest.raises(ValueError, match="waves must be a whole number"):
+            SolidConfig.from_dict(bad)
+
+
+def test_photo_waves_find_the_photos_periodic_components_with_their_phases():
+    H = W = 64
+    r, c = torch.meshgrid(torch.arange(H, dtype=torch.float64), torch.arange(W, dtype=torch.float64), indexing="ij")
+    g = 0.5 + 0.2 * torch.cos(2 * math.pi * (3 * c / W + 5 * r / H) + 0.7) \
+        + 0.1 * torch.cos(2 * math.pi * (7 * c / W - 2 * r / H) - 1.1)
+    w = photo_waves(g.expand(3, H, W).float(), 2, 128.0)
+    # the stronger first; one of each conjugate pair (k_y > 0): (7, -2) comes back as (-7, 2)
+    np.testing.assert_allclose(w[:, :2].numpy(), [[6.0, -10.0], [-14.0, -4.0]], atol=1e-5)
+    np.testing.assert_allclose(w[:, 3].numpy(), [0.2, 0.1] / np.sqrt((0.2 ** 2 + 0.1 ** 2) / 2), rtol=0.02)
+    # at the pixel centres of slice_points' plane the waves give the photo back, phases included (measured on
+    # the periodic component, which differs from an image that tiles only by a faint smooth part)
+    x = slice_points(1, H, 128.0, 2, 0.0, 0.0, torch.Generator().manual_seed(0))
+    f = wave_features(x, w)[0]
+    rec = 0.2 * f[:, 0] / w[0, 3] + 0.1 * f[:, 2] / w[1, 3]
+    assert float((rec.view(H, W) - (g - 0.5).float()).abs().max()) < 0.01
+    shifted = 0.2 * torch.cos(2 * math.pi * (3 * c / W + 5 * r / H) + 0.7 + 0.5)   # a phase error shows
+    assert float((rec.view(H, W) - shifted.float()).abs().max()) > 0.05
+    # the numpy twin the runtime reads
+    np.testing.assert_allclose(wave_features_np(x[0].numpy() + 40.0, w.numpy()),
+                               wave_features(x + 40.0, w)[0].numpy(), atol=1e-6)
+    with pytest.raises(ValueError, match="fewer than 3 spectral peaks"):
+        photo_waves(torch.full((3, 32, 32), 0.5), 3, 128.0)
 
 
 def test_rotations_and_slices():
@@ -167,13 +199,23 @@ def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_
     assert ("| gravel | ours_3d: c continued, **not shipped** | 0.4 / 0.1 / 0.5 | 0.6 / 0.1 / 0.5 |" in text), text
 
 
-@pytest.mark.parametrize("dim,cellular,bricks", [(2, 0, 0), (3, 0, 0), (2, 3, 0), (3, 2, 2)])
-def test_single_export_runtime_matches_torch(tmp_path, dim, cellular, bricks):
-    run, state = _tiny(tmp_path, dim=dim, cellular=cellular, bricks=bricks)
+@pytest.mark.parametrize("dim,cellular,bricks,waves", [(2, 0, 0, 0), (3, 0, 0, 0), (2, 3, 0, 0), (3, 2, 2, 0),
+                                                      (2, 0, 0, 6)])
+def test_single_export_runtime_matches_torch(tmp_path, dim, cellular, bricks, waves):
+    run, state = _tiny(tmp_path, dim=dim, cellular=cellular, bricks=bricks, waves=waves)
     out = tmp_path / "model"
     doc = export(str(run), str(out))
     assert doc["mode"] == "single" and set(doc["files"]) == {"decoder.onnx"} and doc["cellular"] == cellular
-    assert doc["bricks"] == bricks
+    assert doc["bricks"] == bricks and len(doc.get("waves", [])) == waves
+    if waves:   # measured from the exemplar, as training used them
+        np.testing.assert_array_equal(np.asarray(doc["waves"], np.float32),
+                                      photo_waves(training_images(SolidConfig.from_dict(state["config"]))[0],
+                                                  waves, 128.0).numpy())
+        # a run continued from the export keeps them (they are not measured again)
+        cont = dict(state["config"], name="cont", steps=state["step"] + 1, init_onnx=str(out),
+                    init_sha256=fingerprint(doc["files"]))
+        s2 = train(SolidConfig.from_dict(cont), str(tmp_path / "cont"), log=lambda *_: None)
+        np.testing.assert_array_equal(s2["model"]["waves"].numpy(), np.asarray(doc["waves"], np.float32))
     rt = SolidTextureModel(str(out))
     code = rt.default_code()
     assert code.e.shape == (64,) and code.T.shape == (8, dim, dim)

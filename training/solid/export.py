@@ -104,6 +104,8 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
             e, T = model.codes(batch=1)
             doc["code"] = e[0].numpy().astype(float).round(7).tolist()
             doc["T"] = T[0].numpy().astype(float).round(7).tolist()
+            if model.waves is not None:   # the photo's periodic components (waves.py), exact float32 values
+                doc["waves"] = model.waves.double().numpy().tolist()
             if cfg.colour == "affine":   # the exemplar's colour (mu, L), as training rendered it
                 doc["colour_code"] = colour_stats(training_images(cfg)[0].unsqueeze(0))[0].numpy() \
                     .astype(float).round(7).tolist()

@@ -34,6 +34,7 @@ from backend.solid.cellular import FEATURES as CELL_FEATURES
 from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
+from .waves import WAVE_FEATURES, wave_features
 
 __all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
 
@@ -357,7 +358,7 @@ class SolidTexture(nn.Module):
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
                  mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
                  colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False,
-                 cellular: int = 0, bricks: int = 0, max_scale: torch.Tensor | None = None):
+                 cellular: int = 0, bricks: int = 0, max_scale: torch.Tensor | None = None, waves: int = 0):
         super().__init__()
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
@@ -368,8 +369,13 @@ class SolidTexture(nn.Module):
             if not 0 <= k <= octaves:
                 raise ValueError(f"{key} must be 0..{octaves} (octaves with {key} features), got {k}")
         self.colour, self.cellular, self.bricks = colour, cellular, bricks
-        #: decoder inputs: value noise (octaves x channels), then the shape features
-        self.n_noise = octaves * channels + shape_features(cellular, bricks)
+        if waves and (mode != "single" or dim != 2):
+            raise ValueError("waves are measured from one photo's plane: they need mode 'single' and dim 2")
+        #: decoder inputs: value noise (octaves x channels), then the shape features, then the waves
+        self.n_noise = octaves * channels + shape_features(cellular, bricks) + WAVE_FEATURES * waves
+        #: the photo's periodic components (waves.photo_waves: rows f_x, f_y, phi, a), set before training;
+        #: None (and not in the state dict, so models without them load as before) when there are none
+        self.register_buffer("waves", torch.zeros(waves, 4) if waves else None)
         self.decoder = Decoder(self.n_noise, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
                                film=film)
         if mode == "single":
@@ -392,7 +398,8 @@ class SolidTexture(nn.Module):
         ``stats`` (B, 12): the exemplars' :func:`colour_stats` (``colour="affine"`` only); ``gains`` (B, m): the
         exemplars' :func:`spectral_gains`, multiplying each octave's noise (``spectral`` models).
         The decoder reads the value noise (B, N, m C), then the first ``cellular`` octaves' Worley features
-        (B, N, 3 cellular; ``cellular.py``), then the first ``bricks`` octaves' brick features (``brick.py``)."""
+        (B, N, 3 cellular; ``cellular.py``), then the first ``bricks`` octaves' brick features (``brick.py``), then
+        the photo's waves (B, N, 2 K; ``waves.py``, at x itself: they are the photo's own frequencies)."""
         n = lattice_noise(x, T, seeds, self.channels)
         if gains is not None:
             B, N, _ = n.shape
@@ -401,6 +408,8 @@ class SolidTexture(nn.Module):
             n = torch.cat([n, cellular_features(x, T, seeds, self.cellular)], dim=-1)
         if self.bricks:
             n = torch.cat([n, brick_features(x, T, seeds, self.bricks)], dim=-1)
+        if self.waves is not None:
+            n = torch.cat([n, wave_features(x, self.waves)], dim=-1)
         out = self.decoder(n, e.unsqueeze(1))
         if self.colour == "affine":
             if stats is None:

@@ -46,6 +46,7 @@ from .spectrum import spectrum_loss
 from .structure_features import StructureFeatures, load_structure_net
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
+from .waves import photo_waves
 from backend.onnx_models import load_model_json
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain",
@@ -62,6 +63,7 @@ class SolidConfig:
     channels: int = 3               # noise values per octave (<= 3)
     cellular: int = 0               # the first this many octaves also give Worley features (cellular.py)
     bricks: int = 0                 # ... and staggered-lattice (brick) features (brick.py)
+    waves: int = 0                  # single 2D: the exemplar's this many strongest periodic components (waves.py)
     code_dim: int = 64              # |e|
     z_dim: int = 8                  # |z| (space mode)
     width: int = 128
@@ -156,6 +158,8 @@ class SolidConfig:
                 raise ValueError(f"min_spacing must be a number >= 0 (px), got {cfg.min_spacing!r}")
             if cfg.mode != "space" or cfg.transform != "bounded":
                 raise ValueError("min_spacing caps the bounded transforms: it needs mode 'space' and transform 'bounded'")
+        if cfg.waves and not (isinstance(cfg.waves, int) and cfg.waves > 0 and cfg.mode == "single" and cfg.dim == 2):
+            raise ValueError(f"waves must be a whole number >= 0 and needs mode 'single' and dim 2, got {cfg.waves!r}")
         if not (isinstance(cfg.snapshot_every, int) and cfg.snapshot_every >= 0):
             raise ValueError(f"snapshot_every must be a whole number of steps >= 0, got {cfg.snapshot_every!r}")
         if cfg.init_onnx and not cfg.init_sha256:
@@ -212,7 +216,8 @@ def build_model(cfg: SolidConfig) -> SolidTexture:
     return SolidTexture(cfg.dim, cfg.octaves, cfg.channels, cfg.code_dim, cfg.z_dim, cfg.mode, cfg.width,
                         cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform, cfg.film,
                         cfg.standardise, cfg.cellular, cfg.bricks,
-                        max_scales(cfg.octaves, cfg.px_per_unit, cfg.min_spacing) if cfg.min_spacing else None)
+                        max_scales(cfg.octaves, cfg.px_per_unit, cfg.min_spacing) if cfg.min_spacing else None,
+                        cfg.waves)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
@@ -380,6 +385,9 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
                 stretch = initial_stretch(images[0], cfg.fixed_axis)
                 model.T[:, :, fixed_axis_index(cfg.fixed_axis, cfg.dim)] *= stretch
                 log(f"transforms start stretched along the {cfg.fixed_axis} axis by {1 / stretch:.2f}")
+    if cfg.waves and step == 0:     # the photo's periodic components (a resumed run has them in its state)
+        with torch.no_grad():
+            model.waves.copy_(photo_waves(images[0], cfg.waves, cfg.px_per_unit))
     augment = (cfg.dim == 3 and not cfg.fixed_axis) if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     logf = open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8")

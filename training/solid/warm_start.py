@@ -74,6 +74,8 @@ def exported_weights(folder: str, sha256: str) -> dict:
     if doc["mode"] == "single":
         out["code"] = np.asarray(doc["code"], np.float32)
         out["T"] = np.asarray(doc["T"], np.float32)
+        if "waves" in doc:   # the photo's periodic components (waves.py), measured when it was first trained
+            out["waves"] = np.asarray(doc["waves"], np.float32)
     else:
         _, enc = _inits(os.path.join(folder, "encoder.onnx"))
         out.update({f"encoder.{k}": v for k, v in enc.items() if not k.startswith("onnx::")})
