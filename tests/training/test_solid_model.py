@@ -19,7 +19,7 @@ from training.solid.features import RandomFeatures, histogram_loss, style_loss  
 from training.solid.lattice import octave_seeds  # noqa: E402
 from training.solid.model import random_rotations, slice_points  # noqa: E402
 from training.solid.train import SolidConfig, build_model, train, training_images  # noqa: E402
-from training.solid.waves import photo_waves, wave_features  # noqa: E402
+from training.solid.waves import photo_waves, wave_features, wave_share  # noqa: E402
 
 
 def _tiny(tmp_path, mode="single", dim=3, steps=4, **kw):
@@ -68,6 +68,10 @@ def test_photo_waves_find_the_photos_periodic_components_with_their_phases():
     # the numpy twin the runtime reads
     np.testing.assert_allclose(wave_features_np(x[0].numpy() + 40.0, w.numpy()),
                                wave_features(x + 40.0, w)[0].numpy(), atol=1e-6)
+    # a photo that is two waves is all waves; white noise has no period
+    assert wave_share(g.expand(3, H, W).float(), 2) > 0.95
+    noise = torch.rand(3, 64, 64, generator=torch.Generator().manual_seed(0))
+    assert wave_share(noise, 4) < 0.05
     with pytest.raises(ValueError, match="fewer than 3 spectral peaks"):
         photo_waves(torch.full((3, 32, 32), 0.5), 3, 128.0)
 
@@ -594,3 +598,12 @@ def test_snapshots_are_kept_and_averaged(tmp_path):
         average.snapshots(str(run), 9)
     with pytest.raises(ValueError, match="snapshots alone hold no config"):
         average.average_checkpoints([snapshot_path(str(run), 4), snapshot_path(str(run), 5)])
+
+
+def test_training_with_waves_warns_when_the_photo_has_no_period(tmp_path):
+    msgs = []
+    cfg = SolidConfig.from_dict(dict(name="w", dim=2, crop=32, batch=1, steps=1, width=16, threads=1, waves=4,
+                                     exemplars=["gravel"]))
+    train(cfg, str(tmp_path / "w"), log=msgs.append)
+    said = [m for m in msgs if m.startswith("waves:")]
+    assert len(said) == 1 and "under 10 %" in said[0], msgs

@@ -46,7 +46,7 @@ from .spectrum import spectrum_loss
 from .structure_features import StructureFeatures, load_structure_net
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
-from .waves import photo_waves
+from .waves import photo_waves, wave_share
 from backend.onnx_models import load_model_json
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain",
@@ -388,6 +388,10 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
     if cfg.waves and step == 0:     # the photo's periodic components (a resumed run has them in its state)
         with torch.no_grad():
             model.waves.copy_(photo_waves(images[0], cfg.waves, cfg.px_per_unit))
+        share = wave_share(images[0], cfg.waves)
+        log(f"waves: the photo's {cfg.waves} strongest periodic components carry {share:.1%} of its luminance variance"
+            + (" - under 10 %: the photo has no strong period, and the waves will repeat its chance peaks as "
+               "stripes (waves are for courses, grids and weaves)" if share < 0.1 else ""))
     augment = (cfg.dim == 3 and not cfg.fixed_axis) if cfg.augment is None else cfg.augment
     end = cfg.steps if max_steps is None else min(cfg.steps, step + max_steps)
     logf = open(os.path.join(out, "log.jsonl"), "a", encoding="utf-8")
