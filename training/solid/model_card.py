@@ -296,10 +296,13 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
         L += singles_section(singles)
     L += ["## Limits", "",
           "- The point-wise MLP over noise octaves reproduces stochastic, stationary textures (gravel, grass, "
-          "rust, granite) far better than structured ones. The brick model, whose value noise entered training "
-          "only gradually (`noise_ramp`), draws level courses now, but its mortar is a band of blue-grey blotches "
-          "and it draws no head joints; random phase noise and the texture-space model still beat it on the "
-          "brick photo. The marble model (with cellular octaves) beats both on its photo but draws short dark "
+          "rust, granite) far better than structured ones. The 3D brick model, whose value noise entered "
+          "training only gradually (`noise_ramp`), draws level courses, but its mortar is a band of blue-grey "
+          "blotches and it draws no head joints. The 2D brick model also reads the photo's 32 strongest Fourier "
+          "components (`waves`, \"Periodic features from the photo\"): level courses at the photo's pitch with "
+          "light bed joints, head joints faint. Random phase noise still beats both on the brick photo, and the "
+          "texture-space model beats the 3D one. Waves suit materials with a period only: on grass they draw "
+          "stripes. The marble model (with cellular octaves) beats both on its photo but draws short dark "
           "strokes, not veins; the Gram-based evaluation above scores it slightly worse than the model it "
           "replaced. The wood model draws grain along its axis but no plank seams (\"Single-exemplar photo "
           "models\").",
