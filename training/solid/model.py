@@ -31,10 +31,11 @@ from torch import nn
 
 from backend.solid.brick import FEATURES as BRICK_FEATURES
 from backend.solid.cellular import FEATURES as CELL_FEATURES
+from backend.solid.waves import FEATURES as WAVE_FEATURES
 from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise
-from .waves import WAVE_FEATURES, wave_features
+from .waves import wave_features
 
 __all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
 

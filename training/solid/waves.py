@@ -27,10 +27,9 @@ import math
 import numpy as np
 import torch
 
-from backend.solid.waves import FEATURES as WAVE_FEATURES
 from training.evaluate import periodic_component
 
-__all__ = ["photo_waves", "wave_share", "wave_features", "WAVE_FEATURES"]
+__all__ = ["photo_waves", "wave_share", "wave_features"]
 
 
 def _peaks(img: torch.Tensor, min_cycles: int):
