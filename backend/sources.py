@@ -307,10 +307,12 @@ class SolidSource:
     rgb = True
 
     def __init__(self, model, exemplar: str | None = None, seed: int = 0, scale: float = 1.0,
-                 density: float = 1.0, refine: int = 0, code=None, to: str | None = None, mix: float = 0.0):
+                 density: float = 1.0, refine: int = 0, code=None, to: str | None = None, mix: float = 0.0,
+                 periodic: bool = True):
         """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
         code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds);
-        to, mix: a space model's second exemplar and the share of it (interpolation, as ``omninoise solid``)."""
+        to, mix: a space model's second exemplar and the share of it (interpolation, as ``omninoise solid``);
+        periodic: an encoded image keeps its harmonic part (backend/solid/harmonic.py)."""
         from .onnx_models import ModelError
         from .solid.model import SolidTextureModel
 
@@ -322,16 +324,18 @@ class SolidSource:
             raise SettingError("source.scale", f"must be > 0, got {scale}")
         self.dim = self.model.dim
         self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
-        self.exemplar, self.to, self.mix = exemplar, to, float(mix)
+        self.exemplar, self.to, self.mix, self.periodic = exemplar, to, float(mix), bool(periodic)
         self.input_sha256 = None
         if code is not None:
             self.code = code
-            self.input_sha256 = hashlib.sha256(np.concatenate([np.ravel(code.e), np.ravel(code.T)])
-                                               .astype(np.float32).tobytes()).hexdigest()
+            parts = [np.ravel(code.e), np.ravel(code.T)]
+            if code.harmonics is not None:
+                parts += [code.harmonics.freq.ravel(), code.harmonics.amp.real.ravel(), code.harmonics.amp.imag.ravel()]
+            self.input_sha256 = hashlib.sha256(np.concatenate(parts).astype(np.float32).tobytes()).hexdigest()
             return
         from .solid.request import SolidRequest
 
-        req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed).check("source.")
+        req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed, self.periodic).check("source.")
         self.code, self.input_sha256 = req.code(self.model, "source.")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
@@ -355,10 +359,12 @@ class SolidSource:
                  density=self.density)
         if self.to is not None:
             d.update(to=self.to, mix=self.mix)
+        if not self.periodic:
+            d.update(periodic=False)
         return d
 
 
-_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine")
+_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
@@ -481,13 +487,13 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     to = path(d.get("to"))
     mix = d.get("mix", 0.5)
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
-                        d.get("seed", 0)).check("source.")
+                        d.get("seed", 0), d.get("periodic", True)).check("source.")
 
 
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
     req = solid_request_from_dict(d, base_dir)
     return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
-                       to=req.to, mix=req.mix)
+                       to=req.to, mix=req.mix, periodic=req.periodic)
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

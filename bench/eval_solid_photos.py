@@ -19,7 +19,11 @@ Against the photo, per slice axis and pooled:
   luminance's power in log-spaced rings x orientations; speckle, blob size, grain direction), mean over
   the slices against a SIZE² crop of the photo, lower is better, beside random phase noise's
   (``spectrum_random_phase``), which keeps the photo's Fourier modulus;
-- ``colour``: mean colour error (mean over R, G, B of |difference of means|);
+- ``colour``: mean colour error (mean over R, G, B of |difference of means|), mean over the slices
+  (``colour_worst_slice``: the worst slice's);
+- ``swd_walls``, ``colour_walls``: the same over the x and y slices only, the vertical planes on which an
+  encoded photo's harmonic part stands as in the photo (on z slices, horizontal cuts, it shows in profile:
+  a layered photo's horizontal cut lies within one layer, brick courses become that course's colour);
 - ``diversity``: mean absolute difference between two seeds' z slices;
 - ``axis_spread``: (max - min) / mean of the three axes' swd: 0 when x, y and z
   slices are alike (a solid texture, not a 2D one extruded).
@@ -27,6 +31,9 @@ Against the photo, per slice axis and pooled:
 Writes the table as JSON (``-o``, default out/bench/solid_photos.json) and,
 with ``--sheet``, a picture: photo | z slice | x slice | seed 2 | a cube whose
 three visible faces are sampled from the 3D texture (isometric projection).
+
+The texture is the one an artist gets: the encoded code with the photo's harmonic part
+(:mod:`backend.solid.harmonic`); ``--no-periodic`` leaves the harmonic part out.
 """
 from __future__ import annotations
 
@@ -104,19 +111,25 @@ def spectrum_distance(images: list, photo: np.ndarray) -> float:
     return float(np.mean([spectrum_loss(t(im), t(photo[:im.shape[0], :im.shape[1]])).item() for im in images]))
 
 
-def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None) -> dict:
+def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None,
+             periodic: bool = True) -> dict:
     rows = {}
     for path in files:
         photo = read(path)
         rng = np.random.default_rng(0)
         t = time.time()
-        code = model.translate(model.encode(photo))
+        h = model.harmonics(photo) if periodic else None
+        code = model.translate(model.encode(photo), h)
         imgs = {ax: [slice_image(model, code, ax, s) for s in range(seeds)] for ax in "xyz"}
         seconds = time.time() - t
         r = {ax: round(pe.patch_swd(v, photo), 1) for ax, v in imgs.items()}
         pooled = [im for v in imgs.values() for im in v]
         r["swd"] = round(pe.patch_swd(pooled, photo), 1)
         r["colour"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in pooled])), 4)
+        walls = imgs["x"] + imgs["y"]     # vertical planes: where a harmonic part stands as in the photo
+        r["swd_walls"] = round(pe.patch_swd(walls, photo), 1)
+        r["colour_walls"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in walls])), 4)
+        r["colour_worst_slice"] = round(float(max(pe.mean_colour_error(im, photo) for im in pooled)), 4)
         r["diversity"] = round(float(np.abs(imgs["z"][0] - imgs["z"][1]).mean()), 4) if seeds > 1 else None
         ax = np.array([r["x"], r["y"], r["z"]])
         r["axis_spread"] = round(float((ax.max() - ax.min()) / max(ax.mean(), 1e-9)), 3)
@@ -132,6 +145,7 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         r["spectrum_random_phase"] = round(spectrum_distance([pe.random_phase(photo, SIZE, rng) for _ in range(seeds)],
                                                              photo), 3)
         r["seconds"] = round(seconds, 2)
+        r["harmonic_peaks"], r["harmonic_share"] = (len(h), round(h.share, 4)) if h is not None else (0, 0.0)
         rows[os.path.basename(path)] = r
         print(os.path.basename(path), {k: r[k] for k in ("swd", "colour", "random_phase", "pixel_shuffle")},
               flush=True)
@@ -152,6 +166,9 @@ def summary(rows: dict) -> dict:
                 beats_pixel_shuffle=int(sum(r["swd"] < r["pixel_shuffle"] for r in rows.values())),
                 beats_random_phase=int(sum(r["swd"] < r["random_phase"] for r in rows.values())),
                 median_colour=med("colour"), max_colour=round(float(max(r["colour"] for r in rows.values())), 4),
+                median_swd_walls=med("swd_walls"),
+                beats_random_phase_walls=int(sum(r["swd_walls"] < r["random_phase"] for r in rows.values())),
+                max_colour_walls=round(float(max(r["colour_walls"] for r in rows.values())), 4),
                 median_diversity=med("diversity"), median_axis_spread=med("axis_spread"),
                 median_seconds=med("seconds"), worst_swd=float(swd.max()),
                 median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
@@ -195,15 +212,21 @@ def main(argv=None) -> int:
                     help="val (default): the held-out photos every reported figure uses; train: the photos the "
                          "model was trained on, to tell overfitting from a loss that leads away from the photos")
     ap.add_argument("--sheet", help="write a picture of (up to 8) photos and their textures")
+    ap.add_argument("--no-periodic", dest="periodic", action="store_false",
+                    help="leave out the photos' harmonic part (backend/solid/harmonic.py): the decoder alone")
+    ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_photos.json"))
     a = ap.parse_args(argv)
     model = SolidTextureModel(a.model)
     files = photos(a.split)
+    if a.only:
+        files = [f for f in files if os.path.basename(f).startswith(tuple(a.only))]
     if a.limit:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     sheet = [] if a.sheet else None
-    rows = evaluate(model, files, a.seeds, sheet)
+    rows = evaluate(model, files, a.seeds, sheet, a.periodic)
     doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
+               periodic=a.periodic,
                summary=summary(rows), by_category=by_category(rows), photos=rows)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)

@@ -10,7 +10,7 @@ such model, with 2 seeds of 128² images (3D models: x, y and z slices pooled, o
   pyramid, x 1000; lower is better) to the held-out strip;
 - the same for what an artist could make instead from the pixels the model saw (the training region):
   random phase noise (``random_phase``), the pixel shuffle (``pixel_shuffle``) and the shipped space model
-  given that region (``space``: encode, translate, slices); ``photo_crop``: a 128² crop of the training region
+  given that region (``space``: encode with the region's harmonic part, translate, slices); ``photo_crop``: a 128² crop of the training region
   itself (the floor: the photo against its own other part);
 - ``colour``: mean colour error against the strip; ``morph``: the level-set morphology distance
   (training/solid/morphology.py), with random phase noise's beside it.
@@ -70,7 +70,7 @@ def evaluate_model(model: SolidTextureModel, space: SolidTextureModel | None, se
     pics["random_phase"] = [pe.random_phase(train, SIZE, rng) for _ in range(seeds)]
     pics["pixel_shuffle"] = [pe.pixel_shuffle(train, SIZE, rng) for _ in range(seeds)]
     if space is not None:
-        pics["space"] = images(space, space.translate(space.encode(train)), seeds)
+        pics["space"] = images(space, space.translate(space.encode(train), space.harmonics(train)), seeds)
     if previous is not None:
         pics["previous"] = images(previous, previous.default_code(), seeds)
     r = {"photo": model.config["exemplars"][0], "dim": model.dim}

@@ -24,7 +24,7 @@ import os
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from . import tasks
 from ._deps import backend
@@ -98,6 +98,10 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
                         description="Improve the encoded image's code by a search against its texture statistics "
                                     "(about 0.1 s a step)")
+    periodic: BoolProperty(name="Periodic Part", default=True,
+                           description="Keep the image's periodic part (brick courses, plank seams, weaves: its "
+                                       "isolated spectral peaks) on top of the model's texture; upright on faces "
+                                       "normal to Y and on floors, in profile on faces normal to X")
     scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
                          description="Texture units per Blender unit: larger means smaller features")
     seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
@@ -144,7 +148,7 @@ def panel_request(p):
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
         return SolidRequest(os.path.join(models_dir(), name), _image_pixels(p.image), refine=int(p.refine),
-                            seed=int(p.seed)).check()
+                            seed=int(p.seed), periodic=bool(p.periodic)).check()
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
@@ -240,7 +244,7 @@ def _material_with(obj, name: str, make_node):
 
 
 class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
-    """Preview the solid texture: a 128 px slice through the texture (z = 0 plane) as an image"""
+    """Preview the solid texture: a 128 px slice through the texture (the plane y = 0 seen from the front, z up) as an image"""
 
     bl_idname = "omninoise.solid_preview"
     bl_label = "Preview Solid Texture"
@@ -376,6 +380,7 @@ def draw_solid(layout, context) -> None:
     else:
         layout.template_ID(p, "image", open="image.open")
         layout.prop(p, "refine")
+        layout.prop(p, "periodic")
     prev = bpy.data.images.get(f"{p.name} Preview")
     if prev is not None and prev.preview is not None:
         layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)

@@ -166,13 +166,16 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--exemplar", help="a shipped texture (see --list) or an image file (encoded by the space model)")
     s.add_argument("--to", metavar="EXEMPLAR", help="interpolate towards this exemplar (space model)")
     s.add_argument("--mix", type=float, default=0.5, help="interpolation weight of --to, 0..1 (default 0.5)")
-    s.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image (the z = 0 slice); 3: a volume")
+    s.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image (a 3D texture's plane y = 0 seen from the front: x right, z up); 3: a volume")
     s.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
     s.add_argument("--scale", type=float, default=1.0,
                    help="zoom: output pixels per exemplar pixel (default 1, the exemplar's own resolution)")
     s.add_argument("--seed", type=int, default=0, help="variation: another seed gives another texture of the same kind")
     s.add_argument("--refine", type=int, default=0, metavar="N",
                    help="space model: improve an encoded image's code with N search steps (no torch)")
+    s.add_argument("--no-periodic", dest="periodic", action="store_false",
+                   help="space model: leave out an encoded image's periodic part (courses, planks, weaves: its "
+                        "isolated spectral peaks, added to the decoder's texture by default)")
     s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
     s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
     s.add_argument("--quiet", action="store_true")
@@ -655,7 +658,7 @@ def solid_request(a: argparse.Namespace):
     """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
     from backend.solid.request import SolidRequest
 
-    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed).check("--")
+    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic).check("--")
 
 
 def run_solid(a: argparse.Namespace) -> int:

@@ -39,10 +39,11 @@ import torch
 from torch import nn
 import torch.nn.functional as F
 
+from backend.periodic import periodic_component
+
 from . import zoo
 
 __all__ = ["Classifier", "train_classifier", "cached_classifier", "known_params", "frechet", "radial_psd", "psd_error",
-           "periodic_component",
            "orientation_coherence", "gradient_direction", "angle_difference", "direction_error", "oriented_params", "ORIENTED",
            "evaluate"]
 
@@ -112,28 +113,6 @@ def frechet(a: np.ndarray, b: np.ndarray) -> float:
     m = r1 @ s2 @ r1
     tr = np.sqrt(np.clip(np.linalg.eigvalsh((m + m.T) / 2), 0, None)).sum()
     return float(((mu1 - mu2) ** 2).sum() + np.trace(s1) + np.trace(s2) - 2 * tr)
-
-
-def periodic_component(imgs: np.ndarray) -> np.ndarray:
-    """The periodic part p of images u (n, H, W) in the periodic plus smooth decomposition u = p + s (Moisan 2011,
-    "Periodic plus smooth image decomposition", J. Math. Imaging Vis. 39: the smooth s carries the jumps between
-    opposite edges; Sec. 3, Eq. 11-12 in closed form through the FFT).  The discrete Fourier transform treats an
-    image as a tile; an image that is not one jumps at its borders, and those jumps spread power over every
-    frequency (a cross through the spectrum, falling like 1/k²).  p has the image's mean; the s taken from an
-    image that tiles is only what its ordinary steps across the edges make (smooth and faint).  Returns float64
-    (n, H, W)."""
-    u = np.asarray(imgs, np.float64)
-    n, H, W = u.shape
-    v = np.zeros_like(u)  # the boundary image: differences across the opposite edges (Moisan, Eq. 11)
-    v[:, 0, :] = u[:, -1, :] - u[:, 0, :]
-    v[:, -1, :] = -v[:, 0, :]
-    v[:, :, 0] += u[:, :, -1] - u[:, :, 0]
-    v[:, :, -1] -= u[:, :, -1] - u[:, :, 0]
-    q = 2.0 * np.cos(2.0 * np.pi * np.arange(H) / H)[:, None] + 2.0 * np.cos(2.0 * np.pi * np.arange(W) / W)[None, :] - 4.0
-    q[0, 0] = 1.0  # the mean is left to p
-    S = np.fft.fft2(v) / q
-    S[:, 0, 0] = 0.0
-    return u - np.real(np.fft.ifft2(S))
 
 
 def radial_psd(imgs: np.ndarray) -> np.ndarray:

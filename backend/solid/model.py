@@ -10,7 +10,9 @@ against the JSON; sessions are created on first use.
     rgb = tex.evaluate(points, code, seed=0)         # points (N, 3) in units -> float32 (N, 3) sRGB in [0, 1]
 
 Space models also map an exemplar image to a code (``encode``) and codes to
-(e, T) (``translate``); codes interpolate linearly in z (Sec. 5, Fig. 1).
+(e, T) (``translate``); codes interpolate linearly in z (Sec. 5, Fig. 1).  An
+encoded photo's harmonic part (``harmonics``, harmonic.py: its courses and
+weaves, measured, not learned) rides along in the code.
 Positions are in texture units: ``px_per_unit`` exemplar pixels per unit.
 """
 from __future__ import annotations
@@ -26,6 +28,7 @@ from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
 from .brick import brick_features
 from .cellular import cellular_features
+from .harmonic import Harmonics, harmonic_field, photo_harmonics
 from .lattice import lattice_noise
 from .waves import wave_features
 
@@ -33,6 +36,7 @@ __all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb"
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
+HARMONIC_SIDE = 1024      #: photos are measured for their harmonic part at most this many pixels wide
 #: the models the extension ships (``models/solid`` beside ``backend``)
 SHIPPED_MODELS = solid_models()
 
@@ -71,12 +75,14 @@ class TextureCode:
     """What the sampler needs: the extended code e float32 (E,) and the octave transforms T float32 (m, D, D);
     for photo models (``colour_model`` "affine") also the exemplar's colour: mean ``mu`` float32 (3,) and the
     Cholesky factor ``L`` float32 (3, 3) of its colour covariance (rgb = mu + L d); for spectral models the
-    per-octave ``gains`` float32 (m,) measured from the exemplar (:func:`spectral_gains`)."""
+    per-octave ``gains`` float32 (m,) measured from the exemplar (:func:`spectral_gains`); for a photo a space model
+    encoded, its ``harmonics`` (:mod:`backend.solid.harmonic`: the periodic part added to the decoder's)."""
     e: np.ndarray
     T: np.ndarray
     mu: np.ndarray | None = None
     L: np.ndarray | None = None
     gains: np.ndarray | None = None
+    harmonics: Harmonics | None = None
 
 
 def exemplar_category(name: str) -> str:
@@ -214,8 +220,23 @@ class SolidTextureModel:
                                             for c in crops], axis=0)])
         return z.astype(_F)
 
-    def translate(self, z) -> TextureCode:
-        """Space mode, translator h(z) -> (e, T) (Sec. 3)."""
+    def harmonics(self, image: np.ndarray) -> Harmonics | None:
+        """A photo's harmonic part at this model's scale (:func:`backend.solid.harmonic.photo_harmonics`), for
+        :meth:`translate`; None for models without the photo's colour (the part is added in its colour frame)."""
+        if not self.colour_stats:
+            return None
+        img = np.asarray(image, _F)
+        if img.ndim == 2:
+            img = np.repeat(img[..., None], 3, axis=2)
+        img, ppu, W = img[..., :3], self.px_per_unit, img.shape[1]
+        f = HARMONIC_SIDE / max(img.shape[:2])
+        if f < 1.0:     # a large photo is measured at most HARMONIC_SIDE px wide, at its scale in texture units
+            img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
+            ppu *= img.shape[1] / W
+        return photo_harmonics(img, ppu)
+
+    def translate(self, z, harmonics: Harmonics | None = None) -> TextureCode:
+        """Space mode, translator h(z) -> (e, T) (Sec. 3); ``harmonics`` (:meth:`harmonics`) ride along."""
         if self.mode != "space":
             raise SettingError("code", f"model {self.name!r} has no translator (single-exemplar model)")
         z = np.asarray(z, _F).reshape(-1)
@@ -227,7 +248,8 @@ class SolidTextureModel:
             return TextureCode(e[0].astype(_F), T[0].astype(_F))
         c = z[self.z_dim:self.z_dim + self.colour_stats]
         gains = z[self.z_dim + self.colour_stats:].copy() if self.spectral_gains else None
-        return TextureCode(e[0].astype(_F), T[0].astype(_F), *_colour(c), gains)
+        return TextureCode(e[0].astype(_F), T[0].astype(_F), *_colour(c), gains,
+                           harmonics if harmonics is not None and len(harmonics) else None)
 
     def code(self, exemplar: str | None = None) -> TextureCode:
         """A named training exemplar's code (space models), or the default code."""
@@ -252,7 +274,8 @@ class SolidTextureModel:
         Works in chunks of ``chunk`` points (memory stays flat whatever N);
         ``progress(fraction)`` after each chunk (the one progress contract of the core); ``cancel()`` returning True
         stops early with :class:`Cancelled`.  2D points on a 3D model are
-        read on the z = 0 plane.
+        read on the z = 0 plane.  A code with ``harmonics`` adds the photo's harmonic part (harmonic.py):
+        rgb = mu + k L d + h(x).
         """
         pts = np.asarray(points)
         if pts.ndim != 2 or pts.shape[1] not in (2, 3):
@@ -286,16 +309,24 @@ class SolidTextureModel:
             if self.colour_stats:
                 if code.mu is None or code.L is None:
                     raise SettingError("code", f"model {self.name!r} needs the exemplar's colour (mu, L) in its code")
-                d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
+                h = code.harmonics
+                if h is None:
+                    d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
+                else:   # rgb = mu + k L d + h(x) (harmonic.py)
+                    d = np.clip(code.mu + _F(h.keep) * (d @ np.asarray(code.L, _F).T) + harmonic_field(pts[a:b], h, seed),
+                                0.0, 1.0)
             out[a:b] = d
             if progress is not None:
                 progress(b / N)
         return out
 
     def image(self, size: int, code: TextureCode, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),
-              axis: str = "z", **kw) -> np.ndarray:
+              axis: str = "y", **kw) -> np.ndarray:
         """A (size, size, 3) float32 image of the plane through ``offset`` normal to ``axis``,
-        at exemplar resolution times ``scale`` (pixel centres; row 0 at the top)."""
+        at exemplar resolution times ``scale`` (pixel centres; row 0 at the top).  The default, "y", is the front
+        view (x to the right, z up), where models trained with ``fixed_axis`` "rows" and an encoded photo's
+        harmonic part (harmonic.py) show the photo upright; "z" looks down (x right, y up), "x" from the side
+        (y right, z up)."""
         plane = plane_points(size, self.px_per_unit * scale)
         if self.dim == 2:
             pts = plane + np.asarray(offset[:2], np.float64)

@@ -28,6 +28,7 @@ import numpy as np
 from .._export import export
 from ..errors import SettingError
 from ..grid import Cancelled
+from .harmonic import mix_harmonics
 from .model import resize_rgb
 
 __all__ = ["texture_stats", "stats_distance", "refine_code", "exemplar_z", "RENDER_SIZE"]
@@ -71,15 +72,16 @@ def _exemplar_crops(exemplar: np.ndarray, scale: float, n: int = 4) -> list:
 
 
 def refine_code(model, z0, exemplar: np.ndarray, steps: int = 40, seed: int = 0, sigma: float = 0.3,
-                progress=None, cancel=None):
+                progress=None, cancel=None, harmonics=None):
     """(z, distances): z float32 (z_dim,) after ``steps`` candidates; distances[i] the best after candidate i
-    (distances[0]: the start).  ``model`` is a space :class:`SolidTextureModel`."""
+    (distances[0]: the start).  ``model`` is a space :class:`SolidTextureModel`; candidates are rendered with the
+    exemplar's ``harmonics`` (:meth:`SolidTextureModel.harmonics`) when given, as the texture will be."""
     rng = np.random.default_rng(seed)
     target = np.mean([texture_stats(c) for c in _exemplar_crops(exemplar, float(model.config.get("exemplar_scale", 1.0)))],
                      axis=0)
 
     def cost(z):
-        code = model.translate(z)
+        code = model.translate(z, harmonics)
         imgs = [model.image(RENDER_SIZE, code, s, scale=float(model.config.get("exemplar_scale", 1.0)),
                             offset=(7.0 * s, 3.0 * s, 1.0 * s)) for s in (0, 1)]
         return stats_distance(np.mean([texture_stats(i) for i in imgs], axis=0), target)
@@ -107,20 +109,17 @@ def refine_code(model, z0, exemplar: np.ndarray, steps: int = 40, seed: int = 0,
 
 
 def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setting: str = "exemplar",
-               progress=None):
+               progress=None, periodic: bool = True):
     """A space model's z for a training exemplar's name, an image file or pixels float (H, W, 3) (encoded, then
     refined by ``refine`` search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement
-    distances or [])."""
+    distances or [], the image's harmonic part or None (``periodic`` False: None))."""
     if isinstance(exemplar, np.ndarray):  # pixels already read (the Blender panel): float (H, W, 3) sRGB in [0, 1]
         img = np.asarray(exemplar, np.float32)
         if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
             raise SettingError(setting, f"expected finite RGB pixels (H, W, 3), got shape {img.shape}")
-        z, hist = model.encode(img), []
-        if refine > 0:
-            z, hist = refine_code(model, z, img, steps=refine, progress=progress)
-        return z, img, hist
+        return _encoded(model, img, refine, progress, periodic)
     if exemplar in model.codes:
-        return model.codes[exemplar], None, []
+        return model.codes[exemplar], None, [], None
     if exemplar is None or not os.path.isfile(exemplar):
         raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
                                     f"({', '.join(model.codes) or 'none'})")
@@ -128,21 +127,29 @@ def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setti
         img = export.read_rgb(exemplar)
     except ValueError as exc:
         raise SettingError(setting, str(exc)) from None
+    return _encoded(model, img, refine, progress, periodic)
+
+
+def _encoded(model, img: np.ndarray, refine: int, progress, periodic: bool):
+    """:func:`exemplar_z` of pixels: encode, measure the harmonic part, refine with it."""
     z, hist = model.encode(img), []
+    h = model.harmonics(img) if periodic else None
     if refine > 0:
-        z, hist = refine_code(model, z, img, steps=refine, progress=progress)
-    return z, img, hist
+        z, hist = refine_code(model, z, img, steps=refine, progress=progress, harmonics=h)
+    return z, img, hist, h
 
 
 def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: str | None = None, mix: float = 0.0,
-                 refine: int = 0, where: str = "", progress=None, report=None):
+                 refine: int = 0, where: str = "", progress=None, report=None, periodic: bool = True):
     """The one place a texture request becomes a code, for the command line, job files and the farm:
     (TextureCode, the input images' sha256 or None).
 
     A single-exemplar model gives its own texture (``to``, ``refine`` and an ``exemplar`` other than its own are
     errors); a space model
     gives ``exemplar`` (a training exemplar's name or an image file, refined by ``refine`` steps), mixed with
-    ``to`` by ``mix`` in [0, 1] (Henzler et al. 2020, Sec. 4: interpolation in the latent space). ``where``
+    ``to`` by ``mix`` in [0, 1] (Henzler et al. 2020, Sec. 4: interpolation in the latent space; an image's harmonic
+    part, :mod:`backend.solid.harmonic`, comes along unless ``periodic`` is False, mixed by
+    :func:`~backend.solid.harmonic.mix_harmonics`). ``where``
     prefixes the setting names in errors ("source." for job files, "--" for flags); ``report(name, history)``
     hears each refinement's distances."""
     import hashlib
@@ -168,15 +175,16 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
     digests = []
 
     def z_of(ex, key):
-        z, img, hist = exemplar_z(model, ex, refine, name(key), progress)
+        z, img, hist, h = exemplar_z(model, ex, refine, name(key), progress, periodic)
         if img is not None:
             digests.append(hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest())
         if hist and report is not None:
             report(ex, hist)
-        return z
+        return z, h
 
-    z = z_of(exemplar, "exemplar")
+    z, h = z_of(exemplar, "exemplar")
     if to is not None:
-        z = (1.0 - mix) * z + mix * z_of(to, "to")
+        z2, h2 = z_of(to, "to")
+        z, h = (1.0 - mix) * z + mix * z2, mix_harmonics(h, h2, mix)
     sha = hashlib.sha256("".join(digests).encode()).hexdigest() if digests else None
-    return model.translate(z), sha
+    return model.translate(z, h), sha

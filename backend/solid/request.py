@@ -4,7 +4,8 @@ all build (issue 23), validated in one place and turned into a texture code in o
 A request names a model (a folder, a shipped model's name, or None: chosen from the exemplar as the command line
 always did), an exemplar (a space model's training exemplar by name, an image file, or pixels a front-end already
 holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al. 2020, Sec. 4: interpolation in
-the latent space), ``refine`` search steps, and the ``seed`` of the noise.  Where the texture is read (grid,
+the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image's harmonic part,
+:mod:`backend.solid.harmonic`), and the ``seed`` of the noise.  Where the texture is read (grid,
 zoom, scale) belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
@@ -52,7 +53,7 @@ def _digest(x) -> str | None:
 class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
     model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
-    steps, ``seed`` in [0, 2^32)."""
+    steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)
@@ -60,6 +61,7 @@ class SolidRequest:
     mix: float = 0.0
     refine: int = 0
     seed: int = 0
+    periodic: bool = True
 
     def check(self, where: str = "") -> "SolidRequest":
         """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
@@ -72,6 +74,8 @@ class SolidRequest:
             raise bad("refine", f"must be a whole number >= 0, got {self.refine}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
             raise bad("seed", f"must be a whole number in [0, {MAX_SEED}], got {self.seed}")
+        if not isinstance(self.periodic, (bool, np.bool_)):
+            raise bad("periodic", f"must be true or false, got {self.periodic!r}")
         return self
 
     def folder(self, models: str | None = None) -> str:
@@ -102,10 +106,11 @@ class SolidRequest:
         """(TextureCode, the input images' sha256 or None): :func:`backend.solid.refine.texture_code`."""
         from .refine import texture_code
 
-        return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report)
+        return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report,
+                            bool(self.periodic))
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256)."""
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
-                    refine=int(self.refine), seed=int(self.seed))
+                    refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic))

@@ -230,3 +230,10 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
     assert req.key() == flags("--model", space, "--exemplar", str(tmp_path / "ex.png"), "--refine", "4").key()
     assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
                                                  "seed": 3}).key()
+    p.periodic = False     # the Periodic Part box is --no-periodic and a job file's periodic = false
+    req = solid_ui.panel_request(p)
+    assert req.key() == flags("--model", space, "--exemplar", str(tmp_path / "ex.png"), "--refine", "4",
+                              "--no-periodic").key()
+    assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
+                                                 "seed": 3, "periodic": False}).key()
+    p.periodic = True

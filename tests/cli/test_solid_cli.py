@@ -17,6 +17,22 @@ def models():
                 space3=os.path.join(solid_models(), "space"))
 
 
+def write_job(path, extent: float, model: str, source: str) -> None:
+    """A job file baking one 8³ solid volume over [0, extent]³ into job.npy; ``source``: more source lines."""
+    e = repr(extent)
+    path.write_text(f"""
+[[bake]]
+name = "solid"
+output = "job.npy"
+resolution = [8, 8, 8]
+bounds = [[0, 0, 0], [{e}, {e}, {e}]]
+[bake.source]
+kind = "solid"
+model = "{model}"
+{source}
+""")
+
+
 def run(capsys, *args):
     rc = main(["solid", "--quiet", *args])
     return rc, capsys.readouterr().err
@@ -117,21 +133,7 @@ def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
     cli = str(tmp_path / "cli.npy")
     assert run(capsys, "--model", models["space3"], "--exemplar", "gravel", "--to", "wood", "--mix", "0.3", "--dim", "3",
                "--size", "8", "--seed", "2", "-o", cli)[0] == 0
-    e = 8 / space.px_per_unit
-    (tmp_path / "job.toml").write_text(f"""
-[[bake]]
-name = "mixed"
-output = "job.npy"
-resolution = [8, 8, 8]
-bounds = [[0, 0, 0], [{e!r}, {e!r}, {e!r}]]
-[bake.source]
-kind = "solid"
-model = "{models['space3']}"
-exemplar = "gravel"
-to = "wood"
-mix = 0.3
-seed = 2
-""")
+    write_job(tmp_path / "job.toml", 8 / space.px_per_unit, models["space3"], 'exemplar = "gravel"\nto = "wood"\nmix = 0.3\nseed = 2')
     assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
     np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))
     (tmp_path / "job.toml").write_text((tmp_path / "job.toml").read_text().replace("mix = 0.3", "mix = 1.5"))
@@ -166,3 +168,26 @@ def test_texture_codes_are_made_in_one_place(models, tmp_path):
             texture_code(single, **kw)
     with pytest.raises(SettingError, match="needs an exemplar"):
         texture_code(space)
+
+
+def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path, capsys):
+    """An encoded brick photo keeps its courses (backend/solid/harmonic.py) unless --no-periodic; a job file's
+    `periodic = false` gives the volume `--no-periodic` writes."""
+    from backend.solid.model import SolidTextureModel
+    from export.images import read_rgb
+
+    photo = os.path.join(os.path.dirname(TINY), "..", "..", "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+    on, off = str(tmp_path / "on.npy"), str(tmp_path / "off.npy")
+    assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--size", "64", "-o", on)[0] == 0
+    assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--size", "64", "--no-periodic", "-o", off)[0] == 0
+    lum = read_rgb(photo)[:64, :64].mean(2).ravel()
+    r_on = np.corrcoef(np.load(on).mean(2).ravel(), lum)[0, 1]
+    r_off = np.corrcoef(np.load(off).mean(2).ravel(), lum)[0, 1]
+    assert r_on > 0.5 and abs(r_off) < 0.2
+    space = SolidTextureModel(models["space3"])
+    cli = str(tmp_path / "cli.npy")
+    assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--no-periodic", "--dim", "3", "--size", "8",
+               "-o", cli)[0] == 0
+    write_job(tmp_path / "job.toml", 8 / space.px_per_unit, models["space3"], f'exemplar = "{photo}"\nperiodic = false')
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
+    np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))

@@ -119,7 +119,8 @@ def test_periodic_component_solves_moisans_equation_and_removes_the_border_cross
     """u = p + s (Moisan 2011): the discrete periodic Laplacian of s is the boundary image v, s has mean 0; a crop
     of a smooth tiling field, which jumps at its borders, gets its top-band power back down near the field's own,
     and look() then puts the crop beside the whole field (it did not: the crop's border cross looked like grain)."""
-    from training.evaluate import look, periodic_component, radial_psd
+    from backend.periodic import periodic_component
+    from training.evaluate import look, radial_psd
 
     r = np.random.default_rng(5)
     S = 256

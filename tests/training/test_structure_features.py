@@ -5,7 +5,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.evaluate import periodic_component, radial_psd  # noqa: E402
+from backend.periodic import periodic_component  # noqa: E402
+from training.evaluate import radial_psd  # noqa: E402
 from training.solid.structure_features import (StructureFeatures, StructureNet, load_structure_net,  # noqa: E402
                                                phase_randomised, structure_batch, train_structure_net)
 

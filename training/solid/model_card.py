@@ -318,8 +318,13 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "- The single-exemplar models were trained on two CPU cores for minutes per model. The texture-space "
           "model's last stage ran on a lent H100 at batch 16, and a larger batch helped it more than more time "
           "at batch 4 had (\"Photo texture space\"); the single models have not had a GPU run yet.",
-          "- The texture-space model draws grains, pebbles and mottling, not stones with joints, courses, planks "
-          "or weaves: random phase noise is still closer to brick, fabric and metal photos.", ""]
+          "- The texture-space model's decoder draws grains, pebbles and mottling, not stones with joints. "
+          "Courses, plank seams and rows come from the photo's harmonic part, measured at encode time and "
+          "added to the decoder's texture (\"Harmonic part of an encoded photo\"): up to 32 isolated spectral "
+          "peaks, so a motif (a patterned carpet) or head joints that stand out only weakly are not drawn, "
+          "and random phase noise is still closer to fabric and metal photos. In 3D the part stands on "
+          "vertical planes; a horizontal cut through a layered photo takes one layer's colour (a mortar "
+          "course on one brick photo).", ""]
     return "\n".join(L)
 
 

@@ -66,7 +66,7 @@ def phase_randomised(g: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Random-phase twins (Galerne et al. 2011) of images g (n, H, W): the moduli of the Fourier transform of each
     image's periodic component with the phases of white noise's, the mean kept, then rank-mapped back onto the
     image's own values (same histogram).  float32 (n, H, W)."""
-    from training.evaluate import periodic_component
+    from backend.periodic import periodic_component
 
     p = periodic_component(g)
     n, H, W = g.shape

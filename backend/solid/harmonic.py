@@ -1,0 +1,139 @@
+"""The harmonic part of a photo's texture, measured when the texture-space model encodes the photo (issue 20).
+
+A homogeneous texture splits into a harmonic part, a sum of plane waves at isolated spectral peaks, and an
+indeterministic rest (the Wold decomposition of homogeneous random fields; Francos, Meiri & Porat 1993, IEEE
+T-IP 2(1); Liu & Picard 1996, IEEE T-PAMI 18(7)).  Brick courses, plank seams, woven rows and drilled grids are
+harmonic; the texture-space model's decoder, which reads value-noise octaves, draws only the rest.  So an encoded
+photo also keeps its harmonic part, measured from its pixels (nothing is learned), and the texture becomes
+
+    rgb(x) = clip(mu + k L d(x) + h(x)),   h(x) = sum_j Re(A_j exp(2 pi i f_j . q(x))),   k = sqrt(1 - s)
+
+with the decoder's whitened output d, the photo's mean colour mu and colour Cholesky factor L
+(``model.colour_stats``), A_j in C^3 the photo's colour amplitude and phase at peak j, f_j its frequency in
+cycles per texture unit, and s the share of the photo's colour variance the peaks carry (k keeps the total
+variance the photo's).
+
+Peaks: local maxima of the luminance's Fourier modulus on the photo's periodic component (Moisan 2011, so the
+jump at the border adds no cross of false peaks), one of each conjugate pair, at least ``MIN_CYCLES`` cycles per
+photo, with at least ``FLOOR`` of the luminance's power, and at least ``PROMINENCE`` times the mean power around
+them (the ring between the 3 x 3 core and the (2 ``WINDOW`` + 1)^2 square).  Only a peak that stands alone
+counts: a period repeats, so its power collects in one bin; an aperiodic line or edge spreads over a ridge, and
+the spectrum of grass, sand or rock is smooth.  At most ``COUNT`` peaks, the strongest first.  ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
+split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
+39 structured photos more than 5 % closer and 2 farther, and 4 and 2 of 75 others; 4 made 23 closer but 17 others
+farther (stripes from chance peaks).
+
+Placement: on 2D points (2D models) q = p, the photo's plane (row 0 at the top as ``model.plane_points``).  On 3D
+points the photo stands upright and is extruded along the horizontal diagonal (1, -1, 0): q(x, y, z) = (x + y, z),
+so every vertical plane normal to x or to y (a wall seen from the front or from the side, and the 2D image of a 3D
+model, ``model.image``'s front view) shows the harmonic part unchanged, courses level and planks upright at the
+photo's pitch, and a horizontal cut shows it in profile (brick courses vanish there, as in a brick wall; plank
+seams become lines).  A plane wave keeps its frequency on every plane whose section it is, so the texture stays
+one solid.  The other ways to stand the photo up were measured on the training split and were worse (the photo
+on floors and on faces normal to y: median patch distance of the structured training photos 148.5 against
+134.4; ``bench/eval_solid_harmonic.py``).
+
+Shapes: photos float (H, W, 3) sRGB in [0, 1]; points float (N, 2) or (N, 3) in texture units; fields float32
+(N, 3).  Phases are computed in float64 (at |x| ~ 64 units and f ~ 60 cycles per unit the argument reaches
+~2.4e4 rad, where float32 would lose ~2e-3 rad).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..periodic import periodic_component
+
+__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "seed_shift", "mix_harmonics", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES"]
+
+COUNT = 32          #: at most this many peaks
+PROMINENCE = 16.0   #: a peak's power over the mean power of the bins around it
+WINDOW = 3          #: ... in the (2 WINDOW + 1)^2 square, less the 3 x 3 core
+MIN_CYCLES = 2      #: no peak below this many cycles per photo (shading and vignetting, not texture)
+FLOOR = 1e-4        #: nor one with less than this share of the luminance's power (rounding, not texture)
+
+
+@dataclass(frozen=True)
+class Harmonics:
+    """A photo's harmonic part: ``freq`` float64 (K, 2) cycles per texture unit in the photo's plane (u, v),
+    ``amp`` complex128 (K, 3) colour amplitudes with the photo's phases, ``share`` in [0, 1) the share of the
+    photo's colour variance they carry."""
+    freq: np.ndarray
+    amp: np.ndarray
+    share: float
+
+    @property
+    def keep(self) -> float:
+        """The factor k = sqrt(1 - share) on the decoder's part (module doc)."""
+        return float(np.sqrt(max(0.0, 1.0 - self.share)))
+
+    def __len__(self) -> int:
+        return int(self.freq.shape[0])
+
+
+def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
+                    window: int = WINDOW, min_cycles: int = MIN_CYCLES) -> Harmonics:
+    """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc);
+    no peaks (K = 0, share 0) for a photo without a period."""
+    a = np.asarray(img, np.float64)[..., :3]
+    H, W, _ = a.shape
+    F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
+    P = np.abs(F.mean(0)) ** 2                                                         # luminance power
+    ky = np.broadcast_to(np.fft.fftfreq(H, d=1.0 / H)[:, None], (H, W))                # cycles per photo
+    kx = np.broadcast_to(np.fft.fftfreq(W, d=1.0 / W)[None, :], (H, W))
+    peak = np.ones((H, W), bool)
+    ring, n = np.zeros_like(P), 0
+    for dy in range(-window, window + 1):
+        for dx in range(-window, window + 1):
+            if max(abs(dy), abs(dx)) <= 1:
+                if dy or dx:
+                    peak &= P > np.roll(P, (dy, dx), axis=(0, 1))
+            else:
+                ring += np.roll(P, (dy, dx), axis=(0, 1))
+                n += 1
+    half = (ky > 0) | ((ky == 0) & (kx > 0))                       # one of each conjugate pair
+    far = np.hypot(kx / W, ky / H) * min(H, W) >= min_cycles
+    ok = peak & half & far & (P >= prominence * ring / max(n, 1)) & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
+    idx = np.flatnonzero(ok.ravel())
+    idx = idx[np.argsort(-P.ravel()[idx], kind="stable")][:count]
+    Fc = F.reshape(3, -1)[:, idx].T                                                    # (K, 3)
+    total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
+    share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0
+    fx, fy = kx.ravel()[idx], ky.ravel()[idx]
+    # pixel (r, c) sits at p = ((c + 1/2) / u, -(r + 1/2) / u): exp(2 pi i (fx c / W + fy r / H)) =
+    # exp(i (2 pi f . p - pi (fx / W + fy / H))) with f = u (fx / W, -fy / H); both halves of a pair: 2 Re(.)
+    amp = (2.0 / (H * W)) * Fc * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]
+    freq = np.stack([px_per_unit * fx / W, -px_per_unit * fy / H], axis=1)
+    return Harmonics(freq.astype(np.float64), amp.astype(np.complex128), min(share, 0.999))
+
+
+def seed_shift(seed: int) -> np.ndarray:
+    """Where a seed moves the harmonic part in the photo's plane: float64 (2,) texture units, (0, 0) for seed 0
+    (the photo's own placement), else uniform in [0, 64)^2 from the seed.  Another seed is another texture of the
+    same kind: the courses elsewhere, not the same courses under other noise."""
+    if int(seed) == 0:
+        return np.zeros(2)
+    return np.random.default_rng([int(seed), 0x6861726D]).uniform(0.0, 64.0, 2)
+
+
+def harmonic_field(points: np.ndarray, h: Harmonics, seed: int = 0) -> np.ndarray:
+    """h at points float (N, 2) (the photo's plane) or (N, 3) (q = (x + y, z); module doc), moved by
+    :func:`seed_shift`: float32 (N, 3)."""
+    x = np.asarray(points, np.float64)
+    if len(h) == 0:
+        return np.zeros((x.shape[0], 3), np.float32)
+    q = (x if x.shape[1] == 2 else np.stack([x[:, 0] + x[:, 1], x[:, 2]], axis=1)) + seed_shift(seed)
+    t = 2.0 * np.pi * (q @ h.freq.T)                                                   # (N, K)
+    return (np.cos(t) @ h.amp.real - np.sin(t) @ h.amp.imag).astype(np.float32)
+
+
+def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmonics | None:
+    """The harmonic part of a code interpolated by ``t`` from a to b: both sets of waves, their powers weighted
+    (1 - t) and t (amplitudes by the square roots), so the share interpolates linearly; None when both are."""
+    parts = [(h, w) for h, w in ((a, 1.0 - t), (b, t)) if h is not None]
+    if not parts:
+        return None
+    freq = np.concatenate([h.freq for h, _ in parts]).reshape(-1, 2)
+    amp = np.concatenate([h.amp * np.sqrt(w) for h, w in parts]).reshape(-1, 3)
+    return Harmonics(freq, amp, float(sum(h.share * w for h, w in parts)))

@@ -1,0 +1,174 @@
+"""The harmonic part of an encoded photo (backend/solid/harmonic.py): peaks found where a period is and nowhere
+else, the photo's own waves given back in place, the 3D placement, mixing, and the texture an artist gets."""
+import os
+
+import numpy as np
+import pytest
+
+from backend.solid.harmonic import Harmonics, harmonic_field, mix_harmonics, photo_harmonics, seed_shift
+from backend.solid.model import SolidTextureModel, plane_points
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SPACE = os.path.join(ROOT, "models", "solid", "space")
+BRICK = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+PPU = 128.0
+
+
+def waves_photo(H=96, W=128):
+    """A tileable photo made of three colour plane waves at whole cycles per photo, and its mean."""
+    r, c = np.mgrid[0:H, 0:W].astype(np.float64)
+    img = np.full((H, W, 3), 0.5)
+    for (kx, ky, ph, col) in ((5, 0, 0.3, (0.2, 0.1, 0.05)), (3, 7, 1.1, (0.05, 0.1, 0.0)),
+                              (-9, 4, 2.0, (0.0, 0.04, 0.1))):
+        img += np.cos(2 * np.pi * (kx * c / W + ky * r / H) + ph)[..., None] * np.array(col)
+    return img
+
+
+def brick_photo(H=128, W=128, course=16, brick=32, seed=0):
+    """Staggered courses of noisy bricks with light mortar joints: a period in both directions."""
+    rng = np.random.default_rng(seed)
+    r, c = np.mgrid[0:H, 0:W]
+    row = r // course
+    joint = (r % course < 2) | (((c + (row % 2) * brick // 2) % brick) < 2)
+    img = np.where(joint[..., None], 0.85, 0.45 + 0.05 * rng.standard_normal((H, W, 1)))
+    return np.clip(img * np.array([1.0, 0.6, 0.45]), 0, 1)
+
+
+def photo_plane(h, H, W):
+    """The field at the photo's pixel centres (H, W, 3)."""
+    p = plane_points(max(H, W), PPU).reshape(max(H, W), max(H, W), 2)[:H, :W].reshape(-1, 2)
+    return harmonic_field(p, h).reshape(H, W, 3)
+
+
+def test_a_photo_of_waves_is_given_back_in_place():
+    img = waves_photo()
+    h = photo_harmonics(img, PPU)
+    assert len(h) == 3 and h.share > 0.99
+    # within 1 % of the waves' amplitude: the periodic component (Moisan) differs from a tiling image by the
+    # faint smooth part its ordinary steps across the edges make
+    assert np.abs(photo_plane(h, *img.shape[:2]) - (img - img.mean((0, 1)))).max() < 2e-3
+    # frequencies in cycles per unit: 5 cycles over 128 px at 128 px per unit is 5 cycles per unit
+    assert np.any(np.all(np.isclose(h.freq, [5.0, 0.0]), axis=1))
+
+
+def test_aperiodic_photos_have_no_harmonic_part():
+    rng = np.random.default_rng(3)
+    white = rng.random((128, 128, 3))
+    # 1/f noise (rock-like) and one dark line across the photo (a ridge in the spectrum, not a peak)
+    F = np.fft.fft2(rng.standard_normal((128, 128)))
+    f = np.hypot(*np.meshgrid(np.fft.fftfreq(128), np.fft.fftfreq(128)))
+    pink = np.real(np.fft.ifft2(F / np.maximum(f, 1 / 128)))
+    pink = np.repeat(((pink - pink.min()) / np.ptp(pink))[..., None], 3, axis=2)
+    line = pink.copy()
+    line[60:62] = 0.0
+    for img in (white, pink, line):
+        assert photo_harmonics(img, PPU).share < 0.03
+
+
+def test_courses_and_head_joints_are_found():
+    img = brick_photo()
+    h = photo_harmonics(img, PPU)
+    assert h.share > 0.3 and 0.0 < h.keep < 1.0
+    back = photo_plane(h, 128, 128).mean(2)
+    lum = img.mean(2) - img.mean()
+    assert np.corrcoef(back.ravel(), lum.ravel())[0, 1] > 0.7
+    # a course frequency (8 cycles over 128 px vertically) and a head-joint one (horizontal, 4 per 128 px)
+    assert np.any(np.all(np.isclose(np.abs(h.freq), [0.0, 8.0]), axis=1))
+    assert np.any(np.isclose(np.abs(h.freq[:, 0]), 4.0))
+
+
+def test_3d_placement_walls_show_the_photo_floors_its_profile():
+    """q = (x + y, z): planes normal to x and to y show the photo (z up), translated; planes normal to z show a
+    function of x + y only (the photo in profile)."""
+    h = photo_harmonics(waves_photo(), PPU)
+    p = plane_points(64, PPU)
+    u, v = p[:, 0], p[:, 1]
+    flat = harmonic_field(p, h)
+    c = 0.37
+    front = harmonic_field(np.stack([u - c, np.full_like(u, c), v], 1), h)      # y = c, shifted by -c in x
+    side = harmonic_field(np.stack([np.full_like(u, c), u - c, v], 1), h)       # x = c
+    assert np.abs(front - flat).max() < 1e-5 and np.abs(side - flat).max() < 1e-5
+    floor = harmonic_field(np.stack([u, v, np.full_like(u, c)], 1), h)          # z = c: a function of u + v
+    along = harmonic_field(np.stack([u + 0.25, v - 0.25, np.full_like(u, c)], 1), h)
+    assert np.abs(floor - along).max() < 1e-5 and floor.std() > 0.01
+
+
+def test_2d_images_of_3d_models_are_the_front_view():
+    """model.image's default plane is y = 0 (x right, z up): there an encoded photo's harmonic part stands as in
+    the photo."""
+    m = SolidTextureModel(SPACE)
+    photo = waves_photo(128, 128)
+    code = m.translate(m.encode(photo), m.harmonics(photo))
+    zero = code.__class__(code.e, code.T, code.mu, np.zeros((3, 3), np.float32), code.gains, code.harmonics)
+    img = m.image(64, zero, seed=0)                                             # the harmonic part alone, + mu
+    assert np.abs(img - code.mu - photo_plane(code.harmonics, 64, 64)).max() < 1e-4
+    assert np.abs(m.image(64, zero, seed=0, axis="y") - img).max() == 0.0
+
+
+def test_another_seed_moves_the_harmonic_part():
+    """Seed 0 keeps the photo's placement; another seed translates the whole part (every wave alike, so the
+    pattern holds together), differently per seed and the same every time."""
+    h = photo_harmonics(brick_photo(), PPU)
+    p = plane_points(32, PPU)
+    assert np.all(seed_shift(0) == 0) and np.all(seed_shift(5) == seed_shift(5))
+    assert np.abs(seed_shift(5) - seed_shift(6)).max() > 1.0
+    for s in (1, 7):
+        assert np.abs(harmonic_field(p, h, s) - harmonic_field(p + seed_shift(s), h)).max() < 1e-4
+        assert np.abs(harmonic_field(p, h, s) - harmonic_field(p, h)).max() > 0.05
+
+
+def test_mixing_weights_powers():
+    a = photo_harmonics(waves_photo(), PPU)
+    b = photo_harmonics(brick_photo(), PPU)
+    assert mix_harmonics(None, None, 0.3) is None
+    m = mix_harmonics(a, b, 0.25)
+    assert len(m) == len(a) + len(b)
+    assert np.isclose(m.share, 0.75 * a.share + 0.25 * b.share)
+    p = plane_points(32, PPU)
+    assert np.allclose(harmonic_field(p, mix_harmonics(a, None, 0.0)), harmonic_field(p, a), atol=1e-6)
+    assert np.allclose(harmonic_field(p, mix_harmonics(a, b, 1.0)), harmonic_field(p, b), atol=1e-6)
+    assert Harmonics(np.zeros((0, 2)), np.zeros((0, 3), complex), 0.0).keep == 1.0
+
+
+@pytest.fixture(scope="module")
+def space():
+    return SolidTextureModel(SPACE)
+
+
+def test_an_encoded_brick_photo_gets_its_courses_in_place(space):
+    from export import read_rgb
+
+    photo = read_rgb(BRICK)
+    z, h = space.encode(photo), space.harmonics(photo)
+    assert h is not None and h.share > 0.3
+    with_h, without = space.translate(z, h), space.translate(z)
+    assert with_h.harmonics is h and without.harmonics is None
+    S = 128
+    crop = photo[:S, :S].mean(2)
+    a = space.image(S, with_h, seed=0).mean(2)
+    b = space.image(S, without, seed=0).mean(2)
+    # the photo's own phases: the texture at the origin lines up with the photo's top-left corner
+    assert np.corrcoef(a.ravel(), crop.ravel())[0, 1] > 0.5
+    assert abs(np.corrcoef(b.ravel(), crop.ravel())[0, 1]) < 0.2
+    # the decoder's part is scaled by sqrt(1 - share): the colour spread stays the photo's, the mean too
+    assert abs(a.std() - crop.std()) < 0.35 * crop.std()
+    assert np.abs(space.image(S, with_h, seed=1).mean((0, 1)) - photo.mean((0, 1))).max() < 0.03
+
+
+def test_an_aperiodic_photo_is_left_as_the_decoder_draws_it(space):
+    from export import read_rgb
+
+    photo = read_rgb(os.path.join(ROOT, "data", "photos", "val", "rock__cliff_rocky.jpg"))
+    h = space.harmonics(photo)
+    assert h.share < 0.02
+
+
+def test_a_large_photo_is_measured_small_at_the_same_scale(space):
+    """A photo over HARMONIC_SIDE px is resized before its FFT; its waves keep their frequency in texture units."""
+    from backend.solid.model import HARMONIC_SIDE
+
+    img = np.tile(brick_photo(), (9, 9, 1))[: HARMONIC_SIDE + 128, : HARMONIC_SIDE + 128]   # 1152 px, period 16 / 32 px
+    h = space.harmonics(img)
+    assert h.share > 0.2
+    # the course frequency, 1 / 16 px at 128 px per unit: 8 cycles per unit
+    assert np.any(np.all(np.isclose(np.abs(h.freq), [0.0, 8.0], atol=0.15), axis=1))
