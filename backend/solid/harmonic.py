@@ -45,7 +45,8 @@ import numpy as np
 
 from ..periodic import periodic_component
 
-__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "seed_shift", "mix_harmonics", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES"]
+__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "seed_shift", "mix_harmonics", "to_json", "from_json",
+           "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES"]
 
 COUNT = 32          #: at most this many peaks
 PROMINENCE = 16.0   #: a peak's power over the mean power of the bins around it
@@ -137,3 +138,26 @@ def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmoni
     freq = np.concatenate([h.freq for h, _ in parts]).reshape(-1, 2)
     amp = np.concatenate([h.amp * np.sqrt(w) for h, w in parts]).reshape(-1, 3)
     return Harmonics(freq, amp, float(sum(h.share * w for h, w in parts)))
+
+
+def to_json(h: Harmonics) -> dict:
+    """A model folder's stored harmonic part (solid.json "harmonics"): freq rows [f_x, f_y], amp rows
+    [re R, im R, re G, im G, re B, im B], share; float64 values, read back exactly by :func:`from_json`."""
+    amp = np.stack([h.amp.real, h.amp.imag], axis=2).reshape(-1, 6)
+    return dict(freq=h.freq.astype(float).tolist(), amp=amp.astype(float).tolist(), share=float(h.share))
+
+
+def from_json(d) -> Harmonics:
+    """:func:`to_json`'s dict -> Harmonics; ValueError naming what is wrong."""
+    try:
+        freq = np.asarray(d["freq"], np.float64).reshape(-1, 2)
+        amp = np.asarray(d["amp"], np.float64).reshape(-1, 6)
+        share = float(d["share"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(f"harmonics must hold freq (K x 2), amp (K x 6) and share: {exc}") from None
+    if len(freq) != len(amp) or not (np.all(np.isfinite(freq)) and np.all(np.isfinite(amp))) \
+            or not 0.0 <= share < 1.0:
+        raise ValueError(f"harmonics: {len(freq)} frequencies, {len(amp)} amplitudes, share {share}: "
+                         "need as many of each, finite, and a share in [0, 1)")
+    a = amp.reshape(-1, 3, 2)
+    return Harmonics(freq, a[..., 0] + 1j * a[..., 1], share)

@@ -28,7 +28,7 @@ from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
 from .brick import brick_features
 from .cellular import cellular_features
-from .harmonic import Harmonics, harmonic_field, photo_harmonics
+from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics
 from .lattice import lattice_noise
 from .waves import wave_features
 
@@ -163,6 +163,15 @@ class SolidTextureModel:
         self.waves = np.asarray(c.get("waves", []), np.float64).reshape(-1, 4)
         if len(self.waves) and (self.mode != "single" or self.dim != 2):
             raise ModelError(f"model {self.name!r} has waves, which only single 2D models can have")
+        #: a single photo model's stored harmonic part (harmonic.py; training/solid/harmonics.py adds it)
+        self.stored_harmonics = None
+        if "harmonics" in c:
+            if self.mode != "single" or not c.get("colour_stats", 0):
+                raise ModelError(f"model {self.name!r} stores a harmonic part, which only single photo models can")
+            try:
+                self.stored_harmonics = from_json(c["harmonics"])
+            except ValueError as exc:
+                raise ModelError(f"model {self.name!r}: {exc}") from None
         self.z_dim = int(c.get("z_dim", 8))
         if self.mode == "single" and self.colour_stats and len(c.get("colour_code", ())) != self.colour_stats:
             raise ModelError(f"model {self.name!r} draws in its exemplar's colours but its solid.json has no "
@@ -176,12 +185,14 @@ class SolidTextureModel:
 
     # -- codes ----------------------------------------------------------------------------------
     def default_code(self) -> TextureCode:
-        """The single-mode texture, or the space model's first training exemplar."""
+        """The single-mode texture (with its stored harmonic part, if any), or the space model's first training
+        exemplar."""
         if self.mode == "single":
             e, T = np.asarray(self.config["code"], _F), np.asarray(self.config["T"], _F)
             if not self.colour_stats:
                 return TextureCode(e, T)
-            return TextureCode(e, T, *_colour(np.asarray(self.config["colour_code"], _F)))
+            return TextureCode(e, T, *_colour(np.asarray(self.config["colour_code"], _F)),
+                               harmonics=self.stored_harmonics)
         return self.translate(next(iter(self.codes.values())))
 
     def encode(self, image: np.ndarray) -> np.ndarray:

@@ -1,6 +1,7 @@
 """The harmonic part of an encoded photo (backend/solid/harmonic.py): peaks found where a period is and nowhere
 else, the photo's own waves given back in place, the 3D placement, mixing, and the texture an artist gets."""
 import os
+import re
 
 import numpy as np
 import pytest
@@ -172,3 +173,57 @@ def test_a_large_photo_is_measured_small_at_the_same_scale(space):
     assert h.share > 0.2
     # the course frequency, 1 / 16 px at 128 px per unit: 8 cycles per unit
     assert np.any(np.all(np.isclose(np.abs(h.freq), [0.0, 8.0], atol=0.15), axis=1))
+
+
+def test_stored_harmonics_round_trip_and_bad_ones_are_named():
+    from backend.solid.harmonic import from_json, to_json
+
+    h = photo_harmonics(brick_photo(), PPU)
+    back = from_json(json_round_trip(to_json(h)))
+    assert np.array_equal(back.freq, h.freq) and np.array_equal(back.amp, h.amp) and back.share == h.share
+    for bad, why in (({"freq": [[1, 2]], "amp": [[0] * 6] * 2, "share": 0.1}, "1 frequencies, 2 amplitudes"),
+                     ({"freq": [[1, 2]], "amp": [[0] * 6], "share": 1.5}, "share in [0, 1)"),
+                     ({"freq": [[1, 2]], "share": 0.1}, "must hold freq")):
+        with pytest.raises(ValueError, match=re.escape(why)):
+            from_json(bad)
+
+
+def json_round_trip(d):
+    import json
+
+    return json.loads(json.dumps(d))
+
+
+def test_a_single_photo_model_stores_its_harmonic_part(tmp_path):
+    """brick_3d ships with the harmonic part of its photo's training region (python -m training.solid.harmonics);
+    its default code carries it, and the texture differs from the same weights without it; a model that cannot
+    store one is refused by name."""
+    import json
+    import shutil
+    from dataclasses import replace
+
+    from backend.onnx_models import ModelError
+
+    m = SolidTextureModel(os.path.join(ROOT, "models", "solid", "brick_3d"))
+    code = m.default_code()
+    assert code.harmonics is not None and len(code.harmonics) > 0
+    with_h, without = m.image(64, code, 0), m.image(64, replace(code, harmonics=None), 0)
+    assert np.abs(with_h - without).mean() > 0.02
+    # the courses: the spectrum of the front view's row means follows the photo's (its training region)
+    from export import read_rgb
+
+    photo = read_rgb(os.path.join(ROOT, m.config["exemplars"][0]))[:192, :192]
+
+    def rows(a):
+        return np.abs(np.fft.rfft(a.mean((1, 2)) - a.mean()))[2:]
+
+    ref = rows(photo)
+    r_with = np.corrcoef(rows(m.image(192, code, 0)), ref)[0, 1]
+    r_without = np.corrcoef(rows(m.image(192, replace(code, harmonics=None), 0)), ref)[0, 1]
+    assert r_with > 0.5 and r_without < 0.3
+    shutil.copytree(os.path.join(ROOT, "tests", "data", "tiny_solid", "single3"), tmp_path / "tiny")
+    doc = json.loads((tmp_path / "tiny" / "solid.json").read_text())
+    doc["harmonics"] = json.loads((open(os.path.join(ROOT, "models", "solid", "brick_3d", "solid.json")).read()))["harmonics"]
+    (tmp_path / "tiny" / "solid.json").write_text(json.dumps(doc))
+    with pytest.raises(ModelError, match="only single photo models"):
+        SolidTextureModel(str(tmp_path / "tiny"))
