@@ -1,11 +1,13 @@
 """Neural solid textures showcase: out/demo/solid.blend, solid_render.png and solid_slices.png.
 
-A cube, a UV sphere and Suzanne receive solid textures from photographs
-through the add-on's own "Solid Texture from Image" operator (headless,
-blocking): the cube (gravel) and the sphere (grass) as UV images, each texel
-evaluated at its 3D surface point so the UV seams do not show; Suzanne as a
-colour attribute on a subdivided mesh, from the gravel photograph encoded by
-the texture-space model.  A cylinder shows the procedural wood.  The scene
+A cube, a UV sphere, Suzanne and a cylinder receive solid textures from
+photographs through the add-on's own "Solid Texture from Image" operator
+(headless, blocking): the cube from a held-out brick photograph encoded by the
+texture-space model (with the photo's harmonic part: its courses stand on the
+cube's sides), and the sphere (grass photo) as UV images, each texel evaluated
+at its 3D surface point so the UV seams do not show; Suzanne as a colour
+attribute on a subdivided mesh, from a held-out farmland photograph encoded by
+the texture-space model; the cylinder in the wood photo's model.  The scene
 renders in Cycles on the CPU.  solid_slices.png shows, per model, the
 exemplar beside slices of the 3D texture along the three axes and an oblique
 plane.
@@ -32,6 +34,7 @@ MODELS = SHIPPED_MODELS
 EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
 #: a held-out colour photo (never trained on) that the texture-space model encodes for Suzanne
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")
+BRICKS = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
 
 
 def slices_sheet(out: str, size: int = 160) -> list:
@@ -82,7 +85,8 @@ def _add(kind: str, x: float):
 
 
 def build_scene(out: str) -> dict:
-    """Cube, sphere and Suzanne textured from photographs, a cylinder from the procedural wood."""
+    """A cube and Suzanne textured from held-out photographs (bricks, farmland) through the texture-space model,
+    a sphere and a cylinder from single-photo models (grass, wood)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     blender_addon.register()
     sc = bpy.context.scene
@@ -93,7 +97,8 @@ def build_scene(out: str) -> dict:
     p = sc.omninoise_solid
     p.folder = os.path.join(out, "bakes")
     space = os.path.isfile(os.path.join(MODELS, "space", "solid.json"))
-    plan = [("Cube", "gravel_3d", None, "UV_IMAGE", 1.5), ("Sphere", "grass_3d", None, "UV_IMAGE", 1.0),
+    plan = [("Cube", "space" if space else "gravel_3d", BRICKS if space else None, "UV_IMAGE", 1.0),
+            ("Sphere", "grass_3d", None, "UV_IMAGE", 1.0),
             ("Suzanne", "space" if space else "gravel_3d", PHOTO if space else None, "COLOR_ATTRIBUTE", 1.0),
             ("Cylinder", "wood_3d", None, "UV_IMAGE", 1.0)]
     used = {}
