@@ -73,6 +73,17 @@ class Harmonics:
         return int(self.freq.shape[0])
 
 
+def _box(P: np.ndarray, r: int) -> np.ndarray:
+    """Sums of P (H, W) over the (2 r + 1)^2 squares around each bin, the spectrum wrapping round (cumulative
+    sums along each axis)."""
+    for axis in (0, 1):
+        p = np.pad(P, [(r, r) if a == axis else (0, 0) for a in (0, 1)], mode="wrap")
+        c = np.concatenate([np.zeros_like(np.take(p, [0], axis=axis)), np.cumsum(p, axis=axis)], axis=axis)
+        n = P.shape[axis]
+        P = np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)
+    return P
+
+
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
                     window: int = WINDOW, min_cycles: int = MIN_CYCLES) -> Harmonics:
     """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc);
@@ -84,15 +95,11 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     ky = np.broadcast_to(np.fft.fftfreq(H, d=1.0 / H)[:, None], (H, W))                # cycles per photo
     kx = np.broadcast_to(np.fft.fftfreq(W, d=1.0 / W)[None, :], (H, W))
     peak = np.ones((H, W), bool)
-    ring, n = np.zeros_like(P), 0
-    for dy in range(-window, window + 1):
-        for dx in range(-window, window + 1):
-            if max(abs(dy), abs(dx)) <= 1:
-                if dy or dx:
-                    peak &= P > np.roll(P, (dy, dx), axis=(0, 1))
-            else:
-                ring += np.roll(P, (dy, dx), axis=(0, 1))
-                n += 1
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            if dy or dx:
+                peak &= P > np.roll(P, (dy, dx), axis=(0, 1))
+    ring, n = _box(P, window) - _box(P, 1), (2 * window + 1) ** 2 - 9
     half = (ky > 0) | ((ky == 0) & (kx > 0))                       # one of each conjugate pair
     far = np.hypot(kx / W, ky / H) * min(H, W) >= min_cycles
     ok = peak & half & far & (P >= prominence * ring / max(n, 1)) & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
