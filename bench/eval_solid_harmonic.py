@@ -38,19 +38,20 @@ SETTINGS = [(p, w) for w in (3, 5) for p in (4.0, 8.0, 16.0, 32.0)]
 PLACEMENTS = ("wall", "floor", "each")
 
 
-def placed(h: Harmonics, pts: np.ndarray, placement: str) -> np.ndarray:
-    """h at 3D points under another placement, through the shipped field: (x, 0, y + z) gives q = (x, y + z)."""
+def placed(h: Harmonics, pts: np.ndarray, placement: str, seed: int) -> np.ndarray:
+    """h at 3D points under another placement, through the shipped field and its seed shift: the points
+    (x, 0, y + z) give q = (x, y + z)."""
     if placement == "wall":
-        return harmonic_field(pts, h)
+        return harmonic_field(pts, h, seed)
     floor = np.stack([pts[:, 0], np.zeros(len(pts)), pts[:, 1] + pts[:, 2]], 1)
     if placement == "floor":
-        return harmonic_field(floor, h)
+        return harmonic_field(floor, h, seed)
     fx, fy = np.abs(h.freq[:, 0]), np.abs(h.freq[:, 1])
     a, b = fx <= fy, fx > fy      # "wall" leaves fx in the profile, "floor" fy
     out = np.zeros((len(pts), 3), np.float32)
     for sel, p in ((a, pts), (b, floor)):
         if sel.any():
-            out += harmonic_field(p, Harmonics(h.freq[sel], h.amp[sel], h.share))
+            out += harmonic_field(p, Harmonics(h.freq[sel], h.amp[sel], h.share), seed)
     return out
 
 
@@ -79,7 +80,8 @@ def main(argv=None) -> int:
             code = model.translate(z, h)
             return pe.patch_swd([slice_image(model, code, ax, s) for ax in "xyz" for s in range(2)], photo)
 
-        r = dict(model=swd(None), random_phase=pe.patch_swd([pe.random_phase(photo, SIZE, rng) for _ in range(2)], photo))
+        rp = [pe.random_phase(photo, SIZE, rng) for _ in range(2)]
+        r = dict(model=swd(None), random_phase=pe.patch_swd(rp, photo))
         for p, w in SETTINGS:
             h = photo_harmonics(photo, model.px_per_unit, prominence=p, window=w)
             r[f"{p:g}/{w}"] = swd(h) if len(h) else r["model"]
@@ -95,7 +97,7 @@ def main(argv=None) -> int:
                 pts = slice_points(model, ax)
                 for s in range(2):
                     rgb = model.evaluate(pts, code, s)
-                    imgs.append(np.clip(mu + h.keep * (rgb - mu) + placed(h, pts, placement), 0, 1)
+                    imgs.append(np.clip(mu + h.keep * (rgb - mu) + placed(h, pts, placement, s), 0, 1)
                                 .reshape(SIZE, SIZE, 3))
             r[placement] = pe.patch_swd(imgs, photo)
         rows[os.path.basename(path)] = {k: round(float(v), 1) for k, v in r.items()}

@@ -18,20 +18,25 @@ jump at the border adds no cross of false peaks), one of each conjugate pair, at
 photo, with at least ``FLOOR`` of the luminance's power, and at least ``PROMINENCE`` times the mean power around
 them (the ring between the 3 x 3 core and the (2 ``WINDOW`` + 1)^2 square).  Only a peak that stands alone
 counts: a period repeats, so its power collects in one bin; an aperiodic line or edge spreads over a ridge, and
-the spectrum of grass, sand or rock is smooth.  At most ``COUNT`` peaks, the strongest first.  ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
-split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
-39 structured photos more than 5 % closer and 2 farther, and 4 and 2 of 75 others; 4 made 23 closer but 17 others
+the spectrum of grass, sand or rock is smooth.  JPEG's 8 x 8 blocks draw peaks of their own, at whole multiples
+of 1/8 cycle per pixel; there a peak counts only as a harmonic of a peak elsewhere.  At most ``COUNT`` peaks,
+the strongest first.  ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training split
+(``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of 39
+structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10 others
 farther (stripes from chance peaks).
 
 Placement: on 2D points (2D models) q = p, the photo's plane (row 0 at the top as ``model.plane_points``).  On 3D
 points the photo stands upright and is extruded along the horizontal diagonal (1, -1, 0): q(x, y, z) = (x + y, z),
 so every vertical plane normal to x or to y (a wall seen from the front or from the side, and the 2D image of a 3D
 model, ``model.image``'s front view) shows the harmonic part unchanged, courses level and planks upright at the
-photo's pitch, and a horizontal cut shows it in profile (brick courses vanish there, as in a brick wall; plank
-seams become lines).  A plane wave keeps its frequency on every plane whose section it is, so the texture stays
-one solid.  The other ways to stand the photo up were measured on the training split and were worse (the photo
-on floors and on faces normal to y: median patch distance of the structured training photos 148.5 against
-134.4; ``bench/eval_solid_harmonic.py``).
+photo's pitch, and a horizontal cut shows it in profile (a brick wall's cut takes one course's colour, as a real
+one does; plank seams become lines).  A plane wave keeps its frequency on every plane whose section it is, so
+the texture stays one solid.  This is the placement for scenes with z up (a building's walls face x or y in
+object coordinates); it is not the one the pooled slice evaluation prefers: standing the photo on planes normal
+to z and to y instead (floors exact, faces normal to x in profile) scored 127.7 against 138.8 on the structured
+training photos (``bench/eval_solid_harmonic.py``), because pooled slices ask horizontal cuts to look like the
+photo too, and there a brick wall's cut lies within one course.  It would put diagonal stripes on every wall
+facing x.
 
 Shapes: photos float (H, W, 3) sRGB in [0, 1]; points float (N, 2) or (N, 3) in texture units; fields float32
 (N, 3).  Phases are computed in float64 (at |x| ~ 64 units and f ~ 60 cycles per unit the argument reaches
@@ -84,6 +89,25 @@ def _box(P: np.ndarray, r: int) -> np.ndarray:
     return P
 
 
+def _without_jpeg_grid(idx: np.ndarray, kx: np.ndarray, ky: np.ndarray, H: int, W: int) -> np.ndarray:
+    """``idx`` less the peaks on JPEG's block lattice (whole multiples of 1/8 cycle per pixel on both axes: the
+    edges of its 8 x 8 blocks) that are not harmonics of a peak off it: a brick course of 16 px keeps its second
+    harmonic at 1/8 cycle per pixel, a grid that only the compression drew is dropped."""
+    if H % 8 or W % 8:
+        return idx
+    fx, fy = kx[idx].astype(np.int64), ky[idx].astype(np.int64)
+    grid = (fx % (W // 8) == 0) & (fy % (H // 8) == 0)
+    if not grid.any():
+        return idx
+    gx, gy = fx[~grid], fy[~grid]
+    keep = ~grid
+    for i in np.flatnonzero(grid):
+        collinear = fx[i] * gy - fy[i] * gx == 0
+        dot, norm = fx[i] * gx + fy[i] * gy, gx * gx + gy * gy
+        keep[i] = bool(np.any(collinear & (np.abs(dot) >= 2 * norm) & (dot % np.maximum(norm, 1) == 0)))
+    return idx[keep]
+
+
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
                     window: int = WINDOW, min_cycles: int = MIN_CYCLES) -> Harmonics:
     """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc);
@@ -104,7 +128,8 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     far = np.hypot(kx / W, ky / H) * min(H, W) >= min_cycles
     ok = peak & half & far & (P >= prominence * ring / max(n, 1)) & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
     idx = np.flatnonzero(ok.ravel())
-    idx = idx[np.argsort(-P.ravel()[idx], kind="stable")][:count]
+    idx = idx[np.argsort(-P.ravel()[idx], kind="stable")]
+    idx = _without_jpeg_grid(idx, kx.ravel(), ky.ravel(), H, W)[:count]
     Fc = F.reshape(3, -1)[:, idx].T                                                    # (K, 3)
     total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
     share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0

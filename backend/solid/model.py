@@ -76,7 +76,8 @@ class TextureCode:
     for photo models (``colour_model`` "affine") also the exemplar's colour: mean ``mu`` float32 (3,) and the
     Cholesky factor ``L`` float32 (3, 3) of its colour covariance (rgb = mu + L d); for spectral models the
     per-octave ``gains`` float32 (m,) measured from the exemplar (:func:`spectral_gains`); for a photo a space model
-    encoded, its ``harmonics`` (:mod:`backend.solid.harmonic`: the periodic part added to the decoder's)."""
+    encoded, or a single photo model that stores one, the photo's ``harmonics`` (:mod:`backend.solid.harmonic`:
+    the periodic part added to the decoder's)."""
     e: np.ndarray
     T: np.ndarray
     mu: np.ndarray | None = None
@@ -324,8 +325,8 @@ class SolidTextureModel:
                 if h is None:
                     d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
                 else:   # rgb = mu + k L d + h(x) (harmonic.py)
-                    d = np.clip(code.mu + _F(h.keep) * (d @ np.asarray(code.L, _F).T) + harmonic_field(pts[a:b], h, seed),
-                                0.0, 1.0)
+                    hx = harmonic_field(pts[a:b], h, seed)
+                    d = np.clip(code.mu + _F(h.keep) * (d @ np.asarray(code.L, _F).T) + hx, 0.0, 1.0)
             out[a:b] = d
             if progress is not None:
                 progress(b / N)

@@ -223,7 +223,39 @@ def test_a_single_photo_model_stores_its_harmonic_part(tmp_path):
     assert r_with > 0.5 and r_without < 0.3
     shutil.copytree(os.path.join(ROOT, "tests", "data", "tiny_solid", "single3"), tmp_path / "tiny")
     doc = json.loads((tmp_path / "tiny" / "solid.json").read_text())
-    doc["harmonics"] = json.loads((open(os.path.join(ROOT, "models", "solid", "brick_3d", "solid.json")).read()))["harmonics"]
+    with open(os.path.join(ROOT, "models", "solid", "brick_3d", "solid.json"), encoding="utf-8") as f:
+        doc["harmonics"] = json.load(f)["harmonics"]
     (tmp_path / "tiny" / "solid.json").write_text(json.dumps(doc))
     with pytest.raises(ModelError, match="only single photo models"):
         SolidTextureModel(str(tmp_path / "tiny"))
+
+
+def jpeg(img: np.ndarray, quality: int) -> np.ndarray:
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray((np.clip(img, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="JPEG", quality=quality)
+    return np.asarray(Image.open(io.BytesIO(buf.getvalue())).convert("RGB"), np.float64) / 255.0
+
+
+def on_block_grid(h, H, W):
+    k = np.round(np.abs(h.freq) * np.array([W, H]) / PPU).astype(int)
+    return [tuple(x) for x in k if x[0] % (W // 8) == 0 and x[1] % (H // 8) == 0]
+
+
+def test_jpeg_blocks_draw_no_grid_but_a_period_keeps_its_harmonics(monkeypatch):
+    """A held-out photo whose only isolated peaks are its JPEG blocks' (multiples of 1/8 cycle per pixel) gets no
+    harmonic part; compressed bricks keep the harmonics of their courses and joints on that lattice."""
+    import backend.solid.harmonic as hm
+    from export import read_rgb
+
+    blocky = read_rgb(os.path.join(ROOT, "data", "photos", "val", "sand__desert_city_tile.jpg"))
+    with monkeypatch.context() as m:
+        m.setattr(hm, "_without_jpeg_grid", lambda idx, *a: idx)
+        assert len(on_block_grid(hm.photo_harmonics(blocky, PPU), 256, 256)) >= 2   # the compression's peaks ...
+    assert len(photo_harmonics(blocky, PPU)) == 0                                      # ... are dropped
+    bricks = jpeg(brick_photo(256, 256), 30)                                           # courses 16 px, bricks 32
+    kept = on_block_grid(photo_harmonics(bricks, PPU), 256, 256)
+    assert (0, 32) in kept and (32, 0) in kept                                         # their 2nd harmonics
