@@ -39,8 +39,8 @@ photo too, and there a brick wall's cut lies within one course.  It would put di
 facing x.
 
 Shapes: photos float (H, W, 3) sRGB in [0, 1]; points float (N, 2) or (N, 3) in texture units; fields float32
-(N, 3).  Phases are computed in float64 (at |x| ~ 64 units and f ~ 60 cycles per unit the argument reaches
-~2.4e4 rad, where float32 would lose ~2e-3 rad).
+(N, 3).  Phases are computed in float64 and reduced modulo one cycle before the float32 cosines (at |x| ~ 64 units
+and f ~ 60 cycles per unit the argument reaches ~2.4e4 rad, where float32 would lose ~2e-3 rad).
 """
 from __future__ import annotations
 
@@ -157,8 +157,9 @@ def harmonic_field(points: np.ndarray, h: Harmonics, seed: int = 0) -> np.ndarra
     if len(h) == 0:
         return np.zeros((x.shape[0], 3), np.float32)
     q = (x if x.shape[1] == 2 else np.stack([x[:, 0] + x[:, 1], x[:, 2]], axis=1)) + seed_shift(seed)
-    t = 2.0 * np.pi * (q @ h.freq.T)                                                   # (N, K)
-    return (np.cos(t) @ h.amp.real - np.sin(t) @ h.amp.imag).astype(np.float32)
+    c = q @ h.freq.T                                                                   # (N, K) cycles, float64
+    t = ((c - np.floor(c)) * (2.0 * np.pi)).astype(np.float32)   # the phase mod 2 pi, then float32 trigonometry
+    return np.cos(t) @ h.amp.real.astype(np.float32) - np.sin(t) @ h.amp.imag.astype(np.float32)
 
 
 def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmonics | None:
