@@ -359,8 +359,9 @@ class SolidSource:
                  density=self.density)
         if self.to is not None:
             d.update(to=self.to, mix=self.mix)
-        if not self.periodic:
-            d.update(periodic=False)
+        h = getattr(self.code, "harmonics", None)     # the harmonic part in use (an encoded photo's, a stored one)
+        d["harmonics_sha256"] = None if h is None else hashlib.sha256(
+            np.concatenate([h.freq.ravel(), h.amp.real.ravel(), h.amp.imag.ravel()]).astype("<f8").tobytes()).hexdigest()
         return d
 
 

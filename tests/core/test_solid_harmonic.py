@@ -259,3 +259,16 @@ def test_jpeg_blocks_draw_no_grid_but_a_period_keeps_its_harmonics(monkeypatch):
     bricks = jpeg(brick_photo(256, 256), 30)                                           # courses 16 px, bricks 32
     kept = on_block_grid(photo_harmonics(bricks, PPU), 256, 256)
     assert (0, 32) in kept and (32, 0) in kept                                         # their 2nd harmonics
+
+
+def test_bake_keys_know_the_harmonic_part(space):
+    """A bake is up to date only for the same harmonic part: an encoded photo with and without it, and a single
+    model that stores one, give keys that say so."""
+    from backend.sources import SolidSource
+
+    on = SolidSource(space, exemplar=BRICK).to_dict()
+    off = SolidSource(space, exemplar=BRICK, periodic=False).to_dict()
+    assert on["harmonics_sha256"] is not None and off["harmonics_sha256"] is None
+    assert on != off
+    brick3d = SolidSource(os.path.join(ROOT, "models", "solid", "brick_3d")).to_dict()
+    assert brick3d["harmonics_sha256"] is not None
