@@ -691,6 +691,9 @@ def run_solid(a: argparse.Namespace) -> int:
             print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
 
     code, _ = req.code(model, "--", _Bar(a.quiet, "refine "), report)
+    if code.harmonics is not None and not a.quiet:
+        print(f"periodic part: {len(code.harmonics)} spectral peaks, {100 * code.harmonics.share:.0f} % of the "
+              "photo's variance (--no-periodic leaves it out)", file=sys.stderr)
     bar = _Bar(a.quiet)
     from backend.colour import srgb_to_linear
 
