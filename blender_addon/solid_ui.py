@@ -116,6 +116,8 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     size: IntProperty(name="Image Size", default=1024, min=8, soft_max=8192)
     margin: IntProperty(name="Margin", default=4, min=0, max=64, description="Texels padded past each UV island")
     voxels: IntProperty(name="Voxels", default=128, min=4, soft_max=512, description="Voxels along the longest side")
+    periodic_info: StringProperty(name="Periodic Part Found", default="", options={"SKIP_SAVE"},
+                                  description="What the last preview measured of the image's periodic part")
     name: StringProperty(name="Name", default="Solid Texture")
     folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise_bakes",
                            description="Where volumes are written ('//' = beside the .blend)")
@@ -162,6 +164,14 @@ def texture(p):
     req = panel_request(p)
     m = load_model(os.path.basename(req.model))
     return m, lambda: req.code(m)[0]
+
+
+def periodic_info(code) -> str:
+    """A line for the panel: the harmonic part a code carries (backend/solid/harmonic.py), or that there is none."""
+    h = getattr(code, "harmonics", None)
+    if h is None:
+        return "Periodic part: none found"
+    return f"Periodic part: {len(h)} peaks, {100 * h.share:.0f} % of the variance"
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:
@@ -258,10 +268,13 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         def work(progress, cancel):
             code = code_fn()
             progress(0.2)
-            return m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
+            img = m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
+            return img, periodic_info(code)
 
-        def done(img):
+        def done(result):
+            img, info = result
             _store_image(name, np.flipud(img)).preview_ensure()
+            p.periodic_info = info
 
         return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
 
@@ -381,6 +394,8 @@ def draw_solid(layout, context) -> None:
         layout.template_ID(p, "image", open="image.open")
         layout.prop(p, "refine")
         layout.prop(p, "periodic")
+        if p.periodic and p.periodic_info:
+            layout.label(text=p.periodic_info)
     prev = bpy.data.images.get(f"{p.name} Preview")
     if prev is not None and prev.preview is not None:
         layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)

@@ -14,6 +14,7 @@ from backend.solid.bake import srgb_to_linear  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
 
 SHIPPED = solid_ui.MODELS_DIR
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -164,6 +165,29 @@ def test_image_source_is_encoded_by_the_space_model(scene):
     code = m.translate(m.encode(np.flipud(np.round(rgba[..., :3] * 255) / 255)))
     ref = np.flipud(m.image(128, code, seed=3))
     assert np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
+    assert p.periodic_info == "Periodic part: none found"      # random pixels have no period
+
+
+def test_the_preview_shows_the_periodic_part_it_found(scene):
+    """A brick photo's courses and joints (backend/solid/harmonic.py): the preview shows them, the panel says how
+    much of the photo they carry, and the Periodic Part box leaves them out."""
+    from export.images import read_rgb
+
+    path = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+    p = scene.omninoise_solid
+    p.source, p.image, p.seed = "IMAGE", bpy.data.images.load(path), 0
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    assert p.periodic_info == "Periodic part: 32 peaks, 83 % of the variance"
+    log = []
+    solid_ui.draw_solid(Recorder(log), bpy.context)
+    assert ("label", None, p.periodic_info) in [(n, None, t) for n, a, t in log]
+    lum = read_rgb(path)[:128, :128].mean(2).ravel()
+    with_part = np.flipud(_pixels("Solid Texture Preview")).mean(2).ravel()
+    p.periodic = False
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    without = np.flipud(_pixels("Solid Texture Preview")).mean(2).ravel()
+    assert np.corrcoef(with_part, lum)[0, 1] > 0.5 > 0.2 > abs(np.corrcoef(without, lum)[0, 1])
+    p.periodic = True
 
 
 def test_errors_are_reported(scene):
