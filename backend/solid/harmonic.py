@@ -19,11 +19,13 @@ photo, with at least ``FLOOR`` of the luminance's power, and at least ``PROMINEN
 them (the ring between the 3 x 3 core and the (2 ``WINDOW`` + 1)^2 square).  Only a peak that stands alone
 counts: a period repeats, so its power collects in one bin; an aperiodic line or edge spreads over a ridge, and
 the spectrum of grass, sand or rock is smooth.  JPEG's 8 x 8 blocks draw peaks of their own, at whole multiples
-of 1/8 cycle per pixel; there a peak counts only as a harmonic of a peak elsewhere.  At most ``COUNT`` peaks,
-the strongest first.  ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training split
-(``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of 39
-structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10 others
-farther (stripes from chance peaks).
+of 1/8 cycle per pixel; there a peak counts only as a harmonic of a peak elsewhere.  The price: a pattern whose
+own period divides 8 px along both of the photo's axes (stripes exactly 8 or 4 px apart, square to the photo) is
+taken for compression and left to the decoder; a period of 16 px or one a little off 8 keeps its peaks (tested).
+At most ``COUNT`` peaks, the strongest first.  ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
+split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
+39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
+others farther (stripes from chance peaks).
 
 Placement: on 2D points (2D models) q = p, the photo's plane (row 0 at the top as ``model.plane_points``).  On 3D
 points the photo stands upright and is extruded along the horizontal diagonal (1, -1, 0): q(x, y, z) = (x + y, z),

@@ -272,3 +272,17 @@ def test_bake_keys_know_the_harmonic_part(space):
     assert on != off
     brick3d = SolidSource(os.path.join(ROOT, "models", "solid", "brick_3d")).to_dict()
     assert brick3d["harmonics_sha256"] is not None
+
+
+def test_the_price_of_the_jpeg_rule_stripes_exactly_8_px_apart():
+    """The documented limit: stripes whose period divides 8 px (on the compression's lattice) get no harmonic
+    part; 16 px, or 30 stripes across 256 px (8.53 px), keep theirs."""
+    c = np.arange(256)[None, :].repeat(256, 0).astype(np.float64)
+
+    def stripes(cycles):
+        img = 0.5 + 0.3 * np.cos(2 * np.pi * cycles * c / 256)
+        return np.repeat(img[..., None], 3, axis=2)
+
+    assert len(photo_harmonics(stripes(32), PPU)) == 0          # 8 px
+    assert photo_harmonics(stripes(16), PPU).share > 0.9        # 16 px
+    assert photo_harmonics(stripes(30), PPU).share > 0.9        # 8.53 px
