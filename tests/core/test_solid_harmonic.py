@@ -286,3 +286,18 @@ def test_the_price_of_the_jpeg_rule_stripes_exactly_8_px_apart():
     assert len(photo_harmonics(stripes(32), PPU)) == 0          # 8 px
     assert photo_harmonics(stripes(16), PPU).share > 0.9        # 16 px
     assert photo_harmonics(stripes(30), PPU).share > 0.9        # 8.53 px
+
+
+def test_refinement_renders_with_the_harmonic_part(space):
+    """--refine searches the code as the texture will be drawn: with the photo's harmonic part, never worse than
+    the encoder's code, and the part stays as measured."""
+    from backend.solid.refine import refine_code, texture_code
+    from export import read_rgb
+
+    photo = read_rgb(BRICK)
+    z, h = space.encode(photo), space.harmonics(photo)
+    _, with_h = refine_code(space, z, photo, steps=3, harmonics=h)
+    _, without = refine_code(space, z, photo, steps=3)
+    assert with_h[0] != without[0] and with_h[-1] <= with_h[0]
+    code, _ = texture_code(space, BRICK, refine=2)
+    assert code.harmonics is not None and np.array_equal(code.harmonics.freq, h.freq)
