@@ -330,7 +330,7 @@ class SolidSource:
             self.code = code
             parts = [np.ravel(code.e), np.ravel(code.T)]
             if code.harmonics is not None:
-                parts += [code.harmonics.freq.ravel(), code.harmonics.amp.real.ravel(), code.harmonics.amp.imag.ravel()]
+                parts.append(code.harmonics.values())
             self.input_sha256 = hashlib.sha256(np.concatenate(parts).astype(np.float32).tobytes()).hexdigest()
             return
         from .solid.request import SolidRequest
@@ -359,9 +359,8 @@ class SolidSource:
                  density=self.density)
         if self.to is not None:
             d.update(to=self.to, mix=self.mix)
-        h = getattr(self.code, "harmonics", None)     # the harmonic part in use (an encoded photo's, a stored one)
-        d["harmonics_sha256"] = None if h is None else hashlib.sha256(
-            np.concatenate([h.freq.ravel(), h.amp.real.ravel(), h.amp.imag.ravel()]).astype("<f8").tobytes()).hexdigest()
+        h = self.code.harmonics     # the harmonic part in use (an encoded photo's, a stored one)
+        d["harmonics_sha256"] = None if h is None else hashlib.sha256(h.values().astype("<f8").tobytes()).hexdigest()
         return d
 
 

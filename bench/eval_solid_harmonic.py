@@ -28,7 +28,7 @@ sys.path.insert(0, ROOT)
 import numpy as np  # noqa: E402
 
 from backend.solid.harmonic import Harmonics, harmonic_field, photo_harmonics  # noqa: E402
-from backend.solid.model import SolidTextureModel, plane_points  # noqa: E402
+from backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
 from bench.eval_solid_photos import SIZE, photos, read, slice_image  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
@@ -53,14 +53,6 @@ def placed(h: Harmonics, pts: np.ndarray, placement: str, seed: int) -> np.ndarr
         if sel.any():
             out += harmonic_field(p, Harmonics(h.freq[sel], h.amp[sel], h.share), seed)
     return out
-
-
-def slice_points(model, axis: str) -> np.ndarray:
-    plane = plane_points(SIZE, model.px_per_unit)
-    i, j = {"z": (0, 1), "y": (0, 2), "x": (1, 2)}[axis]
-    pts = np.zeros((plane.shape[0], 3))
-    pts[:, i], pts[:, j] = plane[:, 0], plane[:, 1]
-    return pts + np.asarray(pe.SLICE_OFFSETS[axis])
 
 
 def main(argv=None) -> int:
@@ -94,7 +86,7 @@ def main(argv=None) -> int:
                 continue
             imgs = []
             for ax in "xyz":
-                pts = slice_points(model, ax)
+                pts = slice_points(SIZE, model.px_per_unit, ax, pe.SLICE_OFFSETS[ax])
                 for s in range(2):
                     rgb = model.evaluate(pts, code, s)
                     imgs.append(np.clip(mu + h.keep * (rgb - mu) + placed(h, pts, placement, s), 0, 1)

@@ -101,7 +101,7 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     periodic: BoolProperty(name="Periodic Part", default=True,
                            description="Keep the image's periodic part (brick courses, plank seams, weaves: its "
                                        "isolated spectral peaks) on top of the model's texture; upright on faces "
-                                       "normal to Y and on floors, in profile on faces normal to X")
+                                       "normal to X and to Y, in profile on floors")
     scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
                          description="Texture units per Blender unit: larger means smaller features")
     seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
@@ -168,7 +168,7 @@ def texture(p):
 
 def periodic_info(code) -> str:
     """A line for the panel: the harmonic part a code carries (backend/solid/harmonic.py), or that there is none."""
-    h = getattr(code, "harmonics", None)
+    h = code.harmonics
     if h is None:
         return "Periodic part: none found"
     return f"Periodic part: {len(h)} peaks, {100 * h.share:.0f} % of the variance"

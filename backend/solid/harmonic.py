@@ -79,6 +79,11 @@ class Harmonics:
     def __len__(self) -> int:
         return int(self.freq.shape[0])
 
+    def values(self) -> np.ndarray:
+        """Every number of the part, float64 (5 K,): frequencies, then the real and imaginary amplitudes (what bake
+        keys digest)."""
+        return np.concatenate([self.freq.ravel(), self.amp.real.ravel(), self.amp.imag.ravel()])
+
 
 def _box(P: np.ndarray, r: int) -> np.ndarray:
     """Sums of P (H, W) over the (2 r + 1)^2 squares around each bin, the spectrum wrapping round (cumulative

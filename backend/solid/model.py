@@ -32,7 +32,7 @@ from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics
 from .lattice import lattice_noise
 from .waves import wave_features
 
-__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points"]
+__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
@@ -46,6 +46,26 @@ def plane_points(size: int, px_per_unit: float) -> np.ndarray:
     u = (np.arange(size, dtype=np.float64) + 0.5) / px_per_unit
     vv, uu = np.meshgrid(u, u, indexing="ij")
     return np.stack([uu.ravel(), -vv.ravel()], axis=1)
+
+
+def slice_points(size: int, px_per_unit: float, axis: str, offset=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Pixel centres of a size x size image of the plane through ``offset`` normal to ``axis`` ("y": x to the right
+    and z up; "z": x right, y up; "x": y right, z up), row 0 at the top: float64 (size*size, 3) in units."""
+    plane = plane_points(size, px_per_unit)
+    a, b = {"z": (0, 1), "y": (0, 2), "x": (1, 2)}[axis]
+    pts = np.zeros((plane.shape[0], 3))
+    pts[:, a], pts[:, b] = plane[:, 0], plane[:, 1]
+    return pts + np.asarray(offset, np.float64)
+
+
+def _rgb(image) -> np.ndarray:
+    """An exemplar image (H, W), (H, W, 3) or (H, W, 4) as float32 (H, W, 3); SettingError for other shapes."""
+    img = np.asarray(image, _F)
+    if img.ndim == 2:
+        img = np.repeat(img[..., None], 3, axis=2)
+    if img.ndim != 3 or img.shape[2] not in (3, 4):
+        raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
+    return img[..., :3]
 
 
 def load_models(root: str = SHIPPED_MODELS, threads: int = 0, cache: dict | None = None) -> dict:
@@ -205,12 +225,7 @@ class SolidTextureModel:
         if self.mode != "space":
             raise SettingError("exemplar", f"model {self.name!r} was fitted to one exemplar and cannot encode images; "
                                            "use a space model")
-        img = np.asarray(image, _F)
-        if img.ndim == 2:
-            img = np.repeat(img[..., None], 3, axis=2)
-        if img.ndim != 3 or img.shape[2] not in (3, 4):
-            raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
-        img = img[..., :3]
+        img = _rgb(image)
         S = int(self.config.get("encoder_size", 128))
         scale = float(self.config.get("exemplar_scale", 1.0))
         if scale != 1.0:        # the encoder saw exemplars resampled by this factor in training
@@ -237,10 +252,8 @@ class SolidTextureModel:
         :meth:`translate`; None for models without the photo's colour (the part is added in its colour frame)."""
         if not self.colour_stats:
             return None
-        img = np.asarray(image, _F)
-        if img.ndim == 2:
-            img = np.repeat(img[..., None], 3, axis=2)
-        img, ppu, W = img[..., :3], self.px_per_unit, img.shape[1]
+        img = _rgb(image)
+        ppu, W = self.px_per_unit, img.shape[1]
         f = HARMONIC_SIDE / max(img.shape[:2])
         if f < 1.0:     # a large photo is measured at most HARMONIC_SIDE px wide, at its scale in texture units
             img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
@@ -339,12 +352,8 @@ class SolidTextureModel:
         view (x to the right, z up), where models trained with ``fixed_axis`` "rows" and an encoded photo's
         harmonic part (harmonic.py) show the photo upright; "z" looks down (x right, y up), "x" from the side
         (y right, z up)."""
-        plane = plane_points(size, self.px_per_unit * scale)
         if self.dim == 2:
-            pts = plane + np.asarray(offset[:2], np.float64)
+            pts = plane_points(size, self.px_per_unit * scale) + np.asarray(offset[:2], np.float64)
         else:
-            a, b = {"z": (0, 1), "y": (0, 2), "x": (1, 2)}[axis]
-            pts = np.zeros((plane.shape[0], 3))
-            pts[:, a], pts[:, b] = plane[:, 0], plane[:, 1]
-            pts += np.asarray(offset, np.float64)
+            pts = slice_points(size, self.px_per_unit * scale, axis, offset)
         return self.evaluate(pts, code, seed, **kw).reshape(size, size, 3)
