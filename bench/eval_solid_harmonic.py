@@ -61,6 +61,9 @@ def main(argv=None) -> int:
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_harmonic.json"))
     a = ap.parse_args(argv)
     model = SolidTextureModel(a.model)
+    if model.harmonic_rest:
+        ap.error(f"{a.model} was trained on photos' rests: its code depends on the part, and this bench encodes each "
+                 "photo once for every peak test (use a model trained on whole photos)")
     files = [f for i, f in enumerate(photos("train"))
              if os.path.basename(f).startswith(STRUCTURED) or i % 6 == 0]
     rows, t0 = {}, time.time()

@@ -52,7 +52,7 @@ import numpy as np
 
 from ..periodic import periodic_component
 
-__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "seed_shift", "mix_harmonics", "to_json", "from_json",
+__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "remove_harmonics", "seed_shift", "mix_harmonics", "to_json", "from_json",
            "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES"]
 
 COUNT = 32          #: at most this many peaks
@@ -146,6 +146,21 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     amp = (2.0 / (H * W)) * Fc * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]
     freq = np.stack([px_per_unit * fx / W, -px_per_unit * fy / H], axis=1)
     return Harmonics(freq.astype(np.float64), amp.astype(np.complex128), min(share, 0.999))
+
+
+def remove_harmonics(img: np.ndarray, h: Harmonics, px_per_unit: float) -> np.ndarray:
+    """The photo's indeterministic rest: img float (H, W, 3) less its harmonic part h (as :func:`photo_harmonics`
+    measured it from this photo at ``px_per_unit``) at its pixel centres p = ((c + 1/2) / u, -(r + 1/2) / u),
+    clipped to [0, 1]: float32 (H, W, 3).  A model trained on photos' rests (``harmonic_rest`` in its solid.json)
+    encodes this, and its decoder draws only what the part does not (module doc)."""
+    a = np.asarray(img, np.float32)[..., :3]
+    if len(h) == 0:
+        return np.clip(a, 0.0, 1.0)
+    H, W, _ = a.shape
+    u = float(px_per_unit)
+    rr, cc = np.meshgrid(np.arange(H, dtype=np.float64), np.arange(W, dtype=np.float64), indexing="ij")
+    pts = np.stack([(cc.ravel() + 0.5) / u, -(rr.ravel() + 0.5) / u], axis=1)
+    return np.clip(a - harmonic_field(pts, h).reshape(H, W, 3), 0.0, 1.0)
 
 
 def seed_shift(seed: int) -> np.ndarray:

@@ -28,7 +28,7 @@ from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
 from .brick import brick_features
 from .cellular import cellular_features
-from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics
+from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
 from .lattice import lattice_noise
 from .waves import wave_features
 
@@ -193,6 +193,11 @@ class SolidTextureModel:
                 self.stored_harmonics = from_json(c["harmonics"])
             except ValueError as exc:
                 raise ModelError(f"model {self.name!r}: {exc}") from None
+        #: a space model trained on its photos' rests (photo less harmonic part): it encodes a photo's rest when
+        #: the photo's part rides along, and draws it at the rest's own colour covariance (k = 1, harmonic.py)
+        self.harmonic_rest = bool(c.get("harmonic_rest", False))
+        if self.harmonic_rest and (self.mode != "space" or not self.colour_stats):
+            raise ModelError(f"model {self.name!r} was trained on harmonic rests, which only space photo models can")
         self.z_dim = int(c.get("z_dim", 8))
         if self.mode == "single" and self.colour_stats and len(c.get("colour_code", ())) != self.colour_stats:
             raise ModelError(f"model {self.name!r} draws in its exemplar's colours but its solid.json has no "
@@ -216,16 +221,20 @@ class SolidTextureModel:
                                harmonics=self.stored_harmonics)
         return self.translate(next(iter(self.codes.values())))
 
-    def encode(self, image: np.ndarray) -> np.ndarray:
+    def encode(self, image: np.ndarray, harmonics: Harmonics | None = None) -> np.ndarray:
         """Space mode, Sec. 3 encoder g: image float (H, W, 3) or (H, W) in [0, 1] -> z float32 (z_dim,).
 
         The mean code of overlapping 128 px crops (the image is first resized
-        so its short side is at least 128 px, keeping pixels per unit).
+        so its short side is at least 128 px, keeping pixels per unit).  A model trained on rests
+        (``harmonic_rest``) given the image's ``harmonics`` (:meth:`harmonics`) encodes the image less them,
+        as it saw its training photos; other models ignore them.
         """
         if self.mode != "space":
             raise SettingError("exemplar", f"model {self.name!r} was fitted to one exemplar and cannot encode images; "
                                            "use a space model")
         img = _rgb(image)
+        if self.harmonic_rest and harmonics is not None and len(harmonics):
+            img = remove_harmonics(img, harmonics, self.px_per_unit)
         S = int(self.config.get("encoder_size", 128))
         scale = float(self.config.get("exemplar_scale", 1.0))
         if scale != 1.0:        # the encoder saw exemplars resampled by this factor in training
@@ -337,9 +346,10 @@ class SolidTextureModel:
                 h = code.harmonics
                 if h is None:
                     d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
-                else:   # rgb = mu + k L d + h(x) (harmonic.py)
+                else:   # rgb = mu + k L d + h(x) (harmonic.py); a rest model's L is already the rest's: k = 1
                     hx = harmonic_field(pts[a:b], h, seed)
-                    d = np.clip(code.mu + _F(h.keep) * (d @ np.asarray(code.L, _F).T) + hx, 0.0, 1.0)
+                    k = _F(1.0 if self.harmonic_rest else h.keep)
+                    d = np.clip(code.mu + k * (d @ np.asarray(code.L, _F).T) + hx, 0.0, 1.0)
             out[a:b] = d
             if progress is not None:
                 progress(b / N)

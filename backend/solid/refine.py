@@ -132,8 +132,8 @@ def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setti
 
 def _encoded(model, img: np.ndarray, refine: int, progress, periodic: bool):
     """:func:`exemplar_z` of pixels: encode, measure the harmonic part, refine with it."""
-    z, hist = model.encode(img), []
     h = model.harmonics(img) if periodic else None
+    z, hist = model.encode(img, h), []
     if refine > 0:
         z, hist = refine_code(model, z, img, steps=refine, progress=progress, harmonics=h)
     return z, img, hist, h

@@ -301,3 +301,68 @@ def test_refinement_renders_with_the_harmonic_part(space):
     assert with_h[0] != without[0] and with_h[-1] <= with_h[0]
     code, _ = texture_code(space, BRICK, refine=2)
     assert code.harmonics is not None and np.array_equal(code.harmonics.freq, h.freq)
+
+
+def test_the_rest_of_a_photo_keeps_no_period():
+    """remove_harmonics: the photo less its part, at its pixel centres; what is left keeps under 5 % of the power
+    of every peak the part took, its mean is the photo's, and a photo without a part comes back as it was (clipped
+    to [0, 1])."""
+    from backend.solid.harmonic import remove_harmonics
+
+    img = brick_photo()
+    h = photo_harmonics(img, PPU)
+    rest = remove_harmonics(img, h, PPU)
+    assert rest.shape == img.shape and rest.dtype == np.float32 and rest.min() >= 0.0 and rest.max() <= 1.0
+    assert h.share > 0.5
+
+    def power(a):
+        return np.abs(np.fft.fft2(a.mean(2) - a.mean())) ** 2
+
+    H, W, _ = img.shape
+    kx = np.round(h.freq[:, 0] * W / PPU).astype(int) % W
+    ky = np.round(-h.freq[:, 1] * H / PPU).astype(int) % H
+    assert np.all(power(rest)[ky, kx] < 0.05 * power(img)[ky, kx])
+    assert np.abs(rest.mean((0, 1)) - img.mean((0, 1))).max() < 0.01
+    # the part is removed where it was measured: pixel centres in the photo's frame, not a shifted grid
+    assert rest.var((0, 1)).sum() < 0.5 * img.var((0, 1)).sum()
+    none = Harmonics(np.zeros((0, 2)), np.zeros((0, 3), complex), 0.0)
+    np.testing.assert_array_equal(remove_harmonics(img * 1.5, none, PPU), np.clip(img * 1.5, 0, 1).astype(np.float32))
+
+
+def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spread(tmp_path):
+    """A space model whose solid.json says ``harmonic_rest`` encodes the photo less its part when the part rides
+    along (as training saw its photos) and adds its decoder's part unscaled (k = 1: the code's L is the rest's
+    already); without the part it encodes the photo; a single model with the flag is refused by name."""
+    import json
+    import shutil
+    from dataclasses import replace
+
+    from backend.onnx_models import ModelError
+    from backend.solid.harmonic import remove_harmonics
+    from export import read_rgb
+
+    shutil.copytree(SPACE, tmp_path / "rest")
+    doc = json.loads((tmp_path / "rest" / "solid.json").read_text())
+    (tmp_path / "rest" / "solid.json").write_text(json.dumps(dict(doc, harmonic_rest=True)))
+    plain, rest = SolidTextureModel(SPACE), SolidTextureModel(str(tmp_path / "rest"))
+    photo = read_rgb(BRICK)
+    h = rest.harmonics(photo)
+    assert h.share > 0.3
+    np.testing.assert_allclose(rest.encode(photo, h), plain.encode(remove_harmonics(photo, h, PPU)), atol=1e-6)
+    np.testing.assert_array_equal(rest.encode(photo), plain.encode(photo))
+    np.testing.assert_array_equal(plain.encode(photo, h), plain.encode(photo))     # other models ignore the part
+    code = rest.translate(rest.encode(photo, h), h)
+    pts = np.random.default_rng(1).uniform(-2, 2, (4000, 3))
+    d = plain.evaluate(pts, replace(code, harmonics=None), seed=3) - code.mu       # L d where nothing clips
+    field = harmonic_field(pts, h, 3)
+    for model, k in ((rest, 1.0), (plain, h.keep)):
+        got = model.evaluate(pts, code, seed=3) - code.mu - field
+        ok = [(v > 0.01) & (v < 0.99) for v in (code.mu + d, code.mu + k * d + field)]    # where nothing clipped
+        inside = np.all(ok[0] & ok[1], 1)
+        assert inside.mean() > 0.8
+        np.testing.assert_allclose(got[inside], k * d[inside], atol=2e-4)
+    single = json.loads(open(os.path.join(ROOT, "tests", "data", "tiny_solid", "single3", "solid.json")).read())
+    shutil.copytree(os.path.join(ROOT, "tests", "data", "tiny_solid", "single3"), tmp_path / "single")
+    (tmp_path / "single" / "solid.json").write_text(json.dumps(dict(single, harmonic_rest=True)))
+    with pytest.raises(ModelError, match="trained on harmonic rests"):
+        SolidTextureModel(str(tmp_path / "single"))

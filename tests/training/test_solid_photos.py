@@ -467,3 +467,35 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
     assert r["previous"] == r["swd"]          # the "previous" model here is the model itself: the same figures
     assert r["photo_crop"] < r["pixel_shuffle"] and r["photo_crop"] < r["swd"]   # a 2-step model is far from the photo
     assert (tmp_path / "s.png").stat().st_size > 1000
+
+
+def test_harmonic_rest_trains_on_photos_less_their_part_as_the_runtime_encodes_them(tmp_path):
+    """``harmonic_rest``: training crops each photo's rest (its harmonic part removed as the runtime removes it),
+    the export says so, and the exported model encodes a photo's rest when the part rides along; the option
+    needs a space photo model."""
+    from backend.solid.harmonic import photo_harmonics, remove_harmonics
+    from training.solid.train import training_images
+
+    brick = [p for p in ex.photo_set("train") if "brick2b" in p]
+    cfg = dict(name="tiny_rest", mode="space", dim=3, crop=128, batch=2, steps=2, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=brick + ex.photo_set("train")[:1], colour="affine",
+               loss="swd", transform="bounded", swd_width=8, swd_levels=2, harmonic_rest=True)
+    rests = training_images(SolidConfig.from_dict(cfg))
+    fulls = training_images(SolidConfig.from_dict(dict(cfg, harmonic_rest=False)))
+    full = fulls[0].permute(1, 2, 0).numpy()
+    h = photo_harmonics(full, 128.0)
+    assert h.share > 0.5
+    np.testing.assert_allclose(rests[0].permute(1, 2, 0).numpy(), remove_harmonics(full, h, 128.0), atol=1e-6)
+    assert rests[0].var() < 0.6 * fulls[0].var()
+    train(SolidConfig.from_dict(cfg), str(tmp_path / "run"), log=lambda *_: None)
+    doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
+    assert doc["harmonic_rest"] is True
+    rt = SolidTextureModel(str(tmp_path / "m"))
+    photo = ex.load_image(brick[0]).permute(1, 2, 0).numpy()
+    part = rt.harmonics(photo)
+    z = rt.encode(photo, part)
+    np.testing.assert_allclose(z[8:20], colour_stats(remove_harmonics(photo, part, rt.px_per_unit)), atol=1e-5)
+    np.testing.assert_allclose(rt.encode(photo)[8:20], colour_stats(photo), atol=1e-5)
+    for bad in (dict(cfg, mode="single", exemplars=brick), dict(cfg, colour="sigmoid")):
+        with pytest.raises(ValueError, match="harmonic_rest"):
+            SolidConfig.from_dict(bad)

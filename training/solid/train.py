@@ -48,6 +48,7 @@ from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from .waves import photo_waves, wave_share
 from backend.onnx_models import load_model_json
+from backend.solid.harmonic import photo_harmonics, remove_harmonics
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain",
            "snapshot_path"]
@@ -118,6 +119,10 @@ class SolidConfig:
                                     # run's first noise_ramp steps, so the shape features (cellular, bricks) draw
                                     # alone at first and the decoder learns to read them (noise_gain); 0: off.
                                     # Space models: the ramp multiplies the spectral gains
+    harmonic_rest: bool = False     # space photo models: train on each photo less its harmonic part
+                                    # (backend.solid.harmonic.remove_harmonics), so the decoder learns the
+                                    # indeterministic rest the part leaves to it; the export says so (solid.json
+                                    # "harmonic_rest") and the runtime then encodes photos' rests
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -179,6 +184,9 @@ class SolidConfig:
         if cfg.init_stretch and not (cfg.mode == "single" and cfg.fixed_axis):
             raise ValueError("init_stretch scales the transforms along the fixed axis: it needs mode 'single' and "
                              "fixed_axis")
+        if cfg.harmonic_rest and (cfg.mode != "space" or cfg.colour != "affine"):
+            raise ValueError("harmonic_rest trains on photos less their harmonic part, which the runtime adds in the "
+                             "photo's colour frame: it needs mode 'space' and colour 'affine'")
         if cfg.hold_out and cfg.mode != "single":
             raise ValueError("hold_out keeps a quarter of the one exemplar for evaluation: it needs mode 'single' "
                              "(space models hold out whole photos: photos:val)")
@@ -227,10 +235,20 @@ def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
                                            antialias=factor < 1.0, align_corners=False)[0].clamp(0, 1)
 
 
+def harmonic_rest(img: torch.Tensor, px_per_unit: float) -> torch.Tensor:
+    """A photo (3, H, W) less its harmonic part, measured and removed as the runtime does
+    (backend.solid.harmonic: photo_harmonics, remove_harmonics): (3, H, W) in [0, 1]."""
+    a = img.permute(1, 2, 0).numpy()
+    rest = remove_harmonics(a, photo_harmonics(a, px_per_unit), px_per_unit)
+    return torch.from_numpy(rest).permute(2, 0, 1).contiguous()
+
+
 def training_images(cfg: SolidConfig) -> list:
-    """The training regions of the config's exemplars, resampled: list of (3, H, W)."""
-    return [_resample(ex.train_region(ex.exemplar(n), n, cfg.hold_out), cfg.exemplar_scale)
-            for n in ex.expand(cfg.exemplars)]
+    """The training regions of the config's exemplars, resampled (with ``harmonic_rest``: their rests):
+    list of (3, H, W)."""
+    images = [_resample(ex.train_region(ex.exemplar(n), n, cfg.hold_out), cfg.exemplar_scale)
+              for n in ex.expand(cfg.exemplars)]
+    return [harmonic_rest(i, cfg.px_per_unit) for i in images] if cfg.harmonic_rest else images
 
 
 def noise_gain(cfg: SolidConfig, step: int) -> float:
