@@ -11,7 +11,11 @@ Placements (how the photo's plane stands in 3D) are compared under the shipped p
 q = (x + y, z)), ``floor`` (q = (x, y + z): the photo on planes normal to z and to y) and ``each`` (per wave,
 whichever of the two leaves the profile its smaller frequency component).  For these the decoder-only slices are
 recombined here as the model does (mu + k (rgb - mu) + h), with the decoder-only texture's clipping to [0, 1]
-kept; ``wall`` is also reported through the model, to show the difference is small.  The held-out photos
+kept; ``wall`` is also reported through the model, to show the difference is small.
+
+Peak counts: on every training photo where more than ``COUNTS[0]`` peaks pass the shipped test (the cap
+``COUNT`` binds only there), the patch distance of the pooled slices and of the walls (x and y slices) under each
+cap in ``COUNTS`` ("counts" in the JSON).  The held-out photos
 play no part: the constants in ``backend/solid/harmonic.py`` come from this table, and the held-out figures in
 the README from ``bench/eval_solid_photos.py``.
 """
@@ -36,6 +40,7 @@ from training.solid import photo_eval as pe  # noqa: E402
 STRUCTURED = ("brick", "wood", "fabric", "metal", "concrete", "marble", "rust")
 SETTINGS = [(p, w) for w in (3, 5) for p in (4.0, 8.0, 16.0, 32.0)]
 PLACEMENTS = ("wall", "floor", "each")
+COUNTS = (32, 64, 128, 256, 512)
 
 
 def placed(h: Harmonics, pts: np.ndarray, placement: str, seed: int) -> np.ndarray:
@@ -53,6 +58,26 @@ def placed(h: Harmonics, pts: np.ndarray, placement: str, seed: int) -> np.ndarr
         if sel.any():
             out += harmonic_field(p, Harmonics(h.freq[sel], h.amp[sel], h.share), seed)
     return out
+
+
+def count_study(model: SolidTextureModel, paths: list) -> dict:
+    """Per photo whose peak test passes more than COUNTS[0] peaks: per cap, the peaks kept, their share, and the
+    patch distance of the pooled slices and of the walls."""
+    rows = {}
+    for path in paths:
+        photo = read(path)
+        if len(photo_harmonics(photo, model.px_per_unit, count=max(COUNTS) + 1)) <= COUNTS[0]:
+            continue
+        z, r = model.encode(photo), {}
+        for count in COUNTS:
+            h = photo_harmonics(photo, model.px_per_unit, count=count)
+            imgs = {ax: [slice_image(model, model.translate(z, h), ax, s) for s in range(2)] for ax in "xyz"}
+            r[str(count)] = dict(peaks=len(h), share=round(h.share, 3),
+                                 pooled=round(pe.patch_swd([i for v in imgs.values() for i in v], photo), 1),
+                                 walls=round(pe.patch_swd(imgs["x"] + imgs["y"], photo), 1))
+        rows[os.path.basename(path)] = r
+        print(os.path.basename(path), r, flush=True)
+    return rows
 
 
 def main(argv=None) -> int:
@@ -107,9 +132,10 @@ def main(argv=None) -> int:
                                   worse_5pct=int(sum(r[k] > 1.05 * r["model"] for r in rs)))
                           for k in ["model"] + [f"{p:g}/{w}" for p, w in SETTINGS] + list(PLACEMENTS)}
         summary[group]["photos"] = len(rs)
+    counts = count_study(model, photos("train"))
     doc = dict(model=a.model, split="train", settings="prominence/window", placements=PLACEMENTS,
                seconds=round(time.time() - t0),
-               summary=summary, photos=rows)
+               summary=summary, photos=rows, counts=counts)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
     for group, s in summary.items():

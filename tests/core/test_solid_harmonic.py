@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-from backend.solid.harmonic import Harmonics, harmonic_field, mix_harmonics, photo_harmonics, seed_shift
+from backend.solid.harmonic import COUNT, Harmonics, harmonic_field, mix_harmonics, photo_harmonics, seed_shift
 from backend.solid.model import SolidTextureModel, plane_points
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -76,6 +76,13 @@ def test_courses_and_head_joints_are_found():
     # a course frequency (8 cycles over 128 px vertically) and a head-joint one (horizontal, 4 per 128 px)
     assert np.any(np.all(np.isclose(np.abs(h.freq), [0.0, 8.0]), axis=1))
     assert np.any(np.isclose(np.abs(h.freq[:, 0]), 4.0))
+    # every harmonic of the bond that passes the test is kept (64 here: more than the 32 the cap once was), the
+    # strongest first, and a lower cap keeps the strongest of them
+    assert len(h) == 64 and COUNT >= 64
+    power = np.abs(h.amp.mean(1)) ** 2          # the luminance power the peaks are ranked by
+    assert np.all(np.diff(power) <= 1e-12)
+    h8 = photo_harmonics(img, PPU, count=8)
+    assert len(h8) == 8 and np.array_equal(h8.freq, h.freq[:8]) and h8.share < h.share
 
 
 def test_3d_placement_walls_show_the_photo_floors_its_profile():

@@ -320,8 +320,9 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "at batch 4 had (\"Photo texture space\"); the single models have not had a GPU run yet.",
           "- The texture-space model's decoder draws grains, pebbles and mottling, not stones with joints. "
           "Courses, plank seams and rows come from the photo's harmonic part, measured at encode time and "
-          "added to the decoder's texture (\"Harmonic part of an encoded photo\"): up to 32 isolated spectral "
-          "peaks, so a motif (a patterned carpet) or head joints that stand out only weakly are not drawn, "
+          "added to the decoder's texture (\"Harmonic part of an encoded photo\"): up to 256 spectral peaks "
+          "that stand alone, so a motif whose peaks do not (a patterned carpet) or head joints that stand out "
+          "only weakly are not drawn, "
           "and random phase noise is still closer to fabric and metal photos. In 3D the part stands on "
           "vertical planes; a horizontal cut through a layered photo takes one layer's colour (a mortar "
           "course on one brick photo).", ""]
