@@ -25,7 +25,7 @@ taken for compression and left to the decoder; a period of 16 px or one a little
 At most ``COUNT`` peaks, the strongest first.  The cap binds on few photos (5 of the 483 training photos pass
 more than 32 peaks: brick, metal plates, tiles, up to 255); there 256 against 32 made the walls of two more than
 5 % closer to the photo (tiles 109.5 -> 71.6, metal 116.5 -> 95.5) and none farther (``bench/eval_solid_harmonic.py``,
-"counts"); 256 waves cost about 1.4 s per million points, 32 about 0.25 s (the decoder: 1.1 s).
+"counts"); 256 waves cost about 0.7 s per million points, 32 about 0.1 s (the decoder: 1.1 s).
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
@@ -176,16 +176,25 @@ def seed_shift(seed: int) -> np.ndarray:
     return np.random.default_rng([int(seed), 0x6861726D]).uniform(0.0, 64.0, 2)
 
 
+FIELD_BLOCK = 1 << 20   #: harmonic_field works on at most this many point-wave pairs at a time (about 20 MB)
+
+
 def harmonic_field(points: np.ndarray, h: Harmonics, seed: int = 0) -> np.ndarray:
     """h at points float (N, 2) (the photo's plane) or (N, 3) (q = (x + y, z); module doc), moved by
-    :func:`seed_shift`: float32 (N, 3)."""
+    :func:`seed_shift`: float32 (N, 3).  Points go in blocks of FIELD_BLOCK / K, so memory stays flat
+    whatever the number of waves."""
     x = np.asarray(points, np.float64)
+    out = np.zeros((x.shape[0], 3), np.float32)
     if len(h) == 0:
-        return np.zeros((x.shape[0], 3), np.float32)
+        return out
     q = (x if x.shape[1] == 2 else np.stack([x[:, 0] + x[:, 1], x[:, 2]], axis=1)) + seed_shift(seed)
-    c = q @ h.freq.T                                                                   # (N, K) cycles, float64
-    t = ((c - np.floor(c)) * (2.0 * np.pi)).astype(np.float32)   # the phase mod 2 pi, then float32 trigonometry
-    return np.cos(t) @ h.amp.real.astype(np.float32) - np.sin(t) @ h.amp.imag.astype(np.float32)
+    re, im = h.amp.real.astype(np.float32), h.amp.imag.astype(np.float32)
+    step = max(1, FIELD_BLOCK // len(h))
+    for a in range(0, x.shape[0], step):
+        c = q[a:a + step] @ h.freq.T                                                   # (n, K) cycles, float64
+        t = ((c - np.floor(c)) * (2.0 * np.pi)).astype(np.float32)   # the phase mod 2 pi, then float32 trigonometry
+        out[a:a + step] = np.cos(t) @ re - np.sin(t) @ im
+    return out
 
 
 def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmonics | None:

@@ -373,3 +373,16 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
     (tmp_path / "single" / "solid.json").write_text(json.dumps(dict(single, harmonic_rest=True)))
     with pytest.raises(ModelError, match="trained on harmonic rests"):
         SolidTextureModel(str(tmp_path / "single"))
+
+
+def test_the_field_in_blocks_is_the_field_at_once(monkeypatch):
+    """harmonic_field works through the points in blocks of FIELD_BLOCK / K (flat memory for 256 waves); any block
+    size gives the same numbers, to the bit."""
+    import backend.solid.harmonic as hm
+
+    h = photo_harmonics(brick_photo(), PPU)
+    pts = np.random.default_rng(5).uniform(-40, 40, (1000, 3))
+    whole = harmonic_field(pts, h, seed=2)
+    monkeypatch.setattr(hm, "FIELD_BLOCK", 7 * len(h))          # 7 points a block, the last one short
+    np.testing.assert_array_equal(hm.harmonic_field(pts, h, seed=2), whole)
+    assert whole.dtype == np.float32 and whole.shape == (1000, 3) and np.abs(whole).max() > 0.05
