@@ -15,7 +15,8 @@ kept; ``wall`` is also reported through the model, to show the difference is sma
 
 Peak counts: on every training photo where more than ``COUNTS[0]`` peaks pass the shipped test (the cap
 ``COUNT`` binds only there), the patch distance of the pooled slices and of the walls (x and y slices) under each
-cap in ``COUNTS`` ("counts" in the JSON).  The held-out photos
+cap in ``COUNTS`` ("counts" in the JSON).  Main lobes: on every training photo with a harmonic part, the same two
+distances with each peak's bin alone (lobe 0) and with the bins around it (``LOBES``; "lobes" in the JSON).  The held-out photos
 play no part: the constants in ``backend/solid/harmonic.py`` come from this table, and the held-out figures in
 the README from ``bench/eval_solid_photos.py``.
 """
@@ -41,6 +42,7 @@ STRUCTURED = ("brick", "wood", "fabric", "metal", "concrete", "marble", "rust")
 SETTINGS = [(p, w) for w in (3, 5) for p in (4.0, 8.0, 16.0, 32.0)]
 PLACEMENTS = ("wall", "floor", "each")
 COUNTS = (32, 64, 128, 256, 512)
+LOBES = (0, 1, 2)
 
 
 def placed(h: Harmonics, pts: np.ndarray, placement: str, seed: int) -> np.ndarray:
@@ -60,24 +62,38 @@ def placed(h: Harmonics, pts: np.ndarray, placement: str, seed: int) -> np.ndarr
     return out
 
 
-def count_study(model: SolidTextureModel, paths: list) -> dict:
-    """Per photo whose peak test passes more than COUNTS[0] peaks: per cap, the peaks kept, their share, and the
-    patch distance of the pooled slices and of the walls."""
+def study(model: SolidTextureModel, paths: list, variants: dict, include) -> dict:
+    """Per photo (of ``paths``) for which ``include(photo)`` holds: per variant (name -> keyword arguments of
+    photo_harmonics), the waves kept, their share, and the patch distance of the pooled slices and of the walls."""
     rows = {}
     for path in paths:
         photo = read(path)
-        if len(photo_harmonics(photo, model.px_per_unit, count=max(COUNTS) + 1)) <= COUNTS[0]:
+        if not include(photo):
             continue
         z, r = model.encode(photo), {}
-        for count in COUNTS:
-            h = photo_harmonics(photo, model.px_per_unit, count=count)
+        for name, kw in variants.items():
+            h = photo_harmonics(photo, model.px_per_unit, **kw)
             imgs = {ax: [slice_image(model, model.translate(z, h), ax, s) for s in range(2)] for ax in "xyz"}
-            r[str(count)] = dict(peaks=len(h), share=round(h.share, 3),
-                                 pooled=round(pe.patch_swd([i for v in imgs.values() for i in v], photo), 1),
-                                 walls=round(pe.patch_swd(imgs["x"] + imgs["y"], photo), 1))
+            r[name] = dict(waves=len(h), share=round(h.share, 3),
+                           pooled=round(pe.patch_swd([i for v in imgs.values() for i in v], photo), 1),
+                           walls=round(pe.patch_swd(imgs["x"] + imgs["y"], photo), 1))
         rows[os.path.basename(path)] = r
         print(os.path.basename(path), r, flush=True)
     return rows
+
+
+def count_study(model: SolidTextureModel, paths: list) -> dict:
+    """:func:`study` of the caps in COUNTS, each peak its own bin alone (as when the cap was chosen), on the photos
+    whose peak test passes more than COUNTS[0] peaks."""
+    return study(model, paths, {str(c): dict(count=c, lobe=0) for c in COUNTS},
+                 lambda photo: len(photo_harmonics(photo, model.px_per_unit, count=max(COUNTS) + 1, lobe=0))
+                 > COUNTS[0])
+
+
+def lobe_study(model: SolidTextureModel, paths: list) -> dict:
+    """:func:`study` of the lobe widths in LOBES on the photos with a harmonic part."""
+    return study(model, paths, {str(w): dict(lobe=w) for w in LOBES},
+                 lambda photo: len(photo_harmonics(photo, model.px_per_unit, lobe=0)) > 0)
 
 
 def main(argv=None) -> int:
@@ -132,12 +148,21 @@ def main(argv=None) -> int:
                                   worse_5pct=int(sum(r[k] > 1.05 * r["model"] for r in rs)))
                           for k in ["model"] + [f"{p:g}/{w}" for p, w in SETTINGS] + list(PLACEMENTS)}
         summary[group]["photos"] = len(rs)
-    counts = count_study(model, photos("train"))
+    counts, lobes = count_study(model, photos("train")), lobe_study(model, photos("train"))
+    lobe_summary = {}
+    for lobe in LOBES[1:]:
+        for key in ("pooled", "walls"):
+            pairs = [(r["0"][key], r[str(lobe)][key]) for r in lobes.values()]
+            lobe_summary[f"{lobe}/{key}"] = dict(
+                median_lobe0=round(float(np.median([p[0] for p in pairs])), 1),
+                median=round(float(np.median([p[1] for p in pairs])), 1),
+                better_5pct=int(sum(b < 0.95 * a for a, b in pairs)), worse_5pct=int(sum(b > 1.05 * a for a, b in pairs)))
     doc = dict(model=a.model, split="train", settings="prominence/window", placements=PLACEMENTS,
                seconds=round(time.time() - t0),
-               summary=summary, photos=rows, counts=counts)
+               summary=summary, photos=rows, counts=counts, lobes=lobes, lobe_summary=lobe_summary)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
+    print("lobes", lobe_summary)
     for group, s in summary.items():
         print(group, s.pop("photos"), "photos")
         for k, v in s.items():

@@ -171,7 +171,7 @@ def periodic_info(code) -> str:
     h = code.harmonics
     if h is None:
         return "Periodic part: none found"
-    return f"Periodic part: {len(h)} peaks, {100 * h.share:.0f} % of the variance"
+    return f"Periodic part: {len(h)} waves, {100 * h.share:.0f} % of the variance"
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:

@@ -692,8 +692,9 @@ def run_solid(a: argparse.Namespace) -> int:
 
     code, _ = req.code(model, "--", _Bar(a.quiet, "refine "), report)
     if code.harmonics is not None and not a.quiet:
-        print(f"periodic part: {len(code.harmonics)} spectral peaks, {100 * code.harmonics.share:.0f} % of the "
-              "photo's variance (--no-periodic leaves it out)", file=sys.stderr)
+        h = code.harmonics
+        print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
+              "(--no-periodic leaves it out)", file=sys.stderr)
     bar = _Bar(a.quiet)
     from backend.colour import srgb_to_linear
 

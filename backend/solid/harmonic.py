@@ -25,7 +25,13 @@ taken for compression and left to the decoder; a period of 16 px or one a little
 At most ``COUNT`` peaks, the strongest first.  The cap binds on few photos (5 of the 483 training photos pass
 more than 32 peaks: brick, metal plates, tiles, up to 255); there 256 against 32 made the walls of two more than
 5 % closer to the photo (tiles 109.5 -> 71.6, metal 116.5 -> 95.5) and none farther (``bench/eval_solid_harmonic.py``,
-"counts"); 256 waves cost about 0.7 s per million points, 32 about 0.1 s (the decoder: 1.1 s).
+"counts"; each peak its bin alone); 256 waves cost about 0.7 s per million points, 32 about 0.1 s (the decoder:
+1.1 s).  Main lobes: a period that is not a whole fraction of the photo (rows 24.3 px apart in a 256 px photo)
+falls between bins and spreads its power over the bins around the nearest one (a sinc: at half a bin off, its
+neighbour holds as much as it), so each peak brings the bins within ``LOBE`` of it that hold at least
+1 / ``LOBE_DEPTH`` of its power (and ``FLOOR`` of the photo's), each bin once.  A period that is a whole fraction
+keeps its one bin, and the weak bins around a strong peak (noise, or the periodic component's correction near
+the axes) stay out (tested).  Chosen on the training split ("lobes" in the same JSON).
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
@@ -56,7 +62,7 @@ import numpy as np
 
 from ..periodic import periodic_component
 
-__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "remove_harmonics", "seed_shift", "mix_harmonics", "to_json", "from_json",
+__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "remove_harmonics", "LOBE", "seed_shift", "mix_harmonics", "to_json", "from_json",
            "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES"]
 
 COUNT = 256         #: at most this many peaks
@@ -64,6 +70,8 @@ PROMINENCE = 16.0   #: a peak's power over the mean power of the bins around it
 WINDOW = 3          #: ... in the (2 WINDOW + 1)^2 square, less the 3 x 3 core
 MIN_CYCLES = 2      #: no peak below this many cycles per photo (shading and vignetting, not texture)
 FLOOR = 1e-4        #: nor one with less than this share of the luminance's power (rounding, not texture)
+LOBE = 1            #: each peak brings the bins within this many of it (its main lobe) ...
+LOBE_DEPTH = 16.0   #: ... that hold at least 1 / LOBE_DEPTH of its power
 
 
 @dataclass(frozen=True)
@@ -119,10 +127,26 @@ def _without_jpeg_grid(idx: np.ndarray, kx: np.ndarray, ky: np.ndarray, H: int, 
     return idx[keep]
 
 
+def _main_lobes(idx: np.ndarray, lobe: int, keep: np.ndarray, P: np.ndarray, H: int, W: int) -> np.ndarray:
+    """The flat bins within ``lobe`` of each peak in ``idx`` that hold at least 1 / LOBE_DEPTH of its power P
+    (flat, H * W) (peaks in their order, each bin once, as the representative of its conjugate pair that
+    ``keep`` (H * W,) marks eligible, which also holds the bins' other tests)."""
+    iy, ix = np.divmod(idx, W)
+    bins = np.stack([((iy + dy) % H) * W + (ix + dx) % W for dy in range(-lobe, lobe + 1)
+                     for dx in range(-lobe, lobe + 1)], axis=1)
+    bins = bins[P[bins] * LOBE_DEPTH >= P[idx][:, None]]           # the peak's own bin always passes
+    by, bx = np.divmod(bins, W)
+    bins = np.where(keep[bins], bins, ((-by) % H) * W + (-bx) % W)     # the other half's bin: its conjugate's
+    bins = bins[keep[bins]]
+    _, first = np.unique(bins, return_index=True)
+    return bins[np.sort(first)]
+
+
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
-                    window: int = WINDOW, min_cycles: int = MIN_CYCLES) -> Harmonics:
-    """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc);
-    no peaks (K = 0, share 0) for a photo without a period."""
+                    window: int = WINDOW, min_cycles: int = MIN_CYCLES, lobe: int = LOBE) -> Harmonics:
+    """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc):
+    up to ``count`` peaks, each with the bins of its main lobe (within ``lobe`` bins, above FLOOR; 0: the peak's
+    bin alone); no waves (K = 0, share 0) for a photo without a period."""
     a = np.asarray(img, np.float64)[..., :3]
     H, W, _ = a.shape
     F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
@@ -137,10 +161,12 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     ring, n = _box(P, window) - _box(P, 1), (2 * window + 1) ** 2 - 9
     half = (ky > 0) | ((ky == 0) & (kx > 0))                       # one of each conjugate pair
     far = np.hypot(kx / W, ky / H) * min(H, W) >= min_cycles
-    ok = peak & half & far & (P >= prominence * ring / max(n, 1)) & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
-    idx = np.flatnonzero(ok.ravel())
+    strong = half & far & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
+    idx = np.flatnonzero((peak & strong & (P >= prominence * ring / max(n, 1))).ravel())
     idx = idx[np.argsort(-P.ravel()[idx], kind="stable")]
     idx = _without_jpeg_grid(idx, kx.ravel(), ky.ravel(), H, W)[:count]
+    if lobe:
+        idx = _main_lobes(idx, lobe, strong.ravel(), P.ravel(), H, W)
     Fc = F.reshape(3, -1)[:, idx].T                                                    # (K, 3)
     total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
     share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0

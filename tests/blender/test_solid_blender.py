@@ -177,7 +177,7 @@ def test_the_preview_shows_the_periodic_part_it_found(scene):
     p = scene.omninoise_solid
     p.source, p.image, p.seed = "IMAGE", bpy.data.images.load(path), 0
     assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
-    assert p.periodic_info == "Periodic part: 71 peaks, 85 % of the variance"
+    assert p.periodic_info == "Periodic part: 73 waves, 85 % of the variance"
     log = []
     solid_ui.draw_solid(Recorder(log), bpy.context)
     assert ("label", None, p.periodic_info) in [(n, None, t) for n, a, t in log]

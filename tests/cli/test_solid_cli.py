@@ -181,7 +181,7 @@ def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path
     assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--size", "64", "-o", on)[0] == 0
     assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--size", "64", "--no-periodic", "-o", off)[0] == 0
     rc = main(["solid", "--model", models["space3"], "--exemplar", photo, "--size", "8", "-o", str(tmp_path / "x.npy")])
-    assert rc == 0 and "periodic part: 71 spectral peaks, 85 % of the photo's variance" in capsys.readouterr().err
+    assert rc == 0 and "periodic part: 73 waves at spectral peaks, 85 % of the photo's variance" in capsys.readouterr().err
     lum = read_rgb(photo)[:64, :64].mean(2).ravel()
     r_on = np.corrcoef(np.load(on).mean(2).ravel(), lum)[0, 1]
     r_off = np.corrcoef(np.load(off).mean(2).ravel(), lum)[0, 1]

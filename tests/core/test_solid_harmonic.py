@@ -78,10 +78,11 @@ def test_courses_and_head_joints_are_found():
     assert np.any(np.isclose(np.abs(h.freq[:, 0]), 4.0))
     # every harmonic of the bond that passes the test is kept (64 here: more than the 32 the cap once was), the
     # strongest first, and a lower cap keeps the strongest of them
+    h = photo_harmonics(img, PPU, lobe=0)
     assert len(h) == 64 and COUNT >= 64
     power = np.abs(h.amp.mean(1)) ** 2          # the luminance power the peaks are ranked by
     assert np.all(np.diff(power) <= 1e-12)
-    h8 = photo_harmonics(img, PPU, count=8)
+    h8 = photo_harmonics(img, PPU, count=8, lobe=0)
     assert len(h8) == 8 and np.array_equal(h8.freq, h.freq[:8]) and h8.share < h.share
 
 
@@ -386,3 +387,26 @@ def test_the_field_in_blocks_is_the_field_at_once(monkeypatch):
     monkeypatch.setattr(hm, "FIELD_BLOCK", 7 * len(h))          # 7 points a block, the last one short
     np.testing.assert_array_equal(hm.harmonic_field(pts, h, seed=2), whole)
     assert whole.dtype == np.float32 and whole.shape == (1000, 3) and np.abs(whole).max() > 0.05
+
+
+def test_a_period_between_bins_brings_its_main_lobe():
+    """Rows 128 / 5.5 px apart fall between two bins of a 128 px photo: the peak's bin alone holds under 40 % of
+    the photo's variance and its removal leaves most of the rows; with its main lobe (LOBE) the part holds over
+    half, and its removal leaves under 55 % of the rows' spread."""
+    from backend.solid.harmonic import LOBE, remove_harmonics
+
+    rng = np.random.default_rng(2)
+    r = np.arange(128)[:, None, None]
+    img = np.clip(0.5 + 0.2 * np.cos(2 * np.pi * 5.5 * r / 128) * np.array([1.0, 0.8, 0.6])
+                  + 0.02 * rng.standard_normal((128, 128, 3)), 0, 1)
+    alone, lobe = photo_harmonics(img, PPU, lobe=0), photo_harmonics(img, PPU)
+    assert LOBE == 1 and 0 < len(alone) < len(lobe) <= 9 * len(alone)
+    assert alone.share < 0.4 and lobe.share > 0.5
+    rows = img.mean((1, 2)).std()
+    assert remove_harmonics(img, alone, PPU).mean((1, 2)).std() > 0.7 * rows
+    assert remove_harmonics(img, lobe, PPU).mean((1, 2)).std() < 0.55 * rows
+    # whole periods keep their bins alone, and the weak bins around a bond's strong peaks stay out (below
+    # 1 / LOBE_DEPTH of the peak: noise, and near the axes the periodic component's correction, which removing
+    # would add to the photo, not take away)
+    assert len(photo_harmonics(waves_photo(), PPU)) == 3
+    assert len(photo_harmonics(brick_photo(), PPU)) == len(photo_harmonics(brick_photo(), PPU, lobe=0))

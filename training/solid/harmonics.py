@@ -52,7 +52,7 @@ def main(argv=None) -> int:
         return 2
     _ex.write_json(path, doc)
     h = doc.get("harmonics")
-    print(f"{path}: " + (f"{len(h['freq'])} peaks, share {h['share']:.3f}" if h else "no harmonic part"))
+    print(f"{path}: " + (f"{len(h['freq'])} waves, share {h['share']:.3f}" if h else "no harmonic part"))
     return 0
 
 
