@@ -323,7 +323,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "added to the decoder's texture (\"Harmonic part of an encoded photo\"): up to 256 spectral peaks "
           "that stand alone, so a motif whose peaks do not (a patterned carpet) or head joints that stand out "
           "only weakly are not drawn, "
-          "and random phase noise is still closer to fabric and metal photos. In 3D the part stands on "
+          "and random phase noise is still closer to the fabric photos. In 3D the part stands on "
           "vertical planes; a horizontal cut through a layered photo takes one layer's colour (a mortar "
           "course on one brick photo).", ""]
     return "\n".join(L)
