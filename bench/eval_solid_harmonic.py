@@ -73,7 +73,8 @@ def study(model: SolidTextureModel, paths: list, variants: dict, include) -> dic
         z, r = model.encode(photo), {}
         for name, kw in variants.items():
             h = photo_harmonics(photo, model.px_per_unit, **kw)
-            imgs = {ax: [slice_image(model, model.translate(z, h), ax, s) for s in range(2)] for ax in "xyz"}
+            code = model.translate(z, h)
+            imgs = {ax: [slice_image(model, code, ax, s) for s in range(2)] for ax in "xyz"}
             r[name] = dict(waves=len(h), share=round(h.share, 3),
                            pooled=round(pe.patch_swd([i for v in imgs.values() for i in v], photo), 1),
                            walls=round(pe.patch_swd(imgs["x"] + imgs["y"], photo), 1))

@@ -70,7 +70,7 @@ def evaluate_model(model: SolidTextureModel, space: SolidTextureModel | None, se
     pics["random_phase"] = [pe.random_phase(train, SIZE, rng) for _ in range(seeds)]
     pics["pixel_shuffle"] = [pe.pixel_shuffle(train, SIZE, rng) for _ in range(seeds)]
     if space is not None:
-        pics["space"] = images(space, space.translate(space.encode(train), space.harmonics(train)), seeds)
+        pics["space"] = images(space, space.photo_code(train), seeds)
     if previous is not None:
         pics["previous"] = images(previous, previous.default_code(), seeds)
     r = {"photo": model.config["exemplars"][0], "dim": model.dim}

@@ -40,8 +40,7 @@ def main(argv=None) -> int:
         if not os.path.basename(path).startswith(tuple(a.prefixes)):
             continue
         photo = read(path)
-        h = m.harmonics(photo)
-        alone, with_h = m.translate(m.encode(photo)), m.translate(m.encode(photo, h), h)
+        alone, with_h = m.photo_code(photo, periodic=False), m.photo_code(photo)
         cb = cube(m, with_h)
         cb = np.asarray(Image.fromarray((cb * 255).astype(np.uint8)).resize((128, 128)), np.float32) / 255
         cells = [photo[:128, :128], slice_image(m, alone, "y", 0), slice_image(m, with_h, "y", 0),

@@ -269,6 +269,13 @@ class SolidTextureModel:
             ppu *= img.shape[1] / W
         return photo_harmonics(img, ppu)
 
+    def photo_code(self, image: np.ndarray, periodic: bool = True) -> TextureCode:
+        """Space mode: a photo's code as the product makes it before any refinement: the photo's harmonic part
+        (:meth:`harmonics`, unless ``periodic`` is False), the photo encoded with it (:meth:`encode`: a model
+        trained on rests reads the rest), translated with the part riding along."""
+        h = self.harmonics(image) if periodic else None
+        return self.translate(self.encode(image, h), h)
+
     def translate(self, z, harmonics: Harmonics | None = None) -> TextureCode:
         """Space mode, translator h(z) -> (e, T) (Sec. 3); ``harmonics`` (:meth:`harmonics`) ride along."""
         if self.mode != "space":

@@ -360,6 +360,11 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
     np.testing.assert_array_equal(rest.encode(photo), plain.encode(photo))
     np.testing.assert_array_equal(plain.encode(photo, h), plain.encode(photo))     # other models ignore the part
     code = rest.translate(rest.encode(photo, h), h)
+    # photo_code, the benches' one call, is this code; without the part it is the whole photo's
+    made, whole = rest.photo_code(photo), rest.photo_code(photo, periodic=False)
+    np.testing.assert_array_equal(made.e, code.e)
+    assert np.array_equal(made.harmonics.freq, h.freq) and whole.harmonics is None
+    np.testing.assert_array_equal(whole.e, rest.translate(plain.encode(photo)).e)
     pts = np.random.default_rng(1).uniform(-2, 2, (4000, 3))
     d = plain.evaluate(pts, replace(code, harmonics=None), seed=3) - code.mu       # L d where nothing clips
     field = harmonic_field(pts, h, 3)
