@@ -37,6 +37,8 @@ __all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb"
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
 HARMONIC_SIDE = 1024      #: photos are measured for their harmonic part at most this many pixels wide
+ENCODE_SIDE = 8           #: the encoder reads at most this many crops along each side of a photo ...
+ENCODE_BATCH = 16         #: ... this many at a time (a 4096 px photo: 64 crops, not 3969 in one 13 GB batch)
 #: the models the extension ships (``models/solid`` beside ``backend``)
 SHIPPED_MODELS = solid_models()
 
@@ -225,7 +227,8 @@ class SolidTextureModel:
         """Space mode, Sec. 3 encoder g: image float (H, W, 3) or (H, W) in [0, 1] -> z float32 (z_dim,).
 
         The mean code of overlapping 128 px crops (the image is first resized
-        so its short side is at least 128 px, keeping pixels per unit).  A model trained on rests
+        so its short side is at least 128 px, keeping pixels per unit), at most ``ENCODE_SIDE`` along a side,
+        encoded ``ENCODE_BATCH`` at a time.  A model trained on rests
         (``harmonic_rest``) given the image's ``harmonics`` (:meth:`harmonics`) encodes the image less them,
         as it saw its training photos; other models ignore them.
         """
@@ -243,11 +246,14 @@ class SolidTextureModel:
             f = S / min(img.shape[:2])
             img = resize_rgb(img, max(S, round(img.shape[0] * f)), max(S, round(img.shape[1] * f)))
         H, W, _ = img.shape
-        # crops at most S/2 apart that cover the whole image
-        ys = np.unique(np.linspace(0, H - S, -(-(H - S) // (S // 2)) + 1).round().astype(int))
-        xs = np.unique(np.linspace(0, W - S, -(-(W - S) // (S // 2)) + 1).round().astype(int))
+        # crops at most S/2 apart that cover the whole image; on a photo over (ENCODE_SIDE + 1) S/2 px wide,
+        # ENCODE_SIDE crops spread evenly over that side (cost and memory stay those of a 576 px photo)
+        ys, xs = (np.unique(np.linspace(0, n - S, min(ENCODE_SIDE, -(-(n - S) // (S // 2)) + 1))
+                            .round().astype(int)) for n in (H, W))
         crops = np.stack([img[y:y + S, x:x + S].transpose(2, 0, 1) for y in ys for x in xs]).astype(_F)
-        z = self._session("encoder.onnx").run(None, {"exemplar": np.clip(crops, 0.0, 1.0)})[0].mean(0)
+        enc = self._session("encoder.onnx")
+        z = np.concatenate([enc.run(None, {"exemplar": np.clip(crops[i:i + ENCODE_BATCH], 0.0, 1.0)})[0]
+                            for i in range(0, len(crops), ENCODE_BATCH)]).mean(0)
         if self.colour_stats:
             z = np.concatenate([z, colour_stats(img)])
         if self.spectral_gains:   # as training measures them: crop by crop, here averaged over the crops

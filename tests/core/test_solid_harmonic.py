@@ -183,6 +183,38 @@ def test_a_large_photo_is_measured_small_at_the_same_scale(space):
     assert np.any(np.all(np.isclose(np.abs(h.freq), [0.0, 8.0], atol=0.15), axis=1))
 
 
+def test_a_large_photo_is_encoded_from_a_bounded_grid_of_crops_in_batches(space, monkeypatch):
+    """A 4096 px photo once went to the encoder as 3969 crops in one batch (16 GB, 29 s); now at most
+    ENCODE_SIDE^2 crops spread over it, ENCODE_BATCH at a time, and a small photo keeps every crop."""
+    import backend.solid.model as model_mod
+
+    enc = space._session("encoder.onnx")
+    seen = []
+
+    class Counting:
+        def run(self, names, feeds):
+            seen.append(feeds["exemplar"].shape[0])
+            return enc.run(names, feeds)
+
+    monkeypatch.setattr(space, "_session", lambda name, real=space._session: Counting() if name == "encoder.onnx"
+                        else real(name))
+    big = np.tile(brick_photo(), (12, 8, 1))       # 1536 x 1024 px: 23 x 15 crops at 64 px steps
+    z = space.encode(big)
+    assert sum(seen) == model_mod.ENCODE_SIDE ** 2 and max(seen) <= model_mod.ENCODE_BATCH
+    assert np.isfinite(z).all()
+    # a 256 px photo: all 9 crops, and the batching does not change the code
+    seen.clear()
+    small = brick_photo(256, 256)
+    a = space.encode(small)
+    assert seen == [9]
+    monkeypatch.setattr(model_mod, "ENCODE_BATCH", 2)
+    assert np.allclose(space.encode(small), a, atol=1e-5)
+    # the bounded grid still reads the photo: the big brick photo's code is near the small one's
+    # (same bricks), far nearer than a flat grey photo's
+    flat = space.encode(np.full((256, 256, 3), 0.5))
+    assert np.linalg.norm(z[:space.z_dim] - a[:space.z_dim]) < 0.5 * np.linalg.norm(flat[:space.z_dim] - a[:space.z_dim])
+
+
 def test_stored_harmonics_round_trip_and_bad_ones_are_named():
     from backend.solid.harmonic import from_json, to_json
 
