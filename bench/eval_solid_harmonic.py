@@ -32,7 +32,7 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from backend.solid.harmonic import Harmonics, harmonic_field, photo_harmonics  # noqa: E402
+from backend.solid.harmonic import DETECTS, Harmonics, harmonic_field, photo_harmonics  # noqa: E402
 from backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
 from bench.eval_solid_photos import SIZE, photos, read, slice_image  # noqa: E402
 from export.atomic import write_json  # noqa: E402
@@ -97,15 +97,45 @@ def lobe_study(model: SolidTextureModel, paths: list) -> dict:
                  lambda photo: len(photo_harmonics(photo, model.px_per_unit, lobe=0)) > 0)
 
 
+def detect_study(model: SolidTextureModel, paths: list) -> dict:
+    """:func:`study` of the spectra peaks are sought in (``DETECTS``: the luminance's power, the sum of the three
+    channels' powers) on the photos with a harmonic part under either."""
+    return study(model, paths, {d: dict(detect=d) for d in DETECTS},
+                 lambda photo: any(len(photo_harmonics(photo, model.px_per_unit, detect=d)) for d in DETECTS))
+
+
+def paired_summary(rows: dict, base: str, other: str) -> dict:
+    """Per distance (pooled, walls): the medians under ``base`` and ``other`` and the photos ``other`` makes more
+    than 5 % closer or farther than ``base``."""
+    out = {}
+    for key in ("pooled", "walls"):
+        pairs = [(r[base][key], r[other][key]) for r in rows.values()]
+        out[f"{other}/{key}"] = dict(
+            median_base=round(float(np.median([p[0] for p in pairs])), 1),
+            median=round(float(np.median([p[1] for p in pairs])), 1),
+            better_5pct=int(sum(b < 0.95 * a for a, b in pairs)), worse_5pct=int(sum(b > 1.05 * a for a, b in pairs)))
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_harmonic.json"))
+    ap.add_argument("--only", choices=("detect",),
+                    help="run this study alone (its JSON holds it alone): detect, the spectrum peaks are sought in")
     a = ap.parse_args(argv)
     model = SolidTextureModel(a.model)
     if model.harmonic_rest:
         ap.error(f"{a.model} was trained on photos' rests: its code depends on the part, and this bench encodes each "
                  "photo once for every peak test (use a model trained on whole photos)")
+    if a.only == "detect":
+        t0 = time.time()
+        rows = detect_study(model, photos("train"))
+        doc = dict(model=a.model, split="train", seconds=round(time.time() - t0), detect=rows,
+                   detect_summary=paired_summary(rows, "luminance", "colour"))
+        write_json(a.out, doc)
+        print("detect", doc["detect_summary"])
+        return 0
     files = [f for i, f in enumerate(photos("train"))
              if os.path.basename(f).startswith(STRUCTURED) or i % 6 == 0]
     rows, t0 = {}, time.time()
@@ -152,15 +182,12 @@ def main(argv=None) -> int:
     counts, lobes = count_study(model, photos("train")), lobe_study(model, photos("train"))
     lobe_summary = {}
     for lobe in LOBES[1:]:
-        for key in ("pooled", "walls"):
-            pairs = [(r["0"][key], r[str(lobe)][key]) for r in lobes.values()]
-            lobe_summary[f"{lobe}/{key}"] = dict(
-                median_lobe0=round(float(np.median([p[0] for p in pairs])), 1),
-                median=round(float(np.median([p[1] for p in pairs])), 1),
-                better_5pct=int(sum(b < 0.95 * a for a, b in pairs)), worse_5pct=int(sum(b > 1.05 * a for a, b in pairs)))
+        lobe_summary.update(paired_summary(lobes, "0", str(lobe)))
+    detect = detect_study(model, photos("train"))
     doc = dict(model=a.model, split="train", settings="prominence/window", placements=PLACEMENTS,
                seconds=round(time.time() - t0),
-               summary=summary, photos=rows, counts=counts, lobes=lobes, lobe_summary=lobe_summary)
+               summary=summary, photos=rows, counts=counts, lobes=lobes, lobe_summary=lobe_summary,
+               detect=detect, detect_summary=paired_summary(detect, "luminance", "colour"))
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
     print("lobes", lobe_summary)

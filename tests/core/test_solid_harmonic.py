@@ -80,7 +80,7 @@ def test_courses_and_head_joints_are_found():
     # strongest first, and a lower cap keeps the strongest of them
     h = photo_harmonics(img, PPU, lobe=0)
     assert len(h) == 64 and COUNT >= 64
-    power = np.abs(h.amp.mean(1)) ** 2          # the luminance power the peaks are ranked by
+    power = (np.abs(h.amp) ** 2).sum(1)         # the colour power the peaks are ranked by
     assert np.all(np.diff(power) <= 1e-12)
     h8 = photo_harmonics(img, PPU, count=8, lobe=0)
     assert len(h8) == 8 and np.array_equal(h8.freq, h.freq[:8]) and h8.share < h.share
@@ -447,3 +447,20 @@ def test_a_period_between_bins_brings_its_main_lobe():
     # would add to the photo, not take away)
     assert len(photo_harmonics(waves_photo(), PPU)) == 3
     assert len(photo_harmonics(brick_photo(), PPU)) == len(photo_harmonics(brick_photo(), PPU, lobe=0))
+
+
+def test_a_motif_of_colours_at_one_luminance_is_found_in_the_colour_spectrum():
+    """Red diamonds on olive of the same luminance (the held-out carpet's motif): the luminance spectrum holds
+    almost none of it, the summed power of the three channels all of it; a wrong spectrum's name is refused."""
+    rng = np.random.default_rng(5)
+    r, c = np.mgrid[0:128, 0:128]
+    motif = ((np.abs((c % 32) - 16) + np.abs((r % 16) - 8) * 2) < 10).astype(float)      # diamonds, 32 x 16 px
+    red, olive = np.array([0.75, 0.10, 0.10]), np.array([0.40, 0.35, 0.20])               # means 0.317, 0.317
+    img = np.where(motif[..., None] > 0, red, olive) + 0.004 * rng.standard_normal((128, 128, 3))
+    lum, col = photo_harmonics(img, PPU, detect="luminance"), photo_harmonics(img, PPU, detect="colour")
+    assert lum.share < 0.1 and col.share > 0.8
+    assert np.any(np.all(np.isclose(np.abs(col.freq), [4.0, 0.0]), axis=1))        # 4 motifs per 128 px
+    back = photo_plane(col, 128, 128)
+    assert np.corrcoef(back[..., 1].ravel(), img[..., 1].ravel())[0, 1] > 0.9
+    with pytest.raises(ValueError, match="detect must be one of"):
+        photo_harmonics(img, PPU, detect="chroma")

@@ -321,9 +321,9 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "- The texture-space model's decoder draws grains, pebbles and mottling, not stones with joints. "
           "Courses, plank seams and rows come from the photo's harmonic part, measured at encode time and "
           "added to the decoder's texture (\"Harmonic part of an encoded photo\"): up to 256 spectral peaks "
-          "that stand alone, so a motif whose peaks do not (a patterned carpet) or head joints that stand out "
-          "only weakly are not drawn, "
-          "and random phase noise is still closer to the fabric photos. In 3D the part stands on "
+          "that stand alone in the photo's colour spectrum, so head joints that stand out only weakly are not "
+          "drawn; a carpet's motif is, but with the decoder's speckle over it, and random phase noise is still "
+          "closer to the fabric photos by the patch distance. In 3D the part stands on "
           "vertical planes; a horizontal cut through a layered photo takes one layer's colour (a mortar "
           "course on one brick photo).", ""]
     return "\n".join(L)
