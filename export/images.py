@@ -122,9 +122,11 @@ def decode(path: str) -> np.ndarray:
 
     8-bit files are divided by 255, 16-bit ones by 65535 (a 16-bit mask is not
     read as nearly white), float files (.exr, float TIFF, .npy) are kept as
-    they are.  Empty, truncated, non-image, non-finite and oversized
-    (> MAX_PIXELS, 2^27) files raise :class:`ImageError`; a missing one
-    FileNotFoundError.
+    they are.  A file with an EXIF orientation (a phone photo taken upright) is
+    turned as image viewers show it, so a brick photo's courses stay level
+    (Blender's own images are read as Blender shows them).  Empty, truncated,
+    non-image, non-finite and oversized (> MAX_PIXELS, 2^27) files raise
+    :class:`ImageError`; a missing one FileNotFoundError.
     """
     if not os.path.isfile(path):
         raise FileNotFoundError(f"image not found: {path}")
@@ -163,10 +165,13 @@ def decode(path: str) -> np.ndarray:
     return a
 
 
+_EXIF_ORIENTATION = 0x0112   #: EXIF tag: 1 upright, 2-8 mirrored and/or turned (cameras store the sensor's rows)
+
+
 def _decode_pillow(path: str) -> np.ndarray:
     import warnings
 
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image, ImageOps, UnidentifiedImageError
 
     try:
         with warnings.catch_warnings():
@@ -176,6 +181,8 @@ def _decode_pillow(path: str) -> np.ndarray:
                 if w * h > MAX_PIXELS:
                     raise ImageError(f"{path}: {w}x{h} px is more than the {MAX_PIXELS} px an input may have")
                 im.load()
+                if im.getexif().get(_EXIF_ORIENTATION, 1) != 1:
+                    im = ImageOps.exif_transpose(im)     # a phone photo as every viewer shows it, not as stored
                 mode = im.mode
                 if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
                     return np.asarray(im, dtype=np.float32) / 65535.0

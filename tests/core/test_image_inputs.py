@@ -78,3 +78,23 @@ def test_cli_image_inputs_exit_2(tmp_path, capsys):
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert rc == 2 and len(err) == 1 and "t.png" in err[0]
     assert not (tmp_path / "o.png").exists()
+
+
+@pytest.mark.parametrize("orientation, turn", [(1, lambda a: a), (3, lambda a: a[::-1, ::-1]),
+                                               (6, lambda a: np.rot90(a, -1)), (8, lambda a: np.rot90(a, 1)),
+                                               (2, lambda a: a[:, ::-1])])
+def test_exif_orientation_turns_a_photo_as_viewers_show_it(tmp_path, orientation, turn):
+    """A phone photo taken upright stores the sensor's rows and an EXIF orientation; it is read turned (a
+    portrait brick photo keeps level courses), and one without the tag is read as stored."""
+    rng = np.random.default_rng(orientation)
+    stored = np.zeros((24, 40, 3), np.uint8)
+    stored[:, :8] = 255                                     # a white band along the stored left edge
+    stored[20:, :, 1] = rng.integers(0, 255, (4, 40))       # and a noisy stored bottom row
+    path = str(tmp_path / f"o{orientation}.png")
+    exif = Image.Exif()
+    exif[0x0112] = orientation
+    Image.fromarray(stored).save(path, exif=exif)
+    want = turn(stored.astype(np.float32) / 255.0)
+    got = read_rgb(path)
+    assert got.shape == want.shape and np.array_equal(got, want)
+    assert read_image(path).shape == want.shape[:2]
