@@ -16,7 +16,9 @@ kept; ``wall`` is also reported through the model, to show the difference is sma
 Peak counts: on every training photo where more than ``COUNTS[0]`` peaks pass the shipped test (the cap
 ``COUNT`` binds only there), the patch distance of the pooled slices and of the walls (x and y slices) under each
 cap in ``COUNTS`` ("counts" in the JSON).  Main lobes: on every training photo with a harmonic part, the same two
-distances with each peak's bin alone (lobe 0) and with the bins around it (``LOBES``; "lobes" in the JSON).  The held-out photos
+distances with each peak's bin alone (lobe 0) and with the bins around it (``LOBES``; "lobes" in the JSON).  Spectra:
+on every training photo with a part, the same with peaks sought in the luminance's or the colour power spectrum
+("detect"; ``--only detect`` runs it alone).  The held-out photos
 play no part: the constants in ``backend/solid/harmonic.py`` come from this table, and the held-out figures in
 the README from ``bench/eval_solid_photos.py``.
 """
@@ -191,6 +193,7 @@ def main(argv=None) -> int:
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
     print("lobes", lobe_summary)
+    print("detect", doc["detect_summary"])
     for group, s in summary.items():
         print(group, s.pop("photos"), "photos")
         for k, v in s.items():

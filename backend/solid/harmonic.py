@@ -37,7 +37,7 @@ the axes) stay out (tested).  Chosen on the training split ("lobes" in the same 
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
 others farther (stripes from chance peaks).  Measured again with main lobes: 11 and 5, 3 and 0; 4 made 25 closer
-and 30 others farther.
+and 30 others farther (with peaks in colour: 11 and 5, 3 and 0; 23 and 26).
 
 Colour, not luminance: a motif drawn in colours of about one luminance (a held-out carpet's red diamonds on
 olive) leaves almost nothing in the luminance spectrum, where the weave's fine grain outshone it (44 waves, 12 %
