@@ -2,7 +2,7 @@
 
 For every photo of the photo set's validation split (whole photos that
 training never saw, ``data/photos/val``), the texture-space model encodes the
-photo (one click in the add-on: no refinement) and its 3D texture is sliced
+photo (one click in the add-on: no refinement; `--refine N` searches first) and its 3D texture is sliced
 normal to x, y and z (SIZE² px at the photo's resolution, ``--seeds`` seeds).
 Against the photo, per slice axis and pooled:
 
@@ -38,6 +38,7 @@ The texture is the one an artist gets: the encoded code with the photo's harmoni
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import time
@@ -112,13 +113,19 @@ def spectrum_distance(images: list, photo: np.ndarray) -> float:
 
 
 def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None,
-             periodic: bool = True) -> dict:
+             periodic: bool = True, refine: int = 0) -> dict:
     rows = {}
     for path in files:
         photo = read(path)
         rng = np.random.default_rng(0)
         t = time.time()
-        code = model.photo_code(photo, periodic)
+        if refine:      # the add-on's Refine Steps: encode, then search the code (backend/solid/refine.py)
+            from backend.solid.refine import exemplar_z
+
+            z, _, _, h = exemplar_z(model, photo, refine=refine, periodic=periodic)
+            code = model.translate(z, h)
+        else:
+            code = model.photo_code(photo, periodic)
         h = code.harmonics
         imgs = {ax: [slice_image(model, code, ax, s) for s in range(seeds)] for ax in "xyz"}
         seconds = time.time() - t
@@ -203,6 +210,20 @@ def write_sheet(sheet: list, path: str, size: int = 128) -> None:
         Image.fromarray(a).save(tmp, format="PNG")
 
 
+def against(rows: dict, path: str) -> dict:
+    """Per distance (``swd`` pooled, ``swd_walls``): the photos of ``rows`` more than 5 % closer and farther than
+    in the run of this bench stored at ``path``, and both medians over the photos the two share."""
+    with open(path, encoding="utf-8") as fh:
+        other = json.load(fh)["photos"]
+    common = [n for n in rows if n in other]
+    out = {"photos": len(common)}
+    for key in ("swd", "swd_walls"):
+        a, b = (np.array([r[n][key] for n in common]) for r in (other, rows))
+        out[key] = dict(median_against=round(float(np.median(a)), 1), median=round(float(np.median(b)), 1),
+                        closer_5pct=int((b < 0.95 * a).sum()), farther_5pct=int((b > 1.05 * a).sum()))
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
@@ -215,6 +236,10 @@ def main(argv=None) -> int:
     ap.add_argument("--no-periodic", dest="periodic", action="store_false",
                     help="leave out the photos' harmonic part (backend/solid/harmonic.py): the decoder alone")
     ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
+    ap.add_argument("--refine", type=int, default=0, metavar="N",
+                    help="refine each photo's code by N search steps first (the add-on's Refine Steps)")
+    ap.add_argument("--against", metavar="JSON", help="another run of this bench on the same photos: count the "
+                    "photos this one is more than 5 %% closer to or farther from, pooled and on walls")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_photos.json"))
     a = ap.parse_args(argv)
     model = SolidTextureModel(a.model)
@@ -224,10 +249,13 @@ def main(argv=None) -> int:
     if a.limit:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     sheet = [] if a.sheet else None
-    rows = evaluate(model, files, a.seeds, sheet, a.periodic)
+    rows = evaluate(model, files, a.seeds, sheet, a.periodic, a.refine)
     doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
-               periodic=a.periodic,
+               periodic=a.periodic, refine=a.refine,
                summary=summary(rows), by_category=by_category(rows), photos=rows)
+    if a.against:
+        doc["against"] = against(rows, a.against)
+        print("against", a.against, doc["against"])
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, doc)
     if sheet:

@@ -94,10 +94,10 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
         ("IMAGE", "Image", "Any image: the texture-space model encodes it into a texture code")], default="SHIPPED")
     texture: EnumProperty(name="Texture", items=_texture_items)
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
-                           description="A photo of the material (at least 128 px; larger is resized to crops)")
+                           description="A photo of the material (at least 128 px; a large one is read in at most 8 x 8 crops)")
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
-                        description="Improve the encoded image's code by a search against its texture statistics "
-                                    "(about 0.1 s a step)")
+                        description="Improve the encoded image's code by a search against its colour neighbourhoods, "
+                                    "each step checked on planes the search does not see (about 0.1 s a step)")
     periodic: BoolProperty(name="Periodic Part", default=True,
                            description="Keep the image's periodic part (brick courses, plank seams, weaves: its "
                                        "isolated spectral peaks) on top of the model's texture; upright on faces "

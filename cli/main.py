@@ -688,7 +688,10 @@ def run_solid(a: argparse.Namespace) -> int:
 
     def report(name, hist):
         if not a.quiet:
-            print(f"refined {name}: texture-statistics distance {hist[0]:.4f} -> {hist[-1]:.4f}", file=sys.stderr)
+            kept = len(hist) > 1 and hist[-1] == hist[0] and min(hist) < hist[0]
+            print(f"refined {name}: neighbourhood distance {hist[0]:.4f} -> {min(hist):.4f}"
+                  + (" on the searched planes, not closer on fresh ones: the encoder's code is kept" if kept else ""),
+                  file=sys.stderr)
 
     code, _ = req.code(model, "--", _Bar(a.quiet, "refine "), report)
     if code.harmonics is not None and not a.quiet:

@@ -119,7 +119,7 @@ def test_refine_option(models, tmp_path, capsys):
     p = str(tmp_path / "r.npy")
     rc = main(["solid", "--model", models["space3"], "--exemplar", str(img), "--refine", "3", "--size", "8", "-o", p])
     err = capsys.readouterr().err
-    assert rc == 0 and "texture-statistics distance" in err and np.load(p).shape == (8, 8, 3)
+    assert rc == 0 and "neighbourhood distance" in err and np.load(p).shape == (8, 8, 3)
     rc, err = run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--refine", "3", "-o", p)
     assert rc == 2 and "refining needs the space model" in err
 

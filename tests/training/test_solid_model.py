@@ -309,31 +309,51 @@ def test_exemplars_split_and_crops():
         ex.exemplar("cork")
 
 
-def test_refinement_never_worsens_and_moves_a_wrong_start(tmp_path):
+def test_refinement_never_worsens_and_moves_a_wrong_start(tmp_path, monkeypatch):
+    import backend.solid.refine as rf
     from backend.grid import Cancelled
-    from backend.solid.refine import refine_code, stats_distance, texture_stats
+    from backend.solid.refine import refine_code, sliced_distance, sliced_target
     run, _ = _tiny(tmp_path, mode="space", dim=3, crop=128, batch=2, steps=2)
     export(str(run), str(tmp_path / "space"))
     rt = SolidTextureModel(str(tmp_path / "space"))
     img = ex.procedural("rust", 1, 160).permute(1, 2, 0).numpy()
     z0 = rt.codes["grass"]
+    monkeypatch.setattr(rf, "RENDER_SIZE", 48)          # a tiny model: small renders keep the test quick
     z, hist = refine_code(rt, z0, img, steps=12, seed=1)
     assert len(hist) == 13 and all(b <= a for a, b in zip(hist, hist[1:]))
     assert z.dtype == np.float32 and z.shape == (8,)
-    assert (hist[-1] < hist[0]) == (not np.array_equal(z, z0))
+    assert not np.array_equal(z, z0) and hist[-1] < hist[0]   # a grass code refined towards rust
     z_same, h0 = refine_code(rt, z0, img, steps=0)
     np.testing.assert_array_equal(z_same, z0)
     assert h0 == hist[:1]
     with pytest.raises(Cancelled):
         refine_code(rt, z0, img, steps=3, cancel=lambda: True)
-    # the statistics see colour, scale and orientation
+    # the final check: a code the search found is dropped when it is not closer on the fresh planes
+    final = []
+    real = rf.sliced_distance
+
+    def fresh_planes_prefer_the_start(images, target, seed=1):
+        if len(images) != len(rf.FINAL_PLANES):
+            return real(images, target, seed)
+        final.append(1)                                 # the refined code is measured first, then the start
+        return 1.0 if len(final) % 2 else 0.0
+    monkeypatch.setattr(rf, "sliced_distance", fresh_planes_prefer_the_start)
+    z2, hist2 = refine_code(rt, z0, img, steps=12, seed=1)
+    assert min(hist2) < hist2[0]                         # the search moved from the wrong start ...
+    np.testing.assert_array_equal(z2, z0)                # ... and the final check undid it
+    assert hist2[-1] == hist2[0]
+    monkeypatch.setattr(rf, "sliced_distance", real)
+    # the distance sees colour, scale and orientation, and is 0 for the same image
     base = np.tile(np.sin(np.arange(64) * 0.8)[None, :, None] * 0.3 + 0.5, (64, 1, 3))
-    s0 = texture_stats(base)
-    assert stats_distance(s0, texture_stats(base.transpose(1, 0, 2))) > 0.1           # rotated stripes
-    assert stats_distance(s0, texture_stats(base * 0.5)) > 0.1                        # darker
+    t = sliced_target([base])
+    assert sliced_distance([base.transpose(1, 0, 2)], t) > 0.05                      # rotated stripes
+    assert sliced_distance([base * 0.5], t) > 0.05                                    # darker
     fine = np.tile(np.sin(np.arange(64) * 2.4)[None, :, None] * 0.3 + 0.5, (64, 1, 3))
-    assert stats_distance(s0, texture_stats(fine)) > 0.1                               # finer
-    assert stats_distance(s0, texture_stats(base.copy())) == 0.0
+    assert sliced_distance([fine], t) > 0.05                                          # finer
+    assert sliced_distance([base.copy()], t) < 0.02
+    rng = np.random.default_rng(0)
+    noise = rng.random((64, 64, 3))
+    assert sliced_distance([rng.random((64, 64, 3))], sliced_target([noise])) < 0.02   # another draw, same process
 
 
 def test_spectral_aspect_and_the_initial_stretch_follow_the_grain():
