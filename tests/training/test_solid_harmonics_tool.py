@@ -22,7 +22,7 @@ def test_remove_and_add_back(tmp_path, capsys):
     assert main([str(folder), "--remove", "--root", ROOT]) == 0
     assert "harmonics" not in json.loads((folder / "solid.json").read_text())
     assert main([str(folder), "--root", ROOT]) == 0
-    assert "26 waves, share 0.360" in capsys.readouterr().out
+    assert "38 waves, share 0.374" in capsys.readouterr().out
     with open(os.path.join(BRICK, "solid.json"), encoding="utf-8") as f:
         assert json.loads((folder / "solid.json").read_text()) == json.load(f)
 
