@@ -518,7 +518,10 @@ def run_neural(a: argparse.Namespace) -> int:
     _set_threads(a.threads, a.precision)
     sampler = a.sampler or DEFAULT_SAMPLER
     steps = DEFAULT_STEPS if a.steps is None else a.steps
-    check_sampler(sampler, steps, a.spacing, a.eta)
+    try:
+        check_sampler(sampler, steps, a.spacing, a.eta)
+    except SettingError as exc:         # named as the flag the user typed
+        raise SettingError(f"--{exc.setting}", exc.message) from None
     if not 0 <= a.seed < 2 ** 32:
         raise SettingError("--seed", f"must lie in [0, 2^32), got {a.seed}")
     limits.check_memory("--size", float(a.size) ** 2 * 4 * 160, f"a {a.size}² neural image (activations)")

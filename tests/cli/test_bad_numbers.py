@@ -33,6 +33,21 @@ def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("args,setting", [
+    (["--steps", "0"], "--steps: must be a whole number"),
+    (["--sampler", "bogus"], "--sampler: unknown sampler"),
+    (["--spacing", "bogus"], "--spacing: unknown spacing"),
+    (["--eta", "2"], "--eta: must lie in [0, 1]"),
+    (["--sampler", "heun", "--eta", "0.5"], "--eta: eta > 0 is a DDIM"),
+])
+def test_bad_sampler_settings_name_their_flag(tmp_path, capsys, args, setting):
+    out = tmp_path / "x.npy"
+    rc = main(["neural", "--noise", "perlin", "--size", "16", "--quiet", *args, "-o", str(out)])
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(lines) == 1 and setting in lines[0], lines
+    assert not out.exists()
+
+
 def test_memory_error_says_how_much(monkeypatch):
     monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "1M")
     assert limits.memory_limit() == 1 << 20
