@@ -32,7 +32,7 @@ from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, rem
 from .lattice import lattice_noise
 from .waves import wave_features
 
-__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points"]
+__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "measure_harmonics"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
@@ -163,6 +163,20 @@ def spectral_gains(img: np.ndarray, octaves: int = 8, px_per_unit: float = 128.0
     return np.clip(np.sqrt(octaves * e / e.sum()), *GAIN_RANGE).astype(_F)
 
 
+def measure_harmonics(image: np.ndarray, px_per_unit: float) -> Harmonics:
+    """A photo's harmonic part (:func:`backend.solid.harmonic.photo_harmonics`) at ``px_per_unit`` pixels per
+    texture unit: image float (H, W, 3) or (H, W) in [0, 1]; a photo over HARMONIC_SIDE px is measured at that size,
+    its waves kept at their frequency in texture units.  The one measurement the runtime, the export and the
+    harmonics tool share."""
+    img = _rgb(image)
+    ppu, W = float(px_per_unit), img.shape[1]
+    f = HARMONIC_SIDE / max(img.shape[:2])
+    if f < 1.0:
+        img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
+        ppu *= img.shape[1] / W
+    return photo_harmonics(img, ppu)
+
+
 class SolidTextureModel:
     def __init__(self, folder: str, threads: int = 0):
         self.config = load_model_json(folder, "solid.json")
@@ -195,6 +209,17 @@ class SolidTextureModel:
                 self.stored_harmonics = from_json(c["harmonics"])
             except ValueError as exc:
                 raise ModelError(f"model {self.name!r}: {exc}") from None
+        #: a space photo model's named codes' harmonic parts, measured from the photos that name them (export, or
+        #: training/solid/harmonics.py): ``code(name)`` draws a name as encoding its photo would
+        self.code_harmonics = {}
+        for k, v in c.get("code_harmonics", {}).items():
+            if self.mode != "space" or not c.get("colour_stats", 0) or k not in self.codes:
+                raise ModelError(f"model {self.name!r} stores a harmonic part for code {k!r}, which only a space "
+                                 "photo model's named codes can have")
+            try:
+                self.code_harmonics[k] = from_json(v)
+            except ValueError as exc:
+                raise ModelError(f"model {self.name!r}, code {k!r}: {exc}") from None
         #: a space model trained on its photos' rests (photo less harmonic part): it encodes a photo's rest when
         #: the photo's part rides along, and draws it at the rest's own colour covariance (k = 1, harmonic.py)
         self.harmonic_rest = bool(c.get("harmonic_rest", False))
@@ -263,17 +288,11 @@ class SolidTextureModel:
         return z.astype(_F)
 
     def harmonics(self, image: np.ndarray) -> Harmonics | None:
-        """A photo's harmonic part at this model's scale (:func:`backend.solid.harmonic.photo_harmonics`), for
-        :meth:`translate`; None for models without the photo's colour (the part is added in its colour frame)."""
+        """A photo's harmonic part at this model's scale (:func:`measure_harmonics`), for :meth:`translate`; None
+        for models without the photo's colour (the part is added in its colour frame)."""
         if not self.colour_stats:
             return None
-        img = _rgb(image)
-        ppu, W = self.px_per_unit, img.shape[1]
-        f = HARMONIC_SIDE / max(img.shape[:2])
-        if f < 1.0:     # a large photo is measured at most HARMONIC_SIDE px wide, at its scale in texture units
-            img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
-            ppu *= img.shape[1] / W
-        return photo_harmonics(img, ppu)
+        return measure_harmonics(image, self.px_per_unit)
 
     def photo_code(self, image: np.ndarray, periodic: bool = True) -> TextureCode:
         """Space mode: a photo's code as the product makes it before any refinement: the photo's harmonic part
@@ -299,13 +318,14 @@ class SolidTextureModel:
                            harmonics if harmonics is not None and len(harmonics) else None)
 
     def code(self, exemplar: str | None = None) -> TextureCode:
-        """A named training exemplar's code (space models), or the default code."""
+        """A named training exemplar's code (space models), with the harmonic part of the photo that names it when
+        the model stores one (``code_harmonics``), or the default code."""
         if exemplar is None:
             return self.default_code()
         if exemplar not in self.codes:
             raise SettingError("exemplar", f"model {self.name!r} knows no exemplar {exemplar!r}"
                                            + (f"; it knows {', '.join(self.codes)}" if self.codes else ""))
-        return self.translate(self.codes[exemplar])
+        return self.translate(self.codes[exemplar], self.code_harmonics.get(exemplar))
 
     # -- evaluation ------------------------------------------------------------------------------
     def decode(self, noise: np.ndarray, e: np.ndarray) -> np.ndarray:

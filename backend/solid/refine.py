@@ -178,8 +178,8 @@ def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setti
         if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
             raise SettingError(setting, f"expected finite RGB pixels (H, W, 3), got shape {img.shape}")
         return _encoded(model, img, refine, progress, periodic)
-    if exemplar in model.codes:
-        return model.codes[exemplar], None, [], None
+    if exemplar in model.codes:     # a name: its code, with the part of the photo that names it
+        return model.codes[exemplar], None, [], model.code_harmonics.get(exemplar) if periodic else None
     if exemplar is None or not os.path.isfile(exemplar):
         raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
                                     f"({', '.join(model.codes) or 'none'})")

@@ -464,3 +464,32 @@ def test_a_motif_of_colours_at_one_luminance_is_found_in_the_colour_spectrum():
     assert np.corrcoef(back[..., 1].ravel(), img[..., 1].ravel())[0, 1] > 0.9
     with pytest.raises(ValueError, match="detect must be one of"):
         photo_harmonics(img, PPU, detect="chroma")
+
+
+def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
+    """--exemplar metal (a name of the texture-space model) is the code of the photo that names it, with that
+    photo's harmonic part: the plates' seams, as encoding the photo gives them; --no-periodic and mixing carry the
+    part as for a photo; a part stored for a name the model lacks, or on a single model, is refused by name."""
+    import json
+    import shutil
+
+    from backend.onnx_models import ModelError
+    from backend.solid.refine import texture_code
+    from export import read_rgb
+
+    photo = read_rgb(os.path.join(ROOT, "data", "photos", "train", "metal__metal_plates.jpg"))
+    named, encoded = space.code("metal"), space.photo_code(photo)
+    assert named.harmonics is not None and named.harmonics.share > 0.4
+    np.testing.assert_allclose(space.image(64, named, seed=2), space.image(64, encoded, seed=2), atol=1e-4)
+    assert space.code("grass").harmonics is None                     # its photo has no period
+    code, _ = texture_code(space, "metal", periodic=False)
+    assert code.harmonics is None
+    code, _ = texture_code(space, "metal", to="grass", mix=0.25)
+    assert np.isclose(code.harmonics.share, 0.75 * named.harmonics.share)
+    folder = tmp_path / "space"
+    shutil.copytree(SPACE, folder)
+    doc = json.loads((folder / "solid.json").read_text())
+    doc["code_harmonics"]["cork"] = doc["code_harmonics"]["metal"]
+    (folder / "solid.json").write_text(json.dumps(doc))
+    with pytest.raises(ModelError, match="stores a harmonic part for code 'cork'"):
+        SolidTextureModel(str(folder))

@@ -4,7 +4,7 @@ import json
 import os
 import shutil
 
-from training.solid.harmonics import main, measure
+from training.solid.harmonics import main, measure, measure_codes
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BRICK = os.path.join(ROOT, "models", "solid", "brick_3d")
@@ -14,6 +14,32 @@ def test_the_shipped_part_is_what_the_command_measures():
     with open(os.path.join(BRICK, "solid.json"), encoding="utf-8") as f:
         stored = json.load(f)["harmonics"]
     assert json.loads(json.dumps(measure(BRICK, ROOT))) == stored
+
+
+def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, capsys):
+    """The texture-space model stores a part per named code whose photo has one (metal plates, planks, ...),
+    measured from the photo that names it; the command rewrites them the same, and refuses a photo set whose
+    photos no longer encode to the stored codes."""
+    space = os.path.join(ROOT, "models", "solid", "space")
+    with open(os.path.join(space, "solid.json"), encoding="utf-8") as f:
+        stored = json.load(f)["code_harmonics"]
+    assert {"metal", "wood"} <= set(stored)
+    assert json.loads(json.dumps(measure_codes(space, ROOT))) == stored
+    folder = tmp_path / "space"
+    shutil.copytree(space, folder)
+    assert main([str(folder), "--remove", "--root", ROOT]) == 0
+    assert "code_harmonics" not in json.loads((folder / "solid.json").read_text())
+    assert main([str(folder), "--root", ROOT]) == 0
+    assert "metal 132 waves" in capsys.readouterr().out
+    assert json.loads((folder / "solid.json").read_text())["code_harmonics"] == stored
+    train = os.path.join(ROOT, "data", "photos", "train")
+    other = tmp_path / "other"
+    (other / "data" / "photos" / "train").mkdir(parents=True)
+    for f in os.listdir(train):        # the same photo set, but another photo in metal's place
+        src = os.path.join(train, "wood__bridge_wood_b.jpg" if f == "metal__metal_plates.jpg" else f)
+        os.symlink(src, other / "data" / "photos" / "train" / f)
+    assert main([str(folder), "--root", str(other)]) == 2
+    assert "does not encode to the stored code 'metal'" in capsys.readouterr().err
 
 
 def test_remove_and_add_back(tmp_path, capsys):

@@ -496,6 +496,12 @@ def test_harmonic_rest_trains_on_photos_less_their_part_as_the_runtime_encodes_t
     z = rt.encode(photo, part)
     np.testing.assert_allclose(z[8:20], colour_stats(remove_harmonics(photo, part, rt.px_per_unit)), atol=1e-5)
     np.testing.assert_allclose(rt.encode(photo)[8:20], colour_stats(photo), atol=1e-5)
+    # the name "brick" keeps its photo's part, measured from the photo, not its rest: the name draws the photo's
+    # code as encoding the photo would
+    assert set(doc["code_harmonics"]) == {"brick"} and rt.code_harmonics["brick"].share > 0.5
+    named, encoded = rt.code("brick"), rt.photo_code(photo)
+    np.testing.assert_allclose(named.e, encoded.e, atol=1e-4)
+    np.testing.assert_array_equal(named.harmonics.freq, encoded.harmonics.freq)
     for bad in (dict(cfg, mode="single", exemplars=brick), dict(cfg, colour="sigmoid")):
         with pytest.raises(ValueError, match="harmonic_rest"):
             SolidConfig.from_dict(bad)

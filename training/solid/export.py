@@ -24,7 +24,8 @@ from torch import nn
 
 from backend._export import export as _ex
 from backend.onnx_models import sha256_file
-from backend.solid.model import exemplar_category
+from backend.solid.harmonic import to_json
+from backend.solid.model import exemplar_category, measure_harmonics
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
 from .model import COLOUR_STATS, colour_stats, spectral_gains
@@ -118,11 +119,17 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
             files["translator.onnx"] = sha256_file(os.path.join(out, "translator.onnx"))
             # codes of the training exemplars: mean z over a grid of 128 px crops
             # (photo models: one named code per category, its first training photo; z gets the photo's colour)
-            codes = {}
-            for name, img in zip(ex.expand(cfg.exemplars), training_images(cfg)):
+            # and, photo models, each name's harmonic part from its photo (not its rest), which code(name) adds
+            codes, parts = {}, {}
+            photos = training_images(cfg, rests=False) if cfg.colour == "affine" else None
+            for i, (name, img) in enumerate(zip(ex.expand(cfg.exemplars), training_images(cfg))):
                 key = exemplar_category(name)
                 if key in codes:      # photo models: a category's first training photo names it
                     continue
+                if photos is not None:
+                    h = measure_harmonics(photos[i].permute(1, 2, 0).numpy(), cfg.px_per_unit)
+                    if len(h):
+                        parts[key] = to_json(h)
                 crops = img.unfold(1, ENCODER_SIZE, ENCODER_SIZE // 2).unfold(2, ENCODER_SIZE, ENCODER_SIZE // 2)
                 crops = crops.permute(1, 2, 0, 3, 4).reshape(-1, 3, ENCODER_SIZE, ENCODER_SIZE)
                 z = model.encoder(crops).mean(0)
@@ -132,6 +139,8 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                     z = torch.cat([z, spectral_gains(crops, cfg.octaves, cfg.px_per_unit).mean(0)])
                 codes[key] = z.numpy().astype(float).round(6).tolist()
             doc["codes"] = codes
+            if parts:
+                doc["code_harmonics"] = parts
             doc["encoder_size"] = ENCODER_SIZE
     doc["files"] = files
     doc.update(extra or {})

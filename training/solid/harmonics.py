@@ -1,4 +1,9 @@
-"""Store a single photo model's harmonic part: ``python -m training.solid.harmonics MODEL_DIR [--remove]``.
+"""Store a photo model's harmonic parts: ``python -m training.solid.harmonics MODEL_DIR [--remove]``.
+
+A space photo model (the texture-space model) stores one part per named code (``code_harmonics``), measured from
+the training photo that names it (a category's first: the export's rule), so that ``--exemplar NAME`` draws what
+encoding that photo draws; the export writes them too, this adds them to an export made before.  The photo must
+still encode to the stored code (checked).
 
 The texture-space model measures a photo's harmonic part when it encodes it (``backend/solid/harmonic.py``).
 A single-exemplar photo model has no encoder, so its part is measured here, once, from the pixels it was trained
@@ -14,12 +19,14 @@ import json
 import os
 import sys
 
+import numpy as np
+
 from backend._export import export as _ex
 from backend.onnx_models import ModelError
 from backend.solid.harmonic import to_json
 from backend.solid.model import SolidTextureModel
 
-__all__ = ["measure", "main"]
+__all__ = ["measure", "measure_codes", "main"]
 
 
 def measure(folder: str, root: str = ".") -> dict:
@@ -34,6 +41,44 @@ def measure(folder: str, root: str = ".") -> dict:
     return to_json(m.harmonics(photo))
 
 
+def _photos(names, root: str) -> list:
+    """Exemplar names of a solid.json with ``photos:SPLIT`` replaced by that split's files (sorted, as the
+    photo set lists them; torch-free twin of ``training.solid.exemplars.expand``)."""
+    out = []
+    for n in names:
+        if n.startswith("photos:"):
+            folder = os.path.join(root, "data", "photos", n.split(":", 1)[1])
+            out += [os.path.join(folder, f) for f in sorted(os.listdir(folder)) if f.endswith((".jpg", ".png"))]
+        else:
+            out.append(os.path.join(root, n))
+    return out
+
+
+def measure_codes(folder: str, root: str = ".", tolerance: float = 1e-3) -> dict:
+    """A space photo model's ``code_harmonics``: for each named code with a part, the part of its photo."""
+    from backend.solid.model import exemplar_category
+
+    m = SolidTextureModel(folder)
+    if m.mode != "space" or not m.colour_stats:
+        raise ModelError(f"model {m.name!r} is not a space photo model")
+    parts, seen = {}, set()
+    for path in _photos(m.config["exemplars"], root):
+        key = exemplar_category(path)
+        if key in seen or key not in m.codes:
+            continue
+        seen.add(key)
+        photo = _ex.read_rgb(path)
+        h = m.harmonics(photo)
+        z = m.encode(photo, h)
+        off = float(np.abs(z - m.codes[key]).max())
+        if off > tolerance:
+            raise ModelError(f"{path} does not encode to the stored code {key!r} (off by {off:.3g}): the model was "
+                             "exported from other photos")
+        if len(h):
+            parts[key] = to_json(h)
+    return parts
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.solid.harmonics", description=__doc__.split("\n")[0])
     ap.add_argument("folder", help="a single photo model's folder (holds solid.json)")
@@ -44,13 +89,21 @@ def main(argv=None) -> int:
     try:
         with open(path, encoding="utf-8") as f:
             doc = json.load(f)
-        doc.pop("harmonics", None)
-        if not a.remove:
+        space = doc.get("mode") == "space"
+        doc.pop("code_harmonics" if space else "harmonics", None)
+        if not a.remove and space:
+            doc["code_harmonics"] = measure_codes(a.folder, a.root)
+        elif not a.remove:
             doc["harmonics"] = measure(a.folder, a.root)
     except (OSError, ValueError, ModelError) as exc:
         print(f"solid harmonics: error: {exc}", file=sys.stderr)
         return 2
     _ex.write_json(path, doc)
+    if space:
+        parts = doc.get("code_harmonics", {})
+        print(f"{path}: " + (", ".join(f"{k} {len(h['freq'])} waves ({h['share']:.3f})" for k, h in parts.items())
+                             or "no harmonic parts"))
+        return 0
     h = doc.get("harmonics")
     print(f"{path}: " + (f"{len(h['freq'])} waves, share {h['share']:.3f}" if h else "no harmonic part"))
     return 0

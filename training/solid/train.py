@@ -243,12 +243,12 @@ def harmonic_rest(img: torch.Tensor, px_per_unit: float) -> torch.Tensor:
     return torch.from_numpy(rest).permute(2, 0, 1).contiguous()
 
 
-def training_images(cfg: SolidConfig) -> list:
-    """The training regions of the config's exemplars, resampled (with ``harmonic_rest``: their rests):
-    list of (3, H, W)."""
+def training_images(cfg: SolidConfig, rests: bool = True) -> list:
+    """The training regions of the config's exemplars, resampled (with ``harmonic_rest`` and ``rests``: their
+    rests): list of (3, H, W)."""
     images = [_resample(ex.train_region(ex.exemplar(n), n, cfg.hold_out), cfg.exemplar_scale)
               for n in ex.expand(cfg.exemplars)]
-    return [harmonic_rest(i, cfg.px_per_unit) for i in images] if cfg.harmonic_rest else images
+    return [harmonic_rest(i, cfg.px_per_unit) for i in images] if cfg.harmonic_rest and rests else images
 
 
 def noise_gain(cfg: SolidConfig, step: int) -> float:
