@@ -50,15 +50,16 @@ import numpy as np  # noqa: E402
 
 from export.atomic import atomic_path, write_json  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
+from backend.solid.refine import exemplar_z  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
+from training.solid.photo_set import photo_set  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
 
 SIZE = 128
 
 
 def photos(split: str = "val") -> list:
-    folder = os.path.join(ROOT, "data", "photos", split)
-    return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith((".jpg", ".png")))
+    return photo_set(split, os.path.join(ROOT, "data", "photos"))
 
 
 def read(path: str) -> np.ndarray:
@@ -120,8 +121,6 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         rng = np.random.default_rng(0)
         t = time.time()
         if refine:      # the add-on's Refine Steps: encode, then search the code (backend/solid/refine.py)
-            from backend.solid.refine import exemplar_z
-
             z, _, _, h = exemplar_z(model, photo, refine=refine, periodic=periodic)
             code = model.translate(z, h)
         else:

@@ -26,11 +26,7 @@ def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, ca
     assert {"metal", "wood"} <= set(stored)
     assert json.loads(json.dumps(measure_codes(space, ROOT))) == stored
     folder = tmp_path / "space"
-    shutil.copytree(space, folder)
-    assert main([str(folder), "--remove", "--root", ROOT]) == 0
-    assert "code_harmonics" not in json.loads((folder / "solid.json").read_text())
-    assert main([str(folder), "--root", ROOT]) == 0
-    assert "metal 132 waves" in capsys.readouterr().out
+    assert "metal 132 waves" in remove_and_add_back(space, folder, "code_harmonics", capsys)
     assert json.loads((folder / "solid.json").read_text())["code_harmonics"] == stored
     train = os.path.join(ROOT, "data", "photos", "train")
     other = tmp_path / "other"
@@ -42,13 +38,19 @@ def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, ca
     assert "does not encode to the stored code 'metal'" in capsys.readouterr().err
 
 
+def remove_and_add_back(model: str, folder, key: str, capsys) -> str:
+    """A copy of ``model`` in ``folder`` with its stored part(s) ``key`` removed by the command (checked gone),
+    then measured again: what the command printed."""
+    shutil.copytree(model, folder)
+    assert main([str(folder), "--remove", "--root", ROOT]) == 0
+    assert key not in json.loads((folder / "solid.json").read_text())
+    assert main([str(folder), "--root", ROOT]) == 0
+    return capsys.readouterr().out
+
+
 def test_remove_and_add_back(tmp_path, capsys):
     folder = tmp_path / "brick_3d"
-    shutil.copytree(BRICK, folder)
-    assert main([str(folder), "--remove", "--root", ROOT]) == 0
-    assert "harmonics" not in json.loads((folder / "solid.json").read_text())
-    assert main([str(folder), "--root", ROOT]) == 0
-    assert "38 waves, share 0.374" in capsys.readouterr().out
+    assert "38 waves, share 0.374" in remove_and_add_back(BRICK, folder, "harmonics", capsys)
     with open(os.path.join(BRICK, "solid.json"), encoding="utf-8") as f:
         assert json.loads((folder / "solid.json").read_text()) == json.load(f)
 

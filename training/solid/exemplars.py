@@ -28,13 +28,12 @@ import torch
 
 from backend._export import export as _export
 from .. import noise_ops as ops
+from .photo_set import PHOTO_DIR, expand, photo_set
 
 __all__ = ["PHOTO_DIR", "expand", "photo_set", "PHOTOS", "PROCEDURAL", "DATA_DIR", "load_image", "procedural", "exemplar", "train_region",
            "heldout_region", "random_crops"]
 
 DATA_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "data", "exemplars")
-#: the colour photo set (tools/build_photo_set.py): data/photos/{train,val}/CATEGORY__NAME.jpg
-PHOTO_DIR = os.path.join(os.path.dirname(__file__), "..", "..", "data", "photos")
 PHOTOS = ("brick", "grass", "gravel")
 PROCEDURAL = ("wood", "marble", "rust", "granite")
 
@@ -98,25 +97,6 @@ def _procedural(name: str, seed: int, size: int) -> torch.Tensor:
     else:
         raise ValueError(f"unknown procedural exemplar {name!r}; choose from {', '.join(PROCEDURAL)}")
     return img.clamp(0, 1).to(torch.float32)
-
-
-def photo_set(split: str, photo_dir: str | None = None) -> list:
-    """Paths of the photo set's ``split`` ('train' or 'val'), sorted; whole photos are held out, never pixels."""
-    if split not in ("train", "val"):
-        raise ValueError(f"photo split must be 'train' or 'val', got {split!r}")
-    folder = os.path.join(photo_dir or PHOTO_DIR, split)
-    files = sorted(f for f in os.listdir(folder) if f.endswith((".jpg", ".png"))) if os.path.isdir(folder) else []
-    if not files:
-        raise ValueError(f"no photos in {folder}: run python tools/build_photo_set.py")
-    return [os.path.join(folder, f) for f in files]
-
-
-def expand(names) -> tuple:
-    """Exemplar names with ``photos:train`` / ``photos:val`` replaced by the photo set's files."""
-    out = []
-    for n in names:
-        out += photo_set(n.split(":", 1)[1]) if n.startswith("photos:") else [n]
-    return tuple(out)
 
 
 def exemplar(name: str, data_dir: str | None = None) -> torch.Tensor:

@@ -121,8 +121,11 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
             # (photo models: one named code per category, its first training photo; z gets the photo's colour)
             # and, photo models, each name's harmonic part from its photo (not its rest), which code(name) adds
             codes, parts = {}, {}
-            photos = training_images(cfg, rests=False) if cfg.colour == "affine" else None
-            for i, (name, img) in enumerate(zip(ex.expand(cfg.exemplars), training_images(cfg))):
+            images = training_images(cfg)
+            photos = None
+            if cfg.colour == "affine":      # the whole photos the names' parts are measured from, each read once
+                photos = training_images(cfg, rests=False) if cfg.harmonic_rest else images
+            for i, (name, img) in enumerate(zip(ex.expand(cfg.exemplars), images)):
                 key = exemplar_category(name)
                 if key in codes:      # photo models: a category's first training photo names it
                     continue

@@ -24,7 +24,9 @@ import numpy as np
 from backend._export import export as _ex
 from backend.onnx_models import ModelError
 from backend.solid.harmonic import to_json
-from backend.solid.model import SolidTextureModel
+from backend.solid.model import SolidTextureModel, exemplar_category
+
+from .photo_set import expand
 
 __all__ = ["measure", "measure_codes", "main"]
 
@@ -41,28 +43,13 @@ def measure(folder: str, root: str = ".") -> dict:
     return to_json(m.harmonics(photo))
 
 
-def _photos(names, root: str) -> list:
-    """Exemplar names of a solid.json with ``photos:SPLIT`` replaced by that split's files (sorted, as the
-    photo set lists them; torch-free twin of ``training.solid.exemplars.expand``)."""
-    out = []
-    for n in names:
-        if n.startswith("photos:"):
-            folder = os.path.join(root, "data", "photos", n.split(":", 1)[1])
-            out += [os.path.join(folder, f) for f in sorted(os.listdir(folder)) if f.endswith((".jpg", ".png"))]
-        else:
-            out.append(os.path.join(root, n))
-    return out
-
-
 def measure_codes(folder: str, root: str = ".", tolerance: float = 1e-3) -> dict:
     """A space photo model's ``code_harmonics``: for each named code with a part, the part of its photo."""
-    from backend.solid.model import exemplar_category
-
     m = SolidTextureModel(folder)
     if m.mode != "space" or not m.colour_stats:
         raise ModelError(f"model {m.name!r} is not a space photo model")
     parts, seen = {}, set()
-    for path in _photos(m.config["exemplars"], root):
+    for path in expand(m.config["exemplars"], root):
         key = exemplar_category(path)
         if key in seen or key not in m.codes:
             continue
