@@ -308,11 +308,12 @@ class SolidSource:
 
     def __init__(self, model, exemplar: str | None = None, seed: int = 0, scale: float = 1.0,
                  density: float = 1.0, refine: int = 0, code=None, to: str | None = None, mix: float = 0.0,
-                 periodic: bool = True):
+                 periodic: bool = True, gaussian: bool = True):
         """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
         code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds);
         to, mix: a space model's second exemplar and the share of it (interpolation, as ``omninoise solid``);
-        periodic: an encoded image keeps its harmonic part (backend/solid/harmonic.py)."""
+        periodic: an encoded image keeps its harmonic part (backend/solid/harmonic.py);
+        gaussian: and its Gaussian rest where the check keeps one (backend/solid/spectral.py)."""
         from .onnx_models import ModelError
         from .solid.model import SolidTextureModel
 
@@ -325,17 +326,21 @@ class SolidSource:
         self.dim = self.model.dim
         self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
         self.exemplar, self.to, self.mix, self.periodic = exemplar, to, float(mix), bool(periodic)
+        self.gaussian = bool(gaussian)
         self.input_sha256 = None
         if code is not None:
             self.code = code
             parts = [np.ravel(code.e), np.ravel(code.T)]
             if code.harmonics is not None:
                 parts.append(code.harmonics.values())
+            if code.rest is not None:
+                parts.append(code.rest.values())
             self.input_sha256 = hashlib.sha256(np.concatenate(parts).astype(np.float32).tobytes()).hexdigest()
             return
         from .solid.request import SolidRequest
 
-        req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed, self.periodic).check("source.")
+        req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed, self.periodic,
+                           self.gaussian).check("source.")
         self.code, self.input_sha256 = req.code(self.model, "source.")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
@@ -361,10 +366,12 @@ class SolidSource:
             d.update(to=self.to, mix=self.mix)
         h = self.code.harmonics     # the harmonic part in use (an encoded photo's, a stored one)
         d["harmonics_sha256"] = None if h is None else hashlib.sha256(h.values().astype("<f8").tobytes()).hexdigest()
+        r = self.code.rest         # the Gaussian rest in use (backend/solid/spectral.py), if the check kept one
+        d["gaussian_rest_sha256"] = None if r is None else hashlib.sha256(r.values().astype("<f8").tobytes()).hexdigest()
         return d
 
 
-_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic")
+_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
@@ -487,13 +494,13 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     to = path(d.get("to"))
     mix = d.get("mix", 0.5)
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
-                        d.get("seed", 0), d.get("periodic", True)).check("source.")
+                        d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True)).check("source.")
 
 
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
     req = solid_request_from_dict(d, base_dir)
     return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
-                       to=req.to, mix=req.mix, periodic=req.periodic)
+                       to=req.to, mix=req.mix, periodic=req.periodic, gaussian=req.gaussian)
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

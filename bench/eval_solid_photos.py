@@ -114,7 +114,7 @@ def spectrum_distance(images: list, photo: np.ndarray) -> float:
 
 
 def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None,
-             periodic: bool = True, refine: int = 0) -> dict:
+             periodic: bool = True, refine: int = 0, gaussian: bool = True) -> dict:
     rows = {}
     for path in files:
         photo = read(path)
@@ -123,8 +123,10 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         if refine:      # the add-on's Refine Steps: encode, then search the code (backend/solid/refine.py)
             z, _, _, h = exemplar_z(model, photo, refine=refine, periodic=periodic)
             code = model.translate(z, h)
+            if gaussian:
+                code = model.with_gaussian_rest(code, photo)
         else:
-            code = model.photo_code(photo, periodic)
+            code = model.photo_code(photo, periodic, gaussian)
         h = code.harmonics
         imgs = {ax: [slice_image(model, code, ax, s) for s in range(seeds)] for ax in "xyz"}
         seconds = time.time() - t
@@ -152,6 +154,7 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
                                                              photo), 3)
         r["seconds"] = round(seconds, 2)
         r["harmonic_peaks"], r["harmonic_share"] = (len(h), round(h.share, 4)) if h is not None else (0, 0.0)
+        r["gaussian_mix"] = code.rest.mix if code.rest is not None else 0.0
         rows[os.path.basename(path)] = r
         print(os.path.basename(path), {k: r[k] for k in ("swd", "colour", "random_phase", "pixel_shuffle")},
               flush=True)
@@ -177,6 +180,7 @@ def summary(rows: dict) -> dict:
                 max_colour_walls=round(float(max(r["colour_walls"] for r in rows.values())), 4),
                 median_diversity=med("diversity"), median_axis_spread=med("axis_spread"),
                 median_seconds=med("seconds"), worst_swd=float(swd.max()),
+                gaussian_rests=int(sum(r.get("gaussian_mix", 0.0) > 0 for r in rows.values())),
                 median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
                 median_morph_photo_crop=med("morph_photo_crop"),
                 beats_random_phase_morph=int(sum(r["morph"] < r["morph_random_phase"] for r in rows.values())),
@@ -234,6 +238,8 @@ def main(argv=None) -> int:
     ap.add_argument("--sheet", help="write a picture of (up to 8) photos and their textures")
     ap.add_argument("--no-periodic", dest="periodic", action="store_false",
                     help="leave out the photos' harmonic part (backend/solid/harmonic.py): the decoder alone")
+    ap.add_argument("--no-gaussian", dest="gaussian", action="store_false",
+                    help="leave out the Gaussian rest (backend/solid/spectral.py) even where its check keeps one")
     ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
     ap.add_argument("--refine", type=int, default=0, metavar="N",
                     help="refine each photo's code by N search steps first (the add-on's Refine Steps)")
@@ -248,9 +254,9 @@ def main(argv=None) -> int:
     if a.limit:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     sheet = [] if a.sheet else None
-    rows = evaluate(model, files, a.seeds, sheet, a.periodic, a.refine)
+    rows = evaluate(model, files, a.seeds, sheet, a.periodic, a.refine, a.gaussian)
     doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
-               periodic=a.periodic, refine=a.refine,
+               periodic=a.periodic, refine=a.refine, gaussian=a.gaussian,
                summary=summary(rows), by_category=by_category(rows), photos=rows)
     if a.against:
         doc["against"] = against(rows, a.against)

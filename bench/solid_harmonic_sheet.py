@@ -1,11 +1,14 @@
-"""Held-out photos and their solid textures with and without the harmonic part:
-``python bench/solid_harmonic_sheet.py [-o JPG] [PREFIX ...]``.
+"""Held-out photos and their solid textures with and without the harmonic part (or the Gaussian rest):
+``python bench/solid_harmonic_sheet.py [--part harmonic|gaussian] [-o JPG] [PREFIX ...]``.
 
 One row per photo of ``data/photos/val`` whose name starts with a PREFIX (default: the brick, wood, concrete,
 soil and fabric photos): photo (top-left 128²) | the texture-space model alone (front view, plane y) | with the
 photo's harmonic part (backend/solid/harmonic.py): front (y), side (x), floor (z), front at seed 1 | a cube whose
 visible faces are sampled from the 3D texture | random phase noise.  The slices are those of
-``bench/eval_solid_photos.py``.
+``bench/eval_solid_photos.py``.  Neither has the Gaussian rest (backend/solid/spectral.py); with ``--part
+gaussian`` the second column is the texture with its harmonic part and without the Gaussian rest, the next five
+with the rest where the encode-time check keeps one (the default photos: the held-out photos it is kept for, up
+to ``--limit``).
 """
 from __future__ import annotations
 
@@ -30,17 +33,27 @@ def main(argv=None) -> int:
     from PIL import Image
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("prefixes", nargs="*", default=list(DEFAULT))
+    ap.add_argument("prefixes", nargs="*")
+    ap.add_argument("--part", choices=("harmonic", "gaussian"), default="harmonic")
+    ap.add_argument("--limit", type=int, default=8, help="--part gaussian: at most this many rows")
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
-    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "img", "solid_harmonic.jpg"))
+    ap.add_argument("-o", "--out")
     a = ap.parse_args(argv)
+    out = a.out or os.path.join(ROOT, "docs", "img", f"solid_{a.part}.jpg")
+    prefixes = tuple(a.prefixes or (DEFAULT if a.part == "harmonic" else ("",)))
     m = SolidTextureModel(a.model)
     rows = []
     for path in photos():
-        if not os.path.basename(path).startswith(tuple(a.prefixes)):
+        if not os.path.basename(path).startswith(prefixes) or (a.part == "gaussian" and len(rows) >= a.limit):
             continue
         photo = read(path)
-        alone, with_h = m.photo_code(photo, periodic=False), m.photo_code(photo)
+        if a.part == "harmonic":
+            alone, with_h = m.photo_code(photo, periodic=False, gaussian=False), m.photo_code(photo, gaussian=False)
+        else:
+            alone = m.photo_code(photo, gaussian=False)
+            with_h = m.with_gaussian_rest(alone, photo)
+            if with_h.rest is None and not a.prefixes:
+                continue
         cb = cube(m, with_h)
         cb = np.asarray(Image.fromarray((cb * 255).astype(np.uint8)).resize((128, 128)), np.float32) / 255
         cells = [photo[:128, :128], slice_image(m, alone, "y", 0), slice_image(m, with_h, "y", 0),
@@ -51,9 +64,9 @@ def main(argv=None) -> int:
     if not rows:
         raise SystemExit(f"no held-out photo starts with {', '.join(a.prefixes)}")
     img = (np.clip(np.concatenate(rows, 0), 0, 1) * 255 + 0.5).astype(np.uint8)
-    with atomic_path(a.out) as tmp:
+    with atomic_path(out) as tmp:
         Image.fromarray(img).save(tmp, format="JPEG", quality=90)
-    print("wrote", a.out)
+    print("wrote", out)
     return 0
 
 

@@ -102,6 +102,10 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                            description="Keep the image's periodic part (brick courses, plank seams, weaves: its "
                                        "isolated spectral peaks) on top of the model's texture; upright on faces "
                                        "normal to X and to Y, in profile on floors")
+    gaussian: BoolProperty(name="Gaussian Rest", default=True,
+                           description="Where a check on rendered planes finds it closer to the image, mix in the "
+                                       "image's Gaussian rest: random phase noise of what the periodic part leaves, "
+                                       "drawn as a solid (rock faces, sand, wood grain the model draws too coarse)")
     scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
                          description="Texture units per Blender unit: larger means smaller features")
     seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
@@ -118,6 +122,8 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     voxels: IntProperty(name="Voxels", default=128, min=4, soft_max=512, description="Voxels along the longest side")
     periodic_info: StringProperty(name="Periodic Part Found", default="", options={"SKIP_SAVE"},
                                   description="What the last preview measured of the image's periodic part")
+    gaussian_info: StringProperty(name="Gaussian Rest Found", default="", options={"SKIP_SAVE"},
+                                  description="How much of the rest the last preview's check mixed in")
     name: StringProperty(name="Name", default="Solid Texture")
     folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise_bakes",
                            description="Where volumes are written ('//' = beside the .blend)")
@@ -150,7 +156,7 @@ def panel_request(p):
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
         return SolidRequest(os.path.join(models_dir(), name), _image_pixels(p.image), refine=int(p.refine),
-                            seed=int(p.seed), periodic=bool(p.periodic)).check()
+                            seed=int(p.seed), periodic=bool(p.periodic), gaussian=bool(p.gaussian)).check()
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
@@ -172,6 +178,14 @@ def periodic_info(code) -> str:
     if h is None:
         return "Periodic part: none found"
     return f"Periodic part: {len(h)} waves, {100 * h.share:.0f} % of the variance"
+
+
+def gaussian_info(code) -> str:
+    """A line for the panel: the share of the rest a code's Gaussian rest carries (backend/solid/spectral.py)."""
+    r = code.rest
+    if r is None:
+        return "Gaussian rest: not closer, the model's texture alone"
+    return f"Gaussian rest: {100 * r.mix:.0f} % of the rest's variance"
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:
@@ -269,12 +283,12 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
             code = code_fn()
             progress(0.2)
             img = m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
-            return img, periodic_info(code)
+            return img, periodic_info(code), gaussian_info(code)
 
         def done(result):
-            img, info = result
+            img, info, rest = result
             _store_image(name, np.flipud(img)).preview_ensure()
-            p.periodic_info = info
+            p.periodic_info, p.gaussian_info = info, rest
 
         return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
 
@@ -396,6 +410,9 @@ def draw_solid(layout, context) -> None:
         layout.prop(p, "periodic")
         if p.periodic and p.periodic_info:
             layout.label(text=p.periodic_info)
+        layout.prop(p, "gaussian")
+        if p.gaussian and p.gaussian_info:
+            layout.label(text=p.gaussian_info)
     prev = bpy.data.images.get(f"{p.name} Preview")
     if prev is not None and prev.preview is not None:
         layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)

@@ -176,6 +176,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-periodic", dest="periodic", action="store_false",
                    help="space model: leave out an encoded image's periodic part (courses, planks, weaves: its "
                         "isolated spectral peaks, added to the decoder's texture by default)")
+    s.add_argument("--no-gaussian", dest="gaussian", action="store_false",
+                   help="space model: never mix in an encoded image's Gaussian rest (random phase noise of what "
+                        "the periodic part leaves, drawn as a solid; mixed in by default where a check on rendered "
+                        "planes finds it closer to the image)")
     s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
     s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
     s.add_argument("--quiet", action="store_true")
@@ -661,7 +665,7 @@ def solid_request(a: argparse.Namespace):
     """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
     from backend.solid.request import SolidRequest
 
-    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic).check("--")
+    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian).check("--")
 
 
 def run_solid(a: argparse.Namespace) -> int:
@@ -701,6 +705,9 @@ def run_solid(a: argparse.Namespace) -> int:
         h = code.harmonics
         print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
               "(--no-periodic leaves it out)", file=sys.stderr)
+    if code.rest is not None and not a.quiet:
+        print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as a Gaussian solid, found "
+              "closer to the image than the decoder alone (--no-gaussian leaves it out)", file=sys.stderr)
     bar = _Bar(a.quiet)
     from backend.colour import srgb_to_linear
 

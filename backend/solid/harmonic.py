@@ -71,7 +71,7 @@ import numpy as np
 
 from ..periodic import periodic_component
 
-__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "remove_harmonics", "seed_shift", "mix_harmonics",
+__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift", "mix_harmonics",
            "to_json", "from_json", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES", "LOBE", "LOBE_DEPTH"]
 
 COUNT = 256         #: at most this many peaks
@@ -219,22 +219,30 @@ def seed_shift(seed: int) -> np.ndarray:
 FIELD_BLOCK = 1 << 20   #: harmonic_field works on at most this many point-wave pairs at a time (about 20 MB)
 
 
-def harmonic_field(points: np.ndarray, h: Harmonics, seed: int = 0) -> np.ndarray:
-    """h at points float (N, 2) (the photo's plane) or (N, 3) (q = (x + y, z); module doc), moved by
-    :func:`seed_shift`: float32 (N, 3).  Points go in blocks of FIELD_BLOCK / K, so memory stays flat
-    whatever the number of waves."""
-    x = np.asarray(points, np.float64)
-    out = np.zeros((x.shape[0], 3), np.float32)
-    if len(h) == 0:
+def wave_sum(q: np.ndarray, freq: np.ndarray, amp: np.ndarray) -> np.ndarray:
+    """sum_j Re(amp_j exp(2 pi i freq_j . q)) at points q float64 (N, D), freq float64 (K, D) cycles per unit, amp
+    complex (K, 3): float32 (N, 3).  Points go in blocks of FIELD_BLOCK / K, so memory stays flat whatever the
+    number of waves; phases are reduced modulo one cycle in float64 (module doc)."""
+    out = np.zeros((q.shape[0], 3), np.float32)
+    if len(freq) == 0:
         return out
-    q = (x if x.shape[1] == 2 else np.stack([x[:, 0] + x[:, 1], x[:, 2]], axis=1)) + seed_shift(seed)
-    re, im = h.amp.real.astype(np.float32), h.amp.imag.astype(np.float32)
-    step = max(1, FIELD_BLOCK // len(h))
-    for a in range(0, x.shape[0], step):
-        c = q[a:a + step] @ h.freq.T                                                   # (n, K) cycles, float64
+    re, im = amp.real.astype(np.float32), amp.imag.astype(np.float32)
+    step = max(1, FIELD_BLOCK // len(freq))
+    for a in range(0, q.shape[0], step):
+        c = q[a:a + step] @ freq.T                                                     # (n, K) cycles, float64
         t = ((c - np.floor(c)) * (2.0 * np.pi)).astype(np.float32)   # the phase mod 2 pi, then float32 trigonometry
         out[a:a + step] = np.cos(t) @ re - np.sin(t) @ im
     return out
+
+
+def harmonic_field(points: np.ndarray, h: Harmonics, seed: int = 0) -> np.ndarray:
+    """h at points float (N, 2) (the photo's plane) or (N, 3) (q = (x + y, z); module doc), moved by
+    :func:`seed_shift`: float32 (N, 3) (:func:`wave_sum`)."""
+    x = np.asarray(points, np.float64)
+    if len(h) == 0:
+        return np.zeros((x.shape[0], 3), np.float32)
+    q = (x if x.shape[1] == 2 else np.stack([x[:, 0] + x[:, 1], x[:, 2]], axis=1)) + seed_shift(seed)
+    return wave_sum(q, h.freq, h.amp)
 
 
 def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmonics | None:

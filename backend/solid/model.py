@@ -17,6 +17,7 @@ Positions are in texture units: ``px_per_unit`` exemplar pixels per unit.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass
 
@@ -30,6 +31,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
 from .lattice import lattice_noise
+from .spectral import RENDER, RestField, choose_mix, rest_field, rest_waves
 from .waves import wave_features
 
 __all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "measure_harmonics"]
@@ -99,13 +101,15 @@ class TextureCode:
     Cholesky factor ``L`` float32 (3, 3) of its colour covariance (rgb = mu + L d); for spectral models the
     per-octave ``gains`` float32 (m,) measured from the exemplar (:func:`spectral_gains`); for a photo a space model
     encoded, or a single photo model that stores one, the photo's ``harmonics`` (:mod:`backend.solid.harmonic`:
-    the periodic part added to the decoder's)."""
+    the periodic part added to the decoder's); for a photo a space model encoded, the Gaussian ``rest``
+    (:mod:`backend.solid.spectral`) mixed with the decoder's part when the encode-time check kept one."""
     e: np.ndarray
     T: np.ndarray
     mu: np.ndarray | None = None
     L: np.ndarray | None = None
     gains: np.ndarray | None = None
     harmonics: Harmonics | None = None
+    rest: RestField | None = None
 
 
 def exemplar_category(name: str) -> str:
@@ -163,18 +167,24 @@ def spectral_gains(img: np.ndarray, octaves: int = 8, px_per_unit: float = 128.0
     return np.clip(np.sqrt(octaves * e / e.sum()), *GAIN_RANGE).astype(_F)
 
 
-def measure_harmonics(image: np.ndarray, px_per_unit: float) -> Harmonics:
-    """A photo's harmonic part (:func:`backend.solid.harmonic.photo_harmonics`) at ``px_per_unit`` pixels per
-    texture unit: image float (H, W, 3) or (H, W) in [0, 1]; a photo over HARMONIC_SIDE px is measured at that size,
-    its waves kept at their frequency in texture units.  The one measurement the runtime, the export and the
-    harmonics tool share."""
+def _measured(image: np.ndarray, px_per_unit: float) -> tuple:
+    """(image float32 (H', W', 3), its px per unit): a photo over HARMONIC_SIDE px resized to that size, its
+    frequencies in texture units unchanged (what the harmonic part and the Gaussian rest are measured on)."""
     img = _rgb(image)
     ppu, W = float(px_per_unit), img.shape[1]
     f = HARMONIC_SIDE / max(img.shape[:2])
     if f < 1.0:
         img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
         ppu *= img.shape[1] / W
-    return photo_harmonics(img, ppu)
+    return img, ppu
+
+
+def measure_harmonics(image: np.ndarray, px_per_unit: float) -> Harmonics:
+    """A photo's harmonic part (:func:`backend.solid.harmonic.photo_harmonics`) at ``px_per_unit`` pixels per
+    texture unit: image float (H, W, 3) or (H, W) in [0, 1]; a photo over HARMONIC_SIDE px is measured at that size,
+    its waves kept at their frequency in texture units.  The one measurement the runtime, the export and the
+    harmonics tool share."""
+    return photo_harmonics(*_measured(image, px_per_unit))
 
 
 class SolidTextureModel:
@@ -294,12 +304,36 @@ class SolidTextureModel:
             return None
         return measure_harmonics(image, self.px_per_unit)
 
-    def photo_code(self, image: np.ndarray, periodic: bool = True) -> TextureCode:
+    def photo_code(self, image: np.ndarray, periodic: bool = True, gaussian: bool = True) -> TextureCode:
         """Space mode: a photo's code as the product makes it before any refinement: the photo's harmonic part
         (:meth:`harmonics`, unless ``periodic`` is False), the photo encoded with it (:meth:`encode`: a model
-        trained on rests reads the rest), translated with the part riding along."""
+        trained on rests reads the rest), translated with the part riding along, and its Gaussian rest
+        (:meth:`gaussian_rest`, unless ``gaussian`` is False)."""
         h = self.harmonics(image) if periodic else None
-        return self.translate(self.encode(image, h), h)
+        code = self.translate(self.encode(image, h), h)
+        return self.with_gaussian_rest(code, image) if gaussian else code
+
+    def gaussian_rest(self, image: np.ndarray, code: TextureCode) -> RestField | None:
+        """The Gaussian share of a photo's rest to mix into ``code`` (the photo's, without one), or None where the
+        encode-time check keeps the decoder alone (:mod:`backend.solid.spectral`).  Photo models of 3D space
+        only (the rest is a solid)."""
+        if self.mode != "space" or not self.colour_stats or self.dim != 3 or code.rest is not None:
+            return None
+        img, ppu = _measured(image, self.px_per_unit)
+        h = code.harmonics
+        rest = remove_harmonics(img, h, ppu) if h is not None and len(h) else img
+
+        def layers(seed, axis, offset):
+            pts = slice_points(RENDER, self.px_per_unit, axis, offset)
+            fixed, dec = self.layers(pts, code, seed)
+            return fixed, dec, pts
+
+        return choose_mix(layers, _rgb(image), rest_waves(rest, ppu))
+
+    def with_gaussian_rest(self, code: TextureCode, image: np.ndarray) -> TextureCode:
+        """``code`` with :meth:`gaussian_rest` of ``image`` (unchanged where there is none)."""
+        r = self.gaussian_rest(image, code)
+        return code if r is None else dataclasses.replace(code, rest=r)
 
     def translate(self, z, harmonics: Harmonics | None = None) -> TextureCode:
         """Space mode, translator h(z) -> (e, T) (Sec. 3); ``harmonics`` (:meth:`harmonics`) ride along."""
@@ -341,8 +375,8 @@ class SolidTextureModel:
         Works in chunks of ``chunk`` points (memory stays flat whatever N);
         ``progress(fraction)`` after each chunk (the one progress contract of the core); ``cancel()`` returning True
         stops early with :class:`Cancelled`.  2D points on a 3D model are
-        read on the z = 0 plane.  A code with ``harmonics`` adds the photo's harmonic part (harmonic.py):
-        rgb = mu + k L d + h(x).
+        read on the z = 0 plane.  A code with ``harmonics`` adds the photo's harmonic part (harmonic.py), one with
+        a ``rest`` its Gaussian rest (spectral.py): rgb = mu + k sqrt(1 - t) L d + h(x) + sqrt(t) g(x).
         """
         pts = np.asarray(points)
         if pts.ndim != 2 or pts.shape[1] not in (2, 3):
@@ -360,33 +394,69 @@ class SolidTextureModel:
             if cancel is not None and cancel():
                 raise Cancelled("cancelled")
             b = min(N, a + chunk)
-            noise = lattice_noise(pts[a:b], T, seed, self.channels)
-            if self.spectral_gains:
-                if code.gains is None:
-                    raise SettingError("code", f"model {self.name!r} needs the exemplar's spectral gains in its code")
-                noise *= np.repeat(np.asarray(code.gains, _F), self.channels)   # octave-major: i*C + c
-            if self.cellular:
-                noise = np.concatenate([noise, cellular_features(pts[a:b], T, seed, self.cellular)], axis=1)
-            if self.bricks:
-                noise = np.concatenate([noise, brick_features(pts[a:b], T, seed, self.bricks)], axis=1)
-            if len(self.waves):
-                noise = np.concatenate([noise, wave_features(pts[a:b], self.waves)], axis=1)
-            e = code.e if code.e.ndim == 1 else code.e[a:b]
-            d = self.decode(noise, e)
+            d = self._decoded(pts[a:b], code, seed, a, b)
             if self.colour_stats:
-                if code.mu is None or code.L is None:
-                    raise SettingError("code", f"model {self.name!r} needs the exemplar's colour (mu, L) in its code")
-                h = code.harmonics
-                if h is None:
-                    d = np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
-                else:   # rgb = mu + k L d + h(x) (harmonic.py); a rest model's L is already the rest's: k = 1
-                    hx = harmonic_field(pts[a:b], h, seed)
-                    k = _F(1.0 if self.harmonic_rest else h.keep)
-                    d = np.clip(code.mu + k * (d @ np.asarray(code.L, _F).T) + hx, 0.0, 1.0)
+                d = self._coloured(pts[a:b], d, code, seed)
             out[a:b] = d
             if progress is not None:
                 progress(b / N)
         return out
+
+    def _decoded(self, pts: np.ndarray, code: TextureCode, seed: int, a: int = 0, b: int | None = None) -> np.ndarray:
+        """The decoder's output at points float (n, dim) (rows a:b of a per-point code): float32 (n, 3)."""
+        T = np.asarray(code.T, _F)
+        noise = lattice_noise(pts, T, seed, self.channels)
+        if self.spectral_gains:
+            if code.gains is None:
+                raise SettingError("code", f"model {self.name!r} needs the exemplar's spectral gains in its code")
+            noise *= np.repeat(np.asarray(code.gains, _F), self.channels)   # octave-major: i*C + c
+        if self.cellular:
+            noise = np.concatenate([noise, cellular_features(pts, T, seed, self.cellular)], axis=1)
+        if self.bricks:
+            noise = np.concatenate([noise, brick_features(pts, T, seed, self.bricks)], axis=1)
+        if len(self.waves):
+            noise = np.concatenate([noise, wave_features(pts, self.waves)], axis=1)
+        e = code.e if code.e.ndim == 1 else code.e[a:b]
+        return self.decode(noise, e)
+
+    def _check_colour(self, code: TextureCode) -> None:
+        if code.mu is None or code.L is None:
+            raise SettingError("code", f"model {self.name!r} needs the exemplar's colour (mu, L) in its code")
+
+    def _keep(self, code: TextureCode) -> float:
+        """The factor on the decoder's coloured part: k = sqrt(1 - share) with a harmonic part (1 for a model
+        trained on rests, whose L is already the rest's), times sqrt(1 - t) with a Gaussian rest."""
+        k = 1.0 if code.harmonics is None or self.harmonic_rest else code.harmonics.keep
+        return k * float(np.sqrt(1.0 - code.rest.mix)) if code.rest is not None else k
+
+    def _coloured(self, pts: np.ndarray, d: np.ndarray, code: TextureCode, seed: int) -> np.ndarray:
+        """Photo models: rgb = clip(mu + k L d + h(x) + sqrt(t) g(x)) (harmonic.py, spectral.py): float32 (n, 3)."""
+        self._check_colour(code)
+        h, r = code.harmonics, code.rest
+        if h is None and r is None:
+            return np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
+        out = code.mu + _F(self._keep(code)) * (d @ np.asarray(code.L, _F).T)
+        if h is not None:
+            out = out + harmonic_field(pts, h, seed)
+        if r is not None:
+            out = out + rest_field(pts, r, seed)
+        return np.clip(out, 0.0, 1.0)
+
+    def layers(self, points: np.ndarray, code: TextureCode, seed: int = 0) -> tuple:
+        """Photo models, a code without a Gaussian rest: the two parts of :meth:`evaluate` before clipping, float32
+        (N, 3) each: (mu + h(x), k L d(x)) (what the Gaussian rest's check mixes; points as :meth:`evaluate`'s)."""
+        self._check_colour(code)
+        if code.rest is not None:
+            raise SettingError("code", "layers takes a code without a Gaussian rest")
+        pts = np.asarray(points)
+        if pts.shape[1] < self.dim:
+            pts = np.concatenate([pts, np.zeros((pts.shape[0], self.dim - pts.shape[1]), pts.dtype)], axis=1)
+        d = self._decoded(pts, code, seed, 0, pts.shape[0])
+        dec = _F(self._keep(code)) * (d @ np.asarray(code.L, _F).T)
+        fixed = np.broadcast_to(np.asarray(code.mu, _F), dec.shape).copy()
+        if code.harmonics is not None:
+            fixed += harmonic_field(pts, code.harmonics, seed)
+        return fixed, dec
 
     def image(self, size: int, code: TextureCode, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),
               axis: str = "y", **kw) -> np.ndarray:

@@ -31,6 +31,7 @@ Shapes: images float32 (H, W, 3) sRGB values in [0, 1].
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 
 import numpy as np
@@ -39,6 +40,7 @@ from .._export import export
 from ..errors import SettingError
 from ..grid import Cancelled
 from .harmonic import mix_harmonics
+from .spectral import mix_rests
 from .model import resize_rgb
 
 __all__ = ["SlicedTarget", "sliced_target", "sliced_distance", "refine_code", "exemplar_z", "RENDER_SIZE",
@@ -200,7 +202,8 @@ def _encoded(model, img: np.ndarray, refine: int, progress, periodic: bool):
 
 
 def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: str | None = None, mix: float = 0.0,
-                 refine: int = 0, where: str = "", progress=None, report=None, periodic: bool = True):
+                 refine: int = 0, where: str = "", progress=None, report=None, periodic: bool = True,
+                 gaussian: bool = True):
     """The one place a texture request becomes a code, for the command line, job files and the farm:
     (TextureCode, the input images' sha256 or None).
 
@@ -209,7 +212,8 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
     gives ``exemplar`` (a training exemplar's name or an image file, refined by ``refine`` steps), mixed with
     ``to`` by ``mix`` in [0, 1] (Henzler et al. 2020, Sec. 4: interpolation in the latent space; an image's harmonic
     part, :mod:`backend.solid.harmonic`, comes along unless ``periodic`` is False, mixed by
-    :func:`~backend.solid.harmonic.mix_harmonics`). ``where``
+    :func:`~backend.solid.harmonic.mix_harmonics`; an image's Gaussian rest, :mod:`backend.solid.spectral`, where
+    the check keeps one and ``gaussian`` is True, mixed by :func:`~backend.solid.spectral.mix_rests`). ``where``
     prefixes the setting names in errors ("source." for job files, "--" for flags); ``report(name, history)``
     hears each refinement's distances."""
     import hashlib
@@ -240,11 +244,13 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
             digests.append(hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest())
         if hist and report is not None:
             report(ex, hist)
-        return z, h
+        rest = model.gaussian_rest(img, model.translate(z, h)) if gaussian and img is not None else None
+        return z, h, rest
 
-    z, h = z_of(exemplar, "exemplar")
+    z, h, rest = z_of(exemplar, "exemplar")
     if to is not None:
-        z2, h2 = z_of(to, "to")
-        z, h = (1.0 - mix) * z + mix * z2, mix_harmonics(h, h2, mix)
+        z2, h2, rest2 = z_of(to, "to")
+        z, h, rest = (1.0 - mix) * z + mix * z2, mix_harmonics(h, h2, mix), mix_rests(rest, rest2, mix)
     sha = hashlib.sha256("".join(digests).encode()).hexdigest() if digests else None
-    return model.translate(z, h), sha
+    code = model.translate(z, h)
+    return (code if rest is None else dataclasses.replace(code, rest=rest)), sha

@@ -5,7 +5,8 @@ A request names a model (a folder, a shipped model's name, or None: chosen from 
 always did), an exemplar (a space model's training exemplar by name, an image file, or pixels a front-end already
 holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al. 2020, Sec. 4: interpolation in
 the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image's harmonic part,
-:mod:`backend.solid.harmonic`), and the ``seed`` of the noise.  Where the texture is read (grid,
+:mod:`backend.solid.harmonic`), ``gaussian`` (mix in an encoded image's Gaussian rest where the encode-time check
+finds it closer, :mod:`backend.solid.spectral`), and the ``seed`` of the noise.  Where the texture is read (grid,
 zoom, scale) belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
@@ -53,7 +54,8 @@ def _digest(x) -> str | None:
 class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
     model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
-    steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part)."""
+    steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
+    Gaussian rest, where the check keeps one)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)
@@ -62,6 +64,7 @@ class SolidRequest:
     refine: int = 0
     seed: int = 0
     periodic: bool = True
+    gaussian: bool = True
 
     def check(self, where: str = "") -> "SolidRequest":
         """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
@@ -76,6 +79,8 @@ class SolidRequest:
             raise bad("seed", f"must be a whole number in [0, {MAX_SEED}], got {self.seed}")
         if not isinstance(self.periodic, (bool, np.bool_)):
             raise bad("periodic", f"must be true or false, got {self.periodic!r}")
+        if not isinstance(self.gaussian, (bool, np.bool_)):
+            raise bad("gaussian", f"must be true or false, got {self.gaussian!r}")
         return self
 
     def folder(self, models: str | None = None) -> str:
@@ -107,10 +112,11 @@ class SolidRequest:
         from .refine import texture_code
 
         return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report,
-                            bool(self.periodic))
+                            bool(self.periodic), bool(self.gaussian))
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256)."""
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
-                    refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic))
+                    refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),
+                    gaussian=bool(self.gaussian))

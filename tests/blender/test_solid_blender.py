@@ -162,10 +162,12 @@ def test_image_source_is_encoded_by_the_space_model(scene):
     assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
     got = _pixels("Solid Texture Preview")
     m = _model("space")
-    code = m.translate(m.encode(np.flipud(np.round(rgba[..., :3] * 255) / 255)))
+    pixels = np.flipud(np.round(rgba[..., :3] * 255) / 255)
+    code = m.with_gaussian_rest(m.translate(m.encode(pixels)), pixels)
     ref = np.flipud(m.image(128, code, seed=3))
     assert np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
     assert p.periodic_info == "Periodic part: none found"      # random pixels have no period
+    assert p.gaussian_info == solid_ui.gaussian_info(code) and p.gaussian_info.startswith("Gaussian rest: ")
 
 
 def test_the_preview_shows_the_periodic_part_it_found(scene):
@@ -260,4 +262,10 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
                               "--no-periodic").key()
     assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
                                                  "seed": 3, "periodic": False}).key()
-    p.periodic = True
+    p.periodic, p.gaussian = True, False     # the Gaussian Rest box is --no-gaussian and gaussian = false
+    req = solid_ui.panel_request(p)
+    assert req.key() == flags("--model", space, "--exemplar", str(tmp_path / "ex.png"), "--refine", "4",
+                              "--no-gaussian").key()
+    assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
+                                                 "seed": 3, "gaussian": False}).key()
+    p.gaussian = True

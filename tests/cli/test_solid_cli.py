@@ -193,3 +193,22 @@ def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path
     write_job(tmp_path / "job.toml", 8 / space.px_per_unit, models["space3"], f'exemplar = "{photo}"\nperiodic = false')
     assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
     np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))
+
+
+def test_the_gaussian_rest_is_said_and_can_be_left_out(models, tmp_path, capsys):
+    """A held-out rock face the decoder draws too coarse gets its Gaussian rest (backend/solid/spectral.py), and
+    the command says so; --no-gaussian and a job file's `gaussian = false` leave it out alike."""
+    from backend.solid.model import SolidTextureModel
+
+    photo = os.path.join(os.path.dirname(TINY), "..", "..", "data", "photos", "val", "rock__rock_grey.jpg")
+    rc = main(["solid", "--model", models["space3"], "--exemplar", photo, "--size", "8", "-o", str(tmp_path / "x.npy")])
+    assert rc == 0 and "gaussian rest: 100 % of the rest's variance" in capsys.readouterr().err
+    on, off = str(tmp_path / "on.npy"), str(tmp_path / "off.npy")
+    assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--dim", "3", "--size", "8", "-o", on)[0] == 0
+    assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--dim", "3", "--size", "8", "--no-gaussian",
+               "-o", off)[0] == 0
+    assert np.abs(np.load(on) - np.load(off)).mean() > 0.01
+    space = SolidTextureModel(models["space3"])
+    write_job(tmp_path / "job.toml", 8 / space.px_per_unit, models["space3"], f'exemplar = "{photo}"\ngaussian = false')
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
+    np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(off))

@@ -27,6 +27,7 @@ def cli(*args):
     (["--exemplar", "grass", "--to", "gravel"], {"exemplar": "grass", "to": "gravel"}),
     (["--exemplar", "gravel", "--model", "space"], {"exemplar": "gravel", "model": "space"}),
     (["--exemplar", PHOTO, "--no-periodic"], {"exemplar": PHOTO, "periodic": False}),
+    (["--exemplar", PHOTO, "--no-gaussian"], {"exemplar": PHOTO, "gaussian": False}),
 ])
 def test_flags_and_job_tables_give_equal_requests(flags, table):
     a, b = cli(*flags), solid_request_from_dict(dict(table))
@@ -40,11 +41,14 @@ def test_a_file_and_its_pixels_are_one_exemplar():
     assert by_file.key() == by_pixels.key()
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, seed=1).key()
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, periodic=False).key()
+    assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, gaussian=False).key()
 
 
-def test_periodic_must_be_a_yes_or_no():
+def test_periodic_and_gaussian_must_be_a_yes_or_no():
     with pytest.raises(SettingError, match="source.periodic: must be true or false"):
         solid_request_from_dict(dict(exemplar=PHOTO, periodic="yes"))
+    with pytest.raises(SettingError, match="source.gaussian: must be true or false"):
+        solid_request_from_dict(dict(exemplar=PHOTO, gaussian=1))
 
 
 def test_the_model_is_chosen_as_the_command_line_always_did():

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from backend.solid.band_distance import laplacian_bands
 from backend.solid.cellular import cellular_features_numpy
 from backend.solid.lattice import lattice_noise
 
@@ -35,27 +36,11 @@ __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle
 #: where the held-out evaluations cut a 3D texture: a slice normal to each axis through these points (units)
 SLICE_OFFSETS = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
 
-_K = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
-
-
-def _blur(a: np.ndarray) -> np.ndarray:
-    """Separable 5-tap binomial blur with reflected borders: (H, W, C) -> (H, W, C)."""
-    p = np.pad(a, ((2, 2), (2, 2), (0, 0)), mode="reflect")
-    h = sum(_K[i] * p[:, i:i + a.shape[1]] for i in range(5))
-    return sum(_K[i] * h[i:i + a.shape[0]] for i in range(5))
-
 
 def laplacian_pyramid(img: np.ndarray, levels: int) -> list:
-    """Band-pass levels of an image (H, W, 3), finest first; the last level is the low-pass residue."""
-    g = np.asarray(img, np.float64)
-    out = []
-    for _ in range(levels - 1):
-        low = _blur(g)[::2, ::2]
-        up = np.repeat(np.repeat(low, 2, 0), 2, 1)[:g.shape[0], :g.shape[1]]
-        out.append(g - _blur(up))
-        g = low
-    out.append(g)
-    return out
+    """Band-pass levels of an image (H, W, 3), finest first; the last level is the low-pass residue (the
+    runtime's :func:`backend.solid.band_distance.laplacian_bands`)."""
+    return laplacian_bands(img, levels)
 
 
 def _descriptors(level: np.ndarray, n: int, rng: np.random.Generator, size: int = 7) -> np.ndarray:
