@@ -71,8 +71,9 @@ import numpy as np
 
 from ..periodic import periodic_component
 
-__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift", "mix_harmonics",
-           "to_json", "from_json", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES", "LOBE", "LOBE_DEPTH"]
+__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
+           "mix_harmonics", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
+           "LOBE", "LOBE_DEPTH"]
 
 COUNT = 256         #: at most this many peaks
 PROMINENCE = 16.0   #: a peak's power over the mean power of the bins around it
@@ -263,17 +264,24 @@ def to_json(h: Harmonics) -> dict:
     return dict(freq=h.freq.astype(float).tolist(), amp=amp.astype(float).tolist(), share=float(h.share))
 
 
+def read_waves(d, dim: int, scalar: str, ok, rule: str, what: str) -> tuple:
+    """(freq float64 (K, dim), amp complex128 (K, 3), d[scalar]) of stored waves (freq rows of ``dim`` values, amp
+    rows [re R, im R, re G, im G, re B, im B]: harmonic parts here, Gaussian rests in spectral.py); ValueError
+    naming ``what`` unless they hold numbers of those shapes, as many of each, finite, and ``ok(d[scalar])`` (the
+    ``rule`` the message states)."""
+    try:
+        freq = np.asarray(d["freq"], np.float64).reshape(-1, dim)
+        amp = np.asarray(d["amp"], np.float64).reshape(-1, 6)
+        value = float(d[scalar])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must hold freq (K x {dim}), amp (K x 6) and {scalar}: {exc}") from None
+    if len(freq) != len(amp) or not (np.all(np.isfinite(freq)) and np.all(np.isfinite(amp))) or not ok(value):
+        raise ValueError(f"{what}: {len(freq)} frequencies, {len(amp)} amplitudes, {scalar} {value}: "
+                         f"need as many of each, finite, and {rule}")
+    a = amp.reshape(-1, 3, 2)
+    return freq, a[..., 0] + 1j * a[..., 1], value
+
+
 def from_json(d) -> Harmonics:
     """:func:`to_json`'s dict -> Harmonics; ValueError naming what is wrong."""
-    try:
-        freq = np.asarray(d["freq"], np.float64).reshape(-1, 2)
-        amp = np.asarray(d["amp"], np.float64).reshape(-1, 6)
-        share = float(d["share"])
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ValueError(f"harmonics must hold freq (K x 2), amp (K x 6) and share: {exc}") from None
-    if len(freq) != len(amp) or not (np.all(np.isfinite(freq)) and np.all(np.isfinite(amp))) \
-            or not 0.0 <= share < 1.0:
-        raise ValueError(f"harmonics: {len(freq)} frequencies, {len(amp)} amplitudes, share {share}: "
-                         "need as many of each, finite, and a share in [0, 1)")
-    a = amp.reshape(-1, 3, 2)
-    return Harmonics(freq, a[..., 0] + 1j * a[..., 1], share)
+    return Harmonics(*read_waves(d, 2, "share", lambda s: 0.0 <= s < 1.0, "a share in [0, 1)", "harmonics"))

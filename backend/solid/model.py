@@ -31,7 +31,7 @@ from .brick import brick_features
 from .cellular import cellular_features
 from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
 from .lattice import lattice_noise
-from .spectral import RENDER, RestField, choose_mix, rest_field, rest_waves
+from .spectral import RENDER, RestField, choose_mix, rest_field, rest_from_json, rest_waves
 from .waves import wave_features
 
 __all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "measure_harmonics"]
@@ -221,15 +221,9 @@ class SolidTextureModel:
                 raise ModelError(f"model {self.name!r}: {exc}") from None
         #: a space photo model's named codes' harmonic parts, measured from the photos that name them (export, or
         #: training/solid/harmonics.py): ``code(name)`` draws a name as encoding its photo would
-        self.code_harmonics = {}
-        for k, v in c.get("code_harmonics", {}).items():
-            if self.mode != "space" or not c.get("colour_stats", 0) or k not in self.codes:
-                raise ModelError(f"model {self.name!r} stores a harmonic part for code {k!r}, which only a space "
-                                 "photo model's named codes can have")
-            try:
-                self.code_harmonics[k] = from_json(v)
-            except ValueError as exc:
-                raise ModelError(f"model {self.name!r}, code {k!r}: {exc}") from None
+        self.code_harmonics = self._named_parts(c, "code_harmonics", from_json, "a harmonic part")
+        #: ... and their Gaussian rests, where the check kept one for the photo (spectral.py; the same writers)
+        self.code_rests = self._named_parts(c, "code_rests", rest_from_json, "a Gaussian rest")
         #: a space model trained on its photos' rests (photo less harmonic part): it encodes a photo's rest when
         #: the photo's part rides along, and draws it at the rest's own colour covariance (k = 1, harmonic.py)
         self.harmonic_rest = bool(c.get("harmonic_rest", False))
@@ -240,6 +234,20 @@ class SolidTextureModel:
             raise ModelError(f"model {self.name!r} draws in its exemplar's colours but its solid.json has no "
                              f"colour_code of {self.colour_stats} values (mu and L): re-export it")
         self._session = SessionCache(folder, threads)
+
+    def _named_parts(self, c: dict, key: str, read, what: str) -> dict:
+        """solid.json's ``key`` {name: stored part}, read by ``read``; ModelError unless this is a space photo model
+        and every name is one of its codes, or when a part is malformed."""
+        out = {}
+        for k, v in c.get(key, {}).items():
+            if self.mode != "space" or not c.get("colour_stats", 0) or k not in self.codes:
+                raise ModelError(f"model {self.name!r} stores {what} for code {k!r}, which only a space photo "
+                                 "model's named codes can have")
+            try:
+                out[k] = read(v)
+            except ValueError as exc:
+                raise ModelError(f"model {self.name!r}, code {k!r}: {exc}") from None
+        return out
 
     @property
     def exemplar_label(self) -> str:
@@ -351,15 +359,18 @@ class SolidTextureModel:
         return TextureCode(e[0].astype(_F), T[0].astype(_F), *_colour(c), gains,
                            harmonics if harmonics is not None and len(harmonics) else None)
 
-    def code(self, exemplar: str | None = None) -> TextureCode:
+    def code(self, exemplar: str | None = None, gaussian: bool = True) -> TextureCode:
         """A named training exemplar's code (space models), with the harmonic part of the photo that names it when
-        the model stores one (``code_harmonics``), or the default code."""
+        the model stores one (``code_harmonics``) and its Gaussian rest (``code_rests``, unless ``gaussian`` is
+        False), or the default code."""
         if exemplar is None:
             return self.default_code()
         if exemplar not in self.codes:
             raise SettingError("exemplar", f"model {self.name!r} knows no exemplar {exemplar!r}"
                                            + (f"; it knows {', '.join(self.codes)}" if self.codes else ""))
-        return self.translate(self.codes[exemplar], self.code_harmonics.get(exemplar))
+        code = self.translate(self.codes[exemplar], self.code_harmonics.get(exemplar))
+        r = self.code_rests.get(exemplar) if gaussian else None
+        return code if r is None else dataclasses.replace(code, rest=r)
 
     # -- evaluation ------------------------------------------------------------------------------
     def decode(self, noise: np.ndarray, e: np.ndarray) -> np.ndarray:

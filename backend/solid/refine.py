@@ -244,7 +244,12 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
             digests.append(hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest())
         if hist and report is not None:
             report(ex, hist)
-        rest = model.gaussian_rest(img, model.translate(z, h)) if gaussian and img is not None else None
+        if not gaussian:
+            rest = None
+        elif img is not None:
+            rest = model.gaussian_rest(img, model.translate(z, h))
+        else:       # a name: its photo's rest, as the model stores it
+            rest = model.code_rests.get(ex) if isinstance(ex, str) else None
         return z, h, rest
 
     z, h, rest = z_of(exemplar, "exemplar")

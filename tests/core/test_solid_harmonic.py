@@ -478,11 +478,13 @@ def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
     from export import read_rgb
 
     photo = read_rgb(os.path.join(ROOT, "data", "photos", "train", "metal__metal_plates.jpg"))
-    # names carry no Gaussian rest (backend/solid/spectral.py: its check needs the photo), so the photo is
-    # encoded without one here
-    named, encoded = space.code("metal"), space.photo_code(photo, gaussian=False)
-    assert named.harmonics is not None and named.harmonics.share > 0.4 and named.rest is None
+    # with its Gaussian rest (backend/solid/spectral.py), stored to ten and six digits
+    named, encoded = space.code("metal"), space.photo_code(photo)
+    assert named.harmonics is not None and named.harmonics.share > 0.4 and named.rest.mix == encoded.rest.mix
     np.testing.assert_allclose(space.image(64, named, seed=2), space.image(64, encoded, seed=2), atol=1e-4)
+    assert space.code("metal", gaussian=False).rest is None
+    code, _ = texture_code(space, "metal", gaussian=False)
+    assert code.rest is None and texture_code(space, "metal")[0].rest.mix == 1.0
     assert space.code("grass").harmonics is None                     # its photo has no period
     code, _ = texture_code(space, "metal", periodic=False)
     assert code.harmonics is None
@@ -494,4 +496,14 @@ def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
     doc["code_harmonics"]["cork"] = doc["code_harmonics"]["metal"]
     (folder / "solid.json").write_text(json.dumps(doc))
     with pytest.raises(ModelError, match="stores a harmonic part for code 'cork'"):
+        SolidTextureModel(str(folder))
+    del doc["code_harmonics"]["cork"]
+    doc["code_rests"]["cork"] = doc["code_rests"]["metal"]
+    (folder / "solid.json").write_text(json.dumps(doc))
+    with pytest.raises(ModelError, match="stores a Gaussian rest for code 'cork'"):
+        SolidTextureModel(str(folder))
+    del doc["code_rests"]["cork"]
+    doc["code_rests"]["metal"]["mix"] = 0.0
+    (folder / "solid.json").write_text(json.dumps(doc))
+    with pytest.raises(ModelError, match="code 'metal': a Gaussian rest: 512 frequencies, 512 amplitudes, mix 0.0"):
         SolidTextureModel(str(folder))

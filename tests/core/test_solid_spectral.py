@@ -2,6 +2,7 @@
 (backend/solid/band_distance.py): cuts of the solid have the photo's radial spectrum, variance and colours; the
 check keeps the decoder where it is as close and mixes the rest in where the decoder is far; seeds, mixing and
 the texture an artist gets."""
+import json
 import os
 
 import numpy as np
@@ -9,8 +10,8 @@ import pytest
 
 from backend.solid.band_distance import band_distance
 from backend.solid.model import SolidTextureModel, slice_points
-from backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, _deproject, choose_mix, mix_rests, rest_field,
-                                    rest_waves)
+from backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, _deproject, choose_mix, mix_rests,
+                                    rest_field, rest_waves)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SPACE = os.path.join(ROOT, "models", "solid", "space")
@@ -207,3 +208,21 @@ def test_tiny_and_flat_photos_encode(space):
         assert code.rest is None or code.rest.mix in MIXES
     assert space.photo_code(np.full((64, 64, 3), 0.4, np.float32)).rest is None
     assert band_distance([np.zeros((128, 128, 3))], np.zeros((2, 2, 3))) >= 0.0
+
+
+def test_stored_rests_round_trip_to_six_digits_and_bad_ones_are_named():
+    from backend.solid.spectral import rest_from_json, rest_to_json
+
+    img = band_photo(seed=5)
+    r = RestField(*rest_waves(img, PPU), 0.75)
+    back = rest_from_json(json.loads(json.dumps(rest_to_json(r))))
+    assert back.mix == 0.75 and back.freq.shape == r.freq.shape
+    np.testing.assert_allclose(back.freq, r.freq, rtol=6e-10)
+    np.testing.assert_allclose(back.amp, r.amp, rtol=1e-5, atol=1e-9)
+    pts = slice_points(32, PPU, "x", (20.0, 40.0, 60.0))      # far from the origin, where phases grow
+    assert np.abs(rest_field(pts, back, 3) - rest_field(pts, r, 3)).max() < 1e-4
+    for bad, why in ((dict(freq=[[1, 2, 3]], amp=[[1, 0, 0, 0, 0, 0]]), "must hold freq"),
+                     (dict(freq=[[1, 2, 3]], amp=[[1, 0, 0, 0, 0, 0]] * 2, mix=1.0), "1 frequencies, 2 amplitudes"),
+                     (dict(freq=[[1, 2, 3]], amp=[[1, 0, 0, 0, 0, 0]], mix=1.5), "mix in \\(0, 1\\]")):
+        with pytest.raises(ValueError, match=why):
+            rest_from_json(bad)

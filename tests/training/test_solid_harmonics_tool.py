@@ -18,16 +18,21 @@ def test_the_shipped_part_is_what_the_command_measures():
 
 def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, capsys):
     """The texture-space model stores a part per named code whose photo has one (metal plates, planks, ...),
-    measured from the photo that names it; the command rewrites them the same, and refuses a photo set whose
-    photos no longer encode to the stored codes."""
+    measured from the photo that names it, and the Gaussian rest its check keeps (backend/solid/spectral.py);
+    the command rewrites them the same, and refuses a photo set whose photos no longer encode to the stored
+    codes."""
     space = os.path.join(ROOT, "models", "solid", "space")
     with open(os.path.join(space, "solid.json"), encoding="utf-8") as f:
-        stored = json.load(f)["code_harmonics"]
-    assert {"metal", "wood"} <= set(stored)
-    assert json.loads(json.dumps(measure_codes(space, ROOT))) == stored
+        doc = json.load(f)
+    stored, rests = doc["code_harmonics"], doc["code_rests"]
+    assert {"metal", "wood"} <= set(stored) and {"sand", "metal"} <= set(rests) and "grass" not in rests
+    parts, measured = measure_codes(space, ROOT)
+    assert json.loads(json.dumps(parts)) == stored and json.loads(json.dumps(measured)) == rests
     folder = tmp_path / "space"
-    assert "metal 132 waves" in remove_and_add_back(space, folder, "code_harmonics", capsys)
-    assert json.loads((folder / "solid.json").read_text())["code_harmonics"] == stored
+    said = remove_and_add_back(space, folder, "code_harmonics", capsys)
+    assert "metal 132 waves" in said and "Gaussian rests: brick 1.00" in said
+    back = json.loads((folder / "solid.json").read_text())
+    assert back["code_harmonics"] == stored and back["code_rests"] == rests
     train = os.path.join(ROOT, "data", "photos", "train")
     other = tmp_path / "other"
     (other / "data" / "photos" / "train").mkdir(parents=True)

@@ -502,6 +502,11 @@ def test_harmonic_rest_trains_on_photos_less_their_part_as_the_runtime_encodes_t
     named, encoded = rt.code("brick"), rt.photo_code(photo)
     np.testing.assert_allclose(named.e, encoded.e, atol=1e-4)
     np.testing.assert_array_equal(named.harmonics.freq, encoded.harmonics.freq)
+    # and its Gaussian rest where the check keeps one for the photo (written by the export from the photo)
+    assert (named.rest is None) == (encoded.rest is None) == ("brick" not in doc.get("code_rests", {}))
+    if named.rest is not None:
+        assert named.rest.mix == encoded.rest.mix
+        np.testing.assert_allclose(named.rest.freq, encoded.rest.freq, rtol=1e-5)
     for bad in (dict(cfg, mode="single", exemplars=brick), dict(cfg, colour="sigmoid")):
         with pytest.raises(ValueError, match="harmonic_rest"):
             SolidConfig.from_dict(bad)

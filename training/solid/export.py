@@ -120,7 +120,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
             # codes of the training exemplars: mean z over a grid of 128 px crops
             # (photo models: one named code per category, its first training photo; z gets the photo's colour)
             # and, photo models, each name's harmonic part from its photo (not its rest), which code(name) adds
-            codes, parts = {}, {}
+            codes, parts, named = {}, {}, {}
             images = training_images(cfg)
             photos = None
             if cfg.colour == "affine":      # the whole photos the names' parts are measured from, each read once
@@ -130,9 +130,11 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                 if key in codes:      # photo models: a category's first training photo names it
                     continue
                 if photos is not None:
-                    h = measure_harmonics(photos[i].permute(1, 2, 0).numpy(), cfg.px_per_unit)
+                    photo = photos[i].permute(1, 2, 0).numpy()
+                    h = measure_harmonics(photo, cfg.px_per_unit)
                     if len(h):
                         parts[key] = to_json(h)
+                    named[key] = (photo, h if len(h) else None)
                 crops = img.unfold(1, ENCODER_SIZE, ENCODER_SIZE // 2).unfold(2, ENCODER_SIZE, ENCODER_SIZE // 2)
                 crops = crops.permute(1, 2, 0, 3, 4).reshape(-1, 3, ENCODER_SIZE, ENCODER_SIZE)
                 z = model.encoder(crops).mean(0)
@@ -149,6 +151,16 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
     doc.update(extra or {})
     path = os.path.join(out, "solid.json")
     _ex.write_json(path, doc)
+    if cfg.mode == "space" and cfg.colour == "affine" and cfg.dim == 3:
+        # each name's Gaussian rest, as the runtime's check keeps it for its photo (it renders the export itself)
+        from backend.solid.model import SolidTextureModel
+
+        from .harmonics import rests_of
+
+        rests = rests_of(SolidTextureModel(out), named)
+        if rests:
+            doc["code_rests"] = rests
+            _ex.write_json(path, doc)
     return doc
 
 

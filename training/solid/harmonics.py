@@ -1,7 +1,8 @@
 """Store a photo model's harmonic parts: ``python -m training.solid.harmonics MODEL_DIR [--remove]``.
 
 A space photo model (the texture-space model) stores one part per named code (``code_harmonics``), measured from
-the training photo that names it (a category's first: the export's rule), so that ``--exemplar NAME`` draws what
+the training photo that names it (a category's first: the export's rule), and that photo's Gaussian rest where the
+encode-time check keeps one (``code_rests``, ``backend/solid/spectral.py``), so that ``--exemplar NAME`` draws what
 encoding that photo draws; the export writes them too, this adds them to an export made before.  The photo must
 still encode to the stored code (checked).
 
@@ -25,10 +26,11 @@ from backend._export import export as _ex
 from backend.onnx_models import ModelError
 from backend.solid.harmonic import to_json
 from backend.solid.model import SolidTextureModel, exemplar_category
+from backend.solid.spectral import rest_to_json
 
 from .photo_set import expand
 
-__all__ = ["measure", "measure_codes", "main"]
+__all__ = ["measure", "measure_codes", "rests_of", "main"]
 
 
 def measure(folder: str, root: str = ".") -> dict:
@@ -43,12 +45,25 @@ def measure(folder: str, root: str = ".") -> dict:
     return to_json(m.harmonics(photo))
 
 
-def measure_codes(folder: str, root: str = ".", tolerance: float = 1e-3) -> dict:
-    """A space photo model's ``code_harmonics``: for each named code with a part, the part of its photo."""
+def rests_of(m: SolidTextureModel, named: dict) -> dict:
+    """``code_rests`` of a space photo model: for each name of ``named`` {name: (photo float (H, W, 3), its
+    harmonic part or None)}, the Gaussian rest the check keeps for the photo drawn with the name's stored code
+    (names without one are left out)."""
+    out = {}
+    for key, (photo, h) in named.items():
+        r = m.gaussian_rest(photo, m.translate(m.codes[key], h))
+        if r is not None:
+            out[key] = rest_to_json(r)
+    return out
+
+
+def measure_codes(folder: str, root: str = ".", tolerance: float = 1e-3) -> tuple:
+    """A space photo model's (``code_harmonics``, ``code_rests``): for each named code with a part, the part of
+    its photo; for each with a Gaussian rest, that (:func:`rests_of`)."""
     m = SolidTextureModel(folder)
     if m.mode != "space" or not m.colour_stats:
         raise ModelError(f"model {m.name!r} is not a space photo model")
-    parts, seen = {}, set()
+    parts, seen, named = {}, set(), {}
     for path in expand(m.config["exemplars"], root):
         key = exemplar_category(path)
         if key in seen or key not in m.codes:
@@ -63,7 +78,8 @@ def measure_codes(folder: str, root: str = ".", tolerance: float = 1e-3) -> dict
                              "exported from other photos")
         if len(h):
             parts[key] = to_json(h)
-    return parts
+        named[key] = (photo, h if len(h) else None)
+    return parts, rests_of(m, named)
 
 
 def main(argv=None) -> int:
@@ -77,9 +93,10 @@ def main(argv=None) -> int:
         with open(path, encoding="utf-8") as f:
             doc = json.load(f)
         space = doc.get("mode") == "space"
-        doc.pop("code_harmonics" if space else "harmonics", None)
+        for key in ("code_harmonics", "code_rests") if space else ("harmonics",):
+            doc.pop(key, None)
         if not a.remove and space:
-            doc["code_harmonics"] = measure_codes(a.folder, a.root)
+            doc["code_harmonics"], doc["code_rests"] = measure_codes(a.folder, a.root)
         elif not a.remove:
             doc["harmonics"] = measure(a.folder, a.root)
     except (OSError, ValueError, ModelError) as exc:
@@ -87,9 +104,10 @@ def main(argv=None) -> int:
         return 2
     _ex.write_json(path, doc)
     if space:
-        parts = doc.get("code_harmonics", {})
+        parts, rests = doc.get("code_harmonics", {}), doc.get("code_rests", {})
         print(f"{path}: " + (", ".join(f"{k} {len(h['freq'])} waves ({h['share']:.3f})" for k, h in parts.items())
-                             or "no harmonic parts"))
+                             or "no harmonic parts") + "; Gaussian rests: "
+              + (", ".join(f"{k} {r['mix']:.2f}" for k, r in rests.items()) or "none"))
         return 0
     h = doc.get("harmonics")
     print(f"{path}: " + (f"{len(h['freq'])} waves, share {h['share']:.3f}" if h else "no harmonic part"))

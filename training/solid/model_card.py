@@ -329,8 +329,8 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "closer (\"Gaussian rest of an encoded photo\"). It is isotropic: a rock face's strata and a wood's "
           "grain direction are not kept, and it draws no cracks, stones or joints, only their spectrum and "
           "colours. The check is noisy (its slices differ by over 10 % between draws), so it keeps the decoder "
-          "unless the mix is 15 % closer, and on held-out photos it still makes 6 of 87 farther (one pebble "
-          "photo 93.9 -> 128.0). Named textures carry no Gaussian rest.", ""]
+          "unless the mix is 15 % closer, and on held-out photos it still makes 6 of 87 farther (a rock "
+          "photo 101.9 -> 128.4).", ""]
     return "\n".join(L)
 
 
