@@ -394,8 +394,7 @@ class SolidTextureModel:
             raise SettingError("points", f"points must have shape (N, 2) or (N, 3), got {pts.shape}")
         if pts.shape[1] > self.dim:
             raise SettingError("points", f"model {self.name!r} is {self.dim}D and cannot be evaluated at 3D points")
-        if pts.shape[1] < self.dim:
-            pts = np.concatenate([pts, np.zeros((pts.shape[0], self.dim - pts.shape[1]), pts.dtype)], axis=1)
+        pts = self._padded(pts)
         T = np.asarray(code.T, _F)
         if T.shape != (self.octaves, self.dim, self.dim):
             raise SettingError("code", f"transforms have shape {T.shape}, model needs {(self.octaves, self.dim, self.dim)}")
@@ -412,6 +411,12 @@ class SolidTextureModel:
             if progress is not None:
                 progress(b / N)
         return out
+
+    def _padded(self, pts: np.ndarray) -> np.ndarray:
+        """Points (N, D <= dim) with zeros for the missing coordinates: 2D points on a 3D model lie on z = 0."""
+        if pts.shape[1] >= self.dim:
+            return pts
+        return np.concatenate([pts, np.zeros((pts.shape[0], self.dim - pts.shape[1]), pts.dtype)], axis=1)
 
     def _decoded(self, pts: np.ndarray, code: TextureCode, seed: int, a: int = 0, b: int | None = None) -> np.ndarray:
         """The decoder's output at points float (n, dim) (rows a:b of a per-point code): float32 (n, 3)."""
@@ -459,9 +464,7 @@ class SolidTextureModel:
         self._check_colour(code)
         if code.rest is not None:
             raise SettingError("code", "layers takes a code without a Gaussian rest")
-        pts = np.asarray(points)
-        if pts.shape[1] < self.dim:
-            pts = np.concatenate([pts, np.zeros((pts.shape[0], self.dim - pts.shape[1]), pts.dtype)], axis=1)
+        pts = self._padded(np.asarray(points))
         d = self._decoded(pts, code, seed, 0, pts.shape[0])
         dec = _F(self._keep(code)) * (d @ np.asarray(code.L, _F).T)
         fixed = np.broadcast_to(np.asarray(code.mu, _F), dec.shape).copy()

@@ -248,8 +248,8 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
             rest = None
         elif img is not None:
             rest = model.gaussian_rest(img, model.translate(z, h))
-        else:       # a name: its photo's rest, as the model stores it
-            rest = model.code_rests.get(ex) if isinstance(ex, str) else None
+        else:       # a name (exemplar_z reads no image only for one): its photo's rest, as the model stores it
+            rest = model.code_rests.get(ex)
         return z, h, rest
 
     z, h, rest = z_of(exemplar, "exemplar")

@@ -164,8 +164,9 @@ def rest_field(points: np.ndarray, r: RestField, seed: int = 0) -> np.ndarray:
 
 def choose_mix(layers, photo: np.ndarray, waves) -> RestField | None:
     """The Gaussian rest to mix in, or None (module doc).  ``layers(seed, axis, offset)`` gives a check plane's
-    (fixed, decoder) parts float32 (RENDER^2, 3) (fixed: mean colour plus harmonic part; decoder: k L d);
-    ``waves`` is :func:`rest_waves`' result (None: nothing to mix)."""
+    (fixed, decoder, points): parts float32 (RENDER^2, 3) (fixed: mean colour plus harmonic part; decoder: k L d)
+    and the plane's points float64 (RENDER^2, 3); ``waves`` is :func:`rest_waves`' result (None: nothing to
+    mix)."""
     if waves is None:
         return None
     freq, amp = waves
