@@ -368,6 +368,8 @@ class SolidSource:
         d["harmonics_sha256"] = None if h is None else hashlib.sha256(h.values().astype("<f8").tobytes()).hexdigest()
         r = self.code.rest         # the Gaussian rest in use (backend/solid/spectral.py), if the check kept one
         d["gaussian_rest_sha256"] = None if r is None else hashlib.sha256(r.values().astype("<f8").tobytes()).hexdigest()
+        if self.model.spin:        # how the octaves turn with the seed (backend/solid/spin.py): part of the drawing
+            d["spin"] = self.model.spin
         return d
 
 

@@ -30,7 +30,8 @@ from ..paths import solid_models
 from .brick import brick_features
 from .cellular import cellular_features
 from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
-from .lattice import lattice_noise
+from .lattice import lattice_noise, octave_seeds
+from .spin import check_mode, spun
 from .spectral import RENDER, RestField, choose_mix, rest_field, rest_from_json, rest_waves
 from .waves import wave_features
 
@@ -229,6 +230,11 @@ class SolidTextureModel:
         self.harmonic_rest = bool(c.get("harmonic_rest", False))
         if self.harmonic_rest and (self.mode != "space" or not self.colour_stats):
             raise ModelError(f"model {self.name!r} was trained on harmonic rests, which only space photo models can")
+        #: how octaves turn with their seeds (spin.py): "lattice", "octave" or "" (older models: none)
+        try:
+            self.spin = check_mode(c.get("spin", ""))
+        except ValueError as exc:
+            raise ModelError(f"model {self.name!r}: {exc}") from None
         self.z_dim = int(c.get("z_dim", 8))
         if self.mode == "single" and self.colour_stats and len(c.get("colour_code", ())) != self.colour_stats:
             raise ModelError(f"model {self.name!r} draws in its exemplar's colours but its solid.json has no "
@@ -421,6 +427,8 @@ class SolidTextureModel:
     def _decoded(self, pts: np.ndarray, code: TextureCode, seed: int, a: int = 0, b: int | None = None) -> np.ndarray:
         """The decoder's output at points float (n, dim) (rows a:b of a per-point code): float32 (n, 3)."""
         T = np.asarray(code.T, _F)
+        if self.spin:
+            T = spun(T, octave_seeds(seed, self.octaves), self.spin)
         noise = lattice_noise(pts, T, seed, self.channels)
         if self.spectral_gains:
             if code.gains is None:

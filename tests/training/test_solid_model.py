@@ -1,5 +1,6 @@
 """Neural solid textures: training steps, ONNX export, and the torch-free runtime against torch."""
 
+import json
 import math
 
 import numpy as np
@@ -203,12 +204,14 @@ def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_
     assert ("| gravel | ours_3d: c continued, **not shipped** | 0.4 / 0.1 / 0.5 | 0.6 / 0.1 / 0.5 |" in text), text
 
 
-@pytest.mark.parametrize("dim,cellular,bricks,waves", [(2, 0, 0, 0), (3, 0, 0, 0), (2, 3, 0, 0), (3, 2, 2, 0),
-                                                      (2, 0, 0, 6)])
-def test_single_export_runtime_matches_torch(tmp_path, dim, cellular, bricks, waves):
-    run, state = _tiny(tmp_path, dim=dim, cellular=cellular, bricks=bricks, waves=waves)
+@pytest.mark.parametrize("dim,cellular,bricks,waves,spin", [(2, 0, 0, 0, ""), (3, 0, 0, 0, ""), (2, 3, 0, 0, ""),
+                                                           (3, 2, 2, 0, ""), (2, 0, 0, 6, ""), (3, 0, 0, 0, "lattice"),
+                                                           (2, 2, 0, 0, "lattice"), (3, 2, 0, 0, "octave")])
+def test_single_export_runtime_matches_torch(tmp_path, dim, cellular, bricks, waves, spin):
+    run, state = _tiny(tmp_path, dim=dim, cellular=cellular, bricks=bricks, waves=waves, spin=spin)
     out = tmp_path / "model"
     doc = export(str(run), str(out))
+    assert doc["spin"] == spin
     assert doc["mode"] == "single" and set(doc["files"]) == {"decoder.onnx"} and doc["cellular"] == cellular
     assert doc["bricks"] == bricks and len(doc.get("waves", [])) == waves
     if waves:   # measured from the exemplar, as training used them
@@ -231,7 +234,7 @@ def test_single_export_runtime_matches_torch(tmp_path, dim, cellular, bricks, wa
         e, T = m.codes(batch=1)
         ref = m.sample(torch.from_numpy(x), e, T, octave_seeds([7], 8)).numpy()[0]
     got = rt.evaluate(x[0], code, seed=7, chunk=700)
-    assert got.dtype == np.float32 and got.shape == (3000, 3)
+    assert got.dtype == np.float32 and got.shape == (3000, 3) and rt.spin == spin
     if cellular or bricks:   # float32 positions in torch: a point within ~1e-4 of a Voronoi border may pick the other cell
         assert (np.abs(got - ref).max(axis=1) < 2e-4).mean() > 0.995
     else:
@@ -284,6 +287,11 @@ def test_runtime_refuses_altered_and_bad_input(tmp_path):
         rt.encode(np.zeros((128, 128, 3)))
     with pytest.raises(Cancelled):
         rt.evaluate(np.zeros((10, 2)), rt.default_code(), cancel=lambda: True)
+    doc = json.loads((out / "solid.json").read_text())
+    (out / "solid.json").write_text(json.dumps(dict(doc, spin="world")))
+    with pytest.raises(ModelError, match="spin must be one of .* got 'world'"):
+        SolidTextureModel(str(out))
+    (out / "solid.json").write_text(json.dumps(doc))
     with open(out / "decoder.onnx", "ab") as fh:
         fh.write(b"x")
     with pytest.raises(ModelError, match="sha256 does not match"):
@@ -627,3 +635,24 @@ def test_training_with_waves_warns_when_the_photo_has_no_period(tmp_path):
     train(cfg, str(tmp_path / "w"), log=msgs.append)
     said = [m for m in msgs if m.startswith("waves:")]
     assert len(said) == 1 and "under 10 %" in said[0], msgs
+
+
+def test_isotropy_penalty_charges_the_stretch_alone():
+    """isotropy_weight's penalty: 0 for any rotation times a scale, ~0.43 for a 1.45 : 1 stretch, blind to
+    rotations before and after (spun lattices), and its gradient shrinks the stretch; configs check the weight."""
+    from training.solid.model import random_rotations
+    from training.solid.train import isotropy_penalty
+    R = random_rotations(8, 3, 1)
+    assert isotropy_penalty(R * 3.0).item() < 1e-10
+    S = R @ torch.diag(torch.tensor([1.45, 1.0, 1.0]))
+    p = isotropy_penalty(S).item()
+    assert 0.4 < p < 0.47
+    Q = random_rotations(8, 3, 2)
+    assert abs(isotropy_penalty(Q @ S @ R.transpose(-1, -2)).item() - p) < 1e-5
+    T = S.clone().requires_grad_(True)
+    isotropy_penalty(T).backward()
+    with torch.no_grad():
+        s = torch.linalg.svdvals(T - 0.1 * T.grad)
+    assert (s[:, 0] / s[:, 2]).max() < 1.45 - 0.01
+    with pytest.raises(ValueError, match="isotropy_weight"):
+        SolidConfig.from_dict({"isotropy_weight": -1.0})

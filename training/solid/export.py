@@ -96,7 +96,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
                exemplars=list(cfg.exemplars), colour="sRGB", colour_model=cfg.colour,
                colour_stats=COLOUR_STATS if cfg.colour == "affine" else 0,
                spectral_gains=cfg.octaves if cfg.spectral else 0, cellular=cfg.cellular, bricks=cfg.bricks,
-               harmonic_rest=cfg.harmonic_rest, step=int(state["step"]),
+               harmonic_rest=cfg.harmonic_rest, spin=cfg.spin, step=int(state["step"]),
                train_seconds=round(float(state.get("elapsed", 0.0)), 1), n_params=int(state["n_params"]),
                hardware=str(state.get("hardware", "")),
                config=state["config"])

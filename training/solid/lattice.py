@@ -13,8 +13,9 @@ import numpy as np
 import torch
 
 from backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
+from backend.solid.spin import check_mode, octave_spins
 
-__all__ = ["octave_seeds", "salted_seeds", "lattice_noise", "lowbias32_torch", "octave_positions"]
+__all__ = ["octave_seeds", "salted_seeds", "lattice_noise", "lowbias32_torch", "octave_positions", "spun_torch"]
 
 _LEVELS = (1 << BITS) - 1
 
@@ -48,6 +49,18 @@ def octave_positions(x: torch.Tensor, T: torch.Tensor, octaves: int) -> torch.Te
         T = T.unsqueeze(0).expand(B, T.shape[0], D, D)
     scale = (2.0 ** torch.arange(octaves, device=x.device, dtype=x.dtype)).view(1, octaves, 1, 1)
     return torch.einsum("bmij,bnj->bmni", T[:, :octaves] * scale, x)
+
+
+def spun_torch(T: torch.Tensor, seeds: torch.Tensor, mode: str) -> torch.Tensor:
+    """The runtime's ``backend.solid.spin.spun``: Q(xi_i) T_i (``"lattice"``) or T_i Q(xi_i)^T (``"octave"``);
+    T (m, D, D) or (B, m, D, D), octave seeds int64 (B, m) -> (B, m, D, D); the rotations are the runtime's float32
+    matrices, the product in float64 as there.  Gradients reach T."""
+    B, m = seeds.shape
+    D = T.shape[-1]
+    Q = torch.as_tensor(octave_spins(seeds.cpu().numpy(), D), device=T.device, dtype=torch.float64)
+    T = T.unsqueeze(0).expand(B, m, D, D) if T.dim() == 3 else T
+    out = Q @ T.double() if check_mode(mode) == "lattice" else T.double() @ Q.transpose(-1, -2)
+    return out.to(T.dtype)
 
 
 def lattice_noise(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, channels: int = 3) -> torch.Tensor:

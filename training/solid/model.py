@@ -31,10 +31,11 @@ from torch import nn
 
 from backend.solid.brick import FEATURES as BRICK_FEATURES
 from backend.solid.cellular import FEATURES as CELL_FEATURES
+from backend.solid.spin import check_mode
 from backend.solid.waves import FEATURES as WAVE_FEATURES
 from .brick import brick_features
 from .cellular import cellular_features
-from .lattice import lattice_noise
+from .lattice import lattice_noise, spun_torch
 from .waves import wave_features
 
 __all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
@@ -359,8 +360,11 @@ class SolidTexture(nn.Module):
     def __init__(self, dim: int = 3, octaves: int = 8, channels: int = 3, code_dim: int = 64, z_dim: int = 8,
                  mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
                  colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False,
-                 cellular: int = 0, bricks: int = 0, max_scale: torch.Tensor | None = None, waves: int = 0):
+                 cellular: int = 0, bricks: int = 0, max_scale: torch.Tensor | None = None, waves: int = 0,
+                 spin: str = ""):
         super().__init__()
+        #: backend.solid.spin: "lattice" reads octave i at Q(xi_i) T_i 2^(i-1) x, "octave" at T_i Q(xi_i)^T 2^(i-1) x
+        self.spin = check_mode(spin)
         if mode not in ("single", "space"):
             raise ValueError(f"mode must be 'single' or 'space', got {mode!r}")
         if colour not in ("sigmoid", "affine"):
@@ -401,6 +405,8 @@ class SolidTexture(nn.Module):
         The decoder reads the value noise (B, N, m C), then the first ``cellular`` octaves' Worley features
         (B, N, 3 cellular; ``cellular.py``), then the first ``bricks`` octaves' brick features (``brick.py``), then
         the photo's waves (B, N, 2 K; ``waves.py``, at x itself: they are the photo's own frequencies)."""
+        if self.spin:
+            T = spun_torch(T, seeds, self.spin)
         n = lattice_noise(x, T, seeds, self.channels)
         if gains is not None:
             B, N, _ = n.shape

@@ -49,6 +49,7 @@ from .warm_start import exported_weights, warm_start
 from .waves import photo_waves, wave_share
 from backend.onnx_models import load_model_json
 from backend.solid.harmonic import photo_harmonics, remove_harmonics
+from backend.solid.spin import check_mode
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain",
            "snapshot_path"]
@@ -94,6 +95,8 @@ class SolidConfig:
     morphology_weight: float = 0.0  # weight of the soft level-set morphology term (soft_morphology.py); 0: off
     structure_weight: float = 0.0   # weight of the learned structure term (structure_features.py); 0: off
     structure_net: str = ""         # ... the trained structure network it reads (a file of train_structure_net)
+    isotropy_weight: float = 0.0    # weight of a penalty on the octave transforms' anisotropy (isotropy_penalty):
+                                    # a stretch must buy more of the texture loss than it costs; 0: off
     min_spacing: float = 0.0        # bounded space models: no octave's lattice finer than this many px (model.max_scales); 0: off
     seed: int = 0
     log_every: int = 25
@@ -123,6 +126,9 @@ class SolidConfig:
                                     # (backend.solid.harmonic.remove_harmonics), so the decoder learns the
                                     # indeterministic rest the part leaves to it; the export says so (solid.json
                                     # "harmonic_rest") and the runtime then encodes photos' rests
+    spin: str = ""                  # backend.solid.spin: "lattice" turns each octave's lattice by a rotation drawn
+                                    # from its seed (no stretch can line up with the lattice), "octave" turns each
+                                    # octave's whole field; "" neither (solid.json "spin"; the runtime turns the same)
 
     @classmethod
     def from_dict(cls, d: dict) -> "SolidConfig":
@@ -147,7 +153,8 @@ class SolidConfig:
         n_exemplars = len(ex.expand(cfg.exemplars))
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
-        for key in ("spectrum_weight", "morphology_weight", "structure_weight"):
+        check_mode(cfg.spin)
+        for key in ("spectrum_weight", "morphology_weight", "structure_weight", "isotropy_weight"):
             if not (math.isfinite(getattr(cfg, key)) and getattr(cfg, key) >= 0):
                 raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
         if cfg.structure_weight and not cfg.structure_net:
@@ -225,7 +232,7 @@ def build_model(cfg: SolidConfig) -> SolidTexture:
                         cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform, cfg.film,
                         cfg.standardise, cfg.cellular, cfg.bricks,
                         max_scales(cfg.octaves, cfg.px_per_unit, cfg.min_spacing) if cfg.min_spacing else None,
-                        cfg.waves)
+                        cfg.waves, cfg.spin)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
@@ -279,6 +286,16 @@ def texture_loss(cfg: SolidConfig, feats, img: torch.Tensor, ref: torch.Tensor, 
         loss = loss + cfg.structure_weight * swd_loss(structure_features(cfg.structure_net, img.device), img, ref,
                                                       per_sample=per_sample, generator=gen)
     return loss
+
+
+def isotropy_penalty(T: torch.Tensor) -> torch.Tensor:
+    """Mean over transforms of ||A - I||_F^2 with A = T^T T / (tr(T^T T) / D): 0 for a rotation times a scale,
+    ~0.4 for a stretch of 1.45 : 1 along one axis.  T (..., D, D); rotations before or after T change nothing
+    (spun lattices included), so only the stretch is charged, not the lattice's orientation or the octave's scale."""
+    D = T.shape[-1]
+    G = T.transpose(-1, -2) @ T
+    A = G / (G.diagonal(dim1=-2, dim2=-1).sum(-1)[..., None, None] / D)
+    return (A - torch.eye(D, dtype=T.dtype, device=T.device)).square().sum((-2, -1)).mean()
 
 
 _STRUCTURE: dict = {}
@@ -448,6 +465,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
         seeds = torch.randint(0, 2 ** 31 - 1, (cfg.batch,), generator=gen).numpy()
         img = render(model, e, T, x, seeds, cfg.crop, stats if cfg.colour == "affine" else None, gains)
         loss = texture_loss(cfg, feats, img, ref, gen)
+        if cfg.isotropy_weight:
+            loss = loss + cfg.isotropy_weight * isotropy_penalty(T)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
