@@ -21,6 +21,10 @@ Against the photo, per slice axis and pooled:
   (``spectrum_random_phase``), which keeps the photo's Fourier modulus;
 - ``colour``: mean colour error (mean over R, G, B of |difference of means|), mean over the slices
   (``colour_worst_slice``: the worst slice's);
+- ``swd_axes``: the mean of the three axes' distances (``x``, ``y``, ``z``: each axis's slices alone against
+  the photo), what each face of a cube shows; ``beats_random_phase_axes`` counts the axis slices (three per
+  photo) closer than random phase noise.  The pooled ``swd`` mixes the three axes' neighbourhoods, so errors
+  that differ between axes (fronts leaning one way, floors the other) partly cancel in it; these see them;
 - ``swd_walls``, ``colour_walls``: the same over the x and y slices only, the vertical planes on which an
   encoded photo's harmonic part stands as in the photo (on z slices, horizontal cuts, it shows in profile:
   a layered photo's horizontal cut lies within one layer, brick courses become that course's colour);
@@ -131,6 +135,7 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         imgs = {ax: [slice_image(model, code, ax, s) for s in range(seeds)] for ax in "xyz"}
         seconds = time.time() - t
         r = {ax: round(pe.patch_swd(v, photo), 1) for ax, v in imgs.items()}
+        r["swd_axes"] = round(float(np.mean([r[ax] for ax in "xyz"])), 1)
         pooled = [im for v in imgs.values() for im in v]
         r["swd"] = round(pe.patch_swd(pooled, photo), 1)
         r["colour"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in pooled])), 4)
@@ -175,6 +180,8 @@ def summary(rows: dict) -> dict:
                 beats_pixel_shuffle=int(sum(r["swd"] < r["pixel_shuffle"] for r in rows.values())),
                 beats_random_phase=int(sum(r["swd"] < r["random_phase"] for r in rows.values())),
                 median_colour=med("colour"), max_colour=round(float(max(r["colour"] for r in rows.values())), 4),
+                median_swd_axes=med("swd_axes"),
+                beats_random_phase_axes=int(sum(r[ax] < r["random_phase"] for r in rows.values() for ax in "xyz")),
                 median_swd_walls=med("swd_walls"),
                 beats_random_phase_walls=int(sum(r["swd_walls"] < r["random_phase"] for r in rows.values())),
                 max_colour_walls=round(float(max(r["colour_walls"] for r in rows.values())), 4),
@@ -214,14 +221,17 @@ def write_sheet(sheet: list, path: str, size: int = 128) -> None:
 
 
 def against(rows: dict, path: str) -> dict:
-    """Per distance (``swd`` pooled, ``swd_walls``): the photos of ``rows`` more than 5 % closer and farther than
+    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls``): the photos of ``rows`` more than 5 % closer and farther than
     in the run of this bench stored at ``path``, and both medians over the photos the two share."""
     with open(path, encoding="utf-8") as fh:
         other = json.load(fh)["photos"]
     common = [n for n in rows if n in other]
     out = {"photos": len(common)}
-    for key in ("swd", "swd_walls"):
-        a, b = (np.array([r[n][key] for n in common]) for r in (other, rows))
+    for key in ("swd", "swd_axes", "swd_walls"):
+        both = [n for n in common if key in other[n]]     # runs before swd_axes lack it
+        if not both:
+            continue
+        a, b = (np.array([r[n][key] for n in both]) for r in (other, rows))
         out[key] = dict(median_against=round(float(np.median(a)), 1), median=round(float(np.median(b)), 1),
                         closer_5pct=int((b < 0.95 * a).sum()), farther_5pct=int((b > 1.05 * a).sum()))
     return out

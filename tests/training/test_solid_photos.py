@@ -370,7 +370,9 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
         assert set(r) >= {"swd", "morph", "morph_random_phase", "colour", "random_phase", "axis_spread", "spectrum",
                           "spectrum_random_phase"}
         assert r["spectrum"] > 0 and r["spectrum_random_phase"] > 0
+        assert r["swd_axes"] == pytest.approx((r["x"] + r["y"] + r["z"]) / 3, abs=0.06)
     assert doc["summary"]["median_spectrum"] > 0
+    assert 0 <= doc["summary"]["beats_random_phase_axes"] <= 6
 
 
 def test_min_spacing_caps_every_octave_lattice_in_training_and_in_the_export(tmp_path):
