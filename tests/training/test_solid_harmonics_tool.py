@@ -25,12 +25,13 @@ def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, ca
     with open(os.path.join(space, "solid.json"), encoding="utf-8") as f:
         doc = json.load(f)
     stored, rests = doc["code_harmonics"], doc["code_rests"]
+    assert doc["spin"] == "octave"        # the rests were measured as the model draws: its octaves turned
     assert {"metal", "wood"} <= set(stored) and {"sand", "metal"} <= set(rests) and "grass" not in rests
     parts, measured = measure_codes(space, ROOT)
     assert json.loads(json.dumps(parts)) == stored and json.loads(json.dumps(measured)) == rests
     folder = tmp_path / "space"
     said = remove_and_add_back(space, folder, "code_harmonics", capsys)
-    assert "metal 132 waves" in said and "Gaussian rests: brick 1.00" in said
+    assert "metal 132 waves" in said and "Gaussian rests: fabric 1.00" in said
     back = json.loads((folder / "solid.json").read_text())
     assert back["code_harmonics"] == stored and back["code_rests"] == rests
     train = os.path.join(ROOT, "data", "photos", "train")
@@ -41,6 +42,10 @@ def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, ca
         os.symlink(src, other / "data" / "photos" / "train" / f)
     assert main([str(folder), "--root", str(other)]) == 2
     assert "does not encode to the stored code 'metal'" in capsys.readouterr().err
+    # --spin measures the folder as it will be, and leaves it untouched when measuring fails
+    before = (folder / "solid.json").read_text()
+    assert main([str(folder), "--root", str(other), "--spin", "none"]) == 2
+    assert (folder / "solid.json").read_text() == before
 
 
 def remove_and_add_back(model: str, folder, key: str, capsys) -> str:

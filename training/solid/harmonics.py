@@ -12,13 +12,19 @@ on: its exemplar's training region (all but the right quarter when the model was
 ``training.solid.exemplars.train_region``), read as the evaluation reads it, at the model's own scale.  It is
 written into the folder's solid.json as ``harmonics`` (``backend.solid.harmonic.to_json``), which the runtime
 adds to the model's texture; ``--remove`` takes it out.  Nothing is trained and the ONNX files are unchanged.
+
+``--spin MODE`` first sets how the runtime turns the model's octaves with their seeds (solid.json ``spin``,
+``backend/solid/spin.py``: ``octave``, ``lattice`` or ``none``); the named codes' rests are then measured as the
+model will draw them.  Until they are, the folder is not touched.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import shutil
 import sys
+import tempfile
 
 import numpy as np
 
@@ -87,6 +93,8 @@ def main(argv=None) -> int:
     ap.add_argument("folder", help="a single photo model's folder (holds solid.json)")
     ap.add_argument("--remove", action="store_true", help="take the stored harmonic part out")
     ap.add_argument("--root", default=".", help="where the exemplar paths in solid.json start")
+    ap.add_argument("--spin", choices=("none", "lattice", "octave"),
+                    help="set how the runtime turns the octaves with their seeds (solid.json spin) before measuring")
     a = ap.parse_args(argv)
     path = os.path.join(a.folder, "solid.json")
     try:
@@ -95,10 +103,16 @@ def main(argv=None) -> int:
         space = doc.get("mode") == "space"
         for key in ("code_harmonics", "code_rests") if space else ("harmonics",):
             doc.pop(key, None)
-        if not a.remove and space:
-            doc["code_harmonics"], doc["code_rests"] = measure_codes(a.folder, a.root)
-        elif not a.remove:
-            doc["harmonics"] = measure(a.folder, a.root)
+        if a.spin:
+            doc["spin"] = "" if a.spin == "none" else a.spin
+        with tempfile.TemporaryDirectory() as tmp:   # the folder as it will be, measured before it is written
+            staged = os.path.join(tmp, "model")
+            shutil.copytree(a.folder, staged)
+            _ex.write_json(os.path.join(staged, "solid.json"), doc)
+            if not a.remove and space:
+                doc["code_harmonics"], doc["code_rests"] = measure_codes(staged, a.root)
+            elif not a.remove:
+                doc["harmonics"] = measure(staged, a.root)
     except (OSError, ValueError, ModelError) as exc:
         print(f"solid harmonics: error: {exc}", file=sys.stderr)
         return 2

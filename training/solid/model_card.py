@@ -330,7 +330,12 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "grain direction are not kept, and it draws no cracks, stones or joints, only their spectrum and "
           "colours. The check is noisy (its slices differ by over 10 % between draws), so it keeps the decoder "
           "unless the mix is 15 % closer, and on held-out photos it still makes 6 of 87 farther (a rock "
-          "photo 101.9 -> 128.4).", ""]
+          "photo 101.9 -> 128.4).",
+          "- The texture-space model's translator stretches octaves 3 and 6 along the same world diagonal for "
+          "every photo (1.45 : 1), which drew short strokes leaning one way on every front and the other way on "
+          "every floor. Its octaves are now turned by a rotation drawn from the seed (\"Turned octaves\"), so "
+          "the octaves no longer share a direction and the lean is gone; each octave's own short strokes remain. "
+          "Training with spun lattices and a penalty on the stretch did not remove them in 9 GPU minutes.", ""]
     return "\n".join(L)
 
 
