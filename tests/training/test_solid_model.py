@@ -656,3 +656,16 @@ def test_isotropy_penalty_charges_the_stretch_alone():
     assert (s[:, 0] / s[:, 2]).max() < 1.45 - 0.01
     with pytest.raises(ValueError, match="isotropy_weight"):
         SolidConfig.from_dict({"isotropy_weight": -1.0})
+
+
+def test_a_run_from_a_spun_export_must_name_its_spin(tmp_path):
+    """Continuing an export that turns its octaves with a config that does not would draw another texture from the
+    same weights: refused, with the spin named; naming it continues."""
+    run, state = _tiny(tmp_path, dim=3, spin="octave")
+    doc = export(str(run), str(tmp_path / "m"))
+    cont = dict(state["config"], name="cont", steps=state["step"] + 1, init_onnx=str(tmp_path / "m"),
+                init_sha256=fingerprint(doc["files"]), spin="")
+    with pytest.raises(ValueError, match="draws with spin 'octave'; set spin in the config"):
+        train(SolidConfig.from_dict(cont), str(tmp_path / "c1"), log=lambda *_: None)
+    s2 = train(SolidConfig.from_dict(dict(cont, spin="octave")), str(tmp_path / "c2"), log=lambda *_: None)
+    assert s2["step"] == state["step"] + 1

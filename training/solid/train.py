@@ -404,6 +404,9 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
         new = shape_features(cfg.cellular, cfg.bricks) - had
         if had and new:
             raise ValueError("init_onnx: features can be added only to an export without cellular or brick features")
+        if model_json.get("spin", "") and not cfg.spin:
+            raise ValueError(f"init_onnx: {cfg.init_onnx} draws with spin {model_json['spin']!r}; set spin in the "
+                             "config (the same to keep drawing so), or the run and its export would draw unturned")
         warm_start(model, exported_weights(cfg.init_onnx, cfg.init_sha256), new_features=new)
         step, elapsed = int(model_json.get("step", 0)), float(model_json.get("train_seconds", 0.0))
         first = step
