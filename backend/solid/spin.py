@@ -65,7 +65,7 @@ def octave_spins(seeds, dim: int) -> np.ndarray:
         Q = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
         return Q.astype(np.float32)
     if dim != 3:
-        raise ValueError(f"spun lattices need 2 or 3 dimensions, got {dim}")
+        raise ValueError(f"octave spins need 2 or 3 dimensions, got {dim}")
     u1, u2, u3 = _uniforms(seeds, 3)
     a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
     x, y, z, w = a * np.sin(2 * np.pi * u2), a * np.cos(2 * np.pi * u2), b * np.sin(2 * np.pi * u3), b * np.cos(2 * np.pi * u3)
