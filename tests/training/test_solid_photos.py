@@ -188,8 +188,11 @@ def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
     with open(os.path.join(space, "solid.json"), encoding="utf-8") as fh:
         meta = json.load(fh)
     prev = dict(summary=dict(photos=87, median_swd=300.0, ratio_to_random_phase=2.5, beats_pixel_shuffle=70))
-    new = dict(summary=dict(photos=87, median_swd=210.0, ratio_to_random_phase=1.9, beats_pixel_shuffle=77))
+    new = dict(summary=dict(photos=87, median_swd=210.0, ratio_to_random_phase=1.9, beats_pixel_shuffle=77,
+                            median_swd_axes=230.0))
     text = photo_card.section(space, prev, new, True, "older", (("a stage", 5, "1 min", 1.0, 2.0, "3", "4", "no"),))
+    # a run evaluated before the per-axis distance existed shows a dash, not None
+    assert "| median distance per axis (each slice axis alone) ↓ | — | 230.0 |" in text and "None" not in text
     last = "the last stage at " if meta["config"].get("init_onnx") or meta["config"].get("init_from") else ""
     assert f"**Run:** {meta['step']} steps, {last}batch {meta['config']['batch']}" in text
     hardware = meta.get("hardware") or "hardware not recorded"

@@ -31,6 +31,8 @@ ROWS = (("median patch distance (swd) ↓", "median_swd"), ("… random phase no
         ("ratio to random phase ↓ (target ≤ 1.5)", "ratio_to_random_phase"),
         ("photos where it beats the pixel shuffle", "beats_pixel_shuffle"),
         ("photos where it beats random phase", "beats_random_phase"),
+        ("median distance per axis (each slice axis alone) ↓", "median_swd_axes"),
+        ("axis slices where it beats random phase (3 per photo)", "beats_random_phase_axes"),
         ("median mean-colour error ↓ (target ≤ 0.03)", "median_colour"), ("worst mean-colour error", "max_colour"),
         ("median diversity between seeds", "median_diversity"), ("median axis spread (x/y/z) ↓", "median_axis_spread"),
         ("median seconds: encode + six 128² slices", "median_seconds"),
@@ -163,7 +165,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "Wasserstein of 7 x 7 Laplacian-pyramid neighbourhoods x 1000):", "",
          f"| measure | {prev_label} | this model |", "|---|---|---|"]
     for label, key in ROWS:
-        L.append(f"| {label} | {ps.get(key)} | {ns.get(key)} |")
+        L.append(f"| {label} | {ps.get(key, '—')} | {ns.get(key, '—')} |")   # '—': a run before the measure
     if ledger:
         L += ["", "Ledger of this model's stages (oldest first; a stage ships only when the held-out evaluation "
               "says it is better):", "", "| stage | steps | wall time | median swd | ratio to random phase | "
