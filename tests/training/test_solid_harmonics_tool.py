@@ -26,12 +26,12 @@ def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, ca
         doc = json.load(f)
     stored, rests = doc["code_harmonics"], doc["code_rests"]
     assert doc["spin"] == "octave"        # the rests were measured as the model draws: its octaves turned
-    assert {"metal", "wood"} <= set(stored) and {"sand", "metal"} <= set(rests) and "grass" not in rests
+    assert {"metal", "wood"} <= set(stored) and {"sand", "metal"} <= set(rests) and "rock" not in rests
     parts, measured = measure_codes(space, ROOT)
     assert json.loads(json.dumps(parts)) == stored and json.loads(json.dumps(measured)) == rests
     folder = tmp_path / "space"
     said = remove_and_add_back(space, folder, "code_harmonics", capsys)
-    assert "metal 132 waves" in said and "Gaussian rests: fabric 1.00" in said
+    assert "metal 132 waves" in said and "Gaussian rests: brick 1.00" in said
     back = json.loads((folder / "solid.json").read_text())
     assert back["code_harmonics"] == stored and back["code_rests"] == rests
     train = os.path.join(ROOT, "data", "photos", "train")

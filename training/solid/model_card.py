@@ -329,9 +329,9 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "closer (\"Gaussian rest of an encoded photo\"). It is isotropic: a rock face's strata and a wood's "
           "grain direction are not kept, and it draws no cracks, stones or joints, only their spectrum and "
           "colours. The check is noisy (its slices differ by over 10 % between draws), so it keeps the decoder "
-          "unless the mix is 15 % closer; on held-out photos it made 6 of 87 farther (a rock photo "
-          "101.9 -> 128.4), and with turned octaves 1 pooled (a savanna grass 91.0 -> 98.1) and 1 on walls "
-          "(a cliff 83.1 -> 95.4), against 18 closer.",
+          "unless the mix is 8 % closer (15 % before the octaves were turned); on held-out photos it makes 3 of "
+          "87 more than 5 % farther pooled and 4 on walls (a grass photo 92.8 -> 126.0), against 29 and 33 "
+          "closer.",
           "- The texture-space model's translator stretches octaves 3 and 6 along the same world diagonal for "
           "every photo (1.45 : 1), which drew short strokes leaning one way on every front and the other way on "
           "every floor. Its octaves are now turned by a rotation drawn from the seed (\"Turned octaves\"), so "
