@@ -53,6 +53,7 @@ sys.path.insert(0, ROOT)
 import numpy as np  # noqa: E402
 
 from export.atomic import atomic_path, write_json  # noqa: E402
+from export import read_rgb as read  # noqa: E402  (the one image reader; other bench scripts import it from here)
 from backend.solid.model import SolidTextureModel  # noqa: E402
 from backend.solid.refine import exemplar_z  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
@@ -64,13 +65,6 @@ SIZE = 128
 
 def photos(split: str = "val") -> list:
     return photo_set(split, os.path.join(ROOT, "data", "photos"))
-
-
-def read(path: str) -> np.ndarray:
-    from PIL import Image
-
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"), np.float32) / 255.0
 
 
 def slice_image(model: SolidTextureModel, code, axis: str, seed: int, size: int = SIZE) -> np.ndarray:

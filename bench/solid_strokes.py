@@ -29,16 +29,10 @@ sys.path.insert(0, ROOT)
 import numpy as np  # noqa: E402
 
 from backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
+from export import read_rgb  # noqa: E402
 from training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
-
-
-def read(path: str) -> np.ndarray:
-    from PIL import Image
-
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"), np.float32) / 255.0
 
 
 def diagonal_ratio(rgb: np.ndarray) -> float:
@@ -95,7 +89,7 @@ def sheet(path: str, models: list, photos: list, size: int = 192) -> None:
     ms = [SolidTextureModel(d) for d in models]
     rows = []
     for p in photos:
-        img = read(p)
+        img = read_rgb(p)
         cells = [img[:size, :size]]
         for m in ms:
             code = m.photo_code(img, periodic=False, gaussian=False)
@@ -124,7 +118,7 @@ def main(argv=None) -> int:
         sheet(args.sheet, args.models, picked)
         print(args.sheet)
     photos = photo_set("val")[::args.every]
-    images = [read(p) for p in photos]
+    images = [read_rgb(p) for p in photos]
     own = np.log2([diagonal_ratio(img[:SIZE, :SIZE]) for img in images])
     print(f"{len(photos)} held-out photos; log2(+45/-45 power) of the photos themselves: median {np.median(own):+.2f}, "
           f"range {own.min():+.2f} .. {own.max():+.2f}")
