@@ -149,7 +149,7 @@ def main(argv=None) -> int:
             code = model.translate(z, h)
             return pe.patch_swd([slice_image(model, code, ax, s) for ax in "xyz" for s in range(2)], photo)
 
-        rp = [pe.random_phase(photo, SIZE, rng) for _ in range(2)]
+        rp = [pe.random_phase(photo, SIZE, rng) for _ in range(6)]     # as many images as swd's six slices
         r = dict(model=swd(None), random_phase=pe.patch_swd(rp, photo))
         for p, w in SETTINGS:
             h = photo_harmonics(photo, model.px_per_unit, prominence=p, window=w)

@@ -365,7 +365,22 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
     train(SolidConfig.from_dict(cfg), str(tmp_path / "run"), log=lambda *_: None)
     export(str(tmp_path / "run"), str(tmp_path / "m"))
     out = tmp_path / "eval.json"
-    assert mod.main(["--model", str(tmp_path / "m"), "--limit", "2", "-o", str(out)]) == 0
+    counts = []
+    real_swd = mod.pe.patch_swd
+
+    def counting_swd(images, reference, *a, **k):
+        counts.append(1 if isinstance(images, np.ndarray) else len(images))
+        return real_swd(images, reference, *a, **k)
+
+    mod.pe.patch_swd = counting_swd
+    try:
+        assert mod.main(["--model", str(tmp_path / "m"), "--limit", "2", "-o", str(out)]) == 0
+    finally:
+        mod.pe.patch_swd = real_swd
+    # every baseline meets the photo as often as the model's slices do: pooled six (model, 4 baselines), walls
+    # four (model, random phase, the photo's crops), single axes two; nothing scored from another count
+    assert sorted(set(counts)) == [2, 4, 6]
+    assert counts.count(6) == 2 * 5 and counts.count(4) == 2 * 3 and counts.count(2) == 2 * 3 * 3
     doc = json.loads(out.read_text())
     assert doc["summary"]["photos"] == 2 and doc["summary"]["median_morph"] > 0
     for r in doc["photos"].values():
@@ -374,8 +389,26 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
                           "spectrum_random_phase"}
         assert r["spectrum"] > 0 and r["spectrum_random_phase"] > 0
         assert r["swd_axes"] == pytest.approx((r["x"] + r["y"] + r["z"]) / 3, abs=0.06)
+        assert r["photo_crop_axes"] < r["random_phase_axes"] or r["photo_crop_walls"] < r["random_phase_walls"]
     assert doc["summary"]["median_spectrum"] > 0
     assert 0 <= doc["summary"]["beats_random_phase_axes"] <= 6
+
+
+def test_grouped_patch_distance_pools_like_the_model_and_counts_matter():
+    """photo_eval.grouped_swd: each axis alone, their mean, the walls (x and y) and all pooled, each the patch
+    distance of those images; and why the evaluation groups baselines so: the photo's own crops pooled six at a
+    time lie closer to it than two at a time, so a comparison at unequal counts favours the larger."""
+    photo = ex.load_image([p for p in ex.photo_set("val") if "rock1" in p][0]).permute(1, 2, 0).numpy()
+    rng = np.random.default_rng(3)
+    groups = {ax: [pe.photo_crop(photo, 128, rng) for _ in range(2)] for ax in "xyz"}
+    d = pe.grouped_swd(groups, photo)
+    for ax in "xyz":
+        assert d[ax] == round(pe.patch_swd(groups[ax], photo), 1)
+    assert d["axes"] == pytest.approx(np.mean([d[ax] for ax in "xyz"]), abs=0.06)
+    assert d["walls"] == round(pe.patch_swd(groups["x"] + groups["y"], photo), 1)
+    assert d["pooled"] == round(pe.patch_swd([im for v in groups.values() for im in v], photo), 1)
+    assert d["pooled"] < 0.85 * d["axes"]
+    assert pe.photo_crop(photo[:100, :90], 128, rng).shape == (100, 90, 3)     # a small photo: itself
 
 
 def test_min_spacing_caps_every_octave_lattice_in_training_and_in_the_export(tmp_path):
