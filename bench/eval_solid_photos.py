@@ -32,6 +32,10 @@ Against the photo, per slice axis and pooled:
   the photo), what each face of a cube shows; ``beats_random_phase_axes`` counts the axis slices (three per
   photo) closer than random phase noise's draws grouped alike (the mean of its three groups, ``random_phase_axes``).  The pooled ``swd`` mixes the three axes' neighbourhoods, so errors
   that differ between axes (fronts leaning one way, floors the other) partly cancel in it; these see them;
+- ``band`` (and ``band_axes``, ``band_walls``, and per baseline ``random_phase_band`` ...): the same distance
+  over the band-pass levels only (``photo_eval.band_swd``): the low-pass residue of a 128² slice is too small a
+  sample of a photo's large-scale layout, and there the photo's own crops score worst; without it they are the
+  floor;
 - ``swd_walls``, ``colour_walls``: the same over the x and y slices only, the vertical planes on which an
   encoded photo's harmonic part stands as in the photo (on z slices, horizontal cuts, it shows in profile:
   a layered photo's horizontal cut lies within one layer, brick courses become that course's colour);
@@ -142,6 +146,8 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         d = pe.grouped_swd(imgs, photo)
         r = {ax: d[ax] for ax in "xyz"}
         r["swd_axes"], r["swd"], r["swd_walls"] = d["axes"], d["pooled"], d["walls"]
+        r.update({ax + "_band": d[ax + "_band"] for ax in "xyz"})
+        r["band_axes"], r["band"], r["band_walls"] = d["axes_band"], d["pooled_band"], d["walls_band"]
         pooled = [im for v in imgs.values() for im in v]
         r["colour"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in pooled])), 4)
         walls = imgs["x"] + imgs["y"]     # vertical planes: where a harmonic part stands as in the photo
@@ -157,6 +163,7 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
             if name in GROUPED:
                 b = pe.grouped_swd(base[name], photo)
                 r[name], r[name + "_axes"], r[name + "_walls"] = b["pooled"], b["axes"], b["walls"]
+                r[name + "_band"], r[name + "_band_axes"] = b["pooled_band"], b["axes_band"]
             else:
                 r[name] = round(pe.patch_swd([im for v in base[name].values() for im in v], photo), 1)
             r[name + "_colour"] = round(pe.mean_colour_error(base[name]["x"][0], photo), 4)
@@ -208,7 +215,16 @@ def summary(rows: dict) -> dict:
                 median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
                 median_morph_photo_crop=med("morph_photo_crop"),
                 beats_random_phase_morph=beats("morph", "morph_random_phase"),
-                median_spectrum=med("spectrum"), median_spectrum_random_phase=med("spectrum_random_phase"))
+                median_spectrum=med("spectrum"), median_spectrum_random_phase=med("spectrum_random_phase"),
+                # the band-pass levels alone (photo_eval.band_swd): where the photo's own crops are the floor
+                median_band=med("band"), median_band_random_phase=med("random_phase_band"),
+                median_band_photo_crop=med("photo_crop_band"),
+                beats_random_phase_band=beats("band", "random_phase_band"),
+                beats_photo_crop_band=beats("band", "photo_crop_band"),
+                median_band_axes=med("band_axes"), median_band_random_phase_axes=med("random_phase_band_axes"),
+                median_band_photo_crop_axes=med("photo_crop_band_axes"),
+                beats_random_phase_band_axes=int(sum(r[ax + "_band"] < r["random_phase_band_axes"]
+                                                     for r in rows.values() for ax in "xyz")))
 
 
 def by_category(rows: dict) -> dict:
@@ -222,7 +238,10 @@ def by_category(rows: dict) -> dict:
                         pixel_shuffle=med("pixel_shuffle"), perlin_hist=med("perlin_hist"), colour=med("colour"),
                         beats_random_phase=sum(r["swd"] < r["random_phase"] for r in rs),
                         swd_axes=med("swd_axes"), random_phase_axes=med("random_phase_axes"),
-                        beats_random_phase_axes=sum(r[ax] < r["random_phase_axes"] for r in rs for ax in "xyz"))
+                        beats_random_phase_axes=sum(r[ax] < r["random_phase_axes"] for r in rs for ax in "xyz"),
+                        band=med("band"), random_phase_band=med("random_phase_band"),
+                        photo_crop_band=med("photo_crop_band"),
+                        beats_random_phase_band=sum(r["band"] < r["random_phase_band"] for r in rs))
     return out
 
 

@@ -366,17 +366,17 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
     export(str(tmp_path / "run"), str(tmp_path / "m"))
     out = tmp_path / "eval.json"
     counts = []
-    real_swd = mod.pe.patch_swd
+    real_levels = mod.pe.level_distances       # every patch distance goes through it
 
-    def counting_swd(images, reference, *a, **k):
+    def counting_levels(images, reference, *a, **k):
         counts.append(1 if isinstance(images, np.ndarray) else len(images))
-        return real_swd(images, reference, *a, **k)
+        return real_levels(images, reference, *a, **k)
 
-    mod.pe.patch_swd = counting_swd
+    mod.pe.level_distances = counting_levels
     try:
         assert mod.main(["--model", str(tmp_path / "m"), "--limit", "2", "-o", str(out)]) == 0
     finally:
-        mod.pe.patch_swd = real_swd
+        mod.pe.level_distances = real_levels
     # every baseline meets the photo as often as the model's slices do: pooled six (model, 4 baselines), walls
     # four (model, random phase, the photo's crops), single axes two; nothing scored from another count
     assert sorted(set(counts)) == [2, 4, 6]
@@ -390,6 +390,8 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
         assert r["spectrum"] > 0 and r["spectrum_random_phase"] > 0
         assert r["swd_axes"] == pytest.approx((r["x"] + r["y"] + r["z"]) / 3, abs=0.06)
         assert r["photo_crop_axes"] < r["random_phase_axes"] or r["photo_crop_walls"] < r["random_phase_walls"]
+        assert r["photo_crop_band"] < r["band"] and r["photo_crop_band"] < r["pixel_shuffle"]
+        assert r["band_axes"] == pytest.approx((r["x_band"] + r["y_band"] + r["z_band"]) / 3, abs=0.06)
     assert doc["summary"]["median_spectrum"] > 0
     assert 0 <= doc["summary"]["beats_random_phase_axes"] <= 6
 
@@ -408,6 +410,9 @@ def test_grouped_patch_distance_pools_like_the_model_and_counts_matter():
     assert d["walls"] == round(pe.patch_swd(groups["x"] + groups["y"], photo), 1)
     assert d["pooled"] == round(pe.patch_swd([im for v in groups.values() for im in v], photo), 1)
     assert d["pooled"] < 0.85 * d["axes"]
+    lv = pe.level_distances(groups["x"], photo)
+    assert d["x_band"] == round(pe.band_swd(lv), 1) and d["x"] == round(1000 * sum(lv) / 4, 1)
+    assert d["pooled_band"] < d["pooled"]      # the residue is the level where crops lie farthest
     assert pe.photo_crop(photo[:100, :90], 128, rng).shape == (100, 90, 3)     # a small photo: itself
 
 
