@@ -142,9 +142,10 @@ def singles_section(path: str, manifest: str = os.path.join("data", "photos", "m
          "distance: sliced Wasserstein distance of 7 × 7 Laplacian-pyramid neighbourhoods (× 1000, lower is "
          "better). Beside it, what an artist could make from the same three quarters instead: the shipped space "
          "model given them, random phase noise and the pixel shuffle; the model of the same name it replaced "
-         "(fitted to another exemplar); and random 128² crops of the three quarters themselves (the photo against its "
-         "own other part). Every alternative is scored on as many images as the model (before November 27, 2026 "
-         "the baselines were two images against a 3D model's six, which favoured the model). A model replaces the previous one when it is closer to the held-out quarter than that "
+         "(fitted to another exemplar); and random 128² crops of the three quarters themselves (the photo "
+         "against its own other part). Every alternative is scored on as many images as the model (before "
+         "November 27, 2026 the baselines were two images against a 3D model's six, which favoured the model). "
+         "A model replaces the previous one when it is closer to the held-out quarter than that "
          "model and than the pixel shuffle (unless the photo's own crop is not either: a photo whose quarter "
          "differs from the rest), with colour error at most 0.03. **Licence of the weights:** that of the photo "
          "(CC-BY-SA-3.0 for a CC-BY-SA photo).", "",

@@ -99,10 +99,7 @@ def patch_swd(images, reference: np.ndarray, levels: int = 4, n: int = 4096, dir
 
 
 def _scaled(per_level: list) -> float:
-    total = 0.0
-    for d in per_level:
-        total += d
-    return 1000.0 * total / len(per_level)
+    return 1000.0 * sum(per_level) / len(per_level)
 
 
 def band_swd(per_level: list) -> float:
