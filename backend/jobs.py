@@ -84,6 +84,7 @@ grid (with a constant ``density``), an RGB EXR, an sRGB PNG or a (..., 3) .npy::
     # refine = 40                       # search steps refining the encoded code
     # periodic = false                  # leave out the image's periodic part (courses, planks; on by default)
     # gaussian = false                  # never mix in the image's Gaussian rest (on where its check finds it closer)
+    # rest = "upright"                  # its kind: "auto" (the check chooses), "isotropic", "upright" (walls)
     # to = "wood"                       # space models: a second exemplar (name or image) ...
     # mix = 0.3                         # ... and its share, as `omninoise solid --to --mix`
     seed = 0

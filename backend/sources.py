@@ -308,12 +308,13 @@ class SolidSource:
 
     def __init__(self, model, exemplar: str | None = None, seed: int = 0, scale: float = 1.0,
                  density: float = 1.0, refine: int = 0, code=None, to: str | None = None, mix: float = 0.0,
-                 periodic: bool = True, gaussian: bool = True):
+                 periodic: bool = True, gaussian: bool = True, rest: str = "auto"):
         """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
         code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds);
         to, mix: a space model's second exemplar and the share of it (interpolation, as ``omninoise solid``);
         periodic: an encoded image keeps its harmonic part (backend/solid/harmonic.py);
-        gaussian: and its Gaussian rest where the check keeps one (backend/solid/spectral.py)."""
+        gaussian: and its Gaussian rest where the check keeps one (backend/solid/spectral.py);
+        rest: which ("auto", "isotropic", "upright": backend/solid/upright.py)."""
         from .onnx_models import ModelError
         from .solid.model import SolidTextureModel
 
@@ -326,7 +327,7 @@ class SolidSource:
         self.dim = self.model.dim
         self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
         self.exemplar, self.to, self.mix, self.periodic = exemplar, to, float(mix), bool(periodic)
-        self.gaussian = bool(gaussian)
+        self.gaussian, self.rest = bool(gaussian), rest
         self.input_sha256 = None
         if code is not None:
             self.code = code
@@ -340,7 +341,7 @@ class SolidSource:
         from .solid.request import SolidRequest
 
         req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed, self.periodic,
-                           self.gaussian).check("source.")
+                           self.gaussian, rest).check("source.")
         self.code, self.input_sha256 = req.code(self.model, "source.")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
@@ -368,12 +369,14 @@ class SolidSource:
         d["harmonics_sha256"] = None if h is None else hashlib.sha256(h.values().astype("<f8").tobytes()).hexdigest()
         r = self.code.rest         # the Gaussian rest in use (backend/solid/spectral.py), if the check kept one
         d["gaussian_rest_sha256"] = None if r is None else hashlib.sha256(r.values().astype("<f8").tobytes()).hexdigest()
+        d["gaussian_rest_kind"] = None if r is None else r.kind     # isotropic / upright (backend/solid/upright.py)
         if self.model.spin:        # how the octaves turn with the seed (backend/solid/spin.py): part of the drawing
             d["spin"] = self.model.spin
         return d
 
 
-_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian")
+_SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
+               "rest")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
@@ -496,13 +499,14 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     to = path(d.get("to"))
     mix = d.get("mix", 0.5)
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
-                        d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True)).check("source.")
+                        d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
+                        d.get("rest", "auto")).check("source.")
 
 
 def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
     req = solid_request_from_dict(d, base_dir)
     return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
-                       to=req.to, mix=req.mix, periodic=req.periodic, gaussian=req.gaussian)
+                       to=req.to, mix=req.mix, periodic=req.periodic, gaussian=req.gaussian, rest=req.rest)
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

@@ -67,6 +67,7 @@ from export.atomic import atomic_path, write_json  # noqa: E402
 from export import read_rgb as read  # noqa: E402  (the one image reader; other bench scripts import it from here)
 from backend.solid.model import SolidTextureModel  # noqa: E402
 from backend.solid.refine import exemplar_z  # noqa: E402
+from backend.solid import spectral, upright  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
 from training.solid.photo_set import photo_set  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
@@ -176,6 +177,7 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
         r["seconds"] = round(seconds, 2)
         r["harmonic_peaks"], r["harmonic_share"] = (len(h), round(h.share, 4)) if h is not None else (0, 0.0)
         r["gaussian_mix"] = code.rest.mix if code.rest is not None else 0.0
+        r["gaussian_kind"] = code.rest.kind if code.rest is not None else None
         rows[os.path.basename(path)] = r
         print(os.path.basename(path), {k: r[k] for k in ("swd", "colour", "random_phase", "pixel_shuffle")},
               flush=True)
@@ -212,6 +214,7 @@ def summary(rows: dict) -> dict:
                 median_diversity=med("diversity"), median_axis_spread=med("axis_spread"),
                 median_seconds=med("seconds"), worst_swd=float(swd.max()),
                 gaussian_rests=int(sum(r.get("gaussian_mix", 0.0) > 0 for r in rows.values())),
+                upright_rests=int(sum(r.get("gaussian_kind") == "upright" for r in rows.values())),
                 median_morph=med("morph"), median_morph_random_phase=med("morph_random_phase"),
                 median_morph_photo_crop=med("morph_photo_crop"),
                 beats_random_phase_morph=beats("morph", "morph_random_phase"),
@@ -259,13 +262,14 @@ def write_sheet(sheet: list, path: str, size: int = 128) -> None:
 
 
 def against(rows: dict, path: str) -> dict:
-    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls``): the photos of ``rows`` more than 5 % closer and farther than
-    in the run of this bench stored at ``path``, and both medians over the photos the two share."""
+    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls`` and their ``band`` twins): the photos of ``rows`` more
+    than 5 % closer and farther than in the run of this bench stored at ``path``, and both medians over the photos
+    the two share."""
     with open(path, encoding="utf-8") as fh:
         other = json.load(fh)["photos"]
     common = [n for n in rows if n in other]
     out = {"photos": len(common)}
-    for key in ("swd", "swd_axes", "swd_walls"):
+    for key in ("swd", "swd_axes", "swd_walls", "band", "band_axes", "band_walls"):
         both = [n for n in common if key in other[n]]     # runs before swd_axes lack it
         if not both:
             continue
@@ -288,6 +292,13 @@ def main(argv=None) -> int:
                     help="leave out the photos' harmonic part (backend/solid/harmonic.py): the decoder alone")
     ap.add_argument("--no-gaussian", dest="gaussian", action="store_false",
                     help="leave out the Gaussian rest (backend/solid/spectral.py) even where its check keeps one")
+    ap.add_argument("--upright-gate", type=float, metavar="G",
+                    help="offer the upright Gaussian rest where a photo's spectral coherence is above G instead of "
+                         "backend/solid/upright.py's UPRIGHT_GATE (0: to every photo, above 1: to none, as before it; "
+                         "calibration: bench/solid_upright_gate.py)")
+    ap.add_argument("--margin", type=float, metavar="M",
+                    help="keep a Gaussian rest where the check finds it M times as close as the decoder alone "
+                         "instead of backend/solid/spectral.py's MARGIN (calibration, on the training split)")
     ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
     ap.add_argument("--refine", type=int, default=0, metavar="N",
                     help="refine each photo's code by N search steps first (the add-on's Refine Steps)")
@@ -295,6 +306,10 @@ def main(argv=None) -> int:
                     "photos this one is more than 5 %% closer to or farther from, pooled and on walls")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_photos.json"))
     a = ap.parse_args(argv)
+    if a.upright_gate is not None:
+        upright.UPRIGHT_GATE = a.upright_gate
+    if a.margin is not None:
+        spectral.MARGIN = a.margin
     model = SolidTextureModel(a.model)
     files = photos(a.split)
     if a.only:
@@ -304,7 +319,8 @@ def main(argv=None) -> int:
     sheet = [] if a.sheet else None
     rows = evaluate(model, files, a.seeds, sheet, a.periodic, a.refine, a.gaussian)
     doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
-               periodic=a.periodic, refine=a.refine, gaussian=a.gaussian,
+               periodic=a.periodic, refine=a.refine, gaussian=a.gaussian, upright_gate=upright.UPRIGHT_GATE,
+               margin=spectral.MARGIN,
                summary=summary(rows), by_category=by_category(rows), photos=rows)
     if a.against:
         doc["against"] = against(rows, a.against)

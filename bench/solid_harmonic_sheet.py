@@ -1,5 +1,5 @@
-"""Held-out photos and their solid textures with and without the harmonic part (or the Gaussian rest):
-``python bench/solid_harmonic_sheet.py [--part harmonic|gaussian] [-o JPG] [PREFIX ...]``.
+"""Held-out photos and their solid textures with and without the harmonic part (or the Gaussian rest, or its
+upright kind): ``python bench/solid_harmonic_sheet.py [--part harmonic|gaussian|upright] [-o JPG] [PREFIX ...]``.
 
 One row per photo of ``data/photos/val`` whose name starts with a PREFIX (default: the brick, wood, concrete,
 soil and fabric photos): photo (top-left 128²) | the texture-space model alone (front view, plane y) | with the
@@ -8,7 +8,9 @@ visible faces are sampled from the 3D texture | random phase noise.  The slices 
 ``bench/eval_solid_photos.py``.  Neither has the Gaussian rest (backend/solid/spectral.py); with ``--part
 gaussian`` the second column is the texture with its harmonic part and without the Gaussian rest, the next five
 with the rest where the encode-time check keeps one (the default photos: the held-out photos it is kept for, up
-to ``--limit``).
+to ``--limit``).  With ``--part upright`` the second column is the texture as it was before the upright rest
+(backend/solid/upright.py) was offered, the next five the texture with it, for the held-out photos whose check
+takes it.
 """
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
+from backend.solid import upright  # noqa: E402
 from backend.solid.model import SolidTextureModel  # noqa: E402
 from bench.eval_solid_photos import cube, photos, read, slice_image  # noqa: E402
 from export.atomic import atomic_path  # noqa: E402
@@ -34,8 +37,8 @@ def main(argv=None) -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("prefixes", nargs="*")
-    ap.add_argument("--part", choices=("harmonic", "gaussian"), default="harmonic")
-    ap.add_argument("--limit", type=int, default=8, help="--part gaussian: at most this many rows")
+    ap.add_argument("--part", choices=("harmonic", "gaussian", "upright"), default="harmonic")
+    ap.add_argument("--limit", type=int, default=8, help="--part gaussian or upright: at most this many rows")
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
     ap.add_argument("-o", "--out")
     a = ap.parse_args(argv)
@@ -44,11 +47,20 @@ def main(argv=None) -> int:
     m = SolidTextureModel(a.model)
     rows = []
     for path in photos():
-        if not os.path.basename(path).startswith(prefixes) or (a.part == "gaussian" and len(rows) >= a.limit):
+        if not os.path.basename(path).startswith(prefixes) or (a.part != "harmonic" and len(rows) >= a.limit):
             continue
         photo = read(path)
         if a.part == "harmonic":
             alone, with_h = m.photo_code(photo, periodic=False, gaussian=False), m.photo_code(photo, gaussian=False)
+        elif a.part == "upright":
+            with_h = m.photo_code(photo)
+            if (with_h.rest is None or with_h.rest.kind != "upright") and not a.prefixes:
+                continue
+            gate, upright.UPRIGHT_GATE = upright.UPRIGHT_GATE, 2.0    # never offered: the texture before it
+            try:
+                alone = m.photo_code(photo)
+            finally:
+                upright.UPRIGHT_GATE = gate
         else:
             alone = m.photo_code(photo, gaussian=False)
             with_h = m.with_gaussian_rest(alone, photo)

@@ -106,6 +106,11 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                            description="Where a check on rendered planes finds it closer to the image, mix in the "
                                        "image's Gaussian rest: random phase noise of what the periodic part leaves, "
                                        "drawn as a solid (rock faces, sand, wood grain the model draws too coarse)")
+    rest: EnumProperty(name="Rest Kind", items=[
+        ("auto", "Auto", "The check chooses: the upright rest is offered for layered images"),
+        ("isotropic", "Isotropic", "The same in every direction: no layers on any face"),
+        ("upright", "Upright", "The image's layers, grain or strata kept on faces normal to X and to Y (walls, "
+                               "cliffs); floors show only its horizontal detail")], default="auto")
     scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
                          description="Texture units per Blender unit: larger means smaller features")
     seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
@@ -156,7 +161,8 @@ def panel_request(p):
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
         return SolidRequest(os.path.join(models_dir(), name), _image_pixels(p.image), refine=int(p.refine),
-                            seed=int(p.seed), periodic=bool(p.periodic), gaussian=bool(p.gaussian)).check()
+                            seed=int(p.seed), periodic=bool(p.periodic), gaussian=bool(p.gaussian),
+                            rest=str(p.rest)).check()
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
@@ -185,7 +191,7 @@ def gaussian_info(code) -> str:
     r = code.rest
     if r is None:
         return "Gaussian rest: not closer, the model's texture alone"
-    return f"Gaussian rest: {100 * r.mix:.0f} % of the rest's variance"
+    return f"Gaussian rest: {100 * r.mix:.0f} % of the rest's variance, {r.kind}"
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:
@@ -411,6 +417,8 @@ def draw_solid(layout, context) -> None:
         if p.periodic and p.periodic_info:
             layout.label(text=p.periodic_info)
         layout.prop(p, "gaussian")
+        if p.gaussian:
+            layout.prop(p, "rest")
         if p.gaussian and p.gaussian_info:
             layout.label(text=p.gaussian_info)
     prev = bpy.data.images.get(f"{p.name} Preview")

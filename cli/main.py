@@ -180,6 +180,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="space model: never mix in an encoded image's Gaussian rest (random phase noise of what "
                         "the periodic part leaves, drawn as a solid; mixed in by default where a check on rendered "
                         "planes finds it closer to the image)")
+    s.add_argument("--rest", default="auto", choices=("auto", "isotropic", "upright"),
+                   help="space model: the Gaussian rest's kind: auto (default: the check chooses; the upright one is "
+                        "offered for layered images), isotropic, or upright (the image's layers, grain or strata "
+                        "kept on walls, for walls and cliffs: floors show their horizontal detail alone)")
     s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
     s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
     s.add_argument("--quiet", action="store_true")
@@ -665,7 +669,8 @@ def solid_request(a: argparse.Namespace):
     """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
     from backend.solid.request import SolidRequest
 
-    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian).check("--")
+    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
+                        a.rest).check("--")
 
 
 def run_solid(a: argparse.Namespace) -> int:
@@ -706,8 +711,10 @@ def run_solid(a: argparse.Namespace) -> int:
         print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
               "(--no-periodic leaves it out)", file=sys.stderr)
     if code.rest is not None and not a.quiet:
-        print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as a Gaussian solid, found "
-              "closer to the image than the decoder alone (--no-gaussian leaves it out)", file=sys.stderr)
+        from backend.solid.spectral import KIND_WORDS
+        print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as "
+              f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian leaves "
+              "it out)", file=sys.stderr)
     bar = _Bar(a.quiet)
     from backend.colour import srgb_to_linear
 

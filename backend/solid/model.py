@@ -32,7 +32,8 @@ from .cellular import cellular_features
 from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
 from .lattice import lattice_noise, octave_seeds
 from .spin import check_mode, spun
-from .spectral import RENDER, RestField, choose_mix, rest_field, rest_from_json, rest_waves
+from .spectral import CHECK_PLANES, RENDER, WALL_PLANES, RestField, choose_mix, rest_field, rest_from_json
+from .upright import candidates
 from .waves import wave_features
 
 __all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "measure_harmonics"]
@@ -318,35 +319,39 @@ class SolidTextureModel:
             return None
         return measure_harmonics(image, self.px_per_unit)
 
-    def photo_code(self, image: np.ndarray, periodic: bool = True, gaussian: bool = True) -> TextureCode:
+    def photo_code(self, image: np.ndarray, periodic: bool = True, gaussian: bool = True,
+                   rest: str = "auto") -> TextureCode:
         """Space mode: a photo's code as the product makes it before any refinement: the photo's harmonic part
         (:meth:`harmonics`, unless ``periodic`` is False), the photo encoded with it (:meth:`encode`: a model
         trained on rests reads the rest), translated with the part riding along, and its Gaussian rest
-        (:meth:`gaussian_rest`, unless ``gaussian`` is False)."""
+        (:meth:`gaussian_rest` of the kind ``rest`` asks for, unless ``gaussian`` is False)."""
         h = self.harmonics(image) if periodic else None
         code = self.translate(self.encode(image, h), h)
-        return self.with_gaussian_rest(code, image) if gaussian else code
+        return self.with_gaussian_rest(code, image, rest) if gaussian else code
 
-    def gaussian_rest(self, image: np.ndarray, code: TextureCode) -> RestField | None:
+    def gaussian_rest(self, image: np.ndarray, code: TextureCode, rest: str = "auto") -> RestField | None:
         """The Gaussian share of a photo's rest to mix into ``code`` (the photo's, without one), or None where the
-        encode-time check keeps the decoder alone (:mod:`backend.solid.spectral`).  Photo models of 3D space
-        only (the rest is a solid)."""
+        encode-time check keeps the decoder alone (:mod:`backend.solid.spectral`).  ``rest`` (REST_CHOICES):
+        "auto", the check's choice among the rests :func:`~backend.solid.upright.candidates` offers on walls and
+        floors; "isotropic"; "upright", checked on walls alone.  Photo models of 3D space only (the rest is a
+        solid)."""
         if self.mode != "space" or not self.colour_stats or self.dim != 3 or code.rest is not None:
             return None
         img, ppu = _measured(image, self.px_per_unit)
         h = code.harmonics
-        rest = remove_harmonics(img, h, ppu) if h is not None and len(h) else img
+        left = remove_harmonics(img, h, ppu) if h is not None and len(h) else img
+        offered = candidates(left, ppu, rest)      # ValueError naming the choices for another rest
 
         def layers(seed, axis, offset):
             pts = slice_points(RENDER, self.px_per_unit, axis, offset)
             fixed, dec = self.layers(pts, code, seed)
             return fixed, dec, pts
 
-        return choose_mix(layers, _rgb(image), rest_waves(rest, ppu))
+        return choose_mix(layers, _rgb(image), offered, WALL_PLANES if rest == "upright" else CHECK_PLANES)
 
-    def with_gaussian_rest(self, code: TextureCode, image: np.ndarray) -> TextureCode:
+    def with_gaussian_rest(self, code: TextureCode, image: np.ndarray, rest: str = "auto") -> TextureCode:
         """``code`` with :meth:`gaussian_rest` of ``image`` (unchanged where there is none)."""
-        r = self.gaussian_rest(image, code)
+        r = self.gaussian_rest(image, code, rest)
         return code if r is None else dataclasses.replace(code, rest=r)
 
     def translate(self, z, harmonics: Harmonics | None = None) -> TextureCode:

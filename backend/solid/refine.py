@@ -40,7 +40,7 @@ from .._export import export
 from ..errors import SettingError
 from ..grid import Cancelled
 from .harmonic import mix_harmonics
-from .spectral import mix_rests
+from .spectral import REST_CHOICES, mix_rests
 from .model import resize_rgb
 
 __all__ = ["SlicedTarget", "sliced_target", "sliced_distance", "refine_code", "exemplar_z", "RENDER_SIZE",
@@ -203,7 +203,7 @@ def _encoded(model, img: np.ndarray, refine: int, progress, periodic: bool):
 
 def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: str | None = None, mix: float = 0.0,
                  refine: int = 0, where: str = "", progress=None, report=None, periodic: bool = True,
-                 gaussian: bool = True):
+                 gaussian: bool = True, rest: str = "auto"):
     """The one place a texture request becomes a code, for the command line, job files and the farm:
     (TextureCode, the input images' sha256 or None).
 
@@ -213,7 +213,9 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
     ``to`` by ``mix`` in [0, 1] (Henzler et al. 2020, Sec. 4: interpolation in the latent space; an image's harmonic
     part, :mod:`backend.solid.harmonic`, comes along unless ``periodic`` is False, mixed by
     :func:`~backend.solid.harmonic.mix_harmonics`; an image's Gaussian rest, :mod:`backend.solid.spectral`, where
-    the check keeps one and ``gaussian`` is True, mixed by :func:`~backend.solid.spectral.mix_rests`). ``where``
+    the check keeps one and ``gaussian`` is True, of the kind ``rest`` asks for (:meth:`~backend.solid.model.
+    SolidTextureModel.gaussian_rest`; a name brings the rest the model stores for it), mixed by
+    :func:`~backend.solid.spectral.mix_rests`). ``where``
     prefixes the setting names in errors ("source." for job files, "--" for flags); ``report(name, history)``
     hears each refinement's distances."""
     import hashlib
@@ -225,6 +227,8 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
         raise SettingError(name("mix"), f"must be in [0, 1], got {mix}")
     if refine < 0:
         raise SettingError(name("refine"), f"must be >= 0, got {refine}")
+    if rest not in REST_CHOICES:
+        raise SettingError(name("rest"), f"must be one of {', '.join(REST_CHOICES)}, got {rest!r}")
     if model.mode == "single":  # an exemplar may only name the model's own texture
         own = {model.name, model.exemplar_label} | {str(e) for e in model.config.get("exemplars", [])}
         other = exemplar is not None and (not isinstance(exemplar, str) or exemplar not in own)
@@ -245,17 +249,17 @@ def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: st
         if hist and report is not None:
             report(ex, hist)
         if not gaussian:
-            rest = None
+            r = None
         elif img is not None:
-            rest = model.gaussian_rest(img, model.translate(z, h))
+            r = model.gaussian_rest(img, model.translate(z, h), rest)
         else:       # a name (exemplar_z reads no image only for one): its photo's rest, as the model stores it
-            rest = model.code_rests.get(ex)
-        return z, h, rest
+            r = model.code_rests.get(ex)
+        return z, h, r
 
-    z, h, rest = z_of(exemplar, "exemplar")
+    z, h, r = z_of(exemplar, "exemplar")
     if to is not None:
-        z2, h2, rest2 = z_of(to, "to")
-        z, h, rest = (1.0 - mix) * z + mix * z2, mix_harmonics(h, h2, mix), mix_rests(rest, rest2, mix)
+        z2, h2, r2 = z_of(to, "to")
+        z, h, r = (1.0 - mix) * z + mix * z2, mix_harmonics(h, h2, mix), mix_rests(r, r2, mix)
     sha = hashlib.sha256("".join(digests).encode()).hexdigest() if digests else None
     code = model.translate(z, h)
-    return (code if rest is None else dataclasses.replace(code, rest=rest)), sha
+    return (code if r is None else dataclasses.replace(code, rest=r)), sha

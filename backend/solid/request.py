@@ -6,7 +6,8 @@ always did), an exemplar (a space model's training exemplar by name, an image fi
 holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al. 2020, Sec. 4: interpolation in
 the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image's harmonic part,
 :mod:`backend.solid.harmonic`), ``gaussian`` (mix in an encoded image's Gaussian rest where the encode-time check
-finds it closer, :mod:`backend.solid.spectral`), and the ``seed`` of the noise.  Where the texture is read (grid,
+finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("auto", "isotropic" or "upright",
+:mod:`backend.solid.upright`), and the ``seed`` of the noise.  Where the texture is read (grid,
 zoom, scale) belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
@@ -24,6 +25,7 @@ import numpy as np
 
 from ..errors import SettingError
 from ..paths import solid_models
+from .spectral import REST_CHOICES
 
 __all__ = ["SolidRequest", "MAX_SEED"]
 
@@ -55,7 +57,7 @@ class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
     model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
     steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
-    Gaussian rest, where the check keeps one)."""
+    Gaussian rest, where the check keeps one), ``rest`` (which: one of spectral.REST_CHOICES)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)
@@ -65,6 +67,7 @@ class SolidRequest:
     seed: int = 0
     periodic: bool = True
     gaussian: bool = True
+    rest: str = "auto"
 
     def check(self, where: str = "") -> "SolidRequest":
         """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
@@ -81,6 +84,8 @@ class SolidRequest:
             raise bad("periodic", f"must be true or false, got {self.periodic!r}")
         if not isinstance(self.gaussian, (bool, np.bool_)):
             raise bad("gaussian", f"must be true or false, got {self.gaussian!r}")
+        if not isinstance(self.rest, str) or self.rest not in REST_CHOICES:
+            raise bad("rest", f"must be one of {', '.join(REST_CHOICES)}, got {self.rest!r}")
         return self
 
     def folder(self, models: str | None = None) -> str:
@@ -112,11 +117,11 @@ class SolidRequest:
         from .refine import texture_code
 
         return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report,
-                            bool(self.periodic), bool(self.gaussian))
+                            bool(self.periodic), bool(self.gaussian), self.rest)
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256)."""
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),
-                    gaussian=bool(self.gaussian))
+                    gaussian=bool(self.gaussian), rest=self.rest)

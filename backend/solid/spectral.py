@@ -22,23 +22,25 @@ annuli of the rest's periodic component, Moisan 2011) by Richardson-Lucy iterati
 wave's colour c_j is the colour of a Fourier coefficient of the rest drawn from the same annulus by power (so
 colour correlations per scale are the photo's), with a random phase and |c_j|^2 = 2 V / COUNT (V the rest's
 variance summed over channels).  Isotropic: a photo's orientation (a rock face's strata) is not kept; the
-harmonic part keeps its periods, and the decoder, where it is kept, its own structure.
+harmonic part keeps its periods, and the decoder, where it is kept, its own structure.  upright.py draws a second
+kind that keeps it on walls (each wave's vertical frequency on z), offered beside this one for oriented photos.
 
-The mix t: at encode time the texture is rendered on CHECK_PLANES (x, y and z cuts at two seeds, not the planes
-the held-out evaluation cuts), with t = 0 (the decoder alone) and each of MIXES, and compared with the photo by
-:func:`~backend.solid.band_distance.band_distance`; the closest t is kept if its distance is at most MARGIN times
-that of t = 0, else the texture is the decoder's as before.  The check's renders vary by more than 10 % from one
-set of planes to the next on many photos (structure at the scale of a 128² window), and the margin is what keeps
-that chance from choosing: on the training split (80 photos, every sixth), in a prototype with the evaluation's
-own distance as the check, the closest t alone made 22 photos more than 5 % closer and 15 farther by the held-out
-evaluation's distance, a margin of 0.85 made 14 closer and 1 farther.  This module, on the same photos
-(``python bench/eval_solid_photos.py --split train --limit 80``): pooled x, y and z slices of 20 photos closer
-and 2 farther, the x and y slices (walls) 22 and 2; photos beating random phase noise 58 -> 67.  Its first
-version drew the waves' annuli by power alone and kept the photo's lowest frequencies; there a few strong waves
-of a period longer than the photo moved a low-contrast concrete photo's 128² windows off its mean (patch distance
-101 -> 191) and 7 photos went farther.  Now every annulus with power gets waves (half of them spread evenly over
-the annuli, their amplitudes weighted so each annulus keeps its power) and nothing below MIN_CYCLES cycles per
-photo is drawn (shading, as harmonic.py leaves it out).
+The mix t: at encode time the texture is rendered on CHECK_PLANES (x, y and z cuts at two seeds, not the planes the
+held-out evaluation cuts), with t = 0 (the decoder alone) and each of MIXES for each kind offered, and compared
+with the photo by :func:`~backend.solid.band_distance.band_distance`; the closest (kind, t) is kept if its distance
+is at most MARGIN times that of t = 0, else the texture is the decoder's as before. An artist may ask for one kind
+(REST_CHOICES); asking for the upright one checks it on the walls alone (WALL_PLANES). The check's renders vary by
+more than 10 % from one set of planes to the next on many photos (structure at the scale of a 128² window), and the
+margin is what keeps that chance from choosing: on the training split (80 photos, every sixth), in a prototype with
+the evaluation's own distance as the check, the closest t alone made 22 photos more than 5 % closer and 15 farther
+by the held-out evaluation's distance, a margin of 0.85 made 14 closer and 1 farther. This module, on the same
+photos (``python bench/eval_solid_photos.py --split train --limit 80``): pooled x, y and z slices of 20 photos
+closer and 2 farther, the x and y slices (walls) 22 and 2; photos beating random phase noise 58 -> 67. Its first
+version drew the waves' annuli by power alone and kept the photo's lowest frequencies; there a few strong waves of
+a period longer than the photo moved a low-contrast concrete photo's 128² windows off its mean (patch distance 101
+-> 191) and 7 photos went farther. Now every annulus with power gets waves (half of them spread evenly over the
+annuli, their amplitudes weighted so each annulus keeps its power) and nothing below MIN_CYCLES cycles per photo is
+drawn (shading, as harmonic.py leaves it out).
 
 MARGIN was 0.85 until the space model's octaves were turned (spin.py); its decoder then came closer on its own
 and the check misfired less.  On the training split again (decoder + harmonic part alone / margin 0.85 / 0.92):
@@ -65,7 +67,9 @@ from .band_distance import band_distance
 from .harmonic import read_waves, wave_sum
 
 __all__ = ["RestField", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
-           "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "BINS"]
+           "rest_spectrum", "deproject", "wave_sampling", "colour_picks", "wave_amplitudes",
+           "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "WALL_PLANES", "BINS", "KINDS", "KIND_WORDS",
+           "REST_CHOICES"]
 
 COUNT = 512             #: waves in the Gaussian rest (module doc)
 BINS = 64               #: radial annuli of the spectrum
@@ -75,8 +79,17 @@ MARGIN = 0.92           #: a mix is kept only if its check distance is at most M
 RENDER = 128            #: px per check plane
 #: (seed, axis, offset) of the check's planes: x, y and z cuts at seeds 6 and 7
 CHECK_PLANES = tuple((s, a, (13.0 + s, 17.0, 19.0)) for s in (6, 7) for a in "xyz")
+#: the check's walls alone (x and y cuts): where an artist asks for the upright rest, floors are not its concern
+WALL_PLANES = tuple(p for p in CHECK_PLANES if p[1] != "z")
 WAVE_SEED = 0x72657374  #: the waves' draw (fixed: the same photo gives the same texture)
 MIN_CYCLES = 2          #: no power below this many cycles per photo (shading and vignetting, as harmonic.py)
+KINDS = ("isotropic", "upright", "mixed")   #: RestField.kind
+#: what an artist may ask for: the check's choice among the rests offered (upright.py's gate), or one kind
+REST_CHOICES = ("auto", "isotropic", "upright")
+#: what each kind draws, in words for the artist (CLI and panel)
+KIND_WORDS = {"isotropic": "an isotropic Gaussian solid",
+              "upright": "an upright Gaussian solid (the image's layers on walls)",
+              "mixed": "a blend of isotropic and upright Gaussian solids"}
 
 
 @dataclass(frozen=True)
@@ -87,6 +100,7 @@ class RestField:
     freq: np.ndarray
     amp: np.ndarray
     mix: float
+    kind: str = "isotropic"   #: which solid the waves draw: one of KINDS ("mixed": an interpolation of two kinds)
 
     def __len__(self) -> int:
         return int(self.freq.shape[0])
@@ -96,60 +110,94 @@ class RestField:
         return np.concatenate([self.freq.ravel(), self.amp.real.ravel(), self.amp.imag.ravel(), [self.mix]])
 
 
-def _deproject(p2: np.ndarray, edges: np.ndarray, iterations: int = ITERATIONS) -> np.ndarray:
-    """The solid's radial power per annulus float64 (B,) whose isotropic plane cuts have the radial power p2 (B,)
-    (module doc: Richardson-Lucy on p2 = K p3)."""
+def _sphere_inside(a: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """The fraction of waves of magnitude R, their directions uniform on the sphere, whose plane cut shows above a:
+    a cut shows R sin(theta) with cos(theta) uniform, so sqrt(1 - (a / R)^2)."""
+    return np.sqrt(np.clip(1.0 - (np.minimum(a, R) / R) ** 2, 0.0, 1.0))
+
+
+def deproject(p2: np.ndarray, edges: np.ndarray, iterations: int = ITERATIONS, inside=_sphere_inside) -> np.ndarray:
+    """The solid's power per bin float64 (..., B) whose cuts have the power p2 (..., B) along the last axis
+    (module doc: Richardson-Lucy on p2 = K p3; ``inside(a, R)`` is the fraction of a wave of magnitude R whose cut
+    shows above a: :func:`_sphere_inside` for plane cuts of an isotropic solid, upright.py's circle_inside for walls
+    of an upright one)."""
     R = 0.5 * (edges[:-1] + edges[1:])[None, :]
-
-    def inside(a):   # the fraction of a wave of magnitude R whose cut falls above a
-        return np.sqrt(np.clip(1.0 - (np.minimum(a, R) / R) ** 2, 0.0, 1.0))
-
-    K = inside(edges[:-1, None]) - inside(edges[1:, None])      # (B cut, B solid)
+    K = inside(edges[:-1, None], R) - inside(edges[1:, None], R)      # (B cut, B solid)
     p3 = p2 + 1e-300
     norm = np.maximum(K.sum(0), 1e-300)
     for _ in range(iterations):
-        p3 = p3 * (K.T @ (p2 / np.maximum(K @ p3, 1e-300))) / norm
+        p3 = p3 * ((p2 / np.maximum(p3 @ K.T, 1e-300)) @ K) / norm
     return p3
 
 
-def rest_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED):
-    """The Gaussian rest of a photo's rest (H, W, 3) seen at ``px_per_unit`` px per unit (module doc):
-    (freq float64 (count, 3), amp complex128 (count, 3)) at full variance (t = 1); None for a flat photo."""
+def rest_spectrum(rest: np.ndarray, px_per_unit: float):
+    """The rest's spectrum as both solids draw it: (F complex128 (H W, 3) Fourier coefficients of its periodic
+    component (Moisan 2011), scaled so that its variance is the sum of |F|^2; P float64 (H W,) their power summed
+    over channels, zero below MIN_CYCLES; fx, fy float64 (H W,) cycles per unit along the photo's columns and rows;
+    V the variance), or None for a flat photo."""
     a = np.asarray(rest, np.float64)[..., :3]
     H, W, _ = a.shape
     u = periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1))
     F = np.fft.fft2(u).reshape(3, -1).T / (H * W)                 # (H W, 3): mean square = sum |F|^2
     P = (np.abs(F) ** 2).sum(1)
-    fy, fx = np.meshgrid(np.fft.fftfreq(H), np.fft.fftfreq(W), indexing="ij")
-    r = (np.hypot(fy, fx) * px_per_unit).ravel()                  # cycles per unit
-    P[r < MIN_CYCLES * px_per_unit / min(H, W)] = 0.0              # shading and vignetting, not texture
+    fy, fx = (f.ravel() * px_per_unit for f in np.meshgrid(np.fft.fftfreq(H), np.fft.fftfreq(W), indexing="ij"))
+    P[np.hypot(fy, fx) < MIN_CYCLES * px_per_unit / min(H, W)] = 0.0   # shading and vignetting, not texture
     V = float(P.sum())
     if not V > 1e-12:
         return None
+    return F, P, fx, fy, V
+
+
+def wave_sampling(share: np.ndarray) -> np.ndarray:
+    """The probabilities waves are drawn with from bins with the power shares ``share`` (sums to 1): half by power,
+    half evenly over the bins with power (module doc: a few strong waves of long period must not carry a photo)."""
+    return 0.5 * share + 0.5 * (share > 0) / np.count_nonzero(share)
+
+
+def colour_picks(F: np.ndarray, P: np.ndarray, groups: np.ndarray, kb: np.ndarray, rng) -> np.ndarray:
+    """Which photo coefficient each wave takes its colour from: int64 (count,) indices into F, drawn by power
+    among the coefficients of the wave's bin ``kb`` (``groups``: each coefficient's bin, numbered row by row in
+    rows of BINS), from the nearest bin with power where its own has none (the nearest in the same row first)."""
+    filled = np.unique(groups[P > 0])
+    fr, fc = np.divmod(filled, BINS)
+    pick = np.empty(len(kb), np.int64)
+    for k in np.unique(kb):
+        kr, kc = divmod(int(k), BINS)
+        src = filled[np.argmin(np.abs(fr - kr) * 2 * BINS + np.abs(fc - kc))]
+        idx = np.flatnonzero(groups == src)
+        sel = np.flatnonzero(kb == k)
+        pick[sel] = idx[rng.choice(len(idx), size=len(sel), p=P[idx] / P[idx].sum())]
+    return pick
+
+
+def wave_amplitudes(F, P, pick, weight, rng) -> np.ndarray:
+    """The waves' colour amplitudes complex128 (count, 3): the picked coefficients' colours at |c|^2 = weight
+    (importance weights, 2 V share / (count q)), each with a random phase."""
+    return F[pick] / np.sqrt(P[pick])[:, None] * (np.sqrt(weight)[:, None]
+                                                   * np.exp(2j * np.pi * rng.uniform(size=(len(pick), 1))))
+
+
+def rest_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED):
+    """The isotropic Gaussian rest of a photo's rest (H, W, 3) seen at ``px_per_unit`` px per unit (module doc):
+    (freq float64 (count, 3), amp complex128 (count, 3)) at full variance (t = 1); None for a flat photo."""
+    spec = rest_spectrum(rest, px_per_unit)
+    if spec is None:
+        return None
+    F, P, fx, fy, V = spec
+    r = np.hypot(fx, fy)
     top = r.max() * (1.0 + 1e-9)
     edges = np.linspace(0.0, top, BINS + 1)
     b = np.minimum((r / top * BINS).astype(np.int64), BINS - 1)
-    p2 = np.bincount(b, P, BINS)
-    p3 = _deproject(p2, edges)
+    p3 = deproject(np.bincount(b, P, BINS), edges)
     rng = np.random.default_rng(seed)
     share = p3 / p3.sum()
-    q = 0.5 * share + 0.5 * (share > 0) / np.count_nonzero(share)    # every annulus with power gets waves
+    q = wave_sampling(share)
     kb = rng.choice(BINS, size=count, p=q)
     R = rng.uniform(edges[kb], edges[kb + 1])
     d = rng.standard_normal((count, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    amp = np.empty((count, 3), np.complex128)
-    filled = np.flatnonzero(p2 > 0)
-    for k in np.unique(kb):
-        src = k if p2[k] > 0 else filled[np.argmin(np.abs(filled - k))]   # the nearest annulus with power
-        idx = np.flatnonzero(b == src)
-        w = P[idx] / P[idx].sum()
-        sel = np.flatnonzero(kb == k)
-        pick = idx[rng.choice(len(idx), size=len(sel), p=w)]
-        amp[sel] = F[pick] / np.sqrt(P[pick])[:, None]
-    # importance weights: annulus k's waves carry its share of V between them (|c|^2 = 2 V share_k / (count q_k))
-    amp *= np.sqrt(2.0 * V * share[kb] / (count * q[kb]))[:, None] * np.exp(2j * np.pi * rng.uniform(size=(count, 1)))
-    return d * R[:, None], amp
+    pick = colour_picks(F, P, b, kb, rng)
+    return d * R[:, None], wave_amplitudes(F, P, pick, 2.0 * V * share[kb] / (count * q[kb]), rng)
 
 
 def seed_shift3(seed: int) -> np.ndarray:
@@ -168,30 +216,35 @@ def rest_field(points: np.ndarray, r: RestField, seed: int = 0) -> np.ndarray:
     return wave_sum(x + seed_shift3(seed), r.freq, r.amp)
 
 
-def choose_mix(layers, photo: np.ndarray, waves) -> RestField | None:
-    """The Gaussian rest to mix in, or None (module doc).  ``layers(seed, axis, offset)`` gives a check plane's
-    (fixed, decoder, points): parts float32 (RENDER^2, 3) (fixed: mean colour plus harmonic part; decoder: k L d)
-    and the plane's points float64 (RENDER^2, 3); ``waves`` is :func:`rest_waves`' result (None: nothing to
-    mix)."""
-    if waves is None:
+def choose_mix(layers, photo: np.ndarray, offered: dict, planes=CHECK_PLANES) -> RestField | None:
+    """The Gaussian rest to mix in, or None (module doc). ``layers(seed, axis, offset)`` gives a check plane's (fixed,
+    decoder, points): parts float32 (RENDER^2, 3) (fixed: mean colour plus harmonic part; decoder: k L d) and the
+    plane's points float64 (RENDER^2, 3); ``offered`` is :func:`~backend.solid.upright.candidates`' result ({kind:
+    (freq, amp)}, empty: nothing to mix). Every kind at every t of MIXES meets the check; the closest is kept if it
+    is MARGIN closer than the decoder alone (ties go to the kind offered first), on ``planes`` ((seed, axis,
+    offset) as CHECK_PLANES)."""
+    if not offered:
         return None
-    freq, amp = waves
-    full = RestField(freq, amp, 1.0)
-    planes = []
-    for seed, axis, offset in CHECK_PLANES:
-        fixed, dec, pts = layers(seed, axis, offset)
-        planes.append((fixed, dec, rest_field(pts, full, seed)))
+    planes = [layers(seed, axis, offset) + (seed,) for seed, axis, offset in planes]
 
-    def renders(t):
-        return [np.clip(f + np.float32(np.sqrt(1.0 - t)) * d + np.float32(np.sqrt(t)) * g, 0.0, 1.0)
-                .reshape(RENDER, RENDER, 3) for f, d, g in planes]
+    def renders(g, t):
+        return [np.clip(f + np.float32(np.sqrt(1.0 - t)) * d + np.float32(np.sqrt(t)) * gi, 0.0, 1.0)
+                .reshape(RENDER, RENDER, 3) for (f, d, _, _), gi in zip(planes, g)]
 
-    base = band_distance(renders(0.0), photo)
-    dist = {t: band_distance(renders(t), photo) for t in MIXES}
-    t = min(dist, key=dist.get)
-    if dist[t] > MARGIN * base:
+    base = band_distance(renders([0.0] * len(planes), 0.0), photo)
+    best = None
+    for kind, (freq, amp) in offered.items():
+        full = RestField(freq, amp, 1.0, kind)
+        g = [rest_field(pts, full, seed) for _, _, pts, seed in planes]
+        for t in MIXES:
+            dist = band_distance(renders(g, t), photo)
+            if best is None or dist < best[0]:
+                best = (dist, kind, t)
+    dist, kind, t = best
+    if dist > MARGIN * base:
         return None
-    return RestField(freq, amp * np.sqrt(t), float(t))
+    freq, amp = offered[kind]
+    return RestField(freq, amp * np.sqrt(t), float(t), kind)
 
 
 def _digits(a: np.ndarray, n: int) -> list:
@@ -204,12 +257,16 @@ def rest_to_json(r: RestField) -> dict:
     cycles at 100 units for 90 cycles per unit), amplitudes to six (the field to about 1e-5 of its spread)."""
     amp = np.stack([r.amp.real, r.amp.imag], axis=2).reshape(-1, 6)
     return dict(freq=np.reshape(_digits(r.freq, 10), (-1, 3)).tolist(),
-                amp=np.reshape(_digits(amp, 6), (-1, 6)).tolist(), mix=float(r.mix))
+                amp=np.reshape(_digits(amp, 6), (-1, 6)).tolist(), mix=float(r.mix), kind=r.kind)
 
 
 def rest_from_json(d) -> RestField:
-    """:func:`rest_to_json`'s dict -> RestField; ValueError naming what is wrong (at least one wave)."""
-    r = RestField(*read_waves(d, 3, "mix", lambda t: 0.0 < t <= 1.0, "a mix in (0, 1]", "a Gaussian rest"))
+    """:func:`rest_to_json`'s dict -> RestField; ValueError naming what is wrong (at least one wave; a kind of
+    KINDS, "isotropic" where none is stored: files written before the upright rest)."""
+    kind = d.get("kind", "isotropic") if isinstance(d, dict) else "isotropic"
+    if kind not in KINDS:
+        raise ValueError(f"a Gaussian rest: kind {kind!r} is not one of {', '.join(KINDS)}")
+    r = RestField(*read_waves(d, 3, "mix", lambda t: 0.0 < t <= 1.0, "a mix in (0, 1]", "a Gaussian rest"), kind)
     if not len(r):
         raise ValueError("a Gaussian rest: no waves")
     return r
@@ -221,6 +278,7 @@ def mix_rests(a: RestField | None, b: RestField | None, s: float) -> RestField |
     parts = [(r, w) for r, w in ((a, 1.0 - s), (b, s)) if r is not None and w > 0.0]
     if not parts:
         return None
+    kinds = {r.kind for r, _ in parts}
     return RestField(np.concatenate([r.freq for r, _ in parts]).reshape(-1, 3),
                      np.concatenate([r.amp * np.sqrt(w) for r, w in parts]).reshape(-1, 3),
-                     float(sum(r.mix * w for r, w in parts)))
+                     float(sum(r.mix * w for r, w in parts)), kinds.pop() if len(kinds) == 1 else "mixed")

@@ -268,4 +268,11 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
                               "--no-gaussian").key()
     assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
                                                  "seed": 3, "gaussian": False}).key()
-    p.gaussian = True
+    p.gaussian, p.rest = True, "upright"     # the Rest Kind menu is --rest and a job file's rest
+    req = solid_ui.panel_request(p)
+    assert req.rest == "upright"
+    assert req.key() == flags("--model", space, "--exemplar", str(tmp_path / "ex.png"), "--refine", "4",
+                              "--rest", "upright").key()
+    assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
+                                                 "seed": 3, "rest": "upright"}).key()
+    p.rest = "auto"

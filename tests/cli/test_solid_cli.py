@@ -1,5 +1,6 @@
 """The `omninoise solid` command-line contract, without torch (tiny committed models and the shipped space model)."""
 import os
+import re
 
 import numpy as np
 import pytest
@@ -202,7 +203,11 @@ def test_the_gaussian_rest_is_said_and_can_be_left_out(models, tmp_path, capsys)
 
     photo = os.path.join(os.path.dirname(TINY), "..", "..", "data", "photos", "val", "rock__rock_grey.jpg")
     rc = main(["solid", "--model", models["space3"], "--exemplar", photo, "--size", "8", "-o", str(tmp_path / "x.npy")])
-    assert rc == 0 and "gaussian rest: 100 % of the rest's variance" in capsys.readouterr().err
+    assert rc == 0 and re.search(r"gaussian rest: \d+ % of the rest's variance drawn as an? (isotropic|upright) "
+                                 "Gaussian solid", capsys.readouterr().err)
+    rc = main(["solid", "--model", models["space3"], "--exemplar", photo, "--size", "8", "--rest", "isotropic",
+               "-o", str(tmp_path / "x.npy")])
+    assert rc == 0 and "drawn as an isotropic Gaussian solid" in capsys.readouterr().err
     on, off = str(tmp_path / "on.npy"), str(tmp_path / "off.npy")
     assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--dim", "3", "--size", "8", "-o", on)[0] == 0
     assert run(capsys, "--model", models["space3"], "--exemplar", photo, "--dim", "3", "--size", "8", "--no-gaussian",

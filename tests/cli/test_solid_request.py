@@ -28,6 +28,7 @@ def cli(*args):
     (["--exemplar", "gravel", "--model", "space"], {"exemplar": "gravel", "model": "space"}),
     (["--exemplar", PHOTO, "--no-periodic"], {"exemplar": PHOTO, "periodic": False}),
     (["--exemplar", PHOTO, "--no-gaussian"], {"exemplar": PHOTO, "gaussian": False}),
+    (["--exemplar", PHOTO, "--rest", "upright"], {"exemplar": PHOTO, "rest": "upright"}),
 ])
 def test_flags_and_job_tables_give_equal_requests(flags, table):
     a, b = cli(*flags), solid_request_from_dict(dict(table))
@@ -42,6 +43,7 @@ def test_a_file_and_its_pixels_are_one_exemplar():
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, seed=1).key()
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, periodic=False).key()
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, gaussian=False).key()
+    assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, rest="isotropic").key()
 
 
 def test_periodic_and_gaussian_must_be_a_yes_or_no():
@@ -49,6 +51,10 @@ def test_periodic_and_gaussian_must_be_a_yes_or_no():
         solid_request_from_dict(dict(exemplar=PHOTO, periodic="yes"))
     with pytest.raises(SettingError, match="source.gaussian: must be true or false"):
         solid_request_from_dict(dict(exemplar=PHOTO, gaussian=1))
+    with pytest.raises(SettingError, match="source.rest: must be one of auto, isotropic, upright, got 'sideways'"):
+        solid_request_from_dict(dict(exemplar=PHOTO, rest="sideways"))
+    with pytest.raises(SettingError, match="rest: must be one of"):
+        SolidRequest(exemplar=PHOTO, rest=None).check()
 
 
 def test_the_model_is_chosen_as_the_command_line_always_did():

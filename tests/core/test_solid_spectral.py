@@ -10,7 +10,7 @@ import pytest
 
 from backend.solid.band_distance import band_distance
 from backend.solid.model import SolidTextureModel, slice_points
-from backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, _deproject, choose_mix, mix_rests,
+from backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests,
                                     rest_field, rest_waves)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -39,7 +39,7 @@ def radial_power(img, bins):
 
 
 def test_deprojection_inverts_the_abel_kernel():
-    """A solid's radial power on one annulus shows in plane cuts spread below it; _deproject gives it back."""
+    """A solid's radial power on one annulus shows in plane cuts spread below it; deproject gives it back."""
     edges = np.linspace(0, 10, 41)
     R = 0.5 * (edges[:-1] + edges[1:])[None, :]
     inside = lambda a: np.sqrt(np.clip(1 - (np.minimum(a, R) / R) ** 2, 0, 1))
@@ -48,7 +48,7 @@ def test_deprojection_inverts_the_abel_kernel():
     p3[30] = 1.0
     p2 = K @ p3
     assert p2[30] < 0.5 and p2[:30].sum() > 0.5           # a cut sees most of it lower down
-    got = _deproject(p2, edges, iterations=2000)
+    got = deproject(p2, edges, iterations=2000)
     assert got.argmax() == 30 and got[30] / got.sum() > 0.8
 
 
@@ -76,7 +76,7 @@ def test_cuts_of_the_solid_have_the_photo_s_radial_spectrum_variance_and_colour(
     assert np.abs(got - want).sum() < 0.25
     # without the deprojection the cuts' spectrum slides down (each wave shows at R sin(theta), pi / 4 R on average)
     import backend.solid.spectral as spectral
-    monkeypatch.setattr(spectral, "_deproject", lambda p2, edges: p2)
+    monkeypatch.setattr(spectral, "deproject", lambda p2, edges: p2)
     flat = spectrum(cuts_of(rest_waves(img, PPU)))
     assert (centre * flat).sum() / (centre * want).sum() < 0.85 and np.abs(flat - want).sum() > 0.35
     var = np.mean([c.reshape(-1, 3).var(0).sum() for c in cuts])
@@ -123,14 +123,15 @@ def test_the_check_mixes_the_rest_in_where_the_decoder_is_far_and_keeps_a_decode
     img = band_photo(256)
     waves = rest_waves(img, PPU)
     # a decoder that draws nothing (flat): the Gaussian rest is far closer
-    flat = choose_mix(_layers_from(lambda p, s: np.zeros((len(p), 3), np.float32), img), img, waves)
+    flat = choose_mix(_layers_from(lambda p, s: np.zeros((len(p), 3), np.float32), img), img, {"isotropic": waves})
     assert flat is not None and flat.mix == max(MIXES)
     assert np.allclose(flat.amp, waves[1])                 # t = 1: full amplitude
     # a decoder that draws the same Gaussian texture (another draw of it): no mix is MARGIN closer
     other = rest_waves(img, PPU, seed=99)
-    same = choose_mix(_layers_from(lambda p, s: rest_field(p, RestField(*other, 1.0), s + 50), img), img, waves)
+    same = choose_mix(_layers_from(lambda p, s: rest_field(p, RestField(*other, 1.0), s + 50), img), img,
+                      {"isotropic": waves})
     assert same is None
-    assert choose_mix(_layers_from(lambda p, s: np.zeros((len(p), 3), np.float32), img), img, None) is None
+    assert choose_mix(_layers_from(lambda p, s: np.zeros((len(p), 3), np.float32), img), img, {}) is None
     assert 0.0 < MARGIN < 1.0
 
 
