@@ -42,11 +42,14 @@ a period longer than the photo moved a low-contrast concrete photo's 128² windo
 annuli, their amplitudes weighted so each annulus keeps its power) and nothing below MIN_CYCLES cycles per photo is
 drawn (shading, as harmonic.py leaves it out).
 
-MARGIN was 0.85 until the space model's octaves were turned (spin.py); its decoder then came closer on its own
-and the check misfired less.  On the training split again (decoder + harmonic part alone / margin 0.85 / 0.92):
-rests for 0 / 22 / 35 photos, 19 and 30 photos more than 5 % closer than the decoder alone, 2 and 3 farther; walls
-20 / 0 and 31 / 0; the mean distance of the x, y and z slices each alone 111.7 / 107.3 / 105.9 (JSON
-``docs/img/solid_train_turned_decoder.json``, ``solid_gaussian_train_turned_085.json``, ``..._092.json``).
+MARGIN was 0.85 until the space model's octaves were turned (spin.py); its decoder then came closer on its own and
+the check misfired less. On the training split again (decoder + harmonic part alone / margin 0.85 / 0.92): rests
+for 0 / 22 / 35 photos, 19 and 30 photos more than 5 % closer than the decoder alone, 2 and 3 farther; walls 20 / 0
+and 31 / 0; the mean distance of the x, y and z slices each alone 111.7 / 107.3 / 105.9 (JSON
+``docs/img/solid_train_turned_decoder.json``, ``solid_gaussian_train_turned_085.json``, ``..._092.json``). With the
+upright kind gated (upright.py), a margin of 1.0 on the same photos made 6 photos more than 5 % closer and 5
+farther pooled, 2 and 5 per axis, 10 and 3 on the band-pass levels (JSON
+``docs/img/solid_margin_train_{092,100}.json``): 0.92 stays.
 
 COUNT: measured with 1024 waves first (the 20 and 2 above; JSON ``docs/img/solid_gaussian_train_1024.json``),
 then with 512 on the same photos (``docs/img/solid_gaussian_train_512.json``): 21 closer and 3 farther than the
