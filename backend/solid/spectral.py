@@ -180,10 +180,11 @@ def wave_amplitudes(F, P, pick, weight, rng) -> np.ndarray:
                                                    * np.exp(2j * np.pi * rng.uniform(size=(len(pick), 1))))
 
 
-def rest_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED):
+def rest_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED, spectrum=None):
     """The isotropic Gaussian rest of a photo's rest (H, W, 3) seen at ``px_per_unit`` px per unit (module doc):
-    (freq float64 (count, 3), amp complex128 (count, 3)) at full variance (t = 1); None for a flat photo."""
-    spec = rest_spectrum(rest, px_per_unit)
+    (freq float64 (count, 3), amp complex128 (count, 3)) at full variance (t = 1); None for a flat photo.
+    ``spectrum``: :func:`rest_spectrum` of the same rest and scale where the caller has it already."""
+    spec = rest_spectrum(rest, px_per_unit) if spectrum is None else spectrum
     if spec is None:
         return None
     F, P, fx, fy, V = spec
