@@ -299,6 +299,10 @@ def main(argv=None) -> int:
     ap.add_argument("--margin", type=float, metavar="M",
                     help="keep a Gaussian rest where the check finds it M times as close as the decoder alone "
                          "instead of backend/solid/spectral.py's MARGIN (calibration, on the training split)")
+    ap.add_argument("--check-seeds", type=int, metavar="S",
+                    help="the Gaussian rest's check on x, y and z planes at S seeds instead of backend/solid/"
+                         "spectral.py's CHECK_SEEDS (calibration, on the training split; bench/solid_check_noise.py "
+                         "says how often the check's choice depends on its planes)")
     ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
     ap.add_argument("--refine", type=int, default=0, metavar="N",
                     help="refine each photo's code by N search steps first (the add-on's Refine Steps)")
@@ -310,6 +314,10 @@ def main(argv=None) -> int:
         upright.UPRIGHT_GATE = a.upright_gate
     if a.margin is not None:
         spectral.MARGIN = a.margin
+    if a.check_seeds is not None:
+        spectral.CHECK_SEEDS = tuple(range(6, 6 + a.check_seeds))
+        spectral.CHECK_PLANES = spectral.check_planes(spectral.CHECK_SEEDS)
+        spectral.WALL_PLANES = tuple(p for p in spectral.CHECK_PLANES if p[1] != "z")
     model = SolidTextureModel(a.model)
     files = photos(a.split)
     if a.only:
@@ -320,7 +328,7 @@ def main(argv=None) -> int:
     rows = evaluate(model, files, a.seeds, sheet, a.periodic, a.refine, a.gaussian)
     doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
                periodic=a.periodic, refine=a.refine, gaussian=a.gaussian, upright_gate=upright.UPRIGHT_GATE,
-               margin=spectral.MARGIN,
+               margin=spectral.MARGIN, check_seeds=list(spectral.CHECK_SEEDS),
                summary=summary(rows), by_category=by_category(rows), photos=rows)
     if a.against:
         doc["against"] = against(rows, a.against)

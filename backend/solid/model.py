@@ -32,7 +32,8 @@ from .cellular import cellular_features
 from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
 from .lattice import lattice_noise, octave_seeds
 from .spin import check_mode, spun
-from .spectral import CHECK_PLANES, RENDER, WALL_PLANES, RestField, choose_mix, rest_field, rest_from_json
+from . import spectral
+from .spectral import RENDER, RestField, choose_mix, rest_field, rest_from_json
 from .upright import candidates
 from .waves import wave_features
 
@@ -347,7 +348,8 @@ class SolidTextureModel:
             fixed, dec = self.layers(pts, code, seed)
             return fixed, dec, pts
 
-        return choose_mix(layers, _rgb(image), offered, WALL_PLANES if rest == "upright" else CHECK_PLANES)
+        planes = spectral.WALL_PLANES if rest == "upright" else spectral.CHECK_PLANES   # read now: calibration sets them
+        return choose_mix(layers, _rgb(image), offered, planes)
 
     def with_gaussian_rest(self, code: TextureCode, image: np.ndarray, rest: str = "auto") -> TextureCode:
         """``code`` with :meth:`gaussian_rest` of ``image`` (unchanged where there is none)."""

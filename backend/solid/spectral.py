@@ -71,7 +71,7 @@ from .harmonic import read_waves, wave_sum
 
 __all__ = ["RestField", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
            "rest_spectrum", "deproject", "wave_sampling", "colour_picks", "wave_amplitudes",
-           "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "WALL_PLANES", "BINS", "KINDS", "KIND_WORDS",
+           "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "CHECK_SEEDS", "check_planes", "WALL_PLANES", "BINS", "KINDS", "KIND_WORDS",
            "REST_CHOICES"]
 
 COUNT = 512             #: waves in the Gaussian rest (module doc)
@@ -80,8 +80,17 @@ ITERATIONS = 300        #: Richardson-Lucy iterations of the deprojection
 MIXES = (0.25, 0.5, 0.75, 1.0)   #: the shares t of the rest's variance tried against t = 0
 MARGIN = 0.92           #: a mix is kept only if its check distance is at most MARGIN times the decoder's alone
 RENDER = 128            #: px per check plane
-#: (seed, axis, offset) of the check's planes: x, y and z cuts at seeds 6 and 7
-CHECK_PLANES = tuple((s, a, (13.0 + s, 17.0, 19.0)) for s in (6, 7) for a in "xyz")
+
+
+def check_planes(seeds) -> tuple:
+    """(seed, axis, offset) of check planes: x, y and z cuts at each of ``seeds``, each seed's through its own point
+    (none of the held-out evaluation's planes)."""
+    return tuple((int(s), a, (13.0 + s, 17.0, 19.0)) for s in seeds for a in "xyz")
+
+
+CHECK_SEEDS = (6, 7)    #: the check's seeds
+#: (seed, axis, offset) of the check's planes: x, y and z cuts at CHECK_SEEDS
+CHECK_PLANES = check_planes(CHECK_SEEDS)
 #: the check's walls alone (x and y cuts): where an artist asks for the upright rest, floors are not its concern
 WALL_PLANES = tuple(p for p in CHECK_PLANES if p[1] != "z")
 WAVE_SEED = 0x72657374  #: the waves' draw (fixed: the same photo gives the same texture)
