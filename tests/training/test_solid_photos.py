@@ -1,5 +1,6 @@
 """The photo set, the photo models' colour path and bounded transforms, the sliced Wasserstein loss and the
 held-out photo evaluation (issue 20)."""
+import dataclasses
 import hashlib
 import json
 import os
@@ -120,6 +121,33 @@ def test_bounded_transforms_are_never_singular():
         T = bounded_transform(torch.randn(4, 8, 10) * scale, R)
         s = torch.linalg.svdvals(T)
         assert s.min() >= 0.4 * np.exp(-0.5) - 1e-5 and s.max() <= 1.6 * np.exp(0.5) + 1e-5
+
+
+def test_a_translator_without_stretch_only_turns_and_scales_and_continues_a_stretching_one():
+    R = random_rotations(8, 3).unsqueeze(0)
+    raw = torch.randn(4, 8, 10) * 3.0
+    assert torch.equal(bounded_transform(raw, R), bounded_transform(raw, R, max_stretch=0.6))   # the default
+    s = torch.linalg.svdvals(bounded_transform(raw, R, max_stretch=0.0))
+    np.testing.assert_allclose((s.amax(-1) / s.amin(-1)).numpy(), 1.0, atol=1e-5)       # no octave stretched
+    assert (torch.linalg.svdvals(bounded_transform(raw, R)).amax(-1) / s.amax(-1)).max() > 1.2   # the default does
+    root = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "configs",
+                        "solid", "gpu")
+    cfg = SolidConfig.from_dict({**json.load(open(os.path.join(root, "photo_space_gpu_nostretch_a.json"))),
+                                 "device": "cpu", "init_onnx": "", "init_sha256": ""})
+    assert cfg.max_stretch == 0.0 and cfg.spin == "octave"
+    base = build_model(dataclasses.replace(cfg, max_stretch=0.6))
+    model = build_model(cfg)
+    model.load_state_dict(base.state_dict())          # the shipped weights continue into it unchanged
+    z = torch.randn(3, cfg.z_dim)
+    with torch.no_grad():
+        _, T = model.translator(z)
+    s = torch.linalg.svdvals(T)
+    np.testing.assert_allclose((s.amax(-1) / s.amin(-1)).numpy(), 1.0, atol=1e-4)
+    for bad, msg in (({"max_stretch": 1.0}, "max_stretch must be a number in"),
+                     ({"max_stretch": -0.1}, "max_stretch must be a number in"),
+                     ({"max_stretch": 0.0, "transform": "free"}, "max_stretch needs transform 'bounded'")):
+        with pytest.raises(ValueError, match=msg):
+            SolidConfig.from_dict({"mode": "space", "exemplars": ["gravel", "grass"], "transform": "bounded", **bad})
 
 
 def test_swd_loss_prefers_the_texture_to_its_shuffle():

@@ -279,9 +279,12 @@ MAX_STRETCH = 0.6
 MAX_LOG_SCALE = 0.5
 
 
-def bounded_transform(raw: torch.Tensor, R: torch.Tensor, max_scale: torch.Tensor | None = None) -> torch.Tensor:
+def bounded_transform(raw: torch.Tensor, R: torch.Tensor, max_scale: torch.Tensor | None = None,
+                      max_stretch: float = MAX_STRETCH) -> torch.Tensor:
     """T_i = R_i exp(c_i) (I + S_i) from raw (B, m, D*D + 1): S_i = sym(M_i) scaled so its Frobenius norm
-    (a bound on every eigenvalue) stays <= MAX_STRETCH, c_i = MAX_LOG_SCALE tanh(raw_i[-1]).
+    (a bound on every eigenvalue) stays <= ``max_stretch`` (MAX_STRETCH), c_i = MAX_LOG_SCALE tanh(raw_i[-1]).
+    ``max_stretch`` 0: T_i = exp(c_i) R_i, a turn and a scale, no stretch (octaves that cannot draw strokes; the
+    raw layout is the same, so a stretching model's weights continue into one that cannot).
 
     Singular values of T_i then lie in [0.4, 1.6] x e^+-0.5: anisotropic (grain, layers) up to a ratio of 4,
     but never the near-singular T of the free parametrisation, whose zero singular values extruded the
@@ -296,7 +299,7 @@ def bounded_transform(raw: torch.Tensor, R: torch.Tensor, max_scale: torch.Tenso
     M = raw[..., :D * D].view(B, m, D, D)
     S = 0.5 * (M + M.transpose(-1, -2))
     n = S.flatten(2).norm(dim=2).view(B, m, 1, 1)
-    stretch = MAX_STRETCH * torch.tanh(n)                  # ||S_i||_F after scaling, >= its largest |eigenvalue|
+    stretch = max_stretch * torch.tanh(n)                  # ||S_i||_F after scaling, >= its largest |eigenvalue|
     S = S * (stretch / n.clamp_min(1e-6))
     c = torch.exp(MAX_LOG_SCALE * torch.tanh(raw[..., D * D:])).view(B, m, 1, 1)
     if max_scale is not None:
@@ -324,10 +327,16 @@ class Translator(nn.Module):
     by 1: the first models), or ``bounded`` (:func:`bounded_transform`)."""
 
     def __init__(self, z_dim: int, code_dim: int, octaves: int, dim: int, width: int = 128, seed: int = 0,
-                 transform: str = "free", max_scale: torch.Tensor | None = None):
+                 transform: str = "free", max_scale: torch.Tensor | None = None, max_stretch: float = MAX_STRETCH):
         super().__init__()
         if transform not in ("free", "bounded"):
             raise ValueError(f"transform must be 'free' or 'bounded', got {transform!r}")
+        if not (isinstance(max_stretch, (int, float)) and 0.0 <= max_stretch < 1.0):
+            raise ValueError(f"max_stretch must be a number in [0, 1) (1 would let a transform collapse), "
+                             f"got {max_stretch!r}")
+        if max_stretch != MAX_STRETCH and transform != "bounded":
+            raise ValueError("max_stretch needs the bounded transform")
+        self.max_stretch = float(max_stretch)
         if max_scale is not None and (transform != "bounded" or tuple(max_scale.shape) != (octaves,)):
             raise ValueError("max_scale needs the bounded transform and one cap per octave")
         self.code_dim, self.octaves, self.dim, self.transform = code_dim, octaves, dim, transform
@@ -346,7 +355,7 @@ class Translator(nn.Module):
         e = out[:, :self.code_dim]
         if self.transform == "bounded":
             return e, bounded_transform(out[:, self.code_dim:].view(z.shape[0], self.octaves, -1), self.R,
-                                        self.max_scale)
+                                        self.max_scale, self.max_stretch)
         # bounded: an unbounded Delta let a space run grow every T_i to ~100x (all octaves at the pixel
         # scale: fine grain of one average colour for every exemplar)
         delta = torch.tanh(out[:, self.code_dim:]).view(-1, self.octaves, self.dim, self.dim)
@@ -361,7 +370,7 @@ class SolidTexture(nn.Module):
                  mode: str = "single", width: int = 128, layers: int = 4, seed: int = 0, decoder_init: str = "he",
                  colour: str = "sigmoid", transform: str = "free", film: bool = False, standardise: bool = False,
                  cellular: int = 0, bricks: int = 0, max_scale: torch.Tensor | None = None, waves: int = 0,
-                 spin: str = ""):
+                 spin: str = "", max_stretch: float = MAX_STRETCH):
         super().__init__()
         #: backend.solid.spin: "lattice" reads octave i at Q(xi_i) T_i 2^(i-1) x, "octave" at T_i Q(xi_i)^T 2^(i-1) x
         self.spin = check_mode(spin)
@@ -389,7 +398,7 @@ class SolidTexture(nn.Module):
         else:
             self.encoder = Encoder(z_dim, standardise=standardise)
             self.translator = Translator(z_dim, code_dim, octaves, dim, seed=seed, transform=transform,
-                                         max_scale=max_scale)
+                                         max_scale=max_scale, max_stretch=max_stretch)
 
     def codes(self, exemplars: torch.Tensor | None = None, batch: int = 1):
         """(e (B, E), T (B, m, D, D)) for a batch: the single-mode parameters, or h(g(exemplars))."""

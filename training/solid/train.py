@@ -39,8 +39,8 @@ from ..model_card import cpu_name
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import (SolidTexture, fixed_axis_index, axis_rotations, check_fixed_axis, colour_stats, max_scales,
-                    shape_features, slice_points, spectral_aspect, spectral_gains)
+from .model import (MAX_STRETCH, SolidTexture, fixed_axis_index, axis_rotations, check_fixed_axis, colour_stats,
+                    max_scales, shape_features, slice_points, spectral_aspect, spectral_gains)
 from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
 from .structure_features import StructureFeatures, load_structure_net
@@ -97,6 +97,9 @@ class SolidConfig:
     structure_net: str = ""         # ... the trained structure network it reads (a file of train_structure_net)
     isotropy_weight: float = 0.0    # weight of a penalty on the octave transforms' anisotropy (isotropy_penalty):
                                     # a stretch must buy more of the texture loss than it costs; 0: off
+    max_stretch: float = MAX_STRETCH  # bounded space models: the largest stretch of an octave's transform
+                                    # (model.bounded_transform); 0: the translator cannot stretch, only turn and
+                                    # scale, so no octave draws strokes
     min_spacing: float = 0.0        # bounded space models: no octave's lattice finer than this many px (model.max_scales); 0: off
     seed: int = 0
     log_every: int = 25
@@ -154,6 +157,10 @@ class SolidConfig:
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
         check_mode(cfg.spin)
+        if not (isinstance(cfg.max_stretch, (int, float)) and 0.0 <= cfg.max_stretch < 1.0):
+            raise ValueError(f"max_stretch must be a number in [0, 1), got {cfg.max_stretch!r}")
+        if cfg.max_stretch != MAX_STRETCH and cfg.transform != "bounded":
+            raise ValueError("max_stretch needs transform 'bounded'")
         for key in ("spectrum_weight", "morphology_weight", "structure_weight", "isotropy_weight"):
             if not (math.isfinite(getattr(cfg, key)) and getattr(cfg, key) >= 0):
                 raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
@@ -232,7 +239,7 @@ def build_model(cfg: SolidConfig) -> SolidTexture:
                         cfg.layers, cfg.seed, cfg.decoder_init, cfg.colour, cfg.transform, cfg.film,
                         cfg.standardise, cfg.cellular, cfg.bricks,
                         max_scales(cfg.octaves, cfg.px_per_unit, cfg.min_spacing) if cfg.min_spacing else None,
-                        cfg.waves, cfg.spin)
+                        cfg.waves, cfg.spin, cfg.max_stretch)
 
 
 def _resample(img: torch.Tensor, factor: float) -> torch.Tensor:
