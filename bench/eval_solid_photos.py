@@ -317,7 +317,7 @@ def main(argv=None) -> int:
     if a.check_seeds is not None:
         spectral.CHECK_SEEDS = tuple(range(6, 6 + a.check_seeds))
         spectral.CHECK_PLANES = spectral.check_planes(spectral.CHECK_SEEDS)
-        spectral.WALL_PLANES = tuple(p for p in spectral.CHECK_PLANES if p[1] != "z")
+        spectral.WALL_PLANES = spectral.wall_planes(spectral.CHECK_PLANES)
     model = SolidTextureModel(a.model)
     files = photos(a.split)
     if a.only:

@@ -1,5 +1,5 @@
 """How often the Gaussian rest's check (backend/solid/spectral.py, choose_mix) would decide otherwise on other
-planes: ``python bench/solid_check_noise.py [--split train] [--limit 40] [--seeds 2] [--offset 0]``.
+planes: ``python bench/solid_check_noise.py [--split train] [--limit 40] [--seeds 2] [-o JSON]``.
 
 For every photo (every k-th of the split, so that about ``--limit`` are read) the texture-space model encodes the
 photo as the product does (harmonic part, decoder), and the check chooses its Gaussian rest twice, on two disjoint

@@ -348,7 +348,8 @@ class SolidTextureModel:
             fixed, dec = self.layers(pts, code, seed)
             return fixed, dec, pts
 
-        planes = spectral.WALL_PLANES if rest == "upright" else spectral.CHECK_PLANES   # read now: calibration sets them
+        # read when called: calibration (bench/eval_solid_photos.py --check-seeds) sets them
+        planes = spectral.WALL_PLANES if rest == "upright" else spectral.CHECK_PLANES
         return choose_mix(layers, _rgb(image), offered, planes)
 
     def with_gaussian_rest(self, code: TextureCode, image: np.ndarray, rest: str = "auto") -> TextureCode:

@@ -71,8 +71,8 @@ from .harmonic import read_waves, wave_sum
 
 __all__ = ["RestField", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
            "rest_spectrum", "deproject", "wave_sampling", "colour_picks", "wave_amplitudes",
-           "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "CHECK_SEEDS", "check_planes", "WALL_PLANES", "BINS", "KINDS", "KIND_WORDS",
-           "REST_CHOICES"]
+           "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "CHECK_SEEDS", "check_planes", "wall_planes", "WALL_PLANES",
+           "BINS", "KINDS", "KIND_WORDS", "REST_CHOICES"]
 
 COUNT = 512             #: waves in the Gaussian rest (module doc)
 BINS = 64               #: radial annuli of the spectrum
@@ -88,11 +88,17 @@ def check_planes(seeds) -> tuple:
     return tuple((int(s), a, (13.0 + s, 17.0, 19.0)) for s in seeds for a in "xyz")
 
 
+def wall_planes(planes) -> tuple:
+    """The walls (x and y cuts) of check ``planes``: where an artist asks for the upright rest, floors are not its
+    concern."""
+    return tuple(p for p in planes if p[1] != "z")
+
+
 CHECK_SEEDS = (6, 7)    #: the check's seeds
 #: (seed, axis, offset) of the check's planes: x, y and z cuts at CHECK_SEEDS
 CHECK_PLANES = check_planes(CHECK_SEEDS)
-#: the check's walls alone (x and y cuts): where an artist asks for the upright rest, floors are not its concern
-WALL_PLANES = tuple(p for p in CHECK_PLANES if p[1] != "z")
+#: the check's walls alone (wall_planes)
+WALL_PLANES = wall_planes(CHECK_PLANES)
 WAVE_SEED = 0x72657374  #: the waves' draw (fixed: the same photo gives the same texture)
 MIN_CYCLES = 2          #: no power below this many cycles per photo (shading and vignetting, as harmonic.py)
 KINDS = ("isotropic", "upright", "mixed")   #: RestField.kind

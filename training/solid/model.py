@@ -38,7 +38,7 @@ from .cellular import cellular_features
 from .lattice import lattice_noise, spun_torch
 from .waves import wave_features
 
-__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "axis_frame", "axis_rotations", "slice_points"]
+__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "check_max_stretch", "axis_frame", "axis_rotations", "slice_points"]
 
 
 def shape_features(cellular: int, bricks: int) -> int:
@@ -279,6 +279,17 @@ MAX_STRETCH = 0.6
 MAX_LOG_SCALE = 0.5
 
 
+def check_max_stretch(max_stretch, transform: str) -> float:
+    """``max_stretch`` (:func:`bounded_transform`) as a float, or ValueError naming what is wrong: a number in [0, 1)
+    (1 would let a transform collapse), and other than MAX_STRETCH only with the bounded transform."""
+    if not (isinstance(max_stretch, (int, float)) and 0.0 <= max_stretch < 1.0):
+        raise ValueError(f"max_stretch must be a number in [0, 1) (1 would let a transform collapse), "
+                         f"got {max_stretch!r}")
+    if max_stretch != MAX_STRETCH and transform != "bounded":
+        raise ValueError("max_stretch needs transform 'bounded'")
+    return float(max_stretch)
+
+
 def bounded_transform(raw: torch.Tensor, R: torch.Tensor, max_scale: torch.Tensor | None = None,
                       max_stretch: float = MAX_STRETCH) -> torch.Tensor:
     """T_i = R_i exp(c_i) (I + S_i) from raw (B, m, D*D + 1): S_i = sym(M_i) scaled so its Frobenius norm
@@ -331,12 +342,7 @@ class Translator(nn.Module):
         super().__init__()
         if transform not in ("free", "bounded"):
             raise ValueError(f"transform must be 'free' or 'bounded', got {transform!r}")
-        if not (isinstance(max_stretch, (int, float)) and 0.0 <= max_stretch < 1.0):
-            raise ValueError(f"max_stretch must be a number in [0, 1) (1 would let a transform collapse), "
-                             f"got {max_stretch!r}")
-        if max_stretch != MAX_STRETCH and transform != "bounded":
-            raise ValueError("max_stretch needs the bounded transform")
-        self.max_stretch = float(max_stretch)
+        self.max_stretch = check_max_stretch(max_stretch, transform)
         if max_scale is not None and (transform != "bounded" or tuple(max_scale.shape) != (octaves,)):
             raise ValueError("max_scale needs the bounded transform and one cap per octave")
         self.code_dim, self.octaves, self.dim, self.transform = code_dim, octaves, dim, transform

@@ -39,8 +39,8 @@ from ..model_card import cpu_name
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
-from .model import (MAX_STRETCH, SolidTexture, fixed_axis_index, axis_rotations, check_fixed_axis, colour_stats,
-                    max_scales, shape_features, slice_points, spectral_aspect, spectral_gains)
+from .model import (MAX_STRETCH, SolidTexture, fixed_axis_index, axis_rotations, check_fixed_axis, check_max_stretch,
+                    colour_stats, max_scales, shape_features, slice_points, spectral_aspect, spectral_gains)
 from .soft_morphology import soft_morphology_loss
 from .spectrum import spectrum_loss
 from .structure_features import StructureFeatures, load_structure_net
@@ -157,10 +157,7 @@ class SolidConfig:
         if cfg.spectral and (cfg.mode != "space" or cfg.colour != "affine"):
             raise ValueError("spectral gains are measured from the exemplar: they need mode 'space' and colour 'affine'")
         check_mode(cfg.spin)
-        if not (isinstance(cfg.max_stretch, (int, float)) and 0.0 <= cfg.max_stretch < 1.0):
-            raise ValueError(f"max_stretch must be a number in [0, 1), got {cfg.max_stretch!r}")
-        if cfg.max_stretch != MAX_STRETCH and cfg.transform != "bounded":
-            raise ValueError("max_stretch needs transform 'bounded'")
+        check_max_stretch(cfg.max_stretch, cfg.transform)
         for key in ("spectrum_weight", "morphology_weight", "structure_weight", "isotropy_weight"):
             if not (math.isfinite(getattr(cfg, key)) and getattr(cfg, key) >= 0):
                 raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
