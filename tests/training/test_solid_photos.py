@@ -150,6 +150,52 @@ def test_a_translator_without_stretch_only_turns_and_scales_and_continues_a_stre
             SolidConfig.from_dict({"mode": "space", "exemplars": ["gravel", "grass"], "transform": "bounded", **bad})
 
 
+def test_bf16_decoder_draws_the_fp32_texture_and_is_recorded(tmp_path):
+    """``precision`` "bf16": only the decoder's products run under bf16 autocast; the texture stays float32 and
+    within bf16 rounding of fp32's, gradients reach every decoder weight, and the export (traced in fp32) says
+    where and how the run trained.  Bad values get a one-line error."""
+    from training.precision import resolve
+    from training.solid.lattice import octave_seeds
+    from training.solid.model import spectral_gains
+    from training.solid.train import hardware_here
+
+    photos = ex.photo_set("train")[:2]
+    cfg = dict(name="tiny_bf16", mode="space", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
+               checkpoint_every=2, threads=1, exemplars=photos, colour="affine", loss="swd", transform="bounded",
+               swd_width=8, swd_levels=2, film=True, precision="bf16")
+    c = SolidConfig.from_dict(cfg)
+    model = build_model(c)
+    assert model.precision == "fp32"                         # a model traces and exports in fp32 unless told
+    ref = torch.stack([ex.load_image(p)[:, :64, :64] for p in photos])
+    x = torch.from_numpy(np.random.default_rng(0).uniform(-3, 3, (2, 400, 3))).float()
+    seeds = octave_seeds([3, 4], c.octaves)
+    out = {}
+    for prec in ("fp32", "bf16"):
+        model.precision = prec
+        model.zero_grad()
+        e, T = model.codes(ref)
+        rgb = model.sample(x, e, T, seeds, colour_stats_t(ref), spectral_gains(ref, c.octaves, c.px_per_unit))
+        rgb.square().mean().backward()
+        out[prec] = (rgb.detach(), [p.grad.clone() for p in model.decoder.parameters()])
+    assert out["bf16"][0].dtype == torch.float32
+    diff = (out["bf16"][0] - out["fp32"][0]).abs()
+    assert 0 < diff.mean() < 2e-3, diff.mean()               # rounded, not a different texture
+    for g16, g32 in zip(out["bf16"][1], out["fp32"][1]):
+        if g32.abs().sum() > 0:
+            assert torch.nn.functional.cosine_similarity(g16.flatten(), g32.flatten(), dim=0) > 0.98
+    assert hardware_here(c, torch.device("cpu"), "bf16").endswith("1 threads, bf16 decoder, fp32 loss")
+    assert hardware_here(c, torch.device("cpu"), "fp32").endswith("1 threads, fp32")
+    lines = []
+    train(c, str(tmp_path / "run"), log=lines.append)
+    assert "precision: bf16 (the decoder under bf16 autocast)" in lines
+    doc = export(str(tmp_path / "run"), str(tmp_path / "m"))
+    assert doc["hardware"].endswith("bf16 decoder, fp32 loss")
+    assert SolidConfig.from_dict({**cfg, "precision": "auto"}).precision == "auto"
+    assert resolve("auto", torch.device("cpu")) in ("fp32", "bf16")
+    with pytest.raises(ValueError, match="precision must be one of auto, fp32, bf16, got 'fp16'"):
+        SolidConfig.from_dict({**cfg, "precision": "fp16"})
+
+
 def test_swd_loss_prefers_the_texture_to_its_shuffle():
     g = torch.Generator().manual_seed(0)
     feats = SlicedFeatures(width=16, kernels=(3, 7), levels=3)
@@ -510,7 +556,9 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
     train(c, str(tmp_path / "run"), log=lambda *_: None)
     doc = export(str(tmp_path / "run"), str(tmp_path / "models" / "tiny_single"))
     np.testing.assert_allclose(doc["colour_code"], colour_stats(region.permute(1, 2, 0).numpy()), atol=1e-5)
-    assert doc["hardware"].endswith("1 threads, fp32")        # where it trained travels with the export
+    from training.precision import resolve            # precision "auto": bf16 where this CPU computes it natively
+    prec = "fp32" if resolve("auto", torch.device("cpu")) == "fp32" else "bf16 decoder, fp32 loss"
+    assert doc["hardware"].endswith(f"1 threads, {prec}")    # where it trained travels with the export
     rt = SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
     code = rt.default_code()
     np.testing.assert_allclose(code.mu, doc["colour_code"][:3], atol=1e-6)

@@ -33,6 +33,7 @@ from backend.solid.brick import FEATURES as BRICK_FEATURES
 from backend.solid.cellular import FEATURES as CELL_FEATURES
 from backend.solid.spin import check_mode
 from backend.solid.waves import FEATURES as WAVE_FEATURES
+from ..precision import autocast
 from .brick import brick_features
 from .cellular import cellular_features
 from .lattice import lattice_noise, spun_torch
@@ -398,6 +399,9 @@ class SolidTexture(nn.Module):
         self.register_buffer("waves", torch.zeros(waves, 4) if waves else None)
         self.decoder = Decoder(self.n_noise, code_dim, width, layers, decoder_init, sigmoid=colour == "sigmoid",
                                film=film)
+        #: "fp32" or "bf16": the decoder runs under bf16 autocast in :meth:`sample` (set by the trainer from a
+        #: config's ``precision``; not part of the weights, and an export always traces fp32)
+        self.precision = "fp32"
         if mode == "single":
             self.code = nn.Parameter(torch.rand(code_dim) * 2.0 - 1.0)     # U(-1, 1) as the authors' code
             self.T = nn.Parameter(random_rotations(octaves, dim, seed).clone())
@@ -432,7 +436,8 @@ class SolidTexture(nn.Module):
             n = torch.cat([n, brick_features(x, T, seeds, self.bricks)], dim=-1)
         if self.waves is not None:
             n = torch.cat([n, wave_features(x, self.waves)], dim=-1)
-        out = self.decoder(n, e.unsqueeze(1))
+        with autocast(self.precision, n.device):   # bf16 for the MLP's matrix products only (train.py precision)
+            out = self.decoder(n, e.unsqueeze(1)).float()
         if self.colour == "affine":
             if stats is None:
                 raise ValueError("an affine-colour model needs the exemplars' colour statistics")

@@ -36,6 +36,7 @@ from backend._export import export as _ex
 from ..threads import cpu_threads
 from ..config import check_config_keys
 from ..model_card import cpu_name
+from ..precision import PRECISIONS, resolve as resolve_precision
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
@@ -110,6 +111,9 @@ class SolidConfig:
     threads: int = 0                # CPU threads for torch and numba (0: their defaults)
     device: str = "cpu"             # "cpu" or "cuda" / "cuda:N" (model, loss and crops there; the random draws
                                     # stay on the CPU's generator, so a run's data is the same on any device)
+    precision: str = "auto"         # "auto", "fp32" or "bf16": the decoder's matrix products under bf16 autocast
+                                    # ("auto": where the device computes bf16 natively, training/precision.py);
+                                    # noise, transforms, encoder and loss stay fp32. Recorded in the hardware line
     init_from: str = ""             # a run folder to continue (its ckpt.pt and log.jsonl seed a new run)
     init_onnx: str = ""             # or an export folder to continue (its weights; Adam's moments start afresh) ...
     init_sha256: str = ""           # ... whose weights have this fingerprint (backend.onnx_models.fingerprint)
@@ -183,6 +187,8 @@ class SolidConfig:
         if cfg.init_onnx and cfg.init_from:
             raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
         check_fixed_axis(cfg.fixed_axis)
+        if cfg.precision not in PRECISIONS:
+            raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {cfg.precision!r}")
         if not (cfg.device == "cpu" or cfg.device == "cuda" or
                 (cfg.device.startswith("cuda:") and cfg.device[5:].isdigit())):
             raise ValueError(f"device must be 'cpu', 'cuda' or 'cuda:N', got {cfg.device!r}")
@@ -353,12 +359,14 @@ def train_device(name: str) -> torch.device:
     return dev
 
 
-def hardware_here(cfg: SolidConfig, dev: torch.device) -> str:
-    """Where a stretch of training runs, for the model card: the GPU or the CPU and its threads, precision."""
+def hardware_here(cfg: SolidConfig, dev: torch.device, precision: str = "fp32") -> str:
+    """Where a stretch of training runs, for the model card: the GPU or the CPU and its threads, precision
+    ("bf16 decoder": the decoder's products under bf16 autocast, the rest fp32)."""
+    prec = "fp32" if precision == "fp32" else "bf16 decoder, fp32 loss"
     if dev.type == "cuda":
         conv = "TF32 convolutions" if torch.backends.cudnn.allow_tf32 else "fp32 convolutions"
-        return f"{torch.cuda.get_device_name(dev)}, fp32 ({conv})"
-    return f"{cpu_name()}, {cfg.threads or torch.get_num_threads()} threads, fp32"
+        return f"{torch.cuda.get_device_name(dev)}, {prec} ({conv})"
+    return f"{cpu_name()}, {cfg.threads or torch.get_num_threads()} threads, {prec}"
 
 
 def train(cfg: SolidConfig, out: str, max_steps: int | None = None, log=print,
@@ -383,6 +391,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed + 1)
     model = build_model(cfg).to(dev)    # before the optimiser: a resumed one's moments load onto its parameters
+    model.precision = resolve_precision(cfg.precision, dev)
     feats = loss_features(cfg).to(dev)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     step, elapsed = 0, 0.0
@@ -443,7 +452,8 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
         else None
     state = None
     # where training ran: this stretch's device, after those of the stretches it resumes (recorded in the export)
-    here = hardware_here(cfg, dev)
+    here = hardware_here(cfg, dev, model.precision)
+    log(f"precision: {model.precision}" + (" (the decoder under bf16 autocast)" if model.precision == "bf16" else ""))
     hardware = prev_hardware if here in prev_hardware.split("; ") else "; ".join(filter(None, [prev_hardware, here]))
     start, t_loop, t_fit = step, time.time(), 0.0
     while step < end:
