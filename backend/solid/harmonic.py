@@ -72,7 +72,7 @@ import numpy as np
 from ..periodic import periodic_component
 
 __all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
-           "mix_harmonics", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
+           "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
            "LOBE", "LOBE_DEPTH"]
 
 COUNT = 256         #: at most this many peaks
@@ -249,15 +249,25 @@ def harmonic_field(points: np.ndarray, h: Harmonics, seed: int = 0) -> np.ndarra
     return wave_sum(q, h.freq, h.amp)
 
 
-def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmonics | None:
-    """The harmonic part of a code interpolated by ``t`` from a to b: both sets of waves, their powers weighted
-    (1 - t) and t (amplitudes by the square roots), so the share interpolates linearly; None when both are."""
-    parts = [(h, w) for h, w in ((a, 1.0 - t), (b, t)) if h is not None]
+def mix_waves(parts: list, dim: int) -> tuple | None:
+    """The power-weighted union of wave sets ``parts`` [(freq (K, dim), amp complex (K, 3), value, w)], w >= 0:
+    (freq (sum K, dim), amp (sum K, 3), sum of w * value), amplitudes times sqrt(w) so that powers are weighted
+    by w; sets of weight 0 add nothing and are left out; None when none is left.  What interpolating two codes
+    does to their harmonic parts (:func:`mix_harmonics`) and Gaussian rests (spectral.mix_rests)."""
+    parts = [p for p in parts if p[3] > 0.0]
     if not parts:
         return None
-    freq = np.concatenate([h.freq for h, _ in parts]).reshape(-1, 2)
-    amp = np.concatenate([h.amp * np.sqrt(w) for h, w in parts]).reshape(-1, 3)
-    return Harmonics(freq, amp, float(sum(h.share * w for h, w in parts)))
+    return (np.concatenate([f for f, _, _, _ in parts]).reshape(-1, dim),
+            np.concatenate([a * np.sqrt(w) for _, a, _, w in parts]).reshape(-1, 3),
+            float(sum(v * w for _, _, v, w in parts)))
+
+
+def mix_harmonics(a: Harmonics | None, b: Harmonics | None, t: float) -> Harmonics | None:
+    """The harmonic part of a code interpolated by ``t`` from a to b: both sets of waves, their powers weighted
+    (1 - t) and t (amplitudes by the square roots), so the share interpolates linearly; None when neither is
+    left (:func:`mix_waves`)."""
+    m = mix_waves([(h.freq, h.amp, h.share, w) for h, w in ((a, 1.0 - t), (b, t)) if h is not None], 2)
+    return None if m is None else Harmonics(*m)
 
 
 def to_json(h: Harmonics) -> dict:

@@ -461,17 +461,22 @@ class SolidTextureModel:
         k = 1.0 if code.harmonics is None or self.harmonic_rest else code.harmonics.keep
         return k * float(np.sqrt(1.0 - code.rest.mix)) if code.rest is not None else k
 
+    def _parts(self, pts: np.ndarray, d: np.ndarray, code: TextureCode, seed: int) -> tuple:
+        """Photo models: the texture before its Gaussian rest and clipping as two float32 (n, 3) parts,
+        (mu + h(x), k L d(x)), from the decoder's output d (n, 3) at points (n, dim)."""
+        dec = _F(self._keep(code)) * (d @ np.asarray(code.L, _F).T)
+        fixed = np.broadcast_to(np.asarray(code.mu, _F), dec.shape).copy()
+        if code.harmonics is not None:
+            fixed += harmonic_field(pts, code.harmonics, seed)
+        return fixed, dec
+
     def _coloured(self, pts: np.ndarray, d: np.ndarray, code: TextureCode, seed: int) -> np.ndarray:
-        """Photo models: rgb = clip(mu + k L d + h(x) + sqrt(t) g(x)) (harmonic.py, spectral.py): float32 (n, 3)."""
+        """Photo models: rgb = clip(mu + h(x) + k L d + sqrt(t) g(x)) (harmonic.py, spectral.py): float32 (n, 3)."""
         self._check_colour(code)
-        h, r = code.harmonics, code.rest
-        if h is None and r is None:
-            return np.clip(code.mu + d @ np.asarray(code.L, _F).T, 0.0, 1.0)
-        out = code.mu + _F(self._keep(code)) * (d @ np.asarray(code.L, _F).T)
-        if h is not None:
-            out = out + harmonic_field(pts, h, seed)
-        if r is not None:
-            out = out + rest_field(pts, r, seed)
+        fixed, dec = self._parts(pts, d, code, seed)
+        out = fixed + dec
+        if code.rest is not None:
+            out += rest_field(pts, code.rest, seed)
         return np.clip(out, 0.0, 1.0)
 
     def layers(self, points: np.ndarray, code: TextureCode, seed: int = 0) -> tuple:
@@ -481,12 +486,7 @@ class SolidTextureModel:
         if code.rest is not None:
             raise SettingError("code", "layers takes a code without a Gaussian rest")
         pts = self._padded(np.asarray(points))
-        d = self._decoded(pts, code, seed, 0, pts.shape[0])
-        dec = _F(self._keep(code)) * (d @ np.asarray(code.L, _F).T)
-        fixed = np.broadcast_to(np.asarray(code.mu, _F), dec.shape).copy()
-        if code.harmonics is not None:
-            fixed += harmonic_field(pts, code.harmonics, seed)
-        return fixed, dec
+        return self._parts(pts, self._decoded(pts, code, seed, 0, pts.shape[0]), code, seed)
 
     def image(self, size: int, code: TextureCode, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),
               axis: str = "y", **kw) -> np.ndarray:

@@ -120,8 +120,9 @@ class SolidRequest:
                             bool(self.periodic), bool(self.gaussian), self.rest)
 
     def key(self) -> dict:
-        """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256)."""
+        """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
+        kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone)."""
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),
-                    gaussian=bool(self.gaussian), rest=self.rest)
+                    gaussian=bool(self.gaussian), rest=self.rest if self.gaussian else None)

@@ -67,7 +67,7 @@ import numpy as np
 
 from ..periodic import periodic_component
 from .band_distance import band_distance
-from .harmonic import read_waves, wave_sum
+from .harmonic import mix_waves, read_waves, wave_sum
 
 __all__ = ["RestField", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
            "rest_spectrum", "deproject", "wave_sampling", "colour_picks", "wave_amplitudes",
@@ -295,9 +295,8 @@ def mix_rests(a: RestField | None, b: RestField | None, s: float) -> RestField |
     """The Gaussian rest of a code interpolated by ``s`` from a to b: both sets of waves, powers weighted (1 - s)
     and s, the mix interpolating linearly (as :func:`~backend.solid.harmonic.mix_harmonics`); None when both are."""
     parts = [(r, w) for r, w in ((a, 1.0 - s), (b, s)) if r is not None and w > 0.0]
-    if not parts:
+    m = mix_waves([(r.freq, r.amp, r.mix, w) for r, w in parts], 3)
+    if m is None:
         return None
     kinds = {r.kind for r, _ in parts}
-    return RestField(np.concatenate([r.freq for r, _ in parts]).reshape(-1, 3),
-                     np.concatenate([r.amp * np.sqrt(w) for r, w in parts]).reshape(-1, 3),
-                     float(sum(r.mix * w for r, w in parts)), kinds.pop() if len(kinds) == 1 else "mixed")
+    return RestField(*m, kinds.pop() if len(kinds) == 1 else "mixed")

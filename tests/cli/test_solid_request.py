@@ -44,6 +44,9 @@ def test_a_file_and_its_pixels_are_one_exemplar():
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, periodic=False).key()
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, gaussian=False).key()
     assert by_file.key() != SolidRequest(exemplar=PHOTO, refine=2, rest="isotropic").key()
+    # without a Gaussian rest its kind changes nothing: the same texture, the same key
+    assert SolidRequest(exemplar=PHOTO, gaussian=False, rest="upright").key() == \
+        SolidRequest(exemplar=PHOTO, gaussian=False).key()
 
 
 def test_periodic_and_gaussian_must_be_a_yes_or_no():

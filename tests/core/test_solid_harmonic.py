@@ -132,6 +132,7 @@ def test_mixing_weights_powers():
     assert mix_harmonics(None, None, 0.3) is None
     m = mix_harmonics(a, b, 0.25)
     assert len(m) == len(a) + len(b)
+    assert len(mix_harmonics(a, b, 0.0)) == len(a) and mix_harmonics(a, None, 1.0) is None   # weight 0: left out
     assert np.isclose(m.share, 0.75 * a.share + 0.25 * b.share)
     p = plane_points(32, PPU)
     assert np.allclose(harmonic_field(p, mix_harmonics(a, None, 0.0)), harmonic_field(p, a), atol=1e-6)
