@@ -6,7 +6,7 @@ import json
 from dataclasses import dataclass, field, fields
 
 from . import zoo
-from .precision import PRECISIONS
+from .precision import check_precision
 
 __all__ = ["TrainConfig", "load_config", "check_config_keys"]
 
@@ -80,8 +80,7 @@ class TrainConfig:
             raise ValueError(f"size must be a multiple of {1 << levels} (2^levels of the U-Net), got {d['size']}")
         if int(d.get("deep", 0)) < 0:
             raise ValueError(f"deep must be >= 0, got {d['deep']}")
-        if d.get("precision", "auto") not in PRECISIONS:
-            raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {d['precision']!r}")
+        check_precision(d.get("precision", "auto"))
         if not isinstance(d.get("workers", 0), int) or d.get("workers", 0) < 0:
             raise ValueError(f"workers must be an integer >= 0, got {d['workers']!r}")
         if d.get("init_onnx") and not d.get("init_sha256"):

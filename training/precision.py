@@ -16,7 +16,7 @@ import platform
 
 import torch
 
-__all__ = ["cpu_bf16_native", "resolve", "autocast", "PRECISIONS"]
+__all__ = ["cpu_bf16_native", "check_precision", "resolve", "autocast", "PRECISIONS"]
 
 PRECISIONS = ("auto", "fp32", "bf16")
 _BF16_FLAGS = ("amx_bf16", "avx512_bf16")
@@ -39,11 +39,16 @@ def cpu_bf16_native(cpuinfo: str | None = None) -> bool:
     return False
 
 
-def resolve(requested: str, device: torch.device) -> str:
-    """The precision a run uses: ``auto`` -> bf16 on CUDA with bf16 support or a bf16-native CPU, else fp32."""
+def check_precision(requested) -> str:
+    """``requested`` if it is one of PRECISIONS, else ValueError naming the choices (configs check it on load)."""
     if requested not in PRECISIONS:
         raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {requested!r}")
-    if requested != "auto":
+    return requested
+
+
+def resolve(requested: str, device: torch.device) -> str:
+    """The precision a run uses: ``auto`` -> bf16 on CUDA with bf16 support or a bf16-native CPU, else fp32."""
+    if check_precision(requested) != "auto":
         return requested
     if device.type == "cuda":
         return "bf16" if torch.cuda.is_bf16_supported() else "fp32"

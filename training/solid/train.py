@@ -36,7 +36,7 @@ from backend._export import export as _ex
 from ..threads import cpu_threads
 from ..config import check_config_keys
 from ..model_card import cpu_name
-from ..precision import PRECISIONS, resolve as resolve_precision
+from ..precision import check_precision, resolve as resolve_precision
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
 from .lattice import octave_seeds
@@ -187,8 +187,7 @@ class SolidConfig:
         if cfg.init_onnx and cfg.init_from:
             raise ValueError("give init_from (a run folder) or init_onnx (an export), not both")
         check_fixed_axis(cfg.fixed_axis)
-        if cfg.precision not in PRECISIONS:
-            raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {cfg.precision!r}")
+        check_precision(cfg.precision)
         if not (cfg.device == "cpu" or cfg.device == "cuda" or
                 (cfg.device.startswith("cuda:") and cfg.device[5:].isdigit())):
             raise ValueError(f"device must be 'cpu', 'cuda' or 'cuda:N', got {cfg.device!r}")
