@@ -39,7 +39,12 @@ from .cellular import cellular_features
 from .lattice import lattice_noise, spun_torch
 from .waves import wave_features
 
-__all__ = ["shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels", "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations", "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "check_max_stretch", "axis_frame", "axis_rotations", "slice_points"]
+__all__ = [
+    "shape_features", "colour_stats", "spectral_aspect", "COLOUR_STATS", "spectral_gains", "detail_levels",
+    "GAIN_RANGE", "max_scales", "Decoder", "Encoder", "Translator", "SolidTexture", "random_rotations",
+    "FIXED_AXES", "FIXED_AXES_2D", "fixed_axis_index", "check_fixed_axis", "check_max_stretch", "axis_frame",
+    "axis_rotations", "slice_points",
+]
 
 
 def shape_features(cellular: int, bricks: int) -> int:
