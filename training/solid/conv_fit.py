@@ -1,0 +1,76 @@
+"""Fit a :class:`~training.solid.conv_generator.ConvGenerator` to one photo (issue 20, the capacity question).
+
+Each step draws fresh noise, generates ``batch`` textures of side ``cfg.crop`` (2D images, or 3D volumes of which
+one random slice normal to each axis is kept, as Gutierrez et al. 2020 train solid generators from 2D
+exemplars, Sec. 3.2), colours them with the photo's mean and colour Cholesky factor (rgb = mu + L d, as the
+affine per-point decoders) and asks them to match random crops of the photo under the config's texture loss
+(``train.texture_loss``: sliced Wasserstein distances of random features, the colour histogram and the optional
+terms). Adam with the config's cosine learning-rate decay; gradients clipped to norm 1. The generator's
+convolutions may run under bf16 autocast; colour and loss stay fp32.
+
+Shapes: photo (3, H, W) float32 in [0, 1]; generated textures (B, 3, S, S[, S]).
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import torch
+
+from ..precision import autocast
+from . import exemplars as ex
+from .conv_generator import ConvGenerator, draw_noise
+from .model import apply_colour, colour_stats
+
+__all__ = ["colour", "volume_slices", "fit"]
+
+
+def colour(d: torch.Tensor, stats: torch.Tensor) -> torch.Tensor:
+    """Whitened colour d (B, 3, ...) and colour statistics (1 or B, 12) -> rgb (B, 3, ...) = mu + L d."""
+    rgb = apply_colour(d.flatten(2).transpose(1, 2), stats.expand(d.shape[0], -1))
+    return rgb.transpose(1, 2).reshape(d.shape)
+
+
+def volume_slices(vol: torch.Tensor, generator: torch.Generator, upright: bool = False) -> torch.Tensor:
+    """Random slices of volumes (B, 3, Z, Y, X), the same indices for every volume: one normal to each axis,
+    (3B, 3, S, S) with the z slices first; or, ``upright``, only the two through the vertical axis, (2B, 3, S, S),
+    the x slices first, each with z along its rows (a wall's view, as ``fixed_axis`` models are trained)."""
+    S = vol.shape[-1]
+    i, j, k = (int(v) for v in torch.randint(0, S, (3,), generator=generator))
+    walls = [vol[:, :, :, :, k], vol[:, :, :, j]]
+    return torch.cat(walls if upright else [vol[:, :, i]] + walls)
+
+
+def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn, precision: str = "fp32",
+        log=print, device: str = "cpu", upright: bool = False) -> float:
+    """Train ``net`` in place for ``steps`` on ``photo`` with ``cfg``'s crop, batch, learning rates, seed and
+    log_every; ``loss_fn(cfg, feats, images, crops, generator)`` is the texture loss. ``net`` and ``feats`` on
+    ``device``; the random draws stay on the CPU's generator, so a fit's data is the same on any device.
+    In 3D, ``upright`` asks only the slices through the vertical axis to match the photo, upright (courses,
+    strata and grain keep their direction; otherwise crops are turned and flipped at random, since each slice of
+    an isotropic solid may show the photo any way up). Returns the seconds taken."""
+    dev = torch.device(device)
+    stats = colour_stats(photo.unsqueeze(0)).to(dev)
+    g = torch.Generator().manual_seed(cfg.seed)
+    opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
+    t0 = time.time()
+    for step in range(steps):
+        lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / steps))
+        for grp in opt.param_groups:
+            grp["lr"] = lr
+        views = 1 if net.dim == 2 else 2 if upright else 3
+        ref = ex.random_crops(photo, cfg.batch * views, cfg.crop, g, augment=net.dim == 3 and not upright).to(dev)
+        z = draw_noise(cfg.batch, cfg.crop, net.dim, net.scales, net.noise, g, dev)
+        with autocast(precision, dev):
+            d = net(z)
+        img = colour(d.float(), stats)
+        if net.dim == 3:
+            img = volume_slices(img, g, upright)
+        loss = loss_fn(cfg, feats, img, ref, g)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
+        opt.step()
+        if (step + 1) % cfg.log_every == 0 or step + 1 == steps:
+            log(f"step {step + 1}/{steps} loss {loss.item():.4f} ({time.time() - t0:.0f} s)")
+    return time.time() - t0
