@@ -56,6 +56,8 @@ def main(argv=None) -> int:
     ap.add_argument("--noise", type=int, default=4)
     ap.add_argument("--steps", type=int, default=None, help="default: the config's")
     ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--budget-seconds", type=float, default=None, metavar="S",
+                    help="fit the number of steps (at most --steps) to S seconds of training per config")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solid_conv_capacity"))
     a = ap.parse_args(argv)
     rows, tiles = [], []
@@ -69,8 +71,8 @@ def main(argv=None) -> int:
         steps = a.steps or cfg.steps
         precision = resolve(a.precision, torch.device(a.device))
         photo = training_images(cfg)[0]
-        seconds = fit(cfg, net.to(a.device), photo, steps, loss_features(cfg).to(a.device), texture_loss, precision,
-                      device=a.device, upright=a.upright)
+        seconds, steps = fit(cfg, net.to(a.device), photo, steps, loss_features(cfg).to(a.device), texture_loss,
+                             precision, device=a.device, upright=a.upright, budget_seconds=a.budget_seconds)
         net = net.cpu().eval()
         ref = photo.permute(1, 2, 0).numpy().astype(np.float32)
         size = min(MAX_SIZE if a.dim == 2 else MAX_SIZE // 2, *ref.shape[:2])

@@ -6,7 +6,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.solid.conv_fit import colour, fit, volume_slices  # noqa: E402
+from training.solid.conv_fit import FIT_TO, colour, fit, volume_slices  # noqa: E402
 from training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
 from training.solid.model import colour_stats  # noqa: E402
 from training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
@@ -116,3 +116,14 @@ def test_a_short_fit_learns_the_photos_orientation(dim, steps, upright):
         assert min(_anisotropy(s) for s in imgs) > 3.0
     else:            # 3D crops are turned at random, so no solid can band every slice; the slices keep contrast
         assert float(imgs.std((2, 3)).mean()) > 0.5 * float(photo.std((1, 2)).mean())
+
+
+def test_a_time_budget_sets_the_number_of_steps():
+    torch.manual_seed(0)
+    net = ConvGenerator(2, scales=2, noise=2, width=4, grow=False)
+    feats = SlicedFeatures(seed=0, levels=2, width=4, kernels=(3,))
+    lines = []
+    seconds, steps = fit(_Cfg, net, _stripes(), 1000, feats, _loss, log=lines.append, budget_seconds=0.0)
+    assert steps == FIT_TO and any("steps fit in 0 s" in s for s in lines)
+    seconds, steps = fit(_Cfg, net, _stripes(), 30, feats, _loss, log=lines.append, budget_seconds=1e6)
+    assert steps == 30          # never more than asked

@@ -22,7 +22,9 @@ from . import exemplars as ex
 from .conv_generator import ConvGenerator, draw_noise
 from .model import apply_colour, colour_stats
 
-__all__ = ["colour", "volume_slices", "fit"]
+__all__ = ["colour", "volume_slices", "fit", "FIT_FROM", "FIT_TO"]
+
+FIT_FROM, FIT_TO = 5, 25     # with a time budget: the steps whose rate sets the number of steps
 
 
 def colour(d: torch.Tensor, stats: torch.Tensor) -> torch.Tensor:
@@ -42,19 +44,22 @@ def volume_slices(vol: torch.Tensor, generator: torch.Generator, upright: bool =
 
 
 def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn, precision: str = "fp32",
-        log=print, device: str = "cpu", upright: bool = False) -> float:
+        log=print, device: str = "cpu", upright: bool = False, budget_seconds: float | None = None) -> tuple:
     """Train ``net`` in place for ``steps`` on ``photo`` with ``cfg``'s crop, batch, learning rates, seed and
     log_every; ``loss_fn(cfg, feats, images, crops, generator)`` is the texture loss. ``net`` and ``feats`` on
     ``device``; the random draws stay on the CPU's generator, so a fit's data is the same on any device.
     In 3D, ``upright`` asks only the slices through the vertical axis to match the photo, upright (courses,
     strata and grain keep their direction; otherwise crops are turned and flipped at random, since each slice of
-    an isotropic solid may show the photo any way up). Returns the seconds taken."""
+    an isotropic solid may show the photo any way up). ``budget_seconds``: the rate of steps FIT_FROM to FIT_TO
+    sets how many steps fit in the budget (never more than ``steps``), and the learning-rate decay follows them.
+    Returns (seconds taken, steps taken)."""
     dev = torch.device(device)
     stats = colour_stats(photo.unsqueeze(0)).to(dev)
     g = torch.Generator().manual_seed(cfg.seed)
     opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
     t0 = time.time()
-    for step in range(steps):
+    step = 0
+    while step < steps:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / steps))
         for grp in opt.param_groups:
             grp["lr"] = lr
@@ -71,6 +76,16 @@ def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn
         loss.backward()
         torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
         opt.step()
-        if (step + 1) % cfg.log_every == 0 or step + 1 == steps:
-            log(f"step {step + 1}/{steps} loss {loss.item():.4f} ({time.time() - t0:.0f} s)")
-    return time.time() - t0
+        step += 1
+        if budget_seconds is not None and step in (FIT_FROM, FIT_TO):
+            if dev.type == "cuda":
+                torch.cuda.synchronize(dev)     # the rate of finished steps, not of queued kernels
+            if step == FIT_FROM:
+                t_fit = time.time()
+            else:
+                rate = (time.time() - t_fit) / (FIT_TO - FIT_FROM)
+                steps = max(FIT_TO, min(steps, FIT_TO + int((budget_seconds - (time.time() - t0)) / rate)))
+                log(f"{rate:.3f} s a step: {steps} steps fit in {budget_seconds:.0f} s")
+        if step % cfg.log_every == 0 or step == steps:
+            log(f"step {step}/{steps} loss {loss.item():.4f} ({time.time() - t0:.0f} s)")
+    return time.time() - t0, steps
