@@ -28,7 +28,7 @@ sys.path.insert(0, ROOT)
 from export.atomic import write_json  # noqa: E402
 from training.solid.model import colour_stats  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
-from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase  # noqa: E402
+from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase, tile_sheet  # noqa: E402
 from training.solid.train import SolidConfig, build_model, render, training_images  # noqa: E402
 
 MAX_SIZE = 256
@@ -99,15 +99,7 @@ def main(argv=None) -> int:
         print("| " + " | ".join(str(r[c]) for c in cols) + " |")
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     write_json(a.out + ".json", dict(seeds=a.seeds, rows=rows))
-    from PIL import Image
-    n = max(len(v["runs"]) for v in sheet.values()) + 2
-    cell = max(v["size"] for v in sheet.values())
-    canvas = Image.new("RGB", (n * cell, len(sheet) * cell), "white")
-    for i, v in enumerate(sheet.values()):
-        tiles = [v["photo"]] + v["runs"] + [v["rpn"]]
-        for j, t in enumerate(tiles):
-            canvas.paste(Image.fromarray((np.clip(t, 0, 1) * 255 + 0.5).astype(np.uint8)), (j * cell, i * cell))
-    canvas.save(a.out + ".png")
+    tile_sheet([[v["photo"]] + v["runs"] + [v["rpn"]] for v in sheet.values()], a.out + ".png")
     print(f"wrote {a.out}.json and {a.out}.png")
     return 0
 

@@ -33,7 +33,7 @@ from training.solid.conv_fit import colour, fit  # noqa: E402
 from training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
 from training.solid.model import colour_stats  # noqa: E402
 from training.solid.morphology import morphology_distance  # noqa: E402
-from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase  # noqa: E402
+from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase, tile_sheet  # noqa: E402
 from training.solid.train import load_config, loss_features, texture_loss, training_images  # noqa: E402
 
 MAX_SIZE = 256
@@ -113,13 +113,7 @@ def main(argv=None) -> int:
     for r in rows:
         print("| " + " | ".join(str(r[c]) for c in cols) + " |")
     write_json(a.out + ".json", dict(seeds=a.seeds, rows=rows))
-    from PIL import Image
-    cell = max(t[0].shape[0] for t in tiles)
-    canvas = Image.new("RGB", (max(map(len, tiles)) * cell, len(tiles) * cell), "white")
-    for i, row in enumerate(tiles):
-        for j, t in enumerate(row):
-            canvas.paste(Image.fromarray((np.clip(t, 0, 1) * 255 + 0.5).astype(np.uint8)), (j * cell, i * cell))
-    canvas.save(a.out + ".png")
+    tile_sheet(tiles, a.out + ".png")
     print(f"wrote {a.out}.json and {a.out}.png")
     return 0
 

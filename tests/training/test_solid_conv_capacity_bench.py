@@ -30,7 +30,10 @@ def test_tiny_fit_measures_draws_and_keeps_its_weights(tmp_path, dim, capsys):
     row = json.load(open(out + ".json"))["rows"][0]
     assert row["dim"] == dim and row["steps"] == 2 and row["photo"] == "brick__tex_buildings_wall_brick01"
     assert 0 < row["random_phase"] < row["pixel_shuffle"] and row["model"] > 0
-    assert os.path.getsize(out + ".png") > 0
+    from PIL import Image
+    # photo | one texture (3D upright: the x wall; the y wall is the second view) | random phase noise
+    with Image.open(out + ".png") as im:
+        assert im.size == ((3 if dim == 2 else 4) * row["size"], row["size"])
     saved = torch.load(out + "_brick_w128l4.pt", weights_only=False)
     net = mod.ConvGenerator(saved["dim"], saved["scales"], saved["noise"], saved["width"], saved["grow"])
     net.load_state_dict(saved["state"])

@@ -45,7 +45,7 @@ from backend.solid.lattice import lattice_noise
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
            "photo_crop", "colour_by_rank", "voronoi_pavement", "grouped_swd", "level_distances", "band_swd",
-           "BASELINES", "SLICE_OFFSETS"]
+           "BASELINES", "SLICE_OFFSETS", "tile_sheet"]
 
 #: where the held-out evaluations cut a 3D texture: a slice normal to each axis through these points (units)
 SLICE_OFFSETS = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
@@ -195,3 +195,15 @@ def voronoi_pavement(size: int, cell: float, rng: np.random.Generator, joint: fl
 
 BASELINES = {"pixel_shuffle": pixel_shuffle, "random_phase": random_phase, "perlin_hist": perlin_hist,
              "photo_crop": photo_crop}
+
+
+def tile_sheet(rows, path: str) -> None:
+    """Save a PNG sheet: one row per list of (H, W, 3) images in [0, 1], each in a square cell of the largest side,
+    white where a row is shorter or an image smaller."""
+    from PIL import Image
+    cell = max(max(t.shape[:2]) for row in rows for t in row)
+    canvas = Image.new("RGB", (max(map(len, rows)) * cell, len(rows) * cell), "white")
+    for i, row in enumerate(rows):
+        for j, t in enumerate(row):
+            canvas.paste(Image.fromarray((np.clip(t, 0, 1) * 255 + 0.5).astype(np.uint8)), (j * cell, i * cell))
+    canvas.save(path)
