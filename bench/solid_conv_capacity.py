@@ -27,7 +27,7 @@ import torch
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from export.atomic import write_json  # noqa: E402
+from export.atomic import atomic_path, write_json  # noqa: E402
 from training.precision import resolve  # noqa: E402
 from training.solid.conv_fit import colour, fit  # noqa: E402
 from training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
@@ -94,19 +94,21 @@ def main(argv=None) -> int:
         rpn = [random_phase(ref, size, rng) for _ in imgs]
         shuffled = [pixel_shuffle(ref, size, rng) for _ in imgs]
         name = os.path.basename(path).rsplit(".", 1)[0]
-        rows.append(dict(config=name, dim=a.dim, upright=a.upright, photo=os.path.basename(cfg.exemplars[0]).rsplit(".", 1)[0], size=size,
-                         width=a.width, grow=not a.flat, scales=a.scales, params=net.n_params(), steps=steps,
+        rows.append(dict(config=name, dim=a.dim, upright=a.upright,
+                         photo=os.path.basename(cfg.exemplars[0]).rsplit(".", 1)[0], size=size, width=a.width,
+                         grow=not a.flat, scales=a.scales, params=net.n_params(), steps=steps,
                          train_minutes=round(seconds / 60, 1), precision=precision, device=a.device,
                          model=round(patch_swd(imgs, ref), 1),
-                         random_phase=round(patch_swd(rpn, ref), 1), pixel_shuffle=round(patch_swd(shuffled, ref), 1),
+                         random_phase=round(patch_swd(rpn, ref), 1),
+                         pixel_shuffle=round(patch_swd(shuffled, ref), 1),
                          morph=round(morphology_distance(imgs, ref), 3),
                          morph_random_phase=round(morphology_distance(rpn, ref), 3)))
         print(rows[-1], flush=True)
         tiles.append([ref[:size, :size]] + imgs[:3 if a.dim == 3 and not a.upright else 2] + [rpn[0]])
         os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-        torch.save(dict(state=net.state_dict(), dim=a.dim, scales=a.scales, noise=a.noise, width=a.width,
-                        grow=not a.flat, config=path),
-                   f"{a.out}_{name}.pt")
+        with atomic_path(f"{a.out}_{name}.pt") as tmp:
+            torch.save(dict(state=net.state_dict(), dim=a.dim, scales=a.scales, noise=a.noise, width=a.width,
+                            grow=not a.flat, config=path), tmp)
     cols = list(rows[0])
     print("| " + " | ".join(cols) + " |")
     print("|" + "---|" * len(cols))

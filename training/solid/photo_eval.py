@@ -42,6 +42,7 @@ import numpy as np
 from backend.solid.band_distance import laplacian_bands
 from backend.solid.cellular import cellular_features_numpy
 from backend.solid.lattice import lattice_noise
+from backend._export import export as _ex
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
            "photo_crop", "colour_by_rank", "voronoi_pavement", "grouped_swd", "level_distances", "band_swd",
@@ -198,12 +199,13 @@ BASELINES = {"pixel_shuffle": pixel_shuffle, "random_phase": random_phase, "perl
 
 
 def tile_sheet(rows, path: str) -> None:
-    """Save a PNG sheet: one row per list of (H, W, 3) images in [0, 1], each in a square cell of the largest side,
-    white where a row is shorter or an image smaller."""
+    """Save a PNG sheet atomically: one row per list of (H, W, 3) images in [0, 1], each in a square cell of the
+    largest side, white where a row is shorter or an image smaller."""
     from PIL import Image
     cell = max(max(t.shape[:2]) for row in rows for t in row)
     canvas = Image.new("RGB", (max(map(len, rows)) * cell, len(rows) * cell), "white")
     for i, row in enumerate(rows):
         for j, t in enumerate(row):
             canvas.paste(Image.fromarray((np.clip(t, 0, 1) * 255 + 0.5).astype(np.uint8)), (j * cell, i * cell))
-    canvas.save(path)
+    with _ex.atomic_path(path) as tmp:
+        canvas.save(tmp, format="PNG")
