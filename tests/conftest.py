@@ -28,6 +28,22 @@ def psd():
     return radial_psd
 
 
+def load_bench_script(name: str):
+    """``bench/<name>.py`` as a module (bench scripts are not a package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(name, os.path.join(ROOT, "bench", name + ".py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture
+def bench_script():
+    """A loader of bench scripts: ``bench_script("solid_strokes")`` is bench/solid_strokes.py as a module."""
+    return load_bench_script
+
+
 class Recorder:
     """A UILayout stand-in that records what a panel's draw() asks for: (call, property, text) tuples."""
 

@@ -1,17 +1,10 @@
 """bench/solid_check_noise.py: the check's choice on two disjoint sets of planes, and the planes' layout."""
-import importlib.util
 import json
 import os
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
-def _bench():
-    spec = importlib.util.spec_from_file_location("solid_check_noise",
-                                                  os.path.join(ROOT, "bench", "solid_check_noise.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def test_check_planes_are_x_y_and_z_cuts_per_seed_through_their_own_points():
@@ -27,11 +20,11 @@ def test_check_planes_are_x_y_and_z_cuts_per_seed_through_their_own_points():
     assert not {o for _, _, o in spectral.CHECK_PLANES} & set(SLICE_OFFSETS.values())   # not the evaluation's
 
 
-def test_bench_chooses_twice_per_photo(tmp_path, capsys):
+def test_bench_chooses_twice_per_photo(bench_script, tmp_path, capsys):
     from backend.solid.spectral import KINDS, MIXES
 
     out = tmp_path / "noise.json"
-    assert _bench().main(["--limit", "1", "--seeds", "1", "-o", str(out)]) == 0
+    assert bench_script("solid_check_noise").main(["--limit", "1", "--seeds", "1", "-o", str(out)]) == 0
     doc = json.loads(out.read_text())
     (name, got), = doc["photos"].items()
     assert len(got) == 2 and all(c is None or (c[0] in KINDS and c[1] in MIXES) for c in got)

@@ -1,5 +1,4 @@
 """bench/solid_strokes.py: the diagonal-power ratio reads stripes' direction, and the bench runs on the shipped model."""
-import importlib.util
 import os
 
 import numpy as np
@@ -7,15 +6,10 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
-def _bench():
-    spec = importlib.util.spec_from_file_location("solid_strokes", os.path.join(ROOT, "bench", "solid_strokes.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
-def test_diagonal_ratio_reads_the_stripes_direction():
-    mod = _bench()
+def test_diagonal_ratio_reads_the_stripes_direction(bench_script):
+    mod = bench_script("solid_strokes")
     row, col = np.mgrid[0:128, 0:128].astype(np.float64)
     rising = np.repeat(np.sin(2 * np.pi * 0.15 * (col + row))[..., None], 3, axis=2)    # strokes rising to the right
     falling = np.repeat(np.sin(2 * np.pi * 0.15 * (col - row))[..., None], 3, axis=2)
@@ -26,8 +20,8 @@ def test_diagonal_ratio_reads_the_stripes_direction():
     assert abs(np.log2(mod.diagonal_ratio(noise))) < 0.3
 
 
-def test_bench_measures_and_draws_the_shipped_model(tmp_path, capsys):
-    mod = _bench()
+def test_bench_measures_and_draws_the_shipped_model(bench_script, tmp_path, capsys):
+    mod = bench_script("solid_strokes")
     space = os.path.join(ROOT, "models", "solid", "space")
     out = tmp_path / "s.jpg"
     assert mod.main([space, "--every", "44", "--sheet", str(out), "--photos", "sand__desert"]) == 0

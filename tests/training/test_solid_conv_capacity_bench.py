@@ -1,6 +1,5 @@
 """bench/solid_conv_capacity.py: a tiny fit of the convolutional generator runs end to end in 2D and upright 3D,
 writes its table, sheet and weights, and the weights reload into a generator that draws the same texture."""
-import importlib.util
 import json
 import os
 
@@ -12,17 +11,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 CONFIG = os.path.join(ROOT, "configs", "solid", "capacity", "brick_w128l4.json")
 
 
-def _bench():
-    spec = importlib.util.spec_from_file_location("solid_conv_capacity",
-                                                  os.path.join(ROOT, "bench", "solid_conv_capacity.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_tiny_fit_measures_draws_and_keeps_its_weights(tmp_path, dim, capsys):
-    mod = _bench()
+def test_tiny_fit_measures_draws_and_keeps_its_weights(bench_script, tmp_path, dim, capsys):
+    mod = bench_script("solid_conv_capacity")
     out = str(tmp_path / "cap")
     extra = ["--upright", "--scale", "0.25"] if dim == 3 else []
     assert mod.main([CONFIG, "--dim", str(dim), "--steps", "2", "--crop", "32", "--batch", "1", "--width", "4",
