@@ -72,7 +72,7 @@ from .harmonic import mix_waves, read_waves, wave_sum
 __all__ = ["RestField", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
            "rest_spectrum", "deproject", "wave_sampling", "colour_picks", "wave_amplitudes",
            "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "CHECK_SEEDS", "check_planes", "wall_planes", "WALL_PLANES",
-           "BINS", "KINDS", "KIND_WORDS", "REST_CHOICES"]
+           "BINS", "KINDS", "KIND_WORDS", "REST_CHOICES", "seed_shift3"]
 
 COUNT = 512             #: waves in the Gaussian rest (module doc)
 BINS = 64               #: radial annuli of the spectrum

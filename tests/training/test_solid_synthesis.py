@@ -1,0 +1,151 @@
+"""training/solid/synthesis.py (Kopf et al. 2007 solid synthesis by optimisation) and bench/solid_synthesis.py: the
+tile copies a photo's structure at its frequency and orientation, keeps its colours, wraps around, and reports
+progress, cancels and bad settings in one line."""
+import json
+
+import numpy as np
+import pytest
+
+from backend.errors import SettingError
+from backend.grid import Cancelled
+from training.solid.synthesis import SynthesisSettings, TileField, synthesise
+
+
+def _stripes(period: float = 8.0, size: int = 64, along: str = "cols", saw: bool = False) -> np.ndarray:
+    """A colour photo of stripes: brightness varies along columns (vertical stripes) or rows (horizontal ones);
+    ``saw``: a sawtooth that ramps up from the photo's top row downwards, then drops.  With a little noise, as
+    a photo has."""
+    i = np.arange(size, dtype=np.float64)
+    t = (i % period) / period if saw else 0.5 + 0.5 * np.sin(2 * np.pi * i / period)
+    v = np.broadcast_to(t[None, :] if along == "cols" else t[:, None], (size, size))
+    v = v + np.random.default_rng(3).normal(0.0, 0.03, (size, size))
+    return np.stack([0.2 + 0.6 * v, 0.3 + 0.4 * v, 0.5 - 0.3 * v], -1).astype(np.float32)
+
+
+def _peak(profile: np.ndarray) -> int:
+    """The strongest non-zero frequency (cycles per length) of a 1D profile."""
+    p = np.abs(np.fft.rfft(profile - profile.mean()))
+    return int(np.argmax(p[1:]) + 1)
+
+
+SMALL = dict(size=32, levels=2, iterations=(2, 2), sharpness=(10.0, 10.0), candidates=3000)
+
+
+def test_2d_tile_copies_the_stripes_period_direction_and_colours():
+    photo = _stripes(8.0)
+    tile = synthesise(photo, SynthesisSettings(dim=2, **SMALL))
+    assert tile.shape == (32, 32, 3) and tile.dtype == np.float32
+    g = tile[..., 0]
+    assert _peak(g.mean(0)) == 32 // 8                       # across columns: the photo's period, 4 per tile
+    assert g.mean(1).std() < 0.25 * g.mean(0).std()          # and no stripes across rows
+    # histogram matching: the tile's colours are the photo's (means within 0.02, same range)
+    assert np.abs(tile.reshape(-1, 3).mean(0) - photo.reshape(-1, 3).mean(0)).max() < 0.02
+    assert tile.min() >= photo.min() - 1e-4 and tile.max() <= photo.max() + 1e-4
+
+
+def test_upright_solid_lays_the_photos_rows_along_z_the_right_way_up():
+    """Horizontal sawtooth stripes on the walls (planes "walls"): layers normal to z, ramping as the photo does
+    read bottom to top (its top row at the largest z).  The coarse level needs many iterations before the slices
+    agree on one phase, and with the default sharp weights on every level the layers came out at half the photo's
+    period (two short ramps for one long); Kopf's plain weights (k = 1) on the coarse level give the photo's."""
+    photo = _stripes(8.0, along="rows", saw=True)
+    tile = synthesise(photo, SynthesisSettings(dim=3, planes="walls", size=32, levels=2, iterations=(12, 3),
+                                               sharpness=(1.0, 10.0), candidates=3000))     # (z, y, x, 3)
+    assert tile.shape == (32, 32, 32, 3)
+    g = tile[..., 0]
+    layers = g.mean(axis=(1, 2))
+    assert _peak(layers) == 32 // 8
+    assert layers.std() > 4 * g.mean(axis=(0, 1)).std() and layers.std() > 4 * g.mean(axis=(0, 2)).std()
+    # the photo ramps up from its top row down, so upwards (bottom to top) it falls: most steps up z are down
+    assert np.median(np.diff(photo[::-1, 0, 0])) < 0 and np.median(np.diff(layers)) < 0
+
+
+def _ring_share(img: np.ndarray, lo: float, hi: float) -> float:
+    """The share of an image's power at radial frequencies in [lo, hi) cycles per side."""
+    P = np.abs(np.fft.fft2(img - img.mean())) ** 2
+    f = np.fft.fftfreq(img.shape[0]) * img.shape[0]
+    r = np.hypot(f[:, None], f[None, :])
+    return float(P[(r >= lo) & (r < hi)].sum() / P.sum())
+
+
+def test_isotropic_solid_keeps_the_photos_scale_on_every_slice_family():
+    """Dots 8 px apart: the x, y and z slices of the solid put most of their power near the photo's frequency
+    (4 cycles per 32 voxels; white noise would put about a fifth there, the photo all of it)."""
+    i = np.arange(64.0)
+    v = 0.5 + 0.25 * np.cos(2 * np.pi * i / 8)[:, None] + 0.25 * np.cos(2 * np.pi * i / 8)[None, :]
+    v = v + np.random.default_rng(3).normal(0.0, 0.03, v.shape)
+    photo = np.stack([v, 0.5 * v + 0.2, 0.8 - 0.5 * v], -1).astype(np.float32)
+    g = synthesise(photo, SynthesisSettings(dim=3, size=32, levels=2, iterations=(12, 3), sharpness=(1.0, 10.0),
+                                            candidates=3000))[..., 0]
+    assert _ring_share(v[:32, :32], 3.5, 6.5) > 0.95
+    for img in (g[:, :, 5], g[:, 7, :], g[9, :, :]):
+        assert _ring_share(img, 3.5, 6.5) > 0.7
+
+
+def test_tile_field_samples_voxel_centres_and_wraps():
+    rng = np.random.default_rng(1)
+    tile = rng.random((8, 8, 8, 3)).astype(np.float32)
+    f = TileField(tile, px_per_unit=4.0)
+    k, j, i = 3, 5, 6
+    centre = (np.array([[i, j, k]]) + 0.5) / 4.0             # (x, y, z) of voxel (z=k, y=j, x=i)
+    np.testing.assert_allclose(f.evaluate(centre)[0], tile[k, j, i], atol=1e-6)
+    pts = rng.uniform(-3, 3, (50, 3))
+    np.testing.assert_allclose(f.evaluate(pts), f.evaluate(pts + np.array([2.0, -4.0, 6.0])), atol=1e-5)
+    mid = (centre + np.array([[0.125, 0.0, 0.0]]))           # half-way to the next voxel along x
+    np.testing.assert_allclose(f.evaluate(mid)[0], 0.5 * (tile[k, j, i] + tile[k, j, (i + 1) % 8]), atol=1e-6)
+    flat = TileField(tile[0], 4.0)
+    assert flat.evaluate(pts[:, :2]).shape == (50, 3)
+    with pytest.raises(SettingError, match="points"):
+        flat.evaluate(pts)
+    with pytest.raises(SettingError, match="tile"):
+        TileField(tile[..., :2], 4.0)
+    with pytest.raises(SettingError, match="px_per_unit"):
+        TileField(tile, 0.0)
+
+
+def test_progress_and_cancel():
+    photo = _stripes(8.0)
+    seen = []
+    synthesise(photo, SynthesisSettings(dim=2, **SMALL), progress=seen.append)
+    assert seen == sorted(seen) and seen[-1] == pytest.approx(1.0) and len(seen) == 4
+    with pytest.raises(Cancelled):
+        synthesise(photo, SynthesisSettings(dim=3, **SMALL), cancel=lambda: True)
+
+
+@pytest.mark.parametrize("kw, field", [(dict(dim=4), "dim"), (dict(planes="floors"), "planes"),
+                                       (dict(size=30), "size"), (dict(size=16, levels=3, iterations=(1, 1, 1)), "size"),
+                                       (dict(sharpness=(1.0, 10.0)), "sharpness"),
+                                       (dict(iterations=(1, 1)), "iterations"), (dict(stride=0), "stride"),
+                                       (dict(sharpness=(1.0, 0.0, 10.0)), "sharpness"), (dict(components=0), "components")])
+def test_bad_settings_name_the_field_in_one_line(kw, field):
+    with pytest.raises(SettingError) as e:
+        SynthesisSettings(**kw)
+    assert e.value.setting == field
+    assert "\n" not in str(e.value)
+
+
+def test_bad_photos_are_refused_in_one_line():
+    with pytest.raises(SettingError, match="RGB"):
+        synthesise(np.zeros((64, 64), np.float32))
+    with pytest.raises(SettingError, match="non-finite"):
+        synthesise(np.full((64, 64, 3), np.nan, np.float32))
+    with pytest.raises(SettingError, match="at least 36 px"):
+        synthesise(np.zeros((20, 64, 3), np.float32))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_path, dim, capsys):
+    out = str(tmp_path / "syn")
+    mod = bench_script("solid_synthesis")
+    assert mod.main(["--dim", str(dim), "--only", "beige_bricks", "--size", "64" if dim == 2 else "32",
+                     "--iterations", "1,1,1", "--sharpness", "1,1,10",
+                     "--seeds", "1", "--sheet", "--out", out]) == 0
+    doc = json.load(open(out + ".json"))
+    (name, r), = doc["photos"].items()
+    assert name == "brick__beige_bricks.jpg" and doc["settings"]["dim"] == dim
+    for k in ("pooled", "walls", "axes", "random_phase_pooled", "random_phase_walls", "random_phase_axes"):
+        assert np.isfinite(r[k]) and r[k] > 0
+    assert doc["summary"]["photos"] == 1 and doc["summary"]["by_category"]["brick"]["photos"] == 1
+    from PIL import Image
+    assert Image.open(out + ".png").size == (5 * 128 if dim == 3 else 3 * 128, 128)
+    assert "brick__beige_bricks" in capsys.readouterr().out
