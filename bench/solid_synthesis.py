@@ -76,6 +76,8 @@ def main(argv=None) -> int:
     ap.add_argument("--iterations", default="16,6,2")
     ap.add_argument("--sharpness", default="10,10,10", help="the weights' sharpness per level, coarse to fine")
     ap.add_argument("--stride", type=int, default=2)
+    ap.add_argument("--patch", type=int, default=SynthesisSettings.patch)
+    ap.add_argument("--candidates", type=int, default=SynthesisSettings.candidates)
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--against", default=None, help="an eval_solid_photos.py JSON: the neural texture's figures")
     ap.add_argument("--sheet", action="store_true")
@@ -85,7 +87,8 @@ def main(argv=None) -> int:
     files = [f for f in photo_set("val", os.path.join(ROOT, "data", "photos"))
              if not words or any(w in os.path.basename(f) for w in words)]
     files = files[:a.limit] if a.limit else files
-    settings = SynthesisSettings(size=a.size, dim=a.dim, planes=a.planes, stride=a.stride,
+    settings = SynthesisSettings(size=a.size, dim=a.dim, planes=a.planes, stride=a.stride, patch=a.patch,
+                                 candidates=a.candidates,
                                  iterations=tuple(int(x) for x in a.iterations.split(",")),
                                  sharpness=tuple(float(x) for x in a.sharpness.split(",")))
     neural = json.load(open(a.against))["photos"] if a.against else {}
