@@ -51,7 +51,8 @@ def slices(field: TileField, seeds: int, size: int = SIZE) -> dict:
 
 def measure(photo: np.ndarray, imgs: dict, rng: np.random.Generator) -> dict:
     """The grouped patch distances of the slices ({axis: images}) and of random phase noise drawn alike
-    (SIZE² crops), and the colour error.  A 2D texture comes as {"x": images}: its figures are all the same."""
+    (SIZE² crops), and the colour error.  A 2D texture comes as {"x": images}: grouped_swd counts x as the walls,
+    so its pooled, walls and axes figures are the same."""
     d = pe.grouped_swd(imgs, photo)
     seeds = len(imgs["x"])
     b = pe.grouped_swd({ax: [pe.random_phase(photo, SIZE, rng) for _ in range(seeds)] for ax in imgs}, photo)
@@ -59,9 +60,6 @@ def measure(photo: np.ndarray, imgs: dict, rng: np.random.Generator) -> dict:
     keys = [k for k in ("x", "y", "z", "pooled", "walls", "axes") if k in d]
     r = {k: d[k] for k in keys}
     r.update({"random_phase_" + k: b[k] for k in keys})
-    for k in ("walls", "axes"):         # 2D: one group, the same figure everywhere
-        r.setdefault(k, r["pooled"])
-        r.setdefault("random_phase_" + k, r["random_phase_pooled"])
     r["colour"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in pooled])), 4)
     return r
 

@@ -204,7 +204,9 @@ def _level(tile: np.ndarray, photo: np.ndarray, s: SynthesisSettings, iterations
                     scale = float(np.median(d2)) + 1e-6
                 w = (d2 / scale + 1e-3) ** p
                 E = E.reshape(b, G0, G1, n, n, 3) * w.reshape(b, G0, G1, 1, 1, 1)
-                w, pos = w.reshape(b, G0, G1), pos.reshape(b, G0, G1, 2)
+                w = w.reshape(b, G0, G1)
+                # (row, col, family) of each match's top-left pixel; a vote at offset (dr, dc) adds (dr, dc, 0)
+                at = np.concatenate([pos.reshape(b, G0, G1, 2), np.full((b, G0, G1, 1), fam, np.int32)], -1)
                 tacc, tsum, tbest, tsrc = (v[a:a + slab] if s.dim == 3 else v[None] for v in views)
                 for dr in range(n):
                     for dc in range(n):
@@ -213,8 +215,7 @@ def _level(tile: np.ndarray, photo: np.ndarray, s: SynthesisSettings, iterations
                         tsum[:, rr, cc] += w
                         heavier = w > tbest[:, rr, cc]
                         tbest[:, rr, cc] = np.where(heavier, w, tbest[:, rr, cc])
-                        src = np.concatenate([pos + np.array([dr, dc], np.int32),
-                                              np.full(pos.shape[:-1] + (1,), fam, np.int32)], -1)
+                        src = at + np.array([dr, dc, 0], np.int32)
                         tsrc[:, rr, cc] = np.where(heavier[..., None], src, tsrc[:, rr, cc])
             if tick():
                 raise Cancelled("cancelled")
@@ -258,8 +259,8 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
                                     f"{s.patch} px neighbourhoods need at least {(s.patch + 1) * step} px a side")
     img = np.clip(img[::-1], 0.0, 1.0)      # row 0 at the bottom: rows run up the tile (module doc)
     rng = np.random.default_rng(s.seed)
-    fams = len(_families(s.dim, s.planes))
-    total, done = fams * sum(s.iterations), [0]
+    fams = _families(s.dim, s.planes)
+    total, done = len(fams) * sum(s.iterations), [0]
 
     def tick() -> bool:
         done[0] += 1
@@ -276,7 +277,7 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
             flat = ex.reshape(-1, 3)
             tile = flat[rng.integers(0, flat.shape[0], N ** s.dim)].reshape((N,) * s.dim + (3,))
         else:
-            tile = _inherit(sources, ex, _families(s.dim, s.planes))
+            tile = _inherit(sources, ex, fams)
         tile, sources = _level(tile, ex, s, s.iterations[lvl], s.sharpness[lvl], rng, tick)
     return tile
 
