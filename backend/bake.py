@@ -92,11 +92,11 @@ class BakeSpec:
             raise SettingError("output", f"{os.path.basename(self.output)}: .vdb needs a 3D grid (resolution [nx, ny, nz])")
         if ext in (".exr", ".png") and rank != 2:
             raise SettingError("output", f"{os.path.basename(self.output)}: {ext} needs a 2D grid; bake volumes to .vdb or .npy")
-        if rank == 3 and self.source.dim == 2:
-            raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")
-        check = getattr(self.source, "check_grid", None)  # a source's own requirements on the grid
+        check = getattr(self.source, "check_grid", None)  # a source's own requirements on the grid (named first)
         if check is not None:
             check(self.grid.shape)
+        if rank == 3 and self.source.dim == 2:
+            raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")
         if getattr(self.source, "rgb", False) and self.transfer is not None:
             raise SettingError("transfer", "a solid texture has its own colours; remove the transfer function")
         if self.frames is not None:

@@ -91,6 +91,17 @@ grid (with a constant ``density``), an RGB EXR, an sRGB PNG or a (..., 3) .npy::
     scale = 1.0                         # texture units per world unit
     density = 1.0
 
+The same source with ``method = "synthesis"`` bakes a seamless 2D image synthesised from an image exemplar by
+texture optimisation (``backend/solid/synthesis.py``; 2D grids only, as ``omninoise solid --method synthesis``)::
+
+    [bake.source]
+    kind = "solid"
+    method = "synthesis"
+    exemplar = "photo.png"
+    tile = 256                          # the periodic image's side, px (a multiple of 4 in [32, 1024])
+    seed = 0
+    scale = 1.0
+
 Every problem is reported as ``bake 'NAME': what is wrong``.
 """
 from __future__ import annotations

@@ -375,8 +375,56 @@ class SolidSource:
         return d
 
 
+class SynthesisSource:
+    """A solid source with ``method = "synthesis"``: a periodic 2D image of ``tile`` px a side synthesised from an
+    image exemplar (:mod:`backend.solid.synthesis`, Kwatra et al. 2005 / Kopf et al. 2007) when the source is made,
+    then read at the grid's points, ``scale`` times the texture's own size (the photo's pixels at
+    PX_PER_UNIT per unit, as the neural texture).  2D grids only: :meth:`check_grid` names the setting for a
+    volume."""
+
+    kind = "solid"
+    animated = False
+    chunkable = True
+    rgb = True
+    dim = 2
+
+    def __init__(self, request, scale: float = 1.0, field=None, progress=None, cancel=None):
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "synthesis"; field: its
+        ready :class:`~backend.solid.synthesis.TileField` (else synthesised here, with progress and cancel)."""
+        if not scale > 0:
+            raise SettingError("source.scale", f"must be > 0, got {scale}")
+        self.request, self.scale = request, float(scale)
+        self.field = field if field is not None else request.synthesis_field("source.", progress, cancel)
+        self.input_sha256 = request.key()["exemplar"]      # the pixels' sha256, however they were handed over
+
+    def check_grid(self, shape) -> None:
+        if len(shape) != 2:
+            raise SettingError("source.method", "synthesis makes 2D images; a 3D grid needs the neural texture "
+                                                "(method = \"neural\")")
+
+    def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
+        from .colour import srgb_to_linear
+
+        start = np.zeros(2, int) if start is None else np.asarray(start)
+        axes = [first[k] + (start[k] + np.arange(shape[::-1][k])) * step[k] for k in range(2)]   # x, y
+        yy, xx = np.meshgrid(axes[1], axes[0], indexing="ij")
+        if cancel is not None and cancel():
+            from .grid import Cancelled
+
+            raise Cancelled("cancelled")
+        rgb = self.field.evaluate(np.stack([xx.ravel(), yy.ravel()], axis=1) * self.scale)
+        if progress is not None:
+            progress(1.0)
+        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
+
+    def to_dict(self) -> dict:
+        r = self.request
+        return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+                    input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale)
+
+
 _SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
-               "rest")
+               "rest", "method", "tile")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
@@ -500,11 +548,13 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     mix = d.get("mix", 0.5)
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
-                        d.get("rest", "auto")).check("source.")
+                        d.get("rest", "auto"), d.get("method", "neural"), d.get("tile", 256)).check("source.")
 
 
-def _solid_from_dict(d: dict, base_dir: str) -> SolidSource:
+def _solid_from_dict(d: dict, base_dir: str):
     req = solid_request_from_dict(d, base_dir)
+    if req.method == "synthesis":
+        return SynthesisSource(req, d.get("scale", 1.0))
     return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
                        to=req.to, mix=req.mix, periodic=req.periodic, gaussian=req.gaussian, rest=req.rest)
 

@@ -184,6 +184,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="space model: the Gaussian rest's kind: auto (default: the check chooses; the upright one is "
                         "offered for layered images), isotropic, or upright (the image's layers, grain or strata "
                         "kept on walls, for walls and cliffs: floors show their horizontal detail alone)")
+    s.add_argument("--method", default="neural", choices=("neural", "synthesis"),
+                   help="neural (default): the model's texture, 2D or 3D; synthesis: a seamless 2D image synthesised "
+                        "from the image file --exemplar by texture optimisation (Kwatra et al. 2005), copying its "
+                        "courses, planks and stones; --tile px a side, repeated beyond it")
+    s.add_argument("--tile", type=int, default=256, help="--method synthesis: the periodic image's side, px "
+                                                         "(a multiple of 4 in [32, 1024]; default 256)")
     s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
     s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
     s.add_argument("--quiet", action="store_true")
@@ -670,7 +676,7 @@ def solid_request(a: argparse.Namespace):
     from backend.solid.request import SolidRequest
 
     return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
-                        a.rest).check("--")
+                        a.rest, a.method, a.tile).check("--")
 
 
 def run_solid(a: argparse.Namespace) -> int:
@@ -693,7 +699,13 @@ def run_solid(a: argparse.Namespace) -> int:
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
     if ext not in allowed:
         raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
+    if a.method == "synthesis" and a.dim != 2:
+        raise SettingError("--method", "synthesis makes 2D images (--dim 2); volumes come from the neural texture")
     req = solid_request(a)
+    if req.method == "synthesis":
+        field = req.synthesis_field("--", _Bar(a.quiet, "synthesis "))
+        _write_solid_image(a.out, field.image(a.size, a.scale))
+        return 0
     model = req.load("--")
     if a.dim == 3 and model.dim != 3:
         raise SettingError("--dim", f"model {model.name!r} is 2D; it cannot fill a volume")
@@ -716,8 +728,6 @@ def run_solid(a: argparse.Namespace) -> int:
               f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian leaves "
               "it out)", file=sys.stderr)
     bar = _Bar(a.quiet)
-    from backend.colour import srgb_to_linear
-
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
         from backend.bake import BakeSpec, run_bake
         from backend.sources import BoxGrid, SolidSource
@@ -726,14 +736,19 @@ def run_solid(a: argparse.Namespace) -> int:
         grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
         run_bake(BakeSpec("solid", SolidSource(model, seed=a.seed, code=code), grid, a.out), bar, force=True)
         return 0
-    rgb = model.image(a.size, code, a.seed, scale=a.scale, progress=bar)
+    _write_solid_image(a.out, model.image(a.size, code, a.seed, scale=a.scale, progress=bar))
+    return 0
+
+
+def _write_solid_image(out: str, rgb: np.ndarray) -> None:
+    """A 2D solid texture, sRGB float (H, W, 3) in [0, 1]: .png as it is, .exr and .npy linear."""
+    from backend.colour import srgb_to_linear
     from export.images import preview_8bit, write_image, write_png
 
-    if ext == ".png":
-        write_png(a.out, preview_8bit(rgb, 0.0, 1.0))
+    if os.path.splitext(out)[1].lower() == ".png":
+        write_png(out, preview_8bit(rgb, 0.0, 1.0))
     else:
-        write_image(a.out, srgb_to_linear(rgb))
-    return 0
+        write_image(out, srgb_to_linear(rgb))
 
 
 def run_zoo(a: argparse.Namespace) -> int:

@@ -7,7 +7,9 @@ holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al
 the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image's harmonic part,
 :mod:`backend.solid.harmonic`), ``gaussian`` (mix in an encoded image's Gaussian rest where the encode-time check
 finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("auto", "isotropic" or "upright",
-:mod:`backend.solid.upright`), and the ``seed`` of the noise.  Where the texture is read (grid,
+:mod:`backend.solid.upright`), and the ``seed`` of the noise.  ``method`` "synthesis" asks instead for a periodic 2D image of ``tile`` px a side
+synthesised from an image exemplar by texture optimisation (:mod:`backend.solid.synthesis`): no model, no code,
+2D only.  Where the texture is read (grid,
 zoom, scale) belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
@@ -27,7 +29,11 @@ from ..errors import SettingError
 from ..paths import solid_models
 from .spectral import REST_CHOICES
 
-__all__ = ["SolidRequest", "MAX_SEED"]
+__all__ = ["SolidRequest", "MAX_SEED", "METHODS"]
+
+#: how the texture is made: "neural" (a model's texture, the default) or "synthesis" (a periodic 2D image optimised
+#: from an image exemplar, :mod:`backend.solid.synthesis`)
+METHODS = ("neural", "synthesis")
 
 MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the lattice hash, backend/solid/lattice.py)
 
@@ -57,7 +63,8 @@ class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
     model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
     steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
-    Gaussian rest, where the check keeps one), ``rest`` (which: one of spectral.REST_CHOICES)."""
+    Gaussian rest, where the check keeps one), ``rest`` (which: one of spectral.REST_CHOICES), ``method`` (one of
+    :data:`METHODS`) and, for "synthesis", ``tile`` (px per side of the periodic image)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)
@@ -68,6 +75,8 @@ class SolidRequest:
     periodic: bool = True
     gaussian: bool = True
     rest: str = "auto"
+    method: str = "neural"
+    tile: int = 256
 
     def check(self, where: str = "") -> "SolidRequest":
         """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
@@ -86,6 +95,22 @@ class SolidRequest:
             raise bad("gaussian", f"must be true or false, got {self.gaussian!r}")
         if not isinstance(self.rest, str) or self.rest not in REST_CHOICES:
             raise bad("rest", f"must be one of {', '.join(REST_CHOICES)}, got {self.rest!r}")
+        if not isinstance(self.method, str) or self.method not in METHODS:
+            raise bad("method", f"must be one of {', '.join(METHODS)}, got {self.method!r}")
+        if self.method == "synthesis":
+            from .synthesis import MAX_TILE, MIN_TILE, TILE_STEP
+
+            ex = self.exemplar
+            if not isinstance(ex, np.ndarray) and not (isinstance(ex, str) and os.path.isfile(ex)):
+                raise bad("exemplar", f"synthesis works from an image (a file or pixels), got {ex!r}")
+            if self.to is not None:
+                raise bad("to", "interpolation needs the neural texture (method neural); synthesis draws one image")
+            if self.refine:
+                raise bad("refine", "refinement searches a neural texture's code; synthesis has none")
+            t = self.tile
+            if isinstance(t, bool) or not isinstance(t, (int, np.integer)) or not MIN_TILE <= t <= MAX_TILE \
+                    or t % TILE_STEP:
+                raise bad("tile", f"must be a multiple of {TILE_STEP} in [{MIN_TILE}, {MAX_TILE}], got {t!r}")
         return self
 
     def folder(self, models: str | None = None) -> str:
@@ -119,9 +144,34 @@ class SolidRequest:
         return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report,
                             bool(self.periodic), bool(self.gaussian), self.rest)
 
+    def synthesis_field(self, where: str = "", progress=None, cancel=None):
+        """Method "synthesis": the :class:`~backend.solid.synthesis.TileField` of a periodic 2D tile of ``tile`` px
+        synthesised from the exemplar with ``seed`` (:func:`~backend.solid.synthesis.image_settings`; progress and
+        cancel as :func:`~backend.solid.synthesis.synthesise`'s); SettingError naming the exemplar for an image it
+        cannot use."""
+        from .synthesis import PX_PER_UNIT, TileField, image_settings, synthesise
+
+        img = self.exemplar
+        if isinstance(img, str):
+            from .._export import export
+
+            try:
+                img = export.read_rgb(img)
+            except ValueError as exc:
+                raise SettingError(f"{where}exemplar", str(exc)) from None
+        try:
+            tile = synthesise(img, image_settings(self.tile, self.seed), progress, cancel)
+        except SettingError as exc:
+            raise SettingError(f"{where}exemplar", exc.message) from None
+        return TileField(tile, PX_PER_UNIT)
+
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
-        kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone)."""
+        kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone); for
+        method "synthesis" only what it reads (exemplar, seed, tile)."""
+        if self.method == "synthesis":
+            return dict(method="synthesis", exemplar=_digest(self.exemplar), seed=int(self.seed),
+                        tile=int(self.tile))
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),

@@ -192,6 +192,35 @@ def test_the_preview_shows_the_periodic_part_it_found(scene):
     p.periodic = True
 
 
+def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
+    """Tileable Image (backend/solid/synthesis.py) stores the tile the command line's request synthesises from the
+    same pixels, 8-bit, row 0 at the bottom, and the panel draws it for an image exemplar; without one it says
+    what to pick."""
+    from backend.solid.request import SolidRequest
+
+    p = scene.omninoise_solid
+    with pytest.raises(RuntimeError, match="set Source to Image"):
+        bpy.ops.omninoise.solid_tileable()
+    x = np.arange(128)
+    rgb = np.zeros((128, 128, 3), np.float32)
+    rgb[:] = (0.2 + 0.6 * (x % 16 < 8))[None, :, None] * np.array([1.0, 0.8, 0.5], np.float32)
+    ima = bpy.data.images.new("Stripes", 128, 128, alpha=False)
+    rgba = np.ones((128, 128, 4), np.float32)
+    rgba[..., :3] = np.flipud(rgb)
+    ima.pixels.foreach_set(rgba.ravel())
+    p.source, p.image, p.tile, p.seed = "IMAGE", ima, 64, 5
+    assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
+    got = _pixels("Solid Texture Tile")
+    ref = SolidRequest(exemplar=solid_ui._image_pixels(ima), seed=5, method="synthesis",
+                       tile=64).synthesis_field().tile
+    assert got.shape == (64, 64, 3) and np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
+    g = got.mean(2)      # the stripes stay vertical: brightness changes across columns, not down them
+    assert np.abs(np.diff(g, axis=1)).mean() > 10.0 * np.abs(np.diff(g, axis=0)).mean()
+    log = []
+    solid_ui.draw_solid(Recorder(log), bpy.context)
+    assert "Tileable Image" in [t for n, a, t in log if n == "operator"] and "tile" in [a for n, a, t in log]
+
+
 def test_errors_are_reported(scene):
     p = scene.omninoise_solid
     with pytest.raises(RuntimeError, match="select an object"):
@@ -276,3 +305,9 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
     assert req.key() == solid_request_from_dict({"model": space, "exemplar": str(tmp_path / "ex.png"), "refine": 4,
                                                  "seed": 3, "rest": "upright"}).key()
     p.rest = "auto"
+    # Tileable Image is --method synthesis and a job file's method = "synthesis"
+    p.tile = 64
+    req = solid_ui.tile_request(p)
+    assert req.key() == flags("--method", "synthesis", "--exemplar", str(tmp_path / "ex.png"), "--tile", "64").key()
+    assert req.key() == solid_request_from_dict({"method": "synthesis", "exemplar": str(tmp_path / "ex.png"),
+                                                 "tile": 64, "seed": 3}).key()

@@ -1,5 +1,5 @@
-"""training/solid/synthesis.py (Kopf et al. 2007 solid synthesis by optimisation) and bench/solid_synthesis.py: the
-tile copies a photo's structure at its frequency and orientation, keeps its colours, wraps around, and reports
+"""backend/solid/synthesis.py (Kopf et al. 2007 solid synthesis by optimisation; Kwatra et al. 2005 in 2D) and
+bench/solid_synthesis.py: the tile copies a photo's structure at its frequency and orientation, keeps its colours, wraps around, and reports
 progress, cancels and bad settings in one line."""
 import json
 
@@ -8,7 +8,7 @@ import pytest
 
 from backend.errors import SettingError
 from backend.grid import Cancelled
-from training.solid.synthesis import SynthesisSettings, TileField, synthesise
+from backend.solid.synthesis import SynthesisSettings, TileField, synthesise
 
 
 def _stripes(period: float = 8.0, size: int = 64, along: str = "cols", saw: bool = False) -> np.ndarray:
@@ -41,6 +41,20 @@ def test_2d_tile_copies_the_stripes_period_direction_and_colours():
     # histogram matching: the tile's colours are the photo's (means within 0.02, same range)
     assert np.abs(tile.reshape(-1, 3).mean(0) - photo.reshape(-1, 3).mean(0)).max() < 0.02
     assert tile.min() >= photo.min() - 1e-4 and tile.max() <= photo.max() + 1e-4
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_products_2d_settings_keep_stripes_whole(seed):
+    """image_settings (what method "synthesis" draws): square and sawtooth stripes of a 128² photo stay vertical
+    stripes in a 64 px tile, on every seed.  With sharp weights on every level (k = 10) the coarse pieces settled on
+    different phases and most seeds drew offset pieces with horizontal seams (model card, fifteenth session)."""
+    from backend.solid.synthesis import image_settings
+
+    x = np.arange(128)
+    for profile in ((x % 16 < 8) * 0.6 + 0.2, (x % 20) / 20.0 * 0.8 + 0.1):
+        photo = np.broadcast_to(profile[None, :, None] * np.array([1.0, 0.8, 0.5]), (128, 128, 3))
+        g = synthesise(photo.astype(np.float32), image_settings(64, seed)).mean(2)
+        assert np.abs(np.diff(g, axis=1)).mean() > 10.0 * np.abs(np.diff(g, axis=0)).mean()
 
 
 def test_upright_solid_lays_the_photos_rows_along_z_the_right_way_up():
@@ -80,6 +94,20 @@ def test_isotropic_solid_keeps_the_photos_scale_on_every_slice_family():
     assert _ring_share(v[:32, :32], 3.5, 6.5) > 0.95
     for img in (g[:, :, 5], g[:, 7, :], g[9, :, :]):
         assert _ring_share(img, 3.5, 6.5) > 0.7
+
+
+def test_the_search_cuts_out_only_the_neighbourhoods_it_keeps():
+    """A large photo's neighbourhoods are subsampled before any is cut out (a 4096² photo's every 8 x 8 one would
+    take 12 GB); each kept row is the photo's neighbourhood at its position, row-major, colours last."""
+    from backend.solid.synthesis import _Searcher
+
+    photo = np.random.default_rng(0).random((40, 50, 3)).astype(np.float32)
+    s = _Searcher(photo, 4, 8, 100, np.random.default_rng(1))
+    assert s.X.shape == (100, 48) and len(np.unique(s.pos, axis=0)) == 100
+    for (r, c), x in zip(s.pos, s.X):
+        np.testing.assert_array_equal(x, photo[r:r + 4, c:c + 4].reshape(-1))
+    every = _Searcher(photo, 4, 8, 10 ** 6, np.random.default_rng(1))     # fewer than asked for: all of them
+    assert every.X.shape == (37 * 47, 48)
 
 
 def test_tile_field_samples_voxel_centres_and_wraps():
@@ -147,5 +175,7 @@ def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_pa
         assert np.isfinite(r[k]) and r[k] > 0
     assert doc["summary"]["photos"] == 1 and doc["summary"]["by_category"]["brick"]["photos"] == 1
     from PIL import Image
-    assert Image.open(out + ".png").size == (5 * 128 if dim == 3 else 3 * 128, 128)
+    # 3D: photo | x, y, z slices | random phase (128 px); 2D: photo | tile | 2 x 2 of it | random phase (the tile's)
+    assert Image.open(out + ".png").size == ((5 * 128, 128) if dim == 3 else (4 * 64, 64))
+    assert 0 < r["pooled"] < r["pixel_shuffle"]
     assert "brick__beige_bricks" in capsys.readouterr().out

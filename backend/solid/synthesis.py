@@ -1,5 +1,10 @@
-"""Solid textures from a photo by optimisation (Kopf et al. 2007, "Solid Texture Synthesis from 2D Exemplars"):
-a research baseline for issue 20, measured by ``bench/solid_synthesis.py``; the runtime does not use it.
+"""Textures from a photo by optimisation (Kopf et al. 2007, "Solid Texture Synthesis from 2D Exemplars"; in 2D
+Kwatra et al. 2005, "Texture Optimization for Example-based Synthesis"), numpy only.
+
+In 2D this is what ``method = "synthesis"`` draws (:class:`backend.solid.request.SolidRequest`: ``omninoise solid
+--method synthesis``, job files, the panel's Tileable Image): a periodic image that copies the photo's structure
+(courses, planks, stones), closer than random phase noise on most structured held-out photos.  In 3D it stays a
+research baseline measured by ``bench/solid_synthesis.py`` (its slices disagree and settle into blocks; model card).
 
 The neural path (``backend/solid/model.py``) draws a texture from a code in one pass; this module instead
 optimises a periodic tile of voxels so that its slices look like the photo, neighbourhood by neighbourhood
@@ -37,11 +42,12 @@ import dataclasses
 
 import numpy as np
 
-from backend.errors import SettingError
-from backend.grid import Cancelled
-from backend.solid.model import resize_rgb
+from ..errors import SettingError
+from ..grid import Cancelled
+from .model import plane_points, resize_rgb
 
-__all__ = ["SynthesisSettings", "synthesise", "TileField", "PLANES"]
+__all__ = ["SynthesisSettings", "synthesise", "TileField", "image_settings", "PLANES", "PX_PER_UNIT", "MIN_TILE",
+           "MAX_TILE", "TILE_STEP", "IMAGE_SHARPNESS"]
 
 _F = np.float32
 #: which slices must look like the photo: "all" (x, y and z: Kopf's isotropic case) or "walls" (x and y only,
@@ -49,6 +55,17 @@ _F = np.float32
 PLANES = ("all", "walls")
 R = 0.8          #: Kopf's robust exponent r (Eq. 2)
 _CHUNK = 4096    #: query neighbourhoods per nearest-neighbour block
+#: a photo pixel per 1/PX_PER_UNIT texture units: the shipped texture-space model's scale, so the same photo gives
+#: textures of the same size by either method
+PX_PER_UNIT = 128.0
+#: the tile sizes a request may ask for (px a side, 2D): multiples of TILE_STEP (the coarsest of the default three
+#: levels has a quarter of the pixels), at least MIN_TILE (8 x 8 neighbourhoods fit that level)
+MIN_TILE, MAX_TILE, TILE_STEP = 32, 1024, 4
+#: the 2D product's weights per level, coarse to fine (:func:`image_settings`): soft on the coarse and middle
+#: levels, where the copied pieces must agree on a phase (with k = 10 there, stripes broke into offset pieces on most
+#: seeds and a paving photo into blotches), sharp on the finest, which keeps the copied detail crisp.  Chosen on 22
+#: training photos (median patch distance 88.6 -> 75.9; model card, fifteenth session)
+IMAGE_SHARPNESS = (3.0, 3.0, 10.0)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,17 +111,16 @@ class SynthesisSettings:
                                             f"got {self.sharpness}")
 
 
+def image_settings(tile: int, seed: int = 0) -> SynthesisSettings:
+    """What ``method = "synthesis"`` draws: a 2D tile of ``tile`` px with :data:`IMAGE_SHARPNESS`."""
+    return SynthesisSettings(size=int(tile), dim=2, sharpness=IMAGE_SHARPNESS, seed=int(seed))
+
+
 def _families(dim: int, planes: str) -> list:
     """The (row axis, column axis) pairs of the slice families, in tile index order (z, y, x) / (y, x)."""
     if dim == 2:
         return [(0, 1)]
     return [(0, 1), (0, 2)] if planes == "walls" else [(0, 1), (0, 2), (1, 2)]
-
-
-def _patches(img: np.ndarray, n: int) -> np.ndarray:
-    """Every n x n neighbourhood of an image (H, W, 3) -> float32 (M, n*n*3), row-major positions."""
-    v = np.lib.stride_tricks.sliding_window_view(img, (n, n), axis=(0, 1))   # (H-n+1, W-n+1, 3, n, n)
-    return np.ascontiguousarray(v.transpose(0, 1, 3, 4, 2)).reshape(-1, n * n * 3).astype(_F)
 
 
 def _colour_axes(colours: np.ndarray) -> tuple:
@@ -134,12 +150,14 @@ class _Searcher:
     """Exact nearest photo neighbourhood in the principal-component space of the photo's neighbourhoods."""
 
     def __init__(self, photo: np.ndarray, n: int, components: int, candidates: int, rng: np.random.Generator):
-        X = _patches(photo, n)
         w = photo.shape[1] - n + 1
-        keep = np.arange(X.shape[0])
-        if X.shape[0] > candidates:
-            keep = np.sort(rng.choice(X.shape[0], candidates, replace=False))
-            X = X[keep]
+        total = (photo.shape[0] - n + 1) * w
+        keep = np.arange(total)
+        if total > candidates:       # chosen before any is cut out: a large photo's every patch would not fit
+            keep = np.sort(rng.choice(total, candidates, replace=False))
+        d = np.arange(n)
+        X = photo[(keep // w)[:, None, None] + d[:, None], (keep % w)[:, None, None] + d]   # (M, n, n, 3)
+        X = np.ascontiguousarray(X, _F).reshape(keep.shape[0], n * n * 3)
         self.X = X
         self.pos = np.stack([keep // w, keep % w], -1).astype(np.int32)   # (M, 2) top-left (row, col)
         self.mean = X.mean(0)
@@ -244,8 +262,8 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
     """A periodic tile whose slices look like ``photo`` float (H, W, 3) sRGB in [0, 1] (module doc): float32
     (N, N, 3) in 2D, (N, N, N, 3) in 3D (N = ``settings.size``), at the photo's resolution.
 
-    ``progress(fraction)`` after each slice family of each iteration; ``cancel()`` returning True stops with
-    :class:`~backend.grid.Cancelled`.  The photo must be at least ``settings.patch`` px on its short side at the
+    ``progress(fraction)`` after each slice family of each iteration (the fraction of the work, by voxels);
+    ``cancel()`` returning True stops with :class:`~backend.grid.Cancelled`.  The photo must be at least ``settings.patch`` px on its short side at the
     coarsest level."""
     s = settings
     img = np.asarray(photo, _F)
@@ -260,12 +278,14 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
     img = np.clip(img[::-1], 0.0, 1.0)      # row 0 at the bottom: rows run up the tile (module doc)
     rng = np.random.default_rng(s.seed)
     fams = _families(s.dim, s.planes)
-    total, done = len(fams) * sum(s.iterations), [0]
+    # progress in work done: a slice family's pass over a level costs about its voxel count
+    cost = [(s.size // 2 ** (s.levels - 1 - lvl)) ** s.dim for lvl in range(s.levels)]
+    total, done, level = len(fams) * sum(i * c for i, c in zip(s.iterations, cost)), [0], [0]
 
     def tick() -> bool:
-        done[0] += 1
+        done[0] += cost[level[0]]
         if progress is not None:
-            progress(done[0] / total)
+            progress(min(1.0, done[0] / total))
         return cancel is not None and cancel()
 
     tile = sources = None
@@ -278,6 +298,7 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
             tile = flat[rng.integers(0, flat.shape[0], N ** s.dim)].reshape((N,) * s.dim + (3,))
         else:
             tile = _inherit(sources, ex, fams)
+        level[0] = lvl
         tile, sources = _level(tile, ex, s, s.iterations[lvl], s.sharpness[lvl], rng, tick)
     return tile
 
@@ -294,6 +315,11 @@ class TileField:
         if not px_per_unit > 0:
             raise SettingError("px_per_unit", f"px_per_unit must be positive, got {px_per_unit}")
         self.tile, self.dim, self.px_per_unit = t, t.ndim - 1, float(px_per_unit)
+
+    def image(self, size: int, scale: float = 1.0) -> np.ndarray:
+        """A (size, size, 3) float32 image of the plane z = 0 (x right, y up; row 0 at the top) at ``scale`` output
+        pixels per tile pixel: at scale 1 the tile's own pixels, repeated beyond its size."""
+        return self.evaluate(plane_points(size, self.px_per_unit * scale)).reshape(size, size, 3)
 
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 18) -> np.ndarray:
         """points float (P, 2 or 3) in texture units (x, y[, z]) -> float32 (P, 3)."""
