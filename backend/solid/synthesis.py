@@ -130,13 +130,13 @@ def _colour_axes(colours: np.ndarray) -> tuple:
     return m, U
 
 
-def _match_histogram(tile: np.ndarray, colours: np.ndarray, m: np.ndarray, U: np.ndarray,
+def _match_histogram(tile: np.ndarray, ref: np.ndarray, m: np.ndarray, U: np.ndarray,
                      rng: np.random.Generator) -> np.ndarray:
     """Kopf Sec. 3.2, as a projection: each of the tile's decorrelated colour channels takes the photo's values at
-    the same ranks (exact histogram matching along the photo's principal colour axes).  Equal values are ranked
-    at random: ranked in index order, a flat region would become a ramp."""
+    the same ranks (exact histogram matching along the photo's principal colour axes; ``ref`` (K, 3): the photo's
+    colours in those axes, each column sorted).  Equal values are ranked at random: ranked in index order, a flat
+    region would become a ramp."""
     flat = (tile.reshape(-1, 3) - m) @ U
-    ref = np.sort((colours - m) @ U, axis=0)
     q = (np.arange(flat.shape[0]) + 0.5) / flat.shape[0] * ref.shape[0] - 0.5
     out = np.empty_like(flat)
     ties = rng.random(flat.shape[0])
@@ -190,6 +190,7 @@ def _level(tile: np.ndarray, photo: np.ndarray, s: SynthesisSettings, iterations
     search = _Searcher(photo, n, s.components, s.candidates, rng)
     colours = photo.reshape(-1, 3).astype(np.float64)
     m, U = _colour_axes(colours)
+    ref = np.sort((colours - m) @ U, axis=0)     # once per level: a large photo has millions of colours
     fams = _families(s.dim, s.planes)
     offs = np.arange(n)
     sources = None
@@ -237,7 +238,7 @@ def _level(tile: np.ndarray, photo: np.ndarray, s: SynthesisSettings, iterations
                         tsrc[:, rr, cc] = np.where(heavier[..., None], src, tsrc[:, rr, cc])
             if tick():
                 raise Cancelled("cancelled")
-        tile = _match_histogram((acc / np.maximum(wsum, 1e-12)[..., None]).astype(_F), colours, m, U, rng)
+        tile = _match_histogram((acc / np.maximum(wsum, 1e-12)[..., None]).astype(_F), ref, m, U, rng)
     return tile, sources
 
 

@@ -98,7 +98,7 @@ def test_isotropic_solid_keeps_the_photos_scale_on_every_slice_family():
 
 def test_the_search_cuts_out_only_the_neighbourhoods_it_keeps():
     """A large photo's neighbourhoods are subsampled before any is cut out (a 4096² photo's every 8 x 8 one would
-    take 12 GB); each kept row is the photo's neighbourhood at its position, row-major, colours last."""
+    take about 13 GB); each kept row is the photo's neighbourhood at its position, row-major, colours last."""
     from backend.solid.synthesis import _Searcher
 
     photo = np.random.default_rng(0).random((40, 50, 3)).astype(np.float32)
