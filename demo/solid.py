@@ -7,8 +7,10 @@ texture-space model (with the photo's harmonic part: its courses stand on the
 cube's sides), and the sphere (grass photo) as UV images, each texel evaluated
 at its 3D surface point so the UV seams do not show; Suzanne as a colour
 attribute on a subdivided mesh, from a held-out farmland photograph encoded by
-the texture-space model; the cylinder in the wood photo's model.  The scene
-renders in Cycles on the CPU.  solid_slices.png shows, per model, the
+the texture-space model; the cylinder in the wood photo's model.  The floor
+is a tileable image the add-on's Tileable Image operator synthesises from a
+held-out paving photograph (no model), repeated 12 times each way without a
+seam.  The scene renders in Cycles on the CPU.  solid_slices.png shows, per model, the
 exemplar beside slices of the 3D texture along the three axes and an oblique
 plane.
 """
@@ -26,6 +28,7 @@ sys.path.insert(0, ROOT)
 import bpy  # noqa: E402
 
 import blender_addon  # noqa: E402
+from blender_addon.compat import ensure_node_tree  # noqa: E402
 from backend.solid.model import SHIPPED_MODELS, load_models, plane_points  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from export.images import preview_8bit, read_rgb, write_png  # noqa: E402
@@ -35,6 +38,8 @@ EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
 #: a held-out colour photo (never trained on) that the texture-space model encodes for Suzanne
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")
 BRICKS = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+#: a held-out paving photo: the floor is a tileable image synthesised from it (method "synthesis"), repeated
+PAVING = os.path.join(ROOT, "data", "photos", "val", "paving__sahara_paving_stones_01.jpg")
 
 
 def slices_sheet(out: str, size: int = 160) -> list:
@@ -84,6 +89,22 @@ def _add(kind: str, x: float):
     return obj
 
 
+def _tiled_material(obj, image, repeats: float) -> None:
+    """The object's material shows ``image`` repeated ``repeats`` times across its UV square (seamless tiles)."""
+    mat = bpy.data.materials.new("Floor")
+    ensure_node_tree(mat)
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
+    tex, mapping, coords = (nt.nodes.new(t) for t in ("ShaderNodeTexImage", "ShaderNodeMapping",
+                                                         "ShaderNodeTexCoord"))
+    tex.image = image
+    mapping.inputs["Scale"].default_value = (repeats, repeats, 1.0)
+    nt.links.new(coords.outputs["UV"], mapping.inputs["Vector"])
+    nt.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    nt.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+    obj.data.materials.append(mat)
+
+
 def build_scene(out: str) -> dict:
     """A cube and Suzanne textured from held-out photographs (bricks, farmland) through the texture-space model,
     a sphere and a cylinder from single-photo models (grass, wood)."""
@@ -118,6 +139,14 @@ def build_scene(out: str) -> dict:
         used[kind] = dict(model=model, photo=photo, target=target, seconds=round(time.perf_counter() - t, 2),
                           object=obj.name)
     bpy.ops.mesh.primitive_plane_add(size=30.0)
+    if os.path.isfile(PAVING):      # the floor: a tileable image synthesised from a held-out paving photo
+        floor = bpy.context.active_object
+        p.source, p.image, p.tile, p.seed, p.name = "IMAGE", bpy.data.images.load(PAVING), 256, 0, "Floor"
+        t = time.perf_counter()
+        assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
+        tile = bpy.data.images["Floor Tile"]
+        used["Floor"] = dict(method="synthesis", photo=PAVING, tile=256, seconds=round(time.perf_counter() - t, 2))
+        _tiled_material(floor, tile, repeats=12.0)
     bpy.ops.object.camera_add(location=(0.0, -9.0, 3.2), rotation=(1.27, 0.0, 0.0))
     cam = bpy.context.active_object
     cam.data.lens = 38
