@@ -133,3 +133,30 @@ seed = 1
                    .replace(f"bounds = [[0, {-e!r}, 0], [{e!r}, 0, 0]]", "bounds = [[0, 0, 0], [1, 1, 1]]"))
     assert main(["bake", str(job), "--quiet"]) == 2
     assert "source.method: synthesis makes 2D images" in capsys.readouterr().err
+
+
+def test_a_job_file_png_is_redone_only_when_the_synthesis_changes(stripes, tmp_path):
+    import shutil
+
+    from backend.jobs import run_job
+
+    shutil.copy(stripes, tmp_path / "stripes.png")
+    job = tmp_path / "job.toml"
+    job.write_text("""
+[[bake]]
+name = "tile"
+output = "tile.png"
+resolution = [64, 64]
+bounds = [[0, -0.5, 0], [0.5, 0, 0]]
+[bake.source]
+kind = "solid"
+method = "synthesis"
+exemplar = "stripes.png"
+tile = 64
+""")
+    assert [o.status for o in run_job(str(job))] == ["baked"]
+    assert [o.status for o in run_job(str(job))] == ["up to date"]
+    job.write_text(job.read_text().replace("tile = 64", "tile = 32"))
+    assert [o.status for o in run_job(str(job))] == ["baked"]
+    assert read_rgb(str(tmp_path / "tile.png")).shape == (64, 64, 3)
+
