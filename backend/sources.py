@@ -322,8 +322,8 @@ class SolidSource:
             self.model = model if isinstance(model, SolidTextureModel) else SolidTextureModel(model)
         except ModelError as exc:
             raise SettingError("source.model", str(exc)) from None
-        if not scale > 0:
-            raise SettingError("source.scale", f"must be > 0, got {scale}")
+        scale = limits.positive("source.scale", scale)
+        density = limits.in_range("source.density", density, 0.0, float("inf"))
         self.dim = self.model.dim
         self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
         self.exemplar, self.to, self.mix, self.periodic = exemplar, to, float(mix), bool(periodic)
@@ -391,9 +391,7 @@ class SynthesisSource:
     def __init__(self, request, scale: float = 1.0, field=None, progress=None, cancel=None):
         """request: a checked :class:`~backend.solid.request.SolidRequest` with method "synthesis"; field: its
         ready :class:`~backend.solid.synthesis.TileField` (else synthesised here, with progress and cancel)."""
-        if not scale > 0:
-            raise SettingError("source.scale", f"must be > 0, got {scale}")
-        self.request, self.scale = request, float(scale)
+        self.request, self.scale = request, limits.positive("source.scale", scale)
         self.field = field if field is not None else request.synthesis_field("source.", progress, cancel)
         self.input_sha256 = request.key()["exemplar"]      # the pixels' sha256, however they were handed over
 
@@ -418,11 +416,11 @@ class SynthesisSource:
         return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
 
     def to_dict(self) -> dict:
-        r = self.request
         import dataclasses
 
         from .solid.synthesis import image_settings
 
+        r = self.request
         # the settings drawn, so a bake is redone when they change, not only when the request does
         settings = {k: list(v) if isinstance(v, tuple) else v
                     for k, v in dataclasses.asdict(image_settings(r.tile, r.seed)).items()}

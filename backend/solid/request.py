@@ -7,10 +7,10 @@ holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al
 the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image's harmonic part,
 :mod:`backend.solid.harmonic`), ``gaussian`` (mix in an encoded image's Gaussian rest where the encode-time check
 finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("auto", "isotropic" or "upright",
-:mod:`backend.solid.upright`), and the ``seed`` of the noise.  ``method`` "synthesis" asks instead for a periodic 2D image of ``tile`` px a side
-synthesised from an image exemplar by texture optimisation (:mod:`backend.solid.synthesis`): no model, no code,
-2D only.  Where the texture is read (grid,
-zoom, scale) belongs to the bake, not to the texture.
+:mod:`backend.solid.upright`), and the ``seed`` of the noise.  ``method`` "synthesis" asks instead for a periodic
+2D image of ``tile`` px a side synthesised from an image exemplar by texture optimisation
+(:mod:`backend.solid.synthesis`): no model, no code, 2D only.  Where the texture is read (grid, zoom, scale) belongs
+to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
 sha256): equal settings from any front-end give equal keys (tests/cli/test_solid_request.py).

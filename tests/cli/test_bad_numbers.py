@@ -154,3 +154,23 @@ def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp
     assert "--debug" in err[0]
     with pytest.raises(ZeroDivisionError):
         cli.main(["--debug", "zoo", "--noise", "perlin", "-o", str(tmp_path / "z.png")])
+
+
+@pytest.mark.parametrize("source, match", [
+    ('exemplar = "gravel"\nscale = "big"', "source.scale: expected a number"),      # was an internal TypeError
+    ('exemplar = "gravel"\nscale = inf', "source.scale: must be a finite number"),  # was baked
+    ('exemplar = "gravel"\ndensity = -1', r"source.density: must lie in \[0, inf\]"),
+    ('method = "synthesis"\nexemplar = "ex.png"\nscale = "big"', "source.scale: expected a number"),
+    ('method = "synthesis"\nexemplar = "ex.png"\nscale = 0', "source.scale: must be positive"),
+])
+def test_bad_solid_source_numbers_are_named(tmp_path, source, match):
+    from export.images import write_png
+    import numpy as np
+
+    write_png(str(tmp_path / "ex.png"), np.random.default_rng(0).integers(0, 256, (64, 64, 3)).astype(np.uint8))
+    job = tmp_path / "job.toml"
+    job.write_text(f'[[bake]]\nname = "s"\noutput = "s.png"\nresolution = [8, 8]\nbounds = [[0, 0, 0], [1, 1, 0]]\n'
+                   f'[bake.source]\nkind = "solid"\n{source}\n')
+    res = run_job(str(job))
+    assert res[0].status == "invalid" and re.search(match, res[0].message), [r.message for r in res]
+    assert not (tmp_path / "s.png").exists()

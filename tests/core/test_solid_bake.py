@@ -87,7 +87,7 @@ seed = 4
     ({"kind": "solid", "model": "gravel_3d", "colour": 1}, "unknown solid setting"),
     ({"kind": "solid", "model": "gravel_3d", "exemplar": "x.png"}, "holds one texture"),
     ({"kind": "solid", "model": "nope"}, "no solid.json"),
-    ({"kind": "solid", "model": "gravel_3d", "scale": 0}, "must be > 0"),
+    ({"kind": "solid", "model": "gravel_3d", "scale": 0}, "source.scale: must be positive"),
 ])
 def test_bad_sources(tmp_path, source, msg):
     with pytest.raises(SettingError, match=msg):
