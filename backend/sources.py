@@ -289,6 +289,17 @@ class NeuralSource:
         return d
 
 
+def _grid_points(shape, first, step, start=None) -> np.ndarray:
+    """The points of a grid block (the solid sources' evaluate): ``shape`` (ny, nx) or (nz, ny, nx) samples from
+    index ``start`` (x, y[, z]; zeros when None) of a grid whose first sample is at ``first`` with spacing ``step``
+    -> float64 (N, 2 or 3) (x, y[, z]), x fastest."""
+    n = len(shape)
+    start = np.zeros(n, int) if start is None else np.asarray(start)
+    axes = [first[k] + (start[k] + np.arange(shape[::-1][k])) * step[k] for k in range(n)]   # x, y[, z]
+    mesh = np.meshgrid(*reversed(axes), indexing="ij")                                      # (z,) y, x
+    return np.stack([m.ravel() for m in reversed(mesh)], axis=1)
+
+
 class SolidSource:
     """A neural solid texture (Henzler et al. 2020) as a bake source of colours (``rgb``).
 
@@ -348,10 +359,7 @@ class SolidSource:
         from .colour import srgb_to_linear
 
         n = len(shape)
-        start = np.zeros(n, int) if start is None else np.asarray(start)
-        axes = [first[k] + (start[k] + np.arange(shape[::-1][k])) * step[k] for k in range(n)]   # x, y[, z]
-        mesh = np.meshgrid(*reversed(axes), indexing="ij")                                      # (z,) y, x
-        pts = np.stack([m.ravel() for m in reversed(mesh)], axis=1)
+        pts = _grid_points(shape, first, step, start)
         if n == 2:
             pts = np.concatenate([pts, np.full((len(pts), 1), first[2])], axis=1)
         if self.dim == 2:
@@ -403,14 +411,11 @@ class SynthesisSource:
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
 
-        start = np.zeros(2, int) if start is None else np.asarray(start)
-        axes = [first[k] + (start[k] + np.arange(shape[::-1][k])) * step[k] for k in range(2)]   # x, y
-        yy, xx = np.meshgrid(axes[1], axes[0], indexing="ij")
         if cancel is not None and cancel():
             from .grid import Cancelled
 
             raise Cancelled("cancelled")
-        rgb = self.field.evaluate(np.stack([xx.ravel(), yy.ravel()], axis=1) * self.scale)
+        rgb = self.field.evaluate(_grid_points(shape, first, step, start) * self.scale)
         if progress is not None:
             progress(1.0)
         return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
