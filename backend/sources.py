@@ -423,12 +423,10 @@ class SynthesisSource:
     def to_dict(self) -> dict:
         import dataclasses
 
-        from .solid.synthesis import image_settings
-
         r = self.request
         # the settings drawn, so a bake is redone when they change, not only when the request does
         settings = {k: list(v) if isinstance(v, tuple) else v
-                    for k, v in dataclasses.asdict(image_settings(r.tile, r.seed)).items()}
+                    for k, v in dataclasses.asdict(self.field.settings).items()}
         return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
                     input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale,
                     settings=settings)

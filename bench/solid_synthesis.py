@@ -15,7 +15,8 @@ slices of 3D output).
     python bench/solid_synthesis.py [--only brick,wood,rock] [--size 128] [--planes all] [--out out/bench/solid_synthesis]
 
 Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices | random phase; 2D: photo | the first
-tile | the tile repeated 2 x 2 at half size, to show it has no seams | random phase, at the tile's size).
+tile | the second (another seed) | the first repeated 2 x 2 at half size, to show it has no seams | random phase, at
+the tile's size).
 """
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from backend.solid.model import slice_points  # noqa: E402
 from backend.solid.spectral import seed_shift3  # noqa: E402
-from backend.solid.synthesis import (IMAGE_SHARPNESS, PLANES, PX_PER_UNIT, SynthesisSettings, TileField,  # noqa: E402
+from backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
                                      synthesise)
 from training.solid import photo_eval as pe  # noqa: E402
 from training.solid.photo_set import photo_set  # noqa: E402
@@ -75,9 +76,10 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=128, help="tile voxels per side")
     ap.add_argument("--dim", type=int, default=3, choices=(2, 3))
     ap.add_argument("--planes", default="all", choices=PLANES)
-    ap.add_argument("--iterations", default="16,6,2")
+    ap.add_argument("--iterations", default=None, help="per level, coarse to fine (default: the product's in 2D, "
+                                                       "16,6,2 in 3D); as many levels as counts")
     ap.add_argument("--sharpness", default=None, help="the weights' sharpness per level, coarse to fine (default: "
-                                                     "the product's IMAGE_SHARPNESS in 2D, 10,10,10 in 3D)")
+                                                     "the product's in 2D, 10 on every level in 3D)")
     ap.add_argument("--stride", type=int, default=2)
     ap.add_argument("--patch", type=int, default=SynthesisSettings.patch)
     ap.add_argument("--candidates", type=int, default=SynthesisSettings.candidates)
@@ -90,11 +92,13 @@ def main(argv=None) -> int:
     files = [f for f in photo_set("val", os.path.join(ROOT, "data", "photos"))
              if not words or any(w in os.path.basename(f) for w in words)]
     files = files[:a.limit] if a.limit else files
+    # 2D without --iterations and --sharpness: what the product draws from each photo (image_settings)
+    product = a.dim == 2 and a.iterations is None and a.sharpness is None
+    iterations = tuple(int(x) for x in (a.iterations or "16,6,2").split(","))
     settings = SynthesisSettings(size=a.size, dim=a.dim, planes=a.planes, stride=a.stride, patch=a.patch,
-                                 candidates=a.candidates,
-                                 iterations=tuple(int(x) for x in a.iterations.split(",")),
+                                 candidates=a.candidates, levels=len(iterations), iterations=iterations,
                                  sharpness=tuple(float(x) for x in a.sharpness.split(",")) if a.sharpness
-                                 else IMAGE_SHARPNESS if a.dim == 2 else (10.0,) * 3)
+                                 else (10.0,) * len(iterations))
     neural = json.load(open(a.against))["photos"] if a.against else {}
     rows, sheet = {}, []
     print(f"{'photo':44s} {'pooled':>7s} {'rp':>7s} {'walls':>7s} {'rp':>7s} {'axes':>7s} {'rp':>7s} "
@@ -106,12 +110,16 @@ def main(argv=None) -> int:
         if a.dim == 3:
             imgs = slices(TileField(synthesise(photo, settings), PX_PER_UNIT), a.seeds)
         else:       # one tile per seed, its SIZE² image as the product draws it (top row first), grouped as x
-            fields = [TileField(synthesise(photo, dataclasses.replace(settings, seed=s)), PX_PER_UNIT)
-                      for s in range(a.seeds)]
+            drawn = [image_settings(a.size, photo.shape, s) if product else dataclasses.replace(settings, seed=s)
+                     for s in range(a.seeds)]
+            fields = [TileField(synthesise(photo, d), PX_PER_UNIT) for d in drawn]
             imgs = {"x": [f.image(SIZE) for f in fields]}
         seconds = time.time() - t
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
+        if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)
+            r["levels"] = drawn[0].levels
+            r["colour_tile"] = round(float(np.mean([pe.mean_colour_error(f.image(a.size), photo) for f in fields])), 4)
         if name in neural:
             r["neural_pooled"], r["neural_walls"] = neural[name]["swd"], neural[name]["swd_walls"]
             r["neural_axes"] = neural[name]["swd_axes"]
@@ -119,9 +127,9 @@ def main(argv=None) -> int:
         print(f"{name[:44]:44s} {r['pooled']:7.1f} {r['random_phase_pooled']:7.1f} {r['walls']:7.1f} "
               f"{r['random_phase_walls']:7.1f} {r['axes']:7.1f} {r['random_phase_axes']:7.1f} "
               f"{r.get('neural_pooled', float('nan')):7.1f} {r['colour']:7.4f} {seconds:6.1f}", flush=True)
-        if a.sheet and a.dim == 2:     # photo | the first tile | 2 x 2 of it at half size: no seams | random phase
+        if a.sheet and a.dim == 2:  # photo | the first two tiles | 2 x 2 of the first at half size: no seams | random phase
             n = min(a.size, *photo.shape[:2])
-            sheet.append([photo[:n, :n], fields[0].image(n), fields[0].image(n, 0.5),
+            sheet.append([photo[:n, :n]] + [f.image(n) for f in fields[:2]] + [fields[0].image(n, 0.5),
                           pe.random_phase(photo, n, np.random.default_rng(1))])
         elif a.sheet:
             sheet.append([photo[:SIZE, :SIZE]] + [im[:SIZE, :SIZE] for v in imgs.values() for im in v][:3]
@@ -135,6 +143,8 @@ def main(argv=None) -> int:
 
     summary = {"photos": len(rows), "median_seconds": med("seconds"),
                "max_colour": max((r["colour"] for r in rows.values()), default=0.0)}
+    if a.dim == 2:
+        summary["max_colour_tile"] = max((r["colour_tile"] for r in rows.values()), default=0.0)
     for k in ("pooled", "walls", "axes"):
         summary.update({f"median_{k}": med(k), f"median_random_phase_{k}": med("random_phase_" + k),
                         f"beats_random_phase_{k}": beats(k)})
@@ -154,7 +164,8 @@ def main(argv=None) -> int:
                                                  if "neural_pooled" in r))
     print(json.dumps(summary))
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
-    write_json(a.out + ".json", {"settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
+    write_json(a.out + ".json", {"settings": "the product's (image_settings; levels per photo)" if product else
+                                 {k: getattr(settings, k) for k in settings.__dataclass_fields__},
                                  "px_per_unit": PX_PER_UNIT, "seeds": a.seeds, "against": a.against,
                                  "summary": summary, "photos": rows})
     if sheet:

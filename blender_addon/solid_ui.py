@@ -131,7 +131,8 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     voxels: IntProperty(name="Voxels", default=128, min=4, soft_max=512, description="Voxels along the longest side")
     tile: IntProperty(name="Tile Size", default=256, min=32, max=1024, step=4,
                       description="Side of the tileable image synthesised from the exemplar, px (a multiple of 4; "
-                                  "about 3 s at 256 on two cores, 16 times that at 1024)")
+                                  "powers of two let large structures come out whole; about 3 s at 256 on two "
+                                  "cores, 16 times that at 1024)")
     periodic_info: StringProperty(name="Periodic Part Found", default="", options={"SKIP_SAVE"},
                                   description="What the last preview measured of the image's periodic part")
     gaussian_info: StringProperty(name="Gaussian Rest Found", default="", options={"SKIP_SAVE"},

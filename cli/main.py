@@ -189,7 +189,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "from the image file --exemplar by texture optimisation (Kwatra et al. 2005), copying its "
                         "courses, planks and stones; --tile px a side, repeated beyond it")
     s.add_argument("--tile", type=int, default=256, help="--method synthesis: the periodic image's side, px "
-                                                         "(a multiple of 4 in [32, 1024]; default 256)")
+                                                         "(a multiple of 4 in [32, 1024]; default 256; multiples of 8 and "
+                                                         "more let large photos lay out large structures whole)")
     s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
     s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
     s.add_argument("--quiet", action="store_true")

@@ -146,9 +146,9 @@ class SolidRequest:
 
     def synthesis_field(self, where: str = "", progress=None, cancel=None):
         """Method "synthesis": the :class:`~backend.solid.synthesis.TileField` of a periodic 2D tile of ``tile`` px
-        synthesised from the exemplar with ``seed`` (:func:`~backend.solid.synthesis.image_settings`; progress and
-        cancel as :func:`~backend.solid.synthesis.synthesise`'s); SettingError naming the exemplar for an image it
-        cannot use."""
+        synthesised from the exemplar with ``seed`` (:func:`~backend.solid.synthesis.image_settings`, which the field
+        keeps as ``settings``; progress and cancel as :func:`~backend.solid.synthesis.synthesise`'s); SettingError
+        naming the exemplar for an image it cannot use."""
         from .synthesis import PX_PER_UNIT, TileField, image_settings, synthesise
 
         img = self.exemplar
@@ -159,11 +159,12 @@ class SolidRequest:
                 img = export.read_rgb(img)
             except ValueError as exc:
                 raise SettingError(f"{where}exemplar", str(exc)) from None
+        settings = image_settings(self.tile, np.shape(img), self.seed)
         try:
-            tile = synthesise(img, image_settings(self.tile, self.seed), progress, cancel)
+            tile = synthesise(img, settings, progress, cancel)
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
-        return TileField(tile, PX_PER_UNIT)
+        return TileField(tile, PX_PER_UNIT, settings)
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's

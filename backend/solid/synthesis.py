@@ -47,7 +47,8 @@ from ..grid import Cancelled
 from .model import plane_points, resize_rgb
 
 __all__ = ["SynthesisSettings", "synthesise", "TileField", "image_settings", "PLANES", "PX_PER_UNIT", "MIN_TILE",
-           "MAX_TILE", "TILE_STEP", "IMAGE_SHARPNESS"]
+           "MAX_TILE", "TILE_STEP", "COARSE_SHARPNESS", "FINE_SHARPNESS", "MIN_LEVELS", "COARSEST_PATCHES",
+           "image_levels"]
 
 _F = np.float32
 #: which slices must look like the photo: "all" (x, y and z: Kopf's isotropic case) or "walls" (x and y only,
@@ -61,11 +62,15 @@ PX_PER_UNIT = 128.0
 #: the tile sizes a request may ask for (px a side, 2D): multiples of TILE_STEP (the coarsest of the default three
 #: levels has a quarter of the pixels), at least MIN_TILE (8 x 8 neighbourhoods fit that level)
 MIN_TILE, MAX_TILE, TILE_STEP = 32, 1024, 4
-#: the 2D product's weights per level, coarse to fine (:func:`image_settings`): soft on the coarse and middle
-#: levels, where the copied pieces must agree on a phase (with k = 10 there, stripes broke into offset pieces on most
-#: seeds and a paving photo into blotches), sharp on the finest, which keeps the copied detail crisp.  Chosen on 22
-#: training photos (median patch distance 88.6 -> 75.9; model card, fifteenth session)
-IMAGE_SHARPNESS = (3.0, 3.0, 10.0)
+#: the 2D product's weights, coarse to fine (:func:`image_settings`): soft on every level but the finest, where the
+#: copied pieces must agree on a phase (with k = 10 there, stripes broke into offset pieces on most seeds and a
+#: paving photo into blotches), sharp on the finest, which keeps the copied detail crisp.  Chosen on 22 training
+#: photos (median patch distance 88.6 -> 75.9; model card, fifteenth session)
+COARSE_SHARPNESS, FINE_SHARPNESS = 3.0, 10.0
+#: the fewest levels the product draws; it draws more where the tile and the photo allow (:func:`image_levels`)
+MIN_LEVELS = 3
+#: neighbourhoods across the tile and the photo's short side at the product's coarsest level (:func:`image_levels`)
+COARSEST_PATCHES = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -111,9 +116,32 @@ class SynthesisSettings:
                                             f"got {self.sharpness}")
 
 
-def image_settings(tile: int, seed: int = 0) -> SynthesisSettings:
-    """What ``method = "synthesis"`` draws: a 2D tile of ``tile`` px with :data:`IMAGE_SHARPNESS`."""
-    return SynthesisSettings(size=int(tile), dim=2, sharpness=IMAGE_SHARPNESS, seed=int(seed))
+def image_levels(tile: int, photo_shape, patch: int = 8) -> int:
+    """How many levels the 2D product draws a ``tile`` px tile from a photo of ``photo_shape`` (H, W, ...) with:
+    as many as keep :data:`COARSEST_PATCHES` neighbourhoods (``patch`` px each) across both the tile and the
+    photo's short side at the coarsest level (the tile a multiple of 2^(levels - 1)), at least :data:`MIN_LEVELS`.
+    The coarsest level's neighbourhoods then span a quarter of the photo, so large structures (bricks, planks,
+    slabs) are laid out whole there and the finer levels refine them: with three levels, a 256 px photo's bricks and
+    planks came out as offset pieces with straight seams; with neighbourhoods spanning half the photo the tiles
+    copied such large pieces that a 128 px part of one was as far from the photo as a 128 px crop of it (model
+    card, sixteenth session)."""
+    side = min(photo_shape[:2]) if len(photo_shape) >= 2 else 0     # not an image: synthesise says so
+    least = COARSEST_PATCHES * patch
+    levels = MIN_LEVELS
+    while True:
+        f = 2 ** levels          # the next level's factor
+        if tile % f or tile // f < least or side // f < least:
+            return levels
+        levels += 1
+
+
+def image_settings(tile: int, photo_shape, seed: int = 0) -> SynthesisSettings:
+    """What ``method = "synthesis"`` draws from a photo of ``photo_shape`` (H, W, ...): a 2D tile of ``tile`` px on
+    :func:`image_levels` levels, 16 iterations on each but the last two (6 and 2), weights' sharpness
+    :data:`COARSE_SHARPNESS` on each but the finest (:data:`FINE_SHARPNESS`)."""
+    levels = image_levels(int(tile), photo_shape)
+    return SynthesisSettings(size=int(tile), dim=2, levels=levels, iterations=(16,) * (levels - 2) + (6, 2),
+                             sharpness=(COARSE_SHARPNESS,) * (levels - 1) + (FINE_SHARPNESS,), seed=int(seed))
 
 
 def _families(dim: int, planes: str) -> list:
@@ -307,15 +335,16 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
 class TileField:
     """A periodic tile as a colour field over texture space: ``evaluate(points)`` samples it trilinearly
     (bilinearly in 2D) with wrap-around, ``px_per_unit`` voxels per texture unit (the photo's resolution), voxel
-    centres at (i + 1/2) / px_per_unit.  2D points on a 3D tile lie on z = 0."""
+    centres at (i + 1/2) / px_per_unit.  2D points on a 3D tile lie on z = 0.  ``settings``: the
+    :class:`SynthesisSettings` the tile was synthesised with, where known (a bake's key records them)."""
 
-    def __init__(self, tile: np.ndarray, px_per_unit: float):
+    def __init__(self, tile: np.ndarray, px_per_unit: float, settings: SynthesisSettings | None = None):
         t = np.asarray(tile, _F)
         if t.ndim not in (3, 4) or t.shape[-1] != 3 or len(set(t.shape[:-1])) != 1:
             raise SettingError("tile", f"a tile is (N, N, 3) or (N, N, N, 3), got shape {t.shape}")
         if not px_per_unit > 0:
             raise SettingError("px_per_unit", f"px_per_unit must be positive, got {px_per_unit}")
-        self.tile, self.dim, self.px_per_unit = t, t.ndim - 1, float(px_per_unit)
+        self.tile, self.dim, self.px_per_unit, self.settings = t, t.ndim - 1, float(px_per_unit), settings
 
     def image(self, size: int, scale: float = 1.0) -> np.ndarray:
         """A (size, size, 3) float32 image of the plane z = 0 (x right, y up; row 0 at the top) at ``scale`` output

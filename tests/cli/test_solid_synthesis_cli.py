@@ -160,3 +160,17 @@ tile = 64
     assert [o.status for o in run_job(str(job))] == ["baked"]
     assert read_rgb(str(tmp_path / "tile.png")).shape == (64, 64, 3)
 
+
+
+def test_the_bake_key_records_the_levels_the_photo_was_drawn_with():
+    """The levels depend on the photo (image_levels): the field keeps the settings it was synthesised with and a job
+    file's source writes them into its bake key, so a bake is redone when they change."""
+    from backend.solid.synthesis import image_settings
+    from backend.sources import SynthesisSource
+
+    req = SolidRequest(exemplar=PHOTO, method="synthesis", tile=256, seed=2).check()
+    src = SynthesisSource(req)
+    assert src.field.settings == image_settings(256, read_rgb(PHOTO).shape, 2) and src.field.settings.levels == 4
+    d = src.to_dict()
+    assert d["settings"]["levels"] == 4 and d["settings"]["sharpness"] == [3.0, 3.0, 3.0, 10.0]
+    assert d["settings"]["seed"] == 2 and d["tile"] == 256
