@@ -399,9 +399,14 @@ class SynthesisSource:
     def __init__(self, request, scale: float = 1.0, field=None, progress=None, cancel=None):
         """request: a checked :class:`~backend.solid.request.SolidRequest` with method "synthesis"; field: its
         ready :class:`~backend.solid.synthesis.TileField` (else synthesised here, with progress and cancel)."""
+        import dataclasses
+
         self.request, self.scale = request, limits.positive("source.scale", scale)
-        self.field = field if field is not None else request.synthesis_field("source.", progress, cancel)
-        self.input_sha256 = request.key()["exemplar"]      # the pixels' sha256, however they were handed over
+        # a file is decoded once: its pixels serve the synthesis and the key's sha256 (equal to the key's of the
+        # same pixels handed over)
+        pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
+        self.field = field if field is not None else pixels.synthesis_field("source.", progress, cancel)
+        self.input_sha256 = pixels.key()["exemplar"]
 
     def check_grid(self, shape) -> None:
         if len(shape) != 2:

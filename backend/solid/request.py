@@ -144,6 +144,18 @@ class SolidRequest:
         return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report,
                             bool(self.periodic), bool(self.gaussian), self.rest)
 
+    def exemplar_pixels(self, where: str = ""):
+        """Method "synthesis"'s exemplar as pixels: pixels as given, a path decoded to float (H, W, 3) sRGB;
+        SettingError naming the exemplar for a file it cannot read."""
+        if not isinstance(self.exemplar, str):
+            return self.exemplar
+        from .._export import export
+
+        try:
+            return export.read_rgb(self.exemplar)
+        except ValueError as exc:
+            raise SettingError(f"{where}exemplar", str(exc)) from None
+
     def synthesis_field(self, where: str = "", progress=None, cancel=None):
         """Method "synthesis": the :class:`~backend.solid.synthesis.TileField` of a periodic 2D tile of ``tile`` px
         synthesised from the exemplar with ``seed`` (:func:`~backend.solid.synthesis.image_settings`, which the field
@@ -151,14 +163,7 @@ class SolidRequest:
         naming the exemplar for an image it cannot use."""
         from .synthesis import PX_PER_UNIT, TileField, image_settings, synthesise
 
-        img = self.exemplar
-        if isinstance(img, str):
-            from .._export import export
-
-            try:
-                img = export.read_rgb(img)
-            except ValueError as exc:
-                raise SettingError(f"{where}exemplar", str(exc)) from None
+        img = self.exemplar_pixels(where)
         settings = image_settings(self.tile, np.shape(img), self.seed)
         try:
             tile = synthesise(img, settings, progress, cancel)

@@ -162,14 +162,21 @@ tile = 64
 
 
 
-def test_the_bake_key_records_the_levels_the_photo_was_drawn_with():
+def test_the_bake_key_records_the_levels_the_photo_was_drawn_with(monkeypatch):
     """The levels depend on the photo (image_levels): the field keeps the settings it was synthesised with and a job
-    file's source writes them into its bake key, so a bake is redone when they change."""
+    file's source writes them into its bake key, so a bake is redone when they change.  The photo file is decoded
+    once, and its key is the request's."""
+    from backend._export import export
     from backend.solid.synthesis import image_settings
     from backend.sources import SynthesisSource
 
     req = SolidRequest(exemplar=PHOTO, method="synthesis", tile=256, seed=2).check()
+    decoded, read = [], export.read_rgb
+    monkeypatch.setattr(export, "read_rgb", lambda path: decoded.append(path) or read(path))
     src = SynthesisSource(req)
+    assert decoded == [PHOTO]
+    monkeypatch.undo()
+    assert src.input_sha256 == req.key()["exemplar"]
     assert src.field.settings == image_settings(256, read_rgb(PHOTO).shape, 2) and src.field.settings.levels == 4
     d = src.to_dict()
     assert d["settings"]["levels"] == 4 and d["settings"]["sharpness"] == [3.0, 3.0, 3.0, 10.0]
