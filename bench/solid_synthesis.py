@@ -94,7 +94,7 @@ def main(argv=None) -> int:
     files = files[:a.limit] if a.limit else files
     # 2D without --iterations and --sharpness: what the product draws from each photo (image_settings)
     product = a.dim == 2 and a.iterations is None and a.sharpness is None
-    iterations = tuple(int(x) for x in (a.iterations or "16,6,2").split(","))
+    iterations = tuple(int(x) for x in a.iterations.split(",")) if a.iterations else SynthesisSettings.iterations
     settings = SynthesisSettings(size=a.size, dim=a.dim, planes=a.planes, stride=a.stride, patch=a.patch,
                                  candidates=a.candidates, levels=len(iterations), iterations=iterations,
                                  sharpness=tuple(float(x) for x in a.sharpness.split(",")) if a.sharpness
@@ -127,7 +127,7 @@ def main(argv=None) -> int:
         print(f"{name[:44]:44s} {r['pooled']:7.1f} {r['random_phase_pooled']:7.1f} {r['walls']:7.1f} "
               f"{r['random_phase_walls']:7.1f} {r['axes']:7.1f} {r['random_phase_axes']:7.1f} "
               f"{r.get('neural_pooled', float('nan')):7.1f} {r['colour']:7.4f} {seconds:6.1f}", flush=True)
-        if a.sheet and a.dim == 2:  # photo | the first two tiles | 2 x 2 of the first at half size: no seams | random phase
+        if a.sheet and a.dim == 2:  # photo | two tiles | 2 x 2 of the first at half size: no seams | random phase
             n = min(a.size, *photo.shape[:2])
             sheet.append([photo[:n, :n]] + [f.image(n) for f in fields[:2]] + [fields[0].image(n, 0.5),
                           pe.random_phase(photo, n, np.random.default_rng(1))])

@@ -116,7 +116,7 @@ class SynthesisSettings:
                                             f"got {self.sharpness}")
 
 
-def image_levels(tile: int, photo_shape, patch: int = 8) -> int:
+def image_levels(tile: int, photo_shape, patch: int = SynthesisSettings.patch) -> int:
     """How many levels the 2D product draws a ``tile`` px tile from a photo of ``photo_shape`` (H, W, ...) with:
     as many as keep :data:`COARSEST_PATCHES` neighbourhoods (``patch`` px each) across both the tile and the
     photo's short side at the coarsest level (the tile a multiple of 2^(levels - 1)), at least :data:`MIN_LEVELS`.

@@ -161,7 +161,6 @@ tile = 64
     assert read_rgb(str(tmp_path / "tile.png")).shape == (64, 64, 3)
 
 
-
 def test_the_bake_key_records_the_levels_the_photo_was_drawn_with(monkeypatch):
     """The levels depend on the photo (image_levels): the field keeps the settings it was synthesised with and a job
     file's source writes them into its bake key, so a bake is redone when they change.  The photo file is decoded
