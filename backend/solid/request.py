@@ -101,7 +101,9 @@ class SolidRequest:
             from .synthesis import MAX_TILE, MIN_TILE, TILE_STEP
 
             ex = self.exemplar
-            if not isinstance(ex, np.ndarray) and not (isinstance(ex, str) and os.path.isfile(ex)):
+            if isinstance(ex, str) and not os.path.isfile(ex):
+                raise bad("exemplar", f"synthesis works from an image file; there is no file {ex!r}")
+            if not isinstance(ex, (np.ndarray, str)):
                 raise bad("exemplar", f"synthesis works from an image (a file or pixels), got {ex!r}")
             if self.to is not None:
                 raise bad("to", "interpolation needs the neural texture (method neural); synthesis draws one image")

@@ -45,6 +45,7 @@ def test_flags_job_tables_and_pixels_give_one_request(stripes):
 
 @pytest.mark.parametrize("flags, table, field, why", [
     (["--exemplar", "gravel"], {"exemplar": "gravel"}, "exemplar", "works from an image"),
+    (["--exemplar", "no/such.png"], {"exemplar": "no/such.png"}, "exemplar", "there is no file 'no/such.png'"),
     (["--to", "grass"], {"to": "grass"}, "to", "interpolation needs the neural texture"),
     (["--refine", "3"], {"refine": 3}, "refine", "synthesis has none"),
     (["--tile", "30"], {"tile": 30}, "tile", "multiple of 4 in [32, 1024], got 30"),
