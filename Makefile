@@ -29,6 +29,7 @@ demo: $(STAMP) kernel
 	$(BIN)/python demo/showcase_volume.py out/demo
 	$(BIN)/python demo/neural.py out/demo
 	$(BIN)/python demo/solid.py out/demo
+	$(BIN)/python demo/solid_box.py out/demo
 
 $(VENV)/.train: $(STAMP) requirements-train.txt
 	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt

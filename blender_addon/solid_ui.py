@@ -14,7 +14,9 @@ VOLUME           an OpenVDB file (``color`` + ``density`` grids) over the object
 
 From an image exemplar, Tileable Image synthesises a seamless 2D image instead (``backend.solid.synthesis``,
 texture optimisation: the photo's pieces rearranged), stored as the image datablock ``<Name> Tile`` for Image
-Texture nodes; the same request as ``omninoise solid --method synthesis``.
+Texture nodes; the same request as ``omninoise solid --method synthesis``.  Project Tile onto Object gives the
+active mesh a material that shows it without UVs: box projection from object or world positions, at the photo's
+pixel scale times Scale (a surface look, not a solid: a cut through the mesh shows the same projection).
 
 Positions are object-local by default (the texture moves with the object) or
 world.  Everything heavy (encoding, rasterising, evaluating, writing) runs on
@@ -37,7 +39,8 @@ from .bake_ui import draw_progress
 from .tasks import TaskOperator
 from .preferences import threads
 
-__all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "register", "unregister"]
+__all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "tile_repeats", "register",
+           "unregister"]
 
 #: where the shipped models live (``backend.solid.model.SHIPPED_MODELS``, computed here without importing the
 #: backend, so register() stays cheap); tests point it elsewhere
@@ -339,6 +342,77 @@ class OMNINOISE_OT_solid_tileable(TaskOperator, bpy.types.Operator):
         return tasks.start(tasks.Task("Tileable image", work, done, None, threads()), blocking=blocking)
 
 
+#: how soft the seams between the box projection's three planes are (Image Texture's Blend, 0..1)
+BOX_BLEND = 0.2
+
+
+def tile_repeats(scale: float, tile: int) -> float:
+    """How many times a tile of ``tile`` px repeats per Blender unit: ``scale`` texture units per Blender unit,
+    PX_PER_UNIT photo px per texture unit (backend/solid/synthesis.py), so the tile keeps the photo's pixel scale,
+    as bakes keep it."""
+    return float(scale) * _mod("solid.synthesis").PX_PER_UNIT / float(tile)
+
+
+def _project_tile(nt, ima, repeats: float, world: bool):
+    """The Image Texture node of ``ima`` box-projected (no UVs: each face takes the plane of the axis its normal
+    is nearest, blended by BOX_BLEND) from object or world positions scaled by ``repeats``, in node tree ``nt``;
+    the nodes are reused when it runs again."""
+    def get(kind, name):
+        n = nt.nodes.get(name)
+        if n is not None and n.bl_idname != kind:     # object positions before, world positions now (or back)
+            nt.nodes.remove(n)
+            n = None
+        if n is None:
+            n = nt.nodes.new(kind)
+            n.name = n.label = name
+        return n
+
+    img = get("ShaderNodeTexImage", "OmniNoise Tile")
+    img.image, img.projection, img.projection_blend, img.extension = ima, "BOX", BOX_BLEND, "REPEAT"
+    mapping = get("ShaderNodeMapping", "OmniNoise Tile Scale")
+    mapping.inputs["Scale"].default_value = (repeats, repeats, repeats)
+    if world:
+        src = get("ShaderNodeNewGeometry", "OmniNoise Tile Positions").outputs["Position"]
+    else:
+        src = get("ShaderNodeTexCoord", "OmniNoise Tile Positions").outputs["Object"]
+    nt.links.new(src, mapping.inputs["Vector"])
+    nt.links.new(mapping.outputs["Vector"], img.inputs["Vector"])
+    bsdf = next((n for n in nt.nodes if n.type == "BSDF_PRINCIPLED"), None)
+    x, y = (bsdf.location[0] - 320, bsdf.location[1]) if bsdf is not None else (0.0, 0.0)   # where the image goes
+    mapping.location, src.node.location = (x - 220, y), (x - 420, y)
+    return img
+
+
+class OMNINOISE_OT_solid_tile_material(bpy.types.Operator):
+    """Show the tileable image on the active mesh without UVs: box projection (each face takes the plane of its
+    nearest axis; walls show the image upright) at the exemplar's pixel scale times Scale, from object or world
+    positions as Coordinates says (the plane follows the face's normal in object space: World suits objects that
+    are not rotated)"""
+
+    bl_idname = "omninoise.solid_tile_material"
+    bl_label = "Project Tile onto Object"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return tasks.current() is None
+
+    def execute(self, context):
+        p = context.scene.omninoise_solid
+        obj = context.active_object
+        name = f"{p.name} Tile"
+        ima = bpy.data.images.get(name)
+        if obj is None or obj.type != "MESH":
+            self.report({"ERROR"}, "select a mesh to project the tile onto")
+            return {"CANCELLED"}
+        if ima is None:
+            self.report({"ERROR"}, f"no tileable image {name!r} yet: synthesise one with Tileable Image first")
+            return {"CANCELLED"}
+        repeats = tile_repeats(p.scale, ima.size[0])
+        _material_with(obj, name, lambda nt: _project_tile(nt, ima, repeats, p.coords == "WORLD"))
+        return {"FINISHED"}
+
+
 class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
     """Bake the solid texture onto the active object: UV image, colour attribute or volume"""
 
@@ -466,6 +540,9 @@ def draw_solid(layout, context) -> None:
         sub = row.row(align=True)
         sub.enabled = tasks.current() is None
         sub.operator(OMNINOISE_OT_solid_tileable.bl_idname, text="Tileable Image", icon="IMAGE_DATA")
+        if bpy.data.images.get(f"{p.name} Tile") is not None:
+            layout.operator(OMNINOISE_OT_solid_tile_material.bl_idname, text="Project Tile onto Object",
+                            icon="MOD_UVPROJECT")
     for suffix in ("Preview", "Tile"):
         prev = bpy.data.images.get(f"{p.name} {suffix}")
         if prev is not None and prev.preview is not None:
@@ -499,8 +576,8 @@ class OMNINOISE_PT_solid(bpy.types.Panel):
         draw_solid(self.layout, context)
 
 
-classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable, OMNINOISE_OT_solid_bake,
-           OMNINOISE_PT_solid)
+classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable,
+           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_PT_solid)
 
 
 def register():

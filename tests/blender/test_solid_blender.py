@@ -221,6 +221,76 @@ def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     assert "Tileable Image" in [t for n, a, t in log if n == "operator"] and "tile" in [a for n, a, t in log]
 
 
+def _stripes_image(name="Stripes", period=16, size=128):
+    """An image datablock of vertical stripes ``period`` px apart (brightness changes across columns only)."""
+    x = np.arange(size)
+    rgb = np.zeros((size, size, 3), np.float32)
+    rgb[:] = (0.2 + 0.6 * (x % period < period // 2))[None, :, None] * np.array([1.0, 0.8, 0.5], np.float32)
+    ima = bpy.data.images.new(name, size, size, alpha=False)
+    rgba = np.ones((size, size, 4), np.float32)
+    rgba[..., :3] = np.flipud(rgb)
+    ima.pixels.foreach_set(rgba.ravel())
+    return ima
+
+
+def test_the_tile_is_box_projected_onto_a_mesh_without_uvs_at_the_photos_scale(scene, tmp_path):
+    """Project Tile onto Object: a cube without UVs renders (Cycles) the tile's stripes upright on its front face at
+    the photo's pixel scale times Scale (4 repeats of a 64 px tile per Blender unit at Scale 2: 32 stripe periods
+    across a 2 unit face); the nodes are reused when it runs again; errors say what is missing."""
+    p = scene.omninoise_solid
+    with pytest.raises(RuntimeError, match="select a mesh"):
+        bpy.ops.omninoise.solid_tile_material()
+    bpy.ops.mesh.primitive_cube_add(size=2.0)
+    cube = bpy.context.active_object
+    while cube.data.uv_layers:
+        cube.data.uv_layers.remove(cube.data.uv_layers[0])
+    with pytest.raises(RuntimeError, match="synthesise one with Tileable Image first"):
+        bpy.ops.omninoise.solid_tile_material()
+    p.source, p.image, p.tile, p.seed, p.scale = "IMAGE", _stripes_image(), 64, 5, 2.0
+    assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
+    bpy.context.view_layer.objects.active = cube
+    assert bpy.ops.omninoise.solid_tile_material() == {"FINISHED"}
+    assert bpy.ops.omninoise.solid_tile_material() == {"FINISHED"}       # again: the same nodes
+    nt = cube.active_material.node_tree
+    images = [n for n in nt.nodes if n.type == "TEX_IMAGE"]
+    assert len(images) == 1 and images[0].image == bpy.data.images["Solid Texture Tile"]
+    assert images[0].projection == "BOX" and images[0].inputs["Vector"].links[0].from_node.type == "MAPPING"
+    assert tuple(nt.nodes["OmniNoise Tile Scale"].inputs["Scale"].default_value) == pytest.approx((4.0,) * 3)
+    assert solid_ui.tile_repeats(2.0, 64) == pytest.approx(4.0)
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
+    assert bsdf.inputs["Base Color"].links[0].from_node == images[0]
+
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples, scene.cycles.use_denoising = 1, False
+    scene.render.resolution_x = scene.render.resolution_y = 128
+    scene.render.resolution_percentage = 100
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", 2.0
+    cam.location, cam.rotation_euler = (0.0, -10.0, 0.0), (np.pi / 2, 0.0, 0.0)     # facing the -Y face
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.rotation_euler = (np.pi / 2, 0.0, 0.0)
+    for o in (cam, sun):
+        scene.collection.objects.link(o)
+    scene.camera = cam
+    scene.render.filepath = str(tmp_path / "front.png")
+    bpy.ops.render.render(write_still=True)
+    shot = bpy.data.images.load(scene.render.filepath)
+    px = np.empty(128 * 128 * shot.channels, np.float32)
+    shot.pixels.foreach_get(px)
+    g = px.reshape(128, 128, shot.channels)[8:-8, 8:-8, :3].mean(2)
+    assert g.mean() > 0.05                                       # lit, not black
+    cols = np.abs(np.fft.rfft(g.mean(0) - g.mean()))             # brightness across the face, 112 px
+    assert abs(int(np.argmax(cols)) - 32 * 112 / 128) <= 1.5     # 32 periods per 128 px: the photo's scale x 2
+    assert np.abs(np.diff(g, axis=0)).mean() < 0.25 * np.abs(np.diff(g, axis=1)).mean()   # upright: vertical stripes
+    p.coords = "WORLD"
+    assert bpy.ops.omninoise.solid_tile_material() == {"FINISHED"}
+    assert nt.nodes["OmniNoise Tile Scale"].inputs["Vector"].links[0].from_node.type == "NEW_GEOMETRY"
+    p.coords = "OBJECT"
+    assert bpy.ops.omninoise.solid_tile_material() == {"FINISHED"}
+    assert nt.nodes["OmniNoise Tile Scale"].inputs["Vector"].links[0].from_node.type == "TEX_COORD"
+    assert len(nt.nodes) == 5      # output, BSDF, image, mapping, positions: nothing left over from switching
+
+
 def test_errors_are_reported(scene):
     p = scene.omninoise_solid
     with pytest.raises(RuntimeError, match="select an object"):
