@@ -151,15 +151,35 @@ def build_scene(out: str) -> dict:
     cam = bpy.context.active_object
     cam.data.lens = 38
     sc.camera = cam
-    bpy.ops.object.light_add(type="SUN", rotation=(0.8, 0.2, 0.5))
-    bpy.context.active_object.data.energy = 4.0
+    sun_and_sky(sc, (0.8, 0.2, 0.5), 4.0)
+    return used
+
+
+def sun_and_sky(sc, rotation, energy: float) -> None:
+    """A sun of ``energy`` turned by ``rotation`` and a grey-blue sky for scene ``sc`` (the solid demos' light)."""
+    bpy.ops.object.light_add(type="SUN", rotation=rotation)
+    bpy.context.active_object.data.energy = energy
     world = bpy.data.worlds.new("Sky")
     if world.node_tree is None:
         world.use_nodes = True
     next(n for n in world.node_tree.nodes if n.type == "BACKGROUND").inputs["Color"].default_value = \
         (0.35, 0.38, 0.42, 1.0)
     sc.world = world
-    return used
+
+
+def save_and_render(out: str, blend: str, png: str) -> float:
+    """Save the scene as out/blend and render its camera (PNG) to out/png, each written whole (a temporary file
+    renamed): the render's seconds."""
+    sc = bpy.context.scene
+    path = os.path.join(out, blend)
+    bpy.ops.wm.save_as_mainfile(filepath=path + ".tmp.blend", compress=True)
+    os.replace(path + ".tmp.blend", path)
+    sc.render.filepath = os.path.join(out, png + ".tmp.png")
+    sc.render.image_settings.file_format = "PNG"
+    t = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    os.replace(sc.render.filepath, os.path.join(out, png))
+    return time.perf_counter() - t
 
 
 def main(out: str) -> int:
@@ -170,19 +190,11 @@ def main(out: str) -> int:
     t0 = time.perf_counter()
     names = slices_sheet(out)
     used = build_scene(out)
-    sc = bpy.context.scene
-    path = os.path.join(out, "solid.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path + ".tmp.blend", compress=True)
-    os.replace(path + ".tmp.blend", path)
-    sc.render.filepath = os.path.join(out, "solid_render.tmp.png")
-    sc.render.image_settings.file_format = "PNG"
-    t = time.perf_counter()
-    bpy.ops.render.render(write_still=True)
-    os.replace(sc.render.filepath, os.path.join(out, "solid_render.png"))
-    info = dict(slices=names, objects=used, render_seconds=round(time.perf_counter() - t, 1),
+    render = save_and_render(out, "solid.blend", "solid_render.png")
+    info = dict(slices=names, objects=used, render_seconds=round(render, 1),
                 seconds=round(time.perf_counter() - t0, 1))
     write_json(os.path.join(out, "solid.json"), info)
-    print(f"wrote {path}, solid_render.png, solid_slices.png ({info['seconds']} s)")
+    print(f"wrote {os.path.join(out, 'solid.blend')}, solid_render.png, solid_slices.png ({info['seconds']} s)")
     return 0
 
 

@@ -25,6 +25,9 @@ import blender_addon  # noqa: E402
 from backend.solid.model import SHIPPED_MODELS  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from solid import save_and_render, sun_and_sky  # noqa: E402  (demo/solid.py: the same light and files)
+
 VAL = os.path.join(ROOT, "data", "photos", "val")
 PHOTOS = [os.path.join(VAL, n) for n in ("brick__beige_bricks.jpg", "paving__sahara_paving_stones_01.jpg",
                                          "wood__bridge_wood_a.jpg", "rock__rock1.jpg")]
@@ -73,14 +76,7 @@ def build_scene(out: str) -> dict:
     cam = bpy.context.active_object
     cam.data.lens = 36
     sc.camera = cam
-    bpy.ops.object.light_add(type="SUN", rotation=(0.8, 0.3, -0.6))
-    bpy.context.active_object.data.energy = 3.5
-    world = bpy.data.worlds.new("Sky")
-    if world.node_tree is None:
-        world.use_nodes = True
-    next(n for n in world.node_tree.nodes if n.type == "BACKGROUND").inputs["Color"].default_value = \
-        (0.35, 0.38, 0.42, 1.0)
-    sc.world = world
+    sun_and_sky(sc, (0.8, 0.3, -0.6), 3.5)
     return used
 
 
@@ -91,19 +87,10 @@ def main(out: str) -> int:
         return 0
     t0 = time.perf_counter()
     used = build_scene(out)
-    sc = bpy.context.scene
-    path = os.path.join(out, "solid_box.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path + ".tmp.blend", compress=True)
-    os.replace(path + ".tmp.blend", path)
-    sc.render.filepath = os.path.join(out, "solid_box.tmp.png")
-    sc.render.image_settings.file_format = "PNG"
-    t = time.perf_counter()
-    bpy.ops.render.render(write_still=True)
-    os.replace(sc.render.filepath, os.path.join(out, "solid_box.png"))
-    info = dict(photos=used, render_seconds=round(time.perf_counter() - t, 1),
-                seconds=round(time.perf_counter() - t0, 1))
+    render = save_and_render(out, "solid_box.blend", "solid_box.png")
+    info = dict(photos=used, render_seconds=round(render, 1), seconds=round(time.perf_counter() - t0, 1))
     write_json(os.path.join(out, "solid_box.json"), info)
-    print(f"wrote {path}, solid_box.png ({info['seconds']} s)")
+    print(f"wrote {os.path.join(out, 'solid_box.blend')}, solid_box.png ({info['seconds']} s)")
     return 0
 
 
