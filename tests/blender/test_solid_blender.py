@@ -192,6 +192,18 @@ def test_the_preview_shows_the_periodic_part_it_found(scene):
     p.periodic = True
 
 
+def _stripes_image(name="Stripes", period=16, size=128):
+    """An image datablock of vertical stripes ``period`` px apart (brightness changes across columns only)."""
+    x = np.arange(size)
+    rgb = np.zeros((size, size, 3), np.float32)
+    rgb[:] = (0.2 + 0.6 * (x % period < period // 2))[None, :, None] * np.array([1.0, 0.8, 0.5], np.float32)
+    ima = bpy.data.images.new(name, size, size, alpha=False)
+    rgba = np.ones((size, size, 4), np.float32)
+    rgba[..., :3] = np.flipud(rgb)
+    ima.pixels.foreach_set(rgba.ravel())
+    return ima
+
+
 def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     """Tileable Image (backend/solid/synthesis.py) stores the tile the command line's request synthesises from the
     same pixels, 8-bit, row 0 at the bottom, and the panel draws it for an image exemplar; without one it says
@@ -201,13 +213,7 @@ def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     p = scene.omninoise_solid
     with pytest.raises(RuntimeError, match="set Source to Image"):
         bpy.ops.omninoise.solid_tileable()
-    x = np.arange(128)
-    rgb = np.zeros((128, 128, 3), np.float32)
-    rgb[:] = (0.2 + 0.6 * (x % 16 < 8))[None, :, None] * np.array([1.0, 0.8, 0.5], np.float32)
-    ima = bpy.data.images.new("Stripes", 128, 128, alpha=False)
-    rgba = np.ones((128, 128, 4), np.float32)
-    rgba[..., :3] = np.flipud(rgb)
-    ima.pixels.foreach_set(rgba.ravel())
+    ima = _stripes_image()
     p.source, p.image, p.tile, p.seed = "IMAGE", ima, 64, 5
     assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
     got = _pixels("Solid Texture Tile")
@@ -219,18 +225,6 @@ def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     log = []
     solid_ui.draw_solid(Recorder(log), bpy.context)
     assert "Tileable Image" in [t for n, a, t in log if n == "operator"] and "tile" in [a for n, a, t in log]
-
-
-def _stripes_image(name="Stripes", period=16, size=128):
-    """An image datablock of vertical stripes ``period`` px apart (brightness changes across columns only)."""
-    x = np.arange(size)
-    rgb = np.zeros((size, size, 3), np.float32)
-    rgb[:] = (0.2 + 0.6 * (x % period < period // 2))[None, :, None] * np.array([1.0, 0.8, 0.5], np.float32)
-    ima = bpy.data.images.new(name, size, size, alpha=False)
-    rgba = np.ones((size, size, 4), np.float32)
-    rgba[..., :3] = np.flipud(rgb)
-    ima.pixels.foreach_set(rgba.ravel())
-    return ima
 
 
 def test_the_tile_is_box_projected_onto_a_mesh_without_uvs_at_the_photos_scale(scene, tmp_path):
