@@ -272,6 +272,10 @@ def _store_image(name: str, rgb: np.ndarray):
     return ima
 
 
+#: how far left of the Principled BSDF the node feeding its Base Color is placed (node editor units)
+_BESIDE_BSDF = 320
+
+
 def _material_with(obj, name: str, make_node):
     """Wire ``make_node(node_tree)``'s Color output into Base Color: the active material's Principled
     BSDF when it has one, else a new material ``OmniNoise <name>`` given to the object."""
@@ -288,7 +292,7 @@ def _material_with(obj, name: str, make_node):
     bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED") if any(
         n.type == "BSDF_PRINCIPLED" for n in nt.nodes) else nt.nodes.new("ShaderNodeBsdfPrincipled")
     node = make_node(nt)
-    node.location = (bsdf.location[0] - 320, bsdf.location[1])
+    node.location = (bsdf.location[0] - _BESIDE_BSDF, bsdf.location[1])
     nt.links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
     nt.nodes.active = node
     return mat
@@ -378,7 +382,7 @@ def _project_tile(nt, ima, repeats: float, world: bool):
     nt.links.new(src, mapping.inputs["Vector"])
     nt.links.new(mapping.outputs["Vector"], img.inputs["Vector"])
     bsdf = next((n for n in nt.nodes if n.type == "BSDF_PRINCIPLED"), None)
-    x, y = (bsdf.location[0] - 320, bsdf.location[1]) if bsdf is not None else (0.0, 0.0)   # where the image goes
+    x, y = (bsdf.location[0] - _BESIDE_BSDF, bsdf.location[1]) if bsdf is not None else (0.0, 0.0)  # the image's place
     mapping.location, src.node.location = (x - 220, y), (x - 420, y)
     return img
 

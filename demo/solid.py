@@ -108,13 +108,7 @@ def _tiled_material(obj, image, repeats: float) -> None:
 def build_scene(out: str) -> dict:
     """A cube and Suzanne textured from held-out photographs (bricks, farmland) through the texture-space model,
     a sphere and a cylinder from single-photo models (grass, wood)."""
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    blender_addon.register()
-    sc = bpy.context.scene
-    sc.render.engine = "CYCLES"
-    sc.cycles.device = "CPU"
-    sc.cycles.samples = 24
-    sc.render.resolution_x, sc.render.resolution_y = 720, 300
+    sc = cycles_scene(720, 300)
     p = sc.omninoise_solid
     p.folder = os.path.join(out, "bakes")
     space = os.path.isfile(os.path.join(MODELS, "space", "solid.json"))
@@ -153,6 +147,19 @@ def build_scene(out: str) -> dict:
     sc.camera = cam
     sun_and_sky(sc, (0.8, 0.2, 0.5), 4.0)
     return used
+
+
+def cycles_scene(width: int, height: int):
+    """An empty scene with the add-on registered, rendered by Cycles on the CPU (24 samples) at width x height:
+    the solid demos' start."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    blender_addon.register()
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    sc.cycles.device = "CPU"
+    sc.cycles.samples = 24
+    sc.render.resolution_x, sc.render.resolution_y = width, height
+    return sc
 
 
 def sun_and_sky(sc, rotation, energy: float) -> None:

@@ -21,12 +21,11 @@ sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
 
-import blender_addon  # noqa: E402
 from backend.solid.model import SHIPPED_MODELS  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from solid import save_and_render, sun_and_sky  # noqa: E402  (demo/solid.py: the same light and files)
+from solid import cycles_scene, save_and_render, sun_and_sky  # noqa: E402  (demo/solid.py: the same scene)
 
 VAL = os.path.join(ROOT, "data", "photos", "val")
 PHOTOS = [os.path.join(VAL, n) for n in ("brick__beige_bricks.jpg", "paving__sahara_paving_stones_01.jpg",
@@ -40,13 +39,7 @@ def _cube(x: float, y: float):
 
 
 def build_scene(out: str) -> dict:
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    blender_addon.register()
-    sc = bpy.context.scene
-    sc.render.engine = "CYCLES"
-    sc.cycles.device = "CPU"
-    sc.cycles.samples = 24
-    sc.render.resolution_x, sc.render.resolution_y = 900, 500
+    sc = cycles_scene(900, 500)
     p = sc.omninoise_solid
     space = os.path.isfile(os.path.join(SHIPPED_MODELS, "space", "solid.json"))
     used = {}
