@@ -629,3 +629,24 @@ def test_harmonic_rest_trains_on_photos_less_their_part_as_the_runtime_encodes_t
     for bad in (dict(cfg, mode="single", exemplars=brick), dict(cfg, colour="sigmoid")):
         with pytest.raises(ValueError, match="harmonic_rest"):
             SolidConfig.from_dict(bad)
+
+
+def test_axis_imbalance_tells_oriented_photos_from_isotropic_ones_and_bounds_what_a_solid_can_show():
+    n = 128
+    y, x = np.mgrid[:n, :n] / n
+    grey = lambda a: np.repeat(a[..., None], 3, 2)          # noqa: E731
+    planks = grey(0.5 + 0.4 * np.sin(2 * np.pi * 12 * x))    # stripes across the columns only
+    assert pe.axis_imbalance(planks) == pytest.approx(1.0, abs=1e-3)
+    assert pe.axis_imbalance(planks.transpose(1, 0, 2)) == pytest.approx(1.0, abs=1e-3)   # and across the rows
+    assert pe.axis_imbalance(grey(0.5 + 0.2 * np.sin(2 * np.pi * 12 * x) + 0.2 * np.sin(2 * np.pi * 12 * y))) < 1e-3
+    noise = np.random.default_rng(0).random((n, n, 3))
+    assert pe.axis_imbalance(noise) < 0.1
+    # symmetric: a turned photo is as oriented; a flat one is 0
+    assert pe.axis_imbalance(planks[:, :100]) == pytest.approx(pe.axis_imbalance(planks[:, :100].transpose(1, 0, 2)))
+    assert pe.axis_imbalance(np.full((32, 48, 3), 0.3)) == 0.0
+    # a solid whose walls (slices normal to x and y, rows along z) both show the planks: sin(2 pi 12 (x + y));
+    # its floor (normal to z) then has the walls' column spectrum on both axes, so it is not oriented at all
+    f = lambda X, Y, Z: grey(0.5 + 0.4 * np.sin(2 * np.pi * 12 * (X + Y)))     # noqa: E731
+    wall_x, wall_y, floor = f(0.3, x, y), f(x, 0.7, y), f(x, y, 0.1)
+    assert pe.axis_imbalance(wall_x) == pytest.approx(1.0, abs=1e-3) and pe.axis_imbalance(wall_y) > 0.999
+    assert pe.axis_imbalance(floor) < 1e-3

@@ -46,7 +46,7 @@ from backend._export import export as _ex
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
            "photo_crop", "colour_by_rank", "voronoi_pavement", "grouped_swd", "level_distances", "band_swd",
-           "BASELINES", "SLICE_OFFSETS", "tile_sheet"]
+           "BASELINES", "SLICE_OFFSETS", "tile_sheet", "axis_imbalance"]
 
 #: where the held-out evaluations cut a 3D texture: a slice normal to each axis through these points (units)
 SLICE_OFFSETS = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
@@ -114,6 +114,33 @@ def mean_colour_error(img: np.ndarray, reference: np.ndarray) -> float:
     """Mean over R, G, B of |mean colour of img - mean colour of reference| (0-1 scale)."""
     return float(np.abs(np.asarray(img, np.float64).reshape(-1, 3).mean(0)
                         - np.asarray(reference, np.float64).reshape(-1, 3).mean(0)).mean())
+
+
+def axis_imbalance(photo: np.ndarray) -> float:
+    """How far a photo's vertical-frequency spectrum lies from its horizontal one, in [0, 1]: the total variation
+    distance between R(k), the power at row frequency |k| (summed over column frequencies), and C(k), the power at
+    column frequency |k| (summed over row frequencies), on the photo's central square (mean removed, Hann window,
+    R, G and B powers summed).  0 for an isotropic texture, 1 for stripes across one axis only.
+
+    Why it matters for 3D (the slices of a stationary solid with power spectrum S(kx, ky, kz)): a slice normal to x
+    has the spectrum of S integrated over kx, so the power of every slice family at one frequency along an axis is
+    S's marginal on that axis.  If the slices normal to x and to y have the photo's spectrum (rows along z), the
+    marginals on y and on x are both C, so the slices normal to z have C along their rows too, where the photo
+    has R: no solid, Gaussian or not, gives all three slice families the photo's spectrum unless R = C, and the
+    floors' row spectrum is off by exactly this distance when the walls are right.  Random phase noise drawn as a
+    2D image per slice, the evaluation's baseline, has the photo's spectrum on every slice, so on an oriented photo
+    it is a bound no solid can reach."""
+    u = np.asarray(photo, np.float64)
+    n = min(u.shape[:2])
+    y0, x0 = (u.shape[0] - n) // 2, (u.shape[1] - n) // 2
+    u = u[y0:y0 + n, x0:x0 + n].reshape(n, n, -1)
+    w = np.hanning(n)
+    P = sum(np.abs(np.fft.fft2((u[..., c] - u[..., c].mean()) * np.outer(w, w))) ** 2 for c in range(u.shape[2]))
+    k = np.minimum(np.arange(n), n - np.arange(n))          # |frequency| index of each FFT row / column
+    R = np.bincount(k, P.sum(1), n // 2 + 1)
+    C = np.bincount(k, P.sum(0), n // 2 + 1)
+    total = R.sum()
+    return 0.0 if total <= 1e-12 else float(0.5 * np.abs(R - C).sum() / total)    # a flat photo: 0
 
 
 def pixel_shuffle(photo: np.ndarray, size: int, rng: np.random.Generator) -> np.ndarray:
