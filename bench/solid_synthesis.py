@@ -6,7 +6,12 @@ given words, for example ``brick,wood,rock``) a periodic tile is synthesised fro
 normal to x, y and z through ``photo_eval.SLICE_OFFSETS`` (SIZE² px at the photo's resolution, one slice per seed
 and axis; a seed moves the slices through the tile as it moves the runtime's texture).  Patch distances (x 1000,
 lower is better) pooled, on the walls (x and y slices) and per axis, against random phase noise drawn as often and
-grouped alike (``photo_eval.grouped_swd``); mean colour error; seconds and tile size.  With ``--against JSON`` (an
+grouped alike (``photo_eval.grouped_swd``); the same without the low-pass residue (``_band``: the band-pass levels,
+where a photo's own crops are the floor) and the photo's own crops drawn as often (``photo_crop``: how close real
+pieces of it come, and on how many photos even they beat random phase noise); in 3D also random phase noise as a
+solid (:func:`random_phase_solid`, isotropic and upright, and per photo the closer of the two: random phase noise
+drawn as a 2D image per slice has the photo's spectrum on every slice, which no solid can have on an oriented photo,
+``photo_eval.axis_imbalance``, also reported); mean colour error; seconds and tile size.  With ``--against JSON`` (an
 ``eval_solid_photos.py`` result) the neural texture's figures for the same photos are printed beside them.  With ``--dim 2`` the tile is a 2D texture, what ``method = "synthesis"`` ships:
 ``--seeds`` tiles (synthesis seeds), each drawn as the product draws it (its SIZE² image at scale 1, top row first),
 against as many draws of random phase noise and of the pixel shuffle (2D output, where the issue asks for it beside
@@ -35,7 +40,8 @@ import numpy as np  # noqa: E402
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from backend.solid.model import slice_points  # noqa: E402
-from backend.solid.spectral import seed_shift3  # noqa: E402
+from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
+from backend.solid.upright import upright_waves  # noqa: E402
 from backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
                                      synthesise)
 from training.solid import photo_eval as pe  # noqa: E402
@@ -53,6 +59,22 @@ def slices(field: TileField, seeds: int, size: int = SIZE) -> dict:
     return out
 
 
+def random_phase_solid(photo: np.ndarray, kind: str, seeds: int, size: int = SIZE) -> dict:
+    """Random phase noise as a solid, sliced as :func:`slices` slices a tile: {axis: [one (size, size, 3) slice per
+    seed]}.  The photo's mean colour plus the runtime's Gaussian solid of the whole photo (``kind`` "isotropic":
+    ``spectral.rest_waves``, every cut has the photo's radial spectrum and colour correlations; "upright":
+    ``upright.upright_waves``, the walls have its horizontal and vertical frequencies).  Unlike random phase noise
+    drawn as a 2D image per slice, a solid can be cut this way, so it is the Gaussian baseline a solid can reach
+    (``photo_eval.axis_imbalance``)."""
+    waves = (rest_waves if kind == "isotropic" else upright_waves)(photo, PX_PER_UNIT)
+    m = np.asarray(photo, np.float64).reshape(-1, 3).mean(0)
+    if waves is None:       # a flat photo
+        return {ax: [np.broadcast_to(m, (size, size, 3)).astype(np.float32)] * seeds for ax in "xyz"}
+    r = RestField(waves[0], waves[1], 1.0)
+    return {ax: [np.clip(m + rest_field(slice_points(size, PX_PER_UNIT, ax, pe.SLICE_OFFSETS[ax]), r, s),
+                         0.0, 1.0).reshape(size, size, 3).astype(np.float32) for s in range(seeds)] for ax in "xyz"}
+
+
 def measure(photo: np.ndarray, imgs: dict, rng: np.random.Generator) -> dict:
     """The grouped patch distances of the slices ({axis: images}) and of random phase noise drawn alike
     (SIZE² crops), and the colour error.  A 2D texture comes as {"x": images}: grouped_swd counts x as the walls,
@@ -66,6 +88,16 @@ def measure(photo: np.ndarray, imgs: dict, rng: np.random.Generator) -> dict:
     r.update({"random_phase_" + k: b[k] for k in keys})
     r["colour"] = round(float(np.mean([pe.mean_colour_error(im, photo) for im in pooled])), 4)
     r["pixel_shuffle"] = round(pe.patch_swd([pe.pixel_shuffle(photo, SIZE, rng) for _ in pooled], photo), 1)
+    # the band-pass part (no low-pass residue), and the photo's own crops drawn as often (after the
+    # earlier draws, so those stay as they were): the floor of both
+    crops = pe.grouped_swd({"x": [pe.photo_crop(photo, SIZE, rng) for _ in pooled]}, photo)
+    r.update({"pooled_band": d["pooled_band"], "random_phase_pooled_band": b["pooled_band"],
+              "photo_crop": crops["pooled"], "photo_crop_band": crops["pooled_band"]})
+    if "z" in imgs:     # 3D: the Gaussian solids a solid can be compared with, and how oriented the photo is
+        for kind in ("isotropic", "upright"):
+            g = pe.grouped_swd(random_phase_solid(photo, kind, seeds), photo)
+            r.update({f"random_phase_solid_{kind}_{k}": g[k] for k in ("pooled", "walls", "axes")})
+        r["axis_imbalance"] = round(pe.axis_imbalance(photo), 3)
     return r
 
 
@@ -102,7 +134,7 @@ def main(argv=None) -> int:
     neural = json.load(open(a.against))["photos"] if a.against else {}
     rows, sheet = {}, []
     print(f"{'photo':44s} {'pooled':>7s} {'rp':>7s} {'walls':>7s} {'rp':>7s} {'axes':>7s} {'rp':>7s} "
-          f"{'neural':>7s} {'colour':>7s} {'s':>6s}")
+          f"{'neural':>7s} {'colour':>7s} {'s':>6s} {'solid':>7s}")
     for path in files:
         name = os.path.basename(path)
         photo = read_rgb(path)
@@ -117,6 +149,10 @@ def main(argv=None) -> int:
         seconds = time.time() - t
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
+        if a.dim == 3:  # the better of the two Gaussian solids, photo by photo
+            for k in ("pooled", "walls", "axes"):
+                r[f"random_phase_solid_{k}"] = min(r[f"random_phase_solid_{kind}_{k}"]
+                                                   for kind in ("isotropic", "upright"))
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)
             r["levels"] = drawn[0].levels
             r["colour_tile"] = round(float(np.mean([pe.mean_colour_error(f.image(a.size), photo) for f in fields])), 4)
@@ -126,7 +162,8 @@ def main(argv=None) -> int:
         rows[name] = r
         print(f"{name[:44]:44s} {r['pooled']:7.1f} {r['random_phase_pooled']:7.1f} {r['walls']:7.1f} "
               f"{r['random_phase_walls']:7.1f} {r['axes']:7.1f} {r['random_phase_axes']:7.1f} "
-              f"{r.get('neural_pooled', float('nan')):7.1f} {r['colour']:7.4f} {seconds:6.1f}", flush=True)
+              f"{r.get('neural_pooled', float('nan')):7.1f} {r['colour']:7.4f} {seconds:6.1f} "
+              f"{r.get('random_phase_solid_pooled', float('nan')):7.1f}", flush=True)
         if a.sheet and a.dim == 2:  # photo | two tiles | 2 x 2 of the first at half size: no seams | random phase
             n = min(a.size, *photo.shape[:2])
             sheet.append([photo[:n, :n]] + [f.image(n) for f in fields[:2]] + [fields[0].image(n, 0.5),
@@ -148,14 +185,33 @@ def main(argv=None) -> int:
     for k in ("pooled", "walls", "axes"):
         summary.update({f"median_{k}": med(k), f"median_random_phase_{k}": med("random_phase_" + k),
                         f"beats_random_phase_{k}": beats(k)})
+    summary.update({"median_pooled_band": med("pooled_band"),
+                    "median_random_phase_pooled_band": med("random_phase_pooled_band"),
+                    "beats_random_phase_pooled_band": beats("pooled_band"),
+                    "median_photo_crop": med("photo_crop"), "median_photo_crop_band": med("photo_crop_band"),
+                    # how often the photo's own crops are closer than random phase noise: what the distance allows
+                    "photo_crop_beats_random_phase_pooled": int(sum(r["photo_crop"] < r["random_phase_pooled"]
+                                                                    for r in rows.values())),
+                    "photo_crop_beats_random_phase_pooled_band": int(sum(
+                        r["photo_crop_band"] < r["random_phase_pooled_band"] for r in rows.values()))})
+    if a.dim == 3:      # against the better of the two Gaussian solids, photo by photo
+        for k in ("pooled", "walls", "axes"):
+            summary[f"median_random_phase_solid_{k}"] = med(f"random_phase_solid_{k}")
+            summary[f"beats_random_phase_solid_{k}"] = int(sum(r[k] < r[f"random_phase_solid_{k}"]
+                                                               for r in rows.values()))
+            if neural:
+                summary[f"neural_beats_random_phase_solid_{k}"] = int(sum(
+                    r[f"neural_{k}"] < r[f"random_phase_solid_{k}"] for r in rows.values() if "neural_pooled" in r))
     summary["beats_pixel_shuffle_pooled"] = int(sum(r["pooled"] < r["pixel_shuffle"] for r in rows.values()))
     summary["beats_random_phase_axis_slices"] = int(sum(r[ax] < r["random_phase_axes"]
                                                         for r in rows.values() for ax in "xyz" if ax in r))
     cats = {}
     for name, r in rows.items():
         c = cats.setdefault(name.split("__")[0], {"photos": 0, "beats_random_phase_pooled": 0,
-                                                  "beats_random_phase_walls": 0})
+                                                  "beats_random_phase_walls": 0,
+                                                  "beats_random_phase_pooled_band": 0})
         c["photos"] += 1
+        c["beats_random_phase_pooled_band"] += int(r["pooled_band"] < r["random_phase_pooled_band"])
         c["beats_random_phase_pooled"] += int(r["pooled"] < r["random_phase_pooled"])
         c["beats_random_phase_walls"] += int(r["walls"] < r["random_phase_walls"])
     summary["by_category"] = cats

@@ -225,6 +225,18 @@ def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_pa
     # 3D: photo | x, y, z slices | random phase (128 px); 2D: photo | tile | 2 x 2 of it | random phase (the tile's)
     assert Image.open(out + ".png").size == ((5 * 128, 128) if dim == 3 else (4 * 64, 64))
     assert 0 < r["pooled"] < r["pixel_shuffle"]
+    # the band-pass figures (no residue level) are there; the photo's own crops (the floor) are far closer than its
+    # shuffled pixels
+    assert 0 < r["pooled_band"] and 0 < r["random_phase_pooled_band"]
+    assert 0 < r["photo_crop_band"] and r["photo_crop"] < 0.5 * r["pixel_shuffle"]
+    s = doc["summary"]
+    assert s["beats_random_phase_pooled_band"] == int(r["pooled_band"] < r["random_phase_pooled_band"])
+    assert s["photo_crop_beats_random_phase_pooled"] == int(r["photo_crop"] < r["random_phase_pooled"])
+    if dim == 3:    # the Gaussian solids, and the closer of the two
+        iso, up = r["random_phase_solid_isotropic_pooled"], r["random_phase_solid_upright_pooled"]
+        assert 0 < min(iso, up) == r["random_phase_solid_pooled"] < r["pixel_shuffle"]
+        assert s["beats_random_phase_solid_pooled"] == int(r["pooled"] < min(iso, up))
+        assert 0.1 < r["axis_imbalance"] < 0.5        # beige brick's courses: oriented, not stripes
     assert "brick__beige_bricks" in capsys.readouterr().out
 
 
