@@ -19,7 +19,8 @@ slices of 3D output).
 
     python bench/solid_synthesis.py [--only brick,wood,rock] [--size 128] [--planes all] [--out out/bench/solid_synthesis]
 
-Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices | random phase; 2D: photo | the first
+Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices | the same of the closer random phase
+solid | random phase noise drawn in 2D; 2D: photo | the first
 tile | the second (another seed) | the first repeated 2 x 2 at half size, to show it has no seams | random phase, at
 the tile's size).
 """
@@ -168,8 +169,10 @@ def main(argv=None) -> int:
             n = min(a.size, *photo.shape[:2])
             sheet.append([photo[:n, :n]] + [f.image(n) for f in fields[:2]] + [fields[0].image(n, 0.5),
                           pe.random_phase(photo, n, np.random.default_rng(1))])
-        elif a.sheet:
-            sheet.append([photo[:SIZE, :SIZE]] + [im[:SIZE, :SIZE] for v in imgs.values() for im in v][:3]
+        elif a.sheet:   # photo | the tile's x, y, z slices | the closer Gaussian solid's | 2D random phase noise
+            kind = min(("isotropic", "upright"), key=lambda k: r[f"random_phase_solid_{k}_pooled"])
+            solid = random_phase_solid(photo, kind, 1)
+            sheet.append([photo[:SIZE, :SIZE]] + [imgs[ax][0] for ax in "xyz"] + [solid[ax][0] for ax in "xyz"]
                          + [pe.random_phase(photo, SIZE, np.random.default_rng(1))])
 
     def med(k):

@@ -222,8 +222,9 @@ def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_pa
         assert np.isfinite(r[k]) and r[k] > 0
     assert doc["summary"]["photos"] == 1 and doc["summary"]["by_category"]["brick"]["photos"] == 1
     from PIL import Image
-    # 3D: photo | x, y, z slices | random phase (128 px); 2D: photo | tile | 2 x 2 of it | random phase (the tile's)
-    assert Image.open(out + ".png").size == ((5 * 128, 128) if dim == 3 else (4 * 64, 64))
+    # 3D: photo | x, y, z slices | the random phase solid's | random phase (128 px); 2D: photo | tile | 2 x 2 of it |
+    # random phase (the tile's)
+    assert Image.open(out + ".png").size == ((8 * 128, 128) if dim == 3 else (4 * 64, 64))
     assert 0 < r["pooled"] < r["pixel_shuffle"]
     # the band-pass figures (no residue level) are there; the photo's own crops (the floor) are far closer than its
     # shuffled pixels
