@@ -40,7 +40,7 @@ import numpy as np  # noqa: E402
 
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
-from backend.solid.model import slice_points  # noqa: E402
+from backend.solid.model import resize_rgb, slice_points  # noqa: E402
 from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
 from backend.solid.upright import upright_waves  # noqa: E402
 from backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
@@ -117,10 +117,14 @@ def main(argv=None) -> int:
     ap.add_argument("--patch", type=int, default=SynthesisSettings.patch)
     ap.add_argument("--candidates", type=int, default=SynthesisSettings.candidates)
     ap.add_argument("--seeds", type=int, default=2)
+    ap.add_argument("--photo-side", type=int, default=0, help="scale each photo to this many px (at least 128) on its "
+                                                                "short side first (small photos: swatches, game textures)")
     ap.add_argument("--against", default=None, help="an eval_solid_photos.py JSON: the neural texture's figures")
     ap.add_argument("--sheet", action="store_true")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solid_synthesis"))
     a = ap.parse_args(argv)
+    if a.photo_side and a.photo_side < SIZE:
+        ap.error(f"--photo-side must be at least {SIZE} (the measured images are {SIZE}² px)")
     words = [w for w in a.only.split(",") if w]
     files = [f for f in photo_set("val", os.path.join(ROOT, "data", "photos"))
              if not words or any(w in os.path.basename(f) for w in words)]
@@ -139,6 +143,9 @@ def main(argv=None) -> int:
     for path in files:
         name = os.path.basename(path)
         photo = read_rgb(path)
+        if a.photo_side:
+            k = a.photo_side / min(photo.shape[:2])
+            photo = resize_rgb(photo, max(1, round(photo.shape[0] * k)), max(1, round(photo.shape[1] * k)))
         t = time.time()
         if a.dim == 3:
             imgs = slices(TileField(synthesise(photo, settings), PX_PER_UNIT), a.seeds)
@@ -226,6 +233,7 @@ def main(argv=None) -> int:
     write_json(a.out + ".json", {"settings": "the product's (image_settings; levels per photo)" if product else
                                  {k: getattr(settings, k) for k in settings.__dataclass_fields__},
                                  "px_per_unit": PX_PER_UNIT, "seeds": a.seeds, "against": a.against,
+                                 "photo_side": a.photo_side or None,
                                  "summary": summary, "photos": rows})
     if sheet:
         pe.tile_sheet(sheet, a.out + ".png")

@@ -249,7 +249,7 @@ def _level(tile: np.ndarray, photo: np.ndarray, s: SynthesisSettings, iterations
                 E, d2, pos = search.nearest(Q)
                 if scale is None:
                     scale = float(np.median(d2)) + 1e-6
-                w = (d2 / scale + 1e-3) ** p
+                w = (d2.astype(np.float64) / scale + 1e-3) ** p
                 E = E.reshape(b, G0, G1, n, n, 3) * w.reshape(b, G0, G1, 1, 1, 1)
                 w = w.reshape(b, G0, G1)
                 # (row, col, family) of each match's top-left pixel; a vote at offset (dr, dc) adds (dr, dc, 0)
@@ -266,7 +266,13 @@ def _level(tile: np.ndarray, photo: np.ndarray, s: SynthesisSettings, iterations
                         tsrc[:, rr, cc] = np.where(heavier[..., None], src, tsrc[:, rr, cc])
             if tick():
                 raise Cancelled("cancelled")
-        tile = _match_histogram((acc / np.maximum(wsum, 1e-12)[..., None]).astype(_F), ref, m, U, rng)
+        # the weights are relative and may all be tiny: at k = 10 a weight is (d2 / scale)^-6, and where exact
+        # copies are among the photo's neighbourhoods (a photo of 128 px or less) the scale, their median, is ~0,
+        # so a voxel whose votes are all inexact sums to 1e-30 or less.  Dividing by a floor of 1e-12 turned such
+        # voxels black, and histogram matching painted them as flat blotches (a 128 px photo: patch distance 333,
+        # the same photo at 256 px 97); a voxel without any vote keeps its colour
+        mean = acc / np.where(wsum > 0, wsum, 1.0)[..., None]
+        tile = _match_histogram(np.where((wsum > 0)[..., None], mean, tile).astype(_F), ref, m, U, rng)
     return tile, sources
 
 

@@ -143,6 +143,27 @@ def test_isotropic_solid_keeps_the_photos_scale_on_every_slice_family():
         assert _ring_share(img, 3.5, 6.5) > 0.7
 
 
+def test_every_voxel_stays_a_mean_of_photo_colours_on_a_small_photo(monkeypatch):
+    """Each iteration sets a voxel to a weighted mean of photo colours, so before histogram matching it lies inside
+    the photo's colour range.  On a small photo (every neighbourhood searched, exact copies among them) the
+    weights at k = 10 fall to 1e-30 and less; dividing by a floor of 1e-12 once turned such voxels black, and the
+    histogram matching painted them as flat blotches of the darkest colours."""
+    import backend.solid.synthesis as syn
+    from backend.solid.synthesis import image_settings
+    rng = np.random.default_rng(5)
+    v = rng.random((100, 100, 3))
+    for _ in range(2):                       # a little spatial correlation, as a photo of gravel has
+        v = (v + np.roll(v, 1, 0) + np.roll(v, 1, 1)) / 3.0
+    photo = (0.35 + 0.5 * (v - v.min()) / (v.max() - v.min())).astype(np.float32)
+    means = []
+    real = syn._match_histogram
+    monkeypatch.setattr(syn, "_match_histogram", lambda tile, *a: means.append(tile.copy()) or real(tile, *a))
+    synthesise(photo, image_settings(128, photo.shape))
+    lo, hi = photo.reshape(-1, 3).min(0) - 1e-4, photo.reshape(-1, 3).max(0) + 1e-4
+    for t in means:
+        assert (t.reshape(-1, 3) >= lo).all() and (t.reshape(-1, 3) <= hi).all()
+
+
 def test_the_search_cuts_out_only_the_neighbourhoods_it_keeps():
     """A large photo's neighbourhoods are subsampled before any is cut out (a 4096² photo's every 8 x 8 one would
     take about 13 GB); each kept row is the photo's neighbourhood at its position, row-major, colours last."""
@@ -254,3 +275,16 @@ def test_bench_draws_the_products_tiles_by_default_in_2d(bench_script, tmp_path)
     assert doc["summary"]["max_colour_tile"] == r["colour_tile"]
     from PIL import Image
     assert Image.open(out + ".png").size == (5 * 64, 64)     # photo | two tiles | 2 x 2 of the first | random phase
+
+
+def test_bench_scales_photos_down_first_with_photo_side(bench_script, tmp_path):
+    """--photo-side measures small photos (swatches): the photo is scaled to that short side before synthesis."""
+    out = str(tmp_path / "small")
+    mod = bench_script("solid_synthesis")
+    assert mod.main(["--dim", "2", "--only", "beige_bricks", "--size", "256", "--seeds", "1", "--photo-side", "128",
+                     "--out", out]) == 0
+    doc = json.load(open(out + ".json"))
+    (name, r), = doc["photos"].items()
+    # a 256 px tile gets four levels from the 256 px photo, three from it scaled to 128 px (image_levels)
+    assert doc["photo_side"] == 128 and r["levels"] == 3
+    assert 0 < r["pooled"] < r["pixel_shuffle"]
