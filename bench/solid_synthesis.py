@@ -49,6 +49,8 @@ from training.solid import photo_eval as pe  # noqa: E402
 from training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
+#: the Gaussian solids random phase noise is drawn as in 3D (:func:`random_phase_solid`)
+SOLIDS = ("isotropic", "upright")
 
 
 def slices(field: TileField, seeds: int, size: int = SIZE) -> dict:
@@ -94,10 +96,13 @@ def measure(photo: np.ndarray, imgs: dict, rng: np.random.Generator) -> dict:
     crops = pe.grouped_swd({"x": [pe.photo_crop(photo, SIZE, rng) for _ in pooled]}, photo)
     r.update({"pooled_band": d["pooled_band"], "random_phase_pooled_band": b["pooled_band"],
               "photo_crop": crops["pooled"], "photo_crop_band": crops["pooled_band"]})
-    if "z" in imgs:     # 3D: the Gaussian solids a solid can be compared with, and how oriented the photo is
-        for kind in ("isotropic", "upright"):
+    if "z" in imgs:     # 3D: the Gaussian solids a solid can be compared with, each and the closer of the two per
+        # figure, and how oriented the photo is
+        for kind in SOLIDS:
             g = pe.grouped_swd(random_phase_solid(photo, kind, seeds), photo)
             r.update({f"random_phase_solid_{kind}_{k}": g[k] for k in ("pooled", "walls", "axes")})
+        for k in ("pooled", "walls", "axes"):
+            r[f"random_phase_solid_{k}"] = min(r[f"random_phase_solid_{kind}_{k}"] for kind in SOLIDS)
         r["axis_imbalance"] = round(pe.axis_imbalance(photo), 3)
     return r
 
@@ -157,10 +162,6 @@ def main(argv=None) -> int:
         seconds = time.time() - t
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
-        if a.dim == 3:  # the better of the two Gaussian solids, photo by photo
-            for k in ("pooled", "walls", "axes"):
-                r[f"random_phase_solid_{k}"] = min(r[f"random_phase_solid_{kind}_{k}"]
-                                                   for kind in ("isotropic", "upright"))
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)
             r["levels"] = drawn[0].levels
             r["colour_tile"] = round(float(np.mean([pe.mean_colour_error(f.image(a.size), photo) for f in fields])), 4)
@@ -177,7 +178,7 @@ def main(argv=None) -> int:
             sheet.append([photo[:n, :n]] + [f.image(n) for f in fields[:2]] + [fields[0].image(n, 0.5),
                           pe.random_phase(photo, n, np.random.default_rng(1))])
         elif a.sheet:   # photo | the tile's x, y, z slices | the closer Gaussian solid's | 2D random phase noise
-            kind = min(("isotropic", "upright"), key=lambda k: r[f"random_phase_solid_{k}_pooled"])
+            kind = min(SOLIDS, key=lambda k: r[f"random_phase_solid_{k}_pooled"])
             solid = random_phase_solid(photo, kind, 1)
             sheet.append([photo[:SIZE, :SIZE]] + [imgs[ax][0] for ax in "xyz"] + [solid[ax][0] for ax in "xyz"]
                          + [pe.random_phase(photo, SIZE, np.random.default_rng(1))])
