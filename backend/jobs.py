@@ -102,6 +102,18 @@ texture optimisation (``backend/solid/synthesis.py``; 2D grids only, as ``omnino
     seed = 0
     scale = 1.0
 
+With ``method = "spectral"`` it bakes random phase noise of an image exemplar lifted to a solid
+(``backend/solid/spectral_solid.py``: a periodic Gaussian solid with the image's spectrum and colours on every cut;
+2D and 3D grids, as ``omninoise solid --method spectral``)::
+
+    [bake.source]
+    kind = "solid"
+    method = "spectral"
+    exemplar = "photo.png"
+    seed = 0
+    scale = 1.0
+    density = 1.0
+
 Every problem is reported as ``bake 'NAME': what is wrong``.
 """
 from __future__ import annotations

@@ -411,7 +411,7 @@ class SynthesisSource:
     def check_grid(self, shape) -> None:
         if len(shape) != 2:
             raise SettingError("source.method", "synthesis makes 2D images; a 3D grid needs the neural texture "
-                                                "(method = \"neural\")")
+                                                "(method = \"neural\") or method = \"spectral\"")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
@@ -435,6 +435,57 @@ class SynthesisSource:
         return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
                     input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale,
                     settings=settings)
+
+
+class SpectralSource:
+    """A solid source with ``method = "spectral"``: a periodic Gaussian solid whose slices carry an image
+    exemplar's spectrum (:mod:`backend.solid.spectral_solid`: random phase noise lifted to 3D), drawn when the
+    source is made, then read at the grid's points, ``scale`` times the texture's own size (the photo's pixels at
+    PX_PER_UNIT per unit, as the neural texture).  2D grids read a plane of constant z; 3D grids fill volumes
+    (with a constant ``density``, as :class:`SolidSource`)."""
+
+    kind = "solid"
+    animated = False
+    chunkable = True
+    rgb = True
+    dim = 3
+
+    def __init__(self, request, scale: float = 1.0, density: float = 1.0, field=None, progress=None, cancel=None):
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "spectral"; field: its ready
+        :class:`~backend.solid.spectral_solid.SplineField` (else drawn here, with progress and cancel)."""
+        import dataclasses
+
+        self.request, self.scale = request, limits.positive("source.scale", scale)
+        self.density = float(limits.in_range("source.density", density, 0.0, float("inf")))
+        pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
+        self.field = field if field is not None else pixels.spectral_field("source.", progress, cancel)
+        self.input_sha256 = pixels.key()["exemplar"]
+
+    def check_grid(self, shape) -> None:
+        return None
+
+    def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
+        from .colour import srgb_to_linear
+        from .grid import Cancelled
+
+        pts = _grid_points(shape, first, step, start)
+        if len(shape) == 2:
+            pts = np.concatenate([pts, np.full((len(pts), 1), first[2] if len(first) > 2 else 0.0)], axis=1)
+        pts = pts * self.scale
+        out = np.empty((pts.shape[0], 3), np.float32)
+        block = 1 << 18
+        for a in range(0, pts.shape[0], block):      # a 3D grid is read in blocks: progress and cancel between
+            if cancel is not None and cancel():
+                raise Cancelled("cancelled")
+            out[a:a + block] = self.field.evaluate(pts[a:a + block])
+            if progress is not None:
+                progress(min(1.0, (a + block) / pts.shape[0]))
+        return srgb_to_linear(out).reshape(tuple(shape) + (3,))
+
+    def to_dict(self) -> dict:
+        r = self.request
+        return dict(kind=self.kind, method="spectral", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+                    input_sha256=self.input_sha256, seed=int(r.seed), scale=self.scale, density=self.density)
 
 
 _SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
@@ -569,6 +620,8 @@ def _solid_from_dict(d: dict, base_dir: str):
     req = solid_request_from_dict(d, base_dir)
     if req.method == "synthesis":
         return SynthesisSource(req, d.get("scale", 1.0))
+    if req.method == "spectral":
+        return SpectralSource(req, d.get("scale", 1.0), d.get("density", 1.0))
     return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
                        to=req.to, mix=req.mix, periodic=req.periodic, gaussian=req.gaussian, rest=req.rest)
 

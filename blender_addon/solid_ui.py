@@ -12,6 +12,11 @@ COLOR_ATTRIBUTE  a float colour attribute on the mesh's vertices
 VOLUME           an OpenVDB file (``color`` + ``density`` grids) over the object's
                  bounds, loaded as a Volume object
 
+From an image exemplar, Method chooses the texture: the texture-space model's (Neural Texture) or random phase
+noise of the image lifted to a solid (Spectral Solid, ``backend.solid.spectral_solid``: its spectrum and colours on
+every cut, no stones or courses; the same request as ``omninoise solid --method spectral``), previewed and baked to
+the same targets.
+
 From an image exemplar, Tileable Image synthesises a seamless 2D image instead (``backend.solid.synthesis``,
 texture optimisation: the photo's pieces rearranged), stored as the image datablock ``<Name> Tile`` for Image
 Texture nodes; the same request as ``omninoise solid --method synthesis``.  Project Tile onto Object gives the
@@ -100,6 +105,12 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
         ("SHIPPED", "Shipped", "A texture that ships with OmniNoise"),
         ("IMAGE", "Image", "Any image: the texture-space model encodes it into a texture code")], default="SHIPPED")
     texture: EnumProperty(name="Texture", items=_texture_items)
+    method: EnumProperty(name="Method", items=[
+        ("NEURAL", "Neural Texture", "The texture-space model encodes the image into a texture code (with its "
+                                     "periodic part and Gaussian rest)"),
+        ("SPECTRAL", "Spectral Solid", "Random phase noise of the image lifted to a solid: its spectrum and colours "
+                                       "on every cut, no stones or courses (closer to rock, sand and soil photos on "
+                                       "cuts; repeats every 128 image px; about 6 s to draw)")], default="NEURAL")
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
                            description="A photo of the material (at least 128 px; a large one is read in at most 8 x 8 crops)")
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
@@ -168,6 +179,8 @@ def panel_request(p):
     if p.source == "IMAGE":
         if p.image is None:
             raise backend.SettingError("image", "pick an exemplar image (or switch Source to Shipped)")
+        if p.method == "SPECTRAL":
+            return SolidRequest(exemplar=_image_pixels(p.image), seed=int(p.seed), method="spectral").check()
         name = _space_model_name()
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
@@ -195,12 +208,16 @@ def tile_request(p):
 def texture(p):
     """(model, code_fn) for the panel's settings; code_fn() runs on the worker (it may encode an image)."""
     req = panel_request(p)
+    if req.method == "spectral":     # no model: the "code" is the drawn solid (backend.solid.spectral_solid)
+        return _mod("solid.spectral_solid").SpectralTexture(req), lambda: req.spectral_field()
     m = load_model(os.path.basename(req.model))
     return m, lambda: req.code(m)[0]
 
 
 def periodic_info(code) -> str:
     """A line for the panel: the harmonic part a code carries (backend/solid/harmonic.py), or that there is none."""
+    if not hasattr(code, "harmonics"):     # a spectral solid: no model, no parts
+        return ""
     h = code.harmonics
     if h is None:
         return "Periodic part: none found"
@@ -209,6 +226,8 @@ def periodic_info(code) -> str:
 
 def gaussian_info(code) -> str:
     """A line for the panel: the share of the rest a code's Gaussian rest carries (backend/solid/spectral.py)."""
+    if not hasattr(code, "rest"):
+        return ""
     r = code.rest
     if r is None:
         return "Gaussian rest: not closer, the model's texture alone"
@@ -511,7 +530,12 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
 
             def work(progress, cancel):
                 code = code_fn()
-                bake.bake_volume(m, code, grid, path, seed, scale, progress=progress, cancel=cancel)
+                if isinstance(m, _mod("solid.spectral_solid").SpectralTexture):    # the job files' source
+                    src = _mod("sources").SpectralSource(m.request, scale, field=code)
+                    bake_mod = _mod("bake")
+                    bake_mod.run_bake(bake_mod.BakeSpec("solid", src, grid, path), progress, cancel, force=True)
+                else:
+                    bake.bake_volume(m, code, grid, path, seed, scale, progress=progress, cancel=cancel)
                 return path
 
             def done(path):
@@ -530,15 +554,17 @@ def draw_solid(layout, context) -> None:
         layout.prop(p, "texture")
     else:
         layout.template_ID(p, "image", open="image.open")
-        layout.prop(p, "refine")
-        layout.prop(p, "periodic")
-        if p.periodic and p.periodic_info:
-            layout.label(text=p.periodic_info)
-        layout.prop(p, "gaussian")
-        if p.gaussian:
-            layout.prop(p, "rest")
-        if p.gaussian and p.gaussian_info:
-            layout.label(text=p.gaussian_info)
+        layout.prop(p, "method")
+        if p.method == "NEURAL":
+            layout.prop(p, "refine")
+            layout.prop(p, "periodic")
+            if p.periodic and p.periodic_info:
+                layout.label(text=p.periodic_info)
+            layout.prop(p, "gaussian")
+            if p.gaussian:
+                layout.prop(p, "rest")
+            if p.gaussian and p.gaussian_info:
+                layout.label(text=p.gaussian_info)
         row = layout.row(align=True)
         row.prop(p, "tile")
         sub = row.row(align=True)

@@ -184,10 +184,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="space model: the Gaussian rest's kind: auto (default: the check chooses; the upright one is "
                         "offered for layered images), isotropic, or upright (the image's layers, grain or strata "
                         "kept on walls, for walls and cliffs: floors show their horizontal detail alone)")
-    s.add_argument("--method", default="neural", choices=("neural", "synthesis"),
+    s.add_argument("--method", default="neural", choices=("neural", "synthesis", "spectral"),
                    help="neural (default): the model's texture, 2D or 3D; synthesis: a seamless 2D image synthesised "
                         "from the image file --exemplar by texture optimisation (Kwatra et al. 2005), copying its "
-                        "courses, planks and stones; --tile px a side, repeated beyond it")
+                        "courses, planks and stones; --tile px a side, repeated beyond it; spectral: random phase "
+                        "noise of the image file --exemplar lifted to a solid, 2D or 3D (a Gaussian texture with "
+                        "its spectrum and colours on every cut, no stones or courses; repeats every 128 image px)")
     s.add_argument("--tile", type=int, default=256, help="--method synthesis: the periodic image's side, px "
                                                          "(a multiple of 4 in [32, 1024]; default 256; multiples of 8 and "
                                                          "more let large photos lay out large structures whole)")
@@ -701,11 +703,24 @@ def run_solid(a: argparse.Namespace) -> int:
     if ext not in allowed:
         raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
     if a.method == "synthesis" and a.dim != 2:
-        raise SettingError("--method", "synthesis makes 2D images (--dim 2); volumes come from the neural texture")
+        raise SettingError("--method", "synthesis makes 2D images (--dim 2); volumes come from the neural texture "
+                                      "or --method spectral")
     req = solid_request(a)
     if req.method == "synthesis":
         field = req.synthesis_field("--", _Bar(a.quiet, "synthesis "))
         _write_solid_image(a.out, field.image(a.size, a.scale))
+        return 0
+    if req.method == "spectral":
+        field = req.spectral_field("--", _Bar(a.quiet, "spectral solid "))
+        if a.dim == 2:
+            _write_solid_image(a.out, field.image(a.size, a.scale))
+            return 0
+        from backend.bake import BakeSpec, run_bake
+        from backend.sources import BoxGrid, SpectralSource
+
+        extent = a.size / (field.px_per_unit * a.scale)
+        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
+        run_bake(BakeSpec("solid", SpectralSource(req, field=field), grid, a.out), _Bar(a.quiet), force=True)
         return 0
     model = req.load("--")
     if a.dim == 3 and model.dim != 3:

@@ -9,8 +9,9 @@ the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image'
 finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("auto", "isotropic" or "upright",
 :mod:`backend.solid.upright`), and the ``seed`` of the noise.  ``method`` "synthesis" asks instead for a periodic
 2D image of ``tile`` px a side synthesised from an image exemplar by texture optimisation
-(:mod:`backend.solid.synthesis`): no model, no code, 2D only.  Where the texture is read (grid, zoom, scale) belongs
-to the bake, not to the texture.
+(:mod:`backend.solid.synthesis`): no model, no code, 2D only; ``method`` "spectral" a periodic Gaussian solid whose
+slices carry the image's spectrum (random phase noise lifted to 3D, :mod:`backend.solid.spectral_solid`): no model,
+2D and 3D.  Where the texture is read (grid, zoom, scale) belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
 sha256): equal settings from any front-end give equal keys (tests/cli/test_solid_request.py).
@@ -29,11 +30,14 @@ from ..errors import SettingError
 from ..paths import solid_models
 from .spectral import REST_CHOICES
 
-__all__ = ["SolidRequest", "MAX_SEED", "METHODS"]
+__all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
 
-#: how the texture is made: "neural" (a model's texture, the default) or "synthesis" (a periodic 2D image optimised
-#: from an image exemplar, :mod:`backend.solid.synthesis`)
-METHODS = ("neural", "synthesis")
+#: how the texture is made: "neural" (a model's texture, the default), "synthesis" (a periodic 2D image optimised
+#: from an image exemplar, :mod:`backend.solid.synthesis`) or "spectral" (a periodic Gaussian solid with the image
+#: exemplar's spectrum on its slices, :mod:`backend.solid.spectral_solid`)
+METHODS = ("neural", "synthesis", "spectral")
+#: the methods that draw from an image exemplar alone, without a model
+IMAGE_METHODS = ("synthesis", "spectral")
 
 MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the lattice hash, backend/solid/lattice.py)
 
@@ -97,18 +101,19 @@ class SolidRequest:
             raise bad("rest", f"must be one of {', '.join(REST_CHOICES)}, got {self.rest!r}")
         if not isinstance(self.method, str) or self.method not in METHODS:
             raise bad("method", f"must be one of {', '.join(METHODS)}, got {self.method!r}")
+        if self.method in IMAGE_METHODS:
+            m, ex = self.method, self.exemplar
+            if isinstance(ex, str) and not os.path.isfile(ex):
+                raise bad("exemplar", f"{m} works from an image file; there is no file {ex!r}")
+            if not isinstance(ex, (np.ndarray, str)):
+                raise bad("exemplar", f"{m} works from an image (a file or pixels), got {ex!r}")
+            if self.to is not None:
+                raise bad("to", f"interpolation needs the neural texture (method neural); {m} draws one texture")
+            if self.refine:
+                raise bad("refine", f"refinement searches a neural texture's code; {m} has none")
         if self.method == "synthesis":
             from .synthesis import MAX_TILE, MIN_TILE, TILE_STEP
 
-            ex = self.exemplar
-            if isinstance(ex, str) and not os.path.isfile(ex):
-                raise bad("exemplar", f"synthesis works from an image file; there is no file {ex!r}")
-            if not isinstance(ex, (np.ndarray, str)):
-                raise bad("exemplar", f"synthesis works from an image (a file or pixels), got {ex!r}")
-            if self.to is not None:
-                raise bad("to", "interpolation needs the neural texture (method neural); synthesis draws one image")
-            if self.refine:
-                raise bad("refine", "refinement searches a neural texture's code; synthesis has none")
             t = self.tile
             if isinstance(t, bool) or not isinstance(t, (int, np.integer)) or not MIN_TILE <= t <= MAX_TILE \
                     or t % TILE_STEP:
@@ -147,8 +152,8 @@ class SolidRequest:
                             bool(self.periodic), bool(self.gaussian), self.rest)
 
     def exemplar_pixels(self, where: str = ""):
-        """Method "synthesis"'s exemplar as pixels: pixels as given, a path decoded to float (H, W, 3) sRGB;
-        SettingError naming the exemplar for a file it cannot read."""
+        """An image method's exemplar (synthesis, spectral) as pixels: pixels as given, a path decoded to float
+        (H, W, 3) sRGB; SettingError naming the exemplar for a file it cannot read."""
         if not isinstance(self.exemplar, str):
             return self.exemplar
         from .._export import export
@@ -173,13 +178,29 @@ class SolidRequest:
             raise SettingError(f"{where}exemplar", exc.message) from None
         return TileField(tile, PX_PER_UNIT, settings)
 
+    def spectral_field(self, where: str = "", progress=None, cancel=None):
+        """Method "spectral": the :class:`~backend.solid.spectral_solid.SplineField` of a periodic Gaussian solid
+        whose slices carry the exemplar's spectrum, drawn with ``seed`` (progress and cancel as
+        :func:`~backend.solid.spectral_solid.spectral_tile`'s); SettingError naming the exemplar for an image it
+        cannot use."""
+        from .spectral_solid import SplineField, spectral_tile
+
+        img = np.asarray(self.exemplar_pixels(where), np.float32)
+        try:
+            coeffs = spectral_tile(img, int(self.seed), progress=progress, cancel=cancel)
+        except SettingError as exc:
+            raise SettingError(f"{where}exemplar", exc.message) from None
+        return SplineField(coeffs, np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0))
+
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
         kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone); for
-        method "synthesis" only what it reads (exemplar, seed, tile)."""
+        methods "synthesis" and "spectral" only what they read (exemplar, seed and, for synthesis, tile)."""
         if self.method == "synthesis":
             return dict(method="synthesis", exemplar=_digest(self.exemplar), seed=int(self.seed),
                         tile=int(self.tile))
+        if self.method == "spectral":
+            return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed))
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),

@@ -152,6 +152,56 @@ def test_volume_bake(scene, tmp_path):
     assert vol.type == "VOLUME" and tuple(vol.matrix_world.translation) == pytest.approx((1.0, 0.0, 0.0))
 
 
+@needs_openvdb
+def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scene, tmp_path):
+    """Method Spectral Solid (backend/solid/spectral_solid.py): the panel's request is the command line's; the
+    preview, a colour attribute and a volume are the request's solid read at the same points; the panel hides the
+    neural texture's settings."""
+    from backend.solid.spectral_solid import SpectralTexture
+    from cli.main import build_parser, solid_request
+    from export.images import write_png
+
+    rgb = np.random.default_rng(4).integers(0, 256, (64, 72, 3)).astype(np.uint8)
+    write_png(str(tmp_path / "ex.png"), rgb)
+    p = scene.omninoise_solid
+    p.source, p.image, p.method = "IMAGE", bpy.data.images.load(str(tmp_path / "ex.png")), "SPECTRAL"
+    req = solid_ui.panel_request(p)
+    flags = build_parser().parse_args(["solid", "--method", "spectral", "--exemplar", str(tmp_path / "ex.png"),
+                                       "--seed", "3", "-o", "x.png"])
+    assert req.key() == solid_request(flags).key()
+    field = req.spectral_field()
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    ref = np.flipud(SpectralTexture(req).image(128, field))
+    assert np.abs(_pixels("Solid Texture Preview") - ref).max() <= 0.5 / 255 + 1e-4
+    assert p.periodic_info == "" and p.gaussian_info == ""
+    log = []
+    solid_ui.draw_solid(Recorder(log), bpy.context)
+    props = {a for n, a, t in log if n == "prop"}
+    assert "method" in props and not {"refine", "periodic", "gaussian", "rest"} & props
+
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
+    obj = bpy.context.active_object
+    p.target = "COLOR_ATTRIBUTE"
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    me = obj.data
+    got = np.empty(len(me.vertices) * 4, np.float32)
+    me.color_attributes["Solid Texture"].data.foreach_get("color", got)
+    co = np.empty(len(me.vertices) * 3, np.float32)
+    me.vertices.foreach_get("co", co)
+    want = srgb_to_linear(field.evaluate(co.reshape(-1, 3).astype(np.float64) * 2.0))
+    np.testing.assert_allclose(got.reshape(-1, 4)[:, :3], want, atol=1e-5)
+
+    p.target = "VOLUME"
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    from export.vdb import read_volume
+
+    col = read_volume(str(tmp_path / "Solid_Texture.vdb"), "color", (8, 8, 8))
+    c = -1 + (np.arange(8) + 0.5) * 0.25            # voxel centres of the sphere's local bounds [-1, 1]^3
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")
+    want = srgb_to_linear(field.evaluate(np.stack([x, y, z], -1).reshape(-1, 3) * 2.0))
+    np.testing.assert_allclose(col.reshape(-1, 3), want, atol=5e-5)     # the grid's points in its own arithmetic
+
+
 def test_image_source_is_encoded_by_the_space_model(scene):
     p = scene.omninoise_solid
     ima = bpy.data.images.new("Exemplar", 160, 140, alpha=False)

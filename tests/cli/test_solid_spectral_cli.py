@@ -1,0 +1,104 @@
+"""Method "spectral" (backend/solid/spectral_solid.py: random phase noise lifted to a solid) in the command line
+and job files: one request from flags, job tables and pixels; a volume and an image from `omninoise solid --method
+spectral`; the same volume from a job file's bake; one-line errors for what it cannot do.  No torch; three draws
+of the product's tile (about 5 s each on 2 cores)."""
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+from backend.errors import SettingError
+from backend.solid.request import SolidRequest
+from backend.solid.spectral_solid import PX_PER_UNIT
+from backend.sources import solid_request_from_dict
+from cli.main import build_parser, main, solid_request
+from export import read_rgb
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+PHOTO = os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg")
+
+
+def cli(*args):
+    return solid_request(build_parser().parse_args(["solid", *args, "-o", "x.png"]))
+
+
+def test_flags_job_tables_and_pixels_give_one_request():
+    a = cli("--method", "spectral", "--exemplar", PHOTO, "--seed", "4")
+    b = solid_request_from_dict({"method": "spectral", "exemplar": PHOTO, "seed": 4})
+    c = SolidRequest(exemplar=read_rgb(PHOTO), method="spectral", seed=4).check()
+    assert a.key() == b.key() == c.key()
+    assert set(a.key()) == {"method", "exemplar", "seed"}          # what it reads, nothing of a model
+    assert a.key() != cli("--method", "spectral", "--exemplar", PHOTO).key()
+    assert a.key() != cli("--method", "synthesis", "--exemplar", PHOTO, "--seed", "4").key()
+
+
+@pytest.mark.parametrize("flags, table, field, why", [
+    (["--exemplar", "gravel"], {"exemplar": "gravel"}, "exemplar", "spectral works from an image"),
+    (["--exemplar", "no/such.png"], {"exemplar": "no/such.png"}, "exemplar", "there is no file 'no/such.png'"),
+    (["--to", "grass"], {"to": "grass"}, "to", "interpolation needs the neural texture"),
+    (["--refine", "3"], {"refine": 3}, "refine", "spectral has none"),
+])
+def test_what_spectral_cannot_do_is_named(flags, table, field, why):
+    with pytest.raises(SettingError) as e1:
+        cli("--method", "spectral", "--exemplar", PHOTO, *flags)
+    with pytest.raises(SettingError) as e2:
+        solid_request_from_dict(dict({"method": "spectral", "exemplar": PHOTO}, **table))
+    assert e1.value.setting == "--" + field and e2.value.setting == "source." + field
+    assert why in str(e1.value) and why in str(e2.value)
+
+
+def test_a_volume_from_the_command_line_and_from_a_job_file_agree(tmp_path, capsys):
+    """A 3D .npy from the command line (linear colours) is the job file's bake of the same box, and it has the
+    photo's colours: mean within 0.03 and a spread within 30 % of the photo's (linear)."""
+    cli_out = str(tmp_path / "cli.npy")
+    assert main(["solid", "--quiet", "--method", "spectral", "--exemplar", PHOTO, "--dim", "3", "--size", "24",
+                 "--seed", "1", "-o", cli_out]) == 0
+    vol = np.load(cli_out)
+    assert vol.shape == (24, 24, 24, 3) and np.isfinite(vol).all()
+    from backend.colour import srgb_to_linear
+
+    photo = srgb_to_linear(read_rgb(PHOTO)).reshape(-1, 3)
+    assert np.abs(vol.reshape(-1, 3).mean(0) - photo.mean(0)).max() < 0.03
+    ratio = vol.reshape(-1, 3).std(0) / photo.std(0)
+    assert np.all((ratio > 0.7) & (ratio < 1.3)), ratio
+
+    e = 24 / PX_PER_UNIT
+    shutil.copy(PHOTO, tmp_path / "rock.jpg")
+    job = tmp_path / "job.toml"
+    job.write_text(f"""
+[[bake]]
+name = "rock"
+output = "job.npy"
+resolution = [24, 24, 24]
+bounds = [[0, 0, 0], [{e!r}, {e!r}, {e!r}]]
+[bake.source]
+kind = "solid"
+method = "spectral"
+exemplar = "rock.jpg"
+seed = 1
+""")
+    assert main(["bake", str(job), "--quiet"]) == 0
+    np.testing.assert_allclose(np.load(tmp_path / "job.npy"), vol, atol=2e-5)
+    from backend.jobs import run_job
+
+    job.write_text(job.read_text().replace('output = "job.npy"', 'output = "job.vdb"'))   # .npy carry no key
+    assert [o.status for o in run_job(str(job))] == ["baked"]
+    assert [o.status for o in run_job(str(job))] == ["up to date"]
+
+
+def test_an_image_and_one_line_errors(tmp_path, capsys):
+    png = str(tmp_path / "a.png")
+    assert main(["solid", "--quiet", "--method", "spectral", "--exemplar", PHOTO, "--size", "64", "-o", png]) == 0
+    assert read_rgb(png).shape == (64, 64, 3)
+    small = str(tmp_path / "small.png")
+    from export.images import write_png
+
+    write_png(small, np.zeros((20, 30, 3), np.uint8))
+    for args, msg in ((["--exemplar", small], "--exemplar: the photo is 30 x 20 px"),
+                      (["--exemplar", os.path.join(ROOT, "README.md")], "--exemplar: "),
+                      (["--exemplar", PHOTO, "--dim", "3"], "-o: a 3D result is written as .vdb, .npy")):
+        assert main(["solid", "--quiet", "--method", "spectral", *args, "-o", str(tmp_path / "b.png")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert msg in err and len(err.splitlines()) == 1
+    assert not os.path.exists(tmp_path / "b.png")

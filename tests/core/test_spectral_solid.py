@@ -1,0 +1,170 @@
+"""Random phase noise as a solid (backend/solid/spectral_solid.py): the power design meets the projections a solid
+can meet, the photo's spectrum is read with its rows running up, the B-spline field reads a band-limited field
+exactly between voxels, and the slices of a drawn solid have the photo's mean, variance and spectrum.  Small
+periods keep it to seconds."""
+import numpy as np
+import pytest
+
+from backend.errors import SettingError
+from backend.solid.model import slice_points
+from backend.solid.spectral_solid import (PX_PER_UNIT, SplineField, bspline_prefilter, slice_spectrum,
+                                          solid_power, spectral_tile)
+
+
+def _radial_power(img: np.ndarray, bands) -> np.ndarray:
+    """Power of img (H, W, 3) minus its mean, summed over channels, in bands of cycles per px."""
+    u = img - img.mean((0, 1))
+    F = np.fft.fft2(u.transpose(2, 0, 1)) / (u.shape[0] * u.shape[1])
+    P = (np.abs(F) ** 2).sum(0)
+    r = np.hypot(*np.meshgrid(np.fft.fftfreq(u.shape[0]), np.fft.fftfreq(u.shape[1]), indexing="ij"))
+    return np.array([P[(r >= a) & (r < b)].sum() for a, b in bands])
+
+
+def _gaussian_photo(n: int, seed: int, lowest: float = 1.0 / 32) -> np.ndarray:
+    """A (n, n, 3) Gaussian texture with an isotropic 1/f power spectrum from ``lowest`` cycles per px up (a
+    tile's period can hold nothing longer than itself) and correlated colours, mean 0.5."""
+    rng = np.random.default_rng(seed)
+    f = np.hypot(*np.meshgrid(np.fft.fftfreq(n), np.fft.fftfreq(n), indexing="ij"))
+    amp = np.where(f >= lowest, np.maximum(f, 1.0 / n) ** -0.5, 0.0)
+    g = np.real(np.fft.ifft2(amp * np.fft.fft2(rng.standard_normal((n, n)))))
+    h = np.real(np.fft.ifft2(amp * np.fft.fft2(rng.standard_normal((n, n)))))
+    g, h = g / g.std(), h / h.std()
+    rgb = np.stack([0.5 + 0.12 * g, 0.5 + 0.10 * g + 0.03 * h, 0.5 + 0.05 * g - 0.06 * h], -1)
+    return np.clip(rgb, 0.0, 1.0).astype(np.float32)
+
+
+def test_the_design_meets_projections_a_solid_has():
+    """Targets that are the projections of a solid (an isotropic one, nothing on the coordinate axes) are met;
+    the design stays non-negative, keeps the total and leaves the coordinate axes empty."""
+    n = 16
+    k = np.fft.fftfreq(n, 1.0 / n)
+    kz, ky, kx = np.meshgrid(k, k, k, indexing="ij")
+    P0 = np.exp(-np.sqrt(kz ** 2 + ky ** 2 + kx ** 2) / 3.0)
+    P0[0, 0, :] = P0[0, :, 0] = P0[:, 0, 0] = 0.0
+    T = P0.sum(2)
+    np.testing.assert_allclose(P0.sum(1), T, rtol=1e-12)            # isotropic: the three projections agree
+    P = solid_power(T, iterations=200)
+    assert P.min() >= 0.0 and np.isclose(P.sum(), T.sum(), rtol=1e-9)
+    assert P[0, 0, :].sum() == P[0, :, 0].sum() == P[:, 0, 0].sum() == 0.0
+    for proj in (P.sum(2), P.sum(1), P.sum(0)):
+        assert np.abs(proj - T).sum() / T.sum() < 0.02
+    # and it is not the flat start: before any iteration the projections are far
+    assert np.abs(solid_power(T, iterations=0).sum(2) - T).sum() / T.sum() > 0.3
+
+
+def test_the_photo_spectrum_is_read_with_its_rows_running_up():
+    """Stripes with 3 cycles down the rows and 5 across the columns of a 64 px photo: their power lies at row
+    frequency -3 (rows run up in a slice) and column frequency 5, and at the mirror frequency; it sums to about
+    their variance; a 128 px photo of stripes of the same cycles per px gives the same bins of a 64-periodic grid."""
+    def stripes(n, a, b):
+        y, x = np.mgrid[0:n, 0:n]
+        v = 0.5 + 0.2 * np.cos(2 * np.pi * (a * y + b * x) / n)
+        return np.repeat(v[..., None], 3, axis=2)
+
+    S = slice_spectrum(stripes(64, 3, 5), 64)
+    T = np.trace(S, axis1=2, axis2=3)
+    peaks = {tuple(int(i) for i in ij) for ij in np.argwhere(T > 0.1 * T.max())}
+    assert peaks == {((-3) % 64, 5), (3, (-5) % 64)}
+    # the periodic component takes a little from steps across the borders even of a tiling image (Moisan 2011)
+    assert np.isclose(T.sum(), 3 * 0.2 ** 2 / 2, rtol=0.05)
+    T2 = np.trace(slice_spectrum(stripes(128, 6, 10), 64), axis1=2, axis2=3)
+    assert {tuple(int(i) for i in ij) for ij in np.argwhere(T2 > 0.1 * T2.max())} == peaks
+    # the colour cross-spectrum is symmetric and positive semi-definite
+    assert np.allclose(S, S.transpose(0, 1, 3, 2))
+    assert np.linalg.eigvalsh(S[(-3) % 64, 5]).min() > -1e-12
+
+
+def test_the_spline_field_reads_a_band_limited_field_between_voxels():
+    """The coefficients of a periodic field sampled twice as finely as its highest frequency (prefiltered by
+    bspline_prefilter) read back the field itself anywhere, not its voxels blurred; voxel centres at
+    (i + 1/2) / voxels_per_unit, indexed (z, y, x)."""
+    M, over = 32, 2
+    vpu = PX_PER_UNIT * over
+    i = (np.arange(M) + 0.5) / vpu                               # voxel centres, units
+    z, y, x = np.meshgrid(i, i, i, indexing="ij")
+    period = M / vpu
+    k = 2 * np.pi / period * np.array([3.0, -5.0, 7.0])          # x, y, z cycles per period (highest 7 of 16)
+
+    def field(px, py, pz):
+        return np.cos(k[0] * px + k[1] * py + k[2] * pz + 0.3)
+
+    samples = field(x, y, z)
+    b = bspline_prefilter(M)
+    c = np.real(np.fft.ifftn(np.fft.fftn(samples) / (b[:, None, None] * b[None, :, None] * b[None, None, :])))
+    f = SplineField(np.repeat(c[..., None], 3, axis=3).astype(np.float32) * 0.25, (0.5, 0.5, 0.5), over)
+    pts = np.random.default_rng(0).uniform(-2.0, 2.0, (4000, 3))
+    want = 0.5 + 0.25 * field(pts[:, 0], pts[:, 1], pts[:, 2])
+    got = f.evaluate(pts)
+    assert np.abs(got - want[:, None]).max() < 0.01
+    # trilinear reading of the same voxels is off by far more: the B-spline is what keeps the detail
+    from backend.solid.synthesis import TileField
+
+    lin = TileField(np.repeat(0.5 + 0.25 * samples[..., None], 3, axis=3).astype(np.float32), vpu).evaluate(pts)
+    assert np.abs(lin - want[:, None]).max() > 3 * np.abs(got - want[:, None]).max()
+    assert f.period == pytest.approx(period)
+    np.testing.assert_allclose(f.evaluate(pts + period), got, atol=1e-5)         # periodic along every axis
+    np.testing.assert_allclose(f.evaluate(pts[:, :2]), f.evaluate(np.c_[pts[:, :2], np.zeros(len(pts))]))
+
+
+@pytest.fixture(scope="module")
+def drawn():
+    photo = _gaussian_photo(128, 1)
+    return photo, SplineField(spectral_tile(photo, seed=3, period=64), photo.reshape(-1, 3).mean(0))
+
+
+def test_slices_of_the_solid_have_the_photo_mean_variance_and_spectrum(drawn):
+    """Twelve slices normal to x, y and z at arbitrary offsets (not on voxel centres): mean colour within 0.02,
+    per-channel variance within 25 %, power in three octaves of frequency within a factor 1.5 of the photo's, and
+    the colour correlation of red and blue kept."""
+    photo, f = drawn
+    rng = np.random.default_rng(5)
+    imgs = [f.evaluate(slice_points(64, PX_PER_UNIT, ax, rng.uniform(-3, 3, 3))).reshape(64, 64, 3)
+            for ax in "xyz" for _ in range(4)]
+    s = np.stack(imgs)
+    assert np.abs(s.mean((0, 1, 2)) - photo.mean((0, 1))).max() < 0.02
+    ratio = s.var((1, 2)).mean(0) / photo.var((0, 1))
+    assert np.all((ratio > 0.75) & (ratio < 1.25)), ratio
+    bands = [(1 / 32, 1 / 16), (1 / 16, 1 / 8), (1 / 8, 1 / 4)]
+    crops = [photo[a:a + 64, b:b + 64] for a in (0, 64) for b in (0, 64)]
+    want = np.mean([_radial_power(c, bands) for c in crops], 0)
+    got = np.mean([_radial_power(im, bands) for im in imgs], 0)
+    assert np.all((got / want > 1 / 1.5) & (got / want < 1.5)), got / want
+    corr = lambda a: np.corrcoef(a[..., 0].ravel(), a[..., 2].ravel())[0, 1]   # noqa: E731
+    assert abs(corr(s) - corr(photo)) < 0.15
+
+
+def test_a_seed_draws_another_texture_and_the_same_seed_the_same(drawn):
+    photo, f = drawn
+    again = spectral_tile(photo, seed=3, period=64)
+    np.testing.assert_array_equal(again, f.coeffs)
+    other = spectral_tile(photo, seed=4, period=64)
+    assert np.abs(other - f.coeffs).mean() > 0.5 * np.abs(f.coeffs).mean()
+
+
+def test_progress_rises_to_one_and_cancel_stops():
+    photo = _gaussian_photo(64, 2)
+    seen = []
+    spectral_tile(photo, period=16, progress=seen.append)
+    assert seen == sorted(seen) and seen[-1] == pytest.approx(1.0) and len(seen) > 10
+    from backend.grid import Cancelled
+
+    calls = []
+    with pytest.raises(Cancelled):
+        spectral_tile(photo, period=16, cancel=lambda: calls.append(1) or len(calls) > 3)
+
+
+@pytest.mark.parametrize("photo, period, match", [
+    (np.zeros((20, 64, 3), np.float32), 16, "photo is 64 x 20 px"),
+    (np.full((64, 64, 3), np.nan, np.float32), 16, "non-finite"),
+    (np.zeros((64, 64), np.float32), 16, "RGB image"),
+    (np.zeros((64, 64, 3), np.float32), 7, "period must be an even number"),
+])
+def test_bad_input_is_named(photo, period, match):
+    with pytest.raises(SettingError, match=match):
+        spectral_tile(photo, period=period)
+
+
+def test_a_flat_photo_gives_its_flat_colour():
+    photo = np.full((64, 64, 3), (0.2, 0.4, 0.6), np.float32)
+    f = SplineField(spectral_tile(photo, period=16), photo.reshape(-1, 3).mean(0))
+    np.testing.assert_allclose(f.image(16), np.broadcast_to((0.2, 0.4, 0.6), (16, 16, 3)), atol=1e-4)
