@@ -57,13 +57,17 @@ from ..periodic import periodic_component
 from .model import plane_points
 from .synthesis import PX_PER_UNIT
 
-__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "MIN_PHOTO", "slice_spectrum", "solid_power", "colour_factors",
+__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "MIN_PHOTO", "MAX_READ", "slice_spectrum", "solid_power", "colour_factors",
            "spectral_tile", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
 
 PERIOD = 128       #: photo px per repeat of the tile along each axis (the design's grid of PERIOD^3 frequencies)
 OVERSAMPLE = 2     #: voxels per photo px along each axis: PERIOD * OVERSAMPLE voxels a side
 ITERATIONS = 100   #: EM iterations of solid_power (the projections' error stops falling after about 20)
 MIN_PHOTO = 32     #: the shortest photo side read, px
+#: the longest photo side read, px: a larger photo's spectrum is read from its central crop of this size (at its own
+#: pixel scale; each of the 128^2 bins still averages 64 of its Fourier coefficients), which keeps a 4096^2 photo
+#: to seconds and under 1.5 GB
+MAX_READ = 1024
 _SALT = 0x67617573  #: the draw's stream, beside the seed
 
 
@@ -76,13 +80,15 @@ def slice_spectrum(photo: np.ndarray, n: int) -> np.ndarray:
     cycles per px."""
     u = np.asarray(photo, np.float64)[..., :3]
     H, W = u.shape[:2]
-    p = periodic_component((u - u.reshape(-1, 3).mean(0)).transpose(2, 0, 1))
-    F = (np.fft.fft2(p) / (H * W)).transpose(1, 2, 0)                      # (H, W, 3)
-    X = np.real(F[..., :, None] * np.conj(F)[..., None, :])                 # (H, W, 3, 3)
+    F = np.fft.fft2(periodic_component((u - u.reshape(-1, 3).mean(0)).transpose(2, 0, 1))) / (H * W)  # (3, H, W)
     kr = np.round(-np.fft.fftfreq(H) * n).astype(np.int64) % n             # negated: rows run up
     kc = np.round(np.fft.fftfreq(W) * n).astype(np.int64) % n
+    bins = (kr[:, None] * n + kc[None, :]).ravel()
     out = np.zeros((n, n, 3, 3))
-    np.add.at(out, (np.repeat(kr[:, None], W, 1), np.repeat(kc[None, :], H, 0)), X)
+    for a in range(3):          # the real cross-spectrum, summed into bins (a large photo: no (H, W, 3, 3) array)
+        for b in range(a, 3):
+            v = np.bincount(bins, (F[a].real * F[b].real + F[a].imag * F[b].imag).ravel(), n * n).reshape(n, n)
+            out[..., a, b] = out[..., b, a] = v
     out[0, 0] = 0.0
     return out
 
@@ -128,9 +134,9 @@ def colour_factors(P: np.ndarray, S: np.ndarray) -> np.ndarray:
 def spectral_tile(photo: np.ndarray, seed: int = 0, period: int = PERIOD, oversample: int = OVERSAMPLE,
                   iterations: int = ITERATIONS, progress=None, cancel=None) -> np.ndarray:
     """Cubic B-spline coefficients float32 (M, M, M, 3), M = period * oversample, of a periodic Gaussian solid
-    with zero mean whose axis slices carry ``photo``'s (H, W, 3) colour cross-spectrum (module doc); add the
-    photo's mean colour to the field :class:`SplineField` reads.  ``progress(fraction)`` as the work goes;
-    ``cancel()`` returning True stops with Cancelled."""
+    with zero mean whose axis slices carry ``photo``'s (H, W, 3) colour cross-spectrum (module doc; a photo larger
+    than MAX_READ is read from its central crop); add the photo's mean colour to the field :class:`SplineField`
+    reads.  ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled."""
     img = np.asarray(photo, np.float32)
     if img.ndim != 3 or img.shape[2] not in (3, 4):
         raise SettingError("photo", f"the photo must be an RGB image (H, W, 3), got shape {img.shape}")
@@ -153,7 +159,9 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int = PERIOD, oversa
         return cancel is not None and bool(cancel())
 
     n, M = int(period), int(period) * int(oversample)
-    S = slice_spectrum(np.clip(img[..., :3], 0.0, 1.0), n)
+    H, W = img.shape[:2]
+    y0, x0 = max(0, (H - MAX_READ) // 2), max(0, (W - MAX_READ) // 2)
+    S = slice_spectrum(np.clip(img[y0:y0 + MAX_READ, x0:x0 + MAX_READ, :3], 0.0, 1.0), n)
     P = solid_power(np.trace(S, axis1=2, axis2=3), iterations, tick)
     L = colour_factors(P, S)
     amp = np.sqrt(P).astype(np.float32)
