@@ -712,8 +712,10 @@ def run_solid(a: argparse.Namespace) -> int:
         return 0
     if req.method == "spectral":
         field = req.spectral_field("--", _Bar(a.quiet, "spectral solid "))
-        if a.dim == 2:
-            _write_solid_image(a.out, field.image(a.size, a.scale))
+        if a.dim == 2:      # the front view (x right, z up), as a 3D model's 2D image and the panel's preview
+            from backend.solid.spectral_solid import SpectralTexture
+
+            _write_solid_image(a.out, SpectralTexture(req).image(a.size, field, scale=a.scale))
             return 0
         from backend.bake import BakeSpec, run_bake
         from backend.sources import BoxGrid, SpectralSource

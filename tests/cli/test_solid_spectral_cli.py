@@ -88,9 +88,16 @@ seed = 1
 
 
 def test_an_image_and_one_line_errors(tmp_path, capsys):
-    png = str(tmp_path / "a.png")
-    assert main(["solid", "--quiet", "--method", "spectral", "--exemplar", PHOTO, "--size", "64", "-o", png]) == 0
-    assert read_rgb(png).shape == (64, 64, 3)
+    """A 2D image is the front view (x right, z up), as a 3D model's 2D image and the panel's preview are."""
+    out = str(tmp_path / "a.npy")
+    assert main(["solid", "--quiet", "--method", "spectral", "--exemplar", PHOTO, "--size", "64", "--scale", "2",
+                 "-o", out]) == 0
+    from backend.colour import srgb_to_linear
+    from backend.solid.model import slice_points
+
+    req = SolidRequest(exemplar=PHOTO, method="spectral").check()
+    front = req.spectral_field().evaluate(slice_points(64, 2 * PX_PER_UNIT, "y")).reshape(64, 64, 3)
+    np.testing.assert_allclose(np.load(out), srgb_to_linear(front), atol=1e-5)
     small = str(tmp_path / "small.png")
     from export.images import write_png
 
