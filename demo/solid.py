@@ -4,8 +4,9 @@ A cube, a UV sphere, Suzanne and a cylinder receive solid textures from
 photographs through the add-on's own "Solid Texture from Image" operator
 (headless, blocking): the cube from a held-out brick photograph encoded by the
 texture-space model (with the photo's harmonic part: its courses stand on the
-cube's sides), and the sphere (grass photo) as UV images, each texel evaluated
-at its 3D surface point so the UV seams do not show; Suzanne as a colour
+cube's sides), and the sphere (a held-out rock photograph drawn as a spectral
+solid: random phase noise of the photo lifted to 3D, no model) as UV images,
+each texel evaluated at its 3D surface point so the UV seams do not show; Suzanne as a colour
 attribute on a subdivided mesh, from a held-out farmland photograph encoded by
 the texture-space model; the cylinder in the wood photo's model.  The floor
 is a tileable image the add-on's Tileable Image operator synthesises from a
@@ -38,6 +39,8 @@ EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
 #: a held-out colour photo (never trained on) that the texture-space model encodes for Suzanne
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")
 BRICKS = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+#: a held-out rock photo the sphere draws as a spectral solid (backend/solid/spectral_solid.py)
+ROCK = os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg")
 #: a held-out paving photo: the floor is a tileable image synthesised from it (method "synthesis"), repeated
 PAVING = os.path.join(ROOT, "data", "photos", "val", "paving__sahara_paving_stones_01.jpg")
 
@@ -107,23 +110,24 @@ def _tiled_material(obj, image, repeats: float) -> None:
 
 def build_scene(out: str) -> dict:
     """A cube and Suzanne textured from held-out photographs (bricks, farmland) through the texture-space model,
-    a sphere and a cylinder from single-photo models (grass, wood)."""
+    a sphere as the spectral solid of a held-out rock photograph, a cylinder from a single-photo model (wood)."""
     sc = cycles_scene(720, 300)
     p = sc.omninoise_solid
     p.folder = os.path.join(out, "bakes")
     space = os.path.isfile(os.path.join(MODELS, "space", "solid.json"))
     plan = [("Cube", "space" if space else "gravel_3d", BRICKS if space else None, "UV_IMAGE", 1.0),
-            ("Sphere", "grass_3d", None, "UV_IMAGE", 1.0),
+            ("Sphere", "spectral", ROCK, "UV_IMAGE", 0.5),
             ("Suzanne", "space" if space else "gravel_3d", PHOTO if space else None, "COLOR_ATTRIBUTE", 1.0),
             ("Cylinder", "wood_3d", None, "UV_IMAGE", 1.0)]
     used = {}
     x = -3.3
     for kind, model, photo, target, scale in plan:
-        if not os.path.isfile(os.path.join(MODELS, model, "solid.json")):
+        if model != "spectral" and not os.path.isfile(os.path.join(MODELS, model, "solid.json")):
             continue
         obj = _add(kind, x)
         x += 2.2
-        if photo:   # the texture-space model encodes the photograph itself
+        p.method = "SPECTRAL" if model == "spectral" else "NEURAL"
+        if photo:   # the texture-space model encodes the photograph itself, or it is drawn as a spectral solid
             p.source, p.image = "IMAGE", bpy.data.images.load(photo)
         else:
             p.source, p.texture = "SHIPPED", f"single:{model}"
@@ -136,6 +140,7 @@ def build_scene(out: str) -> dict:
     if os.path.isfile(PAVING):      # the floor: a tileable image synthesised from a held-out paving photo
         floor = bpy.context.active_object
         p.source, p.image, p.tile, p.seed, p.name = "IMAGE", bpy.data.images.load(PAVING), 256, 0, "Floor"
+        p.method = "NEURAL"
         t = time.perf_counter()
         assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
         tile = bpy.data.images["Floor Tile"]
