@@ -180,7 +180,8 @@ def panel_request(p):
         if p.image is None:
             raise backend.SettingError("image", "pick an exemplar image (or switch Source to Shipped)")
         if p.method == "SPECTRAL":
-            return SolidRequest(exemplar=_image_pixels(p.image), seed=int(p.seed), method="spectral").check()
+            return SolidRequest(exemplar=_image_pixels(p.image), seed=int(p.seed), periodic=bool(p.periodic),
+                                method="spectral").check()
         name = _space_model_name()
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
@@ -215,9 +216,8 @@ def texture(p):
 
 
 def periodic_info(code) -> str:
-    """A line for the panel: the harmonic part a code carries (backend/solid/harmonic.py), or that there is none."""
-    if not hasattr(code, "harmonics"):     # a spectral solid: no model, no parts
-        return ""
+    """A line for the panel: the harmonic part a code (or a spectral solid) carries (backend/solid/harmonic.py), or
+    that there is none."""
     h = code.harmonics
     if h is None:
         return "Periodic part: none found"
@@ -226,7 +226,7 @@ def periodic_info(code) -> str:
 
 def gaussian_info(code) -> str:
     """A line for the panel: the share of the rest a code's Gaussian rest carries (backend/solid/spectral.py)."""
-    if not hasattr(code, "rest"):
+    if not hasattr(code, "rest"):     # a spectral solid is all Gaussian: no share to report
         return ""
     r = code.rest
     if r is None:
@@ -557,9 +557,10 @@ def draw_solid(layout, context) -> None:
         layout.prop(p, "method")
         if p.method == "NEURAL":
             layout.prop(p, "refine")
-            layout.prop(p, "periodic")
-            if p.periodic and p.periodic_info:
-                layout.label(text=p.periodic_info)
+        layout.prop(p, "periodic")
+        if p.periodic and p.periodic_info:
+            layout.label(text=p.periodic_info)
+        if p.method == "NEURAL":
             layout.prop(p, "gaussian")
             if p.gaussian:
                 layout.prop(p, "rest")

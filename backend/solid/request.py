@@ -11,7 +11,7 @@ finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("
 2D image of ``tile`` px a side synthesised from an image exemplar by texture optimisation
 (:mod:`backend.solid.synthesis`): no model, no code, 2D only; ``method`` "spectral" a periodic Gaussian solid whose
 slices carry the image's spectrum (random phase noise lifted to 3D, :mod:`backend.solid.spectral_solid`): no model,
-2D and 3D.  Where the texture is read (grid, zoom, scale) belongs to the bake, not to the texture.
+2D and 3D, with the image's harmonic part where ``periodic``.  Where the texture is read (grid, zoom, scale) belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
 sha256): equal settings from any front-end give equal keys (tests/cli/test_solid_request.py).
@@ -183,24 +183,28 @@ class SolidRequest:
         whose slices carry the exemplar's spectrum, drawn with ``seed`` (progress and cancel as
         :func:`~backend.solid.spectral_solid.spectral_tile`'s); SettingError naming the exemplar for an image it
         cannot use."""
-        from .spectral_solid import SplineField, spectral_tile
+        from .model import measure_harmonics
+        from .spectral_solid import PX_PER_UNIT, SplineField, spectral_tile
 
         img = np.asarray(self.exemplar_pixels(where), np.float32)
         try:
-            coeffs = spectral_tile(img, int(self.seed), progress=progress, cancel=cancel)
+            h = measure_harmonics(img, PX_PER_UNIT) if self.periodic else None
+            coeffs = spectral_tile(img, int(self.seed), progress=progress, cancel=cancel, harmonics=h)
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
-        return SplineField(coeffs, np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0))
+        return SplineField(coeffs, np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0),
+                           harmonics=h, seed=int(self.seed))
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
         kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone); for
-        methods "synthesis" and "spectral" only what they read (exemplar, seed and, for synthesis, tile)."""
+        methods "synthesis" and "spectral" only what they read (exemplar, seed and tile, or periodic)."""
         if self.method == "synthesis":
             return dict(method="synthesis", exemplar=_digest(self.exemplar), seed=int(self.seed),
                         tile=int(self.tile))
         if self.method == "spectral":
-            return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed))
+            return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed),
+                        periodic=bool(self.periodic))
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),

@@ -131,12 +131,15 @@ def colour_factors(P: np.ndarray, S: np.ndarray) -> np.ndarray:
     return L
 
 
-def spectral_tile(photo: np.ndarray, seed: int = 0, period: int = PERIOD, oversample: int = OVERSAMPLE,
-                  iterations: int = ITERATIONS, progress=None, cancel=None) -> np.ndarray:
-    """Cubic B-spline coefficients float32 (M, M, M, 3), M = period * oversample, of a periodic Gaussian solid
+def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, oversample: int = OVERSAMPLE,
+                  iterations: int = ITERATIONS, progress=None, cancel=None, harmonics=None) -> np.ndarray:
+    """Cubic B-spline coefficients float32 (M, M, M, 3), M = period * oversample (period None: PERIOD, read when
+    called), of a periodic Gaussian solid
     with zero mean whose axis slices carry ``photo``'s (H, W, 3) colour cross-spectrum (module doc; a photo larger
     than MAX_READ is read from its central crop); add the photo's mean colour to the field :class:`SplineField`
-    reads.  ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled."""
+    reads.  ``harmonics``: the photo's harmonic part (:func:`backend.solid.model.measure_harmonics` at PX_PER_UNIT),
+    taken out of the photo first, so the solid draws only the rest (:class:`SplineField` adds the part back).
+    ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled."""
     img = np.asarray(photo, np.float32)
     if img.ndim != 3 or img.shape[2] not in (3, 4):
         raise SettingError("photo", f"the photo must be an RGB image (H, W, 3), got shape {img.shape}")
@@ -145,6 +148,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int = PERIOD, oversa
     if min(img.shape[:2]) < MIN_PHOTO:
         raise SettingError("photo", f"the photo is {img.shape[1]} x {img.shape[0]} px; a spectral solid needs at "
                                     f"least {MIN_PHOTO} px a side")
+    period = PERIOD if period is None else period
     if period < 8 or period % 2 or oversample < 1:
         raise SettingError("period", f"period must be an even number >= 8 and oversample >= 1, got {period}, "
                                      f"{oversample}")
@@ -161,7 +165,15 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int = PERIOD, oversa
     n, M = int(period), int(period) * int(oversample)
     H, W = img.shape[:2]
     y0, x0 = max(0, (H - MAX_READ) // 2), max(0, (W - MAX_READ) // 2)
-    S = slice_spectrum(np.clip(img[y0:y0 + MAX_READ, x0:x0 + MAX_READ, :3], 0.0, 1.0), n)
+    crop = np.clip(img[y0:y0 + MAX_READ, x0:x0 + MAX_READ, :3], 0.0, 1.0)
+    if harmonics is not None and len(harmonics):       # the rest: the part at the crop's pixel centres, taken out
+        from .harmonic import harmonic_field
+
+        h, w = crop.shape[:2]
+        rr, cc = np.meshgrid(np.arange(h, dtype=np.float64) + y0, np.arange(w, dtype=np.float64) + x0, indexing="ij")
+        pts = np.stack([(cc.ravel() + 0.5) / PX_PER_UNIT, -(rr.ravel() + 0.5) / PX_PER_UNIT], axis=1)
+        crop = np.clip(crop - harmonic_field(pts, harmonics).reshape(h, w, 3), 0.0, 1.0)
+    S = slice_spectrum(crop, n)
     P = solid_power(np.trace(S, axis1=2, axis2=3), iterations, tick)
     L = colour_factors(P, S)
     amp = np.sqrt(P).astype(np.float32)
@@ -204,16 +216,20 @@ def bspline_weights(t: np.ndarray) -> np.ndarray:
 class SplineField:
     """A periodic solid as a colour field over texture space: ``mean`` (3,) plus the cubic B-spline of
     ``coeffs`` (M, M, M, 3) indexed (z, y, x), voxel centres at (i + 1/2) / voxels_per_unit, ``voxels_per_unit``
-    = PX_PER_UNIT * oversample (the photo's scale).  ``evaluate(points)`` reads it anywhere with wrap-around,
-    clipped to [0, 1]."""
+    = PX_PER_UNIT * oversample (the photo's scale), plus the photo's harmonic part ``harmonics`` where given (upright
+    on walls, moved by ``seed``: :func:`backend.solid.harmonic.harmonic_field`, as the neural texture draws it).
+    ``evaluate(points)`` reads it anywhere with wrap-around, clipped to [0, 1]."""
 
     dim = 3
 
-    def __init__(self, coeffs: np.ndarray, mean, oversample: int = OVERSAMPLE, px_per_unit: float = PX_PER_UNIT):
+    def __init__(self, coeffs: np.ndarray, mean, oversample: int = OVERSAMPLE, px_per_unit: float = PX_PER_UNIT,
+                 harmonics=None, seed: int = 0):
         c = np.asarray(coeffs, np.float32)
         if c.ndim != 4 or c.shape[-1] != 3 or len(set(c.shape[:3])) != 1:
             raise SettingError("coeffs", f"coefficients are (M, M, M, 3), got shape {c.shape}")
         self.coeffs, self.mean = c, np.asarray(mean, np.float32).reshape(3)
+        self.harmonics = harmonics if harmonics is not None and len(harmonics) else None
+        self.seed = int(seed)
         self.px_per_unit = float(px_per_unit)
         self.voxels_per_unit = float(px_per_unit) * int(oversample)
 
@@ -244,6 +260,10 @@ class SplineField:
                     for r in range(4):
                         acc += (wpq * wx[:, r])[:, None] * c[iz[:, p], iy[:, q], ix[:, r]]
             out[a:a + chunk] = acc
+        if self.harmonics is not None:
+            from .harmonic import harmonic_field
+
+            out += harmonic_field(pts, self.harmonics, self.seed)
         return np.clip(out + self.mean, 0.0, 1.0)
 
     def image(self, size: int, scale: float = 1.0) -> np.ndarray:

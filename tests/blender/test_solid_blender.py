@@ -154,9 +154,9 @@ def test_volume_bake(scene, tmp_path):
 
 @needs_openvdb
 def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scene, tmp_path):
-    """Method Spectral Solid (backend/solid/spectral_solid.py): the panel's request is the command line's; the
-    preview, a colour attribute and a volume are the request's solid read at the same points; the panel hides the
-    neural texture's settings."""
+    """Method Spectral Solid (backend/solid/spectral_solid.py): the panel's request is the command line's (Periodic
+    Part included); the preview, a colour attribute and a volume are the request's solid read at the same points;
+    the panel hides the neural texture's other settings."""
     from backend.solid.spectral_solid import SpectralTexture
     from cli.main import build_parser, solid_request
     from export.images import write_png
@@ -173,11 +173,16 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
     assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
     ref = np.flipud(SpectralTexture(req).image(128, field))
     assert np.abs(_pixels("Solid Texture Preview") - ref).max() <= 0.5 / 255 + 1e-4
-    assert p.periodic_info == "" and p.gaussian_info == ""
+    assert p.periodic_info == "Periodic part: none found" and p.gaussian_info == ""   # random pixels: no period
     log = []
     solid_ui.draw_solid(Recorder(log), bpy.context)
     props = {a for n, a, t in log if n == "prop"}
-    assert "method" in props and not {"refine", "periodic", "gaussian", "rest"} & props
+    assert {"method", "periodic"} <= props and not {"refine", "gaussian", "rest"} & props
+    p.periodic = False      # the Periodic Part box is --no-periodic here too
+    flags = build_parser().parse_args(["solid", "--method", "spectral", "--exemplar", str(tmp_path / "ex.png"),
+                                       "--seed", "3", "--no-periodic", "-o", "x.png"])
+    assert solid_ui.panel_request(p).key() == solid_request(flags).key() != req.key()
+    p.periodic = True
 
     bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
     obj = bpy.context.active_object

@@ -177,3 +177,26 @@ def test_a_large_photo_is_read_from_its_central_crop():
     crop = photo[20:20 + MAX_READ, 5:5 + MAX_READ]
     np.testing.assert_array_equal(spectral_tile(photo, period=16), spectral_tile(crop, period=16))
     assert not np.array_equal(spectral_tile(photo[:MAX_READ, :MAX_READ], period=16), spectral_tile(crop, period=16))
+
+
+def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest():
+    """A photo of level stripes 16 px apart with a little noise: its harmonic part (measured as the neural texture
+    measures it) is taken out before the spectrum is read, so the Gaussian solid carries only the noise, and the
+    field adds the part back upright: a wall's rows follow the stripes' period along z, not along y."""
+    from backend.solid.model import measure_harmonics
+
+    rng = np.random.default_rng(3)
+    r = np.arange(128)[:, None, None]
+    photo = np.clip(0.5 + 0.25 * np.cos(2 * np.pi * r / 16) * np.array([1.0, 0.9, 0.7])
+                    + 0.03 * rng.standard_normal((128, 128, 3)), 0, 1).astype(np.float32)
+    h = measure_harmonics(photo, PX_PER_UNIT)
+    assert len(h) >= 1 and h.share > 0.8
+    rest = spectral_tile(photo, period=32, harmonics=h)
+    whole = spectral_tile(photo, period=32)
+    assert rest.var() < 0.2 * whole.var()
+    f = SplineField(rest, photo.reshape(-1, 3).mean(0), harmonics=h)
+    wall = f.evaluate(slice_points(64, PX_PER_UNIT, "x", (0.3, 0.1, 0.2))).reshape(64, 64, 3).mean(2)
+    down = np.abs(np.fft.rfft(wall.mean(1) - wall.mean())) ** 2      # along z (rows)
+    assert down.argmax() == 64 // 16 and down[4] > 0.8 * down.sum()
+    assert wall.mean(0).std() < 0.1 * wall.mean(1).std()            # level: nothing along y
+    assert SplineField(rest, (0.5, 0.5, 0.5), harmonics=None).harmonics is None
