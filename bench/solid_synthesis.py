@@ -20,8 +20,8 @@ slices of 3D output).
     python bench/solid_synthesis.py [--only brick,wood,rock] [--size 128] [--planes all] [--out out/bench/solid_synthesis]
 
 With ``--method spectral`` the 3D texture measured is instead what ``method = "spectral"`` ships
-(``backend/solid/spectral_solid.py``: random phase noise lifted to a periodic solid, one draw per photo, sliced as
-the tiles are; the synthesis settings are not used).
+(``backend/solid/spectral_solid.py``: random phase noise lifted to a periodic solid with the photo's harmonic part,
+``--no-periodic`` without it; one draw per photo, sliced as the tiles are; the synthesis settings are not used).
 
 Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices | the same of the closer random phase
 solid | random phase noise drawn in 2D; 2D: photo | the first
@@ -47,7 +47,7 @@ from export.atomic import write_json  # noqa: E402
 from backend.solid.model import resize_rgb, slice_points  # noqa: E402
 from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
 from backend.solid.upright import upright_waves  # noqa: E402
-from backend.solid.spectral_solid import SplineField, spectral_tile  # noqa: E402
+from backend.solid.request import SolidRequest  # noqa: E402
 from backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
                                      synthesise)
 from training.solid import photo_eval as pe  # noqa: E402
@@ -131,6 +131,8 @@ def main(argv=None) -> int:
                                                                 "short side first (small photos: swatches, game textures)")
     ap.add_argument("--method", default="synthesis", choices=("synthesis", "spectral"),
                     help="what is measured in 3D: the synthesised tile, or the spectral solid the product draws")
+    ap.add_argument("--no-periodic", action="store_true",
+                    help="--method spectral: without the photo's harmonic part (the product's --no-periodic)")
     ap.add_argument("--against", default=None, help="an eval_solid_photos.py JSON: the neural texture's figures")
     ap.add_argument("--sheet", action="store_true")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solid_synthesis"))
@@ -161,9 +163,9 @@ def main(argv=None) -> int:
             k = a.photo_side / min(photo.shape[:2])
             photo = resize_rgb(photo, max(1, round(photo.shape[0] * k)), max(1, round(photo.shape[1] * k)))
         t = time.time()
-        if a.dim == 3 and a.method == "spectral":
-            imgs = slices(SplineField(spectral_tile(photo), photo.reshape(-1, 3).astype(np.float64).mean(0)),
-                          a.seeds)
+        if a.dim == 3 and a.method == "spectral":     # as the product draws it, through the request
+            req = SolidRequest(exemplar=photo, method="spectral", periodic=not a.no_periodic).check()
+            imgs = slices(req.spectral_field(), a.seeds)
         elif a.dim == 3:
             imgs = slices(TileField(synthesise(photo, settings), PX_PER_UNIT), a.seeds)
         else:       # one tile per seed, its SIZE² image as the product draws it (top row first), grouped as x
@@ -244,6 +246,7 @@ def main(argv=None) -> int:
     print(json.dumps(summary))
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     write_json(a.out + ".json", {"method": a.method if a.dim == 3 else "synthesis",
+                                 "periodic": not a.no_periodic if a.method == "spectral" else None,
                                  "settings": "the product's (image_settings; levels per photo)" if product else
                                  {k: getattr(settings, k) for k in settings.__dataclass_fields__},
                                  "px_per_unit": PX_PER_UNIT, "seeds": a.seeds, "against": a.against,
