@@ -109,8 +109,9 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
         ("NEURAL", "Neural Texture", "The texture-space model encodes the image into a texture code (with its "
                                      "periodic part and Gaussian rest)"),
         ("SPECTRAL", "Spectral Solid", "Random phase noise of the image lifted to a solid: its spectrum and colours "
-                                       "on every cut, no stones or courses (closer to rock, sand and soil photos on "
-                                       "cuts; repeats every 128 image px; about 6 s to draw)")], default="NEURAL")
+                                       "on every cut, its periodic part upright on walls, no stones (closer to rock, "
+                                       "sand and soil photos on cuts; repeats every 128 image px; about 6 s to "
+                                       "draw)")], default="NEURAL")
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
                            description="A photo of the material (at least 128 px; a large one is read in at most 8 x 8 crops)")
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,

@@ -189,7 +189,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "from the image file --exemplar by texture optimisation (Kwatra et al. 2005), copying its "
                         "courses, planks and stones; --tile px a side, repeated beyond it; spectral: random phase "
                         "noise of the image file --exemplar lifted to a solid, 2D or 3D (a Gaussian texture with "
-                        "its spectrum and colours on every cut, no stones or courses; repeats every 128 image px)")
+                        "its spectrum and colours on every cut, its periodic part upright on walls unless "
+                        "--no-periodic; no stones; repeats every 128 image px)")
     s.add_argument("--tile", type=int, default=256, help="--method synthesis: the periodic image's side, px "
                                                          "(a multiple of 4 in [32, 1024]; default 256; multiples of 8 and "
                                                          "more let large photos lay out large structures whole)")

@@ -37,6 +37,10 @@ sees which; on the 35 structured held-out photos, model card "Random phase noise
   DFT, :func:`bspline_prefilter`; Unser 1999, IEEE Signal Processing Magazine 16(6)); :class:`SplineField` reads
   it with 4 x 4 x 4 taps.  The same three photos then score 34, 31 and 31 there.
 
+With ``harmonics`` (the request's ``periodic``, on by default) the photo's harmonic part, its isolated spectral
+peaks (courses, head joints, plank seams: :mod:`backend.solid.harmonic`), is taken out of the photo before its
+spectrum is read and added back by :class:`SplineField` upright on walls, as the neural texture adds it.
+
 The tile repeats every ``period`` photo pixels (``period / PX_PER_UNIT`` units) along x, y and z; nothing longer
 than the period is drawn, which is most of what its cuts still lose to random phase noise (the low-pass residue;
 on the band-pass levels it is as close).  At the default period the tile is 256^3 x 3 float32 (200 MB), drawn in
