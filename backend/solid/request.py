@@ -11,7 +11,8 @@ finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("
 2D image of ``tile`` px a side synthesised from an image exemplar by texture optimisation
 (:mod:`backend.solid.synthesis`): no model, no code, 2D only; ``method`` "spectral" a periodic Gaussian solid whose
 slices carry the image's spectrum (random phase noise lifted to 3D, :mod:`backend.solid.spectral_solid`): no model,
-2D and 3D, with the image's harmonic part where ``periodic``.  Where the texture is read (grid, zoom, scale) belongs to the bake, not to the texture.
+2D and 3D, with the image's harmonic part where ``periodic``.  Where the texture is read (grid, zoom, scale)
+belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
 sha256): equal settings from any front-end give equal keys (tests/cli/test_solid_request.py).
