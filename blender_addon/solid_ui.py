@@ -14,8 +14,8 @@ VOLUME           an OpenVDB file (``color`` + ``density`` grids) over the object
 
 From an image exemplar, Method chooses the texture: the texture-space model's (Neural Texture) or random phase
 noise of the image lifted to a solid (Spectral Solid, ``backend.solid.spectral_solid``: its spectrum and colours on
-every cut, no stones or courses; the same request as ``omninoise solid --method spectral``), previewed and baked to
-the same targets.
+every cut, its periodic part upright on walls, no stones; the same request as ``omninoise solid --method
+spectral``), previewed and baked to the same targets.
 
 From an image exemplar, Tileable Image synthesises a seamless 2D image instead (``backend.solid.synthesis``,
 texture optimisation: the photo's pieces rearranged), stored as the image datablock ``<Name> Tile`` for Image
