@@ -208,12 +208,14 @@ def tile_request(p):
 
 
 def texture(p):
-    """(model, code_fn) for the panel's settings; code_fn() runs on the worker (it may encode an image)."""
+    """(model, code_fn) for the panel's settings; code_fn(progress, cancel) runs on the worker (it may encode an
+    image, or draw a spectral solid, about 6 s, with progress and cancel)."""
     req = panel_request(p)
     if req.method == "spectral":     # no model: the "code" is the drawn solid (backend.solid.spectral_solid)
-        return _mod("solid.spectral_solid").SpectralTexture(req), lambda: req.spectral_field()
+        return (_mod("solid.spectral_solid").SpectralTexture(req),
+                lambda progress=None, cancel=None: req.spectral_field("", progress, cancel))
     m = load_model(os.path.basename(req.model))
-    return m, lambda: req.code(m)[0]
+    return m, lambda progress=None, cancel=None: req.code(m)[0]
 
 
 def periodic_info(code) -> str:
@@ -331,7 +333,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         seed, name = p.seed, f"{p.name} Preview"
 
         def work(progress, cancel):
-            code = code_fn()
+            code = code_fn(lambda f: progress(0.2 * f), cancel)
             progress(0.2)
             img = m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
             return img, periodic_info(code), gaussian_info(code)
@@ -464,7 +466,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
             size, margin = int(p.size), int(p.margin)
 
             def work(progress, cancel):
-                code = code_fn()
+                code = code_fn(None, cancel)
                 mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.3 * f), cancel)
                 mask, pts = surface.dilate(mask, pts, margin)
                 rgb = np.zeros((size, size, 3), np.float32)
@@ -489,7 +491,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
             linear = _mod("solid.bake").srgb_to_linear
 
             def work(progress, cancel):
-                code = code_fn()
+                code = code_fn(None, cancel)
                 rgb = m.evaluate(co * scale, code, seed, progress=progress, cancel=cancel)
                 return linear(rgb)
 
@@ -530,7 +532,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
             bake = _mod("solid.bake")
 
             def work(progress, cancel):
-                code = code_fn()
+                code = code_fn(None, cancel)
                 if isinstance(m, _mod("solid.spectral_solid").SpectralTexture):    # the job files' source
                     src = _mod("sources").SpectralSource(m.request, scale, field=code)
                     bake_mod = _mod("bake")
