@@ -300,6 +300,15 @@ def _grid_points(shape, first, step, start=None) -> np.ndarray:
     return np.stack([m.ravel() for m in reversed(mesh)], axis=1)
 
 
+def _solid_points(shape, first, step, start=None) -> np.ndarray:
+    """:func:`_grid_points` in 3D: a 2D grid's points lie on the plane z = ``first[2]`` (0 where first has no z):
+    float64 (N, 3) (x, y, z)."""
+    pts = _grid_points(shape, first, step, start)
+    if len(shape) == 2:
+        pts = np.concatenate([pts, np.full((len(pts), 1), first[2] if len(first) > 2 else 0.0)], axis=1)
+    return pts
+
+
 class SolidSource:
     """A neural solid texture (Henzler et al. 2020) as a bake source of colours (``rgb``).
 
@@ -358,10 +367,7 @@ class SolidSource:
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
 
-        n = len(shape)
-        pts = _grid_points(shape, first, step, start)
-        if n == 2:
-            pts = np.concatenate([pts, np.full((len(pts), 1), first[2])], axis=1)
+        pts = _solid_points(shape, first, step, start)
         if self.dim == 2:
             pts = pts[:, :2]
         rgb = self.model.evaluate(pts * self.scale, self.code, self.seed, progress=progress, cancel=cancel)
@@ -466,21 +472,10 @@ class SpectralSource:
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
-        from .grid import Cancelled
 
-        pts = _grid_points(shape, first, step, start)
-        if len(shape) == 2:
-            pts = np.concatenate([pts, np.full((len(pts), 1), first[2] if len(first) > 2 else 0.0)], axis=1)
-        pts = pts * self.scale
-        out = np.empty((pts.shape[0], 3), np.float32)
-        block = 1 << 18
-        for a in range(0, pts.shape[0], block):      # a 3D grid is read in blocks: progress and cancel between
-            if cancel is not None and cancel():
-                raise Cancelled("cancelled")
-            out[a:a + block] = self.field.evaluate(pts[a:a + block])
-            if progress is not None:
-                progress(min(1.0, (a + block) / pts.shape[0]))
-        return srgb_to_linear(out).reshape(tuple(shape) + (3,))
+        rgb = self.field.evaluate(_solid_points(shape, first, step, start) * self.scale, progress=progress,
+                                  cancel=cancel)
+        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
 
     def to_dict(self) -> dict:
         r = self.request

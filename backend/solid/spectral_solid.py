@@ -242,8 +242,9 @@ class SplineField:
         """Texture units per repeat along each axis."""
         return self.coeffs.shape[0] / self.voxels_per_unit
 
-    def evaluate(self, points: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
-        """points float (P, 2 or 3) in texture units (x, y[, z]; 2D points lie on z = 0) -> float32 (P, 3)."""
+    def evaluate(self, points: np.ndarray, chunk: int = 1 << 16, progress=None, cancel=None) -> np.ndarray:
+        """points float (P, 2 or 3) in texture units (x, y[, z]; 2D points lie on z = 0) -> float32 (P, 3), in chunks
+        of ``chunk`` points: ``progress(fraction)`` after each, ``cancel()`` returning True raises Cancelled."""
         pts = np.asarray(points, np.float64)
         if pts.ndim != 2 or pts.shape[1] not in (2, 3):
             raise SettingError("points", f"points must have shape (P, 2) or (P, 3), got {pts.shape}")
@@ -252,6 +253,8 @@ class SplineField:
         c, M = self.coeffs, self.coeffs.shape[0]
         out = np.empty((pts.shape[0], 3), np.float32)
         for a in range(0, pts.shape[0], chunk):
+            if cancel is not None and cancel():
+                raise Cancelled("cancelled")
             u = pts[a:a + chunk, ::-1] * self.voxels_per_unit - 0.5       # (z, y, x) in voxels
             i0 = np.floor(u)
             wz, wy, wx = (bspline_weights((u[:, k] - i0[:, k]).astype(np.float32)) for k in range(3))
@@ -264,6 +267,8 @@ class SplineField:
                     for r in range(4):
                         acc += (wpq * wx[:, r])[:, None] * c[iz[:, p], iy[:, q], ix[:, r]]
             out[a:a + chunk] = acc
+            if progress is not None:
+                progress(min(1.0, (a + chunk) / pts.shape[0]))
         if self.harmonics is not None:
             from .harmonic import harmonic_field
 
@@ -289,19 +294,11 @@ class SpectralTexture:
     def __init__(self, request):
         self.request = request
 
-    def evaluate(self, points, code: SplineField, seed: int = 0, chunk: int = 1 << 18, progress=None,
+    def evaluate(self, points, code: SplineField, seed: int = 0, chunk: int = 1 << 16, progress=None,
                  cancel=None) -> np.ndarray:
-        """points float (N, 2 or 3) in texture units -> sRGB float32 (N, 3), in chunks with ``progress(fraction)``
-        after each and ``cancel()`` returning True raising Cancelled."""
-        pts = np.asarray(points, np.float64)
-        out = np.empty((pts.shape[0], 3), np.float32)
-        for a in range(0, pts.shape[0], chunk):
-            if cancel is not None and cancel():
-                raise Cancelled("cancelled")
-            out[a:a + chunk] = code.evaluate(pts[a:a + chunk])
-            if progress is not None:
-                progress(min(1.0, (a + chunk) / max(pts.shape[0], 1)))
-        return out
+        """points float (N, 2 or 3) in texture units -> sRGB float32 (N, 3): :meth:`SplineField.evaluate`, in
+        chunks with ``progress(fraction)`` after each and ``cancel()`` returning True raising Cancelled."""
+        return code.evaluate(points, chunk, progress, cancel)
 
     def image(self, size: int, code: SplineField, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),
               axis: str = "y", **kw) -> np.ndarray:

@@ -200,3 +200,18 @@ def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest():
     assert down.argmax() == 64 // 16 and down[4] > 0.8 * down.sum()
     assert wall.mean(0).std() < 0.1 * wall.mean(1).std()            # level: nothing along y
     assert SplineField(rest, (0.5, 0.5, 0.5), harmonics=None).harmonics is None
+
+
+def test_reading_the_field_reports_progress_and_cancels(drawn):
+    """SplineField.evaluate, which bakes and the panel read through: progress after each chunk, cancel between."""
+    from backend.grid import Cancelled
+
+    _, f = drawn
+    pts = np.random.default_rng(1).uniform(0, 2, (1000, 3))
+    seen = []
+    got = f.evaluate(pts, chunk=128, progress=seen.append)
+    np.testing.assert_array_equal(got, f.evaluate(pts))
+    assert len(seen) == 8 and seen == sorted(seen) and seen[-1] == 1.0
+    calls = []
+    with pytest.raises(Cancelled):
+        f.evaluate(pts, chunk=128, cancel=lambda: calls.append(1) or len(calls) > 2)
