@@ -6,7 +6,9 @@ given words, for example ``brick,wood,rock``) a periodic tile is synthesised fro
 normal to x, y and z through ``photo_eval.SLICE_OFFSETS`` (SIZE² px at the photo's resolution, one slice per seed
 and axis; a seed moves the slices through the tile as it moves the runtime's texture).  Patch distances (x 1000,
 lower is better) pooled, on the walls (x and y slices) and per axis, against random phase noise drawn as often and
-grouped alike (``photo_eval.grouped_swd``); the same without the low-pass residue (``_band``: the band-pass levels,
+grouped alike (``photo_eval.grouped_swd``), and Gaussian spot noise with the photo's expected spectrum drawn alike
+(``gaussian_2d``: ``photo_eval.gaussian_noise``, whose amplitudes vary per draw as a Gaussian solid's slices' do);
+the same without the low-pass residue (``_band``: the band-pass levels,
 where a photo's own crops are the floor) and the photo's own crops drawn as often (``photo_crop``: how close real
 pieces of it come, and on how many photos even they beat random phase noise); in 3D also random phase noise as a
 solid (:func:`random_phase_solid`, isotropic and upright, and per photo the closer of the two: random phase noise
@@ -21,7 +23,8 @@ slices of 3D output).
 
 With ``--method spectral`` the 3D texture measured is instead what ``method = "spectral"`` ships
 (``backend/solid/spectral_solid.py``: random phase noise lifted to a periodic solid with the photo's harmonic part,
-``--no-periodic`` without it; one draw per photo, sliced as the tiles are; the synthesis settings are not used).
+``--no-periodic`` without it, its values mapped onto the photo's marginals, ``--no-marginals`` without that; one draw
+per photo, sliced as the tiles are; the synthesis settings are not used).
 
 Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices | the same of the closer random phase
 solid | random phase noise drawn in 2D; 2D: photo | the first
@@ -44,7 +47,8 @@ import numpy as np  # noqa: E402
 
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
-from backend.solid.model import resize_rgb, slice_points  # noqa: E402
+from backend.solid.model import measure_harmonics, resize_rgb, slice_points  # noqa: E402
+from backend.solid.spectral_solid import spectral_field  # noqa: E402
 from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
 from backend.solid.upright import upright_waves  # noqa: E402
 from backend.solid.request import SolidRequest  # noqa: E402
@@ -101,6 +105,10 @@ def measure(photo: np.ndarray, imgs: dict, rng: np.random.Generator) -> dict:
     crops = pe.grouped_swd({"x": [pe.photo_crop(photo, SIZE, rng) for _ in pooled]}, photo)
     r.update({"pooled_band": d["pooled_band"], "random_phase_pooled_band": b["pooled_band"],
               "photo_crop": crops["pooled"], "photo_crop_band": crops["pooled_band"]})
+    # Gaussian noise with the photo's expected spectrum drawn as a 2D image per slice (spot noise: its amplitudes
+    # vary per draw as a Gaussian solid's slices' do), grouped alike, after the draws above
+    g2 = pe.grouped_swd({ax: [pe.gaussian_noise(photo, SIZE, rng) for _ in range(seeds)] for ax in imgs}, photo)
+    r.update({"gaussian_2d_" + k: g2[k] for k in ("pooled", "walls", "pooled_band")})
     if "z" in imgs:     # 3D: the Gaussian solids a solid can be compared with, each and the closer of the two per
         # figure, and how oriented the photo is
         for kind in SOLIDS:
@@ -131,6 +139,8 @@ def main(argv=None) -> int:
                                                                 "short side first (small photos: swatches, game textures)")
     ap.add_argument("--method", default="synthesis", choices=("synthesis", "spectral"),
                     help="what is measured in 3D: the synthesised tile, or the spectral solid the product draws")
+    ap.add_argument("--no-marginals", action="store_true",
+                    help="--method spectral: the Gaussian tile's values as drawn, not mapped onto the photo's marginals")
     ap.add_argument("--no-periodic", action="store_true",
                     help="--method spectral: without the photo's harmonic part (the product's --no-periodic)")
     ap.add_argument("--against", default=None, help="an eval_solid_photos.py JSON: the neural texture's figures")
@@ -165,7 +175,11 @@ def main(argv=None) -> int:
         t = time.time()
         if a.dim == 3 and a.method == "spectral":     # as the product draws it, through the request
             req = SolidRequest(exemplar=photo, method="spectral", periodic=not a.no_periodic).check()
-            imgs = slices(req.spectral_field(), a.seeds)
+            if a.no_marginals:     # what the request draws, less the map onto the marginals
+                h = measure_harmonics(photo, PX_PER_UNIT) if req.periodic else None
+                imgs = slices(spectral_field(photo, int(req.seed), h, marginals=False), a.seeds)
+            else:
+                imgs = slices(req.spectral_field(), a.seeds)
         elif a.dim == 3:
             imgs = slices(TileField(synthesise(photo, settings), PX_PER_UNIT), a.seeds)
         else:       # one tile per seed, its SIZE² image as the product draws it (top row first), grouped as x
@@ -227,6 +241,9 @@ def main(argv=None) -> int:
             if neural:
                 summary[f"neural_beats_random_phase_solid_{k}"] = int(sum(
                     r[f"neural_{k}"] < r[f"random_phase_solid_{k}"] for r in rows.values() if "neural_pooled" in r))
+    for k in ("pooled", "walls", "pooled_band"):     # against spot noise drawn in 2D
+        summary[f"median_gaussian_2d_{k}"] = med("gaussian_2d_" + k)
+        summary[f"beats_gaussian_2d_{k}"] = int(sum(r[k] < r["gaussian_2d_" + k] for r in rows.values()))
     summary["beats_pixel_shuffle_pooled"] = int(sum(r["pooled"] < r["pixel_shuffle"] for r in rows.values()))
     summary["beats_random_phase_axis_slices"] = int(sum(r[ax] < r["random_phase_axes"]
                                                         for r in rows.values() for ax in "xyz" if ax in r))
@@ -247,6 +264,7 @@ def main(argv=None) -> int:
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     write_json(a.out + ".json", {"method": a.method if a.dim == 3 else "synthesis",
                                  "periodic": not a.no_periodic if a.method == "spectral" else None,
+                                 "marginals": not a.no_marginals if a.method == "spectral" else None,
                                  "settings": "the product's (image_settings; levels per photo)" if product else
                                  {k: getattr(settings, k) for k in settings.__dataclass_fields__},
                                  "px_per_unit": PX_PER_UNIT, "seeds": a.seeds, "against": a.against,

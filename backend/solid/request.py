@@ -181,20 +181,19 @@ class SolidRequest:
 
     def spectral_field(self, where: str = "", progress=None, cancel=None):
         """Method "spectral": the :class:`~backend.solid.spectral_solid.SplineField` of a periodic Gaussian solid
-        whose slices carry the exemplar's spectrum, drawn with ``seed`` (progress and cancel as
+        whose slices carry the exemplar's spectrum, its values mapped onto the exemplar's marginals, drawn with
+        ``seed`` (:func:`~backend.solid.spectral_solid.spectral_field`; progress and cancel as
         :func:`~backend.solid.spectral_solid.spectral_tile`'s); SettingError naming the exemplar for an image it
         cannot use."""
         from .model import measure_harmonics
-        from .spectral_solid import PX_PER_UNIT, SplineField, spectral_tile
+        from .spectral_solid import PX_PER_UNIT, spectral_field
 
         img = np.asarray(self.exemplar_pixels(where), np.float32)
         try:
             h = measure_harmonics(img, PX_PER_UNIT) if self.periodic else None
-            coeffs = spectral_tile(img, int(self.seed), progress=progress, cancel=cancel, harmonics=h)
+            return spectral_field(img, int(self.seed), h, progress, cancel)
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
-        return SplineField(coeffs, np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0),
-                           harmonics=h, seed=int(self.seed))
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's

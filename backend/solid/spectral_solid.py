@@ -37,6 +37,16 @@ sees which; on the 35 structured held-out photos, model card "Random phase noise
   DFT, :func:`bspline_prefilter`; Unser 1999, IEEE Signal Processing Magazine 16(6)); :class:`SplineField` reads
   it with 4 x 4 x 4 taps.  The same three photos then score 34, 31 and 31 there.
 
+- **Marginals**.  A Gaussian field's values have Gaussian marginals; a photo's seldom do (dark cracks between
+  stones, bright specks in gravel skew them).  As Heeger and Bergen match histograms after every pass (SIGGRAPH
+  1995, Sec. 3.3), the tile's values are mapped along the photo's principal colour axes, one monotone function
+  per axis, from their own quantiles to the photo's (:class:`Marginals`, fitted by :func:`fit_marginals`): a
+  pointwise map, so every cut through the solid gets it.  The photo's quantiles are scaled to the tile's own
+  spread on each axis: the tile holds nothing longer than its period, so its variance is a little below the
+  photo's, and matching the photo's whole variance instead amplified the finer bands (on the 35 structured held-out
+  photos: pooled median 89.6 -> 94.5, closer than the tile without the map on only 13; scaled: 89.1, closer on 23
+  pooled, 26 on walls, 28 on the band-pass levels).
+
 With ``harmonics`` (the request's ``periodic``, on by default) the photo's harmonic part, its isolated spectral
 peaks (courses, head joints, plank seams: :mod:`backend.solid.harmonic`), is taken out of the photo before its
 spectrum is read and added back by :class:`SplineField` upright on walls, as the neural texture adds it.
@@ -53,6 +63,8 @@ float64 (P, 3) in texture units at PX_PER_UNIT photo px per unit; fields float32
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..errors import SettingError
@@ -61,8 +73,9 @@ from ..periodic import periodic_component
 from .model import plane_points
 from .synthesis import PX_PER_UNIT
 
-__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "MIN_PHOTO", "MAX_READ", "slice_spectrum", "solid_power",
-           "colour_factors", "spectral_tile", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
+__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES", "slice_spectrum",
+           "solid_power", "colour_factors", "photo_rest", "spectral_tile", "spectral_field", "fit_marginals",
+           "Marginals", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
 
 PERIOD = 128       #: photo px per repeat of the tile along each axis (the design's grid of PERIOD^3 frequencies)
 OVERSAMPLE = 2     #: voxels per photo px along each axis: PERIOD * OVERSAMPLE voxels a side
@@ -72,7 +85,10 @@ MIN_PHOTO = 32     #: the shortest photo side read, px
 #: pixel scale; each of the 128^2 bins still averages 64 of its Fourier coefficients), which keeps a 4096^2 photo
 #: to seconds and under 1.5 GB
 MAX_READ = 1024
+QUANTILES = 257    #: levels of the marginal tables (Marginals), from the least value to the greatest
+MARGINAL_SAMPLES = 1 << 16   #: points of the tile read to measure its marginals
 _SALT = 0x67617573  #: the draw's stream, beside the seed
+_MARGINAL_SALT = 0x6d617267  #: the stream of the points the marginals are measured at
 
 
 def slice_spectrum(photo: np.ndarray, n: int) -> np.ndarray:
@@ -135,6 +151,24 @@ def colour_factors(P: np.ndarray, S: np.ndarray) -> np.ndarray:
     return L
 
 
+def photo_rest(photo: np.ndarray, harmonics=None) -> np.ndarray:
+    """What the solid draws of ``photo`` (H, W, 3+): float32 (h, w, 3) in [0, 1], its central crop of at most
+    MAX_READ px a side less its harmonic part ``harmonics`` where given (at the crop's pixel centres, as
+    :func:`backend.solid.harmonic.harmonic_field` places it on the photo)."""
+    img = np.asarray(photo, np.float32)
+    H, W = img.shape[:2]
+    y0, x0 = max(0, (H - MAX_READ) // 2), max(0, (W - MAX_READ) // 2)
+    crop = np.clip(img[y0:y0 + MAX_READ, x0:x0 + MAX_READ, :3], 0.0, 1.0)
+    if harmonics is not None and len(harmonics):       # the rest: the part at the crop's pixel centres, taken out
+        from .harmonic import harmonic_field
+
+        h, w = crop.shape[:2]
+        rr, cc = np.meshgrid(np.arange(h, dtype=np.float64) + y0, np.arange(w, dtype=np.float64) + x0, indexing="ij")
+        pts = np.stack([(cc.ravel() + 0.5) / PX_PER_UNIT, -(rr.ravel() + 0.5) / PX_PER_UNIT], axis=1)
+        crop = np.clip(crop - harmonic_field(pts, harmonics).reshape(h, w, 3), 0.0, 1.0)
+    return crop
+
+
 def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, oversample: int = OVERSAMPLE,
                   iterations: int = ITERATIONS, progress=None, cancel=None, harmonics=None) -> np.ndarray:
     """Cubic B-spline coefficients float32 (M, M, M, 3), M = period * oversample (period None: PERIOD, read when
@@ -167,17 +201,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, o
         return cancel is not None and bool(cancel())
 
     n, M = int(period), int(period) * int(oversample)
-    H, W = img.shape[:2]
-    y0, x0 = max(0, (H - MAX_READ) // 2), max(0, (W - MAX_READ) // 2)
-    crop = np.clip(img[y0:y0 + MAX_READ, x0:x0 + MAX_READ, :3], 0.0, 1.0)
-    if harmonics is not None and len(harmonics):       # the rest: the part at the crop's pixel centres, taken out
-        from .harmonic import harmonic_field
-
-        h, w = crop.shape[:2]
-        rr, cc = np.meshgrid(np.arange(h, dtype=np.float64) + y0, np.arange(w, dtype=np.float64) + x0, indexing="ij")
-        pts = np.stack([(cc.ravel() + 0.5) / PX_PER_UNIT, -(rr.ravel() + 0.5) / PX_PER_UNIT], axis=1)
-        crop = np.clip(crop - harmonic_field(pts, harmonics).reshape(h, w, 3), 0.0, 1.0)
-    S = slice_spectrum(crop, n)
+    S = slice_spectrum(photo_rest(img, harmonics), n)
     P = solid_power(np.trace(S, axis1=2, axis2=3), iterations, tick)
     L = colour_factors(P, S)
     amp = np.sqrt(P).astype(np.float32)
@@ -217,23 +241,83 @@ def bspline_weights(t: np.ndarray) -> np.ndarray:
     return np.stack([(1.0 - t) ** 3, 3.0 * t3 - 6.0 * t2 + 4.0, -3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0, t3], -1) / 6.0
 
 
+@dataclasses.dataclass(frozen=True)
+class Marginals:
+    """Monotone maps of a zero-mean colour field's values onto a photo's marginals (module doc): along each column
+    of ``basis`` (float32 (3, 3), the photo's principal colour axes), values at the quantiles ``source`` (float32
+    (QUANTILES, 3), non-decreasing: the field's) go to ``target`` (float32 (QUANTILES, 3): the photo's, scaled to
+    the field's spread), piecewise linearly between them; beyond the ends they stay at the ends."""
+
+    basis: np.ndarray
+    source: np.ndarray
+    target: np.ndarray
+
+    def apply(self, values: np.ndarray) -> np.ndarray:
+        """values float (P, 3), zero-mean field values -> float32 (P, 3) mapped."""
+        y = np.asarray(values, np.float32) @ self.basis
+        for k in range(3):
+            y[:, k] = np.interp(y[:, k], self.source[:, k], self.target[:, k])
+        return y @ self.basis.T
+
+
+def fit_marginals(rest: np.ndarray, field: "SplineField", seed: int = 0) -> Marginals:
+    """The maps taking ``field``'s values (its B-spline alone: no mean, part or marginals) onto the marginals of
+    ``rest`` (float (h, w, 3) or (N, 3): the photo's colours the field draws, :func:`photo_rest`) along the rest's
+    principal colour axes, each scaled to the field's spread on that axis (module doc); the field read at
+    MARGINAL_SAMPLES uniform points of its period (their stream from ``seed``).  An axis on which the photo or the
+    field barely varies (a grey photo's chroma) keeps its values."""
+    r = np.asarray(rest, np.float64).reshape(-1, 3)
+    r = r - r.mean(0)
+    _, U = np.linalg.eigh(np.cov(r.T) + 1e-12 * np.eye(3))
+    rng = np.random.default_rng([int(seed), _MARGINAL_SALT])
+    v = field.spline(rng.uniform(0.0, field.period, (MARGINAL_SAMPLES, 3))).astype(np.float64) @ U
+    yp = r @ U
+    levels = np.linspace(0.0, 1.0, QUANTILES)
+    src, dst = np.quantile(v, levels, axis=0), np.quantile(yp, levels, axis=0)
+    sf, sp = v.std(0), yp.std(0)
+    for k in range(3):
+        if sp[k] > 1e-3 * sp.max() and sp[k] > 1e-6 and sf[k] > 1e-3 * sf.max() and sf[k] > 1e-6:
+            dst[:, k] *= sf[k] / sp[k]
+        else:   # keep: the identity over any value a colour field takes
+            src[:, k] = dst[:, k] = np.linspace(-2.0, 2.0, QUANTILES)
+    return Marginals(U.astype(np.float32), src.astype(np.float32), dst.astype(np.float32))
+
+
+def spectral_field(photo: np.ndarray, seed: int = 0, harmonics=None, progress=None, cancel=None,
+                   marginals: bool = True) -> "SplineField":
+    """Method "spectral"'s texture of ``photo`` (H, W, 3): :func:`spectral_tile` drawn with ``seed``, read as a
+    :class:`SplineField` around the photo's mean colour, with the photo's harmonic part ``harmonics`` added back,
+    and (``marginals``) its values mapped onto the marginals of the photo's rest (:func:`fit_marginals`).
+    ``progress`` and ``cancel`` as :func:`spectral_tile`'s."""
+    img = np.asarray(photo, np.float32)
+    coeffs = spectral_tile(img, seed, progress=progress, cancel=cancel, harmonics=harmonics)
+    mean = np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0)
+    field = SplineField(coeffs, mean, harmonics=harmonics, seed=seed)
+    if not marginals:
+        return field
+    return SplineField(coeffs, mean, harmonics=harmonics, seed=seed,
+                       marginals=fit_marginals(photo_rest(img, harmonics), field, seed))
+
+
 class SplineField:
     """A periodic solid as a colour field over texture space: ``mean`` (3,) plus the cubic B-spline of
     ``coeffs`` (M, M, M, 3) indexed (z, y, x), voxel centres at (i + 1/2) / voxels_per_unit, ``voxels_per_unit``
     = PX_PER_UNIT * oversample (the photo's scale), plus the photo's harmonic part ``harmonics`` where given (upright
-    on walls, moved by ``seed``: :func:`backend.solid.harmonic.harmonic_field`, as the neural texture draws it).
-    ``evaluate(points)`` reads it anywhere with wrap-around, clipped to [0, 1]."""
+    on walls, moved by ``seed``: :func:`backend.solid.harmonic.harmonic_field`, as the neural texture draws it),
+    the B-spline's values mapped by ``marginals`` (:class:`Marginals`) where given.  ``evaluate(points)`` reads it
+    anywhere with wrap-around, clipped to [0, 1]."""
 
     dim = 3
 
     def __init__(self, coeffs: np.ndarray, mean, oversample: int = OVERSAMPLE, px_per_unit: float = PX_PER_UNIT,
-                 harmonics=None, seed: int = 0):
+                 harmonics=None, seed: int = 0, marginals: Marginals | None = None):
         c = np.asarray(coeffs, np.float32)
         if c.ndim != 4 or c.shape[-1] != 3 or len(set(c.shape[:3])) != 1:
             raise SettingError("coeffs", f"coefficients are (M, M, M, 3), got shape {c.shape}")
         self.coeffs, self.mean = c, np.asarray(mean, np.float32).reshape(3)
         self.harmonics = harmonics if harmonics is not None and len(harmonics) else None
         self.seed = int(seed)
+        self.marginals = marginals
         self.px_per_unit = float(px_per_unit)
         self.voxels_per_unit = float(px_per_unit) * int(oversample)
 
@@ -245,28 +329,13 @@ class SplineField:
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 16, progress=None, cancel=None) -> np.ndarray:
         """points float (P, 2 or 3) in texture units (x, y[, z]; 2D points lie on z = 0) -> float32 (P, 3), in chunks
         of ``chunk`` points: ``progress(fraction)`` after each, ``cancel()`` returning True raises Cancelled."""
-        pts = np.asarray(points, np.float64)
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
-            raise SettingError("points", f"points must have shape (P, 2) or (P, 3), got {pts.shape}")
-        if pts.shape[1] == 2:
-            pts = np.concatenate([pts, np.zeros((pts.shape[0], 1))], axis=1)
-        c, M = self.coeffs, self.coeffs.shape[0]
+        pts = self._points(points)
         out = np.empty((pts.shape[0], 3), np.float32)
         for a in range(0, pts.shape[0], chunk):
             if cancel is not None and cancel():
                 raise Cancelled("cancelled")
-            u = pts[a:a + chunk, ::-1] * self.voxels_per_unit - 0.5       # (z, y, x) in voxels
-            i0 = np.floor(u)
-            wz, wy, wx = (bspline_weights((u[:, k] - i0[:, k]).astype(np.float32)) for k in range(3))
-            i0 = i0.astype(np.int64) - 1
-            iz, iy, ix = ((i0[:, k][:, None] + np.arange(4)) % M for k in range(3))      # (p, 4) each
-            acc = np.zeros((u.shape[0], 3), np.float32)
-            for p in range(4):
-                for q in range(4):
-                    wpq = wz[:, p] * wy[:, q]
-                    for r in range(4):
-                        acc += (wpq * wx[:, r])[:, None] * c[iz[:, p], iy[:, q], ix[:, r]]
-            out[a:a + chunk] = acc
+            acc = self.spline(pts[a:a + chunk])
+            out[a:a + chunk] = acc if self.marginals is None else self.marginals.apply(acc)
             if progress is not None:
                 progress(min(1.0, (a + chunk) / pts.shape[0]))
         if self.harmonics is not None:
@@ -274,6 +343,34 @@ class SplineField:
 
             out += harmonic_field(pts, self.harmonics, self.seed)
         return np.clip(out + self.mean, 0.0, 1.0)
+
+    @staticmethod
+    def _points(points) -> np.ndarray:
+        """points float (P, 2 or 3) -> float64 (P, 3) (2D points on z = 0); SettingError for another shape."""
+        pts = np.asarray(points, np.float64)
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+            raise SettingError("points", f"points must have shape (P, 2) or (P, 3), got {pts.shape}")
+        if pts.shape[1] == 2:
+            pts = np.concatenate([pts, np.zeros((pts.shape[0], 1))], axis=1)
+        return pts
+
+    def spline(self, points) -> np.ndarray:
+        """The B-spline of the coefficients alone (zero mean: no mean colour, harmonic part, marginals or
+        clipping) at points float (P, 2 or 3) in texture units -> float32 (P, 3); 4 x 4 x 4 taps, wrapping."""
+        pts = self._points(points)
+        c, M = self.coeffs, self.coeffs.shape[0]
+        u = pts[:, ::-1] * self.voxels_per_unit - 0.5       # (z, y, x) in voxels
+        i0 = np.floor(u)
+        wz, wy, wx = (bspline_weights((u[:, k] - i0[:, k]).astype(np.float32)) for k in range(3))
+        i0 = i0.astype(np.int64) - 1
+        iz, iy, ix = ((i0[:, k][:, None] + np.arange(4)) % M for k in range(3))      # (p, 4) each
+        acc = np.zeros((u.shape[0], 3), np.float32)
+        for p in range(4):
+            for q in range(4):
+                wpq = wz[:, p] * wy[:, q]
+                for r in range(4):
+                    acc += (wpq * wx[:, r])[:, None] * c[iz[:, p], iy[:, q], ix[:, r]]
+        return acc
 
     def image(self, size: int, scale: float = 1.0) -> np.ndarray:
         """A (size, size, 3) float32 image of the plane z = 0 (x right, y up; row 0 at the top) at ``scale``

@@ -251,7 +251,10 @@ def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_pa
     # shuffled pixels
     assert 0 < r["pooled_band"] and 0 < r["random_phase_pooled_band"]
     assert 0 < r["photo_crop_band"] and r["photo_crop"] < 0.5 * r["pixel_shuffle"]
+    # spot noise drawn in 2D alike (the Gaussian draw a Gaussian solid's slices compare with)
+    assert 0 < r["gaussian_2d_pooled"] < r["pixel_shuffle"] and 0 < r["gaussian_2d_pooled_band"]
     s = doc["summary"]
+    assert s["beats_gaussian_2d_pooled"] == int(r["pooled"] < r["gaussian_2d_pooled"])
     assert s["beats_random_phase_pooled_band"] == int(r["pooled_band"] < r["random_phase_pooled_band"])
     assert s["photo_crop_beats_random_phase_pooled"] == int(r["photo_crop"] < r["random_phase_pooled"])
     if dim == 3:    # the Gaussian solids, and the closer of the two
@@ -288,3 +291,19 @@ def test_bench_scales_photos_down_first_with_photo_side(bench_script, tmp_path):
     # a 256 px tile gets four levels from the 256 px photo, three from it scaled to 128 px (image_levels)
     assert doc["photo_side"] == 128 and r["levels"] == 3
     assert 0 < r["pooled"] < r["pixel_shuffle"]
+
+
+def test_bench_measures_the_spectral_solid_without_the_marginals(bench_script, tmp_path, monkeypatch):
+    """--method spectral --no-marginals measures the Gaussian tile as drawn (the map onto the photo's marginals,
+    which the request draws, left out: tests/core/test_spectral_solid.py compares the two); the JSON says so."""
+    from backend.solid import spectral_solid
+
+    monkeypatch.setattr(spectral_solid, "PERIOD", 32)
+    out = str(tmp_path / "plain")
+    mod = bench_script("solid_synthesis")
+    assert mod.main(["--method", "spectral", "--only", "beige_bricks", "--seeds", "1", "--no-marginals",
+                     "--out", out]) == 0
+    doc = json.load(open(out + ".json"))
+    r = doc["photos"]["brick__beige_bricks.jpg"]
+    assert doc["method"] == "spectral" and doc["marginals"] is False and doc["periodic"] is True
+    assert 0 < r["pooled"] < r["pixel_shuffle"] and r["colour"] < 0.03

@@ -215,3 +215,64 @@ def test_reading_the_field_reports_progress_and_cancels(drawn):
     calls = []
     with pytest.raises(Cancelled):
         f.evaluate(pts, chunk=128, cancel=lambda: calls.append(1) or len(calls) > 2)
+
+
+def _skewed_photo(n: int, seed: int) -> np.ndarray:
+    """A (n, n, 3) photo whose values are far from Gaussian: exp of a 1/f Gaussian texture (bright specks on a
+    dark ground, skewness about 9), colours along one axis."""
+    g = _gaussian_photo(n, seed)[..., 0]
+    v = np.exp(1.2 * (g - g.mean()) / g.std())
+    v = 0.1 + 0.8 * (v - v.min()) / (v.max() - v.min())
+    return (v[..., None] * np.array([1.0, 0.8, 0.6])).astype(np.float32)
+
+
+def _skew(a: np.ndarray) -> float:
+    a = np.asarray(a, np.float64).ravel()
+    return float(((a - a.mean()) ** 3).mean() / a.std() ** 3)
+
+
+@pytest.fixture
+def period32(monkeypatch):
+    from backend.solid import spectral_solid
+
+    monkeypatch.setattr(spectral_solid, "PERIOD", 32)
+
+
+def _slices(f, n: int = 64) -> np.ndarray:
+    rng = np.random.default_rng(11)
+    return np.stack([f.evaluate(slice_points(n, PX_PER_UNIT, ax, rng.uniform(-3, 3, 3))).reshape(n, n, 3)
+                     for ax in "xyz" for _ in range(3)])
+
+
+def test_the_marginals_follow_a_skewed_photo(period32):
+    """Slices of the spectral field of a photo with bright specks on a dark ground keep its skewed values (the map
+    onto its marginals), where the Gaussian tile alone is symmetric; the spread stays the tile's own, the mean the
+    photo's, and the map is monotone along each axis."""
+    from backend.solid.spectral_solid import spectral_field
+
+    photo = _skewed_photo(128, 4)
+    mapped, plain = spectral_field(photo, seed=2), spectral_field(photo, seed=2, marginals=False)
+    assert plain.marginals is None and mapped.marginals is not None
+    a, b = _slices(mapped)[..., 0], _slices(plain)[..., 0]
+    want = _skew(photo[..., 0])
+    assert want > 1.5 and abs(_skew(b)) < 0.5 and abs(_skew(a) - want) < 0.35 * want, (want, _skew(a), _skew(b))
+    assert abs(a.std() / b.std() - 1.0) < 0.15
+    assert abs(a.mean() - photo[..., 0].mean()) < 0.02
+    m = mapped.marginals
+    line = np.linspace(-0.5, 0.5, 201)[:, None] * m.basis[:, 2]    # along the principal axis
+    y = m.apply(line) @ m.basis[:, 2]
+    assert np.all(np.diff(y) >= -1e-6) and y[-1] > y[0]
+
+
+def test_the_marginals_leave_a_gaussian_photo_and_a_grey_photo_as_they_are(period32):
+    """A Gaussian photo's marginals are the tile's own: the map moves values by a small share of their spread.  A
+    grey photo stays grey (its chroma axes barely vary and keep their values) and finite."""
+    from backend.solid.spectral_solid import spectral_field
+
+    photo = _gaussian_photo(128, 6)
+    a, b = _slices(spectral_field(photo, seed=1)), _slices(spectral_field(photo, seed=1, marginals=False))
+    assert np.abs(a - b).mean() < 0.05 * b.std()
+    grey = np.repeat(_skewed_photo(128, 5)[..., :1], 3, axis=2)
+    g = _slices(spectral_field(grey, seed=1))
+    assert np.isfinite(g).all() and np.ptp(g, axis=-1).max() < 1e-3
+    assert abs(_skew(g[..., 0]) - _skew(grey[..., 0])) < 0.35 * _skew(grey[..., 0])

@@ -94,6 +94,29 @@ def test_random_phase_keeps_colour_and_spectrum():
     assert hist.shape == (32, 32, 3) and pe.mean_colour_error(hist, photo) < 0.02
 
 
+def test_gaussian_noise_has_the_photo_spectrum_on_average_and_varies_per_draw():
+    """Spot noise's power averaged over draws is the photo's periodic component's, band by band, its mean colour
+    the photo's; one draw's amplitudes scatter around it (random phase noise keeps them exactly)."""
+    from backend.periodic import periodic_component
+
+    rng = np.random.default_rng(3)
+    g = np.cumsum(np.cumsum(rng.standard_normal((64, 64)), 0), 1)
+    photo = np.clip(0.5 + 0.2 * (g - g.mean()) / g.std(), 0, 1)[..., None] * np.array([1.0, 0.8, 0.5])
+    photo = photo.astype(np.float32)
+    draws = [pe.gaussian_noise(photo, 64, rng) for _ in range(200)]
+    assert max(pe.mean_colour_error(d, photo) for d in draws[:5]) < 0.05
+    P = lambda x: np.abs(np.fft.fft2(x[..., 0] - x[..., 0].mean())) ** 2   # noqa: E731
+    want = P(periodic_component(photo[None, ..., 0])[0][..., None])
+    got = np.mean([P(d) for d in draws], 0)
+    r = np.hypot(*np.meshgrid(np.fft.fftfreq(64), np.fft.fftfreq(64), indexing="ij"))
+    for a, b in ((0.02, 0.06), (0.06, 0.15), (0.15, 0.5)):
+        band = (r >= a) & (r < b)
+        assert abs(got[band].sum() / want[band].sum() - 1.0) < 0.15, (a, got[band].sum() / want[band].sum())
+    one = np.sqrt(P(draws[0])[r > 0.02] / want[r > 0.02])
+    rp = np.sqrt(P(pe.random_phase(photo, 64, rng))[r > 0.02] / P(photo)[r > 0.02])
+    assert np.median(np.abs(one - 1.0)) > 0.25 and np.median(np.abs(rp - 1.0)) < 0.15
+
+
 torch = pytest.importorskip("torch")
 
 from backend.solid.model import SolidTextureModel, colour_stats  # noqa: E402

@@ -44,7 +44,8 @@ from backend.solid.cellular import cellular_features_numpy
 from backend.solid.lattice import lattice_noise
 from backend._export import export as _ex
 
-__all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "perlin_hist",
+__all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "gaussian_noise",
+           "perlin_hist",
            "photo_crop", "colour_by_rank", "voronoi_pavement", "grouped_swd", "level_distances", "band_swd",
            "BASELINES", "SLICE_OFFSETS", "tile_sheet", "axis_imbalance"]
 
@@ -155,6 +156,23 @@ def random_phase(photo: np.ndarray, size: int, rng: np.random.Generator) -> np.n
     m = u.reshape(-1, 3).mean(0)
     phase = np.exp(1j * np.angle(np.fft.fft2(rng.standard_normal(u.shape[:2]))))
     out = np.stack([np.real(np.fft.ifft2(np.fft.fft2(u[..., c] - m[c]) * phase)) for c in range(3)], -1) + m
+    return np.clip(out[:size, :size], 0.0, 1.0).astype(np.float32)
+
+
+def gaussian_noise(photo: np.ndarray, size: int, rng: np.random.Generator) -> np.ndarray:
+    """Asymptotic discrete spot noise (Galerne et al. 2011, Sec. 2.3, Eq. 5): the photo's periodic component
+    (Moisan 2011) less its mean, convolved with white Gaussian noise of variance 1 / (H W) shared by the channels:
+    the Gaussian texture whose expected spectrum and colour correlations are the photo's.  Its Fourier amplitudes
+    vary from draw to draw (random phase noise keeps the photo's), as those of a Gaussian solid's slices do, so it is
+    the 2D draw a Gaussian solid can be compared with on an unoriented photo.  The photo's size, cropped to
+    ``size``."""
+    from backend.periodic import periodic_component
+
+    u = np.asarray(photo, np.float64)[..., :3]
+    m = u.reshape(-1, 3).mean(0)
+    F = np.fft.fft2(periodic_component((u - m).transpose(2, 0, 1)))
+    w = np.fft.fft2(rng.standard_normal(u.shape[:2])) / np.sqrt(u.shape[0] * u.shape[1])
+    out = np.real(np.fft.ifft2(F * w)).transpose(1, 2, 0) + m
     return np.clip(out[:size, :size], 0.0, 1.0).astype(np.float32)
 
 
