@@ -140,7 +140,8 @@ def main(argv=None) -> int:
     ap.add_argument("--method", default="synthesis", choices=("synthesis", "spectral"),
                     help="what is measured in 3D: the synthesised tile, or the spectral solid the product draws")
     ap.add_argument("--no-marginals", action="store_true",
-                    help="--method spectral: the Gaussian tile's values as drawn, not mapped onto the photo's marginals")
+                    help="--method spectral: the Gaussian tile's values as drawn, not mapped onto the photo's "
+                         "marginals")
     ap.add_argument("--no-periodic", action="store_true",
                     help="--method spectral: without the photo's harmonic part (the product's --no-periodic)")
     ap.add_argument("--against", default=None, help="an eval_solid_photos.py JSON: the neural texture's figures")

@@ -43,20 +43,27 @@ sees which; on the 35 structured held-out photos, model card "Random phase noise
   per axis, from their own quantiles to the photo's (:class:`Marginals`, fitted by :func:`fit_marginals`): a
   pointwise map, so every cut through the solid gets it.  The photo's quantiles are scaled to the tile's own
   spread on each axis: the tile holds nothing longer than its period, so its variance is a little below the
-  photo's, and matching the photo's whole variance instead amplified the finer bands (on the 35 structured held-out
-  photos: pooled median 89.6 -> 94.5, closer than the tile without the map on only 13; scaled: 89.1, closer on 23
-  pooled, 26 on walls, 28 on the band-pass levels).
+  photo's, and matching the photo's whole variance instead amplified the finer bands (a prototype on the 35
+  structured held-out photos: pooled median 89.6 -> 94.5, closer than the tile without the map on only 13).  As
+  shipped, on the 87 held-out photos: pooled median 85.3 -> 81.6, closer than without the map on 65 (ice and
+  cracked dirt most: 203.7 -> 126.4, 95.4 -> 60.6), at most 5.6 % farther (model card "Marginals"); fitting
+  takes about 0.3 s, the map 0.12 s per million points.
 
 With ``harmonics`` (the request's ``periodic``, on by default) the photo's harmonic part, its isolated spectral
 peaks (courses, head joints, plank seams: :mod:`backend.solid.harmonic`), is taken out of the photo before its
 spectrum is read and added back by :class:`SplineField` upright on walls, as the neural texture adds it.
 
 The tile repeats every ``period`` photo pixels (``period / PX_PER_UNIT`` units) along x, y and z; nothing longer
-than the period is drawn, which is most of what its cuts still lose to random phase noise (the low-pass residue;
-on the band-pass levels it is as close).  At the default period the tile is 256^3 x 3 float32 (200 MB), drawn in
-about 6 s on 2 cores (peak 1.3 GB), and read at about 1.5 s per million points.  Another seed draws other phases:
-another texture with the same spectrum.  A Gaussian texture has no stones, courses or planks, and on an oriented
-photo the three cuts' compromise shows as plaid (bridge wood's walls).
+than the period is drawn.  What its cuts still lose to random phase noise is mostly the low-pass residue, and
+there the period is not the cause: a 256 px period (8 times the memory) moved five rock and paving photos from
+73.4, 92.9, 66.4, 86.6, 98.0 to 68.9, 81.4, 63.2, 89.0, 91.8 (random phase noise 61.9, 87.5, 55.1, 67.5, 69.2).
+A Gaussian texture's Fourier amplitudes vary from draw to draw, random phase noise keeps the photo's: Gaussian
+spot noise drawn as a 2D image per cut (``photo_eval.gaussian_noise``) is no closer than this solid (model card
+"Marginals").  At the default period the tile is 256^3 x 3 float32 (200 MB), drawn in about 6 s on 2 cores
+(peak 1.3 GB), and read at about 1.5 s per million points along a cut (about 6 s for points scattered at random
+through the tile, whose reads then miss the cache).  Another seed draws other phases: another texture with the
+same spectrum.  A Gaussian texture has no stones, courses or planks, and on an oriented photo the three cuts'
+compromise shows as plaid (bridge wood's walls).
 
 Conventions as :mod:`backend.solid.synthesis`: tiles indexed (z, y, x), z up; colours sRGB in [0, 1]; points
 float64 (P, 3) in texture units at PX_PER_UNIT photo px per unit; fields float32 (P, 3).
