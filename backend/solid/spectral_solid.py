@@ -158,6 +158,19 @@ def colour_factors(P: np.ndarray, S: np.ndarray) -> np.ndarray:
     return L
 
 
+def _checked(photo) -> np.ndarray:
+    """``photo`` as float32 (H, W, 3 or 4); SettingError naming what is wrong with it for a spectral solid."""
+    img = np.asarray(photo, np.float32)
+    if img.ndim != 3 or img.shape[2] not in (3, 4):
+        raise SettingError("photo", f"the photo must be an RGB image (H, W, 3), got shape {img.shape}")
+    if not np.isfinite(img).all():
+        raise SettingError("photo", "the photo has non-finite values")
+    if min(img.shape[:2]) < MIN_PHOTO:
+        raise SettingError("photo", f"the photo is {img.shape[1]} x {img.shape[0]} px; a spectral solid needs at "
+                                    f"least {MIN_PHOTO} px a side")
+    return img
+
+
 def photo_rest(photo: np.ndarray, harmonics=None) -> np.ndarray:
     """What the solid draws of ``photo`` (H, W, 3+): float32 (h, w, 3) in [0, 1], its central crop of at most
     MAX_READ px a side less its harmonic part ``harmonics`` where given (at the crop's pixel centres, as
@@ -185,14 +198,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, o
     reads.  ``harmonics``: the photo's harmonic part (:func:`backend.solid.model.measure_harmonics` at PX_PER_UNIT),
     taken out of the photo first, so the solid draws only the rest (:class:`SplineField` adds the part back).
     ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled."""
-    img = np.asarray(photo, np.float32)
-    if img.ndim != 3 or img.shape[2] not in (3, 4):
-        raise SettingError("photo", f"the photo must be an RGB image (H, W, 3), got shape {img.shape}")
-    if not np.isfinite(img).all():
-        raise SettingError("photo", "the photo has non-finite values")
-    if min(img.shape[:2]) < MIN_PHOTO:
-        raise SettingError("photo", f"the photo is {img.shape[1]} x {img.shape[0]} px; a spectral solid needs at "
-                                    f"least {MIN_PHOTO} px a side")
+    img = _checked(photo)
     period = PERIOD if period is None else period
     if period < 8 or period % 2 or oversample < 1:
         raise SettingError("period", f"period must be an even number >= 8 and oversample >= 1, got {period}, "
@@ -296,14 +302,14 @@ def spectral_field(photo: np.ndarray, seed: int = 0, harmonics=None, progress=No
     :class:`SplineField` around the photo's mean colour, with the photo's harmonic part ``harmonics`` added back,
     and (``marginals``) its values mapped onto the marginals of the photo's rest (:func:`fit_marginals`).
     ``progress`` and ``cancel`` as :func:`spectral_tile`'s."""
-    img = np.asarray(photo, np.float32)
-    coeffs = spectral_tile(img, seed, progress=progress, cancel=cancel, harmonics=harmonics)
+    img = _checked(photo)
+    rest = photo_rest(img, harmonics)       # once: the tile's spectrum and the marginals both read it
+    coeffs = spectral_tile(rest, seed, progress=progress, cancel=cancel)     # the rest has no part left to take out
     mean = np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0)
     field = SplineField(coeffs, mean, harmonics=harmonics, seed=seed)
     if not marginals:
         return field
-    return SplineField(coeffs, mean, harmonics=harmonics, seed=seed,
-                       marginals=fit_marginals(photo_rest(img, harmonics), field, seed))
+    return SplineField(coeffs, mean, harmonics=harmonics, seed=seed, marginals=fit_marginals(rest, field, seed))
 
 
 class SplineField:

@@ -179,7 +179,7 @@ def test_a_large_photo_is_read_from_its_central_crop():
     assert not np.array_equal(spectral_tile(photo[:MAX_READ, :MAX_READ], period=16), spectral_tile(crop, period=16))
 
 
-def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest():
+def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest(period32):
     """A photo of level stripes 16 px apart with a little noise: its harmonic part (measured as the neural texture
     measures it) is taken out before the spectrum is read, so the Gaussian solid carries only the noise, and the
     field adds the part back upright: a wall's rows follow the stripes' period along z, not along y."""
@@ -200,6 +200,10 @@ def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest():
     assert down.argmax() == 64 // 16 and down[4] > 0.8 * down.sum()
     assert wall.mean(0).std() < 0.1 * wall.mean(1).std()            # level: nothing along y
     assert SplineField(rest, (0.5, 0.5, 0.5), harmonics=None).harmonics is None
+    # spectral_field reads the rest once and draws the same tile from it (period32: PERIOD is 32 here)
+    from backend.solid.spectral_solid import spectral_field
+
+    np.testing.assert_array_equal(spectral_field(photo, 0, h, marginals=False).coeffs, rest)
 
 
 def test_reading_the_field_reports_progress_and_cancels(drawn):
