@@ -198,16 +198,16 @@ class SolidRequest:
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
         kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone); for
-        methods "synthesis" and "spectral" only what they read (exemplar, seed and tile, or periodic and the
-        spectral solid's map onto the photo's marginals)."""
+        methods "synthesis" and "spectral" only what they read (exemplar, seed and tile, or periodic, the
+        spectral solid's map onto the photo's marginals and its power's isotropic start)."""
         if self.method == "synthesis":
             return dict(method="synthesis", exemplar=_digest(self.exemplar), seed=int(self.seed),
                         tile=int(self.tile))
         if self.method == "spectral":
-            # marginals: the tile's values are mapped onto the photo's (spectral_solid.Marginals); a bake keyed
-            # before that map, without it, is redone
+            # marginals: the tile's values are mapped onto the photo's (spectral_solid.Marginals); start: its power
+            # is found from an isotropic start (spectral_solid.solid_power); a bake keyed before either is redone
             return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed),
-                        periodic=bool(self.periodic), marginals=True)
+                        periodic=bool(self.periodic), marginals=True, start="isotropic")
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),

@@ -25,6 +25,16 @@ sees which; on the 35 structured held-out photos, model card "Random phase noise
   constant over planes normal to one axis) moves whole slices' means, which the photo's power at zero frequency
   (none) forbids; those lines stay at zero (without that, a low-contrast brick photo's slices came out 0.7
   standard deviations off its mean colour).
+- **An isotropic start**.  Three projections leave most of P free, and EM settles on the solution nearest its
+  start.  From flat power it put a photo's strong low frequencies at 3D frequencies with one large component
+  (the first update is T(z, y) + T(z, x) + T(y, x), large wherever any one of the three is): sheets along the
+  axes that an axis cut shows at low frequency, but a cut at another angle shows at a middle one, as faint plaid.
+  So :func:`solid_power` first runs EM over radial profiles (P a function of |k|: each shell of frequencies takes
+  its power-weighted mean update), which finds the isotropic solid behind isotropic targets (a 1/f^3 solid: 11 %
+  off where the flat start is 26 % off, tested), then the free EM fits what is not isotropic.  On the 87
+  held-out photos, cuts at six random orientations came closer on 77 (median 90.6 -> 84.7; random phase noise
+  72.1); the axis cuts' band-pass levels came closer on 59 (median 47.7 -> 47.1) and their pooled distance went
+  81.6 -> 83.5, all of it on the low-pass level (model card "Isotropic start").
 - **Colour**.  Each 3D frequency takes the power-weighted mean of its three projections' colour cross-spectra
   (3 x 3, normalised to unit trace); its coefficient is sqrt(P) L w, L the Cholesky factor and w complex white
   noise per channel, so every slice keeps the photo's colour correlations scale by scale
@@ -80,13 +90,14 @@ from ..periodic import periodic_component
 from .model import plane_points
 from .synthesis import PX_PER_UNIT
 
-__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES", "slice_spectrum",
+__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "ISOTROPIC_ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES", "slice_spectrum",
            "solid_power", "colour_factors", "photo_rest", "spectral_tile", "spectral_field", "fit_marginals",
            "Marginals", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
 
 PERIOD = 128       #: photo px per repeat of the tile along each axis (the design's grid of PERIOD^3 frequencies)
 OVERSAMPLE = 2     #: voxels per photo px along each axis: PERIOD * OVERSAMPLE voxels a side
 ITERATIONS = 100   #: EM iterations of solid_power (the projections' error stops falling after about 20)
+ISOTROPIC_ITERATIONS = 30   #: solid_power's EM iterations over radial profiles first (its isotropic start)
 MIN_PHOTO = 32     #: the shortest photo side read, px
 #: the longest photo side read, px: a larger photo's spectrum is read from its central crop of this size (at its own
 #: pixel scale; each of the 128^2 bins still averages 64 of its Fourier coefficients), which keeps a 4096^2 photo
@@ -120,18 +131,30 @@ def slice_spectrum(photo: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-def solid_power(T: np.ndarray, iterations: int = ITERATIONS, tick=None) -> np.ndarray:
+def solid_power(T: np.ndarray, iterations: int = ITERATIONS, tick=None,
+                isotropic_iterations: int = ISOTROPIC_ITERATIONS) -> np.ndarray:
     """The solid's power float64 (n, n, n) indexed (z, y, x) whose sums along x, y and z come closest to T
-    (n, n) as (z, y), (z, x) and (y, x) (module doc: EM from a flat start, the coordinate axes held at zero).
+    (n, n) as (z, y), (z, x) and (y, x) (module doc: EM, the coordinate axes held at zero), from an isotropic
+    start: ``isotropic_iterations`` EM steps over radial profiles first (each shell of 3D frequencies, |k| rounded
+    to whole cycles per period, takes the power-weighted mean of its frequencies' updates, so P stays a function
+    of |k|), then ``iterations`` free ones; ``isotropic_iterations`` 0 starts the free ones from flat power.
     ``tick()`` after each iteration; returning True stops with Cancelled."""
     T = np.asarray(T, np.float64)
     n = T.shape[0]
     P = np.full((n, n, n), T.sum() / n ** 3)
-    for _ in range(iterations):
+    if isotropic_iterations > 0:
+        k = (np.arange(n) + n // 2) % n - n // 2
+        shell = np.rint(np.sqrt(k[:, None, None] ** 2 + k[None, :, None] ** 2 + k[None, None, :] ** 2))
+        shell = shell.astype(np.int64).ravel()
+        shells = int(shell.max()) + 1
+    for it in range(int(isotropic_iterations) + int(iterations)):
         r = (T / np.maximum(P.sum(2), 1e-300))[:, :, None] + (T / np.maximum(P.sum(1), 1e-300))[:, None, :]
         r += (T / np.maximum(P.sum(0), 1e-300))[None, :, :]
+        r *= 1.0 / 3.0
+        if it < isotropic_iterations:     # one factor per shell: the power-weighted mean of r over it
+            pr = np.bincount(shell, (P * r).ravel(), shells)
+            r = (pr / np.maximum(np.bincount(shell, P.ravel(), shells), 1e-300))[shell].reshape(P.shape)
         P *= r
-        P *= 1.0 / 3.0
         P[0, 0, :] = P[0, :, 0] = P[:, 0, 0] = 0.0
         if tick is not None and tick():
             raise Cancelled("cancelled")
@@ -190,14 +213,16 @@ def photo_rest(photo: np.ndarray, harmonics=None) -> np.ndarray:
 
 
 def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, oversample: int = OVERSAMPLE,
-                  iterations: int = ITERATIONS, progress=None, cancel=None, harmonics=None) -> np.ndarray:
+                  iterations: int = ITERATIONS, progress=None, cancel=None, harmonics=None,
+                  isotropic_iterations: int = ISOTROPIC_ITERATIONS) -> np.ndarray:
     """Cubic B-spline coefficients float32 (M, M, M, 3), M = period * oversample (period None: PERIOD, read when
     called), of a periodic Gaussian solid
     with zero mean whose axis slices carry ``photo``'s (H, W, 3) colour cross-spectrum (module doc; a photo larger
     than MAX_READ is read from its central crop); add the photo's mean colour to the field :class:`SplineField`
     reads.  ``harmonics``: the photo's harmonic part (:func:`backend.solid.model.measure_harmonics` at PX_PER_UNIT),
     taken out of the photo first, so the solid draws only the rest (:class:`SplineField` adds the part back).
-    ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled."""
+    ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled.
+    ``iterations``, ``isotropic_iterations``: :func:`solid_power`'s."""
     img = _checked(photo)
     period = PERIOD if period is None else period
     if period < 8 or period % 2 or oversample < 1:
@@ -207,7 +232,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, o
     # quarter, each channel's inverse FFT a sixth
     done = [0.0]
 
-    def tick(share: float = 0.25 / max(iterations, 1)) -> bool:
+    def tick(share: float = 0.25 / max(iterations + isotropic_iterations, 1)) -> bool:
         done[0] += share
         if progress is not None:
             progress(min(1.0, done[0]))
@@ -215,7 +240,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, o
 
     n, M = int(period), int(period) * int(oversample)
     S = slice_spectrum(photo_rest(img, harmonics), n)
-    P = solid_power(np.trace(S, axis1=2, axis2=3), iterations, tick)
+    P = solid_power(np.trace(S, axis1=2, axis2=3), iterations, tick, isotropic_iterations)
     L = colour_factors(P, S)
     amp = np.sqrt(P).astype(np.float32)
     rng = np.random.default_rng([int(seed), _SALT])
@@ -297,14 +322,15 @@ def fit_marginals(rest: np.ndarray, field: "SplineField", seed: int = 0) -> Marg
 
 
 def spectral_field(photo: np.ndarray, seed: int = 0, harmonics=None, progress=None, cancel=None,
-                   marginals: bool = True) -> "SplineField":
+                   marginals: bool = True, isotropic_iterations: int = ISOTROPIC_ITERATIONS) -> "SplineField":
     """Method "spectral"'s texture of ``photo`` (H, W, 3): :func:`spectral_tile` drawn with ``seed``, read as a
     :class:`SplineField` around the photo's mean colour, with the photo's harmonic part ``harmonics`` added back,
     and (``marginals``) its values mapped onto the marginals of the photo's rest (:func:`fit_marginals`).
-    ``progress`` and ``cancel`` as :func:`spectral_tile`'s."""
+    ``progress``, ``cancel`` and ``isotropic_iterations`` as :func:`spectral_tile`'s."""
     img = _checked(photo)
     rest = photo_rest(img, harmonics)       # once: the tile's spectrum and the marginals both read it
-    coeffs = spectral_tile(rest, seed, progress=progress, cancel=cancel)     # the rest has no part left to take out
+    coeffs = spectral_tile(rest, seed, progress=progress, cancel=cancel,     # the rest has no part left to take out
+                           isotropic_iterations=isotropic_iterations)
     mean = np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0)
     field = SplineField(coeffs, mean, harmonics=harmonics, seed=seed)
     if not marginals:

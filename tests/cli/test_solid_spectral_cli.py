@@ -36,9 +36,10 @@ def test_flags_job_tables_and_pixels_give_one_request():
     b = solid_request_from_dict({"method": "spectral", "exemplar": PHOTO, "seed": 4})
     c = SolidRequest(exemplar=read_rgb(PHOTO), method="spectral", seed=4).check()
     assert a.key() == b.key() == c.key()
-    # what it reads, nothing of a model; "marginals" marks the map onto the photo's marginals, so a bake keyed before
-    # it is redone
-    assert set(a.key()) == {"method", "exemplar", "seed", "periodic", "marginals"} and a.key()["marginals"] is True
+    # what it reads, nothing of a model; "marginals" marks the map onto the photo's marginals and "start" the
+    # power's isotropic start, so a bake keyed before either is redone
+    assert set(a.key()) == {"method", "exemplar", "seed", "periodic", "marginals", "start"}
+    assert a.key()["marginals"] is True and a.key()["start"] == "isotropic"
     assert a.key() != cli("--method", "spectral", "--exemplar", PHOTO).key()
     d = cli("--method", "spectral", "--exemplar", PHOTO, "--seed", "4", "--no-periodic")
     assert d.key() != a.key() and d.key() == solid_request_from_dict({"method": "spectral", "exemplar": PHOTO,
