@@ -23,11 +23,15 @@ slices of 3D output).
 
 With ``--method spectral`` the 3D texture measured is instead what ``method = "spectral"`` ships
 (``backend/solid/spectral_solid.py``: random phase noise lifted to a periodic solid with the photo's harmonic part,
-``--no-periodic`` without it, its values mapped onto the photo's marginals, ``--no-marginals`` without that; one draw
-per photo, sliced as the tiles are; the synthesis settings are not used).
+``--no-periodic`` without it, its values mapped onto the photo's marginals, ``--no-marginals`` without that, its
+power found from an isotropic start, ``--flat-start`` from flat power; one draw per photo, sliced as the tiles are;
+the synthesis settings are not used).
 
-Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices | the same of the closer random phase
-solid | random phase noise drawn in 2D; 2D: photo | the first
+In 3D every texture is also cut by six planes at random orientations (OBLIQUE_NORMALS, one image each: ``oblique``,
+``oblique_band``), as a mesh's faces cut it, against random phase noise's pooled draws (six as well).
+
+Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices and the first two oblique cuts | x, y, z
+slices of the closer random phase solid | random phase noise drawn in 2D; 2D: photo | the first
 tile | the second (another seed) | the first repeated 2 x 2 at half size, to show it has no seams | random phase, at
 the tile's size).
 """
@@ -47,7 +51,7 @@ import numpy as np  # noqa: E402
 
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
-from backend.solid.model import measure_harmonics, resize_rgb, slice_points  # noqa: E402
+from backend.solid.model import measure_harmonics, plane_points, resize_rgb, slice_points  # noqa: E402
 from backend.solid.spectral_solid import spectral_field  # noqa: E402
 from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
 from backend.solid.upright import upright_waves  # noqa: E402
@@ -58,6 +62,10 @@ from training.solid import photo_eval as pe  # noqa: E402
 from training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
+#: unit normals of the planes cut at random orientations through a 3D texture (:func:`oblique_slices`): a mesh's
+#: faces are seldom square to the axes, and a solid fitted to its axis cuts can be farther on others
+OBLIQUE_NORMALS = np.random.default_rng(7).standard_normal((6, 3))
+OBLIQUE_NORMALS /= np.linalg.norm(OBLIQUE_NORMALS, axis=1, keepdims=True)
 #: the Gaussian solids random phase noise is drawn as in 3D (:func:`random_phase_solid`)
 SOLIDS = ("isotropic", "upright")
 
@@ -69,6 +77,25 @@ def slices(field: TileField, seeds: int, size: int = SIZE) -> dict:
         pts = slice_points(size, field.px_per_unit, ax, pe.SLICE_OFFSETS[ax])
         out[ax] = [field.evaluate(pts + seed_shift3(s)).reshape(size, size, 3) for s in range(seeds)]
     return out
+
+
+def oblique_points(size: int, px_per_unit: float, normal, offset) -> np.ndarray:
+    """Pixel centres float64 (size*size, 3) in units of a size x size image of the plane through ``offset`` normal
+    to ``normal``: rows along the plane's steepest upward direction (row 0 at the top), columns along its
+    horizontal direction (along x for a horizontal plane), one photo px apart."""
+    n = np.asarray(normal, np.float64) / np.linalg.norm(normal)
+    u = np.cross([0.0, 0.0, 1.0], n)
+    u = u / np.linalg.norm(u) if np.linalg.norm(u) > 1e-6 else np.array([1.0, 0.0, 0.0])
+    v = np.cross(n, u)
+    plane = plane_points(size, px_per_unit)         # (P, 2): x right, y up
+    return plane[:, :1] * u + plane[:, 1:2] * v + np.asarray(offset, np.float64)
+
+
+def oblique_slices(field, size: int = SIZE) -> list:
+    """One (size, size, 3) cut of ``field`` per plane of OBLIQUE_NORMALS, each through another point."""
+    offsets = np.random.default_rng(11).uniform(-4.0, 4.0, (len(OBLIQUE_NORMALS), 3))
+    return [field.evaluate(oblique_points(size, field.px_per_unit, nrm, o)).reshape(size, size, 3)
+            for nrm, o in zip(OBLIQUE_NORMALS, offsets)]
 
 
 def random_phase_solid(photo: np.ndarray, kind: str, seeds: int, size: int = SIZE) -> dict:
@@ -142,6 +169,9 @@ def main(argv=None) -> int:
     ap.add_argument("--no-marginals", action="store_true",
                     help="--method spectral: the Gaussian tile's values as drawn, not mapped onto the photo's "
                          "marginals")
+    ap.add_argument("--flat-start", action="store_true",
+                    help="with --method spectral: the solid's power found by EM from flat power, as before its "
+                         "isotropic start (spectral_solid.solid_power)")
     ap.add_argument("--no-periodic", action="store_true",
                     help="--method spectral: without the photo's harmonic part (the product's --no-periodic)")
     ap.add_argument("--against", default=None, help="an eval_solid_photos.py JSON: the neural texture's figures")
@@ -176,13 +206,16 @@ def main(argv=None) -> int:
         t = time.time()
         if a.dim == 3 and a.method == "spectral":     # as the product draws it, through the request
             req = SolidRequest(exemplar=photo, method="spectral", periodic=not a.no_periodic).check()
-            if a.no_marginals:     # what the request draws, less the map onto the marginals
+            if a.no_marginals or a.flat_start:     # what the request draws, less the marginal map or the start
                 h = measure_harmonics(photo, PX_PER_UNIT) if req.periodic else None
-                imgs = slices(spectral_field(photo, int(req.seed), h, marginals=False), a.seeds)
+                field = spectral_field(photo, int(req.seed), h, marginals=not a.no_marginals,
+                                       **({"isotropic_iterations": 0} if a.flat_start else {}))
             else:
-                imgs = slices(req.spectral_field(), a.seeds)
+                field = req.spectral_field()
+            imgs = slices(field, a.seeds)
         elif a.dim == 3:
-            imgs = slices(TileField(synthesise(photo, settings), PX_PER_UNIT), a.seeds)
+            field = TileField(synthesise(photo, settings), PX_PER_UNIT)
+            imgs = slices(field, a.seeds)
         else:       # one tile per seed, its SIZE² image as the product draws it (top row first), grouped as x
             drawn = [image_settings(a.size, photo.shape, s) if product else dataclasses.replace(settings, seed=s)
                      for s in range(a.seeds)]
@@ -191,6 +224,10 @@ def main(argv=None) -> int:
         seconds = time.time() - t
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
+        if a.dim == 3:      # cuts at random orientations, against random phase noise's pooled draws (as many)
+            obl = oblique_slices(field)
+            lv = pe.level_distances(obl, photo)
+            r["oblique"], r["oblique_band"] = round(1000.0 * float(np.mean(lv)), 1), round(pe.band_swd(lv), 1)
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)
             r["levels"] = drawn[0].levels
             r["colour_tile"] = round(float(np.mean([pe.mean_colour_error(f.image(a.size), photo) for f in fields])), 4)
@@ -206,11 +243,12 @@ def main(argv=None) -> int:
             n = min(a.size, *photo.shape[:2])
             sheet.append([photo[:n, :n]] + [f.image(n) for f in fields[:2]] + [fields[0].image(n, 0.5),
                           pe.random_phase(photo, n, np.random.default_rng(1))])
-        elif a.sheet:   # photo | the tile's x, y, z slices | the closer Gaussian solid's | 2D random phase noise
+        elif a.sheet:   # photo | the tile's x, y, z slices and first two oblique cuts | the closer Gaussian solid's
+            # x, y, z slices | 2D random phase noise
             kind = min(SOLIDS, key=lambda k: r[f"random_phase_solid_{k}_pooled"])
             solid = random_phase_solid(photo, kind, 1)
-            sheet.append([photo[:SIZE, :SIZE]] + [imgs[ax][0] for ax in "xyz"] + [solid[ax][0] for ax in "xyz"]
-                         + [pe.random_phase(photo, SIZE, np.random.default_rng(1))])
+            sheet.append([photo[:SIZE, :SIZE]] + [imgs[ax][0] for ax in "xyz"] + obl[:2]
+                         + [solid[ax][0] for ax in "xyz"] + [pe.random_phase(photo, SIZE, np.random.default_rng(1))])
 
     def med(k):
         return round(float(np.median([r[k] for r in rows.values()])), 1)
@@ -242,6 +280,11 @@ def main(argv=None) -> int:
             if neural:
                 summary[f"neural_beats_random_phase_solid_{k}"] = int(sum(
                     r[f"neural_{k}"] < r[f"random_phase_solid_{k}"] for r in rows.values() if "neural_pooled" in r))
+    if a.dim == 3:      # cuts at random orientations
+        for k in ("", "_band"):
+            summary[f"median_oblique{k}"] = med("oblique" + k)
+            summary[f"beats_random_phase_oblique{k}"] = int(sum(r["oblique" + k] < r["random_phase_pooled" + k]
+                                                                for r in rows.values()))
     for k in ("pooled", "walls", "pooled_band"):     # against spot noise drawn in 2D
         summary[f"median_gaussian_2d_{k}"] = med("gaussian_2d_" + k)
         summary[f"beats_gaussian_2d_{k}"] = int(sum(r[k] < r["gaussian_2d_" + k] for r in rows.values()))
@@ -266,6 +309,7 @@ def main(argv=None) -> int:
     write_json(a.out + ".json", {"method": a.method if a.dim == 3 else "synthesis",
                                  "periodic": not a.no_periodic if a.method == "spectral" else None,
                                  "marginals": not a.no_marginals if a.method == "spectral" else None,
+                                 "isotropic_start": not a.flat_start if a.method == "spectral" else None,
                                  "settings": "the product's (image_settings; levels per photo)" if product else
                                  {k: getattr(settings, k) for k in settings.__dataclass_fields__},
                                  "px_per_unit": PX_PER_UNIT, "seeds": a.seeds, "against": a.against,

@@ -243,9 +243,11 @@ def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_pa
         assert np.isfinite(r[k]) and r[k] > 0
     assert doc["summary"]["photos"] == 1 and doc["summary"]["by_category"]["brick"]["photos"] == 1
     from PIL import Image
-    # 3D: photo | x, y, z slices | the random phase solid's | random phase (128 px); 2D: photo | tile | 2 x 2 of it |
-    # random phase (the tile's)
-    assert Image.open(out + ".png").size == ((8 * 128, 128) if dim == 3 else (4 * 64, 64))
+    # 3D: photo | x, y, z slices, two oblique cuts | the random phase solid's x, y, z | random phase (128 px); 2D:
+    # photo | tile | 2 x 2 of it | random phase (the tile's)
+    assert Image.open(out + ".png").size == ((10 * 128, 128) if dim == 3 else (4 * 64, 64))
+    if dim == 3:        # cuts at random orientations, beside the axis cuts
+        assert 0 < r["oblique_band"] < r["oblique"] < r["pixel_shuffle"]
     assert 0 < r["pooled"] < r["pixel_shuffle"]
     # the band-pass figures (no residue level) are there; the photo's own crops (the floor) are far closer than its
     # shuffled pixels
@@ -294,16 +296,39 @@ def test_bench_scales_photos_down_first_with_photo_side(bench_script, tmp_path):
 
 
 def test_bench_measures_the_spectral_solid_without_the_marginals(bench_script, tmp_path, monkeypatch):
-    """--method spectral --no-marginals measures the Gaussian tile as drawn (the map onto the photo's marginals,
-    which the request draws, left out: tests/core/test_spectral_solid.py compares the two); the JSON says so."""
+    """--method spectral --no-marginals --flat-start measures the Gaussian tile as drawn (the map onto the photo's
+    marginals, which the request draws, left out: tests/core/test_spectral_solid.py compares the two) from flat
+    power; the JSON says so, and holds the cuts at random orientations beside the axis cuts."""
     from backend.solid import spectral_solid
 
     monkeypatch.setattr(spectral_solid, "PERIOD", 32)
     out = str(tmp_path / "plain")
     mod = bench_script("solid_synthesis")
     assert mod.main(["--method", "spectral", "--only", "beige_bricks", "--seeds", "1", "--no-marginals",
-                     "--out", out]) == 0
+                     "--flat-start", "--out", out]) == 0
     doc = json.load(open(out + ".json"))
     r = doc["photos"]["brick__beige_bricks.jpg"]
     assert doc["method"] == "spectral" and doc["marginals"] is False and doc["periodic"] is True
+    assert doc["isotropic_start"] is False
     assert 0 < r["pooled"] < r["pixel_shuffle"] and r["colour"] < 0.03
+    assert 0 < r["oblique_band"] and 0 < r["oblique"] < r["pixel_shuffle"]
+    assert doc["summary"]["median_oblique"] == r["oblique"]
+
+
+def test_bench_cuts_planes_at_any_orientation(bench_script):
+    """The bench's oblique cuts: square to an axis they are the axis cuts' planes (x right and y up on a floor, y
+    right and z up on a wall normal to x); at any normal, rows and columns are orthonormal in the plane, one photo
+    px apart, the columns horizontal and the rows running down."""
+    mod = bench_script("solid_synthesis")
+    ppu = 128.0
+    from backend.solid.model import slice_points
+
+    for axis, normal in (("z", (0, 0, 1)), ("x", (1, 0, 0))):
+        np.testing.assert_allclose(mod.oblique_points(8, ppu, normal, (0.1, 0.2, 0.3)),
+                                   slice_points(8, ppu, axis, (0.1, 0.2, 0.3)), atol=1e-12)
+    for normal in mod.OBLIQUE_NORMALS:
+        p = mod.oblique_points(4, ppu, normal, (0, 0, 0)).reshape(4, 4, 3)
+        col, row = (p[0, 1] - p[0, 0]) * ppu, (p[1, 0] - p[0, 0]) * ppu
+        np.testing.assert_allclose([np.linalg.norm(col), np.linalg.norm(row), col @ row, col @ normal,
+                                    row @ normal], [1, 1, 0, 0, 0], atol=1e-9)
+        assert abs(col[2]) < 1e-12 and row[2] <= 0
