@@ -52,7 +52,7 @@ import numpy as np  # noqa: E402
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from backend.solid.model import measure_harmonics, plane_points, resize_rgb, slice_points  # noqa: E402
-from backend.solid.spectral_solid import spectral_field  # noqa: E402
+from backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field  # noqa: E402
 from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
 from backend.solid.upright import upright_waves  # noqa: E402
 from backend.solid.request import SolidRequest  # noqa: E402
@@ -209,7 +209,7 @@ def main(argv=None) -> int:
             if a.no_marginals or a.flat_start:     # what the request draws, less the marginal map or the start
                 h = measure_harmonics(photo, PX_PER_UNIT) if req.periodic else None
                 field = spectral_field(photo, int(req.seed), h, marginals=not a.no_marginals,
-                                       **({"isotropic_iterations": 0} if a.flat_start else {}))
+                                       isotropic_iterations=0 if a.flat_start else ISOTROPIC_ITERATIONS)
             else:
                 field = req.spectral_field()
             imgs = slices(field, a.seeds)

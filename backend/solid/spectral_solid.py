@@ -90,9 +90,9 @@ from ..periodic import periodic_component
 from .model import plane_points
 from .synthesis import PX_PER_UNIT
 
-__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "ISOTROPIC_ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES", "slice_spectrum",
-           "solid_power", "colour_factors", "photo_rest", "spectral_tile", "spectral_field", "fit_marginals",
-           "Marginals", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
+__all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "ISOTROPIC_ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES",
+           "slice_spectrum", "solid_power", "colour_factors", "photo_rest", "spectral_tile", "spectral_field",
+           "fit_marginals", "Marginals", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
 
 PERIOD = 128       #: photo px per repeat of the tile along each axis (the design's grid of PERIOD^3 frequencies)
 OVERSAMPLE = 2     #: voxels per photo px along each axis: PERIOD * OVERSAMPLE voxels a side
