@@ -226,8 +226,7 @@ def main(argv=None) -> int:
         r["seconds"] = round(seconds, 1)
         if a.dim == 3:      # cuts at random orientations, against random phase noise's pooled draws (as many)
             obl = oblique_slices(field)
-            lv = pe.level_distances(obl, photo)
-            r["oblique"], r["oblique_band"] = round(1000.0 * float(np.mean(lv)), 1), round(pe.band_swd(lv), 1)
+            r["oblique"], r["oblique_band"] = pe.rounded_swds(pe.level_distances(obl, photo))
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)
             r["levels"] = drawn[0].levels
             r["colour_tile"] = round(float(np.mean([pe.mean_colour_error(f.image(a.size), photo) for f in fields])), 4)

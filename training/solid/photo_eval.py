@@ -47,7 +47,7 @@ from backend._export import export as _ex
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "gaussian_noise",
            "perlin_hist",
            "photo_crop", "colour_by_rank", "voronoi_pavement", "grouped_swd", "level_distances", "band_swd",
-           "BASELINES", "SLICE_OFFSETS", "tile_sheet", "axis_imbalance"]
+           "rounded_swds", "BASELINES", "SLICE_OFFSETS", "tile_sheet", "axis_imbalance"]
 
 #: where the held-out evaluations cut a 3D texture: a slice normal to each axis through these points (units)
 SLICE_OFFSETS = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
@@ -109,6 +109,12 @@ def band_swd(per_level: list) -> float:
     The residue of a 128² image is a 16² picture of local mean colours, and its 7 x 7 neighbourhoods sample a
     photo's large-scale layout so thinly that the photo's own crops score worst there (module doc)."""
     return _scaled(per_level[:-1])
+
+
+def rounded_swds(per_level: list) -> tuple:
+    """(:func:`patch_swd`, :func:`band_swd`) of one set of images from its :func:`level_distances`, each rounded
+    to 0.1: the two figures a report gives per group of images."""
+    return round(_scaled(per_level), 1), round(band_swd(per_level), 1)
 
 
 def mean_colour_error(img: np.ndarray, reference: np.ndarray) -> float:
@@ -198,7 +204,7 @@ def grouped_swd(groups: dict, reference: np.ndarray) -> dict:
     out = {}
     for k, ims in sets.items():
         lv = level_distances(ims, reference)
-        out[k], out[k + "_band"] = round(_scaled(lv), 1), round(band_swd(lv), 1)
+        out[k], out[k + "_band"] = rounded_swds(lv)
     for sfx in ("", "_band"):
         out["axes" + sfx] = round(float(np.mean([out[k + sfx] for k in groups])), 1)
     return out
