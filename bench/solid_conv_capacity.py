@@ -13,7 +13,9 @@ In 3D (``--dim 3``) each step generates volumes of side ``--crop`` and fits slic
 (``training/solid/conv_fit.py``); the measure pools the middle slices of 128³ volumes.
 
 Prints a table; writes OUT.json, OUT.png (per photo: the photo, two textures (3D: slices), random phase noise) and
-OUT_<name>.pt (the generator's weights).
+OUT_<name>.pt (the generator's weights). Long fits (3D on a CPU): ``--save-every N`` keeps a checkpoint every N
+steps in OUT_<name>.ckpt, and ``--resume`` goes on from it (the same settings are required; the fit resumes
+exactly, random draws included).
 """
 from __future__ import annotations
 
@@ -58,6 +60,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=4)
     ap.add_argument("--budget-seconds", type=float, default=None, metavar="S",
                     help="fit the number of steps (at most --steps) to S seconds of training per config")
+    ap.add_argument("--save-every", type=int, default=0, metavar="N", help="keep a checkpoint every N steps")
+    ap.add_argument("--resume", action="store_true", help="go on from OUT_<name>.ckpt where it exists")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solid_conv_capacity"))
     a = ap.parse_args(argv)
     rows, tiles = [], []
@@ -71,8 +75,28 @@ def main(argv=None) -> int:
         steps = a.steps or cfg.steps
         precision = resolve(a.precision, torch.device(a.device))
         photo = training_images(cfg)[0]
+        name = os.path.basename(path).rsplit(".", 1)[0]
+        ckpt = f"{a.out}_{name}.ckpt"
+        # what a checkpoint must share with this run to be resumed by it
+        setting = dict(config=os.path.abspath(path), dim=a.dim, crop=cfg.crop, batch=cfg.batch,
+                       scale=cfg.exemplar_scale, width=a.width, grow=not a.flat, scales=a.scales, noise=a.noise,
+                       upright=a.upright, precision=precision)
+        resume = None
+        if a.resume and os.path.exists(ckpt):
+            resume = torch.load(ckpt, weights_only=False, map_location=a.device)
+            if resume["setting"] != setting:
+                diff = sorted(k for k in setting if resume["setting"].get(k) != setting[k])
+                raise SystemExit(f"{ckpt}: made with other settings ({', '.join(diff)}); drop --resume or match them")
+            print(f"resuming {ckpt} at step {resume['step']}/{resume['steps']}", flush=True)
+
+        def save(state: dict) -> None:
+            os.makedirs(os.path.dirname(os.path.abspath(ckpt)), exist_ok=True)
+            with atomic_path(ckpt) as tmp:
+                torch.save(dict(state, setting=setting), tmp)
+
         seconds, steps = fit(cfg, net.to(a.device), photo, steps, loss_features(cfg).to(a.device), texture_loss,
-                             precision, device=a.device, upright=a.upright, budget_seconds=a.budget_seconds)
+                             precision, device=a.device, upright=a.upright, budget_seconds=a.budget_seconds,
+                             resume=resume, save=save if a.save_every else None, save_every=a.save_every)
         net = net.cpu().eval()
         ref = photo.permute(1, 2, 0).numpy().astype(np.float32)
         size = min(MAX_SIZE if a.dim == 2 else MAX_SIZE // 2, *ref.shape[:2])
@@ -93,7 +117,6 @@ def main(argv=None) -> int:
         rng = np.random.default_rng(0)
         rpn = [random_phase(ref, size, rng) for _ in imgs]
         shuffled = [pixel_shuffle(ref, size, rng) for _ in imgs]
-        name = os.path.basename(path).rsplit(".", 1)[0]
         rows.append(dict(config=name, dim=a.dim, upright=a.upright,
                          photo=os.path.basename(cfg.exemplars[0]).rsplit(".", 1)[0], size=size, width=a.width,
                          grow=not a.flat, scales=a.scales, params=net.n_params(), steps=steps,

@@ -1,6 +1,8 @@
 """training/solid/conv_generator.py and conv_fit.py: the multi-scale convolutional generator is periodic (a
 circular shift of its noise shifts its texture), sees a neighbourhood (unlike the per-point decoder), refuses bad
-input with one line, and a short fit learns a photo's orientation in 2D and in 3D slices."""
+input with one line, a short fit learns a photo's orientation in 2D and in 3D slices, and a fit resumes exactly."""
+import copy
+
 import numpy as np
 import pytest
 
@@ -127,3 +129,28 @@ def test_a_time_budget_sets_the_number_of_steps():
     assert steps == FIT_TO and any("steps fit in 0 s" in s for s in lines)
     seconds, steps = fit(_Cfg, net, _stripes(), 30, feats, _loss, log=lines.append, budget_seconds=1e6)
     assert steps == 30          # never more than asked
+
+
+def test_a_fit_stopped_and_resumed_ends_where_one_run_straight_through_ends():
+    feats = SlicedFeatures(seed=0, levels=2, width=4, kernels=(3,))
+
+    def fresh():
+        torch.manual_seed(0)
+        return ConvGenerator(3, scales=2, noise=2, width=4, grow=False)
+
+    straight = fresh()
+    fit(_Cfg, straight, _stripes(), 6, feats, _loss, log=lambda s: None, upright=True)
+    saved = []
+    first = fresh()
+    fit(_Cfg, first, _stripes(), 6, feats, _loss, log=lambda s: None, upright=True,
+        save=lambda c: saved.append(copy.deepcopy(c)), save_every=4)
+    assert [c["step"] for c in saved] == [4, 6] and all(c["steps"] == 6 for c in saved)
+    resumed = fresh()         # from step 4: the steps asked for now are the checkpoint's schedule, not these
+    seconds, steps = fit(_Cfg, resumed, _stripes(), 1000, feats, _loss, log=lambda s: None, upright=True,
+                         resume=saved[0])
+    assert steps == 6
+    for a, b in zip(straight.state_dict().values(), resumed.state_dict().values()):
+        torch.testing.assert_close(a, b, rtol=0, atol=0)
+    cut = fresh()             # the resumed fit did not just redo the run: two steps fewer land elsewhere
+    fit(_Cfg, cut, _stripes(), 6, feats, _loss, log=lambda s: None, upright=True, resume=dict(saved[0], step=6))
+    assert any(not torch.equal(a, b) for a, b in zip(straight.state_dict().values(), cut.state_dict().values()))

@@ -31,3 +31,21 @@ def test_tiny_fit_measures_draws_and_keeps_its_weights(bench_script, tmp_path, d
     net = mod.ConvGenerator(saved["dim"], saved["scales"], saved["noise"], saved["width"], saved["grow"])
     net.load_state_dict(saved["state"])
     assert "| brick_w128l4 |" in capsys.readouterr().out
+
+
+def test_a_long_fit_keeps_checkpoints_and_resumes_only_with_its_settings(bench_script, tmp_path, capsys):
+    mod = bench_script("solid_conv_capacity")
+    out = str(tmp_path / "cap")
+    args = [CONFIG, "--dim", "3", "--upright", "--scale", "0.25", "--steps", "3", "--crop", "16", "--batch", "1",
+            "--width", "4", "--scales", "2", "--seeds", "1", "--flat", "--precision", "fp32", "--out", out]
+    assert mod.main(args + ["--save-every", "2"]) == 0
+    ckpt = torch.load(out + "_brick_w128l4.ckpt", weights_only=False)
+    assert ckpt["step"] == ckpt["steps"] == 3 and ckpt["setting"]["width"] == 4
+    weights = torch.load(out + "_brick_w128l4.pt", weights_only=False)["state"]
+    for k, v in weights.items():
+        torch.testing.assert_close(ckpt["net"][k], v)
+    capsys.readouterr()
+    assert mod.main(args + ["--resume"]) == 0           # the fit is done: it is measured again, not retrained
+    assert "resuming" in capsys.readouterr().out and json.load(open(out + ".json"))["rows"][0]["steps"] == 3
+    with pytest.raises(SystemExit, match="other settings.*width"):
+        mod.main([a if a != "4" else "6" for a in args] + ["--resume"])

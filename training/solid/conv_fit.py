@@ -6,7 +6,9 @@ exemplars, Sec. 3.2), colours them with the photo's mean and colour Cholesky fac
 affine per-point decoders) and asks them to match random crops of the photo under the config's texture loss
 (``train.texture_loss``: sliced Wasserstein distances of random features, the colour histogram and the optional
 terms). Adam with the config's cosine learning-rate decay; gradients clipped to norm 1. The generator's
-convolutions may run under bf16 autocast; colour and loss stay fp32.
+convolutions may run under bf16 autocast; colour and loss stay fp32. A fit hands out checkpoints (step, schedule
+length, weights, optimiser, the random generator's state, seconds) and resumes from one exactly: a fit stopped and
+resumed draws the same crops and noise and ends with the same weights as one run straight through.
 
 Shapes: photo (3, H, W) float32 in [0, 1]; generated textures (B, 3, S, S[, S]).
 """
@@ -44,7 +46,8 @@ def volume_slices(vol: torch.Tensor, generator: torch.Generator, upright: bool =
 
 
 def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn, precision: str = "fp32",
-        log=print, device: str = "cpu", upright: bool = False, budget_seconds: float | None = None) -> tuple:
+        log=print, device: str = "cpu", upright: bool = False, budget_seconds: float | None = None,
+        resume: dict | None = None, save=None, save_every: int = 0) -> tuple:
     """Train ``net`` in place for ``steps`` on ``photo`` with ``cfg``'s crop, batch, learning rates, seed and
     log_every; ``loss_fn(cfg, feats, images, crops, generator)`` is the texture loss. ``net`` and ``feats`` on
     ``device``; the random draws stay on the CPU's generator, so a fit's data is the same on any device.
@@ -52,6 +55,8 @@ def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn
     strata and grain keep their direction; otherwise crops are turned and flipped at random, since each slice of
     an isotropic solid may show the photo any way up). ``budget_seconds``: the rate of steps FIT_FROM to FIT_TO
     sets how many steps fit in the budget (never more than ``steps``), and the learning-rate decay follows them.
+    ``save(checkpoint)`` is called every ``save_every`` steps and at the end with a dict that ``resume`` takes
+    back: the fit goes on from its step to its schedule's length (``steps`` and the budget are then ignored).
     Returns (seconds taken, steps taken)."""
     dev = torch.device(device)
     stats = colour_stats(photo.unsqueeze(0)).to(dev)
@@ -59,6 +64,17 @@ def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn
     opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
     t0 = time.time()
     step = 0
+    if resume is not None:
+        net.load_state_dict(resume["net"])
+        opt.load_state_dict(resume["opt"])
+        g.set_state(resume["generator"])
+        step, steps, budget_seconds = resume["step"], resume["steps"], None
+        t0 -= resume["seconds"]
+
+    def checkpoint() -> dict:
+        return dict(step=step, steps=steps, net=net.state_dict(), opt=opt.state_dict(), generator=g.get_state(),
+                    seconds=time.time() - t0)
+
     while step < steps:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / steps))
         for grp in opt.param_groups:
@@ -88,4 +104,6 @@ def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn
                 log(f"{rate:.3f} s a step: {steps} steps fit in {budget_seconds:.0f} s")
         if step % cfg.log_every == 0 or step == steps:
             log(f"step {step}/{steps} loss {loss.item():.4f} ({time.time() - t0:.0f} s)")
+        if save is not None and ((save_every and step % save_every == 0) or step == steps):
+            save(checkpoint())
     return time.time() - t0, steps
