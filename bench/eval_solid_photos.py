@@ -39,6 +39,9 @@ Against the photo, per slice axis and pooled:
 - ``swd_walls``, ``colour_walls``: the same over the x and y slices only, the vertical planes on which an
   encoded photo's harmonic part stands as in the photo (on z slices, horizontal cuts, it shows in profile:
   a layered photo's horizontal cut lies within one layer, brick courses become that course's colour);
+- ``oblique``, ``oblique_band``: the same distances of six cuts at random orientations
+  (``photo_eval.OBLIQUE_NORMALS``, seed 0), as a mesh's faces cut the texture, beside random phase noise's six
+  draws (``random_phase_oblique``);
 - ``diversity``: mean absolute difference between two seeds' z slices;
 - ``axis_spread``: (max - min) / mean of the three axes' swd: 0 when x, y and z
   slices are alike (a solid texture, not a 2D one extruded).
@@ -168,6 +171,16 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
             else:
                 r[name] = round(pe.patch_swd([im for v in base[name].values() for im in v], photo), 1)
             r[name + "_colour"] = round(pe.mean_colour_error(base[name]["x"][0], photo), 4)
+        # six cuts at random orientations (photo_eval.OBLIQUE_NORMALS), as a mesh's faces cut the texture, against
+        # as many random phase draws (the pooled ones where they are six, as at the default two seeds)
+        obl = pe.oblique_slices(lambda p: model.evaluate(p, code, 0), model.px_per_unit, SIZE)
+        r["oblique"], r["oblique_band"] = pe.rounded_swds(pe.level_distances(obl, photo))
+        rp = [im for v in base["random_phase"].values() for im in v]
+        if len(rp) == len(obl):
+            r["random_phase_oblique"], r["random_phase_oblique_band"] = r["random_phase"], r["random_phase_band"]
+        else:
+            rp = (rp + [pe.random_phase(photo, SIZE, rng) for _ in obl])[:len(obl)]
+            r["random_phase_oblique"], r["random_phase_oblique_band"] = pe.rounded_swds(pe.level_distances(rp, photo))
         r["morph"] = round(morphology_distance(pooled, photo), 3)
         for name in ("random_phase", "photo_crop"):
             r["morph_" + name] = round(morphology_distance([im for v in base[name].values() for im in v], photo), 3)
@@ -227,7 +240,12 @@ def summary(rows: dict) -> dict:
                 median_band_axes=med("band_axes"), median_band_random_phase_axes=med("random_phase_band_axes"),
                 median_band_photo_crop_axes=med("photo_crop_band_axes"),
                 beats_random_phase_band_axes=int(sum(r[ax + "_band"] < r["random_phase_band_axes"]
-                                                     for r in rows.values() for ax in "xyz")))
+                                                     for r in rows.values() for ax in "xyz")),
+                # cuts at random orientations
+                median_oblique=med("oblique"), median_oblique_band=med("oblique_band"),
+                median_random_phase_oblique=med("random_phase_oblique"),
+                beats_random_phase_oblique=beats("oblique", "random_phase_oblique"),
+                beats_random_phase_oblique_band=beats("oblique_band", "random_phase_oblique_band"))
 
 
 def by_category(rows: dict) -> dict:
@@ -262,14 +280,14 @@ def write_sheet(sheet: list, path: str, size: int = 128) -> None:
 
 
 def against(rows: dict, path: str) -> dict:
-    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls`` and their ``band`` twins): the photos of ``rows`` more
+    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls``, ``oblique`` and their ``band`` twins): the photos of ``rows`` more
     than 5 % closer and farther than in the run of this bench stored at ``path``, and both medians over the photos
     the two share."""
     with open(path, encoding="utf-8") as fh:
         other = json.load(fh)["photos"]
     common = [n for n in rows if n in other]
     out = {"photos": len(common)}
-    for key in ("swd", "swd_axes", "swd_walls", "band", "band_axes", "band_walls"):
+    for key in ("swd", "swd_axes", "swd_walls", "band", "band_axes", "band_walls", "oblique", "oblique_band"):
         both = [n for n in common if key in other[n]]     # runs before swd_axes lack it
         if not both:
             continue

@@ -27,7 +27,7 @@ With ``--method spectral`` the 3D texture measured is instead what ``method = "s
 power found from an isotropic start, ``--flat-start`` from flat power; one draw per photo, sliced as the tiles are;
 the synthesis settings are not used).
 
-In 3D every texture is also cut by six planes at random orientations (OBLIQUE_NORMALS, one image each: ``oblique``,
+In 3D every texture is also cut by six planes at random orientations (``photo_eval.OBLIQUE_NORMALS``, one image each: ``oblique``,
 ``oblique_band``), as a mesh's faces cut it, against random phase noise's pooled draws (six as well).
 
 Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices and the first two oblique cuts | x, y, z
@@ -51,7 +51,7 @@ import numpy as np  # noqa: E402
 
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
-from backend.solid.model import measure_harmonics, plane_points, resize_rgb, slice_points  # noqa: E402
+from backend.solid.model import measure_harmonics, resize_rgb, slice_points  # noqa: E402
 from backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field  # noqa: E402
 from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
 from backend.solid.upright import upright_waves  # noqa: E402
@@ -62,10 +62,6 @@ from training.solid import photo_eval as pe  # noqa: E402
 from training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
-#: unit normals of the planes cut at random orientations through a 3D texture (:func:`oblique_slices`): a mesh's
-#: faces are seldom square to the axes, and a solid fitted to its axis cuts can be farther on others
-OBLIQUE_NORMALS = np.random.default_rng(7).standard_normal((6, 3))
-OBLIQUE_NORMALS /= np.linalg.norm(OBLIQUE_NORMALS, axis=1, keepdims=True)
 #: the Gaussian solids random phase noise is drawn as in 3D (:func:`random_phase_solid`)
 SOLIDS = ("isotropic", "upright")
 
@@ -77,25 +73,6 @@ def slices(field: TileField, seeds: int, size: int = SIZE) -> dict:
         pts = slice_points(size, field.px_per_unit, ax, pe.SLICE_OFFSETS[ax])
         out[ax] = [field.evaluate(pts + seed_shift3(s)).reshape(size, size, 3) for s in range(seeds)]
     return out
-
-
-def oblique_points(size: int, px_per_unit: float, normal, offset) -> np.ndarray:
-    """Pixel centres float64 (size*size, 3) in units of a size x size image of the plane through ``offset`` normal
-    to ``normal``: rows along the plane's steepest upward direction (row 0 at the top), columns along its
-    horizontal direction (along x for a horizontal plane), one photo px apart."""
-    n = np.asarray(normal, np.float64) / np.linalg.norm(normal)
-    u = np.cross([0.0, 0.0, 1.0], n)
-    u = u / np.linalg.norm(u) if np.linalg.norm(u) > 1e-6 else np.array([1.0, 0.0, 0.0])
-    v = np.cross(n, u)
-    plane = plane_points(size, px_per_unit)         # (P, 2): x right, y up
-    return plane[:, :1] * u + plane[:, 1:2] * v + np.asarray(offset, np.float64)
-
-
-def oblique_slices(field, size: int = SIZE) -> list:
-    """One (size, size, 3) cut of ``field`` per plane of OBLIQUE_NORMALS, each through another point."""
-    offsets = np.random.default_rng(11).uniform(-4.0, 4.0, (len(OBLIQUE_NORMALS), 3))
-    return [field.evaluate(oblique_points(size, field.px_per_unit, nrm, o)).reshape(size, size, 3)
-            for nrm, o in zip(OBLIQUE_NORMALS, offsets)]
 
 
 def random_phase_solid(photo: np.ndarray, kind: str, seeds: int, size: int = SIZE) -> dict:
@@ -225,7 +202,7 @@ def main(argv=None) -> int:
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
         if a.dim == 3:      # cuts at random orientations, against random phase noise's pooled draws (as many)
-            obl = oblique_slices(field)
+            obl = pe.oblique_slices(field.evaluate, field.px_per_unit)
             r["oblique"], r["oblique_band"] = pe.rounded_swds(pe.level_distances(obl, photo))
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)
             r["levels"] = drawn[0].levels

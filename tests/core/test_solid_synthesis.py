@@ -315,13 +315,14 @@ def test_bench_measures_the_spectral_solid_without_the_marginals(bench_script, t
     assert doc["summary"]["median_oblique"] == r["oblique"]
 
 
-def test_bench_cuts_planes_at_any_orientation(bench_script):
-    """The bench's oblique cuts: square to an axis they are the axis cuts' planes (x right and y up on a floor, y
+def test_the_evaluation_cuts_planes_at_any_orientation():
+    """The benches' oblique cuts (photo_eval.oblique_points): square to an axis they are the axis cuts' planes (x right and y up on a floor, y
     right and z up on a wall normal to x); at any normal, rows and columns are orthonormal in the plane, one photo
     px apart, the columns horizontal and the rows running down."""
-    mod = bench_script("solid_synthesis")
-    ppu = 128.0
     from backend.solid.model import slice_points
+    from training.solid import photo_eval as mod
+
+    ppu = 128.0
 
     for axis, normal in (("z", (0, 0, 1)), ("x", (1, 0, 0))):
         np.testing.assert_allclose(mod.oblique_points(8, ppu, normal, (0.1, 0.2, 0.3)),
@@ -332,3 +333,8 @@ def test_bench_cuts_planes_at_any_orientation(bench_script):
         np.testing.assert_allclose([np.linalg.norm(col), np.linalg.norm(row), col @ row, col @ normal,
                                     row @ normal], [1, 1, 0, 0, 0], atol=1e-9)
         assert abs(col[2]) < 1e-12 and row[2] <= 0
+    seen = []          # oblique_slices: one cut per normal, through its own point, of the field it is given
+    cuts = mod.oblique_slices(lambda p: seen.append(p) or p[:, :1] * np.ones(3), ppu, 4)
+    assert len(cuts) == len(seen) == 6 and all(c.shape == (4, 4, 3) and c.dtype == np.float32 for c in cuts)
+    for p, normal, o in zip(seen, mod.OBLIQUE_NORMALS, mod.OBLIQUE_OFFSETS):
+        np.testing.assert_allclose((p - o) @ normal, 0, atol=1e-9)

@@ -475,9 +475,10 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
     finally:
         mod.pe.level_distances = real_levels
     # every baseline meets the photo as often as the model's slices do: pooled six (model, 4 baselines), walls
-    # four (model, random phase, the photo's crops), single axes two; nothing scored from another count
+    # four (model, random phase, the photo's crops), single axes two; nothing scored from another count; the six
+    # oblique cuts meet random phase noise's six pooled draws
     assert sorted(set(counts)) == [2, 4, 6]
-    assert counts.count(6) == 2 * 5 and counts.count(4) == 2 * 3 and counts.count(2) == 2 * 3 * 3
+    assert counts.count(6) == 2 * 6 and counts.count(4) == 2 * 3 and counts.count(2) == 2 * 3 * 3
     doc = json.loads(out.read_text())
     assert doc["summary"]["photos"] == 2 and doc["summary"]["median_morph"] > 0
     for r in doc["photos"].values():
@@ -489,7 +490,12 @@ def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_pat
         assert r["photo_crop_axes"] < r["random_phase_axes"] or r["photo_crop_walls"] < r["random_phase_walls"]
         assert r["photo_crop_band"] < r["band"] and r["photo_crop_band"] < r["pixel_shuffle"]
         assert r["band_axes"] == pytest.approx((r["x_band"] + r["y_band"] + r["z_band"]) / 3, abs=0.06)
+        assert 0 < r["oblique_band"] < r["oblique"] < r["pixel_shuffle"]
+        assert (r["random_phase_oblique"], r["random_phase_oblique_band"]) == (r["random_phase"],
+                                                                              r["random_phase_band"])
     assert doc["summary"]["median_spectrum"] > 0
+    assert doc["summary"]["beats_random_phase_oblique"] == sum(r["oblique"] < r["random_phase"]
+                                                               for r in doc["photos"].values())
     assert 0 <= doc["summary"]["beats_random_phase_axes"] <= 6
 
 

@@ -42,15 +42,42 @@ import numpy as np
 from backend.solid.band_distance import laplacian_bands
 from backend.solid.cellular import cellular_features_numpy
 from backend.solid.lattice import lattice_noise
+from backend.solid.model import plane_points
 from backend._export import export as _ex
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "gaussian_noise",
            "perlin_hist",
            "photo_crop", "colour_by_rank", "voronoi_pavement", "grouped_swd", "level_distances", "band_swd",
-           "rounded_swds", "BASELINES", "SLICE_OFFSETS", "tile_sheet", "axis_imbalance"]
+           "rounded_swds", "BASELINES", "SLICE_OFFSETS", "OBLIQUE_NORMALS", "OBLIQUE_OFFSETS", "oblique_points",
+           "oblique_slices", "tile_sheet", "axis_imbalance"]
 
 #: where the held-out evaluations cut a 3D texture: a slice normal to each axis through these points (units)
 SLICE_OFFSETS = {"z": (3.1, -2.7, 0.37), "y": (-1.3, 0.41, 2.2), "x": (0.53, 1.9, -3.3)}
+#: and six cuts at random orientations (:func:`oblique_slices`): unit normals, and a point of each plane (units).
+#: A mesh's faces are seldom square to the axes, and a solid fitted to its axis cuts can be farther on others.
+OBLIQUE_NORMALS = np.random.default_rng(7).standard_normal((6, 3))
+OBLIQUE_NORMALS /= np.linalg.norm(OBLIQUE_NORMALS, axis=1, keepdims=True)
+OBLIQUE_OFFSETS = np.random.default_rng(11).uniform(-4.0, 4.0, (len(OBLIQUE_NORMALS), 3))
+
+
+def oblique_points(size: int, px_per_unit: float, normal, offset) -> np.ndarray:
+    """Pixel centres float64 (size*size, 3) in units of a size x size image of the plane through ``offset`` normal
+    to ``normal``: rows along the plane's steepest upward direction (row 0 at the top), columns along its
+    horizontal direction (along x for a horizontal plane), one photo px apart. Square to an axis, the plane of
+    ``backend.solid.model.slice_points``."""
+    n = np.asarray(normal, np.float64) / np.linalg.norm(normal)
+    u = np.cross([0.0, 0.0, 1.0], n)
+    u = u / np.linalg.norm(u) if np.linalg.norm(u) > 1e-6 else np.array([1.0, 0.0, 0.0])
+    v = np.cross(n, u)
+    plane = plane_points(size, px_per_unit)         # (P, 2): x right, y up
+    return plane[:, :1] * u + plane[:, 1:2] * v + np.asarray(offset, np.float64)
+
+
+def oblique_slices(evaluate, px_per_unit: float, size: int = 128) -> list:
+    """One (size, size, 3) cut per plane of OBLIQUE_NORMALS through OBLIQUE_OFFSETS of a 3D texture whose
+    ``evaluate`` maps points float64 (P, 3) in units (``px_per_unit`` photo px each) to colours (P, 3)."""
+    return [np.asarray(evaluate(oblique_points(size, px_per_unit, nrm, o)), np.float32).reshape(size, size, 3)
+            for nrm, o in zip(OBLIQUE_NORMALS, OBLIQUE_OFFSETS)]
 
 
 def laplacian_pyramid(img: np.ndarray, levels: int) -> list:
