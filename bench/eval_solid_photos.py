@@ -180,7 +180,8 @@ def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list 
             r["random_phase_oblique"], r["random_phase_oblique_band"] = r["random_phase"], r["random_phase_band"]
         else:
             rp = (rp + [pe.random_phase(photo, SIZE, rng) for _ in obl])[:len(obl)]
-            r["random_phase_oblique"], r["random_phase_oblique_band"] = pe.rounded_swds(pe.level_distances(rp, photo))
+            r["random_phase_oblique"], r["random_phase_oblique_band"] = pe.rounded_swds(
+                pe.level_distances(rp, photo))
         r["morph"] = round(morphology_distance(pooled, photo), 3)
         for name in ("random_phase", "photo_crop"):
             r["morph_" + name] = round(morphology_distance([im for v in base[name].values() for im in v], photo), 3)
@@ -280,9 +281,9 @@ def write_sheet(sheet: list, path: str, size: int = 128) -> None:
 
 
 def against(rows: dict, path: str) -> dict:
-    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls``, ``oblique`` and their ``band`` twins): the photos of ``rows`` more
-    than 5 % closer and farther than in the run of this bench stored at ``path``, and both medians over the photos
-    the two share."""
+    """Per distance (``swd`` pooled, ``swd_axes``, ``swd_walls``, ``oblique`` and their ``band`` twins): the photos
+    of ``rows`` more than 5 % closer and farther than in the run of this bench stored at ``path``, and both medians
+    over the photos the two share."""
     with open(path, encoding="utf-8") as fh:
         other = json.load(fh)["photos"]
     common = [n for n in rows if n in other]

@@ -78,7 +78,7 @@ def main(argv=None) -> int:
         name = os.path.basename(path).rsplit(".", 1)[0]
         ckpt = f"{a.out}_{name}.ckpt"
         # what a checkpoint must share with this run to be resumed by it
-        setting = dict(config=os.path.abspath(path), dim=a.dim, crop=cfg.crop, batch=cfg.batch,
+        setting = dict(config=os.path.relpath(os.path.abspath(path), ROOT), dim=a.dim, crop=cfg.crop, batch=cfg.batch,
                        scale=cfg.exemplar_scale, width=a.width, grow=not a.flat, scales=a.scales, noise=a.noise,
                        upright=a.upright, precision=precision)
         resume = None

@@ -27,8 +27,9 @@ With ``--method spectral`` the 3D texture measured is instead what ``method = "s
 power found from an isotropic start, ``--flat-start`` from flat power; one draw per photo, sliced as the tiles are;
 the synthesis settings are not used).
 
-In 3D every texture is also cut by six planes at random orientations (``photo_eval.OBLIQUE_NORMALS``, one image each: ``oblique``,
-``oblique_band``), as a mesh's faces cut it, against random phase noise's pooled draws (six as well).
+In 3D every texture is also cut by six planes at random orientations (``photo_eval.OBLIQUE_NORMALS``, one image
+each: ``oblique``, ``oblique_band``), as a mesh's faces cut it, against random phase noise's pooled draws (six as
+well).
 
 Writes OUT.json and, with ``--sheet``, OUT.png (3D: photo | x, y, z slices and the first two oblique cuts | x, y, z
 slices of the closer random phase solid | random phase noise drawn in 2D; 2D: photo | the first

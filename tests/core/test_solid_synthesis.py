@@ -316,9 +316,9 @@ def test_bench_measures_the_spectral_solid_without_the_marginals(bench_script, t
 
 
 def test_the_evaluation_cuts_planes_at_any_orientation():
-    """The benches' oblique cuts (photo_eval.oblique_points): square to an axis they are the axis cuts' planes (x right and y up on a floor, y
-    right and z up on a wall normal to x); at any normal, rows and columns are orthonormal in the plane, one photo
-    px apart, the columns horizontal and the rows running down."""
+    """The benches' oblique cuts (photo_eval.oblique_points): square to an axis they are the axis cuts' planes (x
+    right and y up on a floor, y right and z up on a wall normal to x); at any normal, rows and columns are
+    orthonormal in the plane, one photo px apart, the columns horizontal and the rows running down."""
     from backend.solid.model import slice_points
     from training.solid import photo_eval as mod
 
