@@ -202,7 +202,8 @@ def main(argv=None) -> int:
         seconds = time.time() - t
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
-        if a.dim == 3:      # cuts at random orientations, against random phase noise's pooled draws (as many)
+        if a.dim == 3:      # six cuts at random orientations, against random phase noise's pooled draws (six at
+            # the default two seeds; bench/eval_solid_photos.py draws six where the seeds give another count)
             obl = pe.oblique_slices(field.evaluate, field.px_per_unit)
             r["oblique"], r["oblique_band"] = pe.rounded_swds(pe.level_distances(obl, photo))
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)

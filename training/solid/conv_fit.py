@@ -14,6 +14,7 @@ Shapes: photo (3, H, W) float32 in [0, 1]; generated textures (B, 3, S, S[, S]).
 """
 from __future__ import annotations
 
+import copy
 import math
 import time
 
@@ -71,9 +72,9 @@ def fit(cfg, net: ConvGenerator, photo: torch.Tensor, steps: int, feats, loss_fn
         step, steps, budget_seconds = resume["step"], resume["steps"], None
         t0 -= resume["seconds"]
 
-    def checkpoint() -> dict:
-        return dict(step=step, steps=steps, net=net.state_dict(), opt=opt.state_dict(), generator=g.get_state(),
-                    seconds=time.time() - t0)
+    def checkpoint() -> dict:       # copies: the live state dicts' tensors change with the next step
+        return copy.deepcopy(dict(step=step, steps=steps, net=net.state_dict(), opt=opt.state_dict(),
+                                  generator=g.get_state(), seconds=time.time() - t0))
 
     while step < steps:
         lr = cfg.lr_min + 0.5 * (cfg.lr - cfg.lr_min) * (1 + math.cos(math.pi * step / steps))
