@@ -32,7 +32,11 @@ falls between bins and spreads its power over the bins around the nearest one (a
 neighbour holds as much as it), so each peak brings the bins within ``LOBE`` of it that hold at least
 1 / ``LOBE_DEPTH`` of its power (and ``FLOOR`` of the photo's), each bin once.  A period that is a whole fraction
 keeps its one bin, and the weak bins around a strong peak (noise, or the periodic component's correction near
-the axes) stay out (tested).  Chosen on the training split ("lobes" in the same JSON).
+the axes) stay out (tested).  Chosen on the training split ("lobes" in the same JSON).  A lobe's bins add up to
+the photo inside its frame but beat beyond it, so where the peaks lie on a lattice off the grid (a photograph
+of bricks, tiles or a weave, whose periods do not divide its frame) the part is read as that lattice's motif
+instead, one wave at each lattice point at its own frequency, wherever it holds at least the share of the photo's
+variance the bins hold (:mod:`backend.solid.motif`; ``motif=False`` reads the bins as before).  A tileable photo's lattice lies on the grid, and its part is read from the bins as before.
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
@@ -70,6 +74,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..periodic import periodic_component
+from .motif import motif_waves
 
 __all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
            "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
@@ -156,7 +161,7 @@ def _main_lobes(idx: np.ndarray, lobe: int, keep: np.ndarray, P: np.ndarray, H: 
 
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
                     window: int = WINDOW, min_cycles: int = MIN_CYCLES, lobe: int = LOBE,
-                    detect: str = DETECT) -> Harmonics:
+                    detect: str = DETECT, motif: bool = True) -> Harmonics:
     """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc):
     up to ``count`` peaks, each with the bins of its main lobe (within ``lobe`` bins, above FLOOR; 0: the peak's
     bin alone); no waves (K = 0, share 0) for a photo without a period."""
@@ -180,15 +185,22 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     idx = np.flatnonzero((peak & strong & (P >= prominence * ring / max(n, 1))).ravel())
     idx = idx[np.argsort(-P.ravel()[idx], kind="stable")]
     idx = _without_jpeg_grid(idx, kx.ravel(), ky.ravel(), H, W)[:count]
+    total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
+    found = motif_waves((a - a.mean((0, 1))).transpose(2, 0, 1), idx, P.ravel()[idx], min_cycles, count,
+                        FLOOR) if motif and total > 0 else None
     if lobe:
         idx = _main_lobes(idx, lobe, strong.ravel(), P.ravel(), H, W)
     Fc = F.reshape(3, -1)[:, idx].T                                                    # (K, 3)
-    total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
     share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0
     fx, fy = kx.ravel()[idx], ky.ravel()[idx]
+    A = (2.0 / (H * W)) * Fc
+    if found is not None:       # the lattice's motif (motif.py), where it holds at least what the bins hold
+        motif_share = float(2.0 * (np.abs(found.dtft) ** 2).sum() * (H * W) ** 2 / total)
+        if motif_share >= share:
+            fx, fy, A, share = found.fx, found.fy, 2.0 * found.dtft, motif_share
     # pixel (r, c) sits at p = ((c + 1/2) / u, -(r + 1/2) / u): exp(2 pi i (fx c / W + fy r / H)) =
     # exp(i (2 pi f . p - pi (fx / W + fy / H))) with f = u (fx / W, -fy / H); both halves of a pair: 2 Re(.)
-    amp = (2.0 / (H * W)) * Fc * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]
+    amp = A * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]
     freq = np.stack([px_per_unit * fx / W, -px_per_unit * fy / H], axis=1)
     return Harmonics(freq.astype(np.float64), amp.astype(np.complex128), min(share, 0.999))
 

@@ -277,13 +277,15 @@ BASELINES = {"pixel_shuffle": pixel_shuffle, "random_phase": random_phase, "perl
 
 
 def tile_sheet(rows, path: str) -> None:
-    """Save a PNG sheet atomically: one row per list of (H, W, 3) images in [0, 1], each in a square cell of the
-    largest side, white where a row is shorter or an image smaller."""
+    """Save a sheet atomically, PNG (JPEG, quality 90, where ``path`` ends in .jpg): one row per list of (H, W, 3)
+    images in [0, 1], each in a square cell of the largest side, white where a row is shorter or an image
+    smaller."""
     from PIL import Image
     cell = max(max(t.shape[:2]) for row in rows for t in row)
     canvas = Image.new("RGB", (max(map(len, rows)) * cell, len(rows) * cell), "white")
     for i, row in enumerate(rows):
         for j, t in enumerate(row):
             canvas.paste(Image.fromarray((np.clip(t, 0, 1) * 255 + 0.5).astype(np.uint8)), (j * cell, i * cell))
+    jpeg = path.lower().endswith((".jpg", ".jpeg"))
     with _ex.atomic_path(path) as tmp:
-        canvas.save(tmp, format="PNG")
+        canvas.save(tmp, format="JPEG" if jpeg else "PNG", **({"quality": 90} if jpeg else {}))
