@@ -58,7 +58,7 @@ def remove_and_add_back(model: str, folder, key: str, capsys) -> str:
 
 def test_remove_and_add_back(tmp_path, capsys):
     folder = tmp_path / "brick_3d"
-    assert "38 waves, share 0.374" in remove_and_add_back(BRICK, folder, "harmonics", capsys)
+    assert "11 waves, share 0.403" in remove_and_add_back(BRICK, folder, "harmonics", capsys)
     with open(os.path.join(BRICK, "solid.json"), encoding="utf-8") as f:
         assert json.loads((folder / "solid.json").read_text()) == json.load(f)
 
