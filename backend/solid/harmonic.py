@@ -36,7 +36,8 @@ the axes) stay out (tested).  Chosen on the training split ("lobes" in the same 
 the photo inside its frame but beat beyond it, so where the peaks lie on a lattice off the grid (a photograph
 of bricks, tiles or a weave, whose periods do not divide its frame) the part is read as that lattice's motif
 instead, one wave at each lattice point at its own frequency, wherever it holds at least the share of the photo's
-variance the bins hold (:mod:`backend.solid.motif`; ``motif=False`` reads the bins as before).  A tileable photo's lattice lies on the grid, and its part is read from the bins as before.
+variance the bins hold (:mod:`backend.solid.motif`; ``motif=False`` reads the bins as before).  A tileable
+photo's lattice lies on the grid, and its part is read from the bins as before.
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10

@@ -19,8 +19,9 @@ basis of the pattern's translations (two for bricks, tiles and weaves; one for s
    three Dirichlet kernels; :func:`refine_peaks`, tested against synthetic sinusoids), along each axis.
 2. **The lattice.**  The basis is the coarsest pair of vectors (the largest reciprocal cell, i.e. the smallest
    motif) drawn from the refined peaks and their differences whose whole combinations hold at least
-   ``EXPLAINED`` of the refined peaks' power within ``TOLERANCE`` bins; then fitted to all of them by least squares
-   (:func:`fit_lattice`).  Collinear peaks give one vector (stripes).  Peaks that no lattice explains (two
+   ``EXPLAINED`` of the refined peaks' power and ``EXPLAINED_COUNT`` of the peaks within ``TOLERANCE`` bins,
+   repeated at least ``MIN_CELLS`` times in the photo (stripes at least its square root of times), then fitted
+   to all of them by least squares (:func:`fit_lattice`).  Collinear peaks give one vector (stripes).  Peaks that no lattice explains (two
    unrelated periods) leave the photo to harmonic.py's bins.
 3. **The motif.**  Every lattice point up to the photo's Nyquist frequency is a candidate wave; its colour
    amplitude is the windowed discrete-time Fourier transform at that exact frequency over the window's sum
@@ -54,11 +55,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Motif", "windowed_magnitude", "refine_peaks", "fit_lattice", "lattice_points", "on_grid", "motif_waves", "windowed_dtft", "hann", "TOLERANCE", "EXPLAINED",
-           "ON_GRID", "PROMINENCE", "PEAKS", "EXPLAINED_COUNT", "MIN_CELLS", "MIN_PEAKS", "CANDIDATES"]
+__all__ = ["Motif", "windowed_magnitude", "refine_peaks", "fit_lattice", "lattice_points", "on_grid", "motif_waves",
+           "windowed_dtft", "hann", "TOLERANCE", "EXPLAINED", "EXPLAINED_COUNT", "ON_GRID", "PROMINENCE", "PEAKS",
+           "MIN_CELLS", "MIN_PEAKS", "CANDIDATES"]
 
 CANDIDATES = 24     #: the shortest distinct peaks and differences tried as basis vectors
-MIN_CELLS = 4.0     #: the photo holds at least this many repeats of a motif (the reciprocal cell's area, bins^2)
+MIN_CELLS = 4.0     #: the photo holds at least this many repeats of a motif (the reciprocal cell's area, bins^2;
+                    #: stripes repeat at least its square root of times: the vector's length, bins)
 MIN_PEAKS = (8, 8)  #: peaks a lattice of one or two vectors must hold (module doc)
 PEAKS = 24          #: the strongest peaks of harmonic.py's detection the lattice is sought from
 TOLERANCE = 0.3     #: a peak lies on a lattice when it is within this many bins of a lattice point
@@ -160,6 +163,7 @@ def fit_lattice(F: np.ndarray, w: np.ndarray, tol: float = TOLERANCE, explained:
             keep.append(v)
         if len(keep) == CANDIDATES:
             break
+
     def refit(B):
         """B refitted by least squares to the peaks nearest its points, from small whole coordinates to large:
         a candidate's error grows with the multiple, so the low harmonics fix it before the high ones count."""
@@ -193,7 +197,7 @@ def fit_lattice(F: np.ndarray, w: np.ndarray, tol: float = TOLERANCE, explained:
     if best is None:                   # stripes: the longest vector whose multiples hold the peaks
         for a in keep[::-1]:
             B = refit(a[None, :])
-            if fits(B):
+            if np.linalg.norm(B) >= np.sqrt(MIN_CELLS) and fits(B):
                 best = B
                 break
         if best is None:

@@ -6,8 +6,8 @@ import numpy as np
 
 from backend.solid.harmonic import harmonic_field, photo_harmonics
 from backend.solid.model import plane_points
-from backend.solid.motif import (MIN_PEAKS, fit_lattice, lattice_points, motif_waves, on_grid, refine_peaks,
-                                 windowed_dtft, windowed_magnitude)
+from backend.solid.motif import (MIN_CELLS, MIN_PEAKS, fit_lattice, lattice_points, motif_waves, on_grid,
+                                 refine_peaks, windowed_dtft, windowed_magnitude)
 from tests.core.test_solid_harmonic import brick_photo, waves_photo
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -76,6 +76,10 @@ def test_peaks_without_a_lattice_fit_none_and_two_peaks_are_not_a_lattice():
     fit = fit_lattice(F, 1.0 / k)
     assert fit is not None and fit.shape == (1, 2) and np.allclose(np.abs(fit[0]), np.abs(v), atol=0.02)
     assert fit_lattice(F[:-1], 1.0 / k[:-1]) is None
+    # stripes repeated fewer than twice across the photo are no motif (a 2D motif must repeat MIN_CELLS = 2 x 2)
+    short = np.array([0.7, 1.5])
+    assert fit_lattice(np.outer(k, short), 1.0 / k) is None and np.linalg.norm(short) < np.sqrt(MIN_CELLS)
+    assert fit_lattice(np.outer(k, 1.4 * short), 1.0 / k) is not None
 
 
 def test_lattice_points_fill_the_band_once_per_conjugate_pair():
