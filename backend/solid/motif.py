@@ -21,8 +21,8 @@ basis of the pattern's translations (two for bricks, tiles and weaves; one for s
    motif) drawn from the refined peaks and their differences whose whole combinations hold at least
    ``EXPLAINED`` of the refined peaks' power and ``EXPLAINED_COUNT`` of the peaks within ``TOLERANCE`` bins,
    repeated at least ``MIN_CELLS`` times in the photo (stripes at least its square root of times), then fitted
-   to all of them by least squares (:func:`fit_lattice`).  Collinear peaks give one vector (stripes).  Peaks that no lattice explains (two
-   unrelated periods) leave the photo to harmonic.py's bins.
+   to all of them by least squares (:func:`fit_lattice`).  Collinear peaks give one vector (stripes).  Peaks
+   that no lattice explains (two unrelated periods) leave the photo to harmonic.py's bins.
 3. **The motif.**  Every lattice point up to the photo's Nyquist frequency is a candidate wave; its colour
    amplitude is the windowed discrete-time Fourier transform at that exact frequency over the window's sum
    (D = A e^(i phi) / 2 for a sinusoid A cos(2 pi f . x + phi), whatever f), i.e. the average over the photo's
