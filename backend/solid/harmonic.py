@@ -165,7 +165,9 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
                     detect: str = DETECT, motif: bool = True) -> Harmonics:
     """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc):
     up to ``count`` peaks, each with the bins of its main lobe (within ``lobe`` bins, above FLOOR; 0: the peak's
-    bin alone); no waves (K = 0, share 0) for a photo without a period."""
+    bin alone); no waves (K = 0, share 0) for a photo without a period.  With ``motif`` (the default), peaks on a
+    lattice off the DFT's grid (a photograph's periods, not a tileable texture's) are read as that lattice's motif
+    instead, where it holds at least the share of the photo's variance the bins hold (:mod:`backend.solid.motif`)."""
     a = np.asarray(img, np.float64)[..., :3]
     H, W, _ = a.shape
     F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
