@@ -30,8 +30,8 @@ import numpy as np  # noqa: E402
 import backend.solid.model as solid_model  # noqa: E402
 from backend.solid import harmonic  # noqa: E402
 from backend.solid.request import SolidRequest  # noqa: E402
-from backend.solid.model import slice_points  # noqa: E402
-from backend.solid.spectral import seed_shift3  # noqa: E402
+from bench.eval_solid_photos import slice_image  # noqa: E402
+from bench.solid_synthesis import slices  # noqa: E402
 from export import read_rgb  # noqa: E402
 from export.atomic import write_json  # noqa: E402
 from training.solid import photo_eval as pe  # noqa: E402
@@ -58,11 +58,10 @@ def draw(crop: np.ndarray, method: str, motif: bool):
     try:
         t = time.time()
         req = SolidRequest(exemplar=crop, method=method).check()
-        if method == "spectral":
+        if method == "spectral":      # cut as the synthesis bench cuts a tile, and the neural texture as its bench
             field = req.spectral_field()
             ev, ppu = field.evaluate, field.px_per_unit
-            imgs = {ax: [ev(slice_points(SIZE, ppu, ax, pe.SLICE_OFFSETS[ax]) + seed_shift3(s)).reshape(SIZE, SIZE, 3)
-                         for s in range(2)] for ax in "xyz"}
+            imgs = slices(field, 2, SIZE)
         else:
             model = req.load()
             code = req.code(model)[0]
@@ -71,8 +70,7 @@ def draw(crop: np.ndarray, method: str, motif: bool):
             def ev(q):
                 return model.evaluate(q, code, 0)
 
-            imgs = {ax: [model.image(SIZE, code, seed=s, axis=ax, offset=pe.SLICE_OFFSETS[ax]) for s in range(2)]
-                    for ax in "xyz"}
+            imgs = {ax: [slice_image(model, code, ax, s, SIZE) for s in range(2)] for ax in "xyz"}
         return imgs, pe.oblique_slices(ev, ppu, SIZE), time.time() - t
     finally:
         solid_model.photo_harmonics = saved

@@ -75,7 +75,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..periodic import periodic_component
-from .motif import motif_waves
+from .motif import box_sums, motif_waves
 
 __all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
            "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
@@ -113,17 +113,6 @@ class Harmonics:
         """Every number of the part, float64 (5 K,): frequencies, then the real and imaginary amplitudes (what bake
         keys digest)."""
         return np.concatenate([self.freq.ravel(), self.amp.real.ravel(), self.amp.imag.ravel()])
-
-
-def _box(P: np.ndarray, r: int) -> np.ndarray:
-    """Sums of P (H, W) over the (2 r + 1)^2 squares around each bin, the spectrum wrapping round (cumulative
-    sums along each axis)."""
-    for axis in (0, 1):
-        p = np.pad(P, [(r, r) if a == axis else (0, 0) for a in (0, 1)], mode="wrap")
-        c = np.concatenate([np.zeros_like(np.take(p, [0], axis=axis)), np.cumsum(p, axis=axis)], axis=axis)
-        n = P.shape[axis]
-        P = np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)
-    return P
 
 
 def _without_jpeg_grid(idx: np.ndarray, kx: np.ndarray, ky: np.ndarray, H: int, W: int) -> np.ndarray:
@@ -181,7 +170,7 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
         for dx in (-1, 0, 1):
             if dy or dx:
                 peak &= P > np.roll(P, (dy, dx), axis=(0, 1))
-    ring, n = _box(P, window) - _box(P, 1), (2 * window + 1) ** 2 - 9
+    ring, n = box_sums(P, window) - box_sums(P, 1), (2 * window + 1) ** 2 - 9
     half = (ky > 0) | ((ky == 0) & (kx > 0))                       # one of each conjugate pair
     far = np.hypot(kx / W, ky / H) * min(H, W) >= min_cycles
     strong = half & far & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))

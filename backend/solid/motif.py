@@ -55,9 +55,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Motif", "windowed_magnitude", "refine_peaks", "fit_lattice", "lattice_points", "on_grid", "motif_waves",
-           "windowed_dtft", "hann", "TOLERANCE", "EXPLAINED", "EXPLAINED_COUNT", "ON_GRID", "PROMINENCE", "PEAKS",
-           "MIN_CELLS", "MIN_PEAKS", "CANDIDATES"]
+__all__ = ["Motif", "box_sums", "windowed_magnitude", "refine_peaks", "fit_lattice", "lattice_points", "on_grid",
+           "motif_waves", "windowed_dtft", "hann", "TOLERANCE", "EXPLAINED", "EXPLAINED_COUNT", "ON_GRID",
+           "PROMINENCE", "PEAKS", "MIN_CELLS", "MIN_PEAKS", "CANDIDATES"]
 
 CANDIDATES = 24     #: the shortest distinct peaks and differences tried as basis vectors
 MIN_CELLS = 4.0     #: the photo holds at least this many repeats of a motif (the reciprocal cell's area, bins^2;
@@ -86,6 +86,18 @@ class Motif:
 def hann(n: int) -> np.ndarray:
     """The periodic Hann window of n samples, float64 (n,)."""
     return 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(n) / n)
+
+
+def box_sums(P: np.ndarray, r: int) -> np.ndarray:
+    """Sums of P (H, W) over the (2 r + 1)^2 squares around each bin, the spectrum wrapping round (cumulative
+    sums along each axis): harmonic.py's peak test and the motif's both measure a bin against the ring around
+    it."""
+    for axis in (0, 1):
+        p = np.pad(P, [(r, r) if a == axis else (0, 0) for a in (0, 1)], mode="wrap")
+        c = np.concatenate([np.zeros_like(np.take(p, [0], axis=axis)), np.cumsum(p, axis=axis)], axis=axis)
+        n = P.shape[axis]
+        P = np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)
+    return P
 
 
 def windowed_dtft(u: np.ndarray, fx: np.ndarray, fy: np.ndarray, chunk: int = 256) -> np.ndarray:
@@ -256,12 +268,8 @@ def motif_waves(u: np.ndarray, peaks: np.ndarray, powers: np.ndarray, min_cycles
     # screen by the windowed spectrum at the nearest bin (a point between bins keeps at least ~0.4 of its peak
     # there), then the exact transform at the strongest 2 count
     by, bx = np.round(P[:, 1]).astype(np.int64) % H, np.round(P[:, 0]).astype(np.int64) % W
-    ring = np.zeros((H, W))
-    for dy in range(-_RING, _RING + 1):
-        for dx in range(-_RING, _RING + 1):
-            if max(abs(dy), abs(dx)) > 1:
-                ring += np.roll(M ** 2, (dy, dx), axis=(0, 1))
-    ring /= (2 * _RING + 1) ** 2 - 9
+    M2 = M ** 2
+    ring = (box_sums(M2, _RING) - box_sums(M2, 1)) / ((2 * _RING + 1) ** 2 - 9)
     order = np.argsort(-M[by, bx], kind="stable")[:2 * count]
     P, by, bx = P[order], by[order], bx[order]
     D = windowed_dtft(u, P[:, 0], P[:, 1])
