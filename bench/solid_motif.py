@@ -49,12 +49,13 @@ def same(a, b) -> bool:
     return len(a) == len(b) and np.array_equal(a.freq, b.freq) and np.array_equal(a.amp, b.amp)
 
 
-def draw(crop: np.ndarray, method: str, motif: bool):
+def draw(crop: np.ndarray, method: str, motif: bool, **reading):
     """(slices {axis: [two (SIZE, SIZE, 3) images]}, six oblique cuts, seconds) of the texture drawn from ``crop``
-    with the harmonic part read with or without the motif (every reader of it goes through model.photo_harmonics,
-    which this sets for the call)."""
+    with the harmonic part read with or without the motif, and with ``reading``'s other arguments of
+    harmonic.photo_harmonics (every reader of the part goes through model.photo_harmonics, which this sets for the
+    call)."""
     saved = solid_model.photo_harmonics
-    solid_model.photo_harmonics = functools.partial(harmonic.photo_harmonics, motif=motif)
+    solid_model.photo_harmonics = functools.partial(harmonic.photo_harmonics, motif=motif, **reading)
     try:
         t = time.time()
         req = SolidRequest(exemplar=crop, method=method).check()

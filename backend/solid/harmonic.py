@@ -37,7 +37,12 @@ the photo inside its frame but beat beyond it, so where the peaks lie on a latti
 of bricks, tiles or a weave, whose periods do not divide its frame) the part is read as that lattice's motif
 instead, one wave at each lattice point at its own frequency, wherever it holds at least the share of the photo's
 variance the bins hold (:mod:`backend.solid.motif`; ``motif=False`` reads the bins as before).  A tileable
-photo's lattice lies on the grid, and its part is read from the bins as before.
+photo's lattice lies on the grid, and its part is read from the bins as before.  A tile whose pattern repeats only two to
+four times (a texture library's bricks: two courses of two bricks in 256 x 166 px) puts its peaks one to three
+bins apart, each inside the others' rings, and the peak test finds the courses at most; there the part is read at
+the lattice of the tile's periods, found from its autocorrelation, each bin measured against the bins around it
+that are not lattice points (:mod:`backend.solid.periods`; ``periods=False`` leaves it out), wherever that holds
+more of the photo's variance than the peaks or the motif.
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
@@ -75,7 +80,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..periodic import periodic_component
-from .motif import box_sums, motif_waves
+from .motif import box_sums, motif_waves, on_grid
+from .periods import lattice_bins, period_lattice
 
 __all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
            "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
@@ -88,6 +94,9 @@ MIN_CYCLES = 2      #: no peak below this many cycles per photo (shading and vig
 FLOOR = 1e-4        #: nor one with less than this share of the photo's power (rounding, not texture)
 LOBE = 1            #: each peak brings the bins within this many of it (its main lobe) ...
 LOBE_DEPTH = 16.0   #: ... that hold at least 1 / LOBE_DEPTH of its power
+FEW_GRID = 0.2      #: a lattice of periods within this many bins of whole frequencies is a tile's (periods.py)
+FEW_MARGIN = 0.05   #: ... read there where it holds this much more of the variance than the peaks or the motif
+FEW_MIN_CYCLES = 1  #: its points count from one cycle per photo (the lattice, not a lone peak, says they repeat)
 DETECTS = ("luminance", "colour")
 DETECT = "colour"     #: peaks are sought in this power spectrum (module doc)
 
@@ -149,14 +158,28 @@ def _main_lobes(idx: np.ndarray, lobe: int, keep: np.ndarray, P: np.ndarray, H: 
     return bins[np.sort(first)]
 
 
+def _few_repeats(u: np.ndarray, P: np.ndarray, window: int, total: float, count: int):
+    """Flat bins of a tileable photo's pattern that repeats too few times for the peak test (periods.py): u (3, H, W)
+    mean-free, P its colour power spectrum (of the periodic component), ``total`` its variance's power; None unless
+    the photo's lattice of periods lies on the grid with a reciprocal vector shorter than ``window`` + 1 bins."""
+    B, _ = period_lattice(u)
+    if B is None or not on_grid(B, FEW_GRID) or np.linalg.norm(B, axis=1).min() >= window + 1:
+        return None
+    idx = lattice_bins(P, np.round(B), FEW_MIN_CYCLES)
+    idx = idx[P.ravel()[idx] >= FLOOR * total][:count]
+    return idx if len(idx) else None
+
+
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
                     window: int = WINDOW, min_cycles: int = MIN_CYCLES, lobe: int = LOBE,
-                    detect: str = DETECT, motif: bool = True) -> Harmonics:
+                    detect: str = DETECT, motif: bool = True, periods: bool = True) -> Harmonics:
     """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc):
     up to ``count`` peaks, each with the bins of its main lobe (within ``lobe`` bins, above FLOOR; 0: the peak's
     bin alone); no waves (K = 0, share 0) for a photo without a period.  With ``motif`` (the default), peaks on a
     lattice off the DFT's grid (a photograph's periods, not a tileable texture's) are read as that lattice's motif
-    instead, where it holds at least the share of the photo's variance the bins hold (:mod:`backend.solid.motif`)."""
+    instead, where it holds at least the share of the photo's variance the bins hold (:mod:`backend.solid.motif`).
+    With ``periods`` (the default), a tile whose pattern repeats too few times for the peak test is read at the
+    lattice of its periods instead, where that holds more (:mod:`backend.solid.periods`)."""
     a = np.asarray(img, np.float64)[..., :3]
     H, W, _ = a.shape
     F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
@@ -178,8 +201,8 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     idx = idx[np.argsort(-P.ravel()[idx], kind="stable")]
     idx = _without_jpeg_grid(idx, kx.ravel(), ky.ravel(), H, W)[:count]
     total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
-    found = motif_waves((a - a.mean((0, 1))).transpose(2, 0, 1), idx, P.ravel()[idx], min_cycles, count,
-                        FLOOR) if motif and total > 0 else None
+    u = (a - a.mean((0, 1))).transpose(2, 0, 1)
+    found = motif_waves(u, idx, P.ravel()[idx], min_cycles, count, FLOOR) if motif and total > 0 else None
     if lobe:
         idx = _main_lobes(idx, lobe, strong.ravel(), P.ravel(), H, W)
     Fc = F.reshape(3, -1)[:, idx].T                                                    # (K, 3)
@@ -190,6 +213,12 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
         motif_share = float(2.0 * (np.abs(found.dtft) ** 2).sum() * (H * W) ** 2 / total)
         if motif_share >= share:
             fx, fy, A, share = found.fx, found.fy, 2.0 * found.dtft, motif_share
+    few = _few_repeats(u, P, window, total, count) if periods and total > 0 else None
+    if few is not None:         # a tile's few repeats (periods.py), where they hold more than the others
+        Fc = F.reshape(3, -1)[:, few].T
+        few_share = float(2.0 * (np.abs(Fc) ** 2).sum() / total)
+        if few_share >= share + FEW_MARGIN:
+            fx, fy, A, share = kx.ravel()[few], ky.ravel()[few], (2.0 / (H * W)) * Fc, few_share
     # pixel (r, c) sits at p = ((c + 1/2) / u, -(r + 1/2) / u): exp(2 pi i (fx c / W + fy r / H)) =
     # exp(i (2 pi f . p - pi (fx / W + fy / H))) with f = u (fx / W, -fy / H); both halves of a pair: 2 Re(.)
     amp = A * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]
