@@ -104,3 +104,16 @@ def test_a_pattern_repeated_once_is_no_lattice():
     img, _ = brick_tile(H=160, W=256, course=80, brick=256)
     B, _ = period_lattice(mean_free(img))
     assert B is None
+
+
+def test_a_large_tile_is_measured_on_its_block_means():
+    """A 1024 x 640 px tile (over SIDE px) is searched on its 4 x 4 block means; its periods come back in the
+    tile's own pixels: a brick of 512 px along the course, half a brick and a course of 320 px up."""
+    img, _ = brick_tile(H=640, W=1024, course=320, brick=512)
+    B, T = period_lattice(mean_free(img))
+    true = np.array([(512.0, 0.0), (256.0, 320.0)])
+    assert B is not None
+    assert abs(abs(np.linalg.det(T)) - abs(np.linalg.det(true))) < 0.02 * abs(np.linalg.det(true))
+    coef = np.linalg.solve(true.T, T.T)
+    assert np.abs(coef - np.round(coef)).max() < 0.02
+    assert on_grid(B, 0.05)
