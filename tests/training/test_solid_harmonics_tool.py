@@ -4,16 +4,35 @@ import json
 import os
 import shutil
 
+import numpy as np
+
 from training.solid.harmonics import main, measure
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BRICK = os.path.join(ROOT, "models", "solid", "brick_3d")
 
 
+def same(a, b) -> bool:
+    """JSON values equal, their numbers to 1e-9 relative (the last bits of a sum differ between CPUs' BLAS
+    kernels: the stored parts were measured on one machine and are checked on others)."""
+    if isinstance(a, dict):
+        return isinstance(b, dict) and a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return isinstance(b, list) and len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
+    if isinstance(a, (int, float)) and not isinstance(a, bool):
+        return isinstance(b, (int, float)) and bool(np.isclose(a, b, rtol=1e-9, atol=1e-12))
+    return a == b
+
+
 def test_the_shipped_part_is_what_the_command_measures():
     with open(os.path.join(BRICK, "solid.json"), encoding="utf-8") as f:
         stored = json.load(f)["harmonics"]
-    assert json.loads(json.dumps(measure(BRICK, ROOT))) == stored
+    measured = json.loads(json.dumps(measure(BRICK, ROOT)))
+    assert same(measured, stored)
+    # the comparison sees a real change: one amplitude moved by a millionth
+    moved = json.loads(json.dumps(stored))
+    moved["amp"][0][0] += 1e-6
+    assert not same(measured, moved)
 
 
 def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, capsys):
@@ -29,9 +48,9 @@ def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, ca
     assert {"metal", "wood"} <= set(stored) and {"sand", "metal"} <= set(rests) and "rock" not in rests
     folder = tmp_path / "space"      # removed, then measured again from the photos: what is stored
     said = remove_and_add_back(space, folder, "code_harmonics", capsys)
-    assert "metal 132 waves" in said and "Gaussian rests: brick 1.00" in said
+    assert "metal 141 waves" in said and "Gaussian rests: brick 1.00" in said
     back = json.loads((folder / "solid.json").read_text())
-    assert back["code_harmonics"] == stored and back["code_rests"] == rests
+    assert same(back["code_harmonics"], stored) and same(back["code_rests"], rests)
     train = os.path.join(ROOT, "data", "photos", "train")
     other = tmp_path / "other"
     (other / "data" / "photos" / "train").mkdir(parents=True)
@@ -60,7 +79,7 @@ def test_remove_and_add_back(tmp_path, capsys):
     folder = tmp_path / "brick_3d"
     assert "11 waves, share 0.403" in remove_and_add_back(BRICK, folder, "harmonics", capsys)
     with open(os.path.join(BRICK, "solid.json"), encoding="utf-8") as f:
-        assert json.loads((folder / "solid.json").read_text()) == json.load(f)
+        assert same(json.loads((folder / "solid.json").read_text()), json.load(f))
 
 
 def test_a_model_without_the_photos_colour_is_refused(tmp_path, capsys):
