@@ -85,6 +85,22 @@ def score(photo: np.ndarray, imgs: dict, obl: list) -> dict:
             "colour": round(float(np.mean([pe.mean_colour_error(im, photo) for v in imgs.values() for im in v])), 4)}
 
 
+def compare(rows: list, methods: list, before: str, after: str) -> dict:
+    """{METHOD_FIGURE: {median_BEFORE, median_AFTER, closer, farther}}: each method's FIGURES over the rows (dicts
+    holding METHOD_BEFORE and METHOD_AFTER scores), their medians and how many rows came closer or went farther."""
+    out = {}
+    for m in methods:
+        for k in FIGURES:
+            b = [r[f"{m}_{before}"][k] for r in rows]
+            v = [r[f"{m}_{after}"][k] for r in rows]
+            if b:
+                out[f"{m}_{k}"] = {f"median_{before}": round(float(np.median(b)), 1),
+                                   f"median_{after}": round(float(np.median(v)), 1),
+                                   "closer": int(sum(y < x for x, y in zip(b, v))),
+                                   "farther": int(sum(y > x for x, y in zip(b, v)))}
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--split", default="val", choices=("val", "train"))
@@ -138,16 +154,7 @@ def main(argv=None) -> int:
                   flush=True)
     summary = {"photos": len(files), "framings": len(files) * len(crops), "unchanged": unchanged,
                "changed": len(changed), "changed_photos": len({c.split("|")[0] for c in changed})}
-    for m in methods:
-        for k in FIGURES:
-            b = [r[f"{m}_bins"][k] for r in rows.values()]
-            v = [r[f"{m}_motif"][k] for r in rows.values()]
-            if not b:
-                continue
-            summary[f"{m}_{k}"] = {"median_bins": round(float(np.median(b)), 1),
-                                   "median_motif": round(float(np.median(v)), 1),
-                                   "closer": int(sum(y < x for x, y in zip(b, v))),
-                                   "farther": int(sum(y > x for x, y in zip(b, v)))}
+    summary.update(compare(list(rows.values()), methods, "bins", "motif"))
     for k, v in summary.items():
         print(k, v)
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)

@@ -37,12 +37,15 @@ the photo inside its frame but beat beyond it, so where the peaks lie on a latti
 of bricks, tiles or a weave, whose periods do not divide its frame) the part is read as that lattice's motif
 instead, one wave at each lattice point at its own frequency, wherever it holds at least the share of the photo's
 variance the bins hold (:mod:`backend.solid.motif`; ``motif=False`` reads the bins as before).  A tileable
-photo's lattice lies on the grid, and its part is read from the bins as before.  A tile whose pattern repeats only two to
-four times (a texture library's bricks: two courses of two bricks in 256 x 166 px) puts its peaks one to three
-bins apart, each inside the others' rings, and the peak test finds the courses at most; there the part is read at
-the lattice of the tile's periods, found from its autocorrelation, each bin measured against the bins around it
-that are not lattice points (:mod:`backend.solid.periods`; ``periods=False`` leaves it out), wherever that holds
-more of the photo's variance than the peaks or the motif.
+photo's lattice lies on the grid, and its part is read from the bins as before.  A tile whose pattern repeats
+only two to four times (a texture library's bricks: two courses of two bricks in 256 x 166 px) puts its peaks
+one to three bins apart, each inside the others' rings, and the peak test finds the courses at most; there the
+part is read at the lattice of the tile's periods, found from its autocorrelation, each bin measured against the
+bins around it that are not lattice points (:mod:`backend.solid.periods`; ``periods=False`` leaves it out),
+wherever that holds ``FEW_MARGIN`` more of the photo's variance than the peaks or the motif.  Lines straight
+across the photo that the part leaves (a single floor tile's grout, plank seams, slab joints: rows and columns that
+stand off their neighbours all along) are added where they hold ``FEW_MARGIN`` of its variance (``lines=False``
+leaves them out).
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
@@ -81,11 +84,11 @@ import numpy as np
 
 from ..periodic import periodic_component
 from .motif import box_sums, motif_waves, on_grid
-from .periods import lattice_bins, period_lattice
+from .periods import frame_lines, lattice_bins, period_lattice
 
 __all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
-           "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW", "MIN_CYCLES",
-           "LOBE", "LOBE_DEPTH"]
+           "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW",
+           "MIN_CYCLES", "LOBE", "LOBE_DEPTH", "FEW_GRID", "FEW_MARGIN", "FEW_MIN_CYCLES"]
 
 COUNT = 256         #: at most this many peaks
 PROMINENCE = 16.0   #: a peak's power over the mean power of the bins around it
@@ -170,16 +173,26 @@ def _few_repeats(u: np.ndarray, P: np.ndarray, window: int, total: float, count:
     return idx if len(idx) else None
 
 
+def _grid_field(fx: np.ndarray, fy: np.ndarray, A: np.ndarray, H: int, W: int) -> np.ndarray:
+    """sum_j Re(A_j exp(2 pi i (fx_j c / W + fy_j r / H))) at every pixel (r, c): float64 (3, H, W) (separable)."""
+    ex = np.exp(2j * np.pi * np.outer(fx, np.arange(W)) / W)                   # (K, W)
+    ey = np.exp(2j * np.pi * np.outer(fy, np.arange(H)) / H)                   # (K, H)
+    return np.stack([np.real(ey.T @ (A[:, c, None] * ex)) for c in range(A.shape[1])]) if len(fx) else \
+        np.zeros((A.shape[1] if A.ndim == 2 else 3, H, W))
+
+
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
                     window: int = WINDOW, min_cycles: int = MIN_CYCLES, lobe: int = LOBE,
-                    detect: str = DETECT, motif: bool = True, periods: bool = True) -> Harmonics:
+                    detect: str = DETECT, motif: bool = True, periods: bool = True, lines: bool = True) -> Harmonics:
     """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc):
     up to ``count`` peaks, each with the bins of its main lobe (within ``lobe`` bins, above FLOOR; 0: the peak's
     bin alone); no waves (K = 0, share 0) for a photo without a period.  With ``motif`` (the default), peaks on a
     lattice off the DFT's grid (a photograph's periods, not a tileable texture's) are read as that lattice's motif
     instead, where it holds at least the share of the photo's variance the bins hold (:mod:`backend.solid.motif`).
     With ``periods`` (the default), a tile whose pattern repeats too few times for the peak test is read at the
-    lattice of its periods instead, where that holds more (:mod:`backend.solid.periods`)."""
+    lattice of its periods instead, where that holds ``FEW_MARGIN`` more; with ``lines`` (the default), lines
+    straight across the photo that the part leaves are added where they hold ``FEW_MARGIN`` of it
+    (:mod:`backend.solid.periods`)."""
     a = np.asarray(img, np.float64)[..., :3]
     H, W, _ = a.shape
     F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
@@ -219,6 +232,14 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
         few_share = float(2.0 * (np.abs(Fc) ** 2).sum() / total)
         if few_share >= share + FEW_MARGIN:
             fx, fy, A, share = kx.ravel()[few], ky.ravel()[few], (2.0 / (H * W)) * Fc, few_share
+    if lines and total > 0:     # lines straight across the photo that the part leaves (periods.py)
+        lx, ly, LA = frame_lines(u - _grid_field(fx, fy, A, H, W))
+        keep = (np.abs(LA) ** 2).sum(1) / 2.0 >= 2.0 * FLOOR * total / (H * W) ** 2     # as P >= FLOOR total
+        lx, ly, LA = lx[keep][:count // 2], ly[keep][:count // 2], LA[keep][:count // 2]
+        line_share = float((np.abs(LA) ** 2).sum() / 2.0 * (H * W) ** 2 / total)
+        if line_share >= FEW_MARGIN:
+            fx, fy = np.concatenate([fx, lx]), np.concatenate([fy, ly])
+            A, share = np.concatenate([A, LA]), share + line_share
     # pixel (r, c) sits at p = ((c + 1/2) / u, -(r + 1/2) / u): exp(2 pi i (fx c / W + fy r / H)) =
     # exp(i (2 pi f . p - pi (fx / W + fy / H))) with f = u (fx / W, -fy / H); both halves of a pair: 2 Re(.)
     amp = A * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]

@@ -4,10 +4,10 @@ the harmonic part on their lattice (issue 20), numpy only.
 harmonic.py finds a photo's periods as peaks of its spectrum, each standing ``PROMINENCE`` times over the ring of
 bins around it (up to ``WINDOW`` bins away), and motif.py fits a lattice to those peaks.  Both need the lattice's
 points farther apart than the ring: a pattern repeated 10 times across the photo puts its peaks 10 bins apart.  A
-texture library's tiles repeat their pattern two to four times (a 256 x 166 px tile of two courses of two
-bricks; two courses of stone blocks in 256 x 118 px; planks): their peaks lie one to three bins apart, every
-peak's ring holds its neighbours, and no peak stands out.  On Sweet Home 3D's brick, stone-wall and paving tiles
-the harmonic part found nothing or the courses alone, and the solids lost their bricks and stones.
+texture library's tiles repeat their pattern two to four times (Sweet Home 3D's 256 x 166 px tile of two courses
+of two bricks; its octagon floor tiles, two by two): their peaks lie one to three bins apart, every peak's ring
+holds its neighbours, and no peak stands out.  On those tiles the harmonic part found the courses alone, or
+nothing, and the solids lost their head joints and tiles.
 
 In the image domain the same pattern is plain: the photo matches itself shifted by a period.  So:
 
@@ -33,10 +33,21 @@ In the image domain the same pattern is plain: the photo matches itself shifted 
    with the pattern's own other harmonics taken out of the ring: :func:`lattice_bins`).  A bin of Gaussian noise
    passes with probability e^-8, 3 in 10 000, where a 256 px tile of four cells has some 8 000 lattice bins.
 
+5. **Lines straight across the frame.**  A tile that holds its pattern once (one floor tile framed by its grout) or
+   a floor of planks of irregular widths repeats nothing inside the frame, yet its joints and seams are the pattern.
+   A row is such a line where its mean colour stands ``LINE_STRENGTH`` times the photo's RMS off the median of the
+   row means within ``LINE_WIDTH`` rows (the local level, so that shading and broad bands are not lines) and
+   ``LINE_SAME`` of its pixels lie past the midpoint towards it (a joint runs the whole width; a row of a face's
+   texture holds pixels on both sides); columns likewise (:func:`frame_lines`).  The lines' profile, zero on every
+   other row, is read as waves along the spectrum's axes.  A first version kept the axis bins standing over the
+   bins beside them: every axis bin also carries the row or column mean of the tile's face, and the faces' shading
+   came along as a plaid (model card).
+
 harmonic.py uses this part only where the lattice lies on the grid and is finer than its ring can see (a
 reciprocal basis vector shorter than ``WINDOW`` + 1 bins), counted from one cycle per photo (the lattice, not a
 lone peak, says the low harmonics repeat), and where it holds more of the photo's variance than the peaks and the
-motif do.  A photograph whose few repeats lie off the grid is left to them.
+motif do.  A photograph whose few repeats lie off the grid is left to them.  It adds the lines that the part
+chosen leaves in the photo, where they hold at least ``FEW_MARGIN`` of its variance.
 
 Shapes: photos float (3, H, W) mean-free; translations float64 (K, 2) pixels (x right along columns, y down along
 rows); reciprocal bases float64 (r, 2) cycles per photo (fx along columns, fy along rows).
@@ -47,8 +58,9 @@ import numpy as np
 
 from .motif import box_sums, lattice_points, on_grid
 
-__all__ = ["autocorrelation", "translations", "period_lattice", "lattice_bins", "SIDE", "REACH", "CORRELATION",
-           "DIP", "RING", "ISOLATION", "CLOSE", "MIN_REPEATS", "PROMINENCE", "WINDOW", "TRANSLATIONS"]
+__all__ = ["autocorrelation", "translations", "period_lattice", "lattice_bins", "frame_lines", "SIDE", "REACH",
+           "CORRELATION", "DIP", "RING", "ISOLATION", "CLOSE", "MIN_REPEATS", "PROMINENCE", "WINDOW", "LINE_SAME",
+           "LINE_STRENGTH", "LINE_WIDTH", "TRANSLATIONS"]
 
 SIDE = 256           #: periods are sought at most this many px wide (block means of a larger photo)
 REACH = 0.6          #: shifts up to this share of the frame along each axis
@@ -61,6 +73,9 @@ ISOLATION = 0.03     #: ... by this much (a shift along a course or a plank is a
 CLOSE = 0.05         #: lattices whose basis correlates within this of the best one's compete on fineness
 PROMINENCE = 8.0     #: a lattice bin's power over the mean power of the non-lattice bins around it
 WINDOW = 3           #: ... within this many bins
+LINE_SAME = 0.9      #: a row is a line straight across the photo where this share of its pixels lie past ...
+LINE_STRENGTH = 0.5  #: ... the midpoint to its mean colour, which stands this many times the photo's RMS off ...
+LINE_WIDTH = 8       #: ... the median of the row means within this many rows (px) around it
 
 
 def autocorrelation(u: np.ndarray, reach: float = REACH) -> tuple:
@@ -200,3 +215,45 @@ def lattice_bins(P: np.ndarray, B: np.ndarray, min_cycles: float, prominence: fl
     keep = P[by, bx] >= prominence * env[by, bx]
     idx = (by * W + bx)[keep]
     return idx[np.argsort(-P.ravel()[idx], kind="stable")]
+
+
+def _line_profile(rest: np.ndarray, same: float, strength: float, width: int) -> np.ndarray:
+    """The profile (C, H) of the rows of rest (C, H, W) that are lines straight across it: a row's mean colour less
+    the median of the row means within ``width`` rows around it (the local level: shading and broad bands are not
+    lines), where that stands ``strength`` times the rest's RMS off zero and ``same`` of the row's pixels lie past
+    the midpoint from the local level towards it (a grout joint or a plank seam runs the whole width; a row of a
+    face's texture holds pixels on both sides); zero on every other row."""
+    m = rest.mean(2)                                                             # (C, H)
+    near = np.lib.stride_tricks.sliding_window_view(np.pad(m, ((0, 0), (width, width)), mode="wrap"),
+                                                    2 * width + 1, axis=1)
+    level = np.median(near, axis=2)                                              # (C, H)
+    d = m - level
+    d2 = (d * d).sum(0)
+    proj = ((rest - level[:, :, None]) * d[:, :, None]).sum(0) / np.maximum(d2, 1e-30)[:, None]
+    rms = float(np.sqrt((rest * rest).sum(0).mean()))
+    line = ((proj > 0.5).mean(1) >= same) & (np.sqrt(d2) >= strength * rms)
+    return np.where(line[None, :], d, 0.0)
+
+
+def frame_lines(rest: np.ndarray, same: float = LINE_SAME, strength: float = LINE_STRENGTH,
+                width: int = LINE_WIDTH) -> tuple:
+    """(fx, fy float64 (K,) cycles per photo, A complex128 (K, 3)): the waves of the lines straight across the
+    photo's rest (C, H, W) (its rows, then its columns, less the rows' field: a crossing counts once), one of each
+    conjugate pair, the strongest first: rest(r, c) ~ sum Re(A exp(2 pi i (fx c / W + fy r / H)))."""
+    C, H, W = rest.shape
+    rows = _line_profile(rest, same, strength, width)                            # (C, H)
+    cols = _line_profile((rest - rows[:, :, None]).transpose(0, 2, 1), same, strength, width)     # (C, W)
+    out = []
+    for prof, n, horizontal in ((rows, H, True), (cols, W, False)):
+        if not prof.any():
+            continue
+        k = np.arange(1, (n + 1) // 2)                                           # below Nyquist, one of each pair
+        A = (2.0 / n) * np.fft.fft(prof, axis=1)[:, k].T                         # (K, C)
+        zero = np.zeros(len(k))
+        out.append((zero, k.astype(np.float64), A) if horizontal else (k.astype(np.float64), zero, A))
+    if not out:
+        return np.zeros(0), np.zeros(0), np.zeros((0, C), np.complex128)
+    fx, fy, A = (np.concatenate(v) for v in zip(*out))
+    order = np.argsort(-(np.abs(A) ** 2).sum(1), kind="stable")
+    return fx[order], fy[order], A[order]
+

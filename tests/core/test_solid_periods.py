@@ -5,7 +5,7 @@ import numpy as np
 from backend.solid.harmonic import harmonic_field, photo_harmonics
 from backend.solid.model import plane_points
 from backend.solid.motif import on_grid
-from backend.solid.periods import autocorrelation, period_lattice, translations
+from backend.solid.periods import autocorrelation, frame_lines, period_lattice, translations
 
 PPU = 128.0
 
@@ -65,7 +65,9 @@ def test_the_few_repeats_keep_the_head_joints_the_peak_test_misses():
     or two bins away); the periods' lattice brings the head joints: the part follows the bond's pattern."""
     img, pattern = brick_tile()
     H, W = pattern.shape
-    with_periods, peaks = photo_harmonics(img, PPU), photo_harmonics(img, PPU, periods=False)
+    # the lines across the frame (the courses) left out of both: the periods' part against the peaks'
+    with_periods = photo_harmonics(img, PPU, lines=False)
+    peaks = photo_harmonics(img, PPU, periods=False, lines=False)
     assert with_periods.share > peaks.share + 0.1
     p = pattern - pattern.mean()
     corr = {k: np.corrcoef(field(h, H, W).mean(2).ravel(), p.ravel())[0, 1]
@@ -117,3 +119,52 @@ def test_a_large_tile_is_measured_on_its_block_means():
     coef = np.linalg.solve(true.T, T.T)
     assert np.abs(coef - np.round(coef)).max() < 0.02
     assert on_grid(B, 0.05)
+
+
+def floor_tile(H=192, W=224, grout=4, seed=0):
+    """(photo (H, W, 3), its grout mask (H, W)): one floor tile of a library, framed by its grout along the top and
+    left edges (so that it tiles), its face a smooth random texture with pixel noise."""
+    rng = np.random.default_rng(seed)
+    F = np.fft.fft2(rng.standard_normal((H, W)))
+    f = np.hypot(*np.meshgrid(np.fft.fftfreq(W), np.fft.fftfreq(H)))
+    face = np.real(np.fft.ifft2(F / np.maximum(f, 1 / W) ** 1.2))
+    face = 0.6 + 0.04 * (face - face.mean()) / face.std() + 0.02 * rng.standard_normal((H, W))
+    r, c = np.mgrid[0:H, 0:W]
+    mask = (r < grout) | (c < grout)
+    lum = np.where(mask, 0.35, face)
+    return np.clip(lum[..., None] * np.array([1.0, 0.9, 0.8]), 0.0, 1.0), mask
+
+
+def test_a_tile_framed_by_its_grout_draws_its_joints_and_not_its_face():
+    """One floor tile per frame repeats nothing inside it (no lattice of periods, no peak), but its grout runs
+    straight across the frame: its rows and columns are lines, and the part draws the joints, not a plaid of the
+    face's row and column means."""
+    img, mask = floor_tile()
+    H, W = mask.shape
+    assert period_lattice(mean_free(img)) == (None, None)
+    none, h = photo_harmonics(img, PPU, lines=False), photo_harmonics(img, PPU)
+    assert len(none) == 0 and len(h) > 0 and h.share > 0.1
+    lum = field(h, H, W).mean(2)
+    assert np.corrcoef(lum.ravel(), mask.ravel())[0, 1] < -0.9          # dark where the grout is
+    # both joints, and a flat face: the part varies by under a tenth of the joints' depth away from them
+    face = lum[20:, 20:]
+    assert lum[:4, 20:].mean() < face.mean() - 0.15 and lum[20:, :4].mean() < face.mean() - 0.15
+    assert face.std() < 0.1 * (face.mean() - lum[:4, 20:].mean())
+
+
+def test_shading_and_texture_rows_are_not_lines():
+    """A smooth random texture with a broad dark band across it (shading, 40 px wide): the band is the local level
+    of its rows, not a line; so is every row of the texture: no line is read."""
+    rng = np.random.default_rng(5)
+    F = np.fft.fft2(rng.standard_normal((160, 256)))
+    f = np.hypot(*np.meshgrid(np.fft.fftfreq(256), np.fft.fftfreq(160)))
+    rock = np.real(np.fft.ifft2(F / np.maximum(f, 1 / 256) ** 1.5))
+    rock = (rock - rock.mean()) / rock.std() * 0.05 + 0.5
+    band = 0.25 * np.exp(-0.5 * ((np.arange(160) - 80) / 20.0) ** 2)[:, None]
+    img = np.repeat((rock - band)[..., None], 3, 2)
+    fx, fy, A = frame_lines(mean_free(img))
+    assert len(fx) == 0
+    # a joint 3 px wide, as dark as the band, is a line
+    thin = 0.25 * (np.abs(np.arange(160) - 80) <= 1)[:, None]
+    fx, fy, A = frame_lines(mean_free(np.repeat((rock - thin)[..., None], 3, 2)))
+    assert len(fx) > 0 and np.all(fx == 0)

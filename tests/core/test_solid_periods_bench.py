@@ -24,9 +24,10 @@ def test_the_periods_bench_counts_draws_and_scores_a_tile(bench_script, tmp_path
     assert s["images"] == 2 and s["unchanged"] == 1 and s["changed"] == 1
     row = d["rows"]["bricks.png"]
     assert row["size"] == [256, 160] and row["waves"][1] > row["waves"][0] and row["share"][1] > row["share"][0]
-    for k in ("spectral_peaks", "spectral_periods"):
+    for k in ("spectral_without", "spectral_with"):
         assert set(row[k]) >= {"pooled", "walls", "band", "walls_band", "oblique", "oblique_band", "colour"}
     # the head joints come back on the walls
-    assert row["spectral_periods"]["walls"] < row["spectral_peaks"]["walls"]
+    assert row["spectral_with"]["walls"] < row["spectral_without"]["walls"]
+    assert s["without"] == ["lines", "periods"]
     with Image.open(out + ".jpg") as im:        # tile | the x wall without the periods | with them
         assert im.size == (3 * 128, 128)
