@@ -22,7 +22,8 @@ counts: a period repeats, so its power collects in one bin; an aperiodic line or
 the spectrum of grass, sand or rock is smooth.  JPEG's 8 x 8 blocks draw peaks of their own, at whole multiples
 of 1/8 cycle per pixel; there a peak counts only as a harmonic of a peak elsewhere.  The price: a pattern whose
 own period divides 8 px along both of the photo's axes (stripes exactly 8 or 4 px apart, square to the photo) is
-taken for compression and left to the decoder; a period of 16 px or one a little off 8 keeps its peaks (tested).
+taken for compression and left to the decoder (unless its stripes run straight across the whole frame: the
+lines reading below takes them); a period of 16 px or one a little off 8 keeps its peaks (tested).
 At most ``COUNT`` peaks, the strongest first.  The cap binds on few photos (5 of the 483 training photos pass
 more than 32 peaks: brick, metal plates, tiles, up to 255); there 256 against 32 made the walls of two more than
 5 % closer to the photo (tiles 109.5 -> 71.6, metal 116.5 -> 95.5) and none farther (``bench/eval_solid_harmonic.py``,
@@ -45,7 +46,8 @@ bins around it that are not lattice points (:mod:`backend.solid.periods`; ``peri
 wherever that holds ``FEW_MARGIN`` more of the photo's variance than the peaks or the motif.  Lines straight
 across the photo that the part leaves (a single floor tile's grout, plank seams, slab joints: rows and columns that
 stand off their neighbours all along) are added where they hold ``FEW_MARGIN`` of its variance (``lines=False``
-leaves them out).
+leaves them out).  The price: a photograph with one straight line across its whole frame (a cable, a crack square
+to the frame) gets it once per frame's width on a solid's walls; ``--no-periodic`` leaves the whole part out.
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
 split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
