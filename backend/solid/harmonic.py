@@ -176,11 +176,11 @@ def _few_repeats(u: np.ndarray, P: np.ndarray, window: int, total: float, count:
 
 
 def _grid_field(fx: np.ndarray, fy: np.ndarray, A: np.ndarray, H: int, W: int) -> np.ndarray:
-    """sum_j Re(A_j exp(2 pi i (fx_j c / W + fy_j r / H))) at every pixel (r, c): float64 (3, H, W) (separable)."""
+    """sum_j Re(A_j exp(2 pi i (fx_j c / W + fy_j r / H))) at every pixel (r, c) for A (K, C): float64 (C, H, W)
+    (separable; zeros for K = 0)."""
     ex = np.exp(2j * np.pi * np.outer(fx, np.arange(W)) / W)                   # (K, W)
     ey = np.exp(2j * np.pi * np.outer(fy, np.arange(H)) / H)                   # (K, H)
-    return np.stack([np.real(ey.T @ (A[:, c, None] * ex)) for c in range(A.shape[1])]) if len(fx) else \
-        np.zeros((A.shape[1] if A.ndim == 2 else 3, H, W))
+    return np.stack([np.real(ey.T @ (A[:, c, None] * ex)) for c in range(A.shape[1])])
 
 
 def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
@@ -220,20 +220,22 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, pro
     found = motif_waves(u, idx, P.ravel()[idx], min_cycles, count, FLOOR) if motif and total > 0 else None
     if lobe:
         idx = _main_lobes(idx, lobe, strong.ravel(), P.ravel(), H, W)
-    Fc = F.reshape(3, -1)[:, idx].T                                                    # (K, 3)
-    share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0
-    fx, fy = kx.ravel()[idx], ky.ravel()[idx]
-    A = (2.0 / (H * W)) * Fc
+
+    def from_bins(flat):        # (fx, fy, A (K, 3), share) of the waves at the flat bins
+        Fc = F.reshape(3, -1)[:, flat].T                                               # (K, 3)
+        share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0
+        return kx.ravel()[flat], ky.ravel()[flat], (2.0 / (H * W)) * Fc, share
+
+    fx, fy, A, share = from_bins(idx)
     if found is not None:       # the lattice's motif (motif.py), where it holds at least what the bins hold
         motif_share = float(2.0 * (np.abs(found.dtft) ** 2).sum() * (H * W) ** 2 / total)
         if motif_share >= share:
             fx, fy, A, share = found.fx, found.fy, 2.0 * found.dtft, motif_share
     few = _few_repeats(u, P, window, total, count) if periods and total > 0 else None
     if few is not None:         # a tile's few repeats (periods.py), where they hold more than the others
-        Fc = F.reshape(3, -1)[:, few].T
-        few_share = float(2.0 * (np.abs(Fc) ** 2).sum() / total)
-        if few_share >= share + FEW_MARGIN:
-            fx, fy, A, share = kx.ravel()[few], ky.ravel()[few], (2.0 / (H * W)) * Fc, few_share
+        tile = from_bins(few)
+        if tile[3] >= share + FEW_MARGIN:
+            fx, fy, A, share = tile
     if lines and total > 0:     # lines straight across the photo that the part leaves (periods.py)
         lx, ly, LA = frame_lines(u - _grid_field(fx, fy, A, H, W))
         keep = (np.abs(LA) ** 2).sum(1) / 2.0 >= 2.0 * FLOOR * total / (H * W) ** 2     # as P >= FLOOR total

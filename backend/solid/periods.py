@@ -106,9 +106,8 @@ def _dip(R: np.ndarray, t: np.ndarray, steps: int = 32) -> float:
     return float(end - R[ys, xs].min()) if len(s) else 0.0
 
 
-def _ring_max(R: np.ndarray, iy: int, ix: int, r: int = None) -> float:
-    """The largest R on the square ring of half side r (RING) around (iy, ix)."""
-    r = RING if r is None else r
+def _ring_max(R: np.ndarray, iy: int, ix: int, r: int = RING) -> float:
+    """The largest R on the square ring of half side r around (iy, ix)."""
     h, w = R.shape
     o = np.arange(-r, r + 1)
     ys = np.concatenate([np.full(2 * r + 1, -r), np.full(2 * r + 1, r), o, o]) + iy
@@ -133,7 +132,7 @@ def translations(R: np.ndarray, tx: np.ndarray, ty: np.ndarray, correlation: flo
     out, val = [], []
     for i in idx:
         iy, ix = divmod(int(i), w)
-        t = np.array([float(np.broadcast_to(tx, R.shape)[iy, ix]), float(np.broadcast_to(ty, R.shape)[iy, ix])])
+        t = np.array([float(tx[0, ix]), float(ty[iy, 0])])          # tx (1, w), ty (h, 1)
         if _dip(R, t) < dip or _ring_max(R, iy, ix) > R[iy, ix] - isolation:
             continue
 
