@@ -42,23 +42,27 @@ test: $(STAMP) $(VENV)/.train kernel
 # (Python 3.11), 5.1 and 5.2 (Python 3.13; Blender 5.1+ runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
 PY313 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.13*/bin/python3.13) $(shell command -v python3.13))
 BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy51 .venv-bpy52
-.venv-bpy42/.installed: requirements-blender.txt
+.venv-bpy42/.installed: requirements-blender.txt pyproject.toml
 	$(PY) -m venv .venv-bpy42
 	.venv-bpy42/bin/python -m pip install -q bpy==4.2.23 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
+	.venv-bpy42/bin/python -m pip install -q --no-deps -e .
 	@touch $@
-.venv-bpy45/.installed: requirements-blender.txt
+.venv-bpy45/.installed: requirements-blender.txt pyproject.toml
 	$(PY) -m venv .venv-bpy45
 	.venv-bpy45/bin/python -m pip install -q bpy==4.5.15 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
+	.venv-bpy45/bin/python -m pip install -q --no-deps -e .
 	@touch $@
-.venv-bpy51/.installed: requirements-blender.txt
+.venv-bpy51/.installed: requirements-blender.txt pyproject.toml
 	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.1 (set PY313=...)"; exit 2; }
 	$(PY313) -m venv .venv-bpy51
 	.venv-bpy51/bin/python -m pip install -q bpy==5.1.2 -r requirements-blender.txt
+	.venv-bpy51/bin/python -m pip install -q --no-deps -e .
 	@touch $@
-.venv-bpy52/.installed: requirements-blender.txt
+.venv-bpy52/.installed: requirements-blender.txt pyproject.toml
 	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.2 (set PY313=...)"; exit 2; }
 	$(PY313) -m venv .venv-bpy52
 	.venv-bpy52/bin/python -m pip install -q bpy==5.2.3 -r requirements-blender.txt
+	.venv-bpy52/bin/python -m pip install -q --no-deps -e .
 	@touch $@
 
 test-blender: $(STAMP) kernel $(addsuffix /.installed,$(BPY_VENVS))

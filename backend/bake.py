@@ -43,7 +43,7 @@ from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
-__all__ = ["BakeSpec", "BakeResult", "run_bake", "frame_path", "FORMATS", "KEY_NAME", "Cancelled"]
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "frame_path", "FORMATS", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
@@ -138,7 +138,7 @@ class BakeSpec:
         path = frame_path(self.output, frame)
         if os.path.splitext(path)[1].lower() == ".npy":
             return False
-        from ._export import export
+        from .. import export
 
         return export.read_metadata(path).get(KEY_NAME) == (key or self.key(frame))
 
@@ -195,6 +195,18 @@ def evaluate_slabs(source: Source, grid: BoxGrid, time: float, progress=None, ca
         yield a, evaluate_rows(source, grid, time, a, b, sub, cancel)
 
 
+def evaluate_values(source: Source, grid: BoxGrid, time: float = 0.0, progress=None, cancel=None) -> np.ndarray:
+    """The source on the whole grid, as a .npy bake holds it: float32 ``grid.shape`` (indexed (y, x) or
+    (z, y, x)), with a trailing axis of 3 for a colour source (scene-linear RGB)."""
+    rgb = getattr(source, "rgb", False)
+    values = np.empty(grid.shape + ((3,) if rgb else ()), _F)
+    for a, vals in evaluate_slabs(source, grid, time, progress, cancel):
+        values[a: a + vals.shape[0]] = vals
+    if cancel is not None and cancel():
+        raise Cancelled("cancelled")
+    return values
+
+
 def volume_grids(spec: BakeSpec) -> dict:
     """{grid name: "float" | "vec3"} of the .vdb a spec writes: raw ``density``; with a ramp also ``color``
     (and ``temperature`` where the ramp has temperature stops); a colour source ``color`` and ``density``."""
@@ -239,7 +251,7 @@ def bake_frame(spec: BakeSpec, frame, progress=None, cancel=None) -> str:
 
 
 def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:
-    from ._export import export
+    from .. import export
 
     ext = os.path.splitext(path)[1].lower()
     meta = {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}
@@ -255,12 +267,7 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
         return
     if getattr(spec.source, "rgb", False):
         return _bake_rgb_file(spec, path, time, meta, progress, cancel)
-    shape = spec.grid.shape
-    values = np.empty(shape, _F)
-    for a, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
-        values[a: a + vals.shape[0]] = vals
-    if cancel is not None and cancel():
-        raise Cancelled("cancelled")
+    values = evaluate_values(spec.source, spec.grid, time, progress, cancel)
     if ext == ".npy":
         export.write_npy(path, values)  # indexed (y, x) / (z, y, x) like the grid
         return
@@ -278,14 +285,10 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
 def _bake_rgb_file(spec: BakeSpec, path: str, time: float, meta: dict, progress, cancel) -> None:
     """Image and array files of a colour source (scene-linear RGB values (..., 3)): RGB EXR, sRGB PNG, or
     (..., 3) .npy (its volumes go through _bake_file's .vdb branch: color + constant density)."""
-    from ._export import export
+    from .. import export
 
     ext = os.path.splitext(path)[1].lower()
-    values = np.empty(spec.grid.shape + (3,), _F)
-    for a, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
-        values[a: a + vals.shape[0]] = vals
-    if cancel is not None and cancel():
-        raise Cancelled("cancelled")
+    values = evaluate_values(spec.source, spec.grid, time, progress, cancel)
     if ext == ".npy":
         export.write_npy(path, values)
     elif ext == ".exr":

@@ -22,7 +22,7 @@ import numpy as np
 from . import limits
 from .errors import SettingError
 
-__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "source_from_dict", "register_source", "source_kinds", "SOURCES"]
+__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "solid_volume", "source_from_dict", "register_source", "source_kinds", "SOURCES"]
 
 _F = np.float32
 
@@ -489,6 +489,27 @@ _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
 
+def solid_volume(request, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
+                 on_code=None) -> tuple:
+    """(source, extent) of a ``size``-voxel cube of a :class:`~backend.solid.request.SolidRequest`: the colour source
+    that fills it and its side in world units (``size`` voxels at ``scale`` voxels per exemplar pixel), as
+    ``omninoise solid --dim 3`` bakes it; ``progress``, ``report`` and ``on_code`` as in
+    :meth:`~backend.solid.request.SolidRequest.front_image`.  SettingError for a 2D model or method synthesis."""
+    if request.method == "synthesis":
+        raise SettingError(f"{where}method", "synthesis makes 2D images; volumes come from the neural texture "
+                                             "or method spectral")
+    if request.method == "spectral":
+        field = request.spectral_field(where, progress)
+        return SpectralSource(request, field=field), size / (field.px_per_unit * scale)
+    model = request.load(where)
+    if model.dim != 3:
+        raise SettingError(f"{where}dim", f"model {model.name!r} is 2D; it cannot fill a volume")
+    code, _ = request.code(model, where, progress, report)
+    if on_code is not None:
+        on_code(code)
+    return SolidSource(model, seed=int(request.seed), code=code), size / (model.px_per_unit * scale)
+
+
 def _check_keys(d: dict, known: tuple, kind: str) -> None:
     unknown = sorted(set(d) - set(known))
     if unknown:
@@ -531,7 +552,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
                                                  f"bottom-right), got {c!r}")
         corners = [_spec_value(v, f"source.corners[{i}]") for i, v in enumerate(c)]
     if "map" in d:
-        from ._export import export
+        from .. import export
         from .neural.request import region_key, regions_from_map
 
         if not isinstance(d["map"], str):
@@ -555,7 +576,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         path = os.path.join(base_dir, d["blend"])
         if not os.path.isfile(path):
             raise SettingError("source.blend", f"mask not found: {path}")
-        from ._export import export
+        from .. import export
 
         try:
             mask = export.read_image(path)
@@ -631,7 +652,7 @@ def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
         path = os.path.join(base_dir, d.pop("example"))
         if not os.path.isfile(path):
             raise SettingError("source.example", f"image not found: {path}")
-        from ._export import export
+        from .. import export
 
         try:
             example = export.read_image(path)

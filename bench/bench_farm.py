@@ -16,8 +16,8 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from cli import farm  # noqa: E402
-from backend.jobs import run_job  # noqa: E402
+from omninoise.cli import farm  # noqa: E402
+from omninoise.backend.jobs import run_job  # noqa: E402
 
 JOB = """
 [[bake]]
@@ -59,7 +59,7 @@ def main() -> int:
         for n in (1, 2):
             client = farm.local_client(n)
             try:
-                client.run(lambda: __import__("cli.farm"))
+                client.run(lambda: __import__("omninoise.cli.farm"))
                 farm.run_farm(warm, client, force=True)  # workers import and compile once
                 t = time.perf_counter()
                 farm.run_farm(job(f"w{n}"), client)

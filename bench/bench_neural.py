@@ -37,10 +37,10 @@ FULL_UP_TO = 512  # generate whole images up to this size; above, estimate from 
 
 def _worker(a) -> dict:
     """One configuration in this process: prints a JSON line."""
-    from backend.neural import conditioning as C
-    from backend.neural.generate import auto_tile, generate, image_eps
-    from backend.neural.model import NeuralNoiseModel
-    from backend.neural.sampler import DEFAULT_SPACING, evaluations
+    from omninoise.backend.neural import conditioning as C
+    from omninoise.backend.neural.generate import auto_tile, generate, image_eps
+    from omninoise.backend.neural.model import NeuralNoiseModel
+    from omninoise.backend.neural.sampler import DEFAULT_SPACING, evaluations
 
     t0 = time.perf_counter()
     m = NeuralNoiseModel(a.model, threads=a.threads)
@@ -125,7 +125,7 @@ def network_gflop(model_folder: str, size: int) -> dict | None:
     try:
         import torch
 
-        from training.warm_start import torch_from_export
+        from omninoise.training.warm_start import torch_from_export
     except ImportError:
         return None
     net = torch_from_export(model_folder)
@@ -153,7 +153,7 @@ def network_gflop(model_folder: str, size: int) -> dict | None:
 def whole_command(args: list, threads: int, size: int = 256) -> float:
     with tempfile.TemporaryDirectory() as d:
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "cli", "neural", "--noise", "cells_f1", "--size", str(size), "--quiet",
+        subprocess.run([sys.executable, "-m", "omninoise", "neural", "--noise", "cells_f1", "--size", str(size), "--quiet",
                         "--threads", str(threads), "-o", os.path.join(d, "n.png")] + args, check=True, cwd=ROOT)
         return time.perf_counter() - t0
 
@@ -173,8 +173,8 @@ def main() -> int:
     if a.worker:
         _worker(a)
         return 0
-    from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
-    from training.export_onnx import reexport
+    from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from omninoise.training.export_onnx import reexport
 
     sizes = [s for s in a.sizes if s <= 512] if a.quick else a.sizes
     tmp = tempfile.mkdtemp(prefix="omninoise_onepiece_")
@@ -222,7 +222,7 @@ def main() -> int:
         res["whole_command_1024"] = dict(new_s=round(big, 2))
         print(f"whole command at 1024², new: {big:.1f} s")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
-    from export.atomic import write_json
+    from omninoise.export.atomic import write_json
 
     write_json(a.out, res)
     return 0

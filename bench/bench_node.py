@@ -27,8 +27,8 @@ sys.path.insert(0, ROOT)
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from backend import Spectrum, WaveSettings  # noqa: E402
-from blender_addon.wave_nodes import build_wave_group  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings  # noqa: E402
+from omninoise.blender_addon.wave_nodes import build_wave_group  # noqa: E402
 
 
 def scene(res: int, samples: int, osl: bool = False):

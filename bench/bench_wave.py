@@ -30,8 +30,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
-from backend.wavenoise import ckernel, fast  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
+from omninoise.backend.wavenoise import ckernel, fast  # noqa: E402
 
 
 def timed(fn, repeat):
@@ -94,7 +94,7 @@ def peers(dim, n, repeat):
 def blender_peers(dim, n, repeat):
     try:
         import bpy  # noqa: F401
-        from blender_addon.field_eval import evaluate_field
+        from omninoise.blender_addon.field_eval import evaluate_field
     except ImportError:
         return {}
     g = np.arange(n, dtype=np.float32) * np.float32(4.0 / n)

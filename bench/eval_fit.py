@@ -28,19 +28,19 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural.fit import (describe, distance, fit, fitted_conditioning, load_bank, prepare_target,  # noqa: E402
+from omninoise.backend.neural.fit import (describe, distance, fit, fitted_conditioning, load_bank, prepare_target,  # noqa: E402
                                 render, target_statistic)
-from backend.paths import fit_bank  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from export.images import read_rgb, write_png  # noqa: E402
+from omninoise.backend.paths import fit_bank  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.export.images import read_rgb, write_png  # noqa: E402
 
 
 def zoo_image(name: str, u: np.ndarray, seed: int, size: int, classes: dict) -> tuple:
     import torch
 
-    from training import zoo
+    from omninoise.training import zoo
 
     spec = classes[name]["params"]
     params = {p["name"]: float(p["min"] + uu * (p["max"] - p["min"])) for p, uu in zip(spec, u)}

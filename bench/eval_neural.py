@@ -17,10 +17,10 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from training.evaluate import evaluate, step_seconds  # noqa: E402
-from training.threads import cpu_threads  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.training.evaluate import evaluate, step_seconds  # noqa: E402
+from omninoise.training.threads import cpu_threads  # noqa: E402
 
 
 def main() -> int:
@@ -94,7 +94,7 @@ def _run(a, model, classes) -> int:
     if not a.no_timing:
         res["timing"] = step_seconds(a.model, a.size)
     if not a.timing_only:
-        from backend.neural.sampler import DEFAULT_SPACING
+        from omninoise.backend.neural.sampler import DEFAULT_SPACING
 
         res["sampler"] = dict(name=a.sampler, steps=a.steps, spacing=a.spacing or DEFAULT_SPACING[a.sampler])
         if a.eta:

@@ -28,7 +28,7 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from export.atomic import write_json  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
 
 MODELS = os.path.join(ROOT, "models", "solid")
 
@@ -36,10 +36,10 @@ MODELS = os.path.join(ROOT, "models", "solid")
 def quality(n: int, models_dir: str = MODELS) -> dict:
     import torch
 
-    from training.solid import exemplars as ex
-    from training.solid.evaluate import EVAL_SIZE, evaluate_exemplar, slices_3d
+    from omninoise.training.solid import exemplars as ex
+    from omninoise.training.solid.evaluate import EVAL_SIZE, evaluate_exemplar, slices_3d
 
-    from backend.solid.model import load_models
+    from omninoise.backend.solid.model import load_models
 
     models = load_models(models_dir)
     space = next((m for m in models.values() if m.mode == "space"), None)
@@ -76,7 +76,7 @@ def quality(n: int, models_dir: str = MODELS) -> dict:
 
 
 def _plane(size, ppu, i):
-    from backend.solid.model import plane_points
+    from omninoise.backend.solid.model import plane_points
 
     return plane_points(size, ppu) + np.random.default_rng(i).uniform(-50, 50, 2)
 
@@ -104,7 +104,7 @@ def _peak_mib() -> int:
 
 def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
     """One timing in this process: seconds for all points, peak RSS."""
-    from backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.model import SolidTextureModel
 
     m = SolidTextureModel(os.path.join(MODELS, model))
     pts = _points(dim, size, m.config["px_per_unit"])
@@ -121,8 +121,8 @@ def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
     else:
         import torch
 
-        from training.solid.lattice import octave_seeds
-        from training.solid.train import SolidConfig, build_model
+        from omninoise.training.solid.lattice import octave_seeds
+        from omninoise.training.solid.train import SolidConfig, build_model
 
         state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)
         tm = build_model(SolidConfig.from_dict(state["config"]))

@@ -34,11 +34,11 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from backend.solid.harmonic import DETECTS, Harmonics, harmonic_field, photo_harmonics  # noqa: E402
-from backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
+from omninoise.backend.solid.harmonic import DETECTS, Harmonics, harmonic_field, photo_harmonics  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
 from bench.eval_solid_photos import SIZE, photos, read, slice_image  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
 
 STRUCTURED = ("brick", "wood", "fabric", "metal", "concrete", "marble", "rust")
 SETTINGS = [(p, w) for w in (3, 5) for p in (4.0, 8.0, 16.0, 32.0)]

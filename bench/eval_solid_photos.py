@@ -66,14 +66,14 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from export.atomic import atomic_path, write_json  # noqa: E402
-from export import read_rgb as read  # noqa: E402  (the one image reader; other bench scripts import it from here)
-from backend.solid.model import SolidTextureModel  # noqa: E402
-from backend.solid.refine import exemplar_z  # noqa: E402
-from backend.solid import spectral, upright  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
-from training.solid.photo_set import photo_set  # noqa: E402
-from training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
+from omninoise.export import read_rgb as read  # noqa: E402  (the one image reader; other bench scripts import it from here)
+from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
+from omninoise.backend.solid.refine import exemplar_z  # noqa: E402
+from omninoise.backend.solid import spectral, upright  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
+from omninoise.training.solid.photo_set import photo_set  # noqa: E402
+from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
 
 SIZE = 128
 
@@ -118,7 +118,7 @@ def spectrum_distance(images: list, photo: np.ndarray) -> float:
     top-left crop of the same size."""
     import torch
 
-    from training.solid.spectrum import spectrum_loss
+    from omninoise.training.solid.spectrum import spectrum_loss
 
     def t(a):
         return torch.from_numpy(np.ascontiguousarray(a, np.float32)).permute(2, 0, 1)[None]

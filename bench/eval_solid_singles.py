@@ -32,11 +32,11 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from export.atomic import atomic_path, write_json  # noqa: E402
-from export.images import read_rgb  # noqa: E402
-from backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
-from training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
+from omninoise.export.images import read_rgb  # noqa: E402
+from omninoise.backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
+from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
 
 SIZE = 128
 SEEDS = 2

@@ -19,12 +19,12 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.animate import Keyframe, animate, temporal_coherence  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from export.atomic import atomic_path, write_json  # noqa: E402
-from export.images import write_png  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.animate import Keyframe, animate, temporal_coherence  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
+from omninoise.export.images import write_png  # noqa: E402
 
 
 def main() -> int:

@@ -22,7 +22,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from export.atomic import write_json  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
 
 TIMESTEPS = (980, 950, 900, 850, 800, 700, 500)
 
@@ -32,9 +32,9 @@ def ideal_gain(name: str, size: int, n: int, timesteps=TIMESTEPS) -> list:
     model of class ``name`` (zoo spectra of n images at one direction, and at 12 directions for the mixture)."""
     import torch
 
-    from backend.neural.schedule import cosine_alphas_cumprod
-    from training import zoo
-    from training.evaluate import oriented_params
+    from omninoise.backend.neural.schedule import cosine_alphas_cumprod
+    from omninoise.training import zoo
+    from omninoise.training.evaluate import oriented_params
 
     def power(theta):
         p = {k: np.full(n, v) for k, v in oriented_params(name, theta).items()}
@@ -57,10 +57,10 @@ def model_gain(folder: str, name: str, size: int, n: int, timesteps=TIMESTEPS) -
     from it) on n zoo images of class ``name`` at random directions."""
     import torch
 
-    from training import zoo
-    from training.diffusion import Diffusion
-    from training.evaluate import ORIENTED, oriented_params
-    from training.warm_start import torch_from_export
+    from omninoise.training import zoo
+    from omninoise.training.diffusion import Diffusion
+    from omninoise.training.evaluate import ORIENTED, oriented_params
+    from omninoise.training.warm_start import torch_from_export
 
     pname = ORIENTED[name][0]
     spec = next(p for p in zoo.CLASSES[name].params if p.name == pname)
@@ -103,7 +103,7 @@ def main() -> int:
     a = ap.parse_args()
     import torch
 
-    from training.evaluate import ORIENTED
+    from omninoise.training.evaluate import ORIENTED
 
     if a.noise not in ORIENTED:
         ap.error(f"--noise must be one of {', '.join(ORIENTED)}, got {a.noise!r}")

@@ -22,10 +22,10 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from backend.neural.precision import int8_dot_products  # noqa: E402
-from backend.neural.sampler import initial_noise  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.backend.neural.precision import int8_dot_products  # noqa: E402
+from omninoise.backend.neural.sampler import initial_noise  # noqa: E402
 
 
 def feed(m, name: str, S: int, seed: int, t: float) -> dict:
@@ -43,7 +43,7 @@ def main() -> int:
     import onnxruntime as ort
     from onnxruntime.quantization import QuantType, quantize_dynamic
 
-    from training.quantize_onnx import quantize_folder
+    from omninoise.training.quantize_onnx import quantize_folder
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = a.model

@@ -30,17 +30,17 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from export.atomic import write_json  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
 
 
 def zoo_halves(classes, size: int, n: int) -> dict:
     """{class: (half A, half B)} float32 (n // 2, size, size) zoo images at default parameters."""
     import torch
 
-    from training import zoo
+    from omninoise.training import zoo
 
     out = {}
     for name in classes:
@@ -62,8 +62,8 @@ def main() -> int:
                     help="count spectrum bands under this share of the power as equal (training.evaluate.look)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_nearest.json"))
     a = ap.parse_args()
-    from training import zoo
-    from training.evaluate import look, look_scales, nearest_looks
+    from omninoise.training import zoo
+    from omninoise.training.evaluate import look, look_scales, nearest_looks
 
     models = [NeuralNoiseModel(m, threads=a.threads) for m in a.model]
     labels = a.label or [os.path.basename(os.path.normpath(m)) for m in a.model]

@@ -17,12 +17,12 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from backend.neural.sampler import DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from export.images import preview_8bit, write_png  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.backend.neural.sampler import DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.export.images import preview_8bit, write_png  # noqa: E402
 
 CLASSES = ("cells_f1", "perlin", "clouds", "spots", "fibers", "damascus", "gabor", "wave_cellular")
 

@@ -23,10 +23,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from backend.neural.sampler import evaluations, initial_noise, sample  # noqa: E402
-from export.atomic import write_json  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.backend.neural.sampler import evaluations, initial_noise, sample  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
 
 
 def parse(spec: str) -> tuple:

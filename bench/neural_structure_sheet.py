@@ -19,11 +19,11 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from export.images import write_png  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.export.images import write_png  # noqa: E402
 
 CLASSES = ("damascus", "fibers", "gabor", "gabor_texture", "phasor")
 
@@ -41,8 +41,8 @@ def main() -> int:
     a = ap.parse_args()
     import torch
 
-    from training import zoo
-    from training.evaluate import known_params, orientation_coherence, psd_error
+    from omninoise.training import zoo
+    from omninoise.training.evaluate import known_params, orientation_coherence, psd_error
 
     classes = [c.strip() for c in a.classes.split(",") if c.strip()]
     labels = a.label or [os.path.basename(os.path.normpath(m)) for m in a.model]

@@ -35,14 +35,14 @@ sys.path.insert(0, ROOT)
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
-from backend.solid.model import SolidTextureModel  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from training.solid import exemplars as ex, photo_eval as pe  # noqa: E402
-from training.solid.arrangement import ArrangementFeatures  # noqa: E402
-from training.solid.morphology import morphology_distance  # noqa: E402
-from training.solid.soft_morphology import soft_morphology_loss  # noqa: E402
-from training.solid.swd import swd_loss  # noqa: E402
-from training.solid.train import load_config, loss_features, structure_features, texture_loss  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.training.solid import exemplars as ex, photo_eval as pe  # noqa: E402
+from omninoise.training.solid.arrangement import ArrangementFeatures  # noqa: E402
+from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.training.solid.soft_morphology import soft_morphology_loss  # noqa: E402
+from omninoise.training.solid.swd import swd_loss  # noqa: E402
+from omninoise.training.solid.train import load_config, loss_features, structure_features, texture_loss  # noqa: E402
 
 SIZE = 128
 DEFAULT = ("train/paving__alpine_arctic_paving_stones_01.jpg", "val/paving__sahara_paving_stones_01.jpg",

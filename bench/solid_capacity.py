@@ -1,7 +1,7 @@
 """Can the per-point decoder over noise octaves carry a photo's structure at all? (issue 20)
 
 Single-exemplar 2D models of structured photos (paving stones, brick courses), trained with the sliced
-Wasserstein loss by ``python -m training.solid.train --config C --out RUN``, one per decoder size, are
+Wasserstein loss by ``python -m omninoise.training.solid.train --config C --out RUN``, one per decoder size, are
 rendered at the photo's smaller side (at most 256 px) for several seeds and compared with the photo they were fitted to (a capacity question:
 how near can the model get to its own exemplar, not generalisation) by the patch distance of
 ``training/solid/photo_eval.py`` (x 1000, lower is better) and by the level-set morphology distance of
@@ -25,11 +25,11 @@ import torch
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from export.atomic import write_json  # noqa: E402
-from training.solid.model import colour_stats  # noqa: E402
-from training.solid.morphology import morphology_distance  # noqa: E402
-from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase, tile_sheet  # noqa: E402
-from training.solid.train import SolidConfig, build_model, render, training_images  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.training.solid.model import colour_stats  # noqa: E402
+from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase, tile_sheet  # noqa: E402
+from omninoise.training.solid.train import SolidConfig, build_model, render, training_images  # noqa: E402
 
 MAX_SIZE = 256
 

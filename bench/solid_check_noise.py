@@ -20,8 +20,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "bench"))
 
-from export.atomic import write_json  # noqa: E402
-from backend.solid import spectral  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.backend.solid import spectral  # noqa: E402
 
 
 def choice(model, photo, code, planes) -> tuple | None:
@@ -37,7 +37,7 @@ def choice(model, photo, code, planes) -> tuple | None:
 
 def main(argv=None) -> int:
     from eval_solid_photos import photos, read
-    from backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.model import SolidTextureModel
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))

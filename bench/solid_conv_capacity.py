@@ -29,14 +29,14 @@ import torch
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from export.atomic import atomic_path, write_json  # noqa: E402
-from training.precision import resolve  # noqa: E402
-from training.solid.conv_fit import colour, fit  # noqa: E402
-from training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
-from training.solid.model import colour_stats  # noqa: E402
-from training.solid.morphology import morphology_distance  # noqa: E402
-from training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase, tile_sheet  # noqa: E402
-from training.solid.train import load_config, loss_features, texture_loss, training_images  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
+from omninoise.training.precision import resolve  # noqa: E402
+from omninoise.training.solid.conv_fit import colour, fit  # noqa: E402
+from omninoise.training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
+from omninoise.training.solid.model import colour_stats  # noqa: E402
+from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.training.solid.photo_eval import patch_swd, pixel_shuffle, random_phase, tile_sheet  # noqa: E402
+from omninoise.training.solid.train import load_config, loss_features, texture_loss, training_images  # noqa: E402
 
 MAX_SIZE = 256
 

@@ -23,11 +23,11 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from backend.solid import upright  # noqa: E402
-from backend.solid.model import SolidTextureModel  # noqa: E402
+from omninoise.backend.solid import upright  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
 from bench.eval_solid_photos import cube, photos, read, slice_image  # noqa: E402
-from export.atomic import atomic_path  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
+from omninoise.export.atomic import atomic_path  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
 
 DEFAULT = ("brick", "wood", "concrete", "soil__farmland", "fabric__karts", "paving__aegean_anatolia_paving")
 

@@ -28,10 +28,10 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 import torch.nn.functional as F  # noqa: E402
 
-from export.atomic import atomic_path, write_json  # noqa: E402
-from training.solid import exemplars as ex  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
-from training.solid.train import SolidConfig, load_config, loss_features, texture_loss  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
+from omninoise.training.solid import exemplars as ex  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
+from omninoise.training.solid.train import SolidConfig, load_config, loss_features, texture_loss  # noqa: E402
 
 DEFAULT_PHOTOS = ("gravel", "rock", "brick", "wood", "paving", "grass")
 

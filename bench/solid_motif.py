@@ -27,15 +27,15 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-import backend.solid.model as solid_model  # noqa: E402
-from backend.solid import harmonic  # noqa: E402
-from backend.solid.request import SolidRequest  # noqa: E402
+import omninoise.backend.solid.model as solid_model  # noqa: E402
+from omninoise.backend.solid import harmonic  # noqa: E402
+from omninoise.backend.solid.request import SolidRequest  # noqa: E402
 from bench.eval_solid_photos import slice_image  # noqa: E402
 from bench.solid_synthesis import slices  # noqa: E402
-from export import read_rgb  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
-from training.solid.photo_set import photo_set  # noqa: E402
+from omninoise.export import read_rgb  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
+from omninoise.training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
 #: interior crops (rows, columns) of a 256 px photo whose sides no period of a tileable 256 px texture divides

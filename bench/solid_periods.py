@@ -33,12 +33,12 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from backend.solid import harmonic  # noqa: E402
+from omninoise.backend.solid import harmonic  # noqa: E402
 from bench.solid_motif import METHODS, SIZE, compare, draw, same, score  # noqa: E402
-from export import read_rgb  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
-from training.solid.photo_set import photo_set  # noqa: E402
+from omninoise.export import read_rgb  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
+from omninoise.training.solid.photo_set import photo_set  # noqa: E402
 
 PACKAGE = "sweethome3d"
 JAR = "usr/share/sweethome3d/sweethome3d.jar"

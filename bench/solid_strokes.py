@@ -28,9 +28,9 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
-from export import read_rgb  # noqa: E402
-from training.solid.photo_set import photo_set  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel, slice_points  # noqa: E402
+from omninoise.export import read_rgb  # noqa: E402
+from omninoise.training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
 
@@ -84,7 +84,7 @@ def sheet(path: str, models: list, photos: list, size: int = 192) -> None:
     """Photo | per model: front, floor (slices through (0.3, 0.3, 0.3), seed 1), one row per photo."""
     from PIL import Image
 
-    from export.atomic import atomic_path
+    from omninoise.export.atomic import atomic_path
 
     ms = [SolidTextureModel(d) for d in models]
     rows = []

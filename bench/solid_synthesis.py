@@ -50,17 +50,17 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from export import read_rgb  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from backend.solid.model import measure_harmonics, resize_rgb, slice_points  # noqa: E402
-from backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field  # noqa: E402
-from backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
-from backend.solid.upright import upright_waves  # noqa: E402
-from backend.solid.request import SolidRequest  # noqa: E402
-from backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
+from omninoise.export import read_rgb  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.backend.solid.model import measure_harmonics, resize_rgb, slice_points  # noqa: E402
+from omninoise.backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field  # noqa: E402
+from omninoise.backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
+from omninoise.backend.solid.upright import upright_waves  # noqa: E402
+from omninoise.backend.solid.request import SolidRequest  # noqa: E402
+from omninoise.backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
                                      synthesise)
-from training.solid import photo_eval as pe  # noqa: E402
-from training.solid.photo_set import photo_set  # noqa: E402
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
+from omninoise.training.solid.photo_set import photo_set  # noqa: E402
 
 SIZE = 128
 #: the Gaussian solids random phase noise is drawn as in 3D (:func:`random_phase_solid`)

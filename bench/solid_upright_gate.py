@@ -33,10 +33,10 @@ GATES = (0.0, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4)
 def coherences(names, split: str) -> dict:
     """{photo name: spectral coherence of its rest} as backend.solid.model.gaussian_rest gates it."""
     from eval_solid_photos import photos
-    from export import read_rgb
-    from backend.solid.harmonic import remove_harmonics
-    from backend.solid.model import SolidTextureModel, _measured
-    from backend.solid.upright import orientation
+    from omninoise.export import read_rgb
+    from omninoise.backend.solid.harmonic import remove_harmonics
+    from omninoise.backend.solid.model import SolidTextureModel, _measured
+    from omninoise.backend.solid.upright import orientation
 
     m = SolidTextureModel(os.path.join(ROOT, "models", "solid", "space"))
     out = {}
@@ -93,7 +93,7 @@ def main(argv=None) -> int:
     else:
         coh = coherences(set(new), doc.get("split", "val"))
         if a.coherence:
-            from export.atomic import write_json
+            from omninoise.export.atomic import write_json
             write_json(a.coherence, coh)
     print("\n".join(table(new, old, coh)))
     return 0

@@ -15,7 +15,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from export.atomic import atomic_path  # noqa: E402
+from omninoise.export.atomic import atomic_path  # noqa: E402
 
 
 def main() -> int:
@@ -28,8 +28,8 @@ def main() -> int:
     import torch
     from PIL import Image, ImageDraw
 
-    from training import zoo
-    from training.evaluate import orientation_coherence
+    from omninoise.training import zoo
+    from omninoise.training.evaluate import orientation_coherence
 
     S, cols, label_h, gap = a.size, a.columns, 14, 4
     names = list(zoo.CLASS_NAMES)

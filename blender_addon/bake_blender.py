@@ -9,7 +9,7 @@ import os
 import bpy
 from mathutils import Vector
 
-from ._deps import backend
+from .. import backend
 from .compat import ensure_node_tree
 
 __all__ = ["ramp_node", "transfer_from_color_ramp", "apply_preset", "world_bounds", "load_volume",

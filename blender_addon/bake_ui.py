@@ -19,7 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 
 from . import tasks
 from .tasks import TaskOperator
-from ._deps import backend
+from .. import backend
 from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
                            transfer_from_color_ramp, world_bounds)
 from .preferences import precision, threads

@@ -20,7 +20,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from ._deps import backend
+from .. import backend
 from .wave_nodes import INPUTS, SETTINGS_KEY, clear_tree, group_io, new_group, NodeBuilder, settings_to_json
 
 __all__ = ["build_cellular_group", "new_cellular_tree", "CELL_OUTPUTS"]

@@ -21,7 +21,7 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatPrope
     IntProperty, PointerProperty, StringProperty
 
 from . import tasks
-from ._deps import backend
+from .. import backend
 from .bake_ui import draw_progress
 from .tasks import TaskOperator
 from .preferences import precision, threads
@@ -253,7 +253,7 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
 
             img = _mod("neural.request").generate_request(m, req, callback=step)
             if save_path is not None:  # atomic, off the main thread
-                from ._deps import export
+                from .. import export
 
                 if save_path.endswith(".png"):
                     export.write_png(save_path, export.preview_8bit(img, 0.0, 1.0))
@@ -342,7 +342,7 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
         frame_path = _mod("bake").frame_path
 
         def work(progress, cancel):
-            from ._deps import export
+            from .. import export
 
             finished = []
 
@@ -568,7 +568,7 @@ class OMNINOISE_OT_neural_preset_save(bpy.types.Operator):
     def execute(self, context):
         import json
 
-        from ._deps import export
+        from .. import export
 
         path = bpy.path.ensure_ext(bpy.path.abspath(self.filepath), ".json")
         try:

@@ -38,7 +38,7 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from . import tasks
-from ._deps import backend
+from .. import backend
 from .compat import ensure_node_tree
 from .bake_ui import draw_progress
 from .tasks import TaskOperator
@@ -167,7 +167,7 @@ def _image_pixels(ima) -> np.ndarray:
     px = px.reshape(h, w, ima.channels)
     rgb = px[..., :3] if ima.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
     if ima.is_float:  # float buffers hold scene-linear values; the encoder was trained on sRGB values
-        from ._deps import export
+        from .. import export
 
         rgb = export.linear_to_srgb(rgb)
     return np.ascontiguousarray(np.flipud(rgb), np.float32)

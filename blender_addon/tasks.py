@@ -21,7 +21,7 @@ from typing import Callable
 import bpy
 from bpy.props import BoolProperty
 
-from ._deps import backend
+from .. import backend
 
 __all__ = ["Task", "TaskOperator", "start", "current", "cancel", "wait", "shutdown", "POLL_SECONDS"]
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._deps import backend
+from .. import backend
 
 __all__ = ["stratum_constants", "OUTPUTS"]
 

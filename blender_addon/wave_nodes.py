@@ -41,7 +41,7 @@ import json
 import bpy
 import numpy as np
 
-from ._deps import backend
+from .. import backend
 from .compat import id_property
 from .wave_constants import OUTPUTS, stratum_constants
 

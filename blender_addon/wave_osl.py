@@ -28,7 +28,7 @@ import os
 
 import numpy as np
 
-from ._deps import backend
+from .. import backend
 from .wave_constants import OUTPUTS, stratum_constants
 
 __all__ = ["osl_source", "script_node", "osl_available"]

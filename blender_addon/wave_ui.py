@@ -20,7 +20,7 @@ from bpy.app.handlers import persistent
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
     PointerProperty, StringProperty
 
-from ._deps import backend
+from .. import backend
 from .wave_nodes import add_wave_node, build_wave_group, new_wave_tree, tree_implementation
 
 _SPECTRA = [(k, k.capitalize(), "") for k in ("gaussian", "bandpass", "fractal", "white", "blue", "brown", "twolevel")]

@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from backend.bake import BakeSpec, KEY_NAME, bake_frame, evaluate_rows, frame_path, volume_channels, volume_grids
-from backend.jobs import JobError, JobOutcome, load_job, select_bakes
+from omninoise.backend.bake import BakeSpec, KEY_NAME, bake_frame, evaluate_rows, frame_path, volume_channels, volume_grids
+from omninoise.backend.jobs import JobError, JobOutcome, load_job, select_bakes
 
 __all__ = ["Task", "plan", "run_farm", "local_client", "remote_client", "brick_voxels_for", "CRASH_ENV"]
 
@@ -88,7 +88,7 @@ def _maybe_crash(path: str) -> None:
         os.remove(marker)
     except OSError:
         return  # another worker took it
-    from backend._export import export
+    from omninoise import export
 
     partial = os.path.join(os.path.dirname(path), export.partial_prefix(path) + "crash")
     with open(partial, "wb") as fh:
@@ -98,7 +98,7 @@ def _maybe_crash(path: str) -> None:
 
 def _worker_precision(precision: str) -> None:
     """The client's --precision on this worker (every worker of a farm runs the neural denoiser alike)."""
-    from backend.neural.precision import set_default_precision
+    from omninoise.backend.neural.precision import set_default_precision
 
     set_default_precision(precision)
 
@@ -182,7 +182,7 @@ def local_client(workers: int, memory_limit: str = "auto"):
     """A local cluster of ``workers`` processes (one thread each) listening on 127.0.0.1 only -> Client."""
     from distributed import Client, LocalCluster
 
-    from cli import hugepages
+    from omninoise.cli import hugepages
 
     # the workers are new processes: they start with huge pages for large neural images (cli/hugepages.py)
     os.environ.update(hugepages.environment(os.environ))
@@ -219,7 +219,7 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
     """
     from distributed import as_completed
 
-    from backend._export import export
+    from omninoise import export
 
     job = os.path.abspath(job)
     entries = select_bakes(load_job(job), only)

@@ -13,18 +13,18 @@ import time
 
 import numpy as np
 
-from export.images import ImageError
-from cli import hugepages
-from backend import limits
-from backend.errors import SettingError
-from backend.neural.precision import PRECISIONS
-from backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
-from backend.paths import neural_model
-from backend.wavenoise.settings import WaveSettings
-from backend.wavenoise.cellular import CELLULAR_MODES
-from backend.wavenoise.tables import WAVEFORMS
-from backend.transfer import PRESETS, load_transfer
-from backend.wavenoise.wave import OUTPUTS
+from omninoise.export.images import ImageError
+from omninoise.cli import hugepages
+from omninoise.backend import limits
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural.precision import PRECISIONS
+from omninoise.backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
+from omninoise.backend.paths import neural_model
+from omninoise.backend.wavenoise.settings import WaveSettings
+from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
+from omninoise.backend.wavenoise.tables import WAVEFORMS
+from omninoise.backend.transfer import PRESETS, load_transfer
+from omninoise.backend.wavenoise.wave import OUTPUTS
 
 __all__ = ["main", "build_parser", "settings_from_args"]
 
@@ -49,8 +49,16 @@ def _lobe_arg(text: str) -> tuple:
         raise argparse.ArgumentTypeError(f"expected x,y[,z]:weight, got {text!r}") from None
 
 
+def _version_line() -> str:
+    from omninoise.backend.version import __version__
+    from omninoise.backend.wavenoise.fast import engine_path
+
+    return f"omninoise {__version__} (wave noise: {engine_path()})"
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="omninoise", description="OmniNoise: wave noise and neural noise bakes.")
+    ap.add_argument("--version", action="version", version=_version_line())
     ap.add_argument("--debug", action="store_true",
                     help="show the Python traceback of an internal error (default: one line, exit 1)")
     sub = ap.add_subparsers(dest="command", required=True)
@@ -226,7 +234,7 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
     if a.example:
         if not os.path.isfile(a.example):
             raise SettingError("--example", f"image not found: {a.example}")
-        from export.images import read_image
+        from omninoise.export.images import read_image
 
         example = read_image(a.example)
     profile = ()
@@ -303,6 +311,10 @@ def run_wave(a: argparse.Namespace) -> int:
     if not os.path.isdir(folder):
         raise SettingError("-o", f"output folder does not exist: {folder}")
     s = settings_from_args(a)
+    if not a.quiet:
+        from omninoise.backend.wavenoise.fast import engine_path
+
+        print(f"omninoise wave: {engine_path()}", file=sys.stderr)
     nyq = a.size / (2.0 * a.extent)
     if a.fmax > nyq and a.cellular == "none" and not a.quiet:
         print(f"omninoise wave: warning: --fmax {a.fmax:g} is above the grid's Nyquist {nyq:g}; "
@@ -314,8 +326,8 @@ def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
     """``wave``, every output type, through the bake pipeline: one sampling convention (docs/conventions.md:
     sample centres (i + 1/2) E / N over [0, E)^d; .npy indexed [y, x] / [z, y, x]; images with +y up), the
     ramp, an atomic write."""
-    from backend.bake import BakeSpec, run_bake
-    from backend.sources import BoxGrid, WaveSource
+    from omninoise.backend.bake import BakeSpec, run_bake
+    from omninoise.backend.sources import BoxGrid, WaveSource
 
     tf = load_transfer(a.transfer) if a.transfer else None
     if tf is not None and a.range:
@@ -329,7 +341,7 @@ def _bake_wave(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
 
 def _bake_on_farm(a: argparse.Namespace) -> int:
     """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (cli/farm.py); exit codes as locally."""
-    from backend.jobs import JobError
+    from omninoise.backend.jobs import JobError
 
     if a.workers is not None and a.cluster:
         raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
@@ -385,8 +397,8 @@ def _bake_on_farm(a: argparse.Namespace) -> int:
 
 def _set_threads(n: int, precision: str = "fp32") -> None:
     """The CLI's --threads and --precision as the defaults of every model the command loads."""
-    from backend.neural.precision import set_default_precision
-    from backend.onnx_models import set_default_threads
+    from omninoise.backend.neural.precision import set_default_precision
+    from omninoise.backend.onnx_models import set_default_threads
 
     if n < 0:
         raise SettingError("--threads", f"must be >= 0 (0: all cores), got {n}")
@@ -395,7 +407,7 @@ def _set_threads(n: int, precision: str = "fp32") -> None:
 
 
 def run_bake_job(a: argparse.Namespace) -> int:
-    from backend.jobs import JobError, load_job, run_job
+    from omninoise.backend.jobs import JobError, load_job, run_job
 
     if a.dry_run:
         entries = load_job(a.job)
@@ -464,8 +476,8 @@ def _spec_arg(text: str, flag: str) -> tuple:
 
 def _painted_parts(a: argparse.Namespace) -> tuple:
     """--map and its --region flags -> (regions int (H, W) into specs, specs)."""
-    from export.images import decode
-    from backend.neural.request import region_key, regions_from_map
+    from omninoise.export.images import decode
+    from omninoise.backend.neural.request import region_key, regions_from_map
 
     if not os.path.isfile(a.map):
         raise SettingError("--map", f"map not found: {a.map}")
@@ -486,8 +498,8 @@ def _painted_parts(a: argparse.Namespace) -> tuple:
 
 def neural_request(a: argparse.Namespace, model):
     """The :class:`backend.neural.request.NeuralRequest` of ``omninoise neural`` flags (checked)."""
-    from backend.neural.request import NeuralRequest
-    from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from omninoise.backend.neural.request import NeuralRequest
+    from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
 
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
@@ -503,7 +515,7 @@ def neural_request(a: argparse.Namespace, model):
         regions, specs = _painted_parts(a)
         req = NeuralRequest("painted", specs, regions=regions, **kw)
     elif a.blend:
-        from export.images import read_image
+        from omninoise.export.images import read_image
 
         if not os.path.isfile(a.blend):
             raise SettingError("--blend", f"mask not found: {a.blend}")
@@ -527,11 +539,11 @@ def neural_request(a: argparse.Namespace, model):
 def run_neural(a: argparse.Namespace) -> int:
     import json
 
-    from backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable
-    from backend.neural.request import generate_request
+    from omninoise.backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable
+    from omninoise.backend.neural.request import generate_request
 
-    from backend.neural.generate import check_sampler
-    from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from omninoise.backend.neural.generate import check_sampler
+    from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
 
     _set_threads(a.threads, a.precision)
     sampler = a.sampler or DEFAULT_SAMPLER
@@ -570,7 +582,7 @@ def run_neural(a: argparse.Namespace) -> int:
     req = neural_request(a, model)
     bar = _Bar(a.quiet)
     img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
-    from export.images import preview_8bit, write_image, write_png
+    from omninoise.export.images import preview_8bit, write_image, write_png
 
     if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch
         write_png(a.out, preview_8bit(img, 0.0, 1.0))
@@ -582,9 +594,9 @@ def run_neural(a: argparse.Namespace) -> int:
 def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     """``neural --keys KEYS.toml --frames FIRST LAST -o name_####.png``: one file per frame, each written
     atomically (an interrupted run keeps the frames it finished)."""
-    from backend.bake import frame_path, has_frame_field
-    from backend.neural.animate import animate, read_keys
-    from export.images import preview_8bit, write_image, write_png
+    from omninoise.backend.bake import frame_path, has_frame_field
+    from omninoise.backend.neural.animate import animate, read_keys
+    from omninoise.export.images import preview_8bit, write_image, write_png
 
     if not (a.keys and a.frames):
         raise SettingError("--keys", "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
@@ -627,12 +639,12 @@ def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) ->
     noise at --size with the sampler settings."""
     import json
 
-    from export.atomic import write_json
-    from export.images import decode, preview_8bit, write_image, write_png
-    from backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
-    from backend.neural.generate import generate
-    from backend.onnx_models import ModelError
-    from backend.paths import fit_bank
+    from omninoise.export.atomic import write_json
+    from omninoise.export.images import decode, preview_8bit, write_image, write_png
+    from omninoise.backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
+    from omninoise.backend.neural.generate import generate
+    from omninoise.backend.onnx_models import ModelError
+    from omninoise.backend.paths import fit_bank
 
     if a.noise or a.corners or a.map or a.blend:
         raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
@@ -677,7 +689,7 @@ def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) ->
 
 def solid_request(a: argparse.Namespace):
     """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
-    from backend.solid.request import SolidRequest
+    from omninoise.backend.solid.request import SolidRequest
 
     return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
                         a.rest, a.method, a.tile).check("--")
@@ -686,7 +698,7 @@ def solid_request(a: argparse.Namespace):
 def run_solid(a: argparse.Namespace) -> int:
     import json
 
-    from backend.solid.model import load_models
+    from omninoise.backend.solid.model import load_models
 
     if a.list:
         out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
@@ -707,27 +719,9 @@ def run_solid(a: argparse.Namespace) -> int:
         raise SettingError("--method", "synthesis makes 2D images (--dim 2); volumes come from the neural texture "
                                       "or --method spectral")
     req = solid_request(a)
-    if req.method == "synthesis":
-        field = req.synthesis_field("--", _Bar(a.quiet, "synthesis "))
-        _write_solid_image(a.out, field.image(a.size, a.scale))
-        return 0
-    if req.method == "spectral":
-        field = req.spectral_field("--", _Bar(a.quiet, "spectral solid "))
-        if a.dim == 2:      # the front view (x right, z up), as a 3D model's 2D image and the panel's preview
-            from backend.solid.spectral_solid import SpectralTexture
-
-            _write_solid_image(a.out, SpectralTexture(req).image(a.size, field, scale=a.scale))
-            return 0
-        from backend.bake import BakeSpec, run_bake
-        from backend.sources import BoxGrid, SpectralSource
-
-        extent = a.size / (field.px_per_unit * a.scale)
-        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
-        run_bake(BakeSpec("solid", SpectralSource(req, field=field), grid, a.out), _Bar(a.quiet), force=True)
-        return 0
-    model = req.load("--")
-    if a.dim == 3 and model.dim != 3:
-        raise SettingError("--dim", f"model {model.name!r} is 2D; it cannot fill a volume")
+    t0 = time.perf_counter()
+    if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
+        print(f"encoding {a.exemplar} ...", end="", file=sys.stderr, flush=True)
 
     def report(name, hist):
         if not a.quiet:
@@ -736,33 +730,39 @@ def run_solid(a: argparse.Namespace) -> int:
                   + (" on the searched planes, not closer on fresh ones: the encoder's code is kept" if kept else ""),
                   file=sys.stderr)
 
-    code, _ = req.code(model, "--", _Bar(a.quiet, "refine "), report)
-    if code.harmonics is not None and not a.quiet:
-        h = code.harmonics
-        print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
-              "(--no-periodic leaves it out)", file=sys.stderr)
-    if code.rest is not None and not a.quiet:
-        from backend.solid.spectral import KIND_WORDS
-        print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as "
-              f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian leaves "
-              "it out)", file=sys.stderr)
-    bar = _Bar(a.quiet)
-    if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
-        from backend.bake import BakeSpec, run_bake
-        from backend.sources import BoxGrid, SolidSource
+    def on_code(code):
+        if a.quiet:
+            return
+        if os.path.isfile(a.exemplar):
+            print(f" done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+        if code.harmonics is not None:
+            h = code.harmonics
+            print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
+                  "(--no-periodic leaves it out)", file=sys.stderr)
+        if code.rest is not None:
+            from omninoise.backend.solid.spectral import KIND_WORDS
+            print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as "
+                  f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian "
+                  "leaves it out)", file=sys.stderr)
 
-        extent = a.size / (model.px_per_unit * a.scale)
+    stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid "}[req.method]
+    if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
+        from omninoise.backend.bake import BakeSpec, run_bake
+        from omninoise.backend.sources import BoxGrid, solid_volume
+
+        source, extent = solid_volume(req, a.size, a.scale, "--", _Bar(a.quiet, stage), report, on_code)
         grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
-        run_bake(BakeSpec("solid", SolidSource(model, seed=a.seed, code=code), grid, a.out), bar, force=True)
+        run_bake(BakeSpec("solid", source, grid, a.out), _Bar(a.quiet), force=True)
         return 0
-    _write_solid_image(a.out, model.image(a.size, code, a.seed, scale=a.scale, progress=bar))
+    _write_solid_image(a.out, req.front_image(a.size, a.scale, "--", _Bar(a.quiet, stage), report, on_code,
+                                              _Bar(a.quiet)))
     return 0
 
 
 def _write_solid_image(out: str, rgb: np.ndarray) -> None:
     """A 2D solid texture, sRGB float (H, W, 3) in [0, 1]: .png as it is, .exr and .npy linear."""
-    from backend.colour import srgb_to_linear
-    from export.images import preview_8bit, write_image, write_png
+    from omninoise.backend.colour import srgb_to_linear
+    from omninoise.export.images import preview_8bit, write_image, write_png
 
     if os.path.splitext(out)[1].lower() == ".png":
         write_png(out, preview_8bit(rgb, 0.0, 1.0))
@@ -774,9 +774,9 @@ def run_zoo(a: argparse.Namespace) -> int:
     import json
 
     try:
-        from training import zoo
+        from omninoise.training import zoo
     except ImportError as exc:
-        raise SettingError("zoo", f"needs torch ({exc}); pip install -r requirements-train.txt") from None
+        raise SettingError("zoo", f"needs torch ({exc})") from None
     if a.list:
         print(json.dumps(zoo.describe(), indent=2))
         return 0
@@ -791,7 +791,7 @@ def run_zoo(a: argparse.Namespace) -> int:
         params = zoo.parse_params(a.noise, a.param)
     except ValueError as exc:
         raise SettingError("--noise" if "class" in str(exc) else "--param", str(exc)) from None
-    from export.images import preview_8bit, write_image, write_png
+    from omninoise.export.images import preview_8bit, write_image, write_png
 
     img = zoo.generate(a.noise, params, [a.seed], a.size)[0].numpy()
     ext = os.path.splitext(a.out)[1].lower()
@@ -805,7 +805,7 @@ def run_zoo(a: argparse.Namespace) -> int:
 def run_transfer(a: argparse.Namespace) -> int:
     import json
 
-    from backend.transfer import preset
+    from omninoise.backend.transfer import preset
 
     if a.list or not a.preset:
         print("\n".join(PRESETS))
@@ -814,7 +814,7 @@ def run_transfer(a: argparse.Namespace) -> int:
     if not a.out:
         print(text)
         return 0
-    from export.atomic import atomic_path
+    from omninoise.export.atomic import atomic_path
 
     with atomic_path(a.out) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:
@@ -847,8 +847,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
         return 2
     except Exception as exc:
-        from backend.grid import Cancelled
-        from backend.jobs import JobError
+        from omninoise.backend.grid import Cancelled
+        from omninoise.backend.jobs import JobError
 
         if isinstance(exc, JobError):
             print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)

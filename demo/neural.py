@@ -16,12 +16,12 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
-from backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from export.images import preview_8bit, write_png  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.export.images import preview_8bit, write_png  # noqa: E402
 
 STEPS = DEFAULT_STEPS  # the runtime's default sampler (DPM-Solver++(2M), truncated grid, step noise 0.3) and step count
 PER_ROW = 8  # tiles per row of the sheet; the classes wrap onto as many rows as they need

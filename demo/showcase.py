@@ -16,8 +16,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
-from export.images import preview_8bit, write_exr, write_png  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
+from omninoise.export.images import preview_8bit, write_exr, write_png  # noqa: E402
 
 SIZE, EXTENT = 384, 4.0
 
@@ -78,7 +78,7 @@ def main(out: str) -> None:
         if s.dim == 2:
             img = evaluate_grid(noise, size, EXTENT, s.output, time_value, s.cellular)
         else:  # one z-slice of the volume, evaluated as a 2D cut through 3D / 4D space
-            from backend.grid import evaluate_points
+            from omninoise.backend.grid import evaluate_points
 
             g = np.arange(size, dtype=np.float32) * np.float32(EXTENT / size)
             yy, xx = np.meshgrid(g, g, indexing="ij")

@@ -16,8 +16,8 @@ sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
 
-from backend import Spectrum, WaveSettings  # noqa: E402
-from blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings  # noqa: E402
+from omninoise.blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402
 
 VARIANTS = [
     ("2D band", WaveSettings(dim=2, spectrum=Spectrum("bandpass", 3, 6), directions=16, seed=1), "Value"),
@@ -92,9 +92,9 @@ def add_neural_plane(sc, out: str):
     """
     import numpy as np
 
-    import blender_addon
-    from blender_addon import neural_ui
-    from export.images import preview_8bit, write_png
+    from omninoise import blender_addon
+    from omninoise.blender_addon import neural_ui
+    from omninoise.export.images import preview_8bit, write_png
 
     try:
         neural_ui.model()

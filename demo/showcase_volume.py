@@ -17,7 +17,7 @@ sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
 
-from blender_addon.bake_blender import load_image, load_volume  # noqa: E402
+from omninoise.blender_addon.bake_blender import load_image, load_volume  # noqa: E402
 
 
 def build_scene(bakes: str):

@@ -28,11 +28,11 @@ sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
 
-import blender_addon  # noqa: E402
-from blender_addon.compat import ensure_node_tree  # noqa: E402
-from backend.solid.model import SHIPPED_MODELS, load_models, plane_points  # noqa: E402
-from export.atomic import write_json  # noqa: E402
-from export.images import preview_8bit, read_rgb, write_png  # noqa: E402
+from omninoise import blender_addon  # noqa: E402
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
+from omninoise.backend.solid.model import SHIPPED_MODELS, load_models, plane_points  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.export.images import preview_8bit, read_rgb, write_png  # noqa: E402
 
 MODELS = SHIPPED_MODELS
 EXEMPLARS = os.path.join(ROOT, "data", "exemplars")

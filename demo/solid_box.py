@@ -21,8 +21,8 @@ sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
 
-from backend.solid.model import SHIPPED_MODELS  # noqa: E402
-from export.atomic import write_json  # noqa: E402
+from omninoise.backend.solid.model import SHIPPED_MODELS  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from solid import cycles_scene, save_and_render, sun_and_sky  # noqa: E402  (demo/solid.py: the same scene)

@@ -5,8 +5,24 @@ import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-if ROOT not in sys.path:
-    sys.path.insert(0, ROOT)
+
+
+def _package_from_checkout():
+    """``import omninoise`` is this checkout (the repository root is the package), installed or not: the Blender
+    versions' venvs run the tests without installing it."""
+    import importlib.util
+
+    init = os.path.join(ROOT, "__init__.py")
+    spec = importlib.util.find_spec("omninoise")
+    if spec is not None and spec.origin and os.path.samefile(spec.origin, init):
+        return
+    spec = importlib.util.spec_from_file_location("omninoise", init, submodule_search_locations=[ROOT])
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["omninoise"] = module
+    spec.loader.exec_module(module)
+
+
+_package_from_checkout()
 
 
 def radial_psd(img: np.ndarray, extent: float, nbins: int | None = None):
@@ -60,7 +76,7 @@ class Recorder:
 
 def _has_openvdb() -> bool:
     try:
-        from export.vdb import openvdb_module
+        from omninoise.export.vdb import openvdb_module
 
         openvdb_module()
         return True

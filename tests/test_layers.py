@@ -14,18 +14,29 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PACKAGES = ("backend", "export", "blender_addon", "cli", "training")
+#: the modules at the package's root (the extension's entry points and the Python API)
+ROOT_MODULES = ("__init__.py", "__main__.py", "api.py")
+
 
 def modules() -> dict:
-    """{dotted module name: file path} of every module of the packages above."""
+    """{dotted module name: file path} of every module of the package ``omninoise`` (the repository root)."""
     out = {}
+    for f in ROOT_MODULES:
+        out["omninoise" if f == "__init__.py" else "omninoise." + f[:-3]] = os.path.join(ROOT, f)
     for top in PACKAGES:
         for folder, _, files in os.walk(os.path.join(ROOT, top)):
             for f in files:
                 if f.endswith(".py"):
                     path = os.path.join(folder, f)
-                    name = os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
+                    name = "omninoise." + os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
                     out[name[: -len(".__init__")] if name.endswith(".__init__") else name] = path
     return out
+
+
+def layer(name: str) -> str:
+    """The layer of a dotted name: ``omninoise.backend.bake`` -> ``backend``; outside names as their top."""
+    parts = name.split(".")
+    return parts[1] if parts[0] == "omninoise" and len(parts) > 1 else parts[0]
 
 def imports(name: str, path: str, known: dict) -> dict:
     """{imported name: line} of one module: project modules resolved to their dotted names, others as written
@@ -105,24 +116,53 @@ def test_dependencies_point_one_way():
     known, edges = graph()
     bad = []
     for m, deps in edges.items():
-        runtime = m.split(".")[0] in ("backend", "export")
+        lm = layer(m)
+        runtime = lm in ("backend", "export")
         for d, line in deps.items():
+            ld = layer(d)
             where = f"{m} (line {line}) imports {d}"
-            if d.split(".")[0] == "bpy" and not m.startswith("blender_addon"):
+            if ld == "bpy" and lm != "blender_addon":
                 bad.append(where + ": only blender_addon may import bpy")
-            if runtime and d.split(".")[0] in ("training", "torch", "onnx"):
+            if runtime and ld in ("training", "torch", "onnx"):
                 bad.append(where + ": the runtime never imports training code or torch")
-            if m.split(".")[0] in ("backend", "export", "blender_addon", "training") and d.split(".")[0] == "cli":
+            if lm in ("backend", "export", "blender_addon", "training", "api") and ld == "cli":
                 bad.append(where + ": nothing below the command line imports it")
-            if m.split(".")[0] == "blender_addon" and d.split(".")[0] == "training":
-                bad.append(where + ": the add-on never imports training code")
-            if m.startswith("export") and d.startswith(("backend", "blender_addon")):
+            if lm in ("blender_addon", "api") and ld == "training":
+                bad.append(where + ": the add-on and the API never import training code")
+            if lm == "export" and ld in ("backend", "blender_addon"):
                 bad.append(where + ": the file writers sit below the engines")
-            if d.split(".")[0] in ("dask", "distributed") and m != "cli.farm":
+            if ld in ("dask", "distributed") and m != "omninoise.cli.farm":
                 bad.append(where + ": only cli/farm.py uses Dask (an optional extra)")
-            if m.startswith("backend") and d.startswith("blender_addon"):
-                bad.append(where + ": the core never imports the Blender layer")
+            if lm in ("backend", "api") and ld == "blender_addon":
+                bad.append(where + ": the core and the API never import the Blender layer")
+            if lm in ("backend", "export", "blender_addon") and layer(d) != d.split(".")[0] and \
+                    not m.endswith("__init__") and line and _absolute(known[m], line):
+                bad.append(where + ": the extension's packages import each other relatively (inside Blender the "
+                                   "package is bl_ext.<repository>.omninoise)")
     assert not bad, "\n".join(bad)
+
+
+def _absolute(path: str, line: int) -> bool:
+    """Whether the import statement on ``line`` of ``path`` names ``omninoise`` absolutely."""
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read().splitlines()[line - 1].strip()
+    return text.startswith(("from omninoise", "import omninoise"))
+
+
+def test_nothing_imports_the_old_top_level_names():
+    """Every module, test, bench and tool reaches the code as ``omninoise.<layer>``: a bare ``import backend``
+    would load a second copy of the engines under another name."""
+    import re
+    import subprocess
+
+    files = subprocess.run(["git", "ls-files", "*.py"], cwd=ROOT, capture_output=True, text=True).stdout.split()
+    pat = re.compile(r"^\s*(from|import) (%s)\b" % "|".join(PACKAGES))
+    bad = []
+    for f in files:
+        with open(os.path.join(ROOT, f), encoding="utf-8") as fh:
+            bad += [f"{f}:{n}: {ln.strip()}" for n, ln in enumerate(fh, 1) if pat.match(ln)]
+    assert not bad, "\n".join(bad)
+
 
 def test_files_are_replaced_only_by_the_atomic_helper():
     """One atomic-write helper (export/atomic.py: fsync, stale-temporary clean-up): no other module renames a
@@ -130,7 +170,7 @@ def test_files_are_replaced_only_by_the_atomic_helper():
     known, _ = graph()
     bad = []
     for name, path in known.items():
-        if name == "export.atomic":
+        if name == "omninoise.export.atomic":
             continue
         with open(path, encoding="utf-8") as fh:
             for n, line in enumerate(fh, 1):
@@ -142,7 +182,8 @@ def test_files_are_replaced_only_by_the_atomic_helper():
 #: without torch (the runtime's tests use tests/data/tiny_* and the shipped models)
 TORCH_TEST_FILES = {"test_neural_deep.py", "test_neural_direction.py", "test_neural_eval.py", "test_neural_int8.py", "test_neural_runtime.py", "test_neural_training.py", "test_solid_eval.py", "test_conv_generator.py",
                     "test_solid_model.py", "test_solid_morphology_loss.py", "test_solid_conv_capacity_bench.py",
-                    "test_solid_photos.py", "test_solid_spectrum.py", "test_structure_features.py", "test_zoo.py", "test_zoo_blender.py"}
+                    "test_solid_photos.py", "test_solid_spectrum.py", "test_structure_features.py", "test_zoo.py", "test_zoo_blender.py",
+                    "test_solid_morphology.py", "test_solid_card.py", "test_solid_harmonics_tool.py"}
 
 def test_only_training_and_evaluation_tests_need_torch(tmp_path):
     import re

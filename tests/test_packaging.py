@@ -1,79 +1,131 @@
-"""A non-editable install holds every runtime package (issue 23: it used to leave out backend.neural,
-backend.solid and training)."""
+"""`pip install .` installs one import package, ``omninoise``, holding every runtime package, the models and the
+licence, and nothing else at the top level of site-packages."""
 import os
+import re
+import subprocess
+import sys
 import tomllib
+import zipfile
 
-from setuptools import find_packages
+import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+LAYERS = ("backend", "export", "cli", "training", "blender_addon")
 
 
-def test_every_package_folder_is_installed():
+def _pyproject() -> dict:
     with open(os.path.join(ROOT, "pyproject.toml"), "rb") as fh:
-        cfg = tomllib.load(fh)["tool"]["setuptools"]["packages"]["find"]
-    found = set(find_packages(ROOT, include=cfg["include"]))
-    on_disk = {os.path.relpath(d, ROOT).replace(os.sep, ".")
-               for top in ("backend", "export", "cli", "training") for d, _, files in os.walk(os.path.join(ROOT, top))
-               if "__init__.py" in files}
-    assert on_disk <= found, sorted(on_disk - found)
-    assert {"backend.neural", "backend.solid", "cli", "training", "training.solid"} <= found
-    assert not any(p.startswith(("tests", "blender_addon", "bench")) for p in found)
+        return tomllib.load(fh)
 
 
-def test_a_non_editable_install_runs_every_subcommand(tmp_path):
-    """Build the wheel as `pip install .` would, install it (without dependencies: they are this venv's) into a
-    folder outside the repository, and run each subcommand from there, with the repository off sys.path."""
-    import subprocess
-    import sys
-    import zipfile
+def test_every_package_folder_is_listed_under_omninoise():
+    listed = set(_pyproject()["tool"]["setuptools"]["packages"])
+    on_disk = {"omninoise." + os.path.relpath(d, ROOT).replace(os.sep, ".")
+               for top in LAYERS for d, _, files in os.walk(os.path.join(ROOT, top)) if "__init__.py" in files}
+    assert on_disk | {"omninoise"} == listed, (sorted(on_disk - listed), sorted(listed - on_disk - {"omninoise"}))
+    assert _pyproject()["tool"]["setuptools"]["package-dir"] == {"omninoise": "."}
 
-    wheels = tmp_path / "wheels"
+
+def test_versions_agree():
+    """One version in the package metadata, the extension manifest and ``omninoise.__version__``."""
+    from omninoise.backend.version import __version__
+
+    with open(os.path.join(ROOT, "blender_manifest.toml"), "rb") as fh:
+        manifest = tomllib.load(fh)
+    assert _pyproject()["project"]["version"] == manifest["version"] == __version__
+    with open(os.path.join(ROOT, "CHANGELOG.md"), encoding="utf-8") as fh:
+        assert re.search(r"^## \[?%s\]?" % re.escape(__version__), fh.read(), re.M), "CHANGELOG names the version"
+
+
+def test_extras_declare_the_optional_dependencies():
+    extras = _pyproject()["project"]["optional-dependencies"]
+    names = {k: {re.split(r"[<>=!~ \[]", d)[0].lower() for d in v} for k, v in extras.items()}
+    assert {"numba"} <= names["fast"] and {"dask", "distributed"} <= names["farm"]
+    assert {"torch", "onnx"} <= names["train"]
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """The wheel `pip install .` builds, installed (without dependencies: they are this venv's) into a prefix
+    outside the repository: (wheel, site-packages folder)."""
+    tmp = tmp_path_factory.mktemp("install")
+    wheels = tmp / "wheels"
     r = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w",
                         str(wheels), ROOT], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     (wheel,) = wheels.glob("omninoise-*.whl")
-    names = zipfile.ZipFile(wheel).namelist()
-    for module in ("cli/main.py", "backend/neural/generate.py", "backend/solid/model.py", "cli/farm.py",
-                   "training/zoo.py", "export/vdb.py"):
-        assert module in names, module
-    prefix = tmp_path / "prefix"
-    r = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--ignore-installed", "-q", "--prefix", str(prefix),
-                        str(wheel)],
-                       capture_output=True, text=True, timeout=300)
+    prefix = tmp / "prefix"
+    r = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--ignore-installed", "-q", "--prefix",
+                        str(prefix), str(wheel)], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     (site,) = prefix.glob("lib/python3*/site-packages")
-    assert (prefix / "share" / "omninoise" / "models" / "neural_noise" / "denoiser.onnx").is_file()
-    code = ("import sys, os; sys.path = [p for p in sys.path if os.path.abspath(p or '.') != %r]; "
-            "sys.path.insert(0, %r); import cli.main as c; assert c.__file__.startswith(%r), c.__file__; "
-            "out = %r; "
+    return wheel, site
+
+
+def test_the_wheel_holds_one_package_with_its_models_and_licence(installed):
+    wheel, site = installed
+    tops = {n.split("/")[0] for n in zipfile.ZipFile(wheel).namelist()}
+    assert {t for t in tops if not t.endswith(".dist-info")} == {"omninoise"}, tops
+    assert sorted(p.name for p in site.iterdir() if not p.name.endswith(".dist-info")) == ["omninoise"]
+    pkg = site / "omninoise"
+    for f in ("__init__.py", "__main__.py", "api.py", "LICENSE", "cli/main.py", "backend/neural/generate.py",
+              "backend/solid/model.py", "cli/farm.py", "training/zoo.py", "export/vdb.py",
+              "models/neural_noise/denoiser.onnx", "models/neural_noise/neural_noise.json",
+              "models/solid/space/encoder.onnx", "models/fit_bank/bank.npz"):
+        assert (pkg / f).is_file(), f
+    for folder, _, files in os.walk(os.path.join(ROOT, "models")):     # every shipped model file travels
+        for f in files:
+            rel = os.path.relpath(os.path.join(folder, f), ROOT)
+            assert (pkg / rel).is_file(), f"{rel}: add its pattern to [tool.setuptools.package-data]"
+    meta = next(n for n in zipfile.ZipFile(wheel).namelist() if n.endswith("METADATA"))
+    text = zipfile.ZipFile(wheel).read(meta).decode()
+    for field in ("License: GPL-3.0-or-later", "Provides-Extra: fast", "Provides-Extra: farm",
+                  "Provides-Extra: train", "Classifier: License :: OSI Approved", "Project-URL:"):
+        assert field in text, field
+
+
+def test_the_installed_package_runs_every_subcommand_and_the_api(installed, tmp_path):
+    """From the installed copy, with the repository off sys.path: ``python -m omninoise --version``, each
+    subcommand, and the four API calls."""
+    _, site = installed
+    env = dict(os.environ, PYTHONPATH=str(site))
+    r = subprocess.run([sys.executable, "-I", "-c", "import sys; sys.path.insert(0, %r); "
+                        "sys.argv = ['omninoise', '--version']; import runpy; "
+                        "runpy.run_module('omninoise', run_name='__main__')" % str(site)],
+                       capture_output=True, text=True, cwd=str(tmp_path), timeout=120)
+    assert r.returncode == 0 and re.match(r"omninoise \d+\.\d+\.\d+ \(wave noise: ", r.stdout), r.stdout + r.stderr
+    code = ("import sys; sys.path.insert(0, %r); import omninoise, omninoise.cli.main as c; "
+            "assert omninoise.__file__.startswith(%r), omninoise.__file__; out = %r; "
             "rc = [c.main(['wave', '--size', '8', '--quiet', '-o', out + '/w.npy']), "
             "c.main(['transfer', '--list']), c.main(['neural', '--list']), c.main(['solid', '--list']), "
             "c.main(['zoo', '--noise', 'perlin', '--size', '8', '-o', out + '/z.png']), "
             "c.main(['neural', '--noise', 'perlin', '--size', '8', '--steps', '1', '--quiet', '-o', out + '/n.png']), "
-            "c.main(['solid', '--exemplar', 'grass', '--size', '8', '--quiet', '-o', out + '/s.png'])]; print('RC', rc)"
-            ) % (ROOT, str(site), str(site), str(tmp_path))
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=str(tmp_path), timeout=300)
-    assert "RC [0, 0, 0, 0, 0, 0, 0]" in r.stdout, r.stdout[-2000:] + r.stderr[-2000:]
-
-
-def test_every_shipped_model_folder_is_in_the_data_files():
-    with open(os.path.join(ROOT, "pyproject.toml"), "rb") as fh:
-        data = tomllib.load(fh)["tool"]["setuptools"]["data-files"]
-    models = os.path.join(ROOT, "models")
-    for folder, _, files in os.walk(models):
-        rel = os.path.relpath(folder, models).replace(os.sep, "/")
-        key = "share/omninoise/models" + ("" if rel == "." else "/" + rel)
-        assert key in data, f"{key}: add the folder to [tool.setuptools.data-files] in pyproject.toml"
-        exts = {os.path.splitext(f)[1] for f in files}
-        listed = {os.path.splitext(g)[1] for g in data[key]}
-        assert exts <= listed, (key, exts - listed)
+            "c.main(['solid', '--exemplar', 'grass', '--size', '8', '--quiet', '-o', out + '/s.png'])]; "
+            "a = [omninoise.wave(8).shape, omninoise.neural('perlin', 8, steps=1).shape, "
+            "omninoise.solid('grass', 8).shape]; print('RC', rc, a)"
+            ) % (str(site), str(site), str(tmp_path))
+    r = subprocess.run([sys.executable, "-I", "-c", code], capture_output=True, text=True, cwd=str(tmp_path),
+                       timeout=300, env=env)
+    assert "RC [0, 0, 0, 0, 0, 0, 0] [(8, 8), (8, 8), (8, 8, 3)]" in r.stdout, r.stdout[-2000:] + r.stderr[-2000:]
 
 
 def test_omninoise_models_points_every_front_end_at_another_model_folder(tmp_path, monkeypatch, capsys):
-    from backend import paths
-    from cli.main import main
+    from omninoise.backend import paths
+    from omninoise.cli.main import main
 
     monkeypatch.setenv("OMNINOISE_MODELS", str(tmp_path / "farm-models"))
     assert paths.neural_model() == str(tmp_path / "farm-models" / "neural_noise")
     assert main(["neural", "--noise", "perlin", "-o", str(tmp_path / "n.png")]) == 2
     assert str(tmp_path / "farm-models") in capsys.readouterr().err  # the error names the folder it looked in
+
+
+def test_the_api_examples_run():
+    """The API's docstring examples (and the package's) are doctests."""
+    import doctest
+
+    import omninoise
+    import omninoise.api
+
+    for mod in (omninoise, omninoise.api):
+        res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
+        assert res.attempted > 0 and res.failed == 0, (mod.__name__, res)

@@ -28,9 +28,9 @@ import zipfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from backend.version import __version__  # noqa: E402
-from backend.wavenoise import ckernel  # noqa: E402
-from export.atomic import atomic_path  # noqa: E402
+from omninoise.backend.version import __version__  # noqa: E402
+from omninoise.backend.wavenoise import ckernel  # noqa: E402
+from omninoise.export.atomic import atomic_path  # noqa: E402
 
 SOURCE = os.path.join(ROOT, "backend", "wavenoise", "rows.c")
 FLAGS = ["-O3", "-shared", "-ffp-contract=off", "-fno-math-errno", "-std=c11"]

@@ -47,7 +47,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from export.atomic import atomic_path, write_json  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
 
 OUT = os.path.join(ROOT, "data", "photos")
 PACKAGES = ("0ad-data", "ufoai-textures", "supertuxkart-data")

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Trains several solid-texture configs side by side on one GPU, each with its schedule fitted to a time
-# budget (python -m training.solid.train --budget-seconds), and leaves for each run its checkpoint without
+# budget (python -m omninoise.training.solid.train --budget-seconds), and leaves for each run its checkpoint without
 # the optimiser's moments (RUN.pt: config, model, step, hardware; export it with
-# python -m training.solid.export) and one archive of the logs in OUTDIR.
+# python -m omninoise.training.solid.export) and one archive of the logs in OUTDIR.
 #
 #   tools/gpu_solid_campaign.sh BUDGET_SECONDS OUTDIR CONFIG.json [CONFIG.json ...]
 #
 # SWA_FROM=STEP: each run that keeps weight snapshots (snapshot_every in its config) also comes back as
-# NAME_swa.pt, the mean of its snapshots from that step on (python -m training.solid.average --snapshots); the
+# NAME_swa.pt, the mean of its snapshots from that step on (python -m omninoise.training.solid.average --snapshots); the
 # tool brings back at most 8 files, so at most 3 runs with SWA_FROM.
 # PYTHON (default python3) runs training; EXTRA_SET adds --set KEY=JSON to every run, several separated by ';'
 # (a CPU rehearsal: EXTRA_SET='device="cpu";batch=2;crop=64').  Each run's log is runs/solid/NAME.log; the
@@ -26,7 +26,7 @@ IFS=';' read -r -a extra <<<"${EXTRA_SET:-}"
 names=(); pids=()
 for cfg in "$@"; do
     name=$(basename "$cfg" .json)
-    args=(-m training.solid.train --config "$cfg" --out "runs/solid/$name" --budget-seconds "$budget")
+    args=(-m omninoise.training.solid.train --config "$cfg" --out "runs/solid/$name" --budget-seconds "$budget")
     for kv in "${extra[@]}"; do args+=(--set "$kv"); done
     PYTHONUNBUFFERED=1 "$py" "${args[@]}" >"runs/solid/$name.log" 2>&1 &
     pids+=($!); names+=("$name")
@@ -55,7 +55,7 @@ print(sys.argv[2], "step", state["step"], "of", state["config"]["steps"], "-", s
 PY
     grep -h "schedule fitted" "runs/solid/$n.log" | sed "s/^/  $n: /"
     if [ -n "${SWA_FROM:-}" ] && [ -d "runs/solid/$n/snapshots" ]; then
-        "$py" -m training.solid.average --out "runs/solid/${n}_swa" --snapshots "runs/solid/$n" --from "$SWA_FROM" \
+        "$py" -m omninoise.training.solid.average --out "runs/solid/${n}_swa" --snapshots "runs/solid/$n" --from "$SWA_FROM" \
             && cp "runs/solid/${n}_swa/ckpt.pt" "$out/${n}_swa.pt" || status=1
     fi
 done

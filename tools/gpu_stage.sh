@@ -13,14 +13,14 @@ run=$(mktemp -d)
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null
 $py -c "import torch, numpy, numba; print('torch', torch.__version__, 'cuda', torch.cuda.is_available(), 'numpy', numpy.__version__, 'numba', numba.__version__)"
 t0=$(date +%s)
-$py -m training.train --config "$cfg" --out "$run" --max-seconds "$secs" 2>&1 | tee "$out/train.log"
+$py -m omninoise.training.train --config "$cfg" --out "$run" --max-seconds "$secs" 2>&1 | tee "$out/train.log"
 if [ ! -f "$run/ckpt.pt" ]; then
     # nothing trained (data workers stuck, see training/batches.py): spend what is left making batches in the loop
     left=$(( secs - ($(date +%s) - t0) ))
     if [ "$left" -gt 60 ]; then
         $py -c "import json, sys; c = json.load(open(sys.argv[1])); c['workers'] = 0; json.dump(c, open(sys.argv[2], 'w'))" "$cfg" "$out/config_workers0.json"
         echo "no checkpoint: again without data workers for $left s" | tee -a "$out/train.log"
-        $py -m training.train --config "$out/config_workers0.json" --out "$run" --max-seconds "$left" 2>&1 | tee -a "$out/train.log"
+        $py -m omninoise.training.train --config "$out/config_workers0.json" --out "$run" --max-seconds "$left" 2>&1 | tee -a "$out/train.log"
     fi
 fi
 $py - "$run" "$out" <<'PY'
@@ -37,7 +37,7 @@ print("saved step", st["step"], sorted(os.listdir(out)))
 PY
 if [ -n "${EVAL_CLF:-}" ]; then
     exp=$(mktemp -d)
-    $py tools/gpu_export.py "$out" "$exp/run" && $py -m training.export_onnx "$exp/run" "$exp/model" > "$out/export.log" 2>&1 \
+    $py tools/gpu_export.py "$out" "$exp/run" && $py -m omninoise.training.export_onnx "$exp/run" "$exp/model" > "$out/export.log" 2>&1 \
       && $py bench/eval_neural.py --model "$exp/model" --eval-size 64 --clf-stages 3 --clf-steps 6000 --clf-threads 2 \
            --n "${EVAL_N:-32}" --threads "$(nproc)" --classifier-cache "$EVAL_CLF" --sampler dpmpp_2m --steps 10 --spacing truncated \
            --eta 0.3 --no-timing -o "$out/eval.json" > "$out/eval.log" 2>&1

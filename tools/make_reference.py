@@ -19,7 +19,7 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from export.atomic import write_json  # noqa: E402
+from omninoise.export.atomic import write_json  # noqa: E402
 
 OUT = os.path.join(ROOT, "tests", "data", "reference")
 
@@ -43,9 +43,9 @@ def wave_points(dim: int) -> np.ndarray:
 
 
 def wave_values(flags: list) -> np.ndarray:
-    from cli.main import build_parser, settings_from_args
-    from backend.grid import evaluate_points
-    from backend.wavenoise.settings import compile_noise
+    from omninoise.cli.main import build_parser, settings_from_args
+    from omninoise.backend.grid import evaluate_points
+    from omninoise.backend.wavenoise.settings import compile_noise
 
     a = build_parser().parse_args(["wave"] + flags + ["-o", "x.npy"])
     s = settings_from_args(a)
@@ -55,15 +55,15 @@ def wave_values(flags: list) -> np.ndarray:
 def zoo_values(name: str) -> np.ndarray:
     import torch
 
-    from training import zoo
+    from omninoise.training import zoo
 
     return zoo.generate(name, zoo.default_params(name), torch.tensor([0]), 8)[0].numpy()
 
 
 def neural_values(folder: str) -> np.ndarray:
-    from backend.neural import conditioning as C
-    from backend.neural.generate import generate
-    from backend.neural.model import NeuralNoiseModel
+    from omninoise.backend.neural import conditioning as C
+    from omninoise.backend.neural.generate import generate
+    from omninoise.backend.neural.model import NeuralNoiseModel
 
     m = NeuralNoiseModel(folder, threads=1)
     # the sampler pinned (not the default), so the values follow the weights alone
@@ -72,7 +72,7 @@ def neural_values(folder: str) -> np.ndarray:
 
 
 def solid_values(folder: str) -> np.ndarray:
-    from backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.model import SolidTextureModel
 
     m = SolidTextureModel(folder, threads=1)
     pts = np.random.default_rng(99).uniform(-1.0, 1.0, (16, m.dim))
@@ -90,13 +90,13 @@ def shipped_models() -> dict:
 
 
 def model_fingerprint(kind: str, folder: str) -> str:
-    from backend.onnx_models import fingerprint, load_model_json
+    from omninoise.backend.onnx_models import fingerprint, load_model_json
 
     return fingerprint(load_model_json(folder, "neural_noise.json" if kind == "neural" else "solid.json")["files"])
 
 
 def main() -> int:
-    from training import zoo
+    from omninoise.training import zoo
 
     os.makedirs(OUT, exist_ok=True)
     r = lambda a: np.round(np.asarray(a, np.float64), 7).tolist()  # noqa: E731

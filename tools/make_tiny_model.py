@@ -31,8 +31,8 @@ TINY = dict(size=16, batch=4, steps=3, widths=(8, 16, 16), emb_dim=8, log_every=
 def make_neural(out: str) -> None:
     import torch
 
-    from training.export_onnx import export
-    from training.train import TrainConfig, train
+    from omninoise.training.export_onnx import export
+    from omninoise.training.train import TrainConfig, train
 
     torch.manual_seed(0)
     with tempfile.TemporaryDirectory() as run:
@@ -47,8 +47,8 @@ def make_neural(out: str) -> None:
 def make_solid(root: str) -> None:
     import torch
 
-    from training.solid.export import export
-    from training.solid.train import SolidConfig, train
+    from omninoise.training.solid.export import export
+    from omninoise.training.solid.train import SolidConfig, train
 
     for name, (mode, dim, exemplars) in SOLID.items():
         torch.manual_seed(0)

@@ -5,5 +5,5 @@
 set -e
 PY=${PY:-.venv/bin/python}
 for name in "$@"; do
-  "$PY" -m training.solid.train --config "configs/solid/photo_singles/$name.json" --out "runs/solid/$name"
+  "$PY" -m omninoise.training.solid.train --config "configs/solid/photo_singles/$name.json" --out "runs/solid/$name"
 done

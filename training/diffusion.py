@@ -30,7 +30,7 @@ import math
 
 import torch
 
-from backend.neural.schedule import T_DEFAULT, cosine_alphas_cumprod
+from omninoise.backend.neural.schedule import T_DEFAULT, cosine_alphas_cumprod
 
 __all__ = ["Diffusion"]
 

@@ -39,7 +39,7 @@ import torch
 from torch import nn
 import torch.nn.functional as F
 
-from backend.periodic import periodic_component
+from omninoise.backend.periodic import periodic_component
 
 from . import zoo
 
@@ -310,7 +310,7 @@ def cached_classifier(classes, size: int, steps: int, cache: str | None = None, 
         clf = Classifier(len(classes), stages=stages)
         clf.load_state_dict(saved["state"])
         return clf.eval(), saved["accuracy"]
-    from backend._export import export
+    from omninoise import export
 
     clf, acc = train_classifier(classes, size, steps, log=log, stages=stages)
     os.makedirs(cache, exist_ok=True)
@@ -330,11 +330,11 @@ def evaluate(model, classes, n: int = 32, steps: int = 30, clf_steps: int = 600,
     ``only``: rows for these of ``classes`` alone, measured by the classifier of all ``classes`` (the same
     instrument, the same samples as a full run with this n) and without the seam and locality measures (None).
     ``eta`` > 0: the sampler's stochastic form; every batch's step noise starts from one seed."""
-    from backend.neural import conditioning as C
-    from backend.neural.generate import generate as _generate
-    from backend.neural.sampler import initial_noise, sample as _run_sampler, step_noise_rng
+    from omninoise.backend.neural import conditioning as C
+    from omninoise.backend.neural.generate import generate as _generate
+    from omninoise.backend.neural.sampler import initial_noise, sample as _run_sampler, step_noise_rng
 
-    from backend.neural.sampler import DEFAULT_SPACING
+    from omninoise.backend.neural.sampler import DEFAULT_SPACING
 
     spacing = DEFAULT_SPACING[sampler] if spacing is None else spacing
 
@@ -423,7 +423,7 @@ def step_seconds(model_folder: str, size: int = 256, reps: int = 3) -> dict:
     its output is checked against onnxruntime's first (max |Δε| reported), so both time the
     same network.
     """
-    from backend.neural.model import NeuralNoiseModel
+    from omninoise.backend.neural.model import NeuralNoiseModel
     from .warm_start import torch_from_export
 
     m = NeuralNoiseModel(model_folder)

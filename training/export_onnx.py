@@ -1,4 +1,4 @@
-"""Export a trained ε-network to ONNX for the runtime: ``python -m training.export_onnx RUN OUT_DIR``.
+"""Export a trained ε-network to ONNX for the runtime: ``python -m omninoise.training.export_onnx RUN OUT_DIR``.
 
 Two forms (``form`` in the JSON).  ``split`` (the default) is what the runtime
 wants: the SPADE branch depends on the conditioning only (see :mod:`.unet`), so it
@@ -26,7 +26,7 @@ A ``tile`` input of [0.0] means zero padding and [1.0] circular padding (seamles
 
 The EMA weights are exported (``--raw`` for the optimiser's weights).  An older
 export is re-exported from its own weights, without a checkpoint:
-``python -m training.export_onnx --from-export OLD_DIR OUT_DIR``.
+``python -m omninoise.training.export_onnx --from-export OLD_DIR OUT_DIR``.
 """
 from __future__ import annotations
 
@@ -38,9 +38,9 @@ import sys
 import numpy as np
 import torch
 
-from backend._export import export as _ex
+from omninoise import export as _ex
 
-from backend.neural.model import sha256_file
+from omninoise.backend.neural.model import sha256_file
 from . import zoo
 from .model_card import run_record
 from .train import TrainConfig, build_model, model_names
@@ -56,7 +56,7 @@ SPLIT_FILES = ("encoder.onnx", "denoiser.onnx", "denoiser_tile.onnx", "denoiser.
 
 def onnx_export(module, args: tuple, path: str, inputs: list, outputs: list, dynamic: dict) -> None:
     """``torch.onnx.export`` (opset 17, TorchScript exporter) to a temporary file, then renamed onto ``path``."""
-    from backend._export import export
+    from omninoise import export
 
     with export.atomic_path(path) as tmp:
         torch.onnx.export(module, args, tmp, input_names=inputs, output_names=outputs, dynamic_axes=dynamic,
@@ -101,7 +101,7 @@ def drop_identity_arithmetic(path: str) -> int:
     import onnx
     from onnx import numpy_helper
 
-    from backend._export import export
+    from omninoise import export
 
     model = onnx.load(path)
     graph = model.graph
@@ -144,7 +144,7 @@ def share_weights(folder: str, graphs: list, weights: str) -> None:
     import onnx
     from onnx import external_data_helper, numpy_helper
 
-    from backend._export import export
+    from omninoise import export
 
     models = [onnx.load(os.path.join(folder, g)) for g in graphs]
     where, blob = {}, bytearray()
@@ -242,7 +242,7 @@ _CARRIED = ("trained_classes", "train_size", "step", "weights", "config", "train
 
 def reexport(src: str, out: str, one_piece: bool = False) -> dict:
     """Export folder ``src`` again, from its own weights (torch rebuilt from the export), into ``out``."""
-    from backend.onnx_models import load_model_json
+    from omninoise.backend.onnx_models import load_model_json
     from .warm_start import torch_from_export
 
     old = load_model_json(src, "neural_noise.json")
@@ -253,7 +253,7 @@ def reexport(src: str, out: str, one_piece: bool = False) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.export_onnx", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.export_onnx", description=__doc__.split("\n")[0])
     ap.add_argument("run", help="training run folder (holds ckpt.pt), or with --from-export an export folder")
     ap.add_argument("out", help="output folder for the .onnx files and neural_noise.json")
     ap.add_argument("--raw", action="store_true", help="export the raw weights instead of the EMA")

@@ -1,6 +1,6 @@
 """The inverse-design bank: the fit statistic (backend/neural/fit.py) of zoo images with known class and parameters.
 
-``python -m training.fit_bank --out models/fit_bank [--size 64] [--sets 48] [--seeds 2]`` renders, for every
+``python -m omninoise.training.fit_bank --out models/fit_bank [--size 64] [--sets 48] [--seeds 2]`` renders, for every
 class of the shipped model, ``sets`` parameter sets from the zoo's Halton sequence (starting past the first
 ``offset`` sets) with ``seeds`` seeds each at ``size``², and stores each image's statistic with its class and
 normalised parameters in ``bank.npz`` (float32; class index int16), listed with its sha256 in ``fit_bank.json``.
@@ -19,9 +19,9 @@ import time
 import numpy as np
 import torch
 
-from backend.neural.fit import describe
-from backend.onnx_models import sha256_file
-from backend.paths import neural_model
+from omninoise.backend.neural.fit import describe
+from omninoise.backend.onnx_models import sha256_file
+from omninoise.backend.paths import neural_model
 from . import zoo
 
 __all__ = ["build_bank", "main"]
@@ -67,7 +67,7 @@ def main(argv: list | None = None) -> int:
     t = time.perf_counter()
     bank = build_bank(classes, a.size, a.sets, a.seeds, a.offset)
     os.makedirs(a.out, exist_ok=True)
-    from export.atomic import atomic_path, write_json
+    from omninoise.export.atomic import atomic_path, write_json
 
     buf = io.BytesIO()
     np.savez_compressed(buf, **bank)
@@ -77,7 +77,7 @@ def main(argv: list | None = None) -> int:
     write_json(os.path.join(a.out, "fit_bank.json"), dict(
         kind="omninoise.fit_bank", format=1, classes=classes, size=a.size, sets=a.sets, seeds=a.seeds,
         offset=a.offset, images=int(bank["cls"].shape[0]), zoo="training/zoo.py",
-        command=f"python -m training.fit_bank --out {a.out} --size {a.size} --sets {a.sets} "
+        command=f"python -m omninoise.training.fit_bank --out {a.out} --size {a.size} --sets {a.sets} "
                 f"--seeds {a.seeds} --offset {a.offset}",
         seconds=round(time.perf_counter() - t, 1), files={"bank.npz": sha256_file(os.path.join(a.out, "bank.npz"))}))
     print(f"{bank['cls'].shape[0]} zoo images in {time.perf_counter() - t:.0f} s -> {a.out}", file=sys.stderr)

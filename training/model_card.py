@@ -1,6 +1,6 @@
-"""Write a model's card from its run, export and evaluation: ``python -m training.model_card ...``.
+"""Write a model's card from its run, export and evaluation: ``python -m omninoise.training.model_card ...``.
 
-    python -m training.model_card [--run RUN] --model MODEL_DIR --eval EVAL.json \\
+    python -m omninoise.training.model_card [--run RUN] --model MODEL_DIR --eval EVAL.json \\
         [--ablation-eval EVAL_NO_CUTMIX.json] --train-command "..." -o MODEL_DIR/MODEL_CARD.md
 
 Everything in the card is read from files the project's own commands wrote:
@@ -150,7 +150,7 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
         f"- **Hardware:** {hardware or hardware_line()}.",
         f"- **Steps:** {meta['step']}. **Wall time:** {wall:.1f} min.",
         f"- **Final training MSE** (mean of the last log window): {mse:.4f}. Wall time and loss are from {source}.",
-        f"- **Weights:** {meta['weights']} (exported with `python -m training.export_onnx`).",
+        f"- **Weights:** {meta['weights']} (exported with `python -m omninoise.training.export_onnx`).",
         f"- **Form:** {meta.get('form', 'one-piece')}; **sha256** "
         + ", ".join(f"of `{name}`: `{digest}`" for name, digest in sorted(meta["files"].items())) + ".",
         "",
@@ -209,7 +209,7 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.model_card", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.model_card", description=__doc__.split("\n")[0])
     ap.add_argument("--run", help="the training run (its log.jsonl); default: the export's training record")
     ap.add_argument("--wall-minutes", type=float, help="without --run or a training record: the run's wall time")
     ap.add_argument("--final-mse", type=float, help="without --run or a training record: the run's final MSE")
@@ -245,7 +245,7 @@ def main(argv=None) -> int:
                     ref, cmp, kept, a.wall_minutes, a.final_mse, a.note)
     except ValueError as exc:
         ap.error(str(exc))
-    from backend._export import export
+    from omninoise import export
 
     export.write_text(a.out, text)
     return 0

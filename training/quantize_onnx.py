@@ -1,4 +1,4 @@
-"""int8 denoisers for a split neural noise export: `python -m training.quantize_onnx models/neural_noise`.
+"""int8 denoisers for a split neural noise export: `python -m omninoise.training.quantize_onnx models/neural_noise`.
 
 Writes ``denoiser_int8.onnx`` and ``denoiser_tile_int8.onnx`` beside the fp32 denoisers and records them in
 ``neural_noise.json`` under ``int8`` (sha256 per file, how they were made).  The fp32 files, and so the
@@ -23,10 +23,10 @@ import tempfile
 import numpy as np
 import torch
 
-from backend._export import export as _ex
-from backend.neural import conditioning as C
-from backend.neural.model import NeuralNoiseModel
-from backend.onnx_models import sha256_file
+from omninoise import export as _ex
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.onnx_models import sha256_file
 
 from . import zoo
 
@@ -76,7 +76,7 @@ def quantize_folder(folder: str, size: int = 64, seed: int = 0, log=print) -> di
     model = NeuralNoiseModel(folder)
     if model.form != "split":
         raise SystemExit(f"quantize: {folder} is a {model.form} export; int8 needs the split form "
-                         "(python -m training.export_onnx --from-export)")
+                         "(python -m omninoise.training.export_onnx --from-export)")
     files = {}
     for fp32, int8 in INT8_FILES.items():
         if fp32 not in model.config["files"]:
@@ -117,7 +117,7 @@ def quantize_folder(folder: str, size: int = 64, seed: int = 0, log=print) -> di
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.quantize_onnx", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.quantize_onnx", description=__doc__.split("\n")[0])
     ap.add_argument("folder", help="a split neural noise export (it gains the int8 denoisers)")
     ap.add_argument("--size", type=int, default=64, help="calibration image side (px)")
     ap.add_argument("--seed", type=int, default=0)

@@ -1,4 +1,4 @@
-"""Train the neural noise model: ``python -m training.train --config CONFIG.json --out RUN``.
+"""Train the neural noise model: ``python -m omninoise.training.train --config CONFIG.json --out RUN``.
 
 Data is generated on the fly by :mod:`.zoo` (no files), on the CPU or the GPU.
 Every step: a zoo batch -> CutMix (p = 0.5) -> (random flips, ``flips``) -> ε-prediction loss
@@ -34,7 +34,7 @@ from .precision import autocast, resolve
 from .threads import cpu_threads
 from .unet import UNet
 from .warm_start import exported_weights, warm_start
-from backend.onnx_models import ModelError
+from omninoise.backend.onnx_models import ModelError
 
 __all__ = ["TrainConfig", "train", "load_config", "build_model", "model_names", "check_config_keys"]
 
@@ -79,7 +79,7 @@ def _device(name: str) -> torch.device:
 
 
 def _save(path: str, obj) -> None:
-    from backend._export import export
+    from omninoise import export
 
     with export.atomic_path(path) as tmp:
         torch.save(obj, tmp)
@@ -93,7 +93,7 @@ def _conditions(ids: torch.Tensor, conds: torch.Tensor, size: int):
 
 def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0) -> np.ndarray:
     """DDIM samples of a few classes at their default parameters: float32 (n, S, S) in [0, 1]."""
-    from backend.neural.sampler import ddim_sample, initial_noise
+    from omninoise.backend.neural.sampler import ddim_sample, initial_noise
 
     names = list(names or cfg.classes[:8])
     S = cfg.size
@@ -217,7 +217,7 @@ def _train(cfg: TrainConfig, out: str, max_steps: int | None, log, max_seconds: 
 
 def save_samples(model: UNet, cfg: TrainConfig, device, path: str) -> None:
     """A row of EMA samples (first 8 classes, default parameters) as a PNG."""
-    from backend._export import export
+    from omninoise import export
 
     imgs = sample_grid(model, cfg, device)
     row = np.concatenate(list(imgs), axis=1)
@@ -225,7 +225,7 @@ def save_samples(model: UNet, cfg: TrainConfig, device, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.train", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.train", description=__doc__.split("\n")[0])
     ap.add_argument("--config", required=True, help="JSON config (see TrainConfig)")
     ap.add_argument("--out", required=True, help="run folder: checkpoint, log, samples")
     ap.add_argument("--max-steps", type=int, help="stop after this many more steps (resume later)")

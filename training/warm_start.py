@@ -26,7 +26,7 @@ import os
 import numpy as np
 import torch
 
-from backend.onnx_models import fingerprint, load_model_json
+from omninoise.backend.onnx_models import fingerprint, load_model_json
 from .config import TrainConfig
 
 __all__ = ["exported_weights", "warm_start", "torch_from_export"]

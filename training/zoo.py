@@ -303,9 +303,9 @@ def _blender_gabor(x, y, s, p, n):
 
 def _wave_engine(kind: str):
     def gen(x, y, s, p, n):
-        from backend.grid import evaluate_box
-        from backend.wavenoise.settings import WaveSettings, compile_noise
-        from backend.wavenoise.spectra import Spectrum
+        from omninoise.backend.grid import evaluate_box
+        from omninoise.backend.wavenoise.settings import WaveSettings, compile_noise
+        from omninoise.backend.wavenoise.spectra import Spectrum
 
         out = []
         for b in range(x.shape[0]):

@@ -87,7 +87,7 @@ class NeuralNoiseModel:
     def _check_int8(folder: str, int8: dict) -> None:
         """ModelError unless the folder's int8 denoisers exist and match their sha256 in the JSON."""
         if not int8.get("files"):
-            raise PrecisionUnavailable(f"{folder}: no int8 denoisers (make them with python -m training.quantize_onnx {folder})")
+            raise PrecisionUnavailable(f"{folder}: no int8 denoisers (make them with python -m omninoise.training.quantize_onnx {folder})")
         verify_files(folder, int8["files"], "neural_noise.json")
 
     def denoiser_name(self, tileable: bool) -> str:

@@ -36,7 +36,7 @@ import os
 
 import numpy as np
 
-from .._export import export
+from ... import export
 from ..errors import SettingError
 from ..grid import Cancelled
 from .harmonic import mix_harmonics

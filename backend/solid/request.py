@@ -57,7 +57,7 @@ def _digest(x) -> str | None:
     if isinstance(x, np.ndarray):
         return _pixels_sha(x)
     if os.path.isfile(x):      # a file as the pixels it decodes to: equal to the same pixels handed over
-        from .._export import export
+        from ... import export
 
         return _pixels_sha(export.read_rgb(x))
     return str(x)
@@ -157,7 +157,7 @@ class SolidRequest:
         (H, W, 3) sRGB; SettingError naming the exemplar for a file it cannot read."""
         if not isinstance(self.exemplar, str):
             return self.exemplar
-        from .._export import export
+        from ... import export
 
         try:
             return export.read_rgb(self.exemplar)
@@ -194,6 +194,25 @@ class SolidRequest:
             return spectral_field(img, int(self.seed), h, progress, cancel)
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
+
+    def front_image(self, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
+                    on_code=None, draw_progress=None) -> np.ndarray:
+        """The texture's 2D image: the plane y = 0 seen from the front (x right, z up), as the command line's
+        ``--dim 2`` writes it: sRGB float32 (size, size, 3) in [0, 1], ``scale`` output pixels per exemplar pixel.
+        ``progress`` hears the synthesis, the spectral solid or the refinement, ``draw_progress`` the drawing of
+        a neural texture; ``report`` hears the refinement as in :meth:`code`; ``on_code(code)`` gets the texture
+        code before it is drawn (the neural texture only)."""
+        if self.method == "synthesis":
+            return self.synthesis_field(where, progress).image(size, scale)
+        if self.method == "spectral":
+            from .spectral_solid import SpectralTexture
+
+            return SpectralTexture(self).image(size, self.spectral_field(where, progress), scale=scale)
+        model = self.load(where)
+        code, _ = self.code(model, where, progress, report)
+        if on_code is not None:
+            on_code(code)
+        return model.image(size, code, int(self.seed), scale=scale, progress=draw_progress)
 
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's

@@ -44,6 +44,16 @@ def available() -> bool:
     return bool(numba)
 
 
+def engine_path() -> str:
+    """Which kernel evaluates wave noise grids here, in words: the C row kernel, numba, or numpy (neither is
+    installed: ``pip install 'omninoise[fast]'`` brings numba)."""
+    if ckernel.available():
+        return "C row kernel"
+    if numba:
+        return "numba kernel"
+    return "numpy (pip install 'omninoise[fast]' for the compiled kernel)"
+
+
 def supports(noise) -> bool:
     return bool(numba) and _single(noise)
 

@@ -84,7 +84,7 @@ class WaveTable:
         """Write ``.npz`` (values + JSON metadata) atomically."""
         header = dict(format=_FORMAT, version=_VERSION, period=self.period, mode=self.mode,
                       dim=self.dim, meta=self.meta)
-        from .._export import export
+        from ... import export
 
         with export.atomic_path(path, ".npz") as tmp:
             np.savez(tmp, values=self.values, header=np.frombuffer(json.dumps(header).encode(), np.uint8))

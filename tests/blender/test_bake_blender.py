@@ -9,12 +9,12 @@ from conftest import needs_openvdb
 
 bpy = pytest.importorskip("bpy")
 
-import blender_addon  # noqa: E402
-from blender_addon.compat import ensure_node_tree  # noqa: E402
-from backend.bake import BakeSpec, run_bake  # noqa: E402
-from backend.sources import BoxGrid, WaveSource  # noqa: E402
-from backend.transfer import preset  # noqa: E402
-from export import read_volume  # noqa: E402
+from omninoise import blender_addon  # noqa: E402
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
+from omninoise.backend.bake import BakeSpec, run_bake  # noqa: E402
+from omninoise.backend.sources import BoxGrid, WaveSource  # noqa: E402
+from omninoise.backend.transfer import preset  # noqa: E402
+from omninoise.export import read_volume  # noqa: E402
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -41,7 +41,7 @@ def scene(tmp_path):
 
 
 def _ramp(mode, colour_mode="RGB"):
-    from blender_addon.bake_blender import ramp_node
+    from omninoise.blender_addon.bake_blender import ramp_node
 
     cr = ramp_node().color_ramp
     cr.color_mode = colour_mode
@@ -55,7 +55,7 @@ def _ramp(mode, colour_mode="RGB"):
 
 @pytest.mark.parametrize("mode", ["LINEAR", "CONSTANT", "EASE", "B_SPLINE", "CARDINAL"])
 def test_transfer_equals_blender_color_ramp(scene, mode):
-    from blender_addon.bake_blender import transfer_from_color_ramp
+    from omninoise.blender_addon.bake_blender import transfer_from_color_ramp
 
     cr = _ramp(mode)
     tf = transfer_from_color_ramp(cr, (0.0, 1.0))
@@ -68,7 +68,7 @@ def test_transfer_equals_blender_color_ramp(scene, mode):
 
 
 def test_presets_set_the_ramp(scene):
-    from blender_addon.bake_blender import ramp_node
+    from omninoise.blender_addon.bake_blender import ramp_node
 
     p = scene.omninoise_bake
     for name in ("fire", "marble", "clouds"):
@@ -97,7 +97,7 @@ def test_bake_volume_operator_makes_a_renderable_volume(scene, tmp_path):
     assert pv.inputs["Density Attribute"].default_value == "density"
     assert pv.inputs["Color Attribute"].default_value == "color"
     # the same bake through the Blender-free pipeline gives the same voxels
-    from blender_addon.bake_ui import transfer
+    from omninoise.blender_addon.bake_ui import transfer
 
     spec = BakeSpec("ref", WaveSource(p.wave.to_settings(node=False)), BoxGrid((24, 24, 12),
                     ((-1, -1, -0.5), (1, 1, 0.5))), str(tmp_path / "ref.vdb"), transfer(p))
@@ -196,7 +196,7 @@ def test_bad_settings_report_one_line(scene, tmp_path):
 
 @needs_openvdb
 def test_worker_keeps_main_thread_free_and_cancels(scene, tmp_path):
-    from blender_addon import tasks
+    from omninoise.blender_addon import tasks
 
     src = WaveSource(scene.omninoise_bake.wave.to_settings(node=False).replace(directions=32))
     spec = BakeSpec("big", src, BoxGrid((160, 160, 160)), str(tmp_path / "big.vdb"), preset("smoke"))
@@ -246,7 +246,7 @@ dim = 2
 
 @needs_openvdb
 def test_job_in_blender_matches_the_command_line(tmp_path):
-    from cli.main import main
+    from omninoise.cli.main import main
 
     for sub in ("cli", "bpy"):
         (tmp_path / sub).mkdir()
@@ -255,7 +255,7 @@ def test_job_in_blender_matches_the_command_line(tmp_path):
     assert bpy.ops.omninoise.run_job(filepath=str(tmp_path / "bpy" / "job.toml")) == {"FINISHED"}
     for name in ("vol.vdb", "img.exr"):
         a, b = tmp_path / "cli" / name, tmp_path / "bpy" / name
-        from export import read_metadata
+        from omninoise.export import read_metadata
 
         assert read_metadata(str(a))["omninoise_key"] == read_metadata(str(b))["omninoise_key"]
     np.testing.assert_array_equal(read_volume(str(tmp_path / "cli" / "vol.vdb"), "density", (8, 16, 16)),

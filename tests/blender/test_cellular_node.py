@@ -4,10 +4,10 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
-from backend.errors import SettingError  # noqa: E402
-from blender_addon.cellular_nodes import build_cellular_group  # noqa: E402
-from blender_addon.field_eval import evaluate_field  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
+from omninoise.blender_addon.cellular_nodes import build_cellular_group  # noqa: E402
+from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
 
 
 def _node(s, pts, output, w=None, scale=1.0):
@@ -55,7 +55,7 @@ def test_stit_stays_bake_only():
 
 def test_cycles_renders_the_cellular_shader(tmp_path):
     """16 directions in 3D (32 plane families) compile within Cycles' SVM stack and render cells."""
-    from blender_addon.wave_nodes import add_wave_node
+    from omninoise.blender_addon.wave_nodes import add_wave_node
 
     bpy.ops.wm.read_homefile(use_empty=True)
     sc = bpy.context.scene
@@ -91,8 +91,8 @@ def test_cycles_renders_the_cellular_shader(tmp_path):
 
 
 def test_add_menu_operator_and_live_rebuild():
-    import blender_addon
-    from blender_addon.wave_ui import new_cellular_node_tree
+    from omninoise import blender_addon
+    from omninoise.blender_addon.wave_ui import new_cellular_node_tree
 
     blender_addon.register()
     try:

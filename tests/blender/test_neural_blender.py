@@ -6,10 +6,10 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-import blender_addon  # noqa: E402
+from omninoise import blender_addon  # noqa: E402
 from conftest import Recorder  # noqa: E402
-from blender_addon import neural_ui, tasks  # noqa: E402
-from blender_addon.compat import ensure_node_tree  # noqa: E402
+from omninoise.blender_addon import neural_ui, tasks  # noqa: E402
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -55,8 +55,8 @@ def test_bake_matches_the_runtime(scene, mode):
         bpy.ops.omninoise.blend_map_new()
     assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
     got = _pixels(p.name)
-    from blender_addon._deps import backend  # noqa: F401
-    from backend.neural.generate import generate
+    from omninoise.blender_addon._deps import backend  # noqa: F401
+    from omninoise.backend.neural.generate import generate
 
     ref = generate(neural_ui.model(), neural_ui.build_conditioning(p, 32), seed=5, steps=3)
     np.testing.assert_allclose(got, ref, atol=1e-6)
@@ -68,7 +68,7 @@ def test_bake_matches_the_runtime(scene, mode):
 def test_int8_preference_bakes_with_the_int8_denoiser(scene, monkeypatch):
     """The Neural Precision preference reloads the model with the shipped int8 denoisers; the bake equals the
     runtime's int8 image and stays near the float32 one."""
-    from backend.neural.generate import generate
+    from omninoise.backend.neural.generate import generate
 
     p = scene.omninoise_neural
     assert neural_ui.model().precision == "fp32"  # the default
@@ -90,7 +90,7 @@ def test_painted_regions_carry_their_swatch(scene):
     p = scene.omninoise_neural
     bpy.ops.omninoise.blend_map_new()
     cond = neural_ui.build_conditioning(p, 32)
-    from backend.neural import conditioning as C
+    from omninoise.backend.neural import conditioning as C
 
     m = neural_ui.model()
     np.testing.assert_allclose(cond[:, 0, 0], C.uniform(m, p.swatches[0].spec(), 1, 1)[:, 0, 0], atol=1e-5)
@@ -154,7 +154,7 @@ def test_panel_draws(scene):
 
 
 def test_bake_also_saves_files(scene, tmp_path):
-    from export.images import read_image
+    from omninoise.export.images import read_image
 
     p = scene.omninoise_neural
     p.folder = str(tmp_path) + os.sep
@@ -197,8 +197,8 @@ def test_preset_round_trip_and_errors(scene, tmp_path):
 def test_thumbnails_come_from_the_model_and_are_cached(scene):
     p = scene.omninoise_neural
     assert bpy.ops.omninoise.swatch_thumbnails() == {"FINISHED"}
-    from backend.neural import conditioning as C
-    from backend.neural.generate import generate
+    from omninoise.backend.neural import conditioning as C
+    from omninoise.backend.neural.generate import generate
     for i, s in enumerate(p.swatches):
         ima = bpy.data.images[neural_ui.thumbnail_name(i)]
         assert tuple(ima.size) == (32, 32)
@@ -220,8 +220,8 @@ def test_painted_regions_carry_their_swatch_spectra(scene):
     bpy.ops.omninoise.blend_map_new()         # first colour left, second right
     assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
     img = _pixels(p.name)
-    from backend.neural import conditioning as C
-    from backend.neural.generate import generate
+    from omninoise.backend.neural import conditioning as C
+    from omninoise.backend.neural.generate import generate
 
     def psd(a):
         a = a - a.mean()
@@ -265,8 +265,8 @@ def _bake_emission(obj, nt, node, size):
 
 
 def test_sequence_bake_writes_the_frames_and_plays_them(scene, tmp_path):
-    from export.images import read_image
-    from backend.neural.animate import animate
+    from omninoise.export.images import read_image
+    from omninoise.backend.neural.animate import animate
 
     p = scene.omninoise_neural
     p.size, p.steps, p.frame_start, p.frame_end = 16, 2, 3, 6
@@ -311,9 +311,9 @@ def test_sequence_bake_says_what_is_wrong(scene, tmp_path):
 
 
 def test_fit_to_image_fills_the_active_swatch_as_the_runtime_fits(scene):
-    from backend.neural import conditioning as C
-    from backend.neural.fit import fit
-    from backend.neural.generate import generate
+    from omninoise.backend.neural import conditioning as C
+    from omninoise.backend.neural.fit import fit
+    from omninoise.backend.neural.generate import generate
 
     m = neural_ui.model()
     target = generate(m, C.uniform(m, ("cells_f1", {"scale": 10.0}), 32, 32), seed=9, steps=6)
@@ -339,8 +339,8 @@ def test_fit_to_image_fills_the_active_swatch_as_the_runtime_fits(scene):
 
 @pytest.mark.parametrize("mode", ["SINGLE", "CORNERS", "MAP"])
 def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
-    from cli.main import build_parser, neural_request
-    from export.images import write_png
+    from omninoise.cli.main import build_parser, neural_request
+    from omninoise.export.images import write_png
 
     p = scene.omninoise_neural
     p.mode, p.width = mode, 6.0

@@ -7,11 +7,11 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-import blender_addon  # noqa: E402
+from omninoise import blender_addon  # noqa: E402
 from conftest import Recorder, needs_openvdb  # noqa: E402
-from blender_addon import solid_ui, tasks  # noqa: E402
-from backend.solid.bake import srgb_to_linear  # noqa: E402
-from backend.solid.model import SolidTextureModel  # noqa: E402
+from omninoise.blender_addon import solid_ui, tasks  # noqa: E402
+from omninoise.backend.solid.bake import srgb_to_linear  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
 
 SHIPPED = solid_ui.MODELS_DIR
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -90,8 +90,8 @@ def test_cube_seams_agree(scene):
     p = scene.omninoise_solid
     p.size, p.scale = 256, 0.25
     assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
-    from blender_addon.solid_ui import _mesh_arrays
-    from backend.solid.surface import texel_positions
+    from omninoise.blender_addon.solid_ui import _mesh_arrays
+    from omninoise.backend.solid.surface import texel_positions
     uv, pos = _mesh_arrays(bpy.context, bpy.context.active_object, False, True)
     mask, pts = texel_positions(uv, pos, 256, 256)
     img = _pixels("Solid Texture")
@@ -140,7 +140,7 @@ def test_volume_bake(scene, tmp_path):
     assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
     path = tmp_path / "Solid_Texture.vdb"
     assert path.is_file()
-    from export.vdb import read_volume
+    from omninoise.export.vdb import read_volume
     col = read_volume(str(path), "color", (8, 8, 8))
     # voxel centres of the object's local bounds [-1, 1]^3 at 8 voxels
     c = -1 + (np.arange(8) + 0.5) * 0.25
@@ -157,9 +157,9 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
     """Method Spectral Solid (backend/solid/spectral_solid.py): the panel's request is the command line's (Periodic
     Part included); the preview, a colour attribute and a volume are the request's solid read at the same points;
     the panel hides the neural texture's other settings."""
-    from backend.solid.spectral_solid import SpectralTexture
-    from cli.main import build_parser, solid_request
-    from export.images import write_png
+    from omninoise.backend.solid.spectral_solid import SpectralTexture
+    from omninoise.cli.main import build_parser, solid_request
+    from omninoise.export.images import write_png
 
     rgb = np.random.default_rng(4).integers(0, 256, (64, 72, 3)).astype(np.uint8)
     write_png(str(tmp_path / "ex.png"), rgb)
@@ -198,7 +198,7 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
 
     p.target = "VOLUME"
     assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
-    from export.vdb import read_volume
+    from omninoise.export.vdb import read_volume
 
     col = read_volume(str(tmp_path / "Solid_Texture.vdb"), "color", (8, 8, 8))
     c = -1 + (np.arange(8) + 0.5) * 0.25            # voxel centres of the sphere's local bounds [-1, 1]^3
@@ -228,7 +228,7 @@ def test_image_source_is_encoded_by_the_space_model(scene):
 def test_the_preview_shows_the_periodic_part_it_found(scene):
     """A brick photo's courses and joints (backend/solid/harmonic.py): the preview shows them, the panel says how
     much of the photo they carry, and the Periodic Part box leaves them out."""
-    from export.images import read_rgb
+    from omninoise.export.images import read_rgb
 
     path = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
     p = scene.omninoise_solid
@@ -263,7 +263,7 @@ def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     """Tileable Image (backend/solid/synthesis.py) stores the tile the command line's request synthesises from the
     same pixels, 8-bit, row 0 at the bottom, and the panel draws it for an image exemplar; without one it says
     what to pick."""
-    from backend.solid.request import SolidRequest
+    from omninoise.backend.solid.request import SolidRequest
 
     p = scene.omninoise_solid
     with pytest.raises(RuntimeError, match="set Source to Image"):
@@ -380,9 +380,9 @@ def test_panel_draws(scene):
 def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
     """The panel, the command line and job files build one request (backend.solid.request): equal settings give
     equal keys, an image datablock's pixels count as the file they came from."""
-    from backend.sources import solid_request_from_dict
-    from cli.main import build_parser, solid_request
-    from export.images import write_png
+    from omninoise.backend.sources import solid_request_from_dict
+    from omninoise.cli.main import build_parser, solid_request
+    from omninoise.export.images import write_png
 
     p = scene.omninoise_solid
     space = os.path.join(solid_ui.MODELS_DIR, "space")

@@ -24,8 +24,8 @@ import pytest
 OpenEXR = pytest.importorskip("OpenEXR")
 pytest.importorskip("bpy")
 
-from backend.wavenoise.settings import settings_to_dict  # noqa: E402
-from backend.wavenoise.wave import select_output  # noqa: E402
+from omninoise.backend.wavenoise.settings import settings_to_dict  # noqa: E402
+from omninoise.backend.wavenoise.wave import select_output  # noqa: E402
 from test_wave_node import CASES as NODE_CASES, SOCKETS, _engine  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

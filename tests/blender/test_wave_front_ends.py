@@ -4,9 +4,9 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-import blender_addon  # noqa: E402
-from backend.sources import source_from_dict  # noqa: E402
-from cli.main import build_parser, settings_from_args  # noqa: E402
+from omninoise import blender_addon  # noqa: E402
+from omninoise.backend.sources import source_from_dict  # noqa: E402
+from omninoise.cli.main import build_parser, settings_from_args  # noqa: E402
 
 CASES = [
     # (flags, job-file table, panel properties)

@@ -9,11 +9,11 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
-from backend.wavenoise.wave import select_output  # noqa: E402
-from blender_addon.field_eval import evaluate_field  # noqa: E402
-from blender_addon.compat import ensure_node_tree  # noqa: E402
-from blender_addon.wave_nodes import SETTINGS_KEY, add_wave_node, build_wave_group, settings_from_json  # noqa: E402,E501
+from omninoise.backend import Spectrum, WaveSettings, compile_noise  # noqa: E402
+from omninoise.backend.wavenoise.wave import select_output  # noqa: E402
+from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
+from omninoise.blender_addon.wave_nodes import SETTINGS_KEY, add_wave_node, build_wave_group, settings_from_json  # noqa: E402,E501
 
 OUT = {"Value": "real", "Imaginary": "imag", "Modulus": "modulus", "Phase": "phase"}
 #: the group's input socket of each keyword of _engine (and of CASES' keyword dicts)
@@ -206,8 +206,8 @@ def test_table_image_is_float_and_survives_save(tmp_path):
 def test_settings_key_and_the_key_of_older_files():
     """The settings live under a key no registered property uses (before 5.0 the two share storage);
     trees saved by OmniNoise 0.1 on Blender 5.0 under the old key still give their settings."""
-    from blender_addon.compat import VERSION
-    from blender_addon.wave_nodes import LEGACY_SETTINGS_KEY, tree_settings_json
+    from omninoise.blender_addon.compat import VERSION
+    from omninoise.blender_addon.wave_nodes import LEGACY_SETTINGS_KEY, tree_settings_json
 
     s, _ = CASES["2d"]
     grp = build_wave_group(s, "ShaderNodeTree")

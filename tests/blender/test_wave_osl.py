@@ -8,11 +8,11 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from backend import Spectrum, WaveSettings  # noqa: E402
-from backend.errors import SettingError  # noqa: E402
-from backend.wavenoise.wave import select_output  # noqa: E402
-from blender_addon.wave_nodes import IMPLEMENTATION_KEY, build_wave_group, tree_implementation  # noqa: E402
-from blender_addon.wave_osl import osl_available, osl_source  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
+from omninoise.backend.wavenoise.wave import select_output  # noqa: E402
+from omninoise.blender_addon.wave_nodes import IMPLEMENTATION_KEY, build_wave_group, tree_implementation  # noqa: E402
+from omninoise.blender_addon.wave_osl import osl_available, osl_source  # noqa: E402
 from test_wave_node import CASES, _bake, _engine, _plane_material  # noqa: E402
 
 pytestmark = pytest.mark.skipif(not osl_available(), reason="this bpy has no OSL")
@@ -86,7 +86,7 @@ def test_osl_refused_where_it_cannot_work():
 
 
 def test_osl_source_is_deterministic_and_carries_the_table():
-    from backend import compile_noise
+    from omninoise.backend import compile_noise
 
     noise = compile_noise(CASES["2d"][0])
     a, b = osl_source(noise), osl_source(noise)
@@ -97,8 +97,8 @@ def test_osl_source_is_deterministic_and_carries_the_table():
 def test_automatic_form_renders_in_both_shading_systems(tmp_path):
     """An Automatic group switched by the render itself (render_pre): the first OSL render and the
     first SVM render after a switch both show the noise, never the black of the wrong form."""
-    import blender_addon
-    from blender_addon import wave_ui
+    from omninoise import blender_addon
+    from omninoise.blender_addon import wave_ui
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     blender_addon.register()
@@ -133,7 +133,7 @@ def test_automatic_form_renders_in_both_shading_systems(tmp_path):
 
 def test_rebuilds_reuse_the_compiled_bytecode(monkeypatch):
     """Switching an Automatic node between forms rebuilds the script: the same source compiles once."""
-    from blender_addon import wave_osl
+    from omninoise.blender_addon import wave_osl
 
     s, _ = CASES["3d"]
     _osl_scene()

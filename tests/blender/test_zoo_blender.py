@@ -12,10 +12,10 @@ import pytest
 torch = pytest.importorskip("torch")
 bpy = pytest.importorskip("bpy")
 
-from training import noise_ops as ops  # noqa: E402
-from training import zoo  # noqa: E402
-from training.evaluate import radial_psd  # noqa: E402
-from blender_addon.field_eval import evaluate_field  # noqa: E402
+from omninoise.training import noise_ops as ops  # noqa: E402
+from omninoise.training import zoo  # noqa: E402
+from omninoise.training.evaluate import radial_psd  # noqa: E402
+from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
 
 S = 128
 
@@ -70,7 +70,7 @@ CASES = [
 
 @pytest.mark.parametrize("name, node, settings, inputs", CASES)
 def test_blender_named_classes_match_the_nodes(name, node, settings, inputs):
-    from blender_addon.compat import has_gabor_node
+    from omninoise.blender_addon.compat import has_gabor_node
 
     if node == "ShaderNodeTexGabor" and not has_gabor_node():
         pytest.skip("Blender's Gabor Texture node needs Blender 4.3")

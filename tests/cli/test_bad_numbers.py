@@ -5,10 +5,10 @@ import re
 
 import pytest
 
-from backend import limits
-from cli.main import main
-from backend.errors import SettingError
-from backend.jobs import run_job
+from omninoise.backend import limits
+from omninoise.cli.main import main
+from omninoise.backend.errors import SettingError
+from omninoise.backend.jobs import run_job
 
 from test_jobs import JOB, RAMP
 
@@ -84,7 +84,7 @@ def test_bad_job_numbers_are_named(tmp_path, edit, match):
 def test_atomic_writes_refuse_folders_and_clean_stale_temporaries(tmp_path, capsys):
     import time
 
-    from export.atomic import STALE_SECONDS, atomic_path
+    from omninoise.export.atomic import STALE_SECONDS, atomic_path
 
     old = tmp_path / ".omninoise-dead.npy"          # left by a killed process
     old.write_bytes(b"x")
@@ -109,7 +109,7 @@ def test_atomic_writes_refuse_folders_and_clean_stale_temporaries(tmp_path, caps
 def test_model_without_hashes_is_refused(tmp_path):
     import json
 
-    from backend.onnx_models import ModelError, load_model_json
+    from omninoise.backend.onnx_models import ModelError, load_model_json
 
     (tmp_path / "solid.json").write_text(json.dumps({"model": "neural_solid_texture"}))
     with pytest.raises(ModelError, match="lists no files with their sha256"):
@@ -142,7 +142,7 @@ def test_bad_custom_profiles(tmp_path, capsys, content, name):
 
 def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp_path, capsys, monkeypatch):
     """Exit 1 and one line naming the exception for a bug; `omninoise --debug ...` re-raises it."""
-    import cli.main as cli
+    import omninoise.cli.main as cli
 
     def broken(a):
         raise ZeroDivisionError("float division by zero")
@@ -164,7 +164,7 @@ def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp
     ('method = "synthesis"\nexemplar = "ex.png"\nscale = 0', "source.scale: must be positive"),
 ])
 def test_bad_solid_source_numbers_are_named(tmp_path, source, match):
-    from export.images import write_png
+    from omninoise.export.images import write_png
     import numpy as np
 
     write_png(str(tmp_path / "ex.png"), np.random.default_rng(0).integers(0, 256, (64, 64, 3)).astype(np.uint8))

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from cli.main import main
+from omninoise.cli.main import main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -34,7 +34,7 @@ def test_png_and_exr(tmp_path, capsys):
     with open(png, "rb") as fh:
         assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
     assert run(capsys, "--size", "40", "--quiet", "--output", "phase", "-o", exr)[0] == 0
-    from export.images import read_image
+    from omninoise.export.images import read_image
 
     img = read_image(exr)
     assert img.shape == (40, 40) and img.min() >= -np.pi - 1e-6 and img.max() <= np.pi + 1e-6
@@ -65,7 +65,7 @@ def test_existing_output_survives_failure(tmp_path, capsys):
 
 def test_python_dash_m_backend(tmp_path):
     out = str(tmp_path / "m.npy")
-    r = subprocess.run([sys.executable, "-m", "cli", "wave", "--size", "8", "--quiet", "-o", out],
+    r = subprocess.run([sys.executable, "-m", "omninoise", "wave", "--size", "8", "--quiet", "-o", out],
                        cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert np.load(out).shape == (8, 8)

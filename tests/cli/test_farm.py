@@ -10,11 +10,11 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from cli import farm  # noqa: E402
-from cli.main import main  # noqa: E402
-from backend.jobs import run_job  # noqa: E402
-from export import read_volume  # noqa: E402
-from export.images import decode  # noqa: E402
+from omninoise.cli import farm  # noqa: E402
+from omninoise.cli.main import main  # noqa: E402
+from omninoise.backend.jobs import run_job  # noqa: E402
+from omninoise.export import read_volume  # noqa: E402
+from omninoise.export.images import decode  # noqa: E402
 from conftest import needs_openvdb  # noqa: E402
 
 JOB = """
@@ -108,7 +108,7 @@ def assert_same_outputs(a: str, b: str) -> None:
         if name.endswith(".npy"):
             np.testing.assert_array_equal(np.load(pa), np.load(pb), err_msg=name)
         elif name.endswith(".vdb"):
-            from export.vdb import openvdb_module
+            from omninoise.export.vdb import openvdb_module
 
             vdb = openvdb_module()
             for grid, shape in (("density", (17, 18, 20)), ("color", (17, 18, 20, 3)), ("temperature", (17, 18, 20))):

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from cli import hugepages as hp
+from omninoise.cli import hugepages as hp
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 HERE = dict(system="Linux", libc=("glibc", "2.36"), thp="always [madvise] never\n")
@@ -46,7 +46,7 @@ def test_only_large_neural_images_reexecute():
 
 
 def test_main_reexecutes_a_real_command_line_only(monkeypatch, tmp_path):
-    from cli import main as cli_main
+    from omninoise.cli import main as cli_main
 
     calls = []
     monkeypatch.setattr(hp, "wanted", lambda command, size, env: command == "neural" and size >= 512)

@@ -6,9 +6,9 @@ import sys
 import numpy as np
 import pytest
 
-from cli.main import main
-from backend.jobs import JobError, load_job, run_job
-from export import read_volume
+from omninoise.cli.main import main
+from omninoise.backend.jobs import JobError, load_job, run_job
+from omninoise.export import read_volume
 
 JOB = """
 [defaults]
@@ -144,8 +144,8 @@ def test_wave_cli_vdb_and_transfer(tmp_path, capsys):
     vdb = str(tmp_path / "w.vdb")
     assert main(["wave", "--dim", "3", "--size", "16", "--fmin", "1", "--fmax", "3", "--seed", "5", "--quiet",
                  "-o", vdb]) == 0
-    from backend import WaveSettings, compile_noise, evaluate_points
-    from backend.wavenoise.spectra import Spectrum
+    from omninoise.backend import WaveSettings, compile_noise, evaluate_points
+    from omninoise.backend.wavenoise.spectra import Spectrum
 
     d = read_volume(vdb, "density", (16, 16, 16))
     c = (np.arange(16) + 0.5) * 4.0 / 16
@@ -198,7 +198,7 @@ def test_a_symlink_does_not_lead_outside_the_output_root(tmp_path):
 def test_a_new_source_kind_is_one_class_and_one_registration(tmp_path, monkeypatch):
     """Issue 23 (sources by registry): a registered kind bakes from a job file through the whole pipeline
     (validation, slabs, writers, keys) with no edit to the CLI, jobs or bake code."""
-    from backend import sources
+    from omninoise.backend import sources
 
     class Ramp:
         kind, dim, animated, chunkable = "ramp", 3, False, True

@@ -6,12 +6,12 @@ import os
 import numpy as np
 import pytest
 
-from cli.main import build_parser, main, neural_request
-from backend.errors import SettingError
-from backend.neural.model import NeuralNoiseModel
-from backend.neural.request import NeuralRequest, generate_request
-from backend.sources import source_from_dict
-from export.images import write_png
+from omninoise.cli.main import build_parser, main, neural_request
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.neural.request import NeuralRequest, generate_request
+from omninoise.backend.sources import source_from_dict
+from omninoise.export.images import write_png
 
 TINY = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_neural")
 SAMPLING = ["--size", "32", "--seed", "3", "--steps", "3", "--sampler", "ddim"]
@@ -82,7 +82,7 @@ steps = 3
 sampler = "ddim"
 """)
     assert main(["bake", str(maps / "job.toml"), "--quiet"]) == 0
-    from export.images import read_image
+    from omninoise.export.images import read_image
 
     np.testing.assert_allclose(read_image(str(maps / "job.png")), np.load(maps / "cli.npy"), atol=0.5 / 255 + 1e-6)
 

@@ -5,8 +5,8 @@ import re
 import numpy as np
 import pytest
 
-from cli.main import main
-from backend.paths import solid_models
+from omninoise.cli.main import main
+from omninoise.backend.paths import solid_models
 
 TINY = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_solid")
 
@@ -48,13 +48,13 @@ def test_image_outputs(models, tmp_path, capsys):
     a = np.load(npy)
     assert a.shape == (24, 24, 3) and a.dtype == np.float32 and 0.0 <= a.min() and a.max() <= 1.0
     # the .npy is scene-linear: the runtime's sRGB values, decoded
-    from backend.solid.bake import srgb_to_linear
-    from backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.bake import srgb_to_linear
+    from omninoise.backend.solid.model import SolidTextureModel
     m = SolidTextureModel(models["single2"])
     np.testing.assert_allclose(a, srgb_to_linear(m.image(24, m.default_code(), 0)), atol=1e-6)
     assert run(capsys, "--model", models["single2"], "--exemplar", "gravel", "--size", "24", "--seed", "3",
                "-o", exr)[0] == 0
-    from export.images import read_image
+    from omninoise.export.images import read_image
     assert read_image(exr).shape == (24, 24)
 
 
@@ -66,7 +66,7 @@ def test_volume_outputs(models, tmp_path, capsys):
     assert a.shape == (12, 12, 12, 3)
     assert run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--dim", "3", "--size", "12",
                "-o", vdb)[0] == 0
-    from export.vdb import read_volume
+    from omninoise.export.vdb import read_volume
     col = read_volume(vdb, "color", (12, 12, 12))
     np.testing.assert_allclose(col, a, atol=1e-6)
     np.testing.assert_array_equal(read_volume(vdb, "density", (12, 12, 12)), 1.0)
@@ -128,7 +128,7 @@ def test_refine_option(models, tmp_path, capsys):
 def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
     """`to` and `mix` in a job file (issue 23: job files take everything the command line does) give the volume
     `omninoise solid --to --mix` writes."""
-    from backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.model import SolidTextureModel
 
     space = SolidTextureModel(models["space3"])
     cli = str(tmp_path / "cli.npy")
@@ -146,10 +146,10 @@ def test_texture_codes_are_made_in_one_place(models, tmp_path):
     """A file, the same pixels (the panel's input) and a training exemplar's name all go through texture_code."""
     from PIL import Image
 
-    from backend.errors import SettingError
-    from backend.solid.model import SolidTextureModel
-    from backend.solid.refine import texture_code
-    from export.images import read_rgb
+    from omninoise.backend.errors import SettingError
+    from omninoise.backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.refine import texture_code
+    from omninoise.export.images import read_rgb
 
     space, single = SolidTextureModel(models["space3"]), SolidTextureModel(models["single3"])
     img = tmp_path / "ex.png"
@@ -174,8 +174,8 @@ def test_texture_codes_are_made_in_one_place(models, tmp_path):
 def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path, capsys):
     """An encoded brick photo keeps its courses (backend/solid/harmonic.py) unless --no-periodic; a job file's
     `periodic = false` gives the volume `--no-periodic` writes."""
-    from backend.solid.model import SolidTextureModel
-    from export.images import read_rgb
+    from omninoise.backend.solid.model import SolidTextureModel
+    from omninoise.export.images import read_rgb
 
     photo = os.path.join(os.path.dirname(TINY), "..", "..", "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
     on, off = str(tmp_path / "on.npy"), str(tmp_path / "off.npy")
@@ -199,7 +199,7 @@ def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path
 def test_the_gaussian_rest_is_said_and_can_be_left_out(models, tmp_path, capsys):
     """A held-out rock face the decoder draws too coarse gets its Gaussian rest (backend/solid/spectral.py), and
     the command says so; --no-gaussian and a job file's `gaussian = false` leave it out alike."""
-    from backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.model import SolidTextureModel
 
     photo = os.path.join(os.path.dirname(TINY), "..", "..", "data", "photos", "val", "rock__rock_grey.jpg")
     rc = main(["solid", "--model", models["space3"], "--exemplar", photo, "--size", "8", "-o", str(tmp_path / "x.npy")])

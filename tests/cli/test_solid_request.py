@@ -5,11 +5,11 @@ import os
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.solid.request import SolidRequest
-from backend.sources import solid_request_from_dict
-from cli.main import build_parser, solid_request
-from export import read_rgb
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.sources import solid_request_from_dict
+from omninoise.cli.main import build_parser, solid_request
+from omninoise.export import read_rgb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")

@@ -8,12 +8,12 @@ import shutil
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.solid.request import SolidRequest
-from backend.solid.spectral_solid import PX_PER_UNIT
-from backend.sources import solid_request_from_dict
-from cli.main import build_parser, main, solid_request
-from export import read_rgb
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.solid.spectral_solid import PX_PER_UNIT
+from omninoise.backend.sources import solid_request_from_dict
+from omninoise.cli.main import build_parser, main, solid_request
+from omninoise.export import read_rgb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg")
@@ -22,7 +22,7 @@ PHOTO = os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg")
 @pytest.fixture(autouse=True)
 def small_tiles(monkeypatch):
     """Tiles of a 32 px period (64^3 voxels) instead of the product's 128: the same code, a fiftieth of the work."""
-    from backend.solid import spectral_solid
+    from omninoise.backend.solid import spectral_solid
 
     monkeypatch.setattr(spectral_solid, "PERIOD", 32)
 
@@ -70,7 +70,7 @@ def test_a_volume_from_the_command_line_and_from_a_job_file_agree(tmp_path, caps
                  "--seed", "1", "-o", cli_out]) == 0
     vol = np.load(cli_out)
     assert vol.shape == (24, 24, 24, 3) and np.isfinite(vol).all()
-    from backend.colour import srgb_to_linear
+    from omninoise.backend.colour import srgb_to_linear
 
     photo = srgb_to_linear(read_rgb(PHOTO)).reshape(-1, 3)
     assert np.abs(vol.reshape(-1, 3).mean(0) - photo.mean(0)).max() < 0.03
@@ -94,7 +94,7 @@ seed = 1
 """)
     assert main(["bake", str(job), "--quiet"]) == 0
     np.testing.assert_allclose(np.load(tmp_path / "job.npy"), vol, atol=2e-5)
-    from backend.jobs import run_job
+    from omninoise.backend.jobs import run_job
 
     job.write_text(job.read_text().replace('output = "job.npy"', 'output = "job.vdb"'))   # .npy carry no key
     assert [o.status for o in run_job(str(job))] == ["baked"]
@@ -106,14 +106,14 @@ def test_an_image_and_one_line_errors(tmp_path, capsys):
     out = str(tmp_path / "a.npy")
     assert main(["solid", "--quiet", "--method", "spectral", "--exemplar", PHOTO, "--size", "64", "--scale", "2",
                  "-o", out]) == 0
-    from backend.colour import srgb_to_linear
-    from backend.solid.model import slice_points
+    from omninoise.backend.colour import srgb_to_linear
+    from omninoise.backend.solid.model import slice_points
 
     req = SolidRequest(exemplar=PHOTO, method="spectral").check()
     front = req.spectral_field().evaluate(slice_points(64, 2 * PX_PER_UNIT, "y")).reshape(64, 64, 3)
     np.testing.assert_allclose(np.load(out), srgb_to_linear(front), atol=1e-5)
     small = str(tmp_path / "small.png")
-    from export.images import write_png
+    from omninoise.export.images import write_png
 
     write_png(small, np.zeros((20, 30, 3), np.uint8))
     for args, msg in ((["--exemplar", small], "--exemplar: the photo is 30 x 20 px"),

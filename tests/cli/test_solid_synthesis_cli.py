@@ -6,13 +6,13 @@ import os
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.solid.request import SolidRequest
-from backend.solid.synthesis import PX_PER_UNIT
-from backend.sources import solid_request_from_dict
-from cli.main import build_parser, main, solid_request
-from export import read_rgb
-from export.images import write_png
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.solid.synthesis import PX_PER_UNIT
+from omninoise.backend.sources import solid_request_from_dict
+from omninoise.cli.main import build_parser, main, solid_request
+from omninoise.export import read_rgb
+from omninoise.export.images import write_png
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "brick__beige_bricks.jpg")
@@ -71,7 +71,7 @@ def test_command_line_writes_the_tile_seamlessly_repeated(stripes, tmp_path, cap
     out = str(tmp_path / "t.npy")
     assert main(["solid", "--quiet", "--method", "synthesis", "--exemplar", stripes, "--tile", "64", "--size", "128",
                  "--seed", "2", "-o", out]) == 0
-    from backend.colour import srgb_to_linear
+    from omninoise.backend.colour import srgb_to_linear
 
     img = np.load(out)      # linear
     tile = SolidRequest(exemplar=stripes, method="synthesis", tile=64, seed=2).synthesis_field().tile
@@ -139,7 +139,7 @@ seed = 1
 def test_a_job_file_png_is_redone_only_when_the_synthesis_changes(stripes, tmp_path):
     import shutil
 
-    from backend.jobs import run_job
+    from omninoise.backend.jobs import run_job
 
     shutil.copy(stripes, tmp_path / "stripes.png")
     job = tmp_path / "job.toml"
@@ -166,9 +166,9 @@ def test_the_bake_key_records_the_levels_the_photo_was_drawn_with(monkeypatch):
     """The levels depend on the photo (image_levels): the field keeps the settings it was synthesised with and a job
     file's source writes them into its bake key, so a bake is redone when they change.  The photo file is decoded
     once, and its key is the request's."""
-    from backend._export import export
-    from backend.solid.synthesis import image_settings
-    from backend.sources import SynthesisSource
+    from omninoise import export
+    from omninoise.backend.solid.synthesis import image_settings
+    from omninoise.backend.sources import SynthesisSource
 
     req = SolidRequest(exemplar=PHOTO, method="synthesis", tile=256, seed=2).check()
     decoded, read = [], export.read_rgb

@@ -5,17 +5,17 @@ import tracemalloc
 import numpy as np
 import pytest
 
-import backend.bake as bake_mod
-from backend import WaveSettings, compile_noise, evaluate_points
-from backend.bake import BakeSpec, Cancelled, frame_path, run_bake
-from backend.errors import SettingError
-from backend.grid import evaluate_box
-from backend.sources import BoxGrid, WaveSource
-from backend.wavenoise.spectra import Spectrum
-from backend.transfer import preset
-from export import read_metadata, read_volume
-from export.images import read_image
-from export.vdb import openvdb_module
+import omninoise.backend.bake as bake_mod
+from omninoise.backend import WaveSettings, compile_noise, evaluate_points
+from omninoise.backend.bake import BakeSpec, Cancelled, frame_path, run_bake
+from omninoise.backend.errors import SettingError
+from omninoise.backend.grid import evaluate_box
+from omninoise.backend.sources import BoxGrid, WaveSource
+from omninoise.backend.wavenoise.spectra import Spectrum
+from omninoise.backend.transfer import preset
+from omninoise.export import read_metadata, read_volume
+from omninoise.export.images import read_image
+from omninoise.export.vdb import openvdb_module
 
 S3 = WaveSettings(dim=3, spectrum=Spectrum("fractal", 1.0, 6.0), seed=11)
 
@@ -196,7 +196,8 @@ def test_cancel_leaves_earlier_result_untouched(tmp_path, monkeypatch, ext):
 
 
 def test_failed_write_leaves_no_partial_file(tmp_path, monkeypatch):
-    import export.vdb
+    import omninoise.export.vdb
+    from omninoise import export
 
     out = str(tmp_path / "f.vdb")
 

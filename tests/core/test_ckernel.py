@@ -6,8 +6,8 @@ import sys
 import numpy as np
 import pytest
 
-from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
-from backend.wavenoise import ckernel, fast
+from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
+from omninoise.backend.wavenoise import ckernel, fast
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 HAS_CC = any(shutil.which(c) for c in (os.environ.get("CC") or "cc", "gcc", "clang"))

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from cli.main import main
-from export.images import MAX_PIXELS, ImageError, decode, read_image, read_rgb
+from omninoise.cli.main import main
+from omninoise.export.images import MAX_PIXELS, ImageError, decode, read_image, read_rgb
 
 
 def _png16(path, a):

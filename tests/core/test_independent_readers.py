@@ -13,7 +13,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from cli.main import main
+from omninoise.cli.main import main
 
 SYSTEM_PY = "/usr/bin/python3"
 WAVE = ["wave", "--fmin", "1", "--fmax", "4", "--seed", "6", "--extent", "3", "--quiet"]

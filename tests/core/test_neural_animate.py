@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.neural.animate import even_keys, frame_latent, frame_weight, parse_keys
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural.animate import even_keys, frame_latent, frame_weight, parse_keys
 
 
 def test_even_keys_spread_the_classes_over_the_frames():

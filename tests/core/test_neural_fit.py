@@ -6,16 +6,16 @@ import shutil
 import numpy as np
 import pytest
 
-from cli.main import main
-from backend.errors import SettingError
-from backend.grid import Cancelled
-from backend.neural import conditioning as C
-from backend.neural.fit import (bank_nearest, describe, distance, fit, fitted_conditioning, load_bank,
+from omninoise.cli.main import main
+from omninoise.backend.errors import SettingError
+from omninoise.backend.grid import Cancelled
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.fit import (bank_nearest, describe, distance, fit, fitted_conditioning, load_bank,
                                 prepare_target)
-from backend.neural.generate import generate
-from backend.neural.model import NeuralNoiseModel
-from backend.onnx_models import ModelError
-from backend.paths import fit_bank, neural_model
+from omninoise.backend.neural.generate import generate
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.onnx_models import ModelError
+from omninoise.backend.paths import fit_bank, neural_model
 
 
 @pytest.fixture(scope="module")

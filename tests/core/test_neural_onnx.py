@@ -6,12 +6,12 @@ import os
 import numpy as np
 import pytest
 
-from cli.main import main
-from backend.errors import SettingError
-from backend.neural import conditioning as C
-from backend.neural.generate import generate
-from backend.neural.model import NeuralNoiseModel
-from backend.neural.sampler import ddim_sample, initial_noise
+from omninoise.cli.main import main
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.generate import generate
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.neural.sampler import ddim_sample, initial_noise
 
 TINY_MODEL = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_neural")
 
@@ -145,7 +145,7 @@ def test_neural_cli(tiny, tmp_path, capsys):
     assert np.load(tmp_path / "t.npy").shape == (32, 32)
     mask = np.zeros((32, 32), np.uint8)
     mask[:, 16:] = 255
-    from export.images import write_png
+    from omninoise.export.images import write_png
 
     write_png(str(tmp_path / "m.png"), mask)
     assert main(base + ["--noise", "spots", "--noise2", "perlin", "--param2", "scale=10", "--blend",
@@ -191,10 +191,10 @@ def test_neural_cli(tiny, tmp_path, capsys):
 
 def test_neural_bake_source_in_jobs(tiny, tmp_path):
     """kind = "neural" in a job file: a mask blend baked to PNG/npy, equal to generate() on the same grid."""
-    from backend.bake import BakeSpec, Cancelled, run_bake
-    from backend.jobs import run_job
-    from backend.sources import BoxGrid, NeuralSource
-    from export.images import write_png
+    from omninoise.backend.bake import BakeSpec, Cancelled, run_bake
+    from omninoise.backend.jobs import run_job
+    from omninoise.backend.sources import BoxGrid, NeuralSource
+    from omninoise.export.images import write_png
 
     out = tiny
     mask = np.zeros((24, 40), np.uint8)
@@ -241,7 +241,7 @@ sampler = "ddim"
 
 def test_the_shipped_model_loads_and_generates():
     """models/neural_noise: the committed ONNX passes its hash check and samples every trained class."""
-    from backend.paths import neural_model
+    from omninoise.backend.paths import neural_model
 
     assert neural_model() == os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "models",
                                           "neural_noise")  # the repository's own models
@@ -269,7 +269,7 @@ def test_an_export_with_one_tile_input_denoiser_still_loads(tiny):
 
 def test_animation_hits_its_keyframes_and_moves_smoothly_between_them(tiny, tmp_path):
     """Issue 26: frames at keyframes equal plain generation; frames between move in small, even steps."""
-    from backend.neural.animate import animate, frame_cond, frame_latent, parse_keys, temporal_coherence
+    from omninoise.backend.neural.animate import animate, frame_cond, frame_latent, parse_keys, temporal_coherence
     import tomllib
 
     out = tiny
@@ -336,7 +336,7 @@ def test_animation_cli_writes_numbered_frames_and_refuses_bad_input(tiny, tmp_pa
 def test_animation_in_a_job_file_equals_the_cli_frames(tiny, tmp_path):
     """A job with keys and frames bakes the same frames as `neural --keys --frames` (the job's time is the
     frame number); the keys enter the bake key, and blend with keys is refused."""
-    from backend.jobs import load_job, run_job
+    from omninoise.backend.jobs import load_job, run_job
 
     out = tiny
     (tmp_path / "keys.toml").write_text(KEYS)
@@ -367,8 +367,8 @@ steps = 2
     job.write_text(inline)
     (spec,) = [s for _, s in load_job(str(job))]
     assert spec.source.animated and spec.time == 1.0 and spec.time_step == 1.0
-    from backend.sources import describe
-    from export.images import write_png
+    from omninoise.backend.sources import describe
+    from omninoise.export.images import write_png
 
     assert '"spots"' in describe(spec.source) and '"latent":"slerp"' in describe(spec.source)  # in the bake key
     write_png(str(tmp_path / "mask.png"), np.zeros((16, 16), np.uint8))

@@ -11,11 +11,11 @@ computed by this implementation after the convergence tests below established th
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.neural.generate import check_sampler
-from backend.neural.sampler import (DEFAULT_SAMPLER, DEFAULT_STEPS, SAMPLERS, ddim_sample, evaluations,
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural.generate import check_sampler
+from omninoise.backend.neural.sampler import (DEFAULT_SAMPLER, DEFAULT_STEPS, SAMPLERS, ddim_sample, evaluations,
                                     initial_noise, sample, step_noise_rng)
-from backend.neural.schedule import (TRUNCATED_LAMBDA, alphas_from_config, cosine_alphas_cumprod, ddim_timesteps,
+from omninoise.backend.neural.schedule import (TRUNCATED_LAMBDA, alphas_from_config, cosine_alphas_cumprod, ddim_timesteps,
                                      timesteps)
 
 AB = cosine_alphas_cumprod(1000)
@@ -166,7 +166,7 @@ def test_sampler_settings_are_checked_in_one_place():
 
 
 def test_dpmpp_2m_sde_eta_zero_is_the_ode_solver_and_eta_one_samples_the_data_distribution():
-    from backend.neural.sampler import dpmpp_2m_sample
+    from omninoise.backend.neural.sampler import dpmpp_2m_sample
 
     ode = dpmpp_2m_sample(gaussian_eps, XT, None, 10, clip=False, spacing="truncated")
     np.testing.assert_array_equal(ode, dpmpp_2m_sample(gaussian_eps, XT, None, 10, clip=False, spacing="truncated",
@@ -196,8 +196,8 @@ def test_dpmpp_2m_sde_eta_zero_is_the_ode_solver_and_eta_one_samples_the_data_di
 
 
 def test_requests_name_the_step_noise_they_are_made_with():
-    from backend.neural.request import NeuralRequest
-    from backend.neural.sampler import DEFAULT_ETA
+    from omninoise.backend.neural.request import NeuralRequest
+    from omninoise.backend.neural.sampler import DEFAULT_ETA
 
     assert DEFAULT_ETA == {"ddim": 0.0, "dpmpp_2m": 0.3, "heun": 0.0} and set(DEFAULT_ETA) == set(SAMPLERS)
     r = NeuralRequest("uniform", [("perlin", {})], 16, 16)

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from backend.neural.generate import AUTO_TILE, AUTO_WHOLE, auto_tile
-from backend.neural.tiles import feather, plan
+from omninoise.backend.neural.generate import AUTO_TILE, AUTO_WHOLE, auto_tile
+from omninoise.backend.neural.tiles import feather, plan
 
 
 @pytest.mark.parametrize("H,W,tile,overlap,wrap", [(2048, 2048, 512, 64, False), (1000, 376, 256, 32, False),

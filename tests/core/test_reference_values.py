@@ -37,7 +37,7 @@ def test_wave_variants_match_their_stored_values(variant):
 
 def test_every_zoo_class_matches_its_stored_image():
     pytest.importorskip("torch")
-    from training import zoo
+    from omninoise.training import zoo
 
     want = stored("zoo.json")
     assert list(want) == list(zoo.CLASS_NAMES), "classes were added or renamed: rerun tools/make_reference.py"
@@ -61,7 +61,8 @@ def test_shipped_models_match_their_stored_first_outputs(key):
 
 def test_the_reference_catches_a_changed_output(monkeypatch):
     """The instrument itself: a wave engine whose output moves by 1e-4 fails the comparison."""
-    import backend.grid
+    import omninoise.backend.grid
+    from omninoise import backend
 
     real = backend.grid.evaluate_points
     monkeypatch.setattr(backend.grid, "evaluate_points", lambda *a, **k: real(*a, **k) + np.float32(1e-4))

@@ -8,11 +8,11 @@ z=k). So `.npy`, `.exr` (float and half), `.png` and `.vdb` of the same settings
 import numpy as np
 import pytest
 
-from backend import WaveSettings, compile_noise
-from cli.main import build_parser, main, settings_from_args
-from backend.grid import evaluate_grid
-from export import read_volume
-from export.images import read_image
+from omninoise.backend import WaveSettings, compile_noise
+from omninoise.cli.main import build_parser, main, settings_from_args
+from omninoise.backend.grid import evaluate_grid
+from omninoise.export import read_volume
+from omninoise.export.images import read_image
 from conftest import needs_openvdb
 
 ARGS = ["wave", "--directions", "8", "--fmin", "2", "--fmax", "6", "--seed", "4", "--extent", "2", "--quiet"]

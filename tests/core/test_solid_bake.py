@@ -4,12 +4,12 @@ import os
 import numpy as np
 import pytest
 
-from backend.bake import BakeSpec, run_bake
-from backend.errors import SettingError
-from backend.jobs import run_job
-from backend.solid.bake import srgb_to_linear
-from backend.solid.model import SolidTextureModel
-from backend.sources import BoxGrid, SolidSource, source_from_dict
+from omninoise.backend.bake import BakeSpec, run_bake
+from omninoise.backend.errors import SettingError
+from omninoise.backend.jobs import run_job
+from omninoise.backend.solid.bake import srgb_to_linear
+from omninoise.backend.solid.model import SolidTextureModel
+from omninoise.backend.sources import BoxGrid, SolidSource, source_from_dict
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 GRAVEL = os.path.join(ROOT, "models", "solid", "gravel_3d")
@@ -31,7 +31,7 @@ def _ref(grid: BoxGrid, seed=0, scale=1.0):
 
 
 def test_vdb_npy_exr_png(tmp_path):
-    from export.vdb import read_volume
+    from omninoise.export.vdb import read_volume
     grid = BoxGrid((10, 8, 6), ((-1.0, -1.0, -1.0), (1.0, 0.6, 0.2)))
     src = SolidSource(GRAVEL, seed=2, scale=1.5, density=0.7)
     ref = _ref(grid, 2, 1.5)
@@ -47,14 +47,14 @@ def test_vdb_npy_exr_png(tmp_path):
         rgb = np.asarray(f.channels()["RGB"].pixels)
     np.testing.assert_allclose(rgb[::-1], _ref(img, 2, 1.5), atol=1e-6)   # file rows top-down
     run_bake(BakeSpec("p", src, img, str(tmp_path / "a.png")))
-    from export.images import read_rgb
+    from omninoise.export.images import read_rgb
     png = read_rgb(str(tmp_path / "a.png"))
-    from export.images import encode_srgb8
+    from omninoise.export.images import encode_srgb8
     np.testing.assert_array_equal((png * 255).round().astype(np.uint8), encode_srgb8(_ref(img, 2, 1.5)[::-1]))
 
 
 def test_slabs_change_nothing(tmp_path, monkeypatch):
-    import backend.bake as B
+    import omninoise.backend.bake as B
     grid = BoxGrid((8, 8, 12))
     src = SolidSource(GRAVEL)
     run_bake(BakeSpec("a", src, grid, str(tmp_path / "a.npy")))
@@ -95,7 +95,7 @@ def test_bad_sources(tmp_path, source, msg):
 
 
 def test_transfer_is_refused(tmp_path):
-    from backend.transfer import preset
+    from omninoise.backend.transfer import preset
     spec = BakeSpec("t", SolidSource(GRAVEL), BoxGrid((4, 4, 4)), str(tmp_path / "t.vdb"), preset("clouds"))
     with pytest.raises(SettingError, match="has its own colours"):
         run_bake(spec)
@@ -103,7 +103,7 @@ def test_transfer_is_refused(tmp_path):
 
 def test_evaluate_reports_fractions_and_cancels_between_chunks():
     """The core's one progress contract: ``progress(fraction)``, rising to 1.0; cancel stops before the next chunk."""
-    from backend.grid import Cancelled
+    from omninoise.backend.grid import Cancelled
 
     m = SolidTextureModel(GRAVEL)
     pts = np.random.default_rng(1).uniform(-2, 2, (1000, 3))

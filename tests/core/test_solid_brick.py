@@ -3,7 +3,7 @@ them, one value per brick, the stagger, stored references and the torch twin aga
 import numpy as np
 import pytest
 
-from backend.solid import brick as Bk
+from omninoise.backend.solid import brick as Bk
 
 REF_POINTS = np.array([[0.25, -1.5, 3.75], [1000.125, -2000.5, 0.0], [-0.5, 0.5, -0.5]])
 REF_T = np.stack([np.eye(3) * 0.5, np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]]), np.eye(3)]).astype(np.float32)

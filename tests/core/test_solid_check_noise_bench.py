@@ -8,8 +8,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 
 def test_check_planes_are_x_y_and_z_cuts_per_seed_through_their_own_points():
-    from backend.solid import spectral
-    from training.solid.photo_eval import SLICE_OFFSETS
+    from omninoise.backend.solid import spectral
+    from omninoise.training.solid.photo_eval import SLICE_OFFSETS
 
     planes = spectral.check_planes((6, 9))
     assert [(s, a) for s, a, _ in planes] == [(6, "x"), (6, "y"), (6, "z"), (9, "x"), (9, "y"), (9, "z")]
@@ -21,7 +21,7 @@ def test_check_planes_are_x_y_and_z_cuts_per_seed_through_their_own_points():
 
 
 def test_bench_chooses_twice_per_photo(bench_script, tmp_path, capsys):
-    from backend.solid.spectral import KINDS, MIXES
+    from omninoise.backend.solid.spectral import KINDS, MIXES
 
     out = tmp_path / "noise.json"
     assert bench_script("solid_check_noise").main(["--limit", "1", "--seeds", "1", "-o", str(out)]) == 0

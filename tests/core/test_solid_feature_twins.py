@@ -2,16 +2,16 @@
 import numpy as np
 import pytest
 
-from backend.solid import brick, cellular
+from omninoise.backend.solid import brick, cellular
 
 
 @pytest.mark.parametrize("D", [2, 3])
 @pytest.mark.parametrize("family", ["cellular", "brick"])
 def test_torch_twin_matches_runtime(family, D):
     torch = pytest.importorskip("torch")
-    from training.solid.brick import brick_features
-    from training.solid.cellular import cellular_features
-    from training.solid.lattice import octave_seeds
+    from omninoise.training.solid.brick import brick_features
+    from omninoise.training.solid.cellular import cellular_features
+    from omninoise.training.solid.lattice import octave_seeds
     twin, runtime = {"cellular": (cellular_features, cellular.cellular_features),
                      "brick": (brick_features, brick.brick_features)}[family]
     rng = np.random.default_rng(5)

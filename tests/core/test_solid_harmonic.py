@@ -6,8 +6,8 @@ import re
 import numpy as np
 import pytest
 
-from backend.solid.harmonic import COUNT, Harmonics, harmonic_field, mix_harmonics, photo_harmonics, seed_shift
-from backend.solid.model import SolidTextureModel, plane_points
+from omninoise.backend.solid.harmonic import COUNT, Harmonics, harmonic_field, mix_harmonics, photo_harmonics, seed_shift
+from omninoise.backend.solid.model import SolidTextureModel, plane_points
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SPACE = os.path.join(ROOT, "models", "solid", "space")
@@ -153,7 +153,7 @@ def space():
 
 
 def test_an_encoded_brick_photo_gets_its_courses_in_place(space):
-    from export import read_rgb
+    from omninoise.export import read_rgb
 
     photo = read_rgb(BRICK)
     z, h = space.encode(photo), space.harmonics(photo)
@@ -173,7 +173,7 @@ def test_an_encoded_brick_photo_gets_its_courses_in_place(space):
 
 
 def test_an_aperiodic_photo_is_left_as_the_decoder_draws_it(space):
-    from export import read_rgb
+    from omninoise.export import read_rgb
 
     photo = read_rgb(os.path.join(ROOT, "data", "photos", "val", "rock__cliff_rocky.jpg"))
     h = space.harmonics(photo)
@@ -182,7 +182,7 @@ def test_an_aperiodic_photo_is_left_as_the_decoder_draws_it(space):
 
 def test_a_large_photo_is_measured_small_at_the_same_scale(space):
     """A photo over HARMONIC_SIDE px is resized before its FFT; its waves keep their frequency in texture units."""
-    from backend.solid.model import HARMONIC_SIDE
+    from omninoise.backend.solid.model import HARMONIC_SIDE
 
     img = np.tile(brick_photo(), (9, 9, 1))[: HARMONIC_SIDE + 128, : HARMONIC_SIDE + 128]   # 1152 px, period 16 / 32 px
     h = space.harmonics(img)
@@ -194,7 +194,7 @@ def test_a_large_photo_is_measured_small_at_the_same_scale(space):
 def test_a_large_photo_is_encoded_from_a_bounded_grid_of_crops_in_batches(space, monkeypatch):
     """A 4096 px photo once went to the encoder as 3969 crops in one batch (16 GB, 29 s); now at most
     ENCODE_SIDE^2 crops spread over it, ENCODE_BATCH at a time, and a small photo keeps every crop."""
-    import backend.solid.model as model_mod
+    import omninoise.backend.solid.model as model_mod
 
     enc = space._session("encoder.onnx")
     seen = []
@@ -224,7 +224,7 @@ def test_a_large_photo_is_encoded_from_a_bounded_grid_of_crops_in_batches(space,
 
 
 def test_stored_harmonics_round_trip_and_bad_ones_are_named():
-    from backend.solid.harmonic import from_json, to_json
+    from omninoise.backend.solid.harmonic import from_json, to_json
 
     h = photo_harmonics(brick_photo(), PPU)
     back = from_json(json_round_trip(to_json(h)))
@@ -243,14 +243,14 @@ def json_round_trip(d):
 
 
 def test_a_single_photo_model_stores_its_harmonic_part(tmp_path):
-    """brick_3d ships with the harmonic part of its photo's training region (python -m training.solid.harmonics);
+    """brick_3d ships with the harmonic part of its photo's training region (python -m omninoise.training.solid.harmonics);
     its default code carries it, and the texture differs from the same weights without it; a model that cannot
     store one is refused by name."""
     import json
     import shutil
     from dataclasses import replace
 
-    from backend.onnx_models import ModelError
+    from omninoise.backend.onnx_models import ModelError
 
     m = SolidTextureModel(os.path.join(ROOT, "models", "solid", "brick_3d"))
     code = m.default_code()
@@ -258,7 +258,7 @@ def test_a_single_photo_model_stores_its_harmonic_part(tmp_path):
     with_h, without = m.image(64, code, 0), m.image(64, replace(code, harmonics=None), 0)
     assert np.abs(with_h - without).mean() > 0.02
     # the courses: the spectrum of the front view's row means follows the photo's (its training region)
-    from export import read_rgb
+    from omninoise.export import read_rgb
 
     photo = read_rgb(os.path.join(ROOT, m.config["exemplars"][0]))[:192, :192]
 
@@ -296,8 +296,8 @@ def on_block_grid(h, H, W):
 def test_jpeg_blocks_draw_no_grid_but_a_period_keeps_its_harmonics(monkeypatch):
     """A held-out photo whose only isolated peaks are its JPEG blocks' (multiples of 1/8 cycle per pixel) gets no
     harmonic part; compressed bricks keep the harmonics of their courses and joints on that lattice."""
-    import backend.solid.harmonic as hm
-    from export import read_rgb
+    import omninoise.backend.solid.harmonic as hm
+    from omninoise.export import read_rgb
 
     blocky = read_rgb(os.path.join(ROOT, "data", "photos", "val", "sand__desert_city_tile.jpg"))
     with monkeypatch.context() as m:
@@ -312,7 +312,7 @@ def test_jpeg_blocks_draw_no_grid_but_a_period_keeps_its_harmonics(monkeypatch):
 def test_bake_keys_know_the_harmonic_part(space):
     """A bake is up to date only for the same harmonic part: an encoded photo with and without it, and a single
     model that stores one, give keys that say so."""
-    from backend.sources import SolidSource
+    from omninoise.backend.sources import SolidSource
 
     on = SolidSource(space, exemplar=BRICK).to_dict()
     off = SolidSource(space, exemplar=BRICK, periodic=False).to_dict()
@@ -341,8 +341,8 @@ def test_the_price_of_the_jpeg_rule_stripes_exactly_8_px_apart():
 def test_refinement_renders_with_the_harmonic_part(space):
     """--refine searches the code as the texture will be drawn: with the photo's harmonic part, never worse than
     the encoder's code, and the part stays as measured."""
-    from backend.solid.refine import refine_code, texture_code
-    from export import read_rgb
+    from omninoise.backend.solid.refine import refine_code, texture_code
+    from omninoise.export import read_rgb
 
     photo = read_rgb(BRICK)
     z, h = space.encode(photo), space.harmonics(photo)
@@ -357,7 +357,7 @@ def test_the_rest_of_a_photo_keeps_no_period():
     """remove_harmonics: the photo less its part, at its pixel centres; what is left keeps under 5 % of the power
     of every peak the part took, its mean is the photo's, and a photo without a part comes back as it was (clipped
     to [0, 1])."""
-    from backend.solid.harmonic import remove_harmonics
+    from omninoise.backend.solid.harmonic import remove_harmonics
 
     img = brick_photo()
     h = photo_harmonics(img, PPU)
@@ -387,9 +387,9 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
     import shutil
     from dataclasses import replace
 
-    from backend.onnx_models import ModelError
-    from backend.solid.harmonic import remove_harmonics
-    from export import read_rgb
+    from omninoise.backend.onnx_models import ModelError
+    from omninoise.backend.solid.harmonic import remove_harmonics
+    from omninoise.export import read_rgb
 
     shutil.copytree(SPACE, tmp_path / "rest")
     doc = json.loads((tmp_path / "rest" / "solid.json").read_text())
@@ -426,7 +426,7 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
 def test_the_field_in_blocks_is_the_field_at_once(monkeypatch):
     """harmonic_field works through the points in blocks of FIELD_BLOCK / K (flat memory for 256 waves); any block
     size gives the same numbers, to the bit."""
-    import backend.solid.harmonic as hm
+    import omninoise.backend.solid.harmonic as hm
 
     h = photo_harmonics(brick_photo(), PPU)
     pts = np.random.default_rng(5).uniform(-40, 40, (1000, 3))
@@ -440,7 +440,7 @@ def test_a_period_between_bins_brings_its_main_lobe():
     """Rows 128 / 5.5 px apart fall between two bins of a 128 px photo: the peak's bin alone holds under 40 % of
     the photo's variance and its removal leaves most of the rows; with its main lobe (LOBE) the part holds over
     half, and its removal leaves under 55 % of the rows' spread."""
-    from backend.solid.harmonic import LOBE, remove_harmonics
+    from omninoise.backend.solid.harmonic import LOBE, remove_harmonics
 
     rng = np.random.default_rng(2)
     r = np.arange(128)[:, None, None]
@@ -483,9 +483,9 @@ def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
     import json
     import shutil
 
-    from backend.onnx_models import ModelError
-    from backend.solid.refine import texture_code
-    from export import read_rgb
+    from omninoise.backend.onnx_models import ModelError
+    from omninoise.backend.solid.refine import texture_code
+    from omninoise.export import read_rgb
 
     photo = read_rgb(os.path.join(ROOT, "data", "photos", "train", "metal__metal_plates.jpg"))
     # with its Gaussian rest (backend/solid/spectral.py), stored to ten and six digits

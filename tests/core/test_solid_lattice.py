@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from backend.solid import lattice as L
+from omninoise.backend.solid import lattice as L
 
 # Reference samples (as opensimplex keeps): the hash and blend are part of every trained
 # model, so a change here would silently break the shipped solid textures.
@@ -83,7 +83,7 @@ def test_bad_shapes_raise():
 @pytest.mark.parametrize("D", [2, 3])
 def test_torch_twin_matches_runtime(D):
     torch = pytest.importorskip("torch")
-    from training.solid.lattice import lattice_noise, octave_seeds
+    from omninoise.training.solid.lattice import lattice_noise, octave_seeds
     rng = np.random.default_rng(5)
     x = rng.uniform(-2, 2, (2, 2000, D)).astype(np.float32)
     T = rng.normal(size=(8, D, D)).astype(np.float32)

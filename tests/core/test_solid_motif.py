@@ -4,9 +4,9 @@ import os
 
 import numpy as np
 
-from backend.solid.harmonic import harmonic_field, photo_harmonics
-from backend.solid.model import plane_points
-from backend.solid.motif import (MIN_CELLS, MIN_PEAKS, fit_lattice, lattice_points, motif_waves, on_grid,
+from omninoise.backend.solid.harmonic import harmonic_field, photo_harmonics
+from omninoise.backend.solid.model import plane_points
+from omninoise.backend.solid.motif import (MIN_CELLS, MIN_PEAKS, fit_lattice, lattice_points, motif_waves, on_grid,
                                  refine_peaks, windowed_dtft, windowed_magnitude)
 from tests.core.test_solid_harmonic import brick_photo, waves_photo
 
@@ -134,7 +134,7 @@ def test_a_photographed_brick_wall_repeats_by_its_own_lattice():
     """The held-out red brick photo cropped to 224 x 232 px (its courses and bricks no longer divide the frame):
     the harmonic part holds more of the photo's variance than the bins did (0.89 against 0.71 when measured), and
     its waves lie on one lattice, so its field repeats exactly by the lattice's translations."""
-    from export import read_rgb
+    from omninoise.export import read_rgb
 
     img = read_rgb(BRICK)[8:232, 8:240]
     H, W = img.shape[:2]

@@ -2,10 +2,10 @@
 and a harmonic part that keeps the head joints of a tile holding two courses of two bricks."""
 import numpy as np
 
-from backend.solid.harmonic import harmonic_field, photo_harmonics
-from backend.solid.model import plane_points
-from backend.solid.motif import on_grid
-from backend.solid.periods import autocorrelation, frame_lines, period_lattice, translations
+from omninoise.backend.solid.harmonic import harmonic_field, photo_harmonics
+from omninoise.backend.solid.model import plane_points
+from omninoise.backend.solid.motif import on_grid
+from omninoise.backend.solid.periods import autocorrelation, frame_lines, period_lattice, translations
 
 PPU = 128.0
 

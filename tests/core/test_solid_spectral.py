@@ -8,9 +8,9 @@ import os
 import numpy as np
 import pytest
 
-from backend.solid.band_distance import band_distance
-from backend.solid.model import SolidTextureModel, slice_points
-from backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests,
+from omninoise.backend.solid.band_distance import band_distance
+from omninoise.backend.solid.model import SolidTextureModel, slice_points
+from omninoise.backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests,
                                     rest_field, rest_waves)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -75,7 +75,7 @@ def test_cuts_of_the_solid_have_the_photo_s_radial_spectrum_variance_and_colour(
     assert abs((centre * got).sum() / (centre * want).sum() - 1.0) < 0.03
     assert np.abs(got - want).sum() < 0.25
     # without the deprojection the cuts' spectrum slides down (each wave shows at R sin(theta), pi / 4 R on average)
-    import backend.solid.spectral as spectral
+    import omninoise.backend.solid.spectral as spectral
     monkeypatch.setattr(spectral, "deproject", lambda p2, edges: p2)
     flat = spectrum(cuts_of(rest_waves(img, PPU)))
     assert (centre * flat).sum() / (centre * want).sum() < 0.85 and np.abs(flat - want).sum() > 0.35
@@ -170,8 +170,8 @@ def test_a_code_with_a_rest_is_drawn_as_its_layers_say(space):
 def test_an_encoded_rock_photo_gets_a_rest_that_brings_it_closer(space):
     """The product's path on a held-out rock face whose middle scales the decoder does not draw: the check mixes
     the Gaussian rest in, and the texture's cuts come closer to the photo on planes the check did not see."""
-    from backend.solid.refine import texture_code
-    from export import read_rgb
+    from omninoise.backend.solid.refine import texture_code
+    from omninoise.export import read_rgb
 
     path = os.path.join(ROOT, "data", "photos", "val", "rock__rock_grey.jpg")
     photo = read_rgb(path)
@@ -190,7 +190,7 @@ def test_an_encoded_rock_photo_gets_a_rest_that_brings_it_closer(space):
 
 
 def test_bake_keys_know_the_gaussian_rest(space):
-    from backend.sources import SolidSource
+    from omninoise.backend.sources import SolidSource
 
     img = band_photo(256)
     code = space.photo_code(img, gaussian=False)
@@ -213,7 +213,7 @@ def test_tiny_and_flat_photos_encode(space):
 
 
 def test_stored_rests_round_trip_to_six_digits_and_bad_ones_are_named():
-    from backend.solid.spectral import rest_from_json, rest_to_json
+    from omninoise.backend.solid.spectral import rest_from_json, rest_to_json
 
     img = band_photo(seed=5)
     r = RestField(*rest_waves(img, PPU), 0.75)

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from backend.solid import spin as S
-from backend.solid.lattice import octave_seeds
+from omninoise.backend.solid import spin as S
+from omninoise.backend.solid.lattice import octave_seeds
 
 # the rotations are part of every model trained with spun lattices: a change here would silently change them
 REF_3D = np.array([[-0.43438676, -0.7625306, -0.47943214], [-0.8624078, 0.19849654, 0.46567357],
@@ -62,7 +62,7 @@ def test_spun_turns_each_octave():
 def test_turned_octaves_draw_the_field_turned():
     """"octave": the field of octave i at x is the unturned field at Q_i^T x (one octave, a point set and its
     preimage)."""
-    from backend.solid.lattice import lattice_noise
+    from omninoise.backend.solid.lattice import lattice_noise
     rng = np.random.default_rng(2)
     T = rng.normal(size=(1, 3, 3)).astype(np.float32)
     seeds = octave_seeds(5, 1)
@@ -75,8 +75,8 @@ def test_turned_octaves_draw_the_field_turned():
 def test_bake_keys_know_the_spin():
     """A model's spin is part of what it draws: the shipped space model turns its octaves, and a bake's key says so
     (the same weights unturned would draw another texture)."""
-    from backend.solid.model import SolidTextureModel, SHIPPED_MODELS
-    from backend.sources import SolidSource
+    from omninoise.backend.solid.model import SolidTextureModel, SHIPPED_MODELS
+    from omninoise.backend.sources import SolidSource
     import os
 
     space = SolidTextureModel(os.path.join(SHIPPED_MODELS, "space"))

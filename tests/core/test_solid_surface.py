@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from backend.grid import Cancelled
+from omninoise.backend.grid import Cancelled
 
-from backend.solid.surface import dilate, texel_positions
+from omninoise.backend.solid.surface import dilate, texel_positions
 
 
 def _square(z=0.0):

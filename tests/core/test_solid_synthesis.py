@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.grid import Cancelled
-from backend.solid.synthesis import SynthesisSettings, TileField, synthesise
+from omninoise.backend.errors import SettingError
+from omninoise.backend.grid import Cancelled
+from omninoise.backend.solid.synthesis import SynthesisSettings, TileField, synthesise
 
 
 def _stripes(period: float = 8.0, size: int = 64, along: str = "cols", saw: bool = False) -> np.ndarray:
@@ -48,7 +48,7 @@ def test_the_products_2d_settings_keep_stripes_whole(seed):
     """image_settings (what method "synthesis" draws): square and sawtooth stripes of a 128² photo stay vertical
     stripes in a 64 px tile, on every seed.  With sharp weights on every level (k = 10) the coarse pieces settled on
     different phases and most seeds drew offset pieces with horizontal seams (model card, fifteenth session)."""
-    from backend.solid.synthesis import image_settings
+    from omninoise.backend.solid.synthesis import image_settings
 
     x = np.arange(128)
     for profile in ((x % 16 < 8) * 0.6 + 0.2, (x % 20) / 20.0 * 0.8 + 0.1):
@@ -69,7 +69,7 @@ def test_the_products_2d_settings_keep_stripes_whole(seed):
     (256, (7,), 3),              # not an image: synthesise says so
 ])
 def test_the_product_draws_as_many_levels_as_tile_and_photo_allow(tile, shape, levels):
-    from backend.solid.synthesis import COARSE_SHARPNESS, FINE_SHARPNESS, image_levels, image_settings
+    from omninoise.backend.solid.synthesis import COARSE_SHARPNESS, FINE_SHARPNESS, image_levels, image_settings
 
     assert image_levels(tile, shape) == levels
     s = image_settings(tile, shape, seed=5)
@@ -95,7 +95,7 @@ def test_the_products_levels_keep_brick_courses_whole():
     """A 256² brick wall, a 256 px tile: the courses run across the tile, so its row means vary as much as the
     photo's (mortar rows against brick rows).  Drawn with three levels (the product before) the bricks came out as
     offset pieces and the row means' spread was 0.56 to 0.59 of the photo's on four seeds; with four, 0.65 to 0.86."""
-    from backend.solid.synthesis import image_settings
+    from omninoise.backend.solid.synthesis import image_settings
 
     photo = _bricks()
     ref = photo[..., 0].mean(1).std()
@@ -148,8 +148,8 @@ def test_every_voxel_stays_a_mean_of_photo_colours_on_a_small_photo(monkeypatch)
     the photo's colour range.  On a small photo (every neighbourhood searched, exact copies among them) the
     weights at k = 10 fall to 1e-30 and less; dividing by a floor of 1e-12 once turned such voxels black, and the
     histogram matching painted them as flat blotches of the darkest colours."""
-    import backend.solid.synthesis as syn
-    from backend.solid.synthesis import image_settings
+    import omninoise.backend.solid.synthesis as syn
+    from omninoise.backend.solid.synthesis import image_settings
     rng = np.random.default_rng(5)
     v = rng.random((100, 100, 3))
     for _ in range(2):                       # a little spatial correlation, as a photo of gravel has
@@ -167,7 +167,7 @@ def test_every_voxel_stays_a_mean_of_photo_colours_on_a_small_photo(monkeypatch)
 def test_the_search_cuts_out_only_the_neighbourhoods_it_keeps():
     """A large photo's neighbourhoods are subsampled before any is cut out (a 4096² photo's every 8 x 8 one would
     take about 13 GB); each kept row is the photo's neighbourhood at its position, row-major, colours last."""
-    from backend.solid.synthesis import _Searcher
+    from omninoise.backend.solid.synthesis import _Searcher
 
     photo = np.random.default_rng(0).random((40, 50, 3)).astype(np.float32)
     s = _Searcher(photo, 4, 8, 100, np.random.default_rng(1))
@@ -299,7 +299,7 @@ def test_bench_measures_the_spectral_solid_without_the_marginals(bench_script, t
     """--method spectral --no-marginals --flat-start measures the Gaussian tile as drawn (the map onto the photo's
     marginals, which the request draws, left out: tests/core/test_spectral_solid.py compares the two) from flat
     power; the JSON says so, and holds the cuts at random orientations beside the axis cuts."""
-    from backend.solid import spectral_solid
+    from omninoise.backend.solid import spectral_solid
 
     monkeypatch.setattr(spectral_solid, "PERIOD", 32)
     out = str(tmp_path / "plain")
@@ -319,8 +319,8 @@ def test_the_evaluation_cuts_planes_at_any_orientation():
     """The benches' oblique cuts (photo_eval.oblique_points): square to an axis they are the axis cuts' planes (x
     right and y up on a floor, y right and z up on a wall normal to x); at any normal, rows and columns are
     orthonormal in the plane, one photo px apart, the columns horizontal and the rows running down."""
-    from backend.solid.model import slice_points
-    from training.solid import photo_eval as mod
+    from omninoise.backend.solid.model import slice_points
+    from omninoise.training.solid import photo_eval as mod
 
     ppu = 128.0
 

@@ -8,11 +8,11 @@ import os
 import numpy as np
 import pytest
 
-import backend.solid.upright as upright
-from backend.solid.model import SolidTextureModel, slice_points
-from backend.solid.spectral import (COUNT, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests, rest_field,
+import omninoise.backend.solid.upright as upright
+from omninoise.backend.solid.model import SolidTextureModel, slice_points
+from omninoise.backend.solid.spectral import (COUNT, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests, rest_field,
                                     rest_from_json, rest_to_json, rest_waves)
-from backend.solid.upright import UPRIGHT_GATE, candidates, circle_inside, orientation, upright_waves
+from omninoise.backend.solid.upright import UPRIGHT_GATE, candidates, circle_inside, orientation, upright_waves
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PPU = 128.0
@@ -149,8 +149,8 @@ def _flat_layers(img):
 
 def _check_distances(img, offered):
     """The check's band distance of every (kind, t) for a decoder that draws nothing, computed here."""
-    from backend.solid.band_distance import band_distance
-    from backend.solid.spectral import CHECK_PLANES
+    from omninoise.backend.solid.band_distance import band_distance
+    from omninoise.backend.solid.spectral import CHECK_PLANES
     mean = img.mean((0, 1))
     out = {}
     for kind, waves in offered.items():

@@ -5,9 +5,9 @@ periods keep it to seconds."""
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.solid.model import slice_points
-from backend.solid.spectral_solid import (MAX_READ, PX_PER_UNIT, SplineField, bspline_prefilter, slice_spectrum,
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.model import slice_points
+from omninoise.backend.solid.spectral_solid import (MAX_READ, PX_PER_UNIT, SplineField, bspline_prefilter, slice_spectrum,
                                           solid_power, spectral_tile)
 
 
@@ -127,7 +127,7 @@ def test_the_spline_field_reads_a_band_limited_field_between_voxels():
     got = f.evaluate(pts)
     assert np.abs(got - want[:, None]).max() < 0.01
     # trilinear reading of the same voxels is off by far more: the B-spline is what keeps the detail
-    from backend.solid.synthesis import TileField
+    from omninoise.backend.solid.synthesis import TileField
 
     lin = TileField(np.repeat(0.5 + 0.25 * samples[..., None], 3, axis=3).astype(np.float32), vpu).evaluate(pts)
     assert np.abs(lin - want[:, None]).max() > 3 * np.abs(got - want[:, None]).max()
@@ -176,7 +176,7 @@ def test_progress_rises_to_one_and_cancel_stops():
     seen = []
     spectral_tile(photo, period=16, progress=seen.append)
     assert seen == sorted(seen) and seen[-1] == pytest.approx(1.0) and len(seen) > 10
-    from backend.grid import Cancelled
+    from omninoise.backend.grid import Cancelled
 
     calls = []
     with pytest.raises(Cancelled):
@@ -213,7 +213,7 @@ def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest(per
     """A photo of level stripes 16 px apart with a little noise: its harmonic part (measured as the neural texture
     measures it) is taken out before the spectrum is read, so the Gaussian solid carries only the noise, and the
     field adds the part back upright: a wall's rows follow the stripes' period along z, not along y."""
-    from backend.solid.model import measure_harmonics
+    from omninoise.backend.solid.model import measure_harmonics
 
     rng = np.random.default_rng(3)
     r = np.arange(128)[:, None, None]
@@ -231,14 +231,14 @@ def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest(per
     assert wall.mean(0).std() < 0.1 * wall.mean(1).std()            # level: nothing along y
     assert SplineField(rest, (0.5, 0.5, 0.5), harmonics=None).harmonics is None
     # spectral_field reads the rest once and draws the same tile from it (period32: PERIOD is 32 here)
-    from backend.solid.spectral_solid import spectral_field
+    from omninoise.backend.solid.spectral_solid import spectral_field
 
     np.testing.assert_array_equal(spectral_field(photo, 0, h, marginals=False).coeffs, rest)
 
 
 def test_reading_the_field_reports_progress_and_cancels(drawn):
     """SplineField.evaluate, which bakes and the panel read through: progress after each chunk, cancel between."""
-    from backend.grid import Cancelled
+    from omninoise.backend.grid import Cancelled
 
     _, f = drawn
     pts = np.random.default_rng(1).uniform(0, 2, (1000, 3))
@@ -267,7 +267,7 @@ def _skew(a: np.ndarray) -> float:
 
 @pytest.fixture
 def period32(monkeypatch):
-    from backend.solid import spectral_solid
+    from omninoise.backend.solid import spectral_solid
 
     monkeypatch.setattr(spectral_solid, "PERIOD", 32)
 
@@ -282,7 +282,7 @@ def test_the_marginals_follow_a_skewed_photo(period32):
     """Slices of the spectral field of a photo with bright specks on a dark ground keep its skewed values (the map
     onto its marginals), where the Gaussian tile alone is symmetric; the spread stays the tile's own, the mean the
     photo's, and the map is monotone along each axis."""
-    from backend.solid.spectral_solid import spectral_field
+    from omninoise.backend.solid.spectral_solid import spectral_field
 
     photo = _skewed_photo(128, 4)
     mapped, plain = spectral_field(photo, seed=2), spectral_field(photo, seed=2, marginals=False)
@@ -301,7 +301,7 @@ def test_the_marginals_follow_a_skewed_photo(period32):
 def test_the_marginals_leave_a_gaussian_photo_and_a_grey_photo_as_they_are(period32):
     """A Gaussian photo's marginals are the tile's own: the map moves values by a small share of their spread.  A
     grey photo stays grey (its chroma axes barely vary and keep their values) and finite."""
-    from backend.solid.spectral_solid import spectral_field
+    from omninoise.backend.solid.spectral_solid import spectral_field
 
     photo = _gaussian_photo(128, 6)
     a, b = _slices(spectral_field(photo, seed=1)), _slices(spectral_field(photo, seed=1, marginals=False))

@@ -4,8 +4,8 @@ import json
 import numpy as np
 import pytest
 
-from backend.errors import SettingError
-from backend.transfer import PRESETS, TransferFunction, load_transfer, preset, transfer_from_dict
+from omninoise.backend.errors import SettingError
+from omninoise.backend.transfer import PRESETS, TransferFunction, load_transfer, preset, transfer_from_dict
 
 RAMP = dict(range=[-1.0, 1.0], stops=[[0.0, [0, 0, 0, 0]], [0.5, [1, 0, 0, 0.5]], [1.0, [1, 1, 1, 1]]])
 
@@ -73,7 +73,7 @@ def test_json_round_trip_and_files(tmp_path):
 @pytest.mark.parametrize("name", sorted(PRESETS))
 def test_presets_fill_part_of_a_wave_volume(name):
     """Each preset, on the real output's distribution, leaves empty space and dense space."""
-    from backend import WaveSettings, compile_noise, evaluate_grid
+    from omninoise.backend import WaveSettings, compile_noise, evaluate_grid
 
     v = evaluate_grid(compile_noise(WaveSettings(dim=3, seed=2)), 32, 4.0)
     tf = preset(name)

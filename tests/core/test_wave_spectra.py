@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
-from backend.grid import evaluate_points
+from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
+from omninoise.backend.grid import evaluate_points
 from conftest import radial_psd
 
 E, N = 4.0, 256

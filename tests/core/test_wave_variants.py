@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
-from backend.wavenoise import fast
-from backend.wavenoise.tables import WaveTable, build_table
-from backend.wavenoise.settings import table_rng
+from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
+from omninoise.backend.wavenoise import fast
+from omninoise.backend.wavenoise.tables import WaveTable, build_table
+from omninoise.backend.wavenoise.settings import table_rng
 from conftest import radial_psd
 
 
@@ -121,8 +121,8 @@ def test_fast_path_matches_numpy(dim, speed):
 
 def _grid_reference(noise, size, extent, output, time, origin):
     """The numpy path at the grid's points, reshaped like evaluate_grid's output."""
-    from backend.grid import grid_shape
-    from backend.wavenoise.wave import select_output
+    from omninoise.backend.grid import grid_shape
+    from omninoise.backend.wavenoise.wave import select_output
     shape = grid_shape(noise.dim, size)
     g = np.arange(size, dtype=np.float32) * np.float32(extent / size)
     axes = np.meshgrid(*([g] * len(shape)), indexing="ij")[::-1]  # x fastest
@@ -179,7 +179,7 @@ def test_grid_into_memmap_matches_in_memory(tmp_path):
 
 
 def test_cancel_stops_evaluation():
-    from backend import Cancelled
+    from omninoise.backend import Cancelled
 
     noise = compile_noise(WaveSettings(dim=2, directions=4))
     calls = []

@@ -9,8 +9,8 @@ def exported(tmp_path_factory):
     """A tiny trained run and its export in the default (split) form (read-only for the tests)."""
     pytest.importorskip("torch")
     pytest.importorskip("onnx")
-    from training.export_onnx import export
-    from training.train import TrainConfig, train
+    from omninoise.training.export_onnx import export
+    from omninoise.training.train import TrainConfig, train
 
     run = tmp_path_factory.mktemp("run")
     out = tmp_path_factory.mktemp("model")

@@ -6,10 +6,10 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.solid.conv_fit import FIT_TO, colour, fit, volume_slices  # noqa: E402
-from training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
-from training.solid.model import colour_stats  # noqa: E402
-from training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
+from omninoise.training.solid.conv_fit import FIT_TO, colour, fit, volume_slices  # noqa: E402
+from omninoise.training.solid.conv_generator import ConvGenerator, draw_noise  # noqa: E402
+from omninoise.training.solid.model import colour_stats  # noqa: E402
+from omninoise.training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
 
 
 @pytest.mark.parametrize("dim,grow", [(2, True), (2, False), (3, False)])

@@ -6,14 +6,14 @@ import pytest
 torch = pytest.importorskip("torch")
 pytest.importorskip("onnx")
 
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.model import NeuralNoiseModel  # noqa: E402
-from backend.onnx_models import fingerprint  # noqa: E402
-from training.config import TrainConfig  # noqa: E402
-from training.export_onnx import export  # noqa: E402
-from training.train import build_model, train  # noqa: E402
-from training.unet import UNet, set_circular  # noqa: E402
-from training.warm_start import exported_weights, torch_from_export, warm_start  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
+from omninoise.backend.onnx_models import fingerprint  # noqa: E402
+from omninoise.training.config import TrainConfig  # noqa: E402
+from omninoise.training.export_onnx import export  # noqa: E402
+from omninoise.training.train import build_model, train  # noqa: E402
+from omninoise.training.unet import UNet, set_circular  # noqa: E402
+from omninoise.training.warm_start import exported_weights, torch_from_export, warm_start  # noqa: E402
 from tiny_run import TINY  # noqa: E402  (the shallow export itself: the `exported` fixture of conftest.py)
 
 

@@ -4,7 +4,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.evaluate import frechet, radial_psd, train_classifier  # noqa: E402
+from omninoise.training.evaluate import frechet, radial_psd, train_classifier  # noqa: E402
 
 
 def test_frechet_distance():
@@ -31,7 +31,7 @@ def test_zoo_classifier_learns_distinct_classes():
 
 
 def test_orientation_coherence_tells_bands_from_isotropic_texture():
-    from training.evaluate import orientation_coherence
+    from omninoise.training.evaluate import orientation_coherence
 
     y, x = np.mgrid[0:64, 0:64].astype(np.float64)
     rng = np.random.default_rng(1)
@@ -48,7 +48,7 @@ def test_orientation_coherence_tells_bands_from_isotropic_texture():
 
 
 def test_low_frequency_psd_error_sees_what_the_full_error_averages_away():
-    from training.evaluate import psd_error
+    from omninoise.training.evaluate import psd_error
 
     rng = np.random.default_rng(2)
     y, x = np.mgrid[0:64, 0:64]
@@ -59,7 +59,7 @@ def test_low_frequency_psd_error_sees_what_the_full_error_averages_away():
 
 
 def test_classifier_stages_widen_the_receptive_field():
-    from training.evaluate import Classifier
+    from omninoise.training.evaluate import Classifier
 
     two, three = Classifier(4), Classifier(4, stages=3)
     x = torch.zeros(1, 1, 64, 64, requires_grad=True)
@@ -75,7 +75,7 @@ def test_classifier_stages_widen_the_receptive_field():
 def test_look_tells_spectra_and_histograms_apart_and_finds_the_nearest_class():
     """look(): spectrum shape and value quantiles; nearest_looks ranks a new sample of each kind first,
     a contrast change moves only the histogram term, and identical sets are at distance 0."""
-    from training.evaluate import look, look_distance, look_scales, nearest_looks
+    from omninoise.training.evaluate import look, look_distance, look_scales, nearest_looks
 
     S = 64
     yy, xx = np.mgrid[0:S, 0:S] / S
@@ -119,8 +119,8 @@ def test_periodic_component_solves_moisans_equation_and_removes_the_border_cross
     """u = p + s (Moisan 2011): the discrete periodic Laplacian of s is the boundary image v, s has mean 0; a crop
     of a smooth tiling field, which jumps at its borders, gets its top-band power back down near the field's own,
     and look() then puts the crop beside the whole field (it did not: the crop's border cross looked like grain)."""
-    from backend.periodic import periodic_component
-    from training.evaluate import look, radial_psd
+    from omninoise.backend.periodic import periodic_component
+    from omninoise.training.evaluate import look, radial_psd
 
     r = np.random.default_rng(5)
     S = 256
@@ -154,10 +154,10 @@ def test_periodic_component_solves_moisans_equation_and_removes_the_border_cross
 def test_known_params_keeps_what_the_model_was_trained_with():
     """An export made before fibers gained 'orientation' is evaluated without it (it draws its own); a model
     that has it is told it."""
-    from backend.neural.model import NeuralNoiseModel
-    from backend.paths import neural_model
-    from training import zoo
-    from training.evaluate import known_params
+    from omninoise.backend.neural.model import NeuralNoiseModel
+    from omninoise.backend.paths import neural_model
+    from omninoise.training import zoo
+    from omninoise.training.evaluate import known_params
 
     model = NeuralNoiseModel(neural_model())
     params = zoo.default_params("fibers")
@@ -171,7 +171,7 @@ def test_known_params_keeps_what_the_model_was_trained_with():
 
 def test_cached_classifier_is_keyed_by_the_zoo(tmp_path, monkeypatch):
     """A classifier trained on the zoo before a class changed is another instrument: the cache does not reuse it."""
-    from training import evaluate as E
+    from omninoise.training import evaluate as E
 
     calls = []
     real = E.train_classifier
@@ -192,7 +192,7 @@ def test_cached_classifier_is_keyed_by_the_zoo(tmp_path, monkeypatch):
 
 def test_gradient_direction_of_bands():
     """Bands whose gradient points at angle a (0 along +x, the array's columns) give a, modulo 180."""
-    from training.evaluate import gradient_direction
+    from omninoise.training.evaluate import gradient_direction
 
     y, x = np.mgrid[0:96, 0:96].astype(np.float64)
     for deg in (0, 30, 90, 150):
@@ -206,8 +206,8 @@ def test_direction_error_tells_a_model_that_follows_the_parameter_from_one_that_
     """fibers at 0/45/90/135 degrees: zoo images of other seeds (a model that follows 'orientation') lie within a
     few degrees of the zoo's direction; bands at one fixed direction (a model that draws its own) are 45 off on
     average. gabor_texture is measured on its own parameter name, 'Orientation'."""
-    from training import zoo
-    from training.evaluate import angle_difference, direction_error
+    from omninoise.training import zoo
+    from omninoise.training.evaluate import angle_difference, direction_error
 
     S = 64
 

@@ -9,12 +9,12 @@ import pytest
 torch = pytest.importorskip("torch")
 pytest.importorskip("onnx")
 
-from backend.errors import SettingError  # noqa: E402
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural import precision as P  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable  # noqa: E402
-from training.quantize_onnx import INT8_FILES, calibration_feeds, quantize_folder  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural import precision as P  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable  # noqa: E402
+from omninoise.training.quantize_onnx import INT8_FILES, calibration_feeds, quantize_folder  # noqa: E402
 from tiny_run import TINY  # noqa: E402  (the export itself: the `exported` fixture of tests/training/conftest.py)
 
 
@@ -89,7 +89,7 @@ def test_precision_choice(folders, default_precision):
 
 def test_cli_precision(folders, tmp_path, capsys, default_precision):
     """omninoise neural --precision int8 runs the int8 denoiser; the same command twice gives the same bytes."""
-    from cli.main import main
+    from omninoise.cli.main import main
 
     _, int8, _ = folders
     outs = []

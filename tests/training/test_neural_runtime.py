@@ -9,15 +9,15 @@ import pytest
 torch = pytest.importorskip("torch")
 pytest.importorskip("onnx")
 
-from backend.errors import SettingError  # noqa: E402
-from backend.neural import conditioning as C  # noqa: E402
-from backend.neural.generate import generate  # noqa: E402
-from backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
-from backend.neural.sampler import ddim_sample, initial_noise  # noqa: E402
-from backend.onnx_models import fingerprint  # noqa: E402
-from training.export_onnx import export, reexport  # noqa: E402
-from training.train import TrainConfig, build_model, train  # noqa: E402
-from training.unet import set_circular  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
+from omninoise.backend.neural import conditioning as C  # noqa: E402
+from omninoise.backend.neural.generate import generate  # noqa: E402
+from omninoise.backend.neural.model import ModelError, NeuralNoiseModel  # noqa: E402
+from omninoise.backend.neural.sampler import ddim_sample, initial_noise  # noqa: E402
+from omninoise.backend.onnx_models import fingerprint  # noqa: E402
+from omninoise.training.export_onnx import export, reexport  # noqa: E402
+from omninoise.training.train import TrainConfig, build_model, train  # noqa: E402
+from omninoise.training.unet import set_circular  # noqa: E402
 
 from tiny_run import TINY  # noqa: E402  (the run itself: the `exported` fixture of tests/training/conftest.py)
 
@@ -149,14 +149,14 @@ EVAL = dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param
 
 
 def test_model_card_reads_the_run_export_and_evaluation(exported, tmp_path):
-    from training.model_card import card, wall_seconds
+    from omninoise.training.model_card import card, wall_seconds
 
     run, out = exported
     log = tmp_path / "log.jsonl"
     log.write_text("\n".join(json.dumps(dict(step=i, seconds=s, mse=0.1)) for i, s in enumerate([5, 10, 3, 7])))
     assert wall_seconds(str(log)) == 17  # two segments: 10 s, then a resume for 7 s
     ev = EVAL
-    text = card(str(run), str(out), ev, dict(ev, locality=0.5), "python -m training.train ...", "test CPU")
+    text = card(str(run), str(out), ev, dict(ev, locality=0.5), "python -m omninoise.training.train ...", "test CPU")
     meta = json.loads((out / "neural_noise.json").read_text())
     assert all(digest in text for digest in meta["files"].values()) and "| spots | 1.5 | 0.5 | 0.2 | 0.1 (scale) |" in text
     assert "| without CutMix | 0.5 |" in text and "test CPU" in text
@@ -178,7 +178,7 @@ def test_model_card_without_the_run(exported, tmp_path):
     """Runs are not kept: the export records the log's wall time and loss, and the card reads them from there."""
     import shutil
 
-    from training.model_card import main as card_main, run_figures, wall_seconds
+    from omninoise.training.model_card import main as card_main, run_figures, wall_seconds
 
     run, out = exported
     meta = json.loads((out / "neural_noise.json").read_text())
@@ -209,7 +209,7 @@ def test_model_card_without_the_run(exported, tmp_path):
 
 
 def test_model_card_carries_sections_of_the_earlier_card():
-    from training.model_card import kept_sections
+    from omninoise.training.model_card import kept_sections
 
     old = "# Card\n\nintro\n\n## A\n\nfirst | table\n\n## B (Fig. 13)\n\nsecond\n\n## C\n\nthird\n"
     assert kept_sections(old, ["B (Fig. 13)", "A"]) == "## B (Fig. 13)\n\nsecond\n\n## A\n\nfirst | table"
@@ -220,8 +220,8 @@ def test_model_card_carries_sections_of_the_earlier_card():
 @pytest.mark.parametrize("form", ["split", "one-piece"])
 def test_warm_start_reads_an_export_back_exactly(exported, one_piece, tmp_path, form):
     """A run started from an export (init_onnx) begins with the exported EMA weights, GroupNorm affines included."""
-    from backend.neural.model import sha256_file
-    from training.train import main as train_main
+    from omninoise.backend.neural.model import sha256_file
+    from omninoise.training.train import main as train_main
 
     run, out = exported
     if form == "one-piece":
@@ -248,8 +248,8 @@ def test_warm_start_reads_an_export_back_exactly(exported, one_piece, tmp_path, 
 @pytest.mark.parametrize("form", ["split", "one-piece"])
 def test_torch_is_rebuilt_from_the_export_alone(exported, one_piece, form):
     """The step timing needs no checkpoint: torch runs the export's own weights, as onnxruntime does."""
-    from training.evaluate import step_seconds
-    from training.warm_start import torch_from_export
+    from omninoise.training.evaluate import step_seconds
+    from omninoise.training.warm_start import torch_from_export
 
     run, out = exported
     out = out if form == "split" else one_piece
@@ -264,8 +264,8 @@ def test_torch_is_rebuilt_from_the_export_alone(exported, one_piece, form):
 
 def test_warm_start_grows_the_class_table_and_parameter_slots():
     """New classes keep their fresh embeddings; new parameter slots get zero MLP input columns."""
-    from training.unet import UNet
-    from training.warm_start import warm_start
+    from omninoise.training.unet import UNet
+    from omninoise.training.warm_start import warm_start
 
     torch.manual_seed(0)
     small = UNet(3, 2, emb_dim=4, widths=(8, 16, 16))
@@ -292,8 +292,8 @@ def test_warm_start_grows_the_class_table_and_parameter_slots():
 def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(exported, tmp_path):
     """bench/eval_neural.py's evaluate(): at --eval-size (not the training size), with the structure measures;
     a class's samples, generated as one batch, equal the same seeds generated one by one."""
-    from backend.neural.sampler import sample
-    from training.evaluate import evaluate
+    from omninoise.backend.neural.sampler import sample
+    from omninoise.training.evaluate import evaluate
 
     _, out = exported
     m = NeuralNoiseModel(str(out))
@@ -381,7 +381,7 @@ def test_exported_denoiser_is_folded(exported):
                 for i in n.input:
                     v = consts.get(i)
                     assert v is None or v.size != 1 or float(v.reshape(())) != (n.op_type == "Mul"), n.name
-    from training.warm_start import torch_from_export
+    from omninoise.training.warm_start import torch_from_export
 
     m = torch_from_export(str(out))
     assert tuple(m.downsample[0][1].weight.shape[2:]) == (1, 1)
@@ -394,7 +394,7 @@ def test_drop_identity_arithmetic_keeps_what_changes_values_or_shapes(tmp_path):
     import onnxruntime as ort
     from onnx import TensorProto, helper
 
-    from training.export_onnx import drop_identity_arithmetic
+    from omninoise.training.export_onnx import drop_identity_arithmetic
 
     def const(name, value, shape):
         return helper.make_node("Constant", [], [name], value=helper.make_tensor(name + "_v", TensorProto.FLOAT, shape,

@@ -8,13 +8,13 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from backend.neural.sampler import ddim_sample, ddim_step, initial_noise  # noqa: E402
-from backend.neural.schedule import cosine_alphas_cumprod, ddim_timesteps  # noqa: E402
-from training import zoo  # noqa: E402
-from training.cutmix import cutmix  # noqa: E402
-from training.diffusion import Diffusion  # noqa: E402
-from training.train import TrainConfig, train  # noqa: E402
-from training.unet import UNet, set_circular  # noqa: E402
+from omninoise.backend.neural.sampler import ddim_sample, ddim_step, initial_noise  # noqa: E402
+from omninoise.backend.neural.schedule import cosine_alphas_cumprod, ddim_timesteps  # noqa: E402
+from omninoise.training import zoo  # noqa: E402
+from omninoise.training.cutmix import cutmix  # noqa: E402
+from omninoise.training.diffusion import Diffusion  # noqa: E402
+from omninoise.training.train import TrainConfig, train  # noqa: E402
+from omninoise.training.unet import UNet, set_circular  # noqa: E402
 
 TINY = dict(size=16, batch=4, widths=(8, 16, 16), emb_dim=8, log_every=1, checkpoint_every=2, sample_every=0,
             classes=("perlin", "spots", "cells_f1"))
@@ -102,7 +102,7 @@ def test_loss_parts():
 
 def test_min_snr_weights():
     """Hang et al. 2023, Eq. 8 (ε-prediction): w(t) = min(SNR, γ) / SNR; 1 where SNR <= γ; off at γ = 0."""
-    from backend.neural.schedule import cosine_alphas_cumprod
+    from omninoise.backend.neural.schedule import cosine_alphas_cumprod
 
     ab = cosine_alphas_cumprod()
     snr = ab / (1 - ab)
@@ -127,7 +127,7 @@ def test_min_snr_weights():
 def test_low_snr_weights():
     """min(1/ᾱ_t, W): the ε error turned into the v error (1 + 1/SNR = 1/ᾱ), capped at W; about 1 on the clean
     steps, W on the noisiest; combined with min-SNR-γ by product; off at W = 1."""
-    from backend.neural.schedule import cosine_alphas_cumprod
+    from omninoise.backend.neural.schedule import cosine_alphas_cumprod
 
     ab = cosine_alphas_cumprod()
     t = torch.tensor([0, 300, 700, 900, 999])
@@ -166,7 +166,7 @@ def test_cutmix_pastes_other_classes_with_their_conditions():
 
 def _cutmix_in_place(images, ids, params, rng, p):
     """The in-place form CutMix had before source maps (the reference for the equality below)."""
-    from training.cutmix import rotated_box_mask
+    from omninoise.training.cutmix import rotated_box_mask
 
     src = (images, ids, params)
     images, ids, params = images.clone(), ids.clone(), params.clone()
@@ -192,8 +192,8 @@ def _cutmix_in_place(images, ids, params, rng, p):
 def test_cutmix_by_source_map_equals_pasting_in_place_and_keeps_the_data_stream():
     """Training now draws a source map and gathers on its device (no (B, P, H, W) maps built on the CPU): the same
     mixed batch, bit for bit, as pasting in place, and the same draws from the run's generator after it."""
-    from training.cutmix import cutmix_sources, mix_by_sources
-    from training.train import _conditions
+    from omninoise.training.cutmix import cutmix_sources, mix_by_sources
+    from omninoise.training.train import _conditions
 
     B, H, P = 12, 24, 3
     g = torch.Generator().manual_seed(0)
@@ -250,7 +250,7 @@ def test_training_runs_logs_and_resumes_identically(tmp_path):
 def test_wall_time_budget_stops_with_a_checkpoint_and_resumes(tmp_path):
     """--max-seconds (a lent GPU's lease): the run stops after its first step past the budget, checkpointed and
     logged, and resumes from there."""
-    from training.train import main
+    from omninoise.training.train import main
 
     cfg = TrainConfig.from_dict(dict(TINY, steps=50))
     last = train(cfg, str(tmp_path / "a"), log=lambda s: None, max_seconds=1e-9)
@@ -290,7 +290,7 @@ def test_a_non_finite_batch_is_skipped_not_learned(monkeypatch, tmp_path):
 
 
 def test_a_run_that_keeps_diverging_stops_and_keeps_its_last_checkpoint(monkeypatch, tmp_path):
-    from training import train as train_mod
+    from omninoise.training import train as train_mod
 
     cfg = TrainConfig.from_dict(dict(TINY, steps=10))
     train(cfg, str(tmp_path / "a"), max_steps=2, log=lambda s: None)
@@ -307,7 +307,7 @@ def test_a_run_that_keeps_diverging_stops_and_keeps_its_last_checkpoint(monkeypa
 def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically(tmp_path):
     """workers > 0 (a GPU that outruns one core's zoo): batch k comes from default_rng([seed, k]) in a worker
     process, so one worker or two give the same batches in the same order, and a stopped run resumes exactly."""
-    from training.batches import batch_at, worker_batches, worker_loader
+    from omninoise.training.batches import batch_at, worker_batches, worker_loader
 
     cfg = TrainConfig.from_dict(dict(TINY, steps=4, workers=2))
     one = TrainConfig.from_dict(dict(TINY, steps=4, workers=1))
@@ -327,8 +327,8 @@ def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically
 def test_a_stuck_data_worker_ends_the_run_with_a_one_line_error(monkeypatch, tmp_path):
     """The loader's timeout turns a worker that makes nothing (a lent GPU's lease running out on a hang) into an
     error naming the workers and the way out, with nothing written as if it had trained."""
-    from training import batches as B
-    from training import train as T
+    from omninoise.training import batches as B
+    from omninoise.training import train as T
 
     def stuck(cfg, start, end, pin=False):  # what DataLoader raises when no batch comes within its timeout
         raise RuntimeError(f"DataLoader timed out after {B.BATCH_TIMEOUT_S} seconds")
@@ -345,8 +345,8 @@ def test_mirrors_contradict_oriented_conditioning_so_training_does_not_mirror(mo
     """A left-right mirror turns a gabor of orientation θ into one of π - θ while its conditioning still says θ
     (and damascus's fixed bands into their reflection): the model then learns 'θ or its mirror' and draws both in
     patches.  So training does not mirror unless a config asks for it (the stages that did say so)."""
-    from training import train as T
-    from training.evaluate import gradient_direction
+    from omninoise.training import train as T
+    from omninoise.training.evaluate import gradient_direction
 
     p = dict(zoo.default_params("gabor"), orientation=math.radians(30), bandwidth=0.02)
     img = zoo.generate("gabor", p, torch.arange(1), 128)
@@ -375,7 +375,7 @@ def test_config_errors():
 
 def test_checkpoints_of_a_smaller_zoo_still_load():
     """The zoo is append-only: a model made before classes were added uses the first ids and slots."""
-    from training.train import build_model, model_names
+    from omninoise.training.train import build_model, model_names
 
     cfg = TrainConfig.from_dict(dict(TINY))
     old = UNet(len(zoo.CLASS_NAMES) - 1, len(zoo.PARAM_NAMES) - 3, emb_dim=8, widths=(8, 16, 16))
@@ -388,7 +388,7 @@ def test_checkpoints_of_a_smaller_zoo_still_load():
 def test_cpu_threads_limits_torch_and_numba_and_restores_them():
     """One training thread must also mean one numba worker (the zoo's wave classes run numba kernels)."""
     numba = pytest.importorskip("numba")
-    from training.threads import cpu_threads
+    from omninoise.training.threads import cpu_threads
 
     before = torch.get_num_threads(), numba.get_num_threads()
     with cpu_threads(1):
@@ -402,8 +402,8 @@ def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
     """configs/: each file loads; the production (GPU) config runs one step at its resolution on the CPU."""
     import glob
 
-    from training.solid.train import load_config as load_solid
-    from training.train import load_config
+    from omninoise.training.solid.train import load_config as load_solid
+    from omninoise.training.train import load_config
 
     root = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "configs")
     neural = sorted(glob.glob(os.path.join(root, "*.json")))
@@ -422,7 +422,7 @@ def test_every_shipped_config_parses_and_the_gpu_config_trains_a_step(tmp_path):
 
 
 def test_precision_is_bf16_only_where_the_cpu_computes_it():
-    from training.precision import autocast, cpu_bf16_native, resolve
+    from omninoise.training.precision import autocast, cpu_bf16_native, resolve
 
     assert cpu_bf16_native("processor : 0\nflags : fpu avx2 avx512f amx_bf16 amx_tile\n")
     assert cpu_bf16_native("flags : fpu avx2 avx512_bf16\n")

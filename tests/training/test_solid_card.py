@@ -3,7 +3,11 @@ wrote, names each model's loss and config file, and tabulates the single-exempla
 import json
 import os
 
-from training.solid import model_card as mc
+import pytest
+
+torch = pytest.importorskip("torch")  # omninoise.training needs torch
+
+from omninoise.training.solid import model_card as mc
 
 EXISTING = """# Neural solid texture models
 

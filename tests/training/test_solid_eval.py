@@ -4,8 +4,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.solid import exemplars as ex  # noqa: E402
-from training.solid.evaluate import baselines, evaluate_exemplar, slices_3d  # noqa: E402
+from omninoise.training.solid import exemplars as ex  # noqa: E402
+from omninoise.training.solid.evaluate import baselines, evaluate_exemplar, slices_3d  # noqa: E402
 
 
 def test_metrics_rank_real_pixels_flat_colour_and_copies():

@@ -1,4 +1,4 @@
-"""python -m training.solid.harmonics: a single photo model's stored harmonic part is measured again, exactly,
+"""python -m omninoise.training.solid.harmonics: a single photo model's stored harmonic part is measured again, exactly,
 from its exemplar's training region; --remove takes it out; other models are refused with one line."""
 import json
 import os
@@ -6,7 +6,11 @@ import shutil
 
 import numpy as np
 
-from training.solid.harmonics import main, measure
+import pytest
+
+torch = pytest.importorskip("torch")  # omninoise.training needs torch
+
+from omninoise.training.solid.harmonics import main, measure
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BRICK = os.path.join(ROOT, "models", "solid", "brick_3d")

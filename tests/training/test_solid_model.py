@@ -6,21 +6,21 @@ import math
 import numpy as np
 import pytest
 
-from backend.grid import Cancelled
+from omninoise.backend.grid import Cancelled
 
 torch = pytest.importorskip("torch")
 
-from backend.errors import SettingError  # noqa: E402
-from backend.onnx_models import ModelError, fingerprint  # noqa: E402
-from backend.solid.model import SolidTextureModel, TextureCode  # noqa: E402
-from backend.solid.waves import wave_features as wave_features_np  # noqa: E402
-from training.solid import exemplars as ex  # noqa: E402
-from training.solid.export import export  # noqa: E402
-from training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
-from training.solid.lattice import octave_seeds  # noqa: E402
-from training.solid.model import random_rotations, slice_points  # noqa: E402
-from training.solid.train import SolidConfig, build_model, train, training_images  # noqa: E402
-from training.solid.waves import photo_waves, wave_features, wave_share  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
+from omninoise.backend.onnx_models import ModelError, fingerprint  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel, TextureCode  # noqa: E402
+from omninoise.backend.solid.waves import wave_features as wave_features_np  # noqa: E402
+from omninoise.training.solid import exemplars as ex  # noqa: E402
+from omninoise.training.solid.export import export  # noqa: E402
+from omninoise.training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
+from omninoise.training.solid.lattice import octave_seeds  # noqa: E402
+from omninoise.training.solid.model import random_rotations, slice_points  # noqa: E402
+from omninoise.training.solid.train import SolidConfig, build_model, train, training_images  # noqa: E402
+from omninoise.training.solid.waves import photo_waves, wave_features, wave_share  # noqa: E402
 
 
 def _tiny(tmp_path, mode="single", dim=3, steps=4, **kw):
@@ -139,7 +139,7 @@ def test_features_see_structure_and_colour():
 
 def _fixed_loss(state, img):
     """Style loss of a model on fixed slices, seeds and crops (no batch-to-batch noise)."""
-    from training.solid.train import render
+    from omninoise.training.solid.train import render
     cfg = SolidConfig.from_dict(state["config"])
     m = build_model(cfg)
     m.load_state_dict(state["model"])
@@ -172,7 +172,7 @@ def test_resume_continues_from_checkpoint(tmp_path):
 def test_init_from_continues_a_finished_run_and_the_card_names_both_configs(tmp_path):
     import json
 
-    from training.solid.model_card import card
+    from omninoise.training.solid.model_card import card
 
     base = dict(name="c", dim=2, crop=32, batch=1, steps=4, width=16, checkpoint_every=2, log_every=1, threads=1,
                 exemplars=["gravel"])
@@ -318,9 +318,9 @@ def test_exemplars_split_and_crops():
 
 
 def test_refinement_never_worsens_and_moves_a_wrong_start(tmp_path, monkeypatch):
-    import backend.solid.refine as rf
-    from backend.grid import Cancelled
-    from backend.solid.refine import refine_code, sliced_distance, sliced_target
+    import omninoise.backend.solid.refine as rf
+    from omninoise.backend.grid import Cancelled
+    from omninoise.backend.solid.refine import refine_code, sliced_distance, sliced_target
     run, _ = _tiny(tmp_path, mode="space", dim=3, crop=128, batch=2, steps=2)
     export(str(run), str(tmp_path / "space"))
     rt = SolidTextureModel(str(tmp_path / "space"))
@@ -367,8 +367,8 @@ def test_refinement_never_worsens_and_moves_a_wrong_start(tmp_path, monkeypatch)
 def test_spectral_aspect_and_the_initial_stretch_follow_the_grain():
     """Stripes that run horizontally (grain along the rows) have aspect < 1, standing ones > 1, a noise about 1;
     init_stretch lengthens features along the fixed axis by it, never shortens them, and starts the run so."""
-    from training.solid.model import spectral_aspect
-    from training.solid.train import initial_stretch
+    from omninoise.training.solid.model import spectral_aspect
+    from omninoise.training.solid.train import initial_stretch
 
     g = torch.Generator().manual_seed(0)
     noise = torch.rand(1, 64, 64, generator=g)
@@ -386,8 +386,8 @@ def test_spectral_aspect_and_the_initial_stretch_follow_the_grain():
 def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
     """axis_rotations keep the fixed axis on the lattice's second (brick-row) axis and are rotations; a fresh
     single model with fixed_axis starts from them, its column of the axis scaled by the initial stretch."""
-    from training.solid.model import axis_rotations
-    from training.solid import exemplars as ex
+    from omninoise.training.solid.model import axis_rotations
+    from omninoise.training.solid import exemplars as ex
 
     for axis, k in (("columns", 0), ("rows", 2)):
         T = axis_rotations(8, axis, seed=2)
@@ -409,7 +409,7 @@ def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
     cfg = dict(name="tiny_axis", mode="single", dim=3, crop=32, batch=1, steps=0, width=8, threads=1,
                exemplars=[photo], colour="affine", loss="swd", swd_width=4, swd_levels=1, augment=False,
                fixed_axis="rows", init_stretch=True, checkpoint_every=1)
-    from training.solid.train import initial_stretch, training_images
+    from omninoise.training.solid.train import initial_stretch, training_images
     c = SolidConfig.from_dict(cfg)
     logs = []
     train(SolidConfig.from_dict(dict(cfg, steps=1, lr=0.0, lr_min=0.0)), str(tmp_path / "run"), log=logs.append)
@@ -429,7 +429,7 @@ def test_fixed_axis_models_start_with_lattices_along_the_axis(tmp_path):
 def test_noise_ramp_lets_the_shape_features_draw_first(tmp_path, monkeypatch):
     """noise_ramp: the value noise enters single-mode training with a gain (step + 1) / ramp, capped at 1, so the
     first steps' images are a function of the shape features alone; bad settings are named."""
-    import training.solid.train as tr
+    import omninoise.training.solid.train as tr
 
     with pytest.raises(ValueError, match="noise_ramp needs shape features"):
         SolidConfig.from_dict({"noise_ramp": 5, "steps": 10})
@@ -465,8 +465,8 @@ def test_noise_ramp_lets_the_shape_features_draw_first(tmp_path, monkeypatch):
 def test_noise_ramp_in_space_mode_scales_the_spectral_gains(tmp_path, monkeypatch):
     """A space model's ramp multiplies each photo's measured spectral gains (model.spectral_gains) by the ramp's
     gain, so the ratios between octaves stay the photo's while the noise fades in."""
-    import training.solid.train as tr
-    from training.solid.model import spectral_gains
+    import omninoise.training.solid.train as tr
+    from omninoise.training.solid.model import spectral_gains
 
     seen, render = [], tr.render
 
@@ -491,7 +491,7 @@ def test_noise_ramp_in_space_mode_scales_the_spectral_gains(tmp_path, monkeypatc
 def test_budget_fits_the_schedule_to_the_time_there_is(tmp_path, monkeypatch):
     """--budget-seconds: after steps 10 to 40 of a stretch the run's steps become what the rest of the budget holds
     at the measured rate, the noise ramp keeps its share of the schedule, and the checkpoint records both."""
-    import training.solid.train as tr
+    import omninoise.training.solid.train as tr
 
     cfg = SolidConfig.from_dict({"steps": 1000, "noise_ramp": 200, "bricks": 1})
     fitted = tr.fit_schedule(cfg, 40, 0.5, 100.0)
@@ -521,7 +521,7 @@ def test_budget_fits_the_schedule_to_the_time_there_is(tmp_path, monkeypatch):
 
 
 def test_device_is_checked(tmp_path, capsys):
-    import training.solid.train as tr
+    import omninoise.training.solid.train as tr
 
     with pytest.raises(ValueError, match="device must be 'cpu', 'cuda' or 'cuda:N', got 'gpu'"):
         SolidConfig.from_dict({"device": "gpu"})
@@ -536,7 +536,7 @@ def test_average_of_checkpoints_is_their_mean_and_exports(tmp_path):
     """training.solid.average (stochastic weight averaging): every float tensor is the mean of the runs' tensors,
     the last run gives config and step, the sources are named, a run of another shape is refused in one line, and
     the average exports and is read by the card (no loss log of its own)."""
-    from training.solid import average, photo_card
+    from omninoise.training.solid import average, photo_card
 
     run_a, state_a = _tiny(tmp_path, steps=2)
     run_b = tmp_path / "run_b"
@@ -603,8 +603,8 @@ def test_snapshots_are_kept_and_averaged(tmp_path):
     --from STEP is the mean of those from STEP on, with the run's config; bad settings are named."""
     import os
 
-    from training.solid import average
-    from training.solid.train import snapshot_path
+    from omninoise.training.solid import average
+    from omninoise.training.solid.train import snapshot_path
 
     with pytest.raises(ValueError, match="snapshot_every must be a whole number"):
         SolidConfig.from_dict({"snapshot_every": -1})
@@ -640,8 +640,8 @@ def test_training_with_waves_warns_when_the_photo_has_no_period(tmp_path):
 def test_isotropy_penalty_charges_the_stretch_alone():
     """isotropy_weight's penalty: 0 for any rotation times a scale, ~0.43 for a 1.45 : 1 stretch, blind to
     rotations before and after (spun lattices), and its gradient shrinks the stretch; configs check the weight."""
-    from training.solid.model import random_rotations
-    from training.solid.train import isotropy_penalty
+    from omninoise.training.solid.model import random_rotations
+    from omninoise.training.solid.train import isotropy_penalty
     R = random_rotations(8, 3, 1)
     assert isotropy_penalty(R * 3.0).item() < 1e-10
     S = R @ torch.diag(torch.tensor([1.45, 1.0, 1.0]))

@@ -4,11 +4,11 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.solid.arrangement import ArrangementFeatures, gaussianise, luminance  # noqa: E402
-from training.solid.morphology import morphology_distance  # noqa: E402
-from training.solid.photo_eval import voronoi_pavement  # noqa: E402
-from training.solid.soft_morphology import soft_curves, soft_functionals, soft_morphology_loss  # noqa: E402
-from training.solid.train import SolidConfig, loss_features, texture_loss  # noqa: E402
+from omninoise.training.solid.arrangement import ArrangementFeatures, gaussianise, luminance  # noqa: E402
+from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.training.solid.photo_eval import voronoi_pavement  # noqa: E402
+from omninoise.training.solid.soft_morphology import soft_curves, soft_functionals, soft_morphology_loss  # noqa: E402
+from omninoise.training.solid.train import SolidConfig, loss_features, texture_loss  # noqa: E402
 
 torch.set_num_threads(2)
 

@@ -13,7 +13,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 
 import build_photo_set as bps  # noqa: E402
-from training.solid import photo_eval as pe  # noqa: E402
+
+torch = pytest.importorskip("torch")  # omninoise.training needs torch
+
+from omninoise.training.solid import photo_eval as pe  # noqa: E402
 
 PHOTOS = os.path.join(ROOT, "data", "photos")
 
@@ -97,7 +100,7 @@ def test_random_phase_keeps_colour_and_spectrum():
 def test_gaussian_noise_has_the_photo_spectrum_on_average_and_varies_per_draw():
     """Spot noise's power averaged over draws is the photo's periodic component's, band by band, its mean colour
     the photo's; one draw's amplitudes scatter around it (random phase noise keeps them exactly)."""
-    from backend.periodic import periodic_component
+    from omninoise.backend.periodic import periodic_component
 
     rng = np.random.default_rng(3)
     g = np.cumsum(np.cumsum(rng.standard_normal((64, 64)), 0), 1)
@@ -117,15 +120,13 @@ def test_gaussian_noise_has_the_photo_spectrum_on_average_and_varies_per_draw():
     assert np.median(np.abs(one - 1.0)) > 0.25 and np.median(np.abs(rp - 1.0)) < 0.15
 
 
-torch = pytest.importorskip("torch")
-
-from backend.solid.model import SolidTextureModel, colour_stats  # noqa: E402
-from backend.solid.refine import refine_code  # noqa: E402
-from training.solid import exemplars as ex  # noqa: E402
-from training.solid.export import export  # noqa: E402
-from training.solid.model import bounded_transform, colour_stats as colour_stats_t, random_rotations  # noqa: E402
-from training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
-from training.solid.train import SolidConfig, build_model, train  # noqa: E402
+from omninoise.backend.solid.model import SolidTextureModel, colour_stats  # noqa: E402
+from omninoise.backend.solid.refine import refine_code  # noqa: E402
+from omninoise.training.solid import exemplars as ex  # noqa: E402
+from omninoise.training.solid.export import export  # noqa: E402
+from omninoise.training.solid.model import bounded_transform, colour_stats as colour_stats_t, random_rotations  # noqa: E402
+from omninoise.training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
+from omninoise.training.solid.train import SolidConfig, build_model, train  # noqa: E402
 
 
 def test_colour_stats_twins_agree_and_rebuild_the_covariance():
@@ -177,10 +178,10 @@ def test_bf16_decoder_draws_the_fp32_texture_and_is_recorded(tmp_path):
     """``precision`` "bf16": only the decoder's products run under bf16 autocast; the texture stays float32 and
     within bf16 rounding of fp32's, gradients reach every decoder weight, and the export (traced in fp32) says
     where and how the run trained.  Bad values get a one-line error."""
-    from training.precision import resolve
-    from training.solid.lattice import octave_seeds
-    from training.solid.model import spectral_gains
-    from training.solid.train import hardware_here
+    from omninoise.training.precision import resolve
+    from omninoise.training.solid.lattice import octave_seeds
+    from omninoise.training.solid.model import spectral_gains
+    from omninoise.training.solid.train import hardware_here
 
     photos = ex.photo_set("train")[:2]
     cfg = dict(name="tiny_bf16", mode="space", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
@@ -259,7 +260,7 @@ def test_photo_space_model_colour_path_export_and_refine(tmp_path):
     m = build_model(SolidConfig.from_dict(state["config"]))
     m.load_state_dict(state["model"])
     pts = np.random.default_rng(0).uniform(-3, 3, (500, 3))
-    from training.solid.lattice import octave_seeds
+    from omninoise.training.solid.lattice import octave_seeds
     with torch.no_grad():
         e, T = m.translator(torch.from_numpy(z[:8])[None])
         ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),
@@ -279,7 +280,7 @@ def test_photo_space_model_colour_path_export_and_refine(tmp_path):
 def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
     """The card section is written from the shipped export's solid.json (config, steps, wall time) when the run
     folder is not kept, with the two evaluations side by side and the ledger rows as given."""
-    from training.solid import photo_card
+    from omninoise.training.solid import photo_card
 
     space = os.path.join(ROOT, "models", "solid", "space")
     with open(os.path.join(space, "solid.json"), encoding="utf-8") as fh:
@@ -304,7 +305,7 @@ def test_photo_card_reads_an_export_when_the_run_is_gone(tmp_path):
 def test_photo_card_lists_every_stage_of_a_continued_run(tmp_path):
     """A model trained over stages (a later config continues the earlier run with init_from) gets one training
     command per stage in its card, oldest first, with the first stage's starting export."""
-    from training.solid import photo_card
+    from omninoise.training.solid import photo_card
 
     first = tmp_path / "a_3d.json"
     first.write_text(json.dumps({"name": "a", "init_onnx": "models/solid/space", "init_sha256": "ab" * 32}))
@@ -313,19 +314,19 @@ def test_photo_card_lists_every_stage_of_a_continued_run(tmp_path):
                                   "structure_net": "runs/net.pt"}))
     lines = photo_card.stage_commands([str(first), str(second), str(second)])
     assert lines == ["# starts from the export models/solid/space (sha256 abababababab...): the model this one replaced",
-                     f"python -m training.solid.train --config {first} --out runs/solid/a",
+                     f"python -m omninoise.training.solid.train --config {first} --out runs/solid/a",
                      "# continues runs/solid/a (the stage above)",
-                     "python -m training.solid.structure_features --out runs/net.pt   # the structure term's network",
-                     f"python -m training.solid.train --config {second} --out runs/solid/b",
+                     "python -m omninoise.training.solid.structure_features --out runs/net.pt   # the structure term's network",
+                     f"python -m omninoise.training.solid.train --config {second} --out runs/solid/b",
                      "# continues runs/solid/a (the stage above)",
-                     f"python -m training.solid.train --config {second} --out runs/solid/b"]
+                     f"python -m omninoise.training.solid.train --config {second} --out runs/solid/b"]
     space = os.path.join(ROOT, "models", "solid", "space")
     summary = dict(summary=dict(photos=87))
     third = tmp_path / "c_3d.json"
     third.write_text(json.dumps({"name": "c", "init_onnx": "models/solid/space", "init_sha256": "cd" * 32}))
     assert photo_card.stage_commands([str(first), str(third)])[2:] == [
-        "python -m training.solid.export runs/solid/a models/solid/space   # sha256 cdcdcdcdcdcd..., which the next "
-        "stage starts from", f"python -m training.solid.train --config {third} --out runs/solid/c"]
+        "python -m omninoise.training.solid.export runs/solid/a models/solid/space   # sha256 cdcdcdcdcdcd..., which the next "
+        "stage starts from", f"python -m omninoise.training.solid.train --config {third} --out runs/solid/c"]
     text = photo_card.section(space, summary, summary, True, config=[str(first), str(second)])
     assert text.index("--out runs/solid/a") < text.index("--out runs/solid/b") < text.index("training.solid.export")
 
@@ -336,8 +337,8 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
     torch model equals the trained one on every tensor the export holds, continues at the export's step, and a
     wrong fingerprint or a missing one is refused in one line.  With ``film`` (code-modulated decoder, encoder
     on standardised crops) the runtime's ONNX decoder and encoder also equal torch's."""
-    from backend.onnx_models import fingerprint
-    from training.solid.warm_start import exported_weights, warm_start
+    from omninoise.backend.onnx_models import fingerprint
+    from omninoise.training.solid.warm_start import exported_weights, warm_start
 
     photos = ex.photo_set("train")[:2]
     cfg = dict(name="tiny_photo", mode="space", dim=3, crop=64, batch=2, steps=4, width=16, log_every=1,
@@ -365,7 +366,7 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
             # standardised input: a crop's colour and contrast do not change its code
             np.testing.assert_allclose(m.encoder(crop * 0.5 + 0.2).numpy(), m.encoder(crop).numpy(), rtol=5e-3, atol=5e-3)
         pts = np.random.default_rng(0).uniform(-3, 3, (300, 3))
-        from training.solid.lattice import octave_seeds
+        from omninoise.training.solid.lattice import octave_seeds
         assert z.shape == (8 + 12 + 8,) and rt.translate(z).gains.shape == (8,)
         with torch.no_grad():
             e, T = m.translator(torch.from_numpy(z[:8])[None])
@@ -393,8 +394,8 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
 def test_spectral_gains_twins_agree_and_follow_the_grain():
     """The per-octave gains (training.solid.model.spectral_gains and its numpy twin) agree; a fine-grained image
     raises the fine octaves' gains, a smooth one the coarse octaves'; a flat image gives 1 everywhere."""
-    from backend.solid.model import spectral_gains as gains_np
-    from training.solid.model import spectral_gains as gains_t
+    from omninoise.backend.solid.model import spectral_gains as gains_np
+    from omninoise.training.solid.model import spectral_gains as gains_t
 
     rng = np.random.default_rng(0)
     fine = rng.random((128, 128, 3)).astype(np.float32)                 # pixel noise: detail at 1-2 px
@@ -413,9 +414,9 @@ def test_features_added_to_an_export_start_as_the_export(tmp_path):
     """Cellular and brick features added to a model trained without them (init_onnx with new ``cellular``
     and ``bricks``): their first-layer columns start at zero, so the grown model draws the export's texture
     exactly, and the continued run trains them; features are not added to an export that has some."""
-    from backend.onnx_models import fingerprint
-    from training.solid.lattice import octave_seeds
-    from training.solid.warm_start import exported_weights, warm_start
+    from omninoise.backend.onnx_models import fingerprint
+    from omninoise.training.solid.lattice import octave_seeds
+    from omninoise.training.solid.warm_start import exported_weights, warm_start
 
     photos = ex.photo_set("train")[:2]
     cfg = dict(name="tiny_grow", mode="space", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
@@ -523,9 +524,9 @@ def test_min_spacing_caps_every_octave_lattice_in_training_and_in_the_export(tmp
     """``min_spacing``: no octave's lattice is finer than that many exemplar pixels, whatever the translator
     asks for (largest singular value of T_i <= (px_per_unit / 2^i) / min_spacing), in torch and in the
     exported translator the runtime reads; octaves coarse enough are not touched; bad values are refused."""
-    from backend.onnx_models import fingerprint
-    from training.solid.model import bounded_transform, max_scales, random_rotations
-    from training.solid.warm_start import exported_weights, warm_start
+    from omninoise.backend.onnx_models import fingerprint
+    from omninoise.training.solid.model import bounded_transform, max_scales, random_rotations
+    from omninoise.training.solid.warm_start import exported_weights, warm_start
 
     np.testing.assert_allclose(max_scales(4, 16.0, 2.0).numpy(), [8.0, 4.0, 2.0, 1.0])
     R = random_rotations(4, 3)
@@ -576,7 +577,7 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
                checkpoint_every=2, threads=1, exemplars=[os.path.join(ROOT, photo_path)], colour="affine",
                loss="swd", swd_width=8, swd_levels=2, hold_out=True)
     c = SolidConfig.from_dict(cfg)
-    from training.solid.train import training_images
+    from omninoise.training.solid.train import training_images
     (region,) = training_images(c)
     assert region.shape[2] == img.shape[2] * 3 // 4          # the right quarter never reaches training
     assert training_images(SolidConfig.from_dict({**cfg, "hold_out": False}))[0].shape[2] == img.shape[2]
@@ -585,7 +586,7 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
     train(c, str(tmp_path / "run"), log=lambda *_: None)
     doc = export(str(tmp_path / "run"), str(tmp_path / "models" / "tiny_single"))
     np.testing.assert_allclose(doc["colour_code"], colour_stats(region.permute(1, 2, 0).numpy()), atol=1e-5)
-    from training.precision import resolve            # precision "auto": bf16 where this CPU computes it natively
+    from omninoise.training.precision import resolve            # precision "auto": bf16 where this CPU computes it natively
     prec = "fp32" if resolve("auto", torch.device("cpu")) == "fp32" else "bf16 decoder, fp32 loss"
     assert doc["hardware"].endswith(f"1 threads, {prec}")    # where it trained travels with the export
     rt = SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
@@ -598,7 +599,7 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
     broken = dict(json.loads((tmp_path / "models" / "tiny_single" / "solid.json").read_text()))
     del broken["colour_code"]
     (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(broken))
-    from backend.onnx_models import ModelError
+    from omninoise.backend.onnx_models import ModelError
     with pytest.raises(ModelError, match="colour_code"):
         SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
     (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(doc))
@@ -621,8 +622,8 @@ def test_harmonic_rest_trains_on_photos_less_their_part_as_the_runtime_encodes_t
     """``harmonic_rest``: training crops each photo's rest (its harmonic part removed as the runtime removes it),
     the export says so, and the exported model encodes a photo's rest when the part rides along; the option
     needs a space photo model."""
-    from backend.solid.harmonic import photo_harmonics, remove_harmonics
-    from training.solid.train import training_images
+    from omninoise.backend.solid.harmonic import photo_harmonics, remove_harmonics
+    from omninoise.training.solid.train import training_images
 
     brick = [p for p in ex.photo_set("train") if "brick2b" in p]
     cfg = dict(name="tiny_rest", mode="space", dim=3, crop=128, batch=2, steps=2, width=16, log_every=1,

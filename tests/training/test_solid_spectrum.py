@@ -6,8 +6,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from training.solid.spectrum import band_index, band_shares, spectrum_loss  # noqa: E402
-from training.solid.train import SolidConfig, loss_features, texture_loss  # noqa: E402
+from omninoise.training.solid.spectrum import band_index, band_shares, spectrum_loss  # noqa: E402
+from omninoise.training.solid.train import SolidConfig, loss_features, texture_loss  # noqa: E402
 
 
 def _smooth_noise(seed: int, size: int = 96, sigma: float = 3.0) -> torch.Tensor:
@@ -89,8 +89,8 @@ def test_config_weight_enters_the_training_loss():
 def test_random_phase_of_a_photo_keeps_its_bands():
     """Random phase noise keeps a photo's Fourier modulus: its band shares stay near the photo's, a pixel
     shuffle's do not."""
-    from training.solid import photo_eval as pe
-    from training.solid import exemplars as ex
+    from omninoise.training.solid import photo_eval as pe
+    from omninoise.training.solid import exemplars as ex
 
     photo = ex.photo_set("val")[0]
     img = np.asarray(ex.exemplar(photo).permute(1, 2, 0), np.float32)[:128, :128]

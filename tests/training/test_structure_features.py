@@ -5,9 +5,9 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from backend.periodic import periodic_component  # noqa: E402
-from training.evaluate import radial_psd  # noqa: E402
-from training.solid.structure_features import (StructureFeatures, StructureNet, load_structure_net,  # noqa: E402
+from omninoise.backend.periodic import periodic_component  # noqa: E402
+from omninoise.training.evaluate import radial_psd  # noqa: E402
+from omninoise.training.solid.structure_features import (StructureFeatures, StructureNet, load_structure_net,  # noqa: E402
                                                phase_randomised, structure_batch, train_structure_net)
 
 
@@ -56,7 +56,7 @@ def test_the_network_learns_to_tell_structure_from_its_twin_and_feeds_the_loss(t
 
 
 def test_the_training_loss_takes_the_structure_term_only_with_a_network(tmp_path):
-    from training.solid.train import SolidConfig, loss_features, texture_loss
+    from omninoise.training.solid.train import SolidConfig, loss_features, texture_loss
 
     base = dict(mode="single", dim=2, exemplars=["data/photos/val/brick__beige_bricks.jpg"], loss="swd",
                 colour="affine")

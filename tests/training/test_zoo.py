@@ -7,9 +7,9 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from cli.main import main  # noqa: E402
-from training import zoo  # noqa: E402
-from training.evaluate import gradient_direction  # noqa: E402
+from omninoise.cli.main import main  # noqa: E402
+from omninoise.training import zoo  # noqa: E402
+from omninoise.training.evaluate import gradient_direction  # noqa: E402
 
 
 def centroid(img: np.ndarray) -> float:
@@ -106,7 +106,7 @@ def test_sampler_class_weights():
 
 
 def test_config_class_weights():
-    from training.config import TrainConfig
+    from omninoise.training.config import TrainConfig
 
     cfg = TrainConfig.from_dict({"class_weights": {"fibers": 2.0}})
     assert cfg.class_weights == {"fibers": 2.0}
@@ -148,8 +148,8 @@ def test_orientation_is_a_parameter_every_seed_follows(name, extra):
 
 def test_parameter_slots_and_class_ids_are_append_only():
     """A trained model's conditioning slots are fixed: the zoo's names start with every shipped model's."""
-    from backend.onnx_models import load_model_json
-    from backend.paths import neural_model
+    from omninoise.backend.onnx_models import load_model_json
+    from omninoise.backend.paths import neural_model
 
     doc = load_model_json(neural_model(), "neural_noise.json")
     assert zoo.PARAM_NAMES[: len(doc["params"])] == tuple(doc["params"])

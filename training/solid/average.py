@@ -1,7 +1,7 @@
 """Average the weights of checkpoints along one run's trajectory (stochastic weight averaging).
 
-    python -m training.solid.average --out RUN SRC [SRC ...]
-    python -m training.solid.average --out RUN --snapshots RUN_IN [--from STEP]
+    python -m omninoise.training.solid.average --out RUN SRC [SRC ...]
+    python -m omninoise.training.solid.average --out RUN --snapshots RUN_IN [--from STEP]
 
 Izmailov et al. ("Averaging Weights Leads to Wider Optima and Better
 Generalization", UAI 2018) average the weights a run passes through late in
@@ -20,7 +20,7 @@ the last SRC.  The result ``RUN/ckpt.pt`` takes the config, step, training
 time and hardware of the last SRC that is a run (the latest point), names its sources in
 ``averaged_from`` (folder and step), holds no optimiser state (continue it
 from its export with ``init_onnx``), and exports like any run
-(``python -m training.solid.export RUN OUT``).
+(``python -m omninoise.training.solid.export RUN OUT``).
 """
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ import sys
 
 import torch
 
-from backend._export import export as _ex
+from omninoise import export as _ex
 
 __all__ = ["average_checkpoints", "snapshots", "main"]
 
@@ -87,7 +87,7 @@ def average_checkpoints(runs: list, base: str | None = None) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.solid.average", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.average", description=__doc__.split("\n")[0])
     ap.add_argument("--out", required=True, help="the run folder to write (ckpt.pt)")
     ap.add_argument("runs", nargs="*", help="run folders (ckpt.pt) or snapshot files, oldest first")
     ap.add_argument("--snapshots", metavar="RUN", help="average this run's weight snapshots (snapshot_every)")

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import torch
 
-from backend.solid.brick import BRICK_SALT, FEATURES
-from backend.solid.lattice import BITS, MASK32
+from omninoise.backend.solid.brick import BRICK_SALT, FEATURES
+from omninoise.backend.solid.lattice import BITS, MASK32
 from .lattice import lowbias32_torch, octave_positions, salted_seeds
 
 __all__ = ["brick_features"]

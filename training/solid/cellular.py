@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import torch
 
-from backend.solid.cellular import CELL_SALT, FEATURES, offsets
-from backend.solid.lattice import BITS, MASK32
+from omninoise.backend.solid.cellular import CELL_SALT, FEATURES, offsets
+from omninoise.backend.solid.lattice import BITS, MASK32
 from .lattice import lowbias32_torch, octave_positions, salted_seeds
 
 __all__ = ["cellular_features"]

@@ -31,8 +31,8 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from backend.solid.lattice import lattice_noise
-from backend.solid.model import plane_points
+from omninoise.backend.solid.lattice import lattice_noise
+from omninoise.backend.solid.model import plane_points
 from . import exemplars as ex
 from .features import RandomFeatures, gram_loss, histogram_loss
 from .model import axis_frame

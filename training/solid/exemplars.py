@@ -7,7 +7,7 @@ greyscale; the model still outputs RGB.
 
 Procedural classes (wood rings, marble veins, rust, granite) are generated
 here from the noise zoo's operators, in colour, at any seed:
-``python -m training.solid.exemplars OUT_DIR`` writes the shipped
+``python -m omninoise.training.solid.exemplars OUT_DIR`` writes the shipped
 ones (seed 0 for training, seed 1 held out).
 
 Held-out split: for the photographs, the right quarter (columns >= 3/4 of
@@ -26,7 +26,7 @@ import sys
 import numpy as np
 import torch
 
-from backend._export import export as _export
+from omninoise import export as _export
 from .. import noise_ops as ops
 from .photo_set import PHOTO_DIR, expand, photo_set
 

@@ -1,4 +1,4 @@
-"""Export a trained solid texture to ONNX: ``python -m training.solid.export RUN OUT_DIR``.
+"""Export a trained solid texture to ONNX: ``python -m omninoise.training.solid.export RUN OUT_DIR``.
 
 Writes, each atomically:
 
@@ -22,10 +22,10 @@ import sys
 import torch
 from torch import nn
 
-from backend._export import export as _ex
-from backend.onnx_models import sha256_file
-from backend.solid.harmonic import to_json
-from backend.solid.model import exemplar_category, measure_harmonics
+from omninoise import export as _ex
+from omninoise.backend.onnx_models import sha256_file
+from omninoise.backend.solid.harmonic import to_json
+from omninoise.backend.solid.model import exemplar_category, measure_harmonics
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
 from .model import COLOUR_STATS, colour_stats, spectral_gains
@@ -153,7 +153,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
     _ex.write_json(path, doc)
     if cfg.mode == "space" and cfg.colour == "affine" and cfg.dim == 3:
         # each name's Gaussian rest, as the runtime's check keeps it for its photo (it renders the export itself)
-        from backend.solid.model import SolidTextureModel
+        from omninoise.backend.solid.model import SolidTextureModel
 
         from .harmonics import rests_of
 
@@ -165,7 +165,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.solid.export", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.export", description=__doc__.split("\n")[0])
     ap.add_argument("run", help="training run folder (holds ckpt.pt)")
     ap.add_argument("out", help="output folder for the .onnx files and solid.json")
     a = ap.parse_args(argv)

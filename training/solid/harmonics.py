@@ -1,4 +1,4 @@
-"""Store a photo model's harmonic parts: ``python -m training.solid.harmonics MODEL_DIR [--remove]``.
+"""Store a photo model's harmonic parts: ``python -m omninoise.training.solid.harmonics MODEL_DIR [--remove]``.
 
 A space photo model (the texture-space model) stores one part per named code (``code_harmonics``), measured from
 the training photo that names it (a category's first: the export's rule), and that photo's Gaussian rest where the
@@ -28,11 +28,11 @@ import tempfile
 
 import numpy as np
 
-from backend._export import export as _ex
-from backend.onnx_models import ModelError
-from backend.solid.harmonic import to_json
-from backend.solid.model import SolidTextureModel, exemplar_category
-from backend.solid.spectral import rest_to_json
+from omninoise import export as _ex
+from omninoise.backend.onnx_models import ModelError
+from omninoise.backend.solid.harmonic import to_json
+from omninoise.backend.solid.model import SolidTextureModel, exemplar_category
+from omninoise.backend.solid.spectral import rest_to_json
 
 from .photo_set import expand
 
@@ -89,7 +89,7 @@ def measure_codes(folder: str, root: str = ".", tolerance: float = 1e-3) -> tupl
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.solid.harmonics", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.harmonics", description=__doc__.split("\n")[0])
     ap.add_argument("folder", help="a single photo model's folder (holds solid.json)")
     ap.add_argument("--remove", action="store_true", help="take the stored harmonic part out")
     ap.add_argument("--root", default=".", help="where the exemplar paths in solid.json start")

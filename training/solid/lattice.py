@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
-from backend.solid.spin import check_mode, octave_spins
+from omninoise.backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
+from omninoise.backend.solid.spin import check_mode, octave_spins
 
 __all__ = ["octave_seeds", "salted_seeds", "lattice_noise", "lowbias32_torch", "octave_positions", "spun_torch"]
 

@@ -29,10 +29,10 @@ import math
 import torch
 from torch import nn
 
-from backend.solid.brick import FEATURES as BRICK_FEATURES
-from backend.solid.cellular import FEATURES as CELL_FEATURES
-from backend.solid.spin import check_mode
-from backend.solid.waves import FEATURES as WAVE_FEATURES
+from omninoise.backend.solid.brick import FEATURES as BRICK_FEATURES
+from omninoise.backend.solid.cellular import FEATURES as CELL_FEATURES
+from omninoise.backend.solid.spin import check_mode
+from omninoise.backend.solid.waves import FEATURES as WAVE_FEATURES
 from ..precision import autocast
 from .brick import brick_features
 from .cellular import cellular_features

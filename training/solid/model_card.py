@@ -1,6 +1,6 @@
-"""Write the solid-texture model card: ``python -m training.solid.model_card``.
+"""Write the solid-texture model card: ``python -m omninoise.training.solid.model_card``.
 
-    python -m training.solid.model_card --models models/solid --runs runs/solid \\
+    python -m omninoise.training.solid.model_card --models models/solid --runs runs/solid \\
         --eval out/bench/solid_eval.json -o models/solid/MODEL_CARD.md
 
 Everything in the card is read from files the project's own commands wrote:
@@ -189,12 +189,12 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "Exemplars\" (CVPR 2020), trained by this project's code (`training/solid/`) on CPU.", "",
          "## How they were made", "", "```sh",
          "# one model per config (the table's configs column; configs/solid/ holds them): exemplar, dimension, schedule",
-         "python -m training.solid.structure_features --out runs/structnet/net_cmd.pt   # models with a structure term",
-         "python -m training.solid.train --config configs/solid/photo_singles/NAME.json --out runs/solid/NAME",
-         "python -m training.solid.export runs/solid/NAME models/solid/NAME",
+         "python -m omninoise.training.solid.structure_features --out runs/structnet/net_cmd.pt   # models with a structure term",
+         "python -m omninoise.training.solid.train --config configs/solid/photo_singles/NAME.json --out runs/solid/NAME",
+         "python -m omninoise.training.solid.export runs/solid/NAME models/solid/NAME",
          "python bench/eval_solid.py --speed",
          "python bench/eval_solid_singles.py --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/img/solid_singles.json",
-         "python -m training.solid.model_card --singles docs/img/solid_singles.json -o models/solid/MODEL_CARD.md",
+         "python -m omninoise.training.solid.model_card --singles docs/img/solid_singles.json -o models/solid/MODEL_CARD.md",
          "```", "",
          "- **Exemplars:** the single-exemplar models named by a photo were each fitted to one colour photo of "
          "the photo set's training split (`data/photos/`: package, licence, author and sha256 per file in its "
@@ -257,7 +257,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
               "(`init_from` names the first run; a longer `steps` restarts the cosine learning-rate decay at the "
               "step where the first run ended), each with the `train` command above. Wall time and loss cover "
               "both stages. This is the longest CPU training the session allowed (no GPU was lent): "
-              "`python -m training.solid.train --config configs/solid/NAME_long.json "
+              "`python -m omninoise.training.solid.train --config configs/solid/NAME_long.json "
               "--out runs/solid/NAME_long` after the first run."]
     L += ["", "Full sha256 of every file: each model's `solid.json` (`files`); the runtime refuses a file whose "
           "hash differs. Configs: the configs column, under `configs/solid/`.", ""]
@@ -355,7 +355,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.solid.model_card", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.model_card", description=__doc__.split("\n")[0])
     ap.add_argument("--models", default="models/solid")
     ap.add_argument("--runs", default="runs/solid")
     ap.add_argument("--eval", default="out/bench/solid_eval.json")
@@ -371,7 +371,7 @@ def main(argv=None) -> int:
     if os.path.isfile(a.out):      # sections other tools wrote (the photo space model's, ...) are kept
         with open(a.out, encoding="utf-8") as fh:
             text = keep_other_sections(fh.read(), text)
-    from backend._export import export
+    from omninoise import export
 
     export.write_text(a.out, text)
     print(a.out)

@@ -1,6 +1,6 @@
 """The photo texture-space section of the solid-texture model card.
 
-    python -m training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
+    python -m omninoise.training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
         [--shipped] -o models/solid/MODEL_CARD.md
 
 Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``; or its export's ``solid.json``
@@ -18,7 +18,7 @@ import os
 import re
 import sys
 
-from backend._export import export as _ex
+from omninoise import export as _ex
 from ..model_card import read_json
 
 BEGIN, END = "<!-- photo-space:begin -->", "<!-- photo-space:end -->"
@@ -100,12 +100,12 @@ def stage_commands(configs) -> list:
         elif i and cfg.get("init_from"):
             lines.append(f"# continues {cfg['init_from']} (the stage above)")
         elif i and cfg.get("init_onnx"):  # starts from the stage above's export
-            lines.append(f"python -m training.solid.export runs/solid/{prev} {cfg['init_onnx']}   # sha256 "
+            lines.append(f"python -m omninoise.training.solid.export runs/solid/{prev} {cfg['init_onnx']}   # sha256 "
                          f"{cfg.get('init_sha256', '?')[:12]}..., which the next stage starts from")
         net = cfg.get("structure_net")
         if net and cfg.get("structure_weight") and not any(net in line for line in lines):
-            lines.append(f"python -m training.solid.structure_features --out {net}   # the structure term's network")
-        lines.append(f"python -m training.solid.train --config {path} --out runs/solid/{cfg['name']}")
+            lines.append(f"python -m omninoise.training.solid.structure_features --out {net}   # the structure term's network")
+        lines.append(f"python -m omninoise.training.solid.train --config {path} --out runs/solid/{cfg['name']}")
         prev = cfg["name"]
     return lines
 
@@ -126,16 +126,16 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "training photos are CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or Expat).", "",
          "```sh", "python tools/build_photo_set.py            # the photo set from the packages (already committed)",
          *stage_commands(configs),
-         *([f"python -m training.solid.average --out {run} {' '.join(f['averaged_runs'])}   # the mean of "
+         *([f"python -m omninoise.training.solid.average --out {run} {' '.join(f['averaged_runs'])}   # the mean of "
             "their weights"] if f["averaged"] else []),
-         f"python -m training.solid.export {run if f['averaged'] else 'runs/solid/' + cfg['name']} models/solid/space",
+         f"python -m omninoise.training.solid.export {run if f['averaged'] else 'runs/solid/' + cfg['name']} models/solid/space",
          "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
          f"- **Run:** {step} steps, {'the last stage at ' if f['stages'] else ''}batch {cfg['batch']} "
          f"({cfg['crop']}² crops and slices), "
          f"{f['seconds'] / 60:.1f} min wall in all stages, on {f['hardware'] or 'hardware not recorded'}"
          + (f"; final loss (median of the last ten logged) {f['loss']:.4f}." if f["loss"] is not None else
             f"; the mean of its weights at steps {' and '.join(map(str, f['averaged']))} (stochastic weight "
-            "averaging, Izmailov et al. 2018: `python -m training.solid.average`)." if f["averaged"] else
+            "averaging, Izmailov et al. 2018: `python -m omninoise.training.solid.average`)." if f["averaged"] else
             " (read from the export; the run folder and its loss log were not kept).")
          + (f" Stopped at step {step} of its {cfg['steps']}-step cosine schedule (the session's time; "
             f"learning rate {f['lr']:.2g} at the end); `--out` the same folder resumes it."

@@ -39,11 +39,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from backend.solid.band_distance import laplacian_bands
-from backend.solid.cellular import cellular_features_numpy
-from backend.solid.lattice import lattice_noise
-from backend.solid.model import plane_points
-from backend._export import export as _ex
+from omninoise.backend.solid.band_distance import laplacian_bands
+from omninoise.backend.solid.cellular import cellular_features_numpy
+from omninoise.backend.solid.lattice import lattice_noise
+from omninoise.backend.solid.model import plane_points
+from omninoise import export as _ex
 
 __all__ = ["laplacian_pyramid", "patch_swd", "mean_colour_error", "pixel_shuffle", "random_phase", "gaussian_noise",
            "perlin_hist",
@@ -199,7 +199,7 @@ def gaussian_noise(photo: np.ndarray, size: int, rng: np.random.Generator) -> np
     vary from draw to draw (random phase noise keeps the photo's), as those of a Gaussian solid's slices do, so it is
     the 2D draw a Gaussian solid can be compared with on an unoriented photo.  The photo's size, cropped to
     ``size``."""
-    from backend.periodic import periodic_component
+    from omninoise.backend.periodic import periodic_component
 
     u = np.asarray(photo, np.float64)[..., :3]
     m = u.reshape(-1, 3).mean(0)

@@ -66,7 +66,7 @@ def phase_randomised(g: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Random-phase twins (Galerne et al. 2011) of images g (n, H, W): the moduli of the Fourier transform of each
     image's periodic component with the phases of white noise's, the mean kept, then rank-mapped back onto the
     image's own values (same histogram).  float32 (n, H, W)."""
-    from backend.periodic import periodic_component
+    from omninoise.backend.periodic import periodic_component
 
     p = periodic_component(g)
     n, H, W = g.shape
@@ -158,12 +158,12 @@ def main(argv=None) -> int:
     import argparse
     import os
 
-    from backend._export import export as _ex
+    from omninoise import export as _ex
 
     from . import exemplars as ex
     from ..threads import cpu_threads
 
-    ap = argparse.ArgumentParser(prog="python -m training.solid.structure_features",
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.structure_features",
                                  description="Train the structure network on the photo set (issue 20).")
     ap.add_argument("--out", required=True, help="the network file to write (weights and record)")
     ap.add_argument("--steps", type=int, default=1500)

@@ -1,4 +1,4 @@
-"""Train a neural solid texture: ``python -m training.solid.train --config CONFIG.json --out RUN``.
+"""Train a neural solid texture: ``python -m omninoise.training.solid.train --config CONFIG.json --out RUN``.
 
 Single mode (``mode: "single"``): one exemplar; the decoder f, the code e and
 the transforms T_i are optimised directly (Henzler et al. 2020, Sec. 4,
@@ -32,7 +32,7 @@ from dataclasses import asdict, dataclass, replace
 
 import torch
 
-from backend._export import export as _ex
+from omninoise import export as _ex
 from ..threads import cpu_threads
 from ..config import check_config_keys
 from ..model_card import cpu_name
@@ -48,9 +48,9 @@ from .structure_features import StructureFeatures, load_structure_net
 from .swd import SlicedFeatures, swd_loss
 from .warm_start import exported_weights, warm_start
 from .waves import photo_waves, wave_share
-from backend.onnx_models import load_model_json
-from backend.solid.harmonic import photo_harmonics, remove_harmonics
-from backend.solid.spin import check_mode
+from omninoise.backend.onnx_models import load_model_json
+from omninoise.backend.solid.harmonic import photo_harmonics, remove_harmonics
+from omninoise.backend.solid.spin import check_mode
 
 __all__ = ["SolidConfig", "load_config", "build_model", "train", "render", "fit_schedule", "noise_gain",
            "snapshot_path"]
@@ -106,7 +106,7 @@ class SolidConfig:
     log_every: int = 25
     checkpoint_every: int = 250
     snapshot_every: int = 0         # also keep the model's weights every this many steps and at the end in
-                                    # RUN/snapshots/ (weight averaging: python -m training.solid.average
+                                    # RUN/snapshots/ (weight averaging: python -m omninoise.training.solid.average
                                     # --snapshots RUN); 0: off
     threads: int = 0                # CPU threads for torch and numba (0: their defaults)
     device: str = "cpu"             # "cpu" or "cuda" / "cuda:N" (model, loss and crops there; the random draws
@@ -167,7 +167,7 @@ class SolidConfig:
                 raise ValueError(f"{key} must be a number >= 0, got {getattr(cfg, key)!r}")
         if cfg.structure_weight and not cfg.structure_net:
             raise ValueError("structure_weight needs structure_net, the file of a trained structure network "
-                             "(python -m training.solid.structure_features --out FILE)")
+                             "(python -m omninoise.training.solid.structure_features --out FILE)")
         if cfg.noise_ramp:
             if not (isinstance(cfg.noise_ramp, int) and 0 < cfg.noise_ramp < cfg.steps):
                 raise ValueError(f"noise_ramp must be a whole number of steps in 1 .. steps - 1, got {cfg.noise_ramp!r}")
@@ -316,7 +316,7 @@ def structure_features(path: str, device: str = "cpu") -> StructureFeatures:
     if key not in _STRUCTURE:
         if not os.path.isfile(key[0]):
             raise ValueError(f"structure_net: no trained structure network at {path!r} "
-                             f"(make one: python -m training.solid.structure_features --out {path})")
+                             f"(make one: python -m omninoise.training.solid.structure_features --out {path})")
         _STRUCTURE[key] = StructureFeatures(load_structure_net(key[0])).to(device)
     return _STRUCTURE[key]
 
@@ -521,7 +521,7 @@ def _train(cfg: SolidConfig, out: str, max_steps: int | None, log, budget_second
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.solid.train", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.train", description=__doc__.split("\n")[0])
     ap.add_argument("--config", required=True, help="JSON config (keys: SolidConfig)")
     ap.add_argument("--out", required=True, help="run folder (ckpt.pt, log.jsonl)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=JSON", help="override a config key")

@@ -27,7 +27,7 @@ import math
 import numpy as np
 import torch
 
-from backend.periodic import periodic_component
+from omninoise.backend.periodic import periodic_component
 
 __all__ = ["photo_waves", "wave_share", "wave_features"]
 

@@ -2,8 +2,10 @@
 import numpy as np
 import pytest
 
-from training.solid.morphology import _functionals, minkowski_curves, morphology_distance
-from training.solid.photo_eval import pixel_shuffle, random_phase
+torch = pytest.importorskip("torch")  # omninoise.training needs torch
+
+from omninoise.training.solid.morphology import _functionals, minkowski_curves, morphology_distance
+from omninoise.training.solid.photo_eval import pixel_shuffle, random_phase
 
 
 def _discs(seed, r=10, n=60, S=192):

@@ -1,0 +1,232 @@
+"""The Python API: four calls that do what the ``omninoise`` command does, through the same code.
+
+Each call returns arrays (float32, indexed ``[y, x]`` or ``[z, y, x]`` as the command line's ``.npy`` files are)
+or, given ``out``, writes the file the command line would write for that name (``.png``, ``.exr``, ``.npy``,
+``.vdb``; atomically) and returns its path.  Bad settings raise :class:`~omninoise.backend.errors.SettingError`
+(a ``ValueError``) naming the setting, before any work.  ``progress`` is called with the fraction done in [0, 1].
+
+>>> import omninoise
+>>> img = omninoise.wave(64, extent=2.0, spectrum=("bandpass", 4, 8), directions=8, seed=3)
+>>> img.shape, img.dtype
+((64, 64), dtype('float32'))
+>>> bool(abs(float(img.mean())) < 0.5 and img.std() > 0)
+True
+>>> omninoise.wave(8, spectrum=("bandpass", 4, 8), directions=0)
+Traceback (most recent call last):
+    ...
+omninoise.backend.errors.SettingError: directions: must lie in [1, 4096], got 0
+
+Sample positions follow one convention everywhere (``docs/guide/formats.md``): the ``N`` samples of an axis sit
+at the cell centres ``(i + 1/2) * extent / N`` of ``[0, extent)``.
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable
+
+import numpy as np
+
+from .backend import limits
+from .backend.errors import SettingError
+
+__all__ = ["wave", "neural", "solid", "bake"]
+
+Progress = Callable[[float], None] | None
+
+
+def _spectrum(value):
+    from .backend.wavenoise.spectra import Spectrum
+
+    if value is None or isinstance(value, Spectrum):
+        return value
+    if isinstance(value, dict):
+        return Spectrum(**value)
+    if isinstance(value, (tuple, list)) and value and isinstance(value[0], str):
+        return Spectrum(*value)
+    raise SettingError("spectrum", f"expected a Spectrum, a dict or a (kind, fmin, fmax[, exponent]) tuple, "
+                                   f"got {value!r}")
+
+
+def _check_out(out: str, allowed: tuple, what: str) -> str:
+    ext = os.path.splitext(out)[1].lower()
+    if ext not in allowed:
+        raise SettingError("out", f"{what} is written as {', '.join(allowed)}, not {ext or out!r}")
+    folder = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(folder):
+        raise SettingError("out", f"output folder does not exist: {folder}")
+    return ext
+
+
+def _check_size(size, low: int = 1) -> int:
+    if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < low:
+        raise SettingError("size", f"must be a whole number >= {low}, got {size!r}")
+    return int(size)
+
+
+def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | None = None,
+         transfer: str | None = None, half: bool = False, progress: Progress = None, **settings):
+    """Wave noise (Guehl et al. 2025) on a ``size``-sample grid over ``[0, extent)`` per axis.
+
+    ``settings`` are :class:`~omninoise.backend.wavenoise.settings.WaveSettings` fields (``dim`` 2, 3 or 4,
+    ``spectrum``, ``directions``, ``seed``, ``output``, ``waveform``, ``cellular``, ...); ``spectrum`` may be a
+    :class:`~omninoise.backend.wavenoise.spectra.Spectrum`, a dict of its fields or a tuple
+    ``(kind, fmin, fmax[, exponent])`` with frequencies in cycles per unit.  ``time`` is the animation time (or
+    the fourth coordinate w for ``dim=4``).
+
+    Returns float32 ``(size, size)`` for ``dim=2`` and ``(size, size, size)`` (``[z, y, x]``) for 3D and 4D, or,
+    with ``out``, writes ``.npy``, ``.exr``, ``.png`` (2D) or ``.vdb`` (3D) as ``omninoise wave -o`` does, through
+    the RGBA ramp ``transfer`` (a preset name or a ramp ``.json``) where given, and returns the path.
+
+    >>> vol = wave(16, dim=3, spectrum=("fractal", 1, 6), directions=8)
+    >>> vol.shape
+    (16, 16, 16)
+    """
+    from .backend.bake import BakeSpec, evaluate_values, run_bake
+    from .backend.sources import BoxGrid, WaveSource
+    from .backend.transfer import load_transfer
+    from .backend.wavenoise.settings import WaveSettings
+
+    size = _check_size(size)
+    limits.positive("extent", extent)
+    limits.finite("time", time)
+    if "spectrum" in settings:
+        settings["spectrum"] = _spectrum(settings["spectrum"])
+    s = WaveSettings(**settings)
+    rank = 2 if s.dim == 2 else 3
+    ext = None
+    if out is not None:
+        ext = _check_out(out, (".npy", ".exr", ".png") if s.dim == 2 else (".npy", ".vdb"), f"a {s.dim}D grid")
+        rank = 3 if ext == ".vdb" or (ext == ".npy" and s.dim > 2) else 2
+    elif transfer is not None:
+        raise SettingError("transfer", "maps values onto a ramp for a file; give out= too")
+    limits.check_memory("size", float(size) ** rank * 4 * 2, f"a {size}-sample {s.dim}D grid")
+    grid = BoxGrid((size,) * rank, ((0.0, 0.0, 0.0), (float(extent),) * 3))
+    source = WaveSource(s)
+    if out is None:
+        return evaluate_values(source, grid.validate(), float(time), progress)
+    tf = load_transfer(transfer) if transfer else None
+    run_bake(BakeSpec("wave", source, grid, out, tf, time=float(time), half=half), progress, force=True)
+    return out
+
+
+def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int = 0, steps: int | None = None,
+           sampler: str | None = None, tileable: bool = False, model: str | None = None, out: str | None = None,
+           progress: Progress = None):
+    """Neural noise (Maesumi et al. 2024): one class of the shipped diffusion model, ``size`` x ``size`` pixels.
+
+    ``noise`` is a class name (``omninoise neural --list`` lists them with their ``params``), ``seed`` picks the
+    sample, ``steps`` and ``sampler`` the solver (defaults: the command line's), ``tileable`` makes a seamless tile
+    (``size`` a multiple of 8), ``model`` another model folder.
+
+    Returns float32 ``(size, size)`` in [0, 1], top row first, or, with ``out`` (``.png``, ``.exr``, ``.npy``),
+    writes it as ``omninoise neural -o`` does and returns the path.
+
+    >>> img = neural("perlin", 32, steps=2, seed=1)
+    >>> img.shape, bool(0.0 <= img.min() and img.max() <= 1.0)
+    ((32, 32), True)
+    """
+    from .backend.neural.model import ModelError, NeuralNoiseModel
+    from .backend.neural.request import NeuralRequest, generate_request
+    from .backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from .backend.paths import neural_model
+
+    size = _check_size(size, 8)
+    if out is not None:
+        _check_out(out, (".png", ".exr", ".npy"), "a neural noise image")
+    limits.check_memory("size", float(size) ** 2 * 4 * 160, f"a {size}² neural image (activations)")
+    try:
+        net = NeuralNoiseModel(model or neural_model())
+    except ModelError as exc:
+        raise SettingError("model", str(exc)) from None
+    req = NeuralRequest("uniform", [(noise, dict(params or {}))], width=size, height=size, seed=seed,
+                        steps=DEFAULT_STEPS if steps is None else steps, sampler=sampler or DEFAULT_SAMPLER,
+                        tileable=tileable).check(net)
+    cb = None if progress is None else (lambda i, n, x0: progress((i + 1) / n))
+    img = np.asarray(generate_request(net, req, callback=cb), np.float32)
+    if out is None:
+        return img
+    from .export.images import preview_8bit, write_image, write_png
+
+    if out.lower().endswith(".png"):
+        write_png(out, preview_8bit(img, 0.0, 1.0))
+    else:
+        write_image(out, img)
+    return out
+
+
+def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: str = "neural", seed: int = 0,
+          scale: float = 1.0, refine: int = 0, periodic: bool = True, model: str | None = None,
+          out: str | None = None, progress: Progress = None):
+    """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, or sRGB
+    float pixels ``(H, W, 3)`` in [0, 1]).
+
+    ``method`` is ``"neural"`` (the models' texture, 2D or 3D), ``"spectral"`` (the photo's spectrum and colours
+    on every cut, 2D or 3D) or ``"synthesis"`` (a seamless 2D image); ``scale`` is output pixels per exemplar
+    pixel; ``refine`` search steps improve a photo's code; ``periodic`` keeps a photo's courses and planks.
+
+    Returns scene-linear RGB float32: ``(size, size, 3)`` for ``dim=2`` (the front view: x right, z up, top row
+    first) or ``(size, size, size, 3)`` indexed ``[z, y, x]`` for ``dim=3``; or, with ``out``, writes it as
+    ``omninoise solid -o`` does (2D ``.png``/``.exr``/``.npy``, 3D ``.vdb``/``.npy``) and returns the path.
+
+    >>> rgb = solid("grass", 16)
+    >>> rgb.shape, rgb.dtype
+    ((16, 16, 3), dtype('float32'))
+    """
+    from .backend.colour import srgb_to_linear
+    from .backend.solid.request import SolidRequest
+
+    size = _check_size(size)
+    if dim not in (2, 3) or isinstance(dim, bool):
+        raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
+    limits.positive("scale", scale)
+    limits.check_memory("size", float(size) ** dim * 4 * 4, f"a {size}-sample {dim}D texture")
+    if out is not None:
+        _check_out(out, (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy"), f"a {dim}D texture")
+    req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method).check()
+    if dim == 3:
+        from .backend.bake import BakeSpec, evaluate_values, run_bake
+        from .backend.sources import BoxGrid, solid_volume
+
+        source, extent = solid_volume(req, size, float(scale))
+        grid = BoxGrid((size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
+        if out is None:
+            return evaluate_values(source, grid.validate(), 0.0, progress)
+        run_bake(BakeSpec("solid", source, grid, out), progress, force=True)
+        return out
+    rgb = req.front_image(size, float(scale), draw_progress=progress)
+    if out is None:
+        return np.asarray(srgb_to_linear(rgb), np.float32)
+    from .export.images import preview_8bit, write_image, write_png
+
+    if out.lower().endswith(".png"):
+        write_png(out, preview_8bit(rgb, 0.0, 1.0))
+    else:
+        write_image(out, srgb_to_linear(rgb))
+    return out
+
+
+def bake(job: str, *, only: list | None = None, force: bool = False, keep_going: bool = False,
+         progress: Progress = None) -> list:
+    """Run the bakes of a TOML job file (``docs/guide/jobs.md``) as ``omninoise bake JOB`` does: outputs that are
+    up to date are skipped unless ``force``; ``only`` names the bakes to run.
+
+    Returns one :class:`~omninoise.backend.jobs.JobOutcome` per bake (``name``, ``status`` ``"baked"``,
+    ``"up to date"``, ``"invalid"``, ``"failed"`` or ``"cancelled"``, ``message``).  A job file that cannot be read
+    raises :class:`~omninoise.backend.jobs.JobError`; without ``keep_going`` the first failed bake stops the job and
+    ends the list.
+
+    >>> import os, tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> with open(os.path.join(d, "job.toml"), "w") as fh:
+    ...     _ = fh.write('[[bake]]\\nname = "clouds"\\noutput = "clouds.exr"\\nresolution = [16, 16]\\n'
+    ...                  '[bake.source]\\nkind = "wave"\\n')
+    >>> [(o.name, o.status) for o in bake(os.path.join(d, "job.toml"))]
+    [('clouds', 'baked')]
+    >>> [(o.name, o.status) for o in bake(os.path.join(d, "job.toml"))]
+    [('clouds', 'up to date')]
+    """
+    from .backend.jobs import run_job
+
+    if not isinstance(job, (str, os.PathLike)) or not os.path.isfile(job):
+        raise SettingError("job", f"job file not found: {job!r}")
+    return run_job(os.fspath(job), keep_going=keep_going, force=force, only=only, progress=progress)
