@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: all setup kernel demo test test-blender bench dist clean
+.PHONY: all setup kernel demo test test-blender bench docs dist clean
 
 all: test
 
@@ -75,6 +75,13 @@ $(VENV)/.bench: $(STAMP) requirements-bench.txt
 
 bench: $(VENV)/.bench kernel
 	$(BIN)/python bench/bench_wave.py
+
+# the README's pictures from make demo's output, and docs/benchmarks.md from the benchmarks' JSON
+README_PICTURES := gallery.png showcase_render.png volumes_render.png neural.png neural_panel.png solid_slices.png solid_render.png
+docs: $(STAMP)
+	@for f in $(README_PICTURES); do test -f out/demo/$$f || { echo "make docs: out/demo/$$f is missing: run make demo first"; exit 2; }; done
+	cp $(addprefix out/demo/,$(README_PICTURES)) docs/img/
+	$(BIN)/python tools/benchmarks_md.py
 
 # installable extension zips (linux-x64, windows-x64, macos-arm64) in dist/, built and validated
 # with Blender's own extension builder from the bpy wheel; Zig (PyPI's ziglang) cross-compiles the

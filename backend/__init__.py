@@ -2,7 +2,7 @@
 
 Wave noise (Guehl et al., "Multi-Dimensional Procedural Wave Noise", TOG 2025):
 
-    >>> from backend import WaveSettings, Spectrum, compile_noise, evaluate_grid
+    >>> from omninoise.backend import WaveSettings, Spectrum, compile_noise, evaluate_grid
     >>> noise = compile_noise(WaveSettings(dim=2, spectrum=Spectrum("bandpass", 4, 8)))
     >>> img = evaluate_grid(noise, size=256, extent=4.0)     # float32 (256, 256)
 

@@ -216,7 +216,7 @@ class NeuralSource:
         self.steps, self.seed, self.tileable = int(steps), int(seed), bool(tileable)
         for spec in self.specs:
             self.model.param_vector(*spec)  # unknown classes / parameters fail now, with their names
-        # animation (issue 26): keyframes whose `frame` is the bake's time (a job sets time = frame number)
+        # animation: keyframes whose `frame` is the bake's time (a job sets time = frame number)
         from .neural.animate import LATENT_MODES
 
         self.keys = list(keys) if keys else None

@@ -1,7 +1,7 @@
-"""Neural noise speed: today's path against the new default, in one run: `python bench/bench_neural.py`.
+"""Neural noise speed: the default against a one-piece network with DDIM, in one run: `python bench/bench_neural.py`.
 
-Today's path is the one-piece network (``eps.onnx``, re-exported from the shipped
-weights into a temporary folder) sampled by DDIM with 30 steps; the new default is
+The reference is the one-piece network (``eps.onnx``, re-exported from the shipped
+weights into a temporary folder) sampled by DDIM with 30 steps; the default is
 the split export (encoder once, denoiser per step) with the default sampler and
 step count, in tiles above 1024 px.  Every configuration runs in a process of its
 own, so its peak resident memory is its own.  Per size it prints seconds per step
@@ -14,7 +14,7 @@ GFLOP/s, beside a float32 matrix product of the same machine in the same run.
 Also the whole command (`omninoise neural`, model loading included) at 256², and at 1024² for the
 new default (with the huge pages the command line gives large images, cli/hugepages.py).
 
-Writes out/bench/neural_speed.json.  Options: --sizes, --threads, --quick (256² and 512² only).
+Writes docs/benchmarks/neural_speed.json.  Options: --sizes, --threads, --quick (256² and 512² only).
 """
 from __future__ import annotations
 
@@ -168,7 +168,7 @@ def main() -> int:
     ap.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024, 2048])
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="256² and 512² only")
-    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_speed.json"))
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "neural_speed.json"))
     a = ap.parse_args()
     if a.worker:
         _worker(a)
@@ -178,8 +178,10 @@ def main() -> int:
 
     sizes = [s for s in a.sizes if s <= 512] if a.quick else a.sizes
     tmp = tempfile.mkdtemp(prefix="omninoise_onepiece_")
-    reexport(a.model, tmp, one_piece=True)  # today's network, from the shipped weights
-    res = dict(threads=a.threads, matmul_gflops=round(matmul_gflops(a.threads), 1), rows=[])
+    reexport(a.model, tmp, one_piece=True)  # the one-piece network, from the shipped weights
+    from stamp import stamp
+
+    res = dict(stamp=stamp(), threads=a.threads, matmul_gflops=round(matmul_gflops(a.threads), 1), rows=[])
     flops = network_gflop(a.model, 256)
     print(f"float32 matmul 2048²: {res['matmul_gflops']} GFLOP/s on {a.threads} threads")
     if flops:
@@ -190,8 +192,8 @@ def main() -> int:
     print("|---|---|---|---|---|---|---|---|")
     for S in sizes:
         pair = []
-        for label, folder, sampler, steps in (("today: one-piece, DDIM 30", tmp, "ddim", 30),
-                                              (f"new: split, {DEFAULT_SAMPLER} {DEFAULT_STEPS}", a.model,
+        for label, folder, sampler, steps in (("one-piece, DDIM 30", tmp, "ddim", 30),
+                                              (f"default: split, {DEFAULT_SAMPLER} {DEFAULT_STEPS}", a.model,
                                                DEFAULT_SAMPLER, DEFAULT_STEPS)):
             r = _run(dict(model=folder, size=S, sampler=sampler, steps=steps, threads=a.threads))
             r["path"] = label
@@ -214,13 +216,13 @@ def main() -> int:
                   f"{pair[0]['image_s'] / pair[1]['image_s']:.2f}x | | | |", flush=True)
     old = whole_command(["--model", tmp, "--sampler", "ddim", "--steps", "30"], a.threads)
     new = whole_command([], a.threads)
-    res["whole_command_256"] = dict(today_s=round(old, 2), new_s=round(new, 2), ratio=round(old / new, 2))
-    print(f"\nwhole command at 256² (start-up and model loading included): today {old:.1f} s, new {new:.1f} s "
+    res["whole_command_256"] = dict(one_piece_ddim30_s=round(old, 2), default_s=round(new, 2), ratio=round(old / new, 2))
+    print(f"\nwhole command at 256² (start-up and model loading included): one-piece DDIM 30 {old:.1f} s, default {new:.1f} s "
           f"({old / new:.2f}x)")
-    if 1024 in sizes:   # the new default only (today's takes about nine minutes); huge pages as users get them
+    if 1024 in sizes:   # the default only (DDIM 30 takes about nine minutes); huge pages as users get them
         big = whole_command([], a.threads, 1024)
-        res["whole_command_1024"] = dict(new_s=round(big, 2))
-        print(f"whole command at 1024², new: {big:.1f} s")
+        res["whole_command_1024"] = dict(default_s=round(big, 2))
+        print(f"whole command at 1024², default: {big:.1f} s")
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     from omninoise.export.atomic import write_json
 

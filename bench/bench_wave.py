@@ -12,7 +12,7 @@ of its two table-read forms (register windows or gathers), as the engine picks.
 "wave 16 dirs, numba kernel" is the same engine with the C row kernel switched off.
 Then streams a 512^3 grid and reports peak memory against the output's size.
 
-Run: make bench   (numbers: median of --repeat runs, wall clock, this machine)
+Run: make bench   (numbers: median of --repeat runs, wall clock, this machine; JSON in docs/benchmarks/)
 """
 from __future__ import annotations
 
@@ -32,6 +32,7 @@ sys.path.insert(0, ROOT)
 
 from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
 from omninoise.backend.wavenoise import ckernel, fast  # noqa: E402
+from stamp import DATA, stamp  # noqa: E402
 
 
 def timed(fn, repeat):
@@ -166,7 +167,7 @@ def peak_memory_512() -> dict:
     # appeared to need less than its output
     code = (
         "import resource, numpy as np, sys; sys.path.insert(0, %r)\n"
-        "from backend import *\n"
+        "from omninoise.backend import *\n"
         "def hwm():\n"
         "    try:\n"
         "        return int([l for l in open('/proc/self/status') if l.startswith('VmHWM')][0].split()[1])\n"
@@ -197,14 +198,14 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="smaller grids (smoke run)")
-    ap.add_argument("--json", default=os.path.join(ROOT, "out", "bench", "wave.json"))
+    ap.add_argument("--json", default=os.path.join(DATA, "wave.json"), help="default: docs/benchmarks/wave.json")
     a = ap.parse_args()
     cases = [(2, 256), (3, 48)] if a.quick else [(2, 1024), (3, 128), (3, 256)]
     dirs = (8, 16) if a.quick else (8, 16, 32, 64)
     engine = ("C kernel (" + ("AVX2" if ckernel.vector() else "scalar") + ")" if ckernel.available()
               else "numba" if fast.available() else "numpy")
     print(f"wave noise engine: {engine} grid rows, {os.cpu_count()} cores")
-    results = {}
+    results = {"stamp": stamp(), "engine": engine}
     floor = {} if a.quick else lookup_floor()
     for dim, n in cases:
         samples = n ** dim

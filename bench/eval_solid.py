@@ -11,7 +11,7 @@ exemplar's histogram, a linear noise transform).
 Speed and memory (Table 2): points per second and peak resident memory for a
 2D 1024² image and a 3D 256³ volume, onnxruntime (numba lattice noise + ONNX
 decoder, what the add-on runs) against torch with the same weights, each in a
-fresh process.  Writes out/bench/solid_eval.json.
+fresh process.  Writes docs/benchmarks/solid_eval.json.
 """
 from __future__ import annotations
 
@@ -168,7 +168,7 @@ def main() -> int:
     ap.add_argument("--speed-one", choices=("onnxruntime", "torch"), help=argparse.SUPPRESS)
     ap.add_argument("--dim", type=int, default=3, help=argparse.SUPPRESS)
     ap.add_argument("--size", type=int, default=256, help=argparse.SUPPRESS)
-    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_eval.json"))
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "solid_eval.json"))
     a = ap.parse_args()
     if a.speed_one:
         print(json.dumps(speed_one(a.speed_one, a.model, a.run, a.dim, a.size)))
@@ -195,6 +195,9 @@ def main() -> int:
         for dim in (2, 3):
             o, t = (next(r for r in res["speed"] if r["dim"] == dim and r["engine"] == e) for e in ("onnxruntime", "torch"))
             print(f"{dim}D: onnxruntime / torch speed = {o['points_per_s'] / t['points_per_s']:.2f}x")
+    from stamp import stamp
+
+    res["stamp"] = stamp()
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
     write_json(a.out, res)
     return 0

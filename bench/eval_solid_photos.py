@@ -15,9 +15,8 @@ Against the photo, per slice axis and pooled:
   (``training.solid.photo_eval.grouped_swd``): the distance falls as more images
   are pooled, so the pooled figure meets 3 x seeds draws, walls 2 x seeds and
   each axis seeds (``random_phase_axes``, ``random_phase_walls``, and the same
-  for ``photo_crop``).  Until November 27, 2026 the baselines were scored as
-  ``seeds`` images against the model's pooled 3 x seeds, which favoured the
-  model on the pooled and walls figures (the per-axis ones were fair);
+  for ``photo_crop``): scoring the baselines on fewer images than the model
+  would favour the model on the pooled and walls figures;
 - ``morph``: the level-set morphology distance of :mod:`training.solid.morphology`
   (boundary length and Euler characteristic of quantile excursion sets: region
   sizes, outlines, connectivity), lower is better, beside random phase noise's

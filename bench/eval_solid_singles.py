@@ -12,8 +12,7 @@ such model, with 2 seeds of 128² images (3D models: x, y and z slices pooled, o
   random phase noise (``random_phase``), the pixel shuffle (``pixel_shuffle``) and the shipped space model
   given that region (``space``: encode with the region's harmonic part, translate, slices); ``photo_crop``: random 128² crops of the training
   region itself (the floor: the photo against its own other part).  Each alternative is scored on as many images
-  as the model (before November 27, 2026 the baselines were two images against a 3D model's six, which
-  favoured the model);
+  as the model (fewer images would favour the model);
 - ``colour``: mean colour error against the strip; ``morph``: the level-set morphology distance
   (training/solid/morphology.py), with random phase noise's beside it.
 

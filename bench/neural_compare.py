@@ -1,7 +1,7 @@
 """Compare two evaluations of `bench/eval_neural.py`: `python bench/neural_compare.py BEFORE.json AFTER.json`.
 
 Prints, as Markdown, the tables the model card and the README show for a candidate against the model it would
-replace (issue 22's test: the median per-class FD at most half, no class worse): the aggregate measures side by side
+replace (the test: the median per-class FD at most half, no class worse): the aggregate measures side by side
 with their ratio, then one row per class (FD before and after, ratio, accuracy, PSD errors).  Both evaluations must
 use one instrument: the same evaluation size, classifier, sampler, samples per class and classes; otherwise the
 comparison is refused with a one-line error naming what differs (their FDs would be on different scales).

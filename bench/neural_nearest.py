@@ -1,6 +1,6 @@
 """Is each class's generated image nearest to its own zoo class? `python bench/neural_nearest.py --model M [...]`.
 
-Issue 22 asks that every class's generated images at 256² be nearer, by spectrum and histogram, to the zoo's
+The test: every class's generated images at 256² should be nearer, by spectrum and histogram, to the zoo's
 images of that class than to those of any other class, except classes that are near-duplicates in the zoo
 itself.  This prints and writes (``-o``, JSON) both halves of that test with the measure of
 ``training/evaluate.py`` (:func:`look`: the shape of the radial power spectrum in 24 log-spaced bands and 32

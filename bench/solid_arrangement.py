@@ -1,6 +1,6 @@
 """Does a solid-texture loss prefer stones to speckle?  ``python bench/solid_arrangement.py [PHOTO ...]``
 
-Issue 20: fits settle in speckle because the training loss hardly prefers the
+Fits settle in speckle because the training loss hardly prefers the
 right arrangement once the colours are right.  For each photo (default: the
 paving stones the capacity study fits, and held-out paving, brick, rock and
 gravel photos), candidate images of SIZE² px are scored against random crops of

@@ -1,4 +1,4 @@
-"""Can the per-point decoder over noise octaves carry a photo's structure at all? (issue 20)
+"""Can the per-point decoder over noise octaves carry a photo's structure at all?
 
 Single-exemplar 2D models of structured photos (paving stones, brick courses), trained with the sliced
 Wasserstein loss by ``python -m omninoise.training.solid.train --config C --out RUN``, one per decoder size, are

@@ -1,4 +1,4 @@
-"""Can a decoder that sees a neighbourhood draw a photo's structure where the per-point decoder cannot? (issue 20)
+"""Can a decoder that sees a neighbourhood draw a photo's structure where the per-point decoder cannot?
 
 The capacity experiment of ``bench/solid_capacity.py`` with the per-point decoder replaced by the multi-scale
 convolutional generator of ``training/solid/conv_generator.py``: the same single-exemplar 2D config (photo, crop,

@@ -1,7 +1,7 @@
 """The training zoo itself at 256²: `python bench/zoo_sheet.py OUT.png [--size 256] [--seed 0]`.
 
 Every class at its default parameters (what the model is asked to reproduce), labelled, with the orientation
-coherence of each image (1 = one orientation over the whole image): the check of issue 22 that the zoo shows
+coherence of each image (1 = one orientation over the whole image): the check that the zoo shows
 each class's structure at full size before the model is blamed for losing it.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Job files on a Dask cluster (issue 25): `omninoise bake JOB.toml --workers N` or `--cluster ADDRESS`.
+"""Job files on a Dask cluster: `omninoise bake JOB.toml --workers N` or `--cluster ADDRESS`.
 
 The same bakes as a one-machine `omninoise bake`, spread over Dask distributed workers; scheduling, transport
 and retries are Dask's. Imported only when one of those flags is given (Dask is the `farm` extra, never needed

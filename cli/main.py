@@ -56,167 +56,239 @@ def _version_line() -> str:
     return f"omninoise {__version__} (wave noise: {engine_path()})"
 
 
+class _Help(argparse.RawDescriptionHelpFormatter):
+    """Each option's default after its help (unless it has none, is a switch, or the help names it already);
+    descriptions and examples kept as written."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        d = action.default
+        if d is None or isinstance(d, bool) or d == [] or d is argparse.SUPPRESS or "default" in text:
+            return text
+        if action.option_strings or action.nargs in (argparse.OPTIONAL, argparse.ZERO_OR_MORE):
+            return text + " (default: %(default)s)"
+        return text
+
+
+def _sub(sub, name: str, help: str, description: str, examples: str):
+    return sub.add_parser(name, help=help, description=description, formatter_class=_Help,
+                          epilog="examples:\n" + "\n".join("  " + ln for ln in examples.strip().splitlines()))
+
+
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="omninoise", description="OmniNoise: wave noise and neural noise bakes.")
+    ap = argparse.ArgumentParser(
+        prog="omninoise", formatter_class=_Help,
+        description="OmniNoise: wave noise, neural noise and solid textures from photos, as images, arrays and "
+                    "volumes.",
+        epilog="Run 'omninoise SUBCOMMAND --help' for each subcommand's options and examples. Exit status: 0 done, "
+               "2 bad input (one line naming the option), 1 a failure while running, 130 interrupted.")
     ap.add_argument("--version", action="version", version=_version_line())
     ap.add_argument("--debug", action="store_true",
-                    help="show the Python traceback of an internal error (default: one line, exit 1)")
-    sub = ap.add_subparsers(dest="command", required=True)
-    w = sub.add_parser("wave", help="evaluate wave noise (Guehl et al. 2025) on a grid")
-    w.add_argument("--dim", type=int, choices=(2, 3, 4), default=2)
-    w.add_argument("--size", type=int, default=512, help="samples per axis (N)")
-    w.add_argument("--extent", type=float, default=4.0, help="grid spans [0, E) in every dimension")
-    w.add_argument("--time", type=float, default=0.0, help="animation time, or W for --dim 4")
-    w.add_argument("--speed", type=float, default=0.0, help="wave speed (units per unit time); animated noise")
-    w.add_argument("--spectrum", choices=[k for k in SPECTRUM_KINDS if k != "custom"], default="gaussian")
-    w.add_argument("--fmin", type=float, default=2.0, help="band low, cycles per unit (default 2, as job files and the node)")
-    w.add_argument("--fmax", type=float, default=8.0, help="band high, cycles per unit")
-    w.add_argument("--exponent", type=float, default=1.0, help="fractal amplitude exponent (A ~ f^-n)")
-    w.add_argument("--directions", type=int, default=16)
-    w.add_argument("--output", choices=OUTPUTS, default="real")
-    w.add_argument("--waveform", choices=[x for x in WAVEFORMS if x != "custom"] + ["custom"], default="gaussian")
-    w.add_argument("--profile", help="custom waveform: .npy or text file with a 1D profile")
-    w.add_argument("--cellular", choices=CELLULAR_MODES, default="none")
-    w.add_argument("--cell-size", type=float)
-    w.add_argument("--stit-probability", type=float, default=0.5)
-    w.add_argument("--stit-depth", type=int, default=3)
-    w.add_argument("--anisotropy", choices=("none", "axes", "lobes"), default="none")
-    w.add_argument("--axis-spectrum", type=_spectrum_arg, action="append", default=[],
-                   help="per-axis spectrum kind:fmin:fmax (repeat once per axis)")
-    w.add_argument("--lobe", type=_lobe_arg, action="append", default=[], help="lobe axis and weight x,y[,z]:w")
-    w.add_argument("--spread", type=float, default=20.0, help="lobe / plane band half-angle, degrees")
-    w.add_argument("--example", help="grayscale exemplar image (by-example noise)")
-    w.add_argument("--example-plane", choices=("xy", "xz", "yz"), default="xy")
-    w.add_argument("--example-extent", type=float, help="world units across the exemplar (default: --extent)")
-    w.add_argument("--sectors", type=int, default=8)
-    w.add_argument("--transition", type=_spectrum_arg, help="blend towards kind:fmin:fmax along x")
-    w.add_argument("--transition-length", type=float)
-    w.add_argument("--slice-width", type=float)
-    w.add_argument("--table-size", type=int, default=1024)
-    w.add_argument("--period", type=float, help="table period in world units (default: 255 / fmax)")
-    w.add_argument("--seed", type=int, default=0)
-    w.add_argument("--transfer", help="RGBA ramp: a preset (%s) or a ramp .json; colours .exr/.png, "
-                   "adds color (and temperature) grids to .vdb" % ", ".join(PRESETS))
-    w.add_argument("--range", type=float, nargs=2, metavar=("V0", "V1"),
-                   help="noise values mapped to the ramp's ends (default: the ramp's own)")
-    w.add_argument("--half", action="store_true", help=".exr: 16-bit half floats")
-    w.add_argument("--quiet", action="store_true")
-    w.add_argument("-o", "--out", required=True,
-                   help="output: .npy (raw float32), .exr or .png (2D), .vdb (3D: density [+ color])")
+                    help="show the Python traceback of an internal error instead of one line")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
 
-    b = sub.add_parser("bake", help="run the bakes of a TOML job file (see backend/jobs.py or the README)")
+    w = _sub(sub, "wave", "wave noise on a grid",
+             "Wave noise (Guehl et al. 2025): a sum of randomly oriented waves read from 1D tables, in 2D, 3D or 4D, "
+             "still or animated, written as an array, an image or a volume. The grid has --size samples per axis "
+             "over [0, --extent); frequencies are in cycles per unit.",
+             """omninoise wave --size 512 --spectrum bandpass --fmin 4 --fmax 8 -o band.png
+omninoise wave --dim 3 --size 128 --fmin 1 --fmax 6 --transfer clouds -o clouds.vdb
+omninoise wave --dim 3 --size 128 --speed 0.5 --time 2.0 -o frame.npy
+omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
+    g = w.add_argument_group("grid and output")
+    g.add_argument("-o", "--out", required=True,
+                   help="output: .npy (raw float32), .exr or .png (2D), .vdb (3D: density [+ color])")
+    g.add_argument("--dim", type=int, choices=(2, 3, 4), default=2, help="dimensions of the noise")
+    g.add_argument("--size", type=int, default=512, help="samples per axis")
+    g.add_argument("--extent", type=float, default=4.0, help="the grid spans [0, EXTENT) in every dimension")
+    g.add_argument("--time", type=float, default=0.0, help="animation time, or the coordinate W of 4D noise")
+    g.add_argument("--speed", type=float, default=0.0, help="wave speed in units per unit time (animated noise)")
+    g.add_argument("--output", choices=OUTPUTS, default="real", help="which part of the complex noise")
+    g.add_argument("--transfer", help="an RGBA ramp: a preset (%s) or a ramp .json; colours .exr and .png, adds "
+                                      "color (and temperature) grids to .vdb" % ", ".join(PRESETS))
+    g.add_argument("--range", type=float, nargs=2, metavar=("V0", "V1"),
+                   help="noise values mapped to the ramp's ends (default: the ramp's own)")
+    g.add_argument("--half", action="store_true", help="16-bit half floats (.exr and .vdb)")
+    g.add_argument("--seed", type=int, default=0, help="another seed draws other directions and phases")
+    g.add_argument("--quiet", action="store_true", help="no progress bar or notes")
+    g = w.add_argument_group("spectrum")
+    g.add_argument("--spectrum", choices=[k for k in SPECTRUM_KINDS if k != "custom"], default="gaussian",
+                   help="amplitude profile over the band")
+    g.add_argument("--fmin", type=float, default=2.0, help="band low, cycles per unit")
+    g.add_argument("--fmax", type=float, default=8.0, help="band high, cycles per unit")
+    g.add_argument("--exponent", type=float, default=1.0, help="fractal amplitude exponent (A ~ f^-n)")
+    g.add_argument("--directions", type=int, default=16, help="wave directions summed (more: smoother, slower)")
+    g = w.add_argument_group("waveform and cells")
+    g.add_argument("--waveform", choices=[x for x in WAVEFORMS if x != "custom"] + ["custom"], default="gaussian",
+                   help="the profile of each wave")
+    g.add_argument("--profile", help="--waveform custom: a .npy or text file with a 1D profile")
+    g.add_argument("--cellular", choices=CELLULAR_MODES, default="none", help="cellular variant")
+    g.add_argument("--cell-size", type=float, help="cellular: cell size in units (default: from the band)")
+    g.add_argument("--stit-probability", type=float, default=0.5, help="--cellular stit: split probability")
+    g.add_argument("--stit-depth", type=int, default=3, help="--cellular stit: split depth")
+    g = w.add_argument_group("anisotropy")
+    g.add_argument("--anisotropy", choices=("none", "axes", "lobes"), default="none",
+                   help="axes: a spectrum per axis; lobes: directions gathered around axes")
+    g.add_argument("--axis-spectrum", type=_spectrum_arg, action="append", default=[], metavar="KIND:FMIN:FMAX",
+                   help="--anisotropy axes: one per axis, in order")
+    g.add_argument("--lobe", type=_lobe_arg, action="append", default=[], metavar="X,Y[,Z]:WEIGHT",
+                   help="--anisotropy lobes: a lobe's axis and weight (repeat)")
+    g.add_argument("--spread", type=float, default=20.0, help="lobe or plane band half-angle, degrees")
+    g = w.add_argument_group("by example and transitions")
+    g.add_argument("--example", help="a grayscale image whose spectrum the noise takes")
+    g.add_argument("--example-plane", choices=("xy", "xz", "yz"), default="xy", help="the plane the image lies in")
+    g.add_argument("--example-extent", type=float, help="world units across the image (default: --extent)")
+    g.add_argument("--sectors", type=int, default=8, help="angular sectors read from the image's spectrum")
+    g.add_argument("--transition", type=_spectrum_arg, metavar="KIND:FMIN:FMAX",
+                   help="blend towards this spectrum along x")
+    g.add_argument("--transition-length", type=float, help="units over which the blend runs (default: --extent)")
+    g = w.add_argument_group("tables")
+    g.add_argument("--slice-width", type=float, help="width of a direction's slices in units (default: from the band)")
+    g.add_argument("--table-size", type=int, default=1024, help="samples per wave table")
+    g.add_argument("--period", type=float, help="table period in units (default: 255 / fmax)")
+
+    b = _sub(sub, "bake", "run the bakes of a TOML job file",
+             "Run every bake of a job file (TOML): wave, neural and solid sources into .vdb, .exr, .png and .npy "
+             "files, numbered sequences included. Outputs that are up to date are skipped. Every bake is checked "
+             "before any runs. The job-file reference is in docs/guide/jobs.md.",
+             """omninoise bake job.toml
+omninoise bake job.toml --only clouds --force
+omninoise bake job.toml --dry-run
+omninoise bake job.toml --workers 4""")
     b.add_argument("job", help="job file (.toml)")
     b.add_argument("--only", action="append", metavar="NAME", help="bake only these (repeatable)")
     b.add_argument("--force", action="store_true", help="re-bake outputs that are up to date")
     b.add_argument("--keep-going", action="store_true", help="after a failed bake, carry on with the others")
     b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
-    b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (default 0: all cores)")
+    b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (0: all cores)")
     b.add_argument("--precision", default="fp32", choices=PRECISIONS,
-                   help="neural noise denoiser arithmetic (default fp32; int8: faster draft on CPUs with VNNI)")
-    b.add_argument("--quiet", action="store_true")
-    farm = b.add_argument_group("farm (Dask distributed; pip install .[farm])")
+                   help="neural noise arithmetic (int8: a faster draft on CPUs with int8 dot products)")
+    b.add_argument("--quiet", action="store_true", help="no progress bars")
+    farm = b.add_argument_group("farm (Dask; pip install 'omninoise[farm]')")
     farm.add_argument("--workers", type=int, metavar="N", help="bake on a local cluster of N worker processes")
     farm.add_argument("--cluster", metavar="ADDRESS", help="bake on a running Dask scheduler (tcp:// or tls://)")
-    farm.add_argument("--retries", type=int, default=2, help="farm: runs of a failed task after the first (default 2)")
-    farm.add_argument("--brick-voxels", type=int, help="farm: voxels per brick of a large volume (default: from "
-                                                       "the workers' memory)")
-    farm.add_argument("--tls-ca-file", help="farm, tls://: the CA certificate")
-    farm.add_argument("--tls-cert", help="farm, tls://: this client's certificate")
-    farm.add_argument("--tls-key", help="farm, tls://: this client's private key")
+    farm.add_argument("--retries", type=int, default=2, help="runs of a failed task after the first")
+    farm.add_argument("--brick-voxels", type=int, help="voxels per brick of a large volume (default: from the "
+                                                       "workers' memory)")
+    farm.add_argument("--tls-ca-file", help="tls://: the CA certificate")
+    farm.add_argument("--tls-cert", help="tls://: this client's certificate")
+    farm.add_argument("--tls-key", help="tls://: this client's private key")
 
-    n = sub.add_parser("neural", help="neural noise (Maesumi et al. 2024) from the trained ONNX model")
-    n.add_argument("--noise", help="class name (see --list)")
-    n.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
-    n.add_argument("--size", type=int, default=256, help="output side in pixels")
-    n.add_argument("--sampler", default=None, help="ddim, dpmpp_2m or heun (default: dpmpp_2m)")
-    n.add_argument("--steps", type=int, default=None, help="sampler timesteps (default: 10)")
-    n.add_argument("--spacing", default=None,
-                   help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own, see README)")
-    n.add_argument("--eta", type=float, default=None,
-                   help="ddim or dpmpp_2m: step noise, 0 (deterministic) .. 1 (DDPM; the SDE solver); "
-                        "default 0.3 for dpmpp_2m, 0 for ddim; animation is always 0")
-    n.add_argument("--tile", type=int, default=None,
-                   help="generate in overlapping tiles of this side (default: one piece up to 1024 px, "
-                        "else 512 px tiles; 0: never)")
-    n.add_argument("--threads", type=int, default=0, help="CPU threads for onnxruntime (default 0: all cores)")
-    n.add_argument("--precision", default="fp32", choices=PRECISIONS,
-                   help="denoiser arithmetic (default fp32; int8: about 1.7x faster steps on CPUs with int8 dot "
-                        "products (VNNI), images slightly further from the reference)")
-    n.add_argument("--seed", type=int, default=0)
-    n.add_argument("--tileable", action="store_true", help="seamless tile (circular padding); size a multiple of 8")
-    n.add_argument("--blend", metavar="MASK", help="grayscale mask image: white areas take --noise2 / --param2")
-    n.add_argument("--noise2", help="class of the masked area (default: --noise)")
-    n.add_argument("--param2", action="append", default=[], metavar="NAME=VALUE")
-    n.add_argument("--width", type=float, default=32.0, help="blend transition width, px")
-    n.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1 = linear)")
-    n.add_argument("--corners", nargs=4, metavar="SPEC",
+    n = _sub(sub, "neural", "neural noise from the trained diffusion model",
+             "Neural noise (Maesumi et al. 2024): one diffusion model for 23 noise classes and their blends, at "
+             "any size, on the CPU. One class, a blend through a mask, four corners or a painted map; animated "
+             "between keyframes; or fitted to an image.",
+             """omninoise neural --list
+omninoise neural --noise cells_f1 --param scale=12 --size 256 --seed 7 --tileable -o cells.png
+omninoise neural --noise cells_f1 --blend mask.png --noise2 noise --size 256 -o blend.png
+omninoise neural --map painted.png --region '#ff0000=spots' --region '#0000ff=gabor' -o map.png
+omninoise neural --keys anim.toml --frames 1 48 --latent slerp -o morph_####.png
+omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
+    g = n.add_argument_group("noise and output")
+    g.add_argument("--noise", help="class name (see --list)")
+    g.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a class parameter (repeat)")
+    g.add_argument("--size", type=int, default=256, help="output side in pixels")
+    g.add_argument("--seed", type=int, default=0, help="another seed draws another image")
+    g.add_argument("--tileable", action="store_true", help="a seamless tile (size a multiple of 8)")
+    g.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+    g.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
+    g.add_argument("--model", help="another model folder (default: the shipped model)")
+    g.add_argument("--quiet", action="store_true", help="no progress bar")
+    g = n.add_argument_group("blends")
+    g.add_argument("--blend", metavar="MASK", help="a grayscale mask image: white areas take --noise2 / --param2")
+    g.add_argument("--noise2", help="class of the masked area (default: --noise)")
+    g.add_argument("--param2", action="append", default=[], metavar="NAME=VALUE", help="its parameters (repeat)")
+    g.add_argument("--width", type=float, default=32.0, help="blend transition width, px")
+    g.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1: linear)")
+    g.add_argument("--corners", nargs=4, metavar="SPEC",
                    help="four-corner blend: top-left top-right bottom-left bottom-right, each CLASS[:NAME=V,...]")
-    n.add_argument("--map", metavar="PAINTED", help="multi-class map: an indexed/grey or colour-coded image")
-    n.add_argument("--region", action="append", default=[], metavar="KEY=SPEC",
-                   help="--map region: grey index (0-255) or #rrggbb colour = CLASS[:NAME=V,...] (repeat)")
-    n.add_argument("--keys", metavar="KEYS.toml", help="animate: keyframes of class and parameters over frames "
-                                                       "(see backend/neural/animate.py); needs --frames")
-    n.add_argument("--frames", type=int, nargs=2, metavar=("FIRST", "LAST"),
-                   help="animate: write frames FIRST..LAST into -o with '#' for the frame number")
-    n.add_argument("--latent", choices=("fixed", "slerp", "drift"), default="fixed",
-                   help="animate: how the initial latent moves (fixed; slerp between the keys' seeds; drift)")
-    n.add_argument("--drift", type=float, default=0.05, help="animate, --latent drift: radians per frame")
-    n.add_argument("--fit", metavar="IMAGE", help="inverse design: find the class weights, parameters and seed whose "
-                                                  "noise looks like IMAGE (grey; colour is converted), write it to -o")
-    n.add_argument("--report", metavar="FIT.json", help="--fit: write the fitted classes, parameters and seed here")
-    n.add_argument("--fit-size", type=int, default=64, help="--fit: side of the windows compared, px (default 64)")
-    n.add_argument("--model", help="model folder (default: models/neural_noise beside the package)")
-    n.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
-    n.add_argument("--quiet", action="store_true")
-    n.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+    g.add_argument("--map", metavar="PAINTED", help="a painted map: an indexed, grey or colour-coded image")
+    g.add_argument("--region", action="append", default=[], metavar="KEY=SPEC",
+                   help="--map: a grey index (0-255) or #rrggbb colour = CLASS[:NAME=V,...] (repeat)")
+    g = n.add_argument_group("animation")
+    g.add_argument("--keys", metavar="KEYS.toml", help="keyframes of class and parameters over frames (needs "
+                                                       "--frames)")
+    g.add_argument("--frames", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                   help="write frames FIRST..LAST into -o with '#' for the frame number")
+    g.add_argument("--latent", choices=("fixed", "slerp", "drift"), default="fixed",
+                   help="how the initial latent moves: fixed, slerp between the keys' seeds, or drift")
+    g.add_argument("--drift", type=float, default=0.05, help="--latent drift: radians per frame")
+    g = n.add_argument_group("inverse design")
+    g.add_argument("--fit", metavar="IMAGE", help="find the classes, parameters and seed whose noise looks like "
+                                                  "IMAGE and write that noise to -o")
+    g.add_argument("--report", metavar="FIT.json", help="--fit: write the fitted classes, parameters and seed here")
+    g.add_argument("--fit-size", type=int, default=64, help="--fit: side of the windows compared, px")
+    g = n.add_argument_group("sampling and speed")
+    g.add_argument("--sampler", default=None, help="ddim, dpmpp_2m or heun (default: dpmpp_2m)")
+    g.add_argument("--steps", type=int, default=None, help="model evaluations (default: 10)")
+    g.add_argument("--spacing", default=None,
+                   help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own)")
+    g.add_argument("--eta", type=float, default=None,
+                   help="ddim or dpmpp_2m: fresh noise per step, 0 (deterministic) to 1 (default: 0.3 for "
+                        "dpmpp_2m, 0 for ddim; animation always 0)")
+    g.add_argument("--tile", type=int, default=None,
+                   help="draw in overlapping tiles of this side (default: whole up to 1024 px, else 512 px tiles; "
+                        "0: never)")
+    g.add_argument("--threads", type=int, default=0, help="CPU threads (0: all cores)")
+    g.add_argument("--precision", default="fp32", choices=PRECISIONS,
+                   help="int8: about 1.7x faster steps on CPUs with int8 dot products (VNNI), a draft")
 
-    s = sub.add_parser("solid", help="neural solid textures (Henzler et al. 2020) from trained ONNX models")
-    s.add_argument("--exemplar", help="a shipped texture (see --list) or an image file (encoded by the space model)")
-    s.add_argument("--to", metavar="EXEMPLAR", help="interpolate towards this exemplar (space model)")
-    s.add_argument("--mix", type=float, default=0.5, help="interpolation weight of --to, 0..1 (default 0.5)")
-    s.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image (a 3D texture's plane y = 0 seen from the front: x right, z up); 3: a volume")
-    s.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
-    s.add_argument("--scale", type=float, default=1.0,
-                   help="zoom: output pixels per exemplar pixel (default 1, the exemplar's own resolution)")
-    s.add_argument("--seed", type=int, default=0, help="variation: another seed gives another texture of the same kind")
-    s.add_argument("--refine", type=int, default=0, metavar="N",
-                   help="space model: improve an encoded image's code with N search steps (no torch)")
-    s.add_argument("--no-periodic", dest="periodic", action="store_false",
-                   help="space model: leave out an encoded image's periodic part (courses, planks, weaves: its "
-                        "isolated spectral peaks, added to the decoder's texture by default)")
-    s.add_argument("--no-gaussian", dest="gaussian", action="store_false",
-                   help="space model: never mix in an encoded image's Gaussian rest (random phase noise of what "
-                        "the periodic part leaves, drawn as a solid; mixed in by default where a check on rendered "
-                        "planes finds it closer to the image)")
-    s.add_argument("--rest", default="auto", choices=("auto", "isotropic", "upright"),
-                   help="space model: the Gaussian rest's kind: auto (default: the check chooses; the upright one is "
-                        "offered for layered images), isotropic, or upright (the image's layers, grain or strata "
-                        "kept on walls, for walls and cliffs: floors show their horizontal detail alone)")
-    s.add_argument("--method", default="neural", choices=("neural", "synthesis", "spectral"),
-                   help="neural (default): the model's texture, 2D or 3D; synthesis: a seamless 2D image synthesised "
-                        "from the image file --exemplar by texture optimisation (Kwatra et al. 2005), copying its "
-                        "courses, planks and stones; --tile px a side, repeated beyond it; spectral: random phase "
-                        "noise of the image file --exemplar lifted to a solid, 2D or 3D (a Gaussian texture with "
-                        "its spectrum and colours on every cut, its periodic part upright on walls unless "
-                        "--no-periodic; no stones; repeats every 128 image px)")
-    s.add_argument("--tile", type=int, default=256, help="--method synthesis: the periodic image's side, px "
-                                                         "(a multiple of 4 in [32, 1024]; default 256; multiples of 8 and "
-                                                         "more let large photos lay out large structures whole)")
-    s.add_argument("--model", help="model folder (default: models/solid/EXEMPLAR, else models/solid/space)")
-    s.add_argument("--list", action="store_true", help="print the shipped models and their exemplars as JSON")
-    s.add_argument("--quiet", action="store_true")
-    s.add_argument("-o", "--out", help="2D: .png (sRGB), .exr or .npy (linear); 3D: .vdb or .npy (linear)")
+    s = _sub(sub, "solid", "solid textures from shipped textures or photos",
+             "Solid textures (Henzler et al. 2020): a shipped texture or any photo becomes a 3D texture, written as "
+             "an image (--dim 2: the plane y = 0 seen from the front, x right, z up) or a volume (--dim 3).",
+             """omninoise solid --list
+omninoise solid --exemplar wood_3d --dim 3 --size 128 -o wood.vdb
+omninoise solid --exemplar photo.jpg --size 512 -o like.png
+omninoise solid --exemplar gravel --to marble --mix 0.5 -o halfway.png
+omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 128 -o rock.vdb
+omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png""")
+    g = s.add_argument_group("texture and output")
+    g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file")
+    g.add_argument("-o", "--out", help="2D: .png (sRGB), .exr or .npy (linear); 3D: .vdb or .npy (linear)")
+    g.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image; 3: a volume")
+    g.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
+    g.add_argument("--scale", type=float, default=1.0, help="zoom: output pixels per exemplar pixel")
+    g.add_argument("--seed", type=int, default=0, help="another seed gives another texture of the same kind")
+    g.add_argument("--method", default="neural", choices=("neural", "synthesis", "spectral"),
+                   help="neural: the models' texture, 2D or 3D; spectral: the photo's spectrum and colours on every "
+                        "cut, 2D or 3D, no network; synthesis: a seamless 2D image copied from the photo")
+    g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
+    g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
+                                   "texture-space model)")
+    g.add_argument("--quiet", action="store_true", help="no progress or notes")
+    g = s.add_argument_group("photos (the texture-space model)")
+    g.add_argument("--refine", type=int, default=0, metavar="N", help="improve a photo's code with N search steps")
+    g.add_argument("--to", metavar="EXEMPLAR", help="interpolate towards this exemplar")
+    g.add_argument("--mix", type=float, default=0.5, help="interpolation weight of --to, 0 to 1")
+    g.add_argument("--no-periodic", dest="periodic", action="store_false",
+                   help="leave out the photo's periodic part (courses, plank seams, tile joints)")
+    g.add_argument("--no-gaussian", dest="gaussian", action="store_false",
+                   help="never mix in fine detail drawn from the photo's spectrum (by default mixed in where a "
+                        "check on rendered planes finds it closer)")
+    g.add_argument("--rest", default="auto", choices=("auto", "isotropic", "upright"),
+                   help="that detail's kind: auto (the check chooses), isotropic, or upright (layers and grain "
+                        "kept on walls)")
+    g = s.add_argument_group("--method synthesis")
+    g.add_argument("--tile", type=int, default=256, help="the tile's side, px (a multiple of 4 in [32, 1024])")
 
-    z = sub.add_parser("zoo", help="ground-truth images of the neural noise training zoo (needs torch)")
+    z = _sub(sub, "zoo", "images of the neural model's training classes (needs torch)",
+             "Ground-truth images of the procedural zoo the neural model was trained on. Needs torch: "
+             "pip install 'omninoise[train]'.",
+             """omninoise zoo --list
+omninoise zoo --noise damascus --param frequency=6 --size 256 -o damascus.png""")
     z.add_argument("--noise", help="class name (see --list)")
-    z.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
-    z.add_argument("--size", type=int, default=256)
-    z.add_argument("--seed", type=int, default=0)
-    z.add_argument("--list", action="store_true", help="print classes and parameters as JSON")
+    z.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a class parameter (repeat)")
+    z.add_argument("--size", type=int, default=256, help="side in pixels")
+    z.add_argument("--seed", type=int, default=0, help="another seed draws another image")
+    z.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
     z.add_argument("-o", "--out", help="output: .png, .exr or .npy")
 
-    t = sub.add_parser("transfer", help="print or save a transfer-function preset as an editable ramp .json")
-    t.add_argument("preset", nargs="?", choices=tuple(PRESETS))
+    t = _sub(sub, "transfer", "print or save a transfer-function preset as an editable ramp",
+             "Transfer functions map noise values to colour, density and temperature, as Blender's Color Ramp "
+             "does. Save a preset as a ramp .json, edit it, and pass it to --transfer or a job file.",
+             """omninoise transfer --list
+omninoise transfer fire -o my_ramp.json""")
+    t.add_argument("preset", nargs="?", choices=tuple(PRESETS), help="the preset to print or save")
     t.add_argument("--list", action="store_true", help="list the presets")
     t.add_argument("-o", "--out", help="write the ramp here (default: print it)")
     return ap

@@ -1,4 +1,4 @@
-"""The import graph keeps its layers (issue 23): no cycles, not even through imports inside functions, and
+"""The import graph keeps its layers: no cycles, not even through imports inside functions, and
 dependencies point one way.
 
     cli (omninoise, farms)  ->  backend (core: wave, neural, solid, bakes, job files)  ->  export (file writers)
@@ -166,7 +166,7 @@ def test_nothing_imports_the_old_top_level_names():
 
 def test_files_are_replaced_only_by_the_atomic_helper():
     """One atomic-write helper (export/atomic.py: fsync, stale-temporary clean-up): no other module renames a
-    hand-written temporary file onto its result (issue 23, item 8)."""
+    hand-written temporary file onto its result."""
     known, _ = graph()
     bad = []
     for name, path in known.items():
@@ -203,7 +203,7 @@ def test_only_training_and_evaluation_tests_need_torch(tmp_path):
 
 
 def test_modules_import_only_public_names_from_each_other():
-    """Public names only across modules (issue 23, item 5): no ``from .x import _private`` in the project."""
+    """Public names only across modules: no ``from .x import _private`` in the project."""
     bad = []
     for name, path in modules().items():
         with open(path, encoding="utf-8") as fh:

@@ -129,3 +129,26 @@ def test_the_api_examples_run():
     for mod in (omninoise, omninoise.api):
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
         assert res.attempted > 0 and res.failed == 0, (mod.__name__, res)
+
+
+def test_the_extension_lists_each_bundled_wheels_licence(tmp_path):
+    """build_dist writes THIRD_PARTY_LICENSES.md from the wheels' own metadata, pointing at their licence texts."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("build_dist", os.path.join(ROOT, "tools", "build_dist.py"))
+    bd = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bd)
+    wheels = []
+    for name, meta, lic in (("alpha", "License-Expression: MIT\n", "alpha-1.0.dist-info/licenses/LICENSE"),
+                            ("beta", "License: " + "x" * 200 + "\nClassifier: License :: OSI Approved :: BSD License\n",
+                             "beta-2.0.dist-info/LICENSE.txt")):
+        version = "1.0" if name == "alpha" else "2.0"
+        w = tmp_path / f"{name}-{version}-py3-none-any.whl"
+        with zipfile.ZipFile(w, "w") as z:
+            z.writestr(f"{name}-{version}.dist-info/METADATA",
+                       f"Metadata-Version: 2.4\nName: {name}\nVersion: {version}\n{meta}\nlong description")
+            z.writestr(lic, "licence text")
+        wheels.append(str(w))
+    text = open(bd.write_third_party(str(tmp_path), wheels), encoding="utf-8").read()
+    assert "| alpha | 1.0 | MIT | alpha-1.0.dist-info/licenses/LICENSE |" in text
+    assert "| beta | 2.0 | BSD License | beta-2.0.dist-info/LICENSE.txt |" in text

@@ -42,7 +42,7 @@ PLATFORMS = {  # Blender platform -> pip platform tag
     "windows-x64": "win_amd64",
     "macos-arm64": "macosx_14_0_arm64",
 }
-RUNTIME = ("__init__.py", "blender_manifest.toml", "blender_addon", "backend", "export", "models")
+RUNTIME = ("__init__.py", "api.py", "blender_manifest.toml", "LICENSE", "blender_addon", "backend", "export", "models")
 EXCLUDE_DIRS = {"__pycache__"}
 #: the C row kernel built for this machine (tools/build_kernel.py) is not a file of the platform-independent
 #: extension: installed extensions run the numpy path of wave noise, or numba where Blender's Python has it
@@ -88,6 +88,47 @@ def download_wheels() -> list[str]:
     return out
 
 
+def wheel_licence(path: str) -> tuple:
+    """(name, version, licence, licence files) of a wheel: the licence from its METADATA (License-Expression,
+    License, or the licence classifiers), and the paths of the licence texts it carries."""
+    import zipfile
+
+    with zipfile.ZipFile(path) as z:
+        meta_name = next(n for n in z.namelist() if n.endswith(".dist-info/METADATA"))
+        meta = z.read(meta_name).decode("utf-8", "replace").split("\n\n", 1)[0]
+        files = sorted(n for n in z.namelist() if ".dist-info/" in n and
+                       re.search(r"(LICEN[CS]E|COPYING|NOTICE)", n.rsplit("/", 1)[-1], re.I))
+    fields = {}
+    for line in meta.splitlines():
+        k, _, v = line.partition(": ")
+        fields.setdefault(k, []).append(v.strip())
+    licence = (fields.get("License-Expression") or fields.get("License") or [""])[0]
+    if not licence or len(licence) > 80:        # a whole licence text pasted into the field: use the classifiers
+        classes = [c.rsplit(" :: ", 1)[-1] for c in fields.get("Classifier", []) if c.startswith("License ::")]
+        licence = ", ".join(classes) or "see the wheel's licence files"
+    return fields.get("Name", ["?"])[0], fields.get("Version", ["?"])[0], licence, files
+
+
+def write_third_party(dst: str, wheels: list[str]) -> str:
+    """THIRD_PARTY_LICENSES.md in the staged extension: each bundled wheel, its version, its licence and where in
+    the wheel its licence text is (each wheel keeps its own licence files)."""
+    rows, seen = [], set()
+    for w in sorted(wheels):
+        name, version, licence, files = wheel_licence(w)
+        if (name, version) in seen:
+            continue
+        seen.add((name, version))
+        rows.append(f"| {name} | {version} | {licence} | {', '.join(files) or 'in its METADATA'} |")
+    text = ("# Third-party software bundled with OmniNoise\n\n"
+            "The extension installs these Python wheels (in `wheels/`). Each wheel carries its own licence text, at "
+            "the path given, and Blender installs it with the wheel.\n\n"
+            "| package | version | licence | licence text in the wheel |\n|---|---|---|---|\n" + "\n".join(rows) + "\n")
+    path = os.path.join(dst, "THIRD_PARTY_LICENSES.md")
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    return path
+
+
 def stage(wheels: list[str], platforms=tuple(PLATFORMS)) -> str:
     dst = os.path.join(ROOT, "build", "extension-nowheels" if not wheels else "extension")
     shutil.rmtree(dst, ignore_errors=True)
@@ -106,6 +147,8 @@ def stage(wheels: list[str], platforms=tuple(PLATFORMS)) -> str:
         if name not in names:
             shutil.copy2(w, os.path.join(dst, "wheels", name))
             names.append(name)
+    if names:
+        write_third_party(dst, [os.path.join(dst, "wheels", n) for n in names])
     man = os.path.join(dst, "blender_manifest.toml")
     text = open(man, encoding="utf-8").read()
     extra = ""

@@ -1,6 +1,6 @@
 """Rebuild the photo set of the neural solid textures from Debian's packages: ``python tools/build_photo_set.py``.
 
-Real colour material photographs (issue 20), from two packages whose
+Real colour material photographs, from two packages whose
 copyright files license them for redistribution:
 
 * ``0ad-data`` (every texture CC-BY-SA-3.0, Wildfire Games): the terrain

@@ -1,4 +1,4 @@
-"""Turn what tools/gpu_stage.sh brought back from a lent GPU into a run folder that training.export_onnx reads.
+"""Turn what tools/gpu_stage.sh brought back from a GPU machine into a run folder that training.export_onnx reads.
 
     python tools/gpu_export.py GPU_OUT RUN_DIR
 

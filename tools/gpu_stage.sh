@@ -1,5 +1,5 @@
 #!/bin/bash
-# One lent-GPU training stage in one call (device tool): train CONFIG for SECONDS of wall time from its init_onnx,
+# One GPU training stage in one call: train CONFIG for SECONDS of wall time from its init_onnx,
 # then write the EMA weights (two halves, each under the 16 MiB a returned file may have), the log and the config
 # into OUT_DIR. Locally: tools/gpu_export.py turns them back into a run folder that training.export_onnx reads.
 #   tools/gpu_stage.sh CONFIG SECONDS OUT_DIR [PYTHON]

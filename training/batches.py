@@ -1,6 +1,6 @@
 """Training batches made by worker processes, for a machine whose training device outruns one CPU core's zoo.
 
-On a lent H200 the 128² stage ran 0.58 s a step with the zoo, CutMix and the condition maps made in the training
+On an H200 the 128² stage ran 0.58 s a step with the zoo, CutMix and the condition maps made in the training
 loop: the GPU waited.  With ``TrainConfig.workers`` = W > 0, W processes make the batches ahead of the loop, each
 with one torch and one numba thread.  Batch k is drawn from its own generator ``default_rng([seed, k])``, so it
 depends on the run's seed and k alone: not on W, not on which worker made it, and a resumed run gets the batches an
@@ -62,7 +62,7 @@ BATCH_TIMEOUT_S = 120
 def worker_batches(cfg, start: int, end: int, pin: bool = False):
     """An iterator over batches ``start`` .. ``end - 1`` made by ``cfg.workers`` processes.
 
-    The workers are *spawned*, not forked.  On a lent H200 forked workers deadlocked before their first batch (0 % CPU,
+    The workers are *spawned*, not forked.  On an H200 machine forked workers deadlocked before their first batch (0 % CPU,
     each stopped inside a torch op of the zoo): the training process had already started CUDA's and torch's threads,
     and a fork copies their held locks but not the threads that would release them.  A spawned worker starts a fresh
     interpreter and imports what it needs (a few seconds, once per run).  A batch that does not come within

@@ -10,7 +10,7 @@ is a graph of its own that a sampler runs once per image:
     OUT_DIR/denoiser_tile.onnx the same with circular padding (seamless tiles)
     OUT_DIR/denoiser.weights   the two denoisers' weights, once (ONNX external data)
 
-(Exports before November 2026 had one denoiser with a ``tile`` input, which blended both paddings at every
+(Older exports have one denoiser with a ``tile`` input, which blended both paddings at every
 convolution: 20 % of each step at 256²; the runtime still loads them.)
 
 ``one-piece`` (``--one-piece``; the form of models exported before the split):

@@ -112,7 +112,7 @@ def sample_grid(model: UNet, cfg: TrainConfig, device, names=None, seed: int = 0
 
 def train(cfg: TrainConfig, out: str, max_steps: int | None = None, log=print, max_seconds: float | None = None) -> dict:
     """Train (or resume) into folder ``out``; stops after ``max_steps`` more steps if given, or at the first step
-    that ends ``max_seconds`` of wall time after the loop began (a lent GPU's lease), with a checkpoint either way.
+    that ends ``max_seconds`` of wall time after the loop began (a GPU machine's time limit), with a checkpoint either way.
     Returns the last log."""
     with cpu_threads(cfg.threads):
         return _train(cfg, out, max_steps, log, max_seconds)

@@ -25,7 +25,7 @@ forward pass is two functions (one code path for training and both exports):
 A sampler runs ``encode`` once per image and ``denoise`` at every step.
 
 ``denoise(..., fold=True)`` is the same function in fewer full-resolution operations, for the exported
-denoiser (issue 21): GroupNorm's affine (w, b) and the time modulation fold into one scale and shift per
+denoiser: GroupNorm's affine (w, b) and the time modulation fold into one scale and shift per
 channel, h = norm(conv(x)) * w(1 + γ₁) + (b(1 + γ₁) + β₁), computed on (B, C) vectors instead of four passes
 over the feature map; and each downsampling (pixel unshuffle, then a 1x1 convolution of the 4C channels) is
 the 2x2 stride-2 convolution with the same weights, K[o, c, i, j] = W[o, 4c + 2i + j], without the unshuffle's
@@ -35,7 +35,7 @@ transpose.  Only the rounding differs.
 (downsample, two ResBlocks, upsample) whose output is added to the bottleneck through a zero-initialised
 convolution.  It doubles the network's reach per level (long-range structure: damascus bands, fibre runs)
 and, zero at initialisation, leaves a warm-started network's function exactly as it was, so a deeper
-model continues the shipped weights instead of starting over (issue 22).
+model continues the shipped weights instead of starting over.
 """
 from __future__ import annotations
 

@@ -1,10 +1,8 @@
 """Which arithmetic the neural noise denoiser runs in: float32 (the default), or the int8 export.
 
-The int8 denoisers (``training/quantize_onnx.py``) are a faster draft mode, not a free gain: on a CPU with
-int8 dot products (x86 VNNI) a 256² step took 0.217 s against 0.361 s in float32 (1.66x,
-``bench/neural_int8.py``), and without them int8 gains little (1.19x measured on an AVX2 CPU); but on the
-project's evaluation the images are measurably further from the zoo (median per-class FD 93 -> 98, 20 of 23
-classes higher; the model card has the table).  So float32 stays the default and int8 is opt-in.
+The int8 denoisers (``training/quantize_onnx.py``) are a faster draft mode, not a free gain: about 1.7x faster
+steps on CPUs with int8 dot products (x86 VNNI), little without them, and images measurably further from the zoo
+(the model card and docs/decisions/neural.md).  So float32 stays the default and int8 is opt-in.
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """One neural-noise image, whatever asked for it: the typed request the command line, job files and the Blender
-panel all build (issue 23), and the one place that turns it into a conditioning grid and an image.
+panel all build, and the one place that turns it into a conditioning grid and an image.
 
 A request is a layout of class specs (Maesumi et al. 2024, Sec. 3.2: a uniform class, a mask blend of two, a
 left-to-right gradient of two, the bilinear four-corner blend of Fig. 4, or a painted map of any number) plus the sampler settings. Front-ends parse

@@ -3,7 +3,7 @@
 Value-noise octaves (:mod:`backend.solid.lattice`, Henzler et al. 2020, Eq. 5)
 have no closed outlines, straight edges or per-region constants, so a
 pointwise decoder over them draws speckle where a photo has stones or
-cobbles (the decoder capacity study, models/solid/MODEL_CARD.md).  These
+cobbles (docs/decisions/solid.md).  These
 features add what a threshold can turn into a stone: for the first K octaves,
 at the same transformed position as the value noise,
 

@@ -1,4 +1,4 @@
-"""The harmonic part of a photo's texture, measured when the texture-space model encodes the photo (issue 20).
+"""The harmonic part of a photo's texture, measured when the texture-space model encodes the photo.
 
 A homogeneous texture splits into a harmonic part, a sum of plane waves at isolated spectral peaks, and an
 indeterministic rest (the Wold decomposition of homogeneous random fields; Francos, Meiri & Porat 1993, IEEE
@@ -24,11 +24,8 @@ of 1/8 cycle per pixel; there a peak counts only as a harmonic of a peak elsewhe
 own period divides 8 px along both of the photo's axes (stripes exactly 8 or 4 px apart, square to the photo) is
 taken for compression and left to the decoder (unless its stripes run straight across the whole frame: the
 lines reading below takes them); a period of 16 px or one a little off 8 keeps its peaks (tested).
-At most ``COUNT`` peaks, the strongest first.  The cap binds on few photos (5 of the 483 training photos pass
-more than 32 peaks: brick, metal plates, tiles, up to 255); there 256 against 32 made the walls of two more than
-5 % closer to the photo (tiles 109.5 -> 71.6, metal 116.5 -> 95.5) and none farther (``bench/eval_solid_harmonic.py``,
-"counts"; each peak its bin alone); 256 waves cost about 0.7 s per million points, 32 about 0.1 s (the decoder:
-1.1 s).  Main lobes: a period that is not a whole fraction of the photo (rows 24.3 px apart in a 256 px photo)
+At most ``COUNT`` peaks, the strongest first (the cap binds on brick, metal plates and tiles; see
+docs/decisions/solid.md); 256 waves cost about 0.7 s per million points (the decoder: 1.1 s).  Main lobes: a period that is not a whole fraction of the photo (rows 24.3 px apart in a 256 px photo)
 falls between bins and spreads its power over the bins around the nearest one (a sinc: at half a bin off, its
 neighbour holds as much as it), so each peak brings the bins within ``LOBE`` of it that hold at least
 1 / ``LOBE_DEPTH`` of its power (and ``FLOOR`` of the photo's), each bin once.  A period that is a whole fraction

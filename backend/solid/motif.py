@@ -1,5 +1,5 @@
 """The repeating motif of a photo whose period is not a whole fraction of its frame: its lattice of spectral peaks
-found off the DFT's grid, and the photo's colour amplitude at every point of that lattice (issue 20), numpy only.
+found off the DFT's grid, and the photo's colour amplitude at every point of that lattice, numpy only.
 
 harmonic.py reads a photo's harmonic part from the bins of its discrete Fourier transform.  That is exact for a
 tileable texture, whose periods divide the frame (the photo set's game textures), and not for a photograph: a
@@ -32,19 +32,8 @@ basis of the pattern's translations (two for bricks, tiles and weaves; one for s
 
 A photo whose lattice lies on the grid (within ``ON_GRID`` bins at every basis vector: a tileable texture) is
 left to harmonic.py as before, whose bins are then exact; so are photos with fewer than ``MIN_PEAKS`` peaks on a
-lattice.  A first version took three peaks on a line as stripes: on paving and rock photos with a faint row
-structure (3 to 5 peaks) it moved the walls both ways, up to a third farther (sahara paving stones, 250 x 200 px,
-spectral solid: 126.4 -> 168.9), so a lattice must hold eight peaks; bricks, tiles, plates and weaves hold 15 to
-24 of the 24 sought.
-
-Measured (``python bench/solid_motif.py``, JSON ``docs/img/solid_motif.json``): of the 87 held-out photos framed
-four ways (whole and three interior crops), 10 framings of 3 photos change (the two brick walls' crops, and the
-carpet whole and cropped: its weave is not quite whole periods of its frame); on them the walls of the neural
-texture came closer on 10 of 10 (median patch distance 98.8 -> 80.4) and those of the spectral solid on 9 (96.3
--> 77.0), cuts at random orientations on 9 and 9 (103.7 -> 98.5, 105.4 -> 92.7).  The x, y and z slices pooled
-do not all gain (spectral solid 117.9 -> 133.2): with its courses level again a brick wall's horizontal cut lies
-in one course, as it does for the tileable photos.  A few milliseconds to a second per photo (a 1000 px photo of
-bricks: 1.0 s against 0.45 s with the bins alone; AMD EPYC, 2 cores).
+lattice (fewer peaks drew false stripes on paving and rock photos; see docs/decisions/solid.md, whose evidence
+is ``python bench/solid_motif.py``).
 
 Shapes: photos float (3, H, W) with their mean removed; frequencies in cycles per photo along x (columns, fx)
 and y (rows, fy), float64; amplitudes complex128 (K, 3).

@@ -1,5 +1,5 @@
 """The periods of a photo whose pattern repeats only a few times in its frame, found from its autocorrelation, and
-the harmonic part on their lattice (issue 20), numpy only.
+the harmonic part on their lattice, numpy only.
 
 harmonic.py finds a photo's periods as peaks of its spectrum, each standing ``PROMINENCE`` times over the ring of
 bins around it (up to ``WINDOW`` bins away), and motif.py fits a lattice to those peaks.  Both need the lattice's
@@ -41,7 +41,7 @@ In the image domain the same pattern is plain: the photo matches itself shifted 
    texture holds pixels on both sides); columns likewise (:func:`frame_lines`).  The lines' profile, zero on every
    other row, is read as waves along the spectrum's axes.  A first version kept the axis bins standing over the
    bins beside them: every axis bin also carries the row or column mean of the tile's face, and the faces' shading
-   came along as a plaid (model card).
+   came along as a plaid (docs/decisions/solid.md).
 
 harmonic.py uses this part only where the lattice lies on the grid and is finer than its ring can see (a
 reciprocal basis vector shorter than ``WINDOW`` + 1 bins), counted from one cycle per photo (the lattice, not a

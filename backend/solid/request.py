@@ -1,5 +1,5 @@
 """One solid texture, whatever asked for it: the typed request the command line, job files and the Blender panel
-all build (issue 23), validated in one place and turned into a texture code in one place.
+all build, validated in one place and turned into a texture code in one place.
 
 A request names a model (a folder, a shipped model's name, or None: chosen from the exemplar as the command line
 always did), an exemplar (a space model's training exemplar by name, an image file, or pixels a front-end already

@@ -1,4 +1,4 @@
-"""A Gaussian share of a photo's indeterministic rest, drawn as a solid (issue 20).
+"""A Gaussian share of a photo's indeterministic rest, drawn as a solid.
 
 The texture-space model's decoder draws the rest (the photo less its harmonic part, harmonic.py) from value-noise
 octaves; on photos whose middle scales it cannot draw (rock faces, sand, dunes, wood grain) random phase noise,
@@ -31,31 +31,11 @@ with the photo by :func:`~backend.solid.band_distance.band_distance`; the closes
 is at most MARGIN times that of t = 0, else the texture is the decoder's as before. An artist may ask for one kind
 (REST_CHOICES); asking for the upright one checks it on the walls alone (WALL_PLANES). The check's renders vary by
 more than 10 % from one set of planes to the next on many photos (structure at the scale of a 128² window), and the
-margin is what keeps that chance from choosing: on the training split (80 photos, every sixth), in a prototype with
-the evaluation's own distance as the check, the closest t alone made 22 photos more than 5 % closer and 15 farther
-by the held-out evaluation's distance, a margin of 0.85 made 14 closer and 1 farther. This module, on the same
-photos (``python bench/eval_solid_photos.py --split train --limit 80``): pooled x, y and z slices of 20 photos
-closer and 2 farther, the x and y slices (walls) 22 and 2; photos beating random phase noise 58 -> 67. Its first
-version drew the waves' annuli by power alone and kept the photo's lowest frequencies; there a few strong waves of
-a period longer than the photo moved a low-contrast concrete photo's 128² windows off its mean (patch distance 101
--> 191) and 7 photos went farther. Now every annulus with power gets waves (half of them spread evenly over the
-annuli, their amplitudes weighted so each annulus keeps its power) and nothing below MIN_CYCLES cycles per photo is
-drawn (shading, as harmonic.py leaves it out).
-
-MARGIN was 0.85 until the space model's octaves were turned (spin.py); its decoder then came closer on its own and
-the check misfired less. On the training split again (decoder + harmonic part alone / margin 0.85 / 0.92): rests
-for 0 / 22 / 35 photos, 19 and 30 photos more than 5 % closer than the decoder alone, 2 and 3 farther; walls 20 / 0
-and 31 / 0; the mean distance of the x, y and z slices each alone 111.7 / 107.3 / 105.9 (JSON
-``docs/img/solid_train_turned_decoder.json``, ``solid_gaussian_train_turned_085.json``, ``..._092.json``). With the
-upright kind gated (upright.py), a margin of 1.0 on the same photos made 6 photos more than 5 % closer and 5
-farther pooled, 2 and 5 per axis, 10 and 3 on the band-pass levels (JSON
-``docs/img/solid_margin_train_{092,100}.json``): 0.92 stays.
-
-COUNT: measured with 1024 waves first (the 20 and 2 above; JSON ``docs/img/solid_gaussian_train_1024.json``),
-then with 512 on the same photos (``docs/img/solid_gaussian_train_512.json``): 21 closer and 3 farther than the
-decoder alone, walls 23 and 4, median 97.7 -> 91.5 (1024: 95.3), 71 photos beating random phase (1024: 67);
-photo by photo the two counts differ within the check's noise (11 closer, 15 farther).  512 costs half: about
-2 s per million points on top of the decoder's 1.2 s (AMD EPYC, 2 cores), only for codes that carry a rest.
+margin is what keeps that chance from choosing. Every annulus with power gets waves (half of them spread evenly
+over the annuli, their amplitudes weighted so each annulus keeps its power), so a few strong waves cannot move a
+low-contrast photo's windows off its mean, and nothing below MIN_CYCLES cycles per photo is drawn (shading, as
+harmonic.py leaves it out). MARGIN and COUNT were chosen on the training split (docs/decisions/solid.md); 512
+waves cost about 2 s per million points on top of the decoder's 1.2 s, only for codes that carry a rest.
 
 Shapes: photos float (H, W, 3) sRGB in [0, 1]; points float64 (N, 3) texture units; fields float32 (N, 3).
 """

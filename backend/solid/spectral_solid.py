@@ -1,5 +1,5 @@
 """Random phase noise as a solid: a periodic Gaussian voxel tile whose axis slices carry a photo's colour
-cross-spectrum as closely as a solid can (issue 20), numpy only.
+cross-spectrum as closely as a solid can, numpy only.
 
 Random phase noise (Galerne, Gousseau & Morel 2011, IEEE T-IP 20(1)) keeps a photo's Fourier amplitudes and draws
 new phases: a stationary Gaussian texture with the photo's power spectrum and colour correlations.  Drawn as a 2D
@@ -8,7 +8,7 @@ Gaussian rest (spectral.py) lifts it to 3D as a sum of 512 plane waves, whose cu
 photos without orientation (three rock photos: 88.5, 89.3, 96.4 against 55.1, 59.2, 69.2 by the held-out patch
 distance).  This module lifts it on a grid of every frequency instead (the same photos: 66.4, 67.9 and 98.2, the
 last 72.8 with another draw: a tile holds few of a photo's longest waves, and the distance's low-pass level
-sees which; on the 35 structured held-out photos, model card "Random phase noise as a solid"):
+sees which; on the 35 structured held-out photos, docs/decisions/solid.md):
 
 - **Power** (the projection-slice theorem).  A slice normal to an axis through a stationary Gaussian solid has
   the solid's 3D power spectrum P summed along that axis as its 2D spectrum.  On a periodic grid of n^3
@@ -31,10 +31,8 @@ sees which; on the 35 structured held-out photos, model card "Random phase noise
   axes that an axis cut shows at low frequency, but a cut at another angle shows at a middle one, as faint plaid.
   So :func:`solid_power` first runs EM over radial profiles (P a function of |k|: each shell of frequencies takes
   its power-weighted mean update), which finds the isotropic solid behind isotropic targets (a 1/f^3 solid: 11 %
-  off where the flat start is 26 % off, tested), then the free EM fits what is not isotropic.  On the 87
-  held-out photos, cuts at six random orientations came closer on 77 (median 90.6 -> 84.7; random phase noise
-  72.1); the axis cuts' band-pass levels came closer on 59 (median 47.7 -> 47.1) and their pooled distance went
-  81.6 -> 83.5, all of it on the low-pass level (model card "Isotropic start").
+  off where the flat start is 26 % off, tested), then the free EM fits what is not isotropic (cuts at random orientations come closer to the photos; see
+  docs/decisions/solid.md).
 - **Colour**.  Each 3D frequency takes the power-weighted mean of its three projections' colour cross-spectra
   (3 x 3, normalised to unit trace); its coefficient is sqrt(P) L w, L the Cholesky factor and w complex white
   noise per channel, so every slice keeps the photo's colour correlations scale by scale
@@ -53,11 +51,8 @@ sees which; on the 35 structured held-out photos, model card "Random phase noise
   per axis, from their own quantiles to the photo's (:class:`Marginals`, fitted by :func:`fit_marginals`): a
   pointwise map, so every cut through the solid gets it.  The photo's quantiles are scaled to the tile's own
   spread on each axis: the tile holds nothing longer than its period, so its variance is a little below the
-  photo's, and matching the photo's whole variance instead amplified the finer bands (a prototype on the 35
-  structured held-out photos: pooled median 89.6 -> 94.5, closer than the tile without the map on only 13).  As
-  shipped, on the 87 held-out photos: pooled median 85.3 -> 81.6, closer than without the map on 65 (ice and
-  cracked dirt most: 203.7 -> 126.4, 95.4 -> 60.6), at most 5.6 % farther (model card "Marginals"); fitting
-  takes about 0.3 s, the map 0.12 s per million points.
+  photo's, and matching the photo's whole variance instead amplifies the finer bands (docs/decisions/solid.md).
+  Fitting takes about 0.3 s, the map 0.12 s per million points.
 
 With ``harmonics`` (the request's ``periodic``, on by default) the photo's harmonic part, its isolated spectral
 peaks (courses, head joints, plank seams: :mod:`backend.solid.harmonic`), is taken out of the photo before its

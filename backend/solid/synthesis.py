@@ -4,7 +4,7 @@ Kwatra et al. 2005, "Texture Optimization for Example-based Synthesis"), numpy o
 In 2D this is what ``method = "synthesis"`` draws (:class:`backend.solid.request.SolidRequest`: ``omninoise solid
 --method synthesis``, job files, the panel's Tileable Image): a periodic image that copies the photo's structure
 (courses, planks, stones), closer than random phase noise on most structured held-out photos.  In 3D it stays a
-research baseline measured by ``bench/solid_synthesis.py`` (its slices disagree and settle into blocks; model card).
+research baseline measured by ``bench/solid_synthesis.py`` (its slices disagree and settle into blocks; docs/decisions/solid.md).
 
 The neural path (``backend/solid/model.py``) draws a texture from a code in one pass; this module instead
 optimises a periodic tile of voxels so that its slices look like the photo, neighbourhood by neighbourhood
@@ -65,7 +65,7 @@ MIN_TILE, MAX_TILE, TILE_STEP = 32, 1024, 4
 #: the 2D product's weights, coarse to fine (:func:`image_settings`): soft on every level but the finest, where the
 #: copied pieces must agree on a phase (with k = 10 there, stripes broke into offset pieces on most seeds and a
 #: paving photo into blotches), sharp on the finest, which keeps the copied detail crisp.  Chosen on 22 training
-#: photos (median patch distance 88.6 -> 75.9; model card, fifteenth session)
+#: photos (docs/decisions/solid.md)
 COARSE_SHARPNESS, FINE_SHARPNESS = 3.0, 10.0
 #: the fewest levels the product draws; it draws more where the tile and the photo allow (:func:`image_levels`)
 MIN_LEVELS = 3
@@ -123,8 +123,8 @@ def image_levels(tile: int, photo_shape, patch: int = SynthesisSettings.patch) -
     The coarsest level's neighbourhoods then span a quarter of the photo, so large structures (bricks, planks,
     slabs) are laid out whole there and the finer levels refine them: with three levels, a 256 px photo's bricks and
     planks came out as offset pieces with straight seams; with neighbourhoods spanning half the photo the tiles
-    copied such large pieces that a 128 px part of one was as far from the photo as a 128 px crop of it (model
-    card, sixteenth session)."""
+    copied such large pieces that a 128 px part of one was as far from the photo as a 128 px crop of it
+    (docs/decisions/solid.md)."""
     side = min(photo_shape[:2]) if len(photo_shape) >= 2 else 0     # not an image: synthesise says so
     least = COARSEST_PATCHES * patch
     levels = MIN_LEVELS

@@ -1,4 +1,4 @@
-"""The upright Gaussian rest: a photo's orientation kept on walls (issue 20).
+"""The upright Gaussian rest: a photo's orientation kept on walls.
 
 The isotropic Gaussian rest of spectral.py draws every wave in a uniformly random direction, so a wood photo's
 grain or a cliff's strata become blotches in every cut.  Photos of materials are mostly taken of walls, and the

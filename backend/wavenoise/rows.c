@@ -20,7 +20,7 @@
  *                               multiply-adds in the lerps, weights and sums, and the weights' cosine
  *                               from a shorter (minimax) polynomial: within 1e-6 of it.
  *
- * The AVX2 loops count operations (issue 27: each one saved was measurable on a 3D grid): a power-of-two
+ * The AVX2 loops count operations (each one saved was measurable on a 3D grid): a power-of-two
  * table size wraps texel indices with an integer and, the tables are addressed from their texel 1, the
  * amplitude multiplies the blended sum once, and the walk's bookkeeping is compiled for AVX2 too (its
  * float64 floor and ceil become single instructions).
@@ -61,7 +61,7 @@
 /* Slices of at least this many samples take the segment walk, shorter ones the blocks.  Since the walk writes
  * scratch rows (pure_avx2), 16 was as fast as any of 0, 8, 16 and 24 at 3D 128³ and 64³ and faster than 48
  * (128³: 11.6 against 14.2-14.7 ns per sample, and 16.7 against 18.4 with gathered table reads), while at 32³
- * (slices of 6 to 9 samples) the blocks were faster than the walk (AMD EPYC, 2 threads, November 26, 2026).
+ * (slices of 6 to 9 samples) the blocks were faster than the walk (AMD EPYC, 2 threads).
  * It was 48 when the walk added into the output in place (Sapphire Rapids). */
 #ifndef SEGMENT_WALK
 #define SEGMENT_WALK 16
@@ -221,8 +221,7 @@ AVX2 static inline void lerp8(const job_t *J, __m256 tau, __m256 fN, __m256 inv_
  * row one stratum later (omni_rows), when its stores have left the store buffer.  The earlier loops added into
  * the output row segment by segment with masked loads and stores at the segments' ends, and each segment's
  * first block loaded what the previous segment's last masked store had just written, partly: a load the CPU
- * cannot forward from a store, so it waited for the store to complete (issue 27: 3D 128³ 14.7 -> 11.7 ns per
- * sample with the inlined loops and padded coordinates, AMD EPYC, 2 threads).  Texel coordinates and the ramp's
+ * cannot forward from a store, so it waited for the store to complete.  Texel coordinates and the ramp's
  * position p = x s_x + q exactly as the reference computes them; the lerps, the ramp's weights and sums with
  * fused multiply-adds, the amplitude applied once (within 2e-6 of the reference, tested). */
 AVX2 static inline __attribute__((always_inline)) void pure_avx2(const job_t *J, int64_t o, int64_t m, float a,

@@ -30,6 +30,8 @@ def test_zip_holds_runtime_files_only(built_zip):
     import zipfile
     names = zipfile.ZipFile(built_zip).namelist()
     assert "blender_manifest.toml" in names and "blender_addon/wave_nodes.py" in names
+    assert "LICENSE" in names and "api.py" in names        # the licence travels; omninoise.wave() works in Blender
+    assert ("THIRD_PARTY_LICENSES.md" in names) == any(n.startswith("wheels/") for n in names)
     assert "backend/wavenoise/wave.py" in names and "export/images.py" in names
     assert "blender_addon/solid_ui.py" in names and "backend/solid/model.py" in names
     assert "models/solid/gravel_3d/decoder.onnx" in names and "models/solid/gravel_3d/solid.json" in names
@@ -66,6 +68,7 @@ def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
     assert (out["form_osl_scene"], out["scripts_osl_scene"]) == want
     assert (out["form_svm_scene"], out["groups_svm_scene"]) == ("nodes", 5)
     assert out["cache_dir"].startswith(str(tmp_path))  # the user folder, not the extension's own
+    assert out["api_wave_shape"] == [8, 8]
     # the installed extension found the kernel in the wheel Blender installed, and it computes the engine's noise
     assert out["kernel_available"] == KERNEL
     if KERNEL:

@@ -1,4 +1,4 @@
-"""The Wave Noise node rendered by EEVEE equals the engine (issue 3: Cycles *and* EEVEE).
+"""The Wave Noise node rendered by EEVEE equals the engine (Cycles *and* EEVEE).
 
 EEVEE needs an OpenGL 4.3 context; without a GPU, Mesa's llvmpipe gives one on
 the CPU (.ci/run installs it).  The renders run in a fresh Python

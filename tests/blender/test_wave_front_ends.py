@@ -1,4 +1,4 @@
-"""One wave request for every front-end (issue 23): the command line's flags, a job file's source table and the
+"""One wave request for every front-end: the command line's flags, a job file's source table and the
 Wave Noise node's panel give the same frozen WaveSettings for the same settings."""
 import pytest
 

@@ -42,6 +42,8 @@ bpy.ops.render.render()
 out["form_svm_scene"] = tree.get("omninoise_wave_implementation")
 out["groups_svm_scene"] = sum(n.bl_idname == "ShaderNodeGroup" for n in tree.nodes)
 out["cache_dir"] = importlib.import_module(MOD + ".blender_addon.preferences").cache_dir()
+# the Python API through the installed package (its lazy attributes, the api module in the zip)
+out["api_wave_shape"] = list(importlib.import_module(MOD).wave(8, directions=4).shape)
 # a volume bake through the installed package (its relative backend/export imports, bundled openvdb)
 vdb = importlib.import_module(MOD + ".export.vdb")
 try:

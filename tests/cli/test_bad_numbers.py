@@ -1,4 +1,4 @@
-"""Bad numbers never reach the kernels (issue 24): NaN/inf time and speed, zero extent and period, absurd
+"""Bad numbers never reach the kernels: NaN/inf time and speed, zero extent and period, absurd
 directions, table sizes and grid sizes each give a one-line error naming the setting, exit 2, nothing written."""
 import os
 import re

@@ -1,4 +1,4 @@
-"""Job files on a Dask cluster (issue 25), on a local cluster of 2 worker processes over loopback: the same
+"""Job files on a Dask cluster, on a local cluster of 2 worker processes over loopback: the same
 files as a one-machine bake (images, a sequence, a bricked volume, a neural map), a worker killed mid-task,
 resume, and a failing output that leaves the others written."""
 import os

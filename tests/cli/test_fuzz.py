@@ -1,4 +1,4 @@
-"""Property-based fuzzing of every entry point (issue 24): CLI arguments and job-file documents.
+"""Property-based fuzzing of every entry point: CLI arguments and job-file documents.
 
 Hypothesis builds argument lists from each subcommand's real flags with hostile values (NaN, infinities,
 negative and huge numbers, text where a number belongs, empty strings, paths that are folders or do not

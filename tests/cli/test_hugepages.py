@@ -61,7 +61,7 @@ def test_a_large_neural_command_runs_again_with_the_tunable(tmp_path):
     """The real thing: the command line (here ``python -c`` around cli.main) re-executes itself once with
     GLIBC_TUNABLES set and then makes the image; a 256² image does not re-execute."""
     code = ("import os, sys; open(sys.argv[1], 'a').write(os.environ.get('GLIBC_TUNABLES', '-') + '\\n'); "
-            "sys.argv = ['omninoise'] + sys.argv[2:]; from cli.main import main; sys.exit(main())")
+            "sys.argv = ['omninoise'] + sys.argv[2:]; from omninoise.cli.main import main; sys.exit(main())")
     env = {k: v for k, v in os.environ.items() if k not in ("GLIBC_TUNABLES", hp.OFF_ENV)}
     for size, lines in ((512, ["-", hp.TUNABLE]), (256, ["-"])):
         log, out = tmp_path / f"env{size}.txt", tmp_path / f"n{size}.png"

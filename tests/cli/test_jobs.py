@@ -162,7 +162,7 @@ def test_wave_cli_vdb_and_transfer(tmp_path, capsys):
 
 
 def test_outputs_stay_inside_the_output_root(tmp_path):
-    """A job writes only inside its own folder unless it names output_root (issue 24: output = "../../x")."""
+    """A job writes only inside its own folder unless it names output_root (output = "../../x")."""
     jobdir = tmp_path / "jobs" / "a"
     jobdir.mkdir(parents=True)
     body = ('[[bake]]\nname = "w"\noutput = "{out}"\nresolution = [8, 8]\n'
@@ -196,7 +196,7 @@ def test_a_symlink_does_not_lead_outside_the_output_root(tmp_path):
 
 
 def test_a_new_source_kind_is_one_class_and_one_registration(tmp_path, monkeypatch):
-    """Issue 23 (sources by registry): a registered kind bakes from a job file through the whole pipeline
+    """Sources by registry: a registered kind bakes from a job file through the whole pipeline
     (validation, slabs, writers, keys) with no edit to the CLI, jobs or bake code."""
     from omninoise.backend import sources
 

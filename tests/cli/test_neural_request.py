@@ -1,4 +1,4 @@
-"""One request for every front-end (issue 23): equal neural-noise settings from command-line flags and from a job
+"""One request for every front-end: equal neural-noise settings from command-line flags and from a job
 file give equal requests and equal images (the panel's: tests/blender/test_neural_blender.py); job files take every
 layout the command line does. On the committed tiny model (no torch)."""
 import os

@@ -126,7 +126,7 @@ def test_refine_option(models, tmp_path, capsys):
 
 
 def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
-    """`to` and `mix` in a job file (issue 23: job files take everything the command line does) give the volume
+    """`to` and `mix` in a job file (job files take everything the command line does) give the volume
     `omninoise solid --to --mix` writes."""
     from omninoise.backend.solid.model import SolidTextureModel
 

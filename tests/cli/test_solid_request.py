@@ -1,4 +1,4 @@
-"""One solid-texture request for every front-end (issue 23): the command line's flags and a job file's source
+"""One solid-texture request for every front-end: the command line's flags and a job file's source
 table give equal requests for equal settings, and the same errors, named in each front-end's own terms."""
 import os
 

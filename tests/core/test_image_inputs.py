@@ -1,4 +1,4 @@
-"""One reader for every image input (issue 24): files of any depth by their own range, broken files refused in
+"""One reader for every image input: files of any depth by their own range, broken files refused in
 one line naming the file, and the CLI turning each into exit 2."""
 import struct
 import zlib

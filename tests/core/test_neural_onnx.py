@@ -268,7 +268,7 @@ def test_an_export_with_one_tile_input_denoiser_still_loads(tiny):
 
 
 def test_animation_hits_its_keyframes_and_moves_smoothly_between_them(tiny, tmp_path):
-    """Issue 26: frames at keyframes equal plain generation; frames between move in small, even steps."""
+    """Animation: frames at keyframes equal plain generation; frames between move in small, even steps."""
     from omninoise.backend.neural.animate import animate, frame_cond, frame_latent, parse_keys, temporal_coherence
     import tomllib
 

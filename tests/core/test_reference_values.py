@@ -1,4 +1,4 @@
-"""Stored reference values (issue 23): the wave engine's variants, every zoo class and each shipped model's
+"""Stored reference values: the wave engine's variants, every zoo class and each shipped model's
 first outputs for a fixed seed, against `tests/data/reference/*.json` (written by `tools/make_reference.py`,
 run on purpose when an output is meant to change). A change that alters every output no longer passes.
 

@@ -1,4 +1,4 @@
-"""One sampling convention for every output of `omninoise wave` (issues 23 and 24).
+"""One sampling convention for every output of `omninoise wave`.
 
 Sample i of N over an extent E sits at the centre of its cell, (i + 1/2) E / N. `.npy` holds the grid as
 [y, x] or [z, y, x]; image files (.exr, .png) put +y at the top (row 0 is the largest y), which is how an image

@@ -47,7 +47,7 @@ def test_2d_tile_copies_the_stripes_period_direction_and_colours():
 def test_the_products_2d_settings_keep_stripes_whole(seed):
     """image_settings (what method "synthesis" draws): square and sawtooth stripes of a 128² photo stay vertical
     stripes in a 64 px tile, on every seed.  With sharp weights on every level (k = 10) the coarse pieces settled on
-    different phases and most seeds drew offset pieces with horizontal seams (model card, fifteenth session)."""
+    different phases and most seeds drew offset pieces with horizontal seams."""
     from omninoise.backend.solid.synthesis import image_settings
 
     x = np.arange(128)

@@ -248,7 +248,7 @@ def test_training_runs_logs_and_resumes_identically(tmp_path):
 
 
 def test_wall_time_budget_stops_with_a_checkpoint_and_resumes(tmp_path):
-    """--max-seconds (a lent GPU's lease): the run stops after its first step past the budget, checkpointed and
+    """--max-seconds (a GPU machine's time limit): the run stops after its first step past the budget, checkpointed and
     logged, and resumes from there."""
     from omninoise.training.train import main
 
@@ -316,7 +316,7 @@ def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically
         for u, v, w in zip(x, y, batch_at(cfg, k + 1)):
             assert torch.equal(u, v) and torch.equal(u, w)
     assert not torch.equal(a[0][0], a[1][0])
-    # spawned, not forked (forked workers deadlocked on a lent H200), and a stuck worker ends the run with an error
+    # spawned, not forked (forked workers deadlocked on an H200 machine), and a stuck worker ends the run with an error
     loader = worker_loader(cfg, 0, 1)
     assert loader.multiprocessing_context.get_start_method() == "spawn" and 0 < loader.timeout <= 600
     _stopped_and_resumed_equals_uninterrupted(cfg, tmp_path)
@@ -325,7 +325,7 @@ def test_worker_batches_depend_on_the_seed_and_step_alone_and_resume_identically
 
 
 def test_a_stuck_data_worker_ends_the_run_with_a_one_line_error(monkeypatch, tmp_path):
-    """The loader's timeout turns a worker that makes nothing (a lent GPU's lease running out on a hang) into an
+    """The loader's timeout turns a worker that makes nothing (a GPU machine's time limit running out on a hang) into an
     error naming the workers and the way out, with nothing written as if it had trained."""
     from omninoise.training import batches as B
     from omninoise.training import train as T

@@ -22,12 +22,12 @@ old top
 - old limit
 
 <!-- photo-space:begin -->
-## Photo texture space (issue 20)
+## Photo texture space
 
 ledger
 <!-- photo-space:end -->
 
-## Decoder capacity (issue 20)
+## Decoder capacity
 
 capacity text
 """

@@ -1,4 +1,4 @@
-"""The arrangement features and the soft level-set morphology term of the solid-texture loss (issue 20)."""
+"""The arrangement features and the soft level-set morphology term of the solid-texture loss."""
 import numpy as np
 import pytest
 

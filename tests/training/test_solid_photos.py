@@ -1,5 +1,5 @@
 """The photo set, the photo models' colour path and bounded transforms, the sliced Wasserstein loss and the
-held-out photo evaluation (issue 20)."""
+held-out photo evaluation."""
 import dataclasses
 import hashlib
 import json

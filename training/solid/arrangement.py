@@ -1,8 +1,8 @@
-"""Arrangement loss: a texture's structure with its colour distribution factored out (issue 20).
+"""Arrangement loss: a texture's structure with its colour distribution factored out.
 
 Scored against a paving photo, a hand-made Voronoi pavement with the photo's
 colour histogram beat the trained speckle by only 7 % in the training loss
-(models/solid/MODEL_CARD.md, "Shape features"): the colour terms weigh far
+(docs/decisions/solid.md): the colour terms weigh far
 more than where the colours are, so fits settle in speckle.  This term sees
 only the arrangement.  Each image's luminance
 

@@ -1,4 +1,4 @@
-"""Fit a :class:`~training.solid.conv_generator.ConvGenerator` to one photo (issue 20, the capacity question).
+"""Fit a :class:`~training.solid.conv_generator.ConvGenerator` to one photo (the capacity question).
 
 Each step draws fresh noise, generates ``batch`` textures of side ``cfg.crop`` (2D images, or 3D volumes of which
 one random slice normal to each axis is kept, as Gutierrez et al. 2020 train solid generators from 2D

@@ -1,7 +1,7 @@
 """Write the solid-texture model card: ``python -m omninoise.training.solid.model_card``.
 
     python -m omninoise.training.solid.model_card --models models/solid --runs runs/solid \\
-        --eval out/bench/solid_eval.json -o models/solid/MODEL_CARD.md
+        --eval docs/benchmarks/solid_eval.json -o models/solid/MODEL_CARD.md
 
 Everything in the card is read from files the project's own commands wrote:
 each model's ``solid.json`` (config, steps, sha256), its run's ``log.jsonl``
@@ -135,7 +135,7 @@ def singles_section(path: str, manifest: str = os.path.join("data", "photos", "m
     if os.path.isfile(manifest):
         files = {os.path.join("data", "photos", p["file"]): p for p in read_json(manifest)["photos"]}
     rows, s = doc["rows"], doc["summary"]
-    L = ["## Single-exemplar photo models (issue 20)", "",
+    L = ["## Single-exemplar photo models", "",
          "Each fitted to one photo of the photo set's training split, never seeing its right quarter; measured "
          "on that quarter (`python bench/eval_solid_singles.py --prev OLD_MODELS --sheet docs/img/solid_singles.png`, "
          "2 seeds of 128² images; 3D: x, y and z slices pooled, or the two slices through a `fixed_axis`). Patch "
@@ -143,8 +143,8 @@ def singles_section(path: str, manifest: str = os.path.join("data", "photos", "m
          "better). Beside it, what an artist could make from the same three quarters instead: the shipped space "
          "model given them, random phase noise and the pixel shuffle; the model of the same name it replaced "
          "(fitted to another exemplar); and random 128² crops of the three quarters themselves (the photo "
-         "against its own other part). Every alternative is scored on as many images as the model (before "
-         "November 27, 2026 the baselines were two images against a 3D model's six, which favoured the model). "
+         "against its own other part). Every alternative is scored on as many images as the model (fewer "
+         "images would favour the model). "
          "A model replaces the previous one when it is closer to the held-out quarter than that "
          "model and than the pixel shuffle (unless the photo's own crop is not either: a photo whose quarter "
          "differs from the rest), with colour error at most 0.03. **Licence of the weights:** that of the photo "
@@ -320,7 +320,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "although their training losses fell; the held-out evaluation, not the training loss, decides what "
           "ships.",
           "- The single-exemplar models were trained on two CPU cores for minutes per model. The texture-space "
-          "model's last stage ran on a lent H100 at batch 16, and a larger batch helped it more than more time "
+          "model's last stage ran on an H100 at batch 16, and a larger batch helped it more than more time "
           "at batch 4 had (\"Photo texture space\"); the single models have not had a GPU run yet.",
           "- The texture-space model's decoder draws grains, pebbles and mottling, not stones with joints. "
           "Courses, plank seams and rows come from the photo's harmonic part, measured at encode time and "
@@ -349,8 +349,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
           "on walls, and on 144 of 261 axis slices by the full distance but 59 by its band-pass levels (where the "
           "photo's own crops are the floor). It wins on brick and metal (their harmonic parts) and loses on wood (0"
           " of 2) and rock (4 of 21 on the band-pass levels): wood grain comes out as blotches, and rock strata as "
-          "mottling unless the upright rest is taken. Figures reported before November 27, 2026 drew the baselines two times against six pooled "
-          "slices and favoured the model on the pooled and wall comparisons (69 and 64 photos then).", ""]
+          "mottling unless the upright rest is taken.", ""]
     return "\n".join(L)
 
 
@@ -358,7 +357,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.model_card", description=__doc__.split("\n")[0])
     ap.add_argument("--models", default="models/solid")
     ap.add_argument("--runs", default="runs/solid")
-    ap.add_argument("--eval", default="out/bench/solid_eval.json")
+    ap.add_argument("--eval", default="docs/benchmarks/solid_eval.json")
     ap.add_argument("--configs", default="configs/solid")
     ap.add_argument("--previous-eval", help="evaluation JSON of the models that retrained ones replaced")
     ap.add_argument("--rejected", nargs="*", default=[], metavar="MODEL=EVAL_JSON",

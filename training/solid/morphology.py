@@ -3,7 +3,7 @@
 The patch distance of :mod:`training.solid.photo_eval` compares 7 x 7
 neighbourhoods; it scored a speckle of the right colours nearer to a photo of
 paving stones than random phase noise, which draws blobs of the stones' size
-(models/solid/MODEL_CARD.md, "Decoder capacity").  Stones, cobbles and brick
+(docs/decisions/solid.md).  Stones, cobbles and brick
 courses are shapes: regions of a size, with outlines of a length, connected
 or apart.  Minkowski functionals of thresholded images measure exactly that
 (Mecke, Buchert, Wagner 1994; for textures Mantz, Jacobs, Mecke 2008): for

@@ -119,7 +119,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
     n_photos = len([n for n in os.listdir(os.path.join("data", "photos", "train"))]) if os.path.isdir(
         os.path.join("data", "photos", "train")) else "?"
     ps, ns = prev["summary"], new["summary"]
-    L = [BEGIN, "## Photo texture space (issue 20)", "",
+    L = [BEGIN, "## Photo texture space", "",
          f"**{'Shipped as `space`; its row in the Models table above; the Gram evaluation does not score it (colour from the photo: see its own figures below)' if shipped else 'Candidate, not shipped'}.** Trained on the photo set "
          f"(`data/photos/train`, {n_photos} colour photographs from Debian's 0ad-data, ufoai-textures and "
          "supertuxkart-data; `data/photos/ATTRIBUTION.md`). **Licence of the weights: CC-BY-SA-3.0** (the "

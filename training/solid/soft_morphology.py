@@ -1,4 +1,4 @@
-"""A differentiable level-set morphology term: the loss sees shapes, not colours (issue 20).
+"""A differentiable level-set morphology term: the loss sees shapes, not colours.
 
 Random-feature losses hardly tell stones from speckle once the colours are
 right: on a paving photo a Voronoi pavement with the photo's colours beats

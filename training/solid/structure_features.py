@@ -1,8 +1,8 @@
-"""Structure features trained on the photo set: a loss that tells a photo's arrangement from a Gaussian field (issue 20).
+"""Structure features trained on the photo set: a loss that tells a photo's arrangement from a Gaussian field.
 
 The random-feature losses of :mod:`.swd` and :mod:`.arrangement` hardly separate a photo from the
 blotches the solid models draw: a single-exemplar fit of a paving photo ends at a training loss of
-0.09-0.11, where the photo's own crops score 0.086 (models/solid/MODEL_CARD.md, "Shape features").
+0.09-0.11, where the photo's own crops score 0.086 (docs/decisions/solid.md).
 Random filters see second-order statistics and local colour; what the blotches lack is the phase
 structure of the photo: edges that run on, closed outlines, joints.  So these features are *learned*:
 a small CNN is trained to tell a crop of a training photo from the same crop with its Fourier phases
@@ -164,7 +164,7 @@ def main(argv=None) -> int:
     from ..threads import cpu_threads
 
     ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.structure_features",
-                                 description="Train the structure network on the photo set (issue 20).")
+                                 description="Train the structure network on the photo set.")
     ap.add_argument("--out", required=True, help="the network file to write (weights and record)")
     ap.add_argument("--steps", type=int, default=1500)
     ap.add_argument("--width", type=int, default=32)

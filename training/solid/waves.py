@@ -1,4 +1,4 @@
-"""Periodic (plane-wave) features measured from a photo: the decoder's input for courses and weaves (issue 20).
+"""Periodic (plane-wave) features measured from a photo: the decoder's input for courses and weaves.
 
 Value noise, cellular and brick octaves have no period of their own, so a per-point decoder over them cannot
 draw the regular courses of a brick wall or the weave of a cloth, which random phase noise (the photo's own

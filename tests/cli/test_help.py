@@ -1,0 +1,49 @@
+"""The command line's help: every subcommand has a description, examples and option groups, shows its defaults,
+and names no source files."""
+import re
+
+import pytest
+
+from omninoise.cli.main import build_parser
+
+SUBCOMMANDS = ("wave", "bake", "neural", "solid", "zoo", "transfer")
+
+
+def _help(name: str) -> str:
+    ap = build_parser()
+    sub = next(a for a in ap._actions if a.dest == "command")
+    return sub.choices[name].format_help()
+
+
+@pytest.mark.parametrize("name", SUBCOMMANDS)
+def test_every_subcommand_has_a_description_and_runnable_looking_examples(name):
+    text = _help(name)
+    assert "examples:" in text
+    examples = text.split("examples:", 1)[1].strip().splitlines()
+    assert examples and all(line.strip().startswith(f"omninoise {name}") for line in examples), examples
+    assert not re.search(r"\b[\w/]+\.py\b", text), "the help names a source file"
+
+
+def test_defaults_are_shown_and_switches_carry_none():
+    wave = _help("wave")
+    assert re.search(r"--size SIZE\s+samples per axis \(default: 512\)", wave)
+    assert "(default: gaussian)" in wave and "(default: 2.0)" in wave
+    assert "(default: False)" not in wave and "(default: None)" not in wave
+    solid = _help("solid")
+    assert "(default: True)" not in solid
+
+
+def test_options_are_grouped():
+    for name, groups in (("wave", ("grid and output", "spectrum", "anisotropy")),
+                         ("neural", ("blends", "animation", "inverse design", "sampling and speed")),
+                         ("solid", ("photos (the texture-space model)",))):
+        text = _help(name)
+        for g in groups:
+            assert f"\n{g}:\n" in text, (name, g)
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as e:
+        build_parser().parse_args(["--version"])
+    assert e.value.code == 0
+    assert re.match(r"omninoise \d+\.\d+\.\d+ \(wave noise: (C row kernel|numba kernel|numpy)", capsys.readouterr().out)

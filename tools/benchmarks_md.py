@@ -1,0 +1,136 @@
+"""Write ``docs/benchmarks.md`` from the benchmarks' JSON in ``docs/benchmarks/``: ``python tools/benchmarks_md.py``
+(``make docs``).
+
+Each benchmark writes its figures with a stamp (``bench/stamp.py``: command, machine, software, date, commit); this
+page shows today's figures only, one section per benchmark, each with its stamp. A benchmark whose JSON is missing
+is listed with the command that makes it. ``--check`` exits 1 when the page differs from what the JSON gives.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DATA = os.path.join(ROOT, "docs", "benchmarks")
+PAGE = os.path.join(ROOT, "docs", "benchmarks.md")
+
+
+def _stamp(doc: dict) -> list:
+    s = doc.get("stamp") or {}
+    if not s:
+        return ["*No stamp: machine, date and commit unknown.*", ""]
+    soft = f"Python {s.get('python')}, numpy {s.get('numpy')}" + (
+        f", onnxruntime {s['onnxruntime']}" if s.get("onnxruntime") else "")
+    return [f"*Measured on {s.get('machine')} ({soft}), {s.get('date')}, commit `{s.get('commit')}`:* "
+            f"`{s.get('command')}`", ""]
+
+
+def wave(doc: dict) -> list:
+    out = [f"Wave noise grids, nanoseconds per sample (median of repeated runs, wall clock); engine: "
+           f"{doc.get('engine', '?')}. Peers: 5-octave fractal Perlin (pyfastnoisesimd, FastNoise Lite), "
+           "opensimplex and Blender's Noise and Gabor textures, where installed.", ""]
+    for grid, rows in doc.items():
+        if not isinstance(rows, dict) or grid in ("stamp", "floor", "stream_512") or not grid[0].isdigit():
+            continue
+        dim, n = grid.split("D_")
+        peers = {k: v for k, v in rows.items() if not k.startswith(("wave", "harness"))}
+        fastest = min(peers, key=peers.get) if peers else None
+        out += [f"**{dim}D, {n}^{dim} samples**", "", "| method | ns per sample | ratio to the fastest peer |",
+                "|---|---|---|"]
+        for k, v in sorted(rows.items(), key=lambda kv: kv[1]):
+            ratio = f"{v / peers[fastest]:.2f}x" if fastest else "—"
+            out.append(f"| {k} | {v:.1f} | {ratio} |")
+        out.append("")
+    m = doc.get("stream_512")
+    if m:
+        out += [f"A 512³ grid (8 directions) streams in {m['seconds']:.1f} s with a process peak of "
+                f"{m['peak_mib']:.0f} MiB for an output of {m['output_mib']:.0f} MiB.", ""]
+    return out
+
+
+def neural(doc: dict) -> list:
+    out = [f"Neural noise on {doc.get('threads')} threads: seconds per network evaluation (step) and per image; "
+           f"float32 matrix products run at {doc.get('matmul_gflops')} GFLOP/s on the same machine. "
+           "`est.`: encoder + steps × a measured step.", "",
+           "| size | path | s per step | encoder s | s per image | peak RSS MiB |", "|---|---|---|---|---|---|"]
+    for r in doc.get("rows", []):
+        if "failed" in r:
+            out.append(f"| {r.get('size')}² | {r.get('path')} | failed: {r['failed']} | | | |")
+            continue
+        est = " est." if r.get("estimated") else ""
+        tiles = f" ({r['tiles']} tiles)" if r.get("tiles") else ""
+        out.append(f"| {r['size']}² | {r['path']}{tiles} | {r['step_s']} | {r['encoder_s']} | {r['image_s']}{est} | "
+                   f"{r['peak_rss_mib']} |")
+    out.append("")
+    w = doc.get("whole_command_256")
+    if w:
+        out.append(f"The whole command at 256² (start-up and model loading included): {w['default_s']} s by default, "
+                   f"{w['one_piece_ddim30_s']} s with the one-piece network and DDIM 30.")
+    big = doc.get("whole_command_1024")
+    if big:
+        out.append(f"At 1024²: {big['default_s']} s.")
+    return out + [""]
+
+
+def solid(doc: dict) -> list:
+    out = []
+    if doc.get("speed"):
+        out += ["Solid textures: every point of a grid evaluated, in a fresh process each (peak memory includes the "
+                "interpreter and libraries).", "", "| grid | engine | points per second | seconds | peak MiB |",
+                "|---|---|---|---|---|"]
+        for r in doc["speed"]:
+            out.append(f"| {'×'.join([str(r['size'])] * r['dim'])} | {r['engine']} | {r['points_per_s']:,} | "
+                       f"{r['seconds']} | {r['peak_mib']} |")
+        out.append("")
+    return out
+
+
+#: (JSON file, heading, renderer, the command that makes it)
+BENCHES = (
+    ("wave.json", "Wave noise", wave, "make bench"),
+    ("neural_speed.json", "Neural noise", neural, "python bench/bench_neural.py --sizes 256 512 1024"),
+    ("solid_eval.json", "Solid textures", solid, "python bench/eval_solid.py --only-speed"),
+)
+
+
+def page() -> str:
+    lines = ["# Benchmarks", "",
+             "Today's figures, regenerated from the benchmarks' JSON in `docs/benchmarks/` by "
+             "`python tools/benchmarks_md.py` (`make docs`). Each section states the machine, date and commit it "
+             "was measured on. Quality evaluations of the models are in their model cards "
+             "([neural noise](../models/neural_noise/MODEL_CARD.md), [solid textures](../models/solid/MODEL_CARD.md)).",
+             ""]
+    for name, heading, render, command in BENCHES:
+        lines += [f"## {heading}", ""]
+        path = os.path.join(DATA, name)
+        if not os.path.isfile(path):
+            lines += [f"Not measured yet: `{command}` writes `docs/benchmarks/{name}`.", ""]
+            continue
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+        lines += _stamp(doc) + render(doc)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="exit 1 when docs/benchmarks.md is not up to date")
+    a = ap.parse_args(argv)
+    text = page()
+    if a.check:
+        with open(PAGE, encoding="utf-8") as fh:
+            same = fh.read() == text
+        print("docs/benchmarks.md is " + ("up to date" if same else "out of date: run python tools/benchmarks_md.py"))
+        return 0 if same else 1
+    tmp = PAGE + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    os.replace(tmp, PAGE)
+    print(f"wrote {os.path.relpath(PAGE, ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
