@@ -146,9 +146,11 @@ def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
 
 
 def speed(model: str, run: str) -> list:
+    """The timings of every engine; torch only where the model's training run (its checkpoint) is at hand."""
     rows = []
+    engines = ("onnxruntime", "torch") if os.path.isfile(os.path.join(run, "ckpt.pt")) else ("onnxruntime",)
     for dim, size in ((2, 1024), (3, 256)):
-        for engine in ("onnxruntime", "torch"):
+        for engine in engines:
             r = subprocess.run([sys.executable, __file__, "--speed-one", engine, "--model", model, "--run", run,
                                 "--dim", str(dim), "--size", str(size)], capture_output=True, text=True, check=True)
             rows.append(json.loads(r.stdout.strip().splitlines()[-1]))
@@ -193,8 +195,10 @@ def main() -> int:
             print(f"| {'x'.join([str(r['size'])] * r['dim'])} | {r['engine']} | {r['points_per_s']:,} | "
                   f"{r['seconds']} | {r['peak_mib']} |")
         for dim in (2, 3):
-            o, t = (next(r for r in res["speed"] if r["dim"] == dim and r["engine"] == e) for e in ("onnxruntime", "torch"))
-            print(f"{dim}D: onnxruntime / torch speed = {o['points_per_s'] / t['points_per_s']:.2f}x")
+            o, t = (next((r for r in res["speed"] if r["dim"] == dim and r["engine"] == e), None)
+                    for e in ("onnxruntime", "torch"))
+            if o and t:
+                print(f"{dim}D: onnxruntime / torch speed = {o['points_per_s'] / t['points_per_s']:.2f}x")
     from stamp import stamp
 
     res["stamp"] = stamp()
