@@ -180,8 +180,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
     limits.positive("scale", scale)
     limits.check_memory("size", float(size) ** dim * 4 * 4, f"a {size}-sample {dim}D texture")
-    if out is not None:
-        _check_out(out, (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy"), f"a {dim}D texture")
+    if out is not None and _check_out(out, (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy"),
+                                      f"a {dim}D texture") == ".vdb":
+        from .backend.bake import require_vdb
+
+        require_vdb("out")
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method).check()
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake

@@ -43,7 +43,7 @@ from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
-__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "frame_path", "FORMATS", "KEY_NAME", "Cancelled"]
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "FORMATS", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
@@ -90,6 +90,8 @@ class BakeSpec:
         rank = self.grid.rank
         if ext == ".vdb" and rank != 3:
             raise SettingError("output", f"{os.path.basename(self.output)}: .vdb needs a 3D grid (resolution [nx, ny, nz])")
+        if ext == ".vdb":
+            require_vdb("output")
         if ext in (".exr", ".png") and rank != 2:
             raise SettingError("output", f"{os.path.basename(self.output)}: {ext} needs a 2D grid; bake volumes to .vdb or .npy")
         check = getattr(self.source, "check_grid", None)  # a source's own requirements on the grid (named first)
@@ -164,6 +166,16 @@ def frame_path(pattern: str, frame) -> str:
     m = runs[-1]
     base = base[: m.start()] + f"{int(frame):0{len(m.group())}d}" + base[m.end():]
     return os.path.join(folder, base)
+
+
+def require_vdb(setting: str) -> None:
+    """SettingError naming ``setting`` where no OpenVDB Python module can write .vdb files (before any work)."""
+    from ..export.vdb import openvdb_module
+
+    try:
+        openvdb_module()
+    except RuntimeError as exc:
+        raise SettingError(setting, str(exc)) from None
 
 
 def _slabs(n_outer: int, per_outer: int, chunkable: bool):

@@ -365,6 +365,10 @@ def run_wave(a: argparse.Namespace) -> int:
         raise SettingError("-o", f"a {a.dim}D grid is a volume; write it as .vdb or .npy")
     if a.dim == 2 and ext == ".vdb":
         raise SettingError("-o", "a .vdb volume needs --dim 3 or 4")
+    if ext == ".vdb":
+        from omninoise.backend.bake import require_vdb
+
+        require_vdb("-o")
     if a.transfer and ext == ".npy":
         raise SettingError("--transfer", ".npy holds raw values; use .vdb, .exr or .png for a ramp")
     if a.range and not a.transfer:
@@ -787,6 +791,10 @@ def run_solid(a: argparse.Namespace) -> int:
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
     if ext not in allowed:
         raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
+    if ext == ".vdb":
+        from omninoise.backend.bake import require_vdb
+
+        require_vdb("-o")
     if a.method == "synthesis" and a.dim != 2:
         raise SettingError("--method", "synthesis makes 2D images (--dim 2); volumes come from the neural texture "
                                       "or --method spectral")

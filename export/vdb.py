@@ -43,9 +43,9 @@ def openvdb_module():
             import openvdb
 
             return openvdb
-    raise RuntimeError("writing .vdb needs Blender's OpenVDB Python module (openvdb, or pyopenvdb in "
-                       "Blender 4.2), which this Blender or bpy build lacks; write .npy or .exr instead, "
-                       "or use Blender 4.4+ / pip install bpy==5.0.1")
+    raise RuntimeError("writing .vdb needs the OpenVDB Python module (openvdb, or pyopenvdb in Blender 4.2), "
+                       "which this Python lacks; write .npy or .exr instead, or install it: Blender 4.4+ and "
+                       "the bpy package bundle it (pip install bpy), Debian ships python3-openvdb")
 
 
 class VolumeWriter:

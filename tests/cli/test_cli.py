@@ -69,3 +69,22 @@ def test_python_dash_m_backend(tmp_path):
                        cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert np.load(out).shape == (8, 8)
+
+
+@pytest.mark.parametrize("argv", [["wave", "--dim", "3", "--size", "8"], ["solid", "--exemplar", "gravel_3d", "--dim", "3",
+                                                                          "--size", "8"]])
+def test_vdb_without_openvdb_is_bad_input_before_any_work(argv, tmp_path, monkeypatch, capsys):
+    """Where no OpenVDB module can write .vdb (a pip install without bpy), the command says so in one line and
+    exits 2 before any work, as every front end does (the bake's validation)."""
+    import omninoise.export.vdb as vdb
+    from omninoise.cli.main import main
+
+    def missing():
+        raise RuntimeError("writing .vdb needs the OpenVDB Python module (test)")
+
+    monkeypatch.setattr(vdb, "openvdb_module", missing)
+    out = tmp_path / "v.vdb"
+    assert main(argv + ["--quiet", "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "-o: writing .vdb needs the OpenVDB Python module" in err[0], err
+    assert not out.exists() and not list(tmp_path.iterdir())
