@@ -2,7 +2,7 @@
 
 Every check raises :class:`SettingError` naming the setting, so each front-end
 reports a one-line error (exit status 2) instead of a traceback, a hang or a
-crash in a compiled kernel (NaN or infinite time used to reach the numba row
+crash in a compiled kernel (NaN or infinite time would reach the numba row
 kernel and end the process with a segmentation fault).
 
 Limits (documented in the README, "Limits"):

@@ -1,9 +1,10 @@
-"""Write a model's card from its run, export and evaluation: ``python -m omninoise.training.model_card ...``.
+"""A neural model's report from its run, export and evaluation: ``python -m omninoise.training.model_card ...``.
 
     python -m omninoise.training.model_card [--run RUN] --model MODEL_DIR --eval EVAL.json \\
-        [--ablation-eval EVAL_NO_CUTMIX.json] --train-command "..." -o MODEL_DIR/MODEL_CARD.md
+        [--ablation-eval EVAL_NO_CUTMIX.json] --train-command "..." -o runs/cards/neural_noise.md
 
-Everything in the card is read from files the project's own commands wrote:
+A maintainer updates ``models/neural_noise/MODEL_CARD.md`` (kept short by hand) from it.
+Everything in the report is read from files the project's own commands wrote:
 the run's log (wall time, final loss), the export's JSON (config, steps, sha256,
 classes) and the evaluation JSON of ``bench/eval_neural.py``.  Runs are not kept,
 so the export also records the log's figures (``training`` in its JSON) and the

@@ -55,7 +55,6 @@ def test_bake_matches_the_runtime(scene, mode):
         bpy.ops.omninoise.blend_map_new()
     assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
     got = _pixels(p.name)
-    from omninoise.blender_addon._deps import backend  # noqa: F401
     from omninoise.backend.neural.generate import generate
 
     ref = generate(neural_ui.model(), neural_ui.build_conditioning(p, 32), seed=5, steps=3)

@@ -8,7 +8,7 @@ from omninoise.backend.solid.harmonic import harmonic_field, photo_harmonics
 from omninoise.backend.solid.model import plane_points
 from omninoise.backend.solid.motif import (MIN_CELLS, MIN_PEAKS, fit_lattice, lattice_points, motif_waves, on_grid,
                                  refine_peaks, windowed_dtft, windowed_magnitude)
-from tests.core.test_solid_harmonic import brick_photo, waves_photo
+from test_solid_harmonic import brick_photo, waves_photo  # noqa: E402  (a sibling test module)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BRICK = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")

@@ -4,7 +4,7 @@ import json
 
 import numpy as np
 
-from tests.core.test_solid_periods import brick_tile
+from test_solid_periods import brick_tile  # a sibling test module
 
 
 def test_the_periods_bench_counts_draws_and_scores_a_tile(bench_script, tmp_path):

@@ -1,8 +1,8 @@
 """A decoder that sees a neighbourhood: a multi-scale convolutional generator of periodic 2D or 3D textures.
 
-The per-point decoder of Henzler et al. (2020) colours each point from noise values at that point alone, and in
-every run so far it drew speckle and blotches, never stones, grain or courses (models/solid/MODEL_CARD.md,
-"Decoder capacity", "The translator without stretch"). This generator is the alternative the card names: the
+The per-point decoder of Henzler et al. (2020) colours each point from noise values at that point alone, and it
+draws speckle and blotches, not stones, grain or courses (models/solid/MODEL_CARD.md, Limitations). This generator
+is the alternative: the
 multi-scale architecture of Ulyanov et al. ("Texture Networks", ICML 2016), in 3D as Gutierrez, Rabin, Galerne
 and Hurtut ("On demand solid texture synthesis using deep 3D networks", Computer Graphics Forum 2020) use it for
 solid textures trained from 2D slices.

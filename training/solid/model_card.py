@@ -1,9 +1,11 @@
-"""Write the solid-texture model card: ``python -m omninoise.training.solid.model_card``.
+"""The tables behind the solid-texture model card: ``python -m omninoise.training.solid.model_card``.
 
     python -m omninoise.training.solid.model_card --models models/solid --runs runs/solid \\
-        --eval docs/benchmarks/solid_eval.json -o models/solid/MODEL_CARD.md
+        --eval docs/benchmarks/solid_eval.json -o runs/cards/solid.md
 
-Everything in the card is read from files the project's own commands wrote:
+It writes a long report (every model's config, loss, run, evaluation and the single-photo models' table) from
+which a maintainer updates ``models/solid/MODEL_CARD.md``; the card itself is kept short by hand.
+Everything in the report is read from files the project's own commands wrote:
 each model's ``solid.json`` (config, steps, sha256), its run's ``log.jsonl``
 (wall time, final loss) and the evaluation JSON of ``bench/eval_solid.py``.
 """
@@ -363,7 +365,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rejected", nargs="*", default=[], metavar="MODEL=EVAL_JSON",
                     help="continued runs that did not beat the shipped model, with their evaluation")
     ap.add_argument("--singles", help="JSON of bench/eval_solid_singles.py (the photo single-exemplar models)")
-    ap.add_argument("-o", "--out", default="models/solid/MODEL_CARD.md")
+    ap.add_argument("-o", "--out", default=os.path.join("runs", "cards", "solid.md"))
     a = ap.parse_args(argv)
     rejected = dict(r.split("=", 1) for r in a.rejected)
     text = card(a.models, a.runs, a.eval, a.configs, a.previous_eval, rejected, a.singles)
@@ -372,6 +374,7 @@ def main(argv=None) -> int:
             text = keep_other_sections(fh.read(), text)
     from omninoise import export
 
+    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     export.write_text(a.out, text)
     print(a.out)
     return 0

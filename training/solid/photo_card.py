@@ -1,7 +1,8 @@
-"""The photo texture-space section of the solid-texture model card.
+"""The photo texture-space section of the solid-texture report (``training/solid/model_card.py``), from which
+a maintainer updates the model card's evaluation.
 
     python -m omninoise.training.solid.photo_card --run RUN --prev PREV.json --new NEW.json \\
-        [--shipped] -o models/solid/MODEL_CARD.md
+        [--shipped] -o runs/cards/solid.md
 
 Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``; or its export's ``solid.json``
 when the run folder is gone), and two
@@ -193,7 +194,7 @@ def main(argv=None) -> int:
                                      "shipped) for the ledger table")
     ap.add_argument("--config", action="append", help="the run's config (for the command); repeated for a run "
                                                       "continued over stages, oldest first")
-    ap.add_argument("-o", "--out", default=os.path.join("models", "solid", "MODEL_CARD.md"))
+    ap.add_argument("-o", "--out", default=os.path.join("runs", "cards", "solid.md"))
     a = ap.parse_args(argv)
     text = section(a.run, read_json(a.prev), read_json(a.new), a.shipped, a.prev_label,
                    tuple(read_json(a.ledger)) if a.ledger else (), a.config or [DEFAULT_CONFIG])
