@@ -96,7 +96,7 @@ def wheel_licence(path: str) -> tuple:
     with zipfile.ZipFile(path) as z:
         meta_name = next(n for n in z.namelist() if n.endswith(".dist-info/METADATA"))
         meta = z.read(meta_name).decode("utf-8", "replace").split("\n\n", 1)[0]
-        files = sorted(n for n in z.namelist() if ".dist-info/" in n and
+        files = sorted(n for n in z.namelist() if (".dist-info/" in n or n.count("/") <= 1) and
                        re.search(r"(LICEN[CS]E|COPYING|NOTICE)", n.rsplit("/", 1)[-1], re.I))
     fields = {}
     for line in meta.splitlines():
@@ -118,7 +118,7 @@ def write_third_party(dst: str, wheels: list[str]) -> str:
         if (name, version) in seen:
             continue
         seen.add((name, version))
-        rows.append(f"| {name} | {version} | {licence} | {', '.join(files) or 'in its METADATA'} |")
+        rows.append(f"| {name} | {version} | {licence} | {', '.join(files) or 'none (the licence is named in its METADATA)'} |")
     text = ("# Third-party software bundled with OmniNoise\n\n"
             "The extension installs these Python wheels (in `wheels/`). Each wheel carries its own licence text, at "
             "the path given, and Blender installs it with the wheel.\n\n"
