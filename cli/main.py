@@ -75,6 +75,16 @@ def _sub(sub, name: str, help: str, description: str, examples: str):
                           epilog="examples:\n" + "\n".join("  " + ln for ln in examples.strip().splitlines()))
 
 
+def _class_args(g) -> None:
+    """The options of one noise class image, shared by ``neural`` and ``zoo``."""
+    g.add_argument("--noise", help="class name (see --list)")
+    g.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a class parameter (repeat)")
+    g.add_argument("--size", type=int, default=256, help="output side in pixels")
+    g.add_argument("--seed", type=int, default=0, help="another seed draws another image")
+    g.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+    g.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
         prog="omninoise", formatter_class=_Help,
@@ -185,13 +195,8 @@ omninoise neural --map painted.png --region '#ff0000=spots' --region '#0000ff=ga
 omninoise neural --keys anim.toml --frames 1 48 --latent slerp -o morph_####.png
 omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
     g = n.add_argument_group("noise and output")
-    g.add_argument("--noise", help="class name (see --list)")
-    g.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a class parameter (repeat)")
-    g.add_argument("--size", type=int, default=256, help="output side in pixels")
-    g.add_argument("--seed", type=int, default=0, help="another seed draws another image")
+    _class_args(g)
     g.add_argument("--tileable", action="store_true", help="a seamless tile (size a multiple of 8)")
-    g.add_argument("-o", "--out", help="output: .png, .exr or .npy")
-    g.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
     g.add_argument("--model", help="another model folder (default: the shipped model)")
     g.add_argument("--quiet", action="store_true", help="no progress bar")
     g = n.add_argument_group("blends")
@@ -276,12 +281,7 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
              "pip install 'omninoise[train]'.",
              """omninoise zoo --list
 omninoise zoo --noise damascus --param frequency=6 --size 256 -o damascus.png""")
-    z.add_argument("--noise", help="class name (see --list)")
-    z.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a class parameter (repeat)")
-    z.add_argument("--size", type=int, default=256, help="side in pixels")
-    z.add_argument("--seed", type=int, default=0, help="another seed draws another image")
-    z.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
-    z.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+    _class_args(z)
 
     t = _sub(sub, "transfer", "print or save a transfer-function preset as an editable ramp",
              "Transfer functions map noise values to colour, density and temperature, as Blender's Color Ramp "
