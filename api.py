@@ -92,11 +92,9 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     if "spectrum" in settings:
         settings["spectrum"] = _spectrum(settings["spectrum"])
     s = WaveSettings(**settings)
-    rank = 2 if s.dim == 2 else 3
-    ext = None
+    rank = 2 if s.dim == 2 else 3          # 3D and 4D noise fill a volume (4D: at w = time)
     if out is not None:
-        ext = _check_out(out, (".npy", ".exr", ".png") if s.dim == 2 else (".npy", ".vdb"), f"a {s.dim}D grid")
-        rank = 3 if ext == ".vdb" or (ext == ".npy" and s.dim > 2) else 2
+        _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid")
     elif transfer is not None:
         raise SettingError("transfer", "maps values onto a ramp for a file; give out= too")
     limits.check_memory("size", float(size) ** rank * 4 * 2, f"a {size}-sample {s.dim}D grid")
@@ -145,12 +143,9 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     img = np.asarray(generate_request(net, req, callback=cb), np.float32)
     if out is None:
         return img
-    from .export.images import preview_8bit, write_image, write_png
+    from .export.images import write_unit_image
 
-    if out.lower().endswith(".png"):
-        write_png(out, preview_8bit(img, 0.0, 1.0))
-    else:
-        write_image(out, img)
+    write_unit_image(out, img)
     return out
 
 
@@ -197,14 +192,12 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         run_bake(BakeSpec("solid", source, grid, out), progress, force=True)
         return out
     rgb = req.front_image(size, float(scale), draw_progress=progress)
+    linear = srgb_to_linear(rgb)       # float32, as the command line's .npy holds it
     if out is None:
-        return np.asarray(srgb_to_linear(rgb), np.float32)
-    from .export.images import preview_8bit, write_image, write_png
+        return linear
+    from .export.images import write_unit_image
 
-    if out.lower().endswith(".png"):
-        write_png(out, preview_8bit(rgb, 0.0, 1.0))
-    else:
-        write_image(out, srgb_to_linear(rgb))
+    write_unit_image(out, rgb, linear)
     return out
 
 

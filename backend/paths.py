@@ -12,15 +12,10 @@ __all__ = ["models_root", "neural_model", "solid_models", "fit_bank"]
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the package folder, holding backend/
 
 
-def _candidates() -> list:
-    env = os.environ.get("OMNINOISE_MODELS")
-    return [env] if env else [os.path.join(_HERE, "models")]
-
-
 def models_root() -> str:
     """The folder of models: ``OMNINOISE_MODELS`` when set (even if missing: its error then names it), else the
     package's own ``models`` folder."""
-    return _candidates()[0]
+    return os.environ.get("OMNINOISE_MODELS") or os.path.join(_HERE, "models")
 
 
 def neural_model() -> str:

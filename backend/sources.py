@@ -496,17 +496,15 @@ def solid_volume(request, size: int, scale: float = 1.0, where: str = "", progre
     ``omninoise solid --dim 3`` bakes it; ``progress``, ``report`` and ``on_code`` as in
     :meth:`~backend.solid.request.SolidRequest.front_image`.  SettingError for a 2D model or method synthesis."""
     if request.method == "synthesis":
-        raise SettingError(f"{where}method", "synthesis makes 2D images; volumes come from the neural texture "
-                                             "or method spectral")
+        raise SettingError(f"{where}method", f"synthesis makes 2D images ({where}dim 2); volumes come from the "
+                                             f"neural texture or {where}method spectral")
     if request.method == "spectral":
         field = request.spectral_field(where, progress)
         return SpectralSource(request, field=field), size / (field.px_per_unit * scale)
     model = request.load(where)
     if model.dim != 3:
         raise SettingError(f"{where}dim", f"model {model.name!r} is 2D; it cannot fill a volume")
-    code, _ = request.code(model, where, progress, report)
-    if on_code is not None:
-        on_code(code)
+    code, _ = request.code(model, where, progress, report, on_code)
     return SolidSource(model, seed=int(request.seed), code=code), size / (model.px_per_unit * scale)
 
 

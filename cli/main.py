@@ -56,6 +56,18 @@ def _version_line() -> str:
     return f"omninoise {__version__} (wave noise: {engine_path()})"
 
 
+class _Version(argparse.Action):
+    """``--version``: the line of :func:`_version_line`, made only when asked for (finding the wave kernel loads
+    the C library, which no other option needs at start-up)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(_version_line())      # on standard output, as argparse's own version action prints
+        parser.exit()
+
+
 class _Help(argparse.RawDescriptionHelpFormatter):
     """Each option's default after its help (unless it has none, is a switch, or the help names it already);
     descriptions and examples kept as written."""
@@ -92,7 +104,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "volumes.",
         epilog="Run 'omninoise SUBCOMMAND --help' for each subcommand's options and examples. Exit status: 0 done, "
                "2 bad input (one line naming the option), 1 a failure while running, 130 interrupted.")
-    ap.add_argument("--version", action="version", version=_version_line())
+    ap.add_argument("--version", action=_Version, help="print the version and the wave kernel in use, then exit")
     ap.add_argument("--debug", action="store_true",
                     help="show the Python traceback of an internal error instead of one line")
     sub = ap.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
@@ -658,12 +670,9 @@ def run_neural(a: argparse.Namespace) -> int:
     req = neural_request(a, model)
     bar = _Bar(a.quiet)
     img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
-    from omninoise.export.images import preview_8bit, write_image, write_png
+    from omninoise.export.images import write_unit_image
 
-    if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch
-        write_png(a.out, preview_8bit(img, 0.0, 1.0))
-    else:
-        write_image(a.out, img)
+    write_unit_image(a.out, img)
     return 0
 
 
@@ -672,7 +681,7 @@ def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile
     atomically (an interrupted run keeps the frames it finished)."""
     from omninoise.backend.bake import frame_path, has_frame_field
     from omninoise.backend.neural.animate import animate, read_keys
-    from omninoise.export.images import preview_8bit, write_image, write_png
+    from omninoise.export.images import write_unit_image
 
     if not (a.keys and a.frames):
         raise SettingError("--keys", "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
@@ -701,11 +710,7 @@ def _animate_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile
     frames = animate(model, keys, (first, last), a.size, a.size, latent=a.latent, speed=a.drift, steps=steps,
                      sampler=sampler, spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=tile)
     for i, (f, img) in enumerate(frames):
-        path = frame_path(a.out, f)
-        if ext == ".png":
-            write_png(path, preview_8bit(img, 0.0, 1.0))
-        else:
-            write_image(path, img)
+        write_unit_image(frame_path(a.out, f), img)
         bar((i + 1) / n)
     return 0
 
@@ -716,7 +721,7 @@ def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) ->
     import json
 
     from omninoise.export.atomic import write_json
-    from omninoise.export.images import decode, preview_8bit, write_image, write_png
+    from omninoise.export.images import decode, write_unit_image
     from omninoise.backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
     from omninoise.backend.neural.generate import generate
     from omninoise.backend.onnx_models import ModelError
@@ -750,10 +755,7 @@ def _fit_neural(a: argparse.Namespace, model, sampler: str, steps: int, tile) ->
     cond = fitted_conditioning(model, res, a.size, a.size)
     out = generate(model, cond, res.seed, steps, a.tileable, callback=lambda i, n, x0: bar(0.8 + 0.2 * (i + 1) / n),
                    sampler=sampler, spacing=a.spacing, tile=tile)
-    if ext == ".png":
-        write_png(a.out, preview_8bit(out, 0.0, 1.0))
-    else:
-        write_image(a.out, out)
+    write_unit_image(a.out, out)
     report = dict(res.to_json(), image=os.path.abspath(a.fit), output=os.path.abspath(a.out), size=a.size,
                   model=model.fingerprint)
     if a.report:
@@ -795,9 +797,6 @@ def run_solid(a: argparse.Namespace) -> int:
         from omninoise.backend.bake import require_vdb
 
         require_vdb("-o")
-    if a.method == "synthesis" and a.dim != 2:
-        raise SettingError("--method", "synthesis makes 2D images (--dim 2); volumes come from the neural texture "
-                                      "or --method spectral")
     req = solid_request(a)
     t0 = time.perf_counter()
     if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
@@ -842,12 +841,9 @@ def run_solid(a: argparse.Namespace) -> int:
 def _write_solid_image(out: str, rgb: np.ndarray) -> None:
     """A 2D solid texture, sRGB float (H, W, 3) in [0, 1]: .png as it is, .exr and .npy linear."""
     from omninoise.backend.colour import srgb_to_linear
-    from omninoise.export.images import preview_8bit, write_image, write_png
+    from omninoise.export.images import write_unit_image
 
-    if os.path.splitext(out)[1].lower() == ".png":
-        write_png(out, preview_8bit(rgb, 0.0, 1.0))
-    else:
-        write_image(out, srgb_to_linear(rgb))
+    write_unit_image(out, rgb, srgb_to_linear(rgb))
 
 
 def run_zoo(a: argparse.Namespace) -> int:
@@ -871,14 +867,9 @@ def run_zoo(a: argparse.Namespace) -> int:
         params = zoo.parse_params(a.noise, a.param)
     except ValueError as exc:
         raise SettingError("--noise" if "class" in str(exc) else "--param", str(exc)) from None
-    from omninoise.export.images import preview_8bit, write_image, write_png
+    from omninoise.export.images import write_unit_image
 
-    img = zoo.generate(a.noise, params, [a.seed], a.size)[0].numpy()
-    ext = os.path.splitext(a.out)[1].lower()
-    if ext == ".png":  # values are in [0, 1]: keep them, no percentile stretch
-        write_png(a.out, preview_8bit(img, 0.0, 1.0))
-    else:
-        write_image(a.out, img)
+    write_unit_image(a.out, zoo.generate(a.noise, params, [a.seed], a.size)[0].numpy())
     return 0
 
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from .atomic import atomic_path
 
-__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
+__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "write_unit_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -108,6 +108,16 @@ def write_image(path: str, array: np.ndarray) -> None:
         write_png(path, preview_8bit(array))
     else:
         raise ValueError(f"unsupported output type {ext!r} (use .npy, .exr or .png)")
+
+
+def write_unit_image(path: str, img: np.ndarray, linear: np.ndarray | None = None) -> None:
+    """An image whose values lie in [0, 1] (neural noise; sRGB colours): .png 8-bit as they are, without the
+    percentile stretch of :func:`write_image`; .exr and .npy float: ``linear`` where given (a colour image's
+    scene-linear values), else ``img``."""
+    if os.path.splitext(path)[1].lower() == ".png":
+        write_png(path, preview_8bit(img, 0.0, 1.0))
+    else:
+        write_image(path, img if linear is None else linear)
 
 
 MAX_PIXELS = 1 << 27          #: largest image any input reads (about 11585 x 11585; below Pillow's own bomb limit)

@@ -8,8 +8,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def _package_from_checkout():
-    """``import omninoise`` is this checkout (the repository root is the package), installed or not: the Blender
-    versions' venvs run the tests without installing it."""
+    """``import omninoise`` is this checkout (the repository root is the package) in-process, also where the
+    environment has not installed it or has installed another copy (``make`` installs it editable; tests that start
+    a fresh interpreter need that install)."""
     import importlib.util
 
     init = os.path.join(ROOT, "__init__.py")

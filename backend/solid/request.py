@@ -145,12 +145,16 @@ class SolidRequest:
         except ModelError as exc:
             raise SettingError(f"{where}model", f"{exc}; see models/solid/MODEL_CARD.md") from None
 
-    def code(self, model, where: str = "", progress=None, report=None):
-        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.refine.texture_code`."""
+    def code(self, model, where: str = "", progress=None, report=None, on_code=None):
+        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.refine.texture_code`;
+        ``on_code(code)`` hears the code once it is made (a front end's note on what the encoding kept)."""
         from .refine import texture_code
 
-        return texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress, report,
-                            bool(self.periodic), bool(self.gaussian), self.rest)
+        code, sha = texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress,
+                                 report, bool(self.periodic), bool(self.gaussian), self.rest)
+        if on_code is not None:
+            on_code(code)
+        return code, sha
 
     def exemplar_pixels(self, where: str = ""):
         """An image method's exemplar (synthesis, spectral) as pixels: pixels as given, a path decoded to float
@@ -209,9 +213,7 @@ class SolidRequest:
 
             return SpectralTexture(self).image(size, self.spectral_field(where, progress), scale=scale)
         model = self.load(where)
-        code, _ = self.code(model, where, progress, report)
-        if on_code is not None:
-            on_code(code)
+        code, _ = self.code(model, where, progress, report, on_code)
         return model.image(size, code, int(self.seed), scale=scale, progress=draw_progress)
 
     def key(self) -> dict:
