@@ -15,7 +15,7 @@ _ORDINAL = (r"(first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|
 #: what a line about how the project was made looks like; dates only outside measurement data (benchmarks state
 #: when they were measured)
 HISTORY = {
-    "an issue number": re.compile(r"\bissues? ?#?\d+\b|\bissue\d+\b", re.I),
+    "an issue number": re.compile(r"\bissues? ?#?\d+\b|\bissue\d+", re.I),
     "a round of work": re.compile(r"\b(session|sprint)s? \d+\b|\b" + _ORDINAL + r" (session|sprint)\b"
                                   r"|\brounds? of (work|development)\b", re.I),
     "a borrowed machine": re.compile(r"\b(lent|borrowed|loaned)( an?| the| one)?( NVIDIA)? (GPU|H100|H200|machine|"
