@@ -73,8 +73,10 @@ $(VENV)/.bench: $(STAMP) requirements-bench.txt
 	$(BIN)/python -m pip install -q --no-build-isolation -r requirements-bench.txt
 	@touch $@
 
+# the speed suites (python -m bench speed: wave, neural, solid), whose JSON docs/benchmarks.md shows;
+# python -m bench lists every suite
 bench: $(VENV)/.bench kernel
-	$(BIN)/python bench/bench_wave.py
+	$(BIN)/python -m bench speed
 
 # the README's pictures from make demo's output, and docs/benchmarks.md from the benchmarks' JSON
 README_PICTURES := gallery.png showcase_render.png volumes_render.png neural.png neural_panel.png solid_slices.png solid_render.png

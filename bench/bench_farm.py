@@ -1,4 +1,4 @@
-"""Farm speed-up, measured: `python bench/bench_farm.py [--frames 12] [--size 48]`.
+"""Farm speed-up, measured: `python -m bench farm [--frames 12] [--size 48]`.
 
 The same job (an animated 3D wave-noise sequence through the fire ramp, one .vdb per frame) baked three ways
 in one run: on this machine as `omninoise bake` does, and on local Dask clusters of 1 and 2 worker processes.
@@ -13,11 +13,9 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.cli import farm  # noqa: E402
-from omninoise.backend.jobs import run_job  # noqa: E402
+from omninoise.cli import farm
+from omninoise.backend.jobs import run_job
 
 JOB = """
 [[bake]]
@@ -35,11 +33,11 @@ spectrum = {{kind = "fractal", fmin = 1, fmax = 8, exponent = 1.0}}
 """
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=12)
     ap.add_argument("--size", type=int, default=48)
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     text = JOB.format(n=a.size, frames=a.frames)
     res = {}
     with tempfile.TemporaryDirectory() as tmp:

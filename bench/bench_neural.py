@@ -1,4 +1,4 @@
-"""Neural noise speed: the default against a one-piece network with DDIM, in one run: `python bench/bench_neural.py`.
+"""Neural noise speed: the default against a one-piece network with DDIM, in one run: `python -m bench neural`.
 
 The reference is the one-piece network (``eps.onnx``, re-exported from the shipped
 weights into a temporary folder) sampled by DDIM with 30 steps; the default is
@@ -28,9 +28,8 @@ import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 FULL_UP_TO = 512  # generate whole images up to this size; above, estimate from measured steps
 
@@ -158,7 +157,7 @@ def whole_command(args: list, threads: int, size: int = 256) -> float:
         return time.perf_counter() - t0
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
@@ -169,7 +168,7 @@ def main() -> int:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="256² and 512² only")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "neural_speed.json"))
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     if a.worker:
         _worker(a)
         return 0
@@ -179,7 +178,7 @@ def main() -> int:
     sizes = [s for s in a.sizes if s <= 512] if a.quick else a.sizes
     tmp = tempfile.mkdtemp(prefix="omninoise_onepiece_")
     reexport(a.model, tmp, one_piece=True)  # the one-piece network, from the shipped weights
-    from stamp import stamp
+    from bench.stamp import stamp
 
     res = dict(stamp=stamp(), threads=a.threads, matmul_gflops=round(matmul_gflops(a.threads), 1), rows=[])
     flops = network_gflop(a.model, 256)

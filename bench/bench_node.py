@@ -11,24 +11,22 @@ directions (see :func:`lookup_floor`): what Alg. 1 costs in SVM at the least.  T
 "OSL:" rows render with Cycles' Open Shading Language, the Wave Noise group in its
 OSL form (blender_addon/wave_osl.py), and Gabor under OSL for comparison.
 
-    python bench/bench_node.py [--res 256] [--samples 4] [--repeat 2]
+    python -m bench node [--res 256] [--samples 4] [--repeat 2]
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
-import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-from omninoise.backend import Spectrum, WaveSettings  # noqa: E402
-from omninoise.blender_addon.wave_nodes import build_wave_group  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings
+from omninoise.blender_addon.wave_nodes import build_wave_group
 
 
 def scene(res: int, samples: int, osl: bool = False):
@@ -155,12 +153,12 @@ def lookup_floor(k: int, sliced: bool):
     return make
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--res", type=int, default=256)
     ap.add_argument("--samples", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=2)
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     # (name, tree maker, OSL shading system)
     cases = [
         ("Blender Noise detail 5", texture("ShaderNodeTexNoise", Detail=5.0, Scale=5.0), False),

@@ -28,11 +28,10 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid  # noqa: E402
-from omninoise.backend.wavenoise import ckernel, fast  # noqa: E402
-from stamp import DATA, stamp  # noqa: E402
+from omninoise.backend import Spectrum, WaveSettings, compile_noise, evaluate_grid
+from omninoise.backend.wavenoise import ckernel, fast
+from bench.stamp import DATA, stamp
 
 
 def timed(fn, repeat):
@@ -166,7 +165,7 @@ def peak_memory_512() -> dict:
     # starts at the bench process's own peak, which a child inherits through fork and exec, so the 512^3 grid
     # appeared to need less than its output
     code = (
-        "import resource, numpy as np, sys; sys.path.insert(0, %r)\n"
+        "import resource, numpy as np\n"
         "from omninoise.backend import *\n"
         "def hwm():\n"
         "    try:\n"
@@ -182,7 +181,7 @@ def peak_memory_512() -> dict:
         "base = hwm()\n"
         "a = evaluate_grid(n, 512, 4.0)\n"
         "peak = hwm()\n"
-        "print(base * 1024, peak * 1024, a.nbytes)\n" % ROOT)
+        "print(base * 1024, peak * 1024, a.nbytes)\n")
     # the first run fills numba's on-disk cache (compiling takes memory of its own);
     # the second loads the compiled kernel and measures the evaluation alone
     subprocess.run([sys.executable, "-c", code.replace("512", "17")], capture_output=True, check=True)
@@ -194,12 +193,12 @@ def peak_memory_512() -> dict:
                 extra_mib=(peak - base - nbytes) / 2**20, seconds=wall)
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="smaller grids (smoke run)")
     ap.add_argument("--json", default=os.path.join(DATA, "wave.json"), help="default: docs/benchmarks/wave.json")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     cases = [(2, 256), (3, 48)] if a.quick else [(2, 1024), (3, 128), (3, 256)]
     dirs = (8, 16) if a.quick else (8, 16, 32, 64)
     engine = ("C kernel (" + ("AVX2" if ckernel.vector() else "scalar") + ")" if ckernel.available()

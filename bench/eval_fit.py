@@ -1,4 +1,4 @@
-"""Inverse design, evaluated: `python bench/eval_fit.py OUT_PREFIX [--size 128] [--fit-size 64] [--per-class 1]`.
+"""Inverse design, evaluated: `python -m bench fit OUT_PREFIX [--size 128] [--fit-size 64] [--per-class 1]`.
 
 Held-out zoo images: for every trained class, ``--per-class`` images rendered by the zoo (training/zoo.py)
 with parameters drawn uniformly in their ranges and seeds the training never drew (10⁶ and up). Each is fitted
@@ -26,15 +26,14 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend.neural.fit import (describe, distance, fit, fitted_conditioning, load_bank, prepare_target,  # noqa: E402
+from omninoise.backend.neural.fit import (describe, distance, fit, fitted_conditioning, load_bank, prepare_target,
                                 render, target_statistic)
-from omninoise.backend.paths import fit_bank  # noqa: E402
-from omninoise.backend.neural.generate import generate  # noqa: E402
-from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
-from omninoise.export.atomic import write_json  # noqa: E402
-from omninoise.export.images import read_rgb, write_png  # noqa: E402
+from omninoise.backend.paths import fit_bank
+from omninoise.backend.neural.generate import generate
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.export.atomic import write_json
+from omninoise.export.images import read_rgb, write_png
 
 
 def zoo_image(name: str, u: np.ndarray, seed: int, size: int, classes: dict) -> tuple:
@@ -60,7 +59,7 @@ def sheet(pairs: list, size: int, path: str) -> None:
     write_png(path, (np.clip(out, 0, 1) * 255 + 0.5).astype(np.uint8))
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out")
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
@@ -70,7 +69,7 @@ def main() -> int:
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--photos", type=int, default=1, help="photos per category (0: none)")
     ap.add_argument("--bank", default=fit_bank(), help="inverse-design bank folder ('' : none)")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     m = NeuralNoiseModel(a.model, threads=a.threads)
     names = list(m.config.get("trained_classes") or m.classes)
     bank = load_bank(a.bank) if a.bank else None

@@ -1,4 +1,4 @@
-"""Evaluate a neural noise model: `python bench/eval_neural.py --model models/neural_noise`.
+"""Evaluate a neural noise model: `python -m bench neural-eval --model models/neural_noise`.
 
 Prints the per-class table of training/evaluate.py (Fréchet distance in
 a zoo classifier's features, classifier accuracy on generated samples, power-
@@ -15,15 +15,14 @@ import os
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
-from omninoise.export.atomic import write_json  # noqa: E402
-from omninoise.training.evaluate import evaluate, step_seconds  # noqa: E402
-from omninoise.training.threads import cpu_threads  # noqa: E402
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.export.atomic import write_json
+from omninoise.training.evaluate import evaluate, step_seconds
+from omninoise.training.threads import cpu_threads
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
     ap.add_argument("--classes", help="comma-separated classes to evaluate (default: the model's trained classes); "
@@ -54,7 +53,7 @@ def main() -> int:
                     help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
     ap.add_argument("--no-timing", action="store_true", help="skip the DDIM step timing (a busy machine)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     model = NeuralNoiseModel(a.model, threads=a.threads, precision=a.precision)
     classes = tuple(model.config["trained_classes"])
     if a.classes:

@@ -1,4 +1,4 @@
-"""Evaluate the shipped neural solid textures: `python bench/eval_solid.py [--speed]`.
+"""Evaluate the shipped neural solid textures: `python -m bench solid [--speed]`.
 
 Quality (Henzler et al. 2020, Table 3): for every exemplar with a shipped
 model, style error (independent random-feature Gram distance + colour term),
@@ -24,11 +24,10 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.export.atomic import write_json
 
 MODELS = os.path.join(ROOT, "models", "solid")
 
@@ -48,7 +47,7 @@ def quality(n: int, models_dir: str = MODELS) -> dict:
         if m.mode == "single":
             singles.setdefault(m.config["exemplars"][0], {})[m.dim] = m
     # the space model's codes that name a shipped exemplar (photo models' codes name categories of the
-    # photo set, evaluated on held-out photos by bench/eval_solid_photos.py)
+    # photo set, evaluated on held-out photos by python -m bench solid-photos)
     known = set(ex.PHOTOS) | set(ex.PROCEDURAL)
     names = sorted(set(singles) | ((set(space.codes) & known) if space else set()))
     table = {}
@@ -158,7 +157,7 @@ def speed(model: str, run: str) -> list:
     return rows
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=8, help="samples (seeds) per method")
     ap.add_argument("--models", default=MODELS, help="folder of model folders to evaluate (candidates before shipping)")
@@ -171,7 +170,7 @@ def main() -> int:
     ap.add_argument("--dim", type=int, default=3, help=argparse.SUPPRESS)
     ap.add_argument("--size", type=int, default=256, help=argparse.SUPPRESS)
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "solid_eval.json"))
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     if a.speed_one:
         print(json.dumps(speed_one(a.speed_one, a.model, a.run, a.dim, a.size)))
         return 0
@@ -199,7 +198,7 @@ def main() -> int:
                     for e in ("onnxruntime", "torch"))
             if o and t:
                 print(f"{dim}D: onnxruntime / torch speed = {o['points_per_s'] / t['points_per_s']:.2f}x")
-    from stamp import stamp
+    from bench.stamp import stamp
 
     res["stamp"] = stamp()
     os.makedirs(os.path.dirname(a.out), exist_ok=True)

@@ -1,4 +1,4 @@
-"""Solid textures from held-out photos: ``python bench/eval_solid_photos.py [--model DIR] [--limit N] [--sheet PNG]``.
+"""Solid textures from held-out photos: ``python -m bench solid-photos [--model DIR] [--limit N] [--sheet PNG]``.
 
 For every photo of the photo set's validation split (whole photos that
 training never saw, ``data/photos/val``), the texture-space model encodes the
@@ -61,18 +61,17 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
-from omninoise.export import read_rgb as read  # noqa: E402  (the one image reader; other bench scripts import it from here)
-from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
-from omninoise.backend.solid.refine import exemplar_z  # noqa: E402
-from omninoise.backend.solid import spectral, upright  # noqa: E402
-from omninoise.training.solid import photo_eval as pe  # noqa: E402
-from omninoise.training.solid.photo_set import photo_set  # noqa: E402
-from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json
+from omninoise.export import read_rgb as read
+from omninoise.backend.solid.model import SolidTextureModel
+from omninoise.backend.solid.refine import exemplar_z
+from omninoise.backend.solid import spectral, upright
+from omninoise.training.solid import photo_eval as pe
+from omninoise.training.solid.photo_set import photo_set
+from omninoise.training.solid.morphology import morphology_distance
 
 SIZE = 128
 
@@ -312,15 +311,13 @@ def main(argv=None) -> int:
                     help="leave out the Gaussian rest (backend/solid/spectral.py) even where its check keeps one")
     ap.add_argument("--upright-gate", type=float, metavar="G",
                     help="offer the upright Gaussian rest where a photo's spectral coherence is above G instead of "
-                         "backend/solid/upright.py's UPRIGHT_GATE (0: to every photo, above 1: to none, as before it; "
-                         "calibration: bench/solid_upright_gate.py)")
+                         "backend/solid/upright.py's UPRIGHT_GATE (0: to every photo, above 1: to none)")
     ap.add_argument("--margin", type=float, metavar="M",
                     help="keep a Gaussian rest where the check finds it M times as close as the decoder alone "
                          "instead of backend/solid/spectral.py's MARGIN (calibration, on the training split)")
     ap.add_argument("--check-seeds", type=int, metavar="S",
                     help="the Gaussian rest's check on x, y and z planes at S seeds instead of backend/solid/"
-                         "spectral.py's CHECK_SEEDS (calibration, on the training split; bench/solid_check_noise.py "
-                         "says how often the check's choice depends on its planes)")
+                         "spectral.py's CHECK_SEEDS (calibration, on the training split)")
     ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
     ap.add_argument("--refine", type=int, default=0, metavar="N",
                     help="refine each photo's code by N search steps first (the add-on's Refine Steps)")

@@ -1,5 +1,5 @@
 """Single-exemplar solid textures fitted to photos, measured on pixels they never saw:
-`python bench/eval_solid_singles.py [--models DIR] [--prev DIR] [-o JSON] [--sheet PNG]`.
+`python -m bench solid-singles [--models DIR] [--prev DIR] [-o JSON] [--sheet PNG]`.
 
 A single-exemplar model trained with ``hold_out`` saw only its photo's left three quarters
 (``training.solid.exemplars.train_region``); the right quarter (H x W/4) is the reference here.  For each
@@ -24,18 +24,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
-from omninoise.export.images import read_rgb  # noqa: E402
-from omninoise.backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models  # noqa: E402
-from omninoise.training.solid import photo_eval as pe  # noqa: E402
-from omninoise.training.solid.morphology import morphology_distance  # noqa: E402
+from omninoise.export.atomic import atomic_path, write_json
+from omninoise.export.images import read_rgb
+from omninoise.backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models
+from omninoise.training.solid import photo_eval as pe
+from omninoise.training.solid.morphology import morphology_distance
 
 SIZE = 128
 SEEDS = 2
@@ -142,7 +140,7 @@ def summary(rows: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python bench/eval_solid_singles.py", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--models", default=SHIPPED_MODELS, help="folder of solid models (default: the shipped ones)")
     ap.add_argument("--space", default=None, help="space model folder (default: the models folder's 'space')")
     ap.add_argument("--prev", default=None, help="folder of the previous models of the same names")

@@ -1,4 +1,4 @@
-"""Compare two evaluations of `bench/eval_neural.py`: `python bench/neural_compare.py BEFORE.json AFTER.json`.
+"""Compare two evaluations of `python -m bench neural-eval`: `python -m bench neural-compare BEFORE.json AFTER.json`.
 
 Prints, as Markdown, the tables the model card and the README show for a candidate against the model it would
 replace (the test: the median per-class FD at most half, no class worse): the aggregate measures side by side
@@ -25,7 +25,7 @@ def load(path: str) -> dict:
     except (OSError, ValueError) as exc:
         raise SystemExit(f"neural_compare: error: cannot read {path}: {exc}") from None
     if not isinstance(d, dict) or not isinstance(d.get("classes"), dict) or not d["classes"]:
-        raise SystemExit(f"neural_compare: error: {path} is not an evaluation of bench/eval_neural.py (no classes)")
+        raise SystemExit(f"neural_compare: error: {path} is not an evaluation of python -m bench neural-eval (no classes)")
     return d
 
 

@@ -1,4 +1,4 @@
-"""int8 for the neural denoiser, measured: `python bench/neural_int8.py [--size 256] [--threads 2]`.
+"""int8 for the neural denoiser, measured: `python -m bench int8 [--size 256] [--threads 2]`.
 
 Times the model folder's float32 denoiser against two int8 forms of it, its convolutions quantized (where the
 FLOPs are): the static QDQ form the project ships (``training/quantize_onnx.py``: int8 weights per channel,
@@ -20,12 +20,11 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend.neural import conditioning as C  # noqa: E402
-from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
-from omninoise.backend.neural.precision import int8_dot_products  # noqa: E402
-from omninoise.backend.neural.sampler import initial_noise  # noqa: E402
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.neural.precision import int8_dot_products
+from omninoise.backend.neural.sampler import initial_noise
 
 
 def feed(m, name: str, S: int, seed: int, t: float) -> dict:
@@ -33,12 +32,12 @@ def feed(m, name: str, S: int, seed: int, t: float) -> dict:
     return dict(maps, x=initial_noise(seed, (1, 1, S, S)) * 0.6, t=np.array([t], np.float32))
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--threads", type=int, default=2)
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     import onnx
     import onnxruntime as ort
     from onnxruntime.quantization import QuantType, quantize_dynamic

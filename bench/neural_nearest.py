@@ -1,4 +1,4 @@
-"""Is each class's generated image nearest to its own zoo class? `python bench/neural_nearest.py --model M [...]`.
+"""Is each class's generated image nearest to its own zoo class? `python -m bench neural-nearest --model M [...]`.
 
 The test: every class's generated images at 256² should be nearer, by spectrum and histogram, to the zoo's
 images of that class than to those of any other class, except classes that are near-duplicates in the zoo
@@ -28,12 +28,11 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend.neural import conditioning as C  # noqa: E402
-from omninoise.backend.neural.generate import generate  # noqa: E402
-from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
-from omninoise.export.atomic import write_json  # noqa: E402
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.generate import generate
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.export.atomic import write_json
 
 
 def zoo_halves(classes, size: int, n: int) -> dict:
@@ -49,7 +48,7 @@ def zoo_halves(classes, size: int, n: int) -> dict:
     return out
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", action="append", default=[], help="a model folder (repeat to compare)")
     ap.add_argument("--label", action="append", help="a label per --model")
@@ -61,7 +60,7 @@ def main() -> int:
     ap.add_argument("--floor", type=float, default=0.0,
                     help="count spectrum bands under this share of the power as equal (training.evaluate.look)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_nearest.json"))
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     from omninoise.training import zoo
     from omninoise.training.evaluate import look, look_scales, nearest_looks
 

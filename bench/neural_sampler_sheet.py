@@ -1,4 +1,4 @@
-"""Side-by-side sheet of samplers on the same seeds: `python bench/neural_sampler_sheet.py OUT.png [--size S]`.
+"""Side-by-side sheet of samplers on the same seeds: `python -m bench sheet-samplers OUT.png [--size S]`.
 
 Each row is one conditioning (a class at its default parameters, or a mask, four-corner or painted blend).
 Columns, all from the same x_T: DDIM with 30 steps (the sampler before DPM-Solver++); the runtime's default
@@ -15,14 +15,13 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend.neural import conditioning as C  # noqa: E402
-from omninoise.backend.neural.generate import generate  # noqa: E402
-from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
-from omninoise.backend.neural.sampler import DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS  # noqa: E402
-from omninoise.export.atomic import write_json  # noqa: E402
-from omninoise.export.images import preview_8bit, write_png  # noqa: E402
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.generate import generate
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.neural.sampler import DEFAULT_ETA, DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS
+from omninoise.export.atomic import write_json
+from omninoise.export.images import preview_8bit, write_png
 
 CLASSES = ("cells_f1", "perlin", "clouds", "spots", "fibers", "damascus", "gabor", "wave_cellular")
 
@@ -43,13 +42,13 @@ def conditions(model, S: int) -> list:
     return rows
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out")
     ap.add_argument("--size", type=int, default=128)
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "neural_noise"))
     ap.add_argument("--threads", type=int, default=0)
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     model = NeuralNoiseModel(a.model, threads=a.threads)
     S, gap = a.size, 4
     columns = (("ddim 30", dict(steps=30, sampler="ddim")),

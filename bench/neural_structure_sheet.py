@@ -1,4 +1,4 @@
-"""Long-range structure at 256²: `python bench/neural_structure_sheet.py OUT.png --model A [--model B ...]`.
+"""Long-range structure at 256²: `python -m bench sheet-structure OUT.png --model A [--model B ...]`.
 
 The classes whose structure spans more than a small crop (damascus bands, fibre runs, Gabor and phasor
 orientation and frequency, by default) at their default parameters: one row per class, the zoo's ground truth
@@ -16,19 +16,17 @@ import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.backend.neural import conditioning as C  # noqa: E402
-from omninoise.backend.neural.generate import generate  # noqa: E402
-from omninoise.backend.neural.model import NeuralNoiseModel  # noqa: E402
-from omninoise.export.atomic import write_json  # noqa: E402
-from omninoise.export.images import write_png  # noqa: E402
+from omninoise.backend.neural import conditioning as C
+from omninoise.backend.neural.generate import generate
+from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.export.atomic import write_json
+from omninoise.export.images import write_png
 
 CLASSES = ("damascus", "fibers", "gabor", "gabor_texture", "phasor")
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out")
     ap.add_argument("--model", action="append", required=True, help="a model folder (repeat to compare)")
@@ -38,7 +36,7 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--zoo-seeds", type=int, default=8, help="zoo images per class for the spectrum reference")
     ap.add_argument("--threads", type=int, default=0, help="onnxruntime threads (0: its default, every core)")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     import torch
 
     from omninoise.training import zoo

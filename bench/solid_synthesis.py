@@ -1,5 +1,5 @@
 """Textures by optimisation (``backend/solid/synthesis.py``, Kopf et al. 2007; Kwatra et al. 2005) on held-out photos, measured as
-``bench/eval_solid_photos.py`` measures the neural texture, beside random phase noise and the shipped model.
+``python -m bench solid-photos`` measures the neural texture, beside random phase noise and the shipped model.
 
 With ``--dim 3`` (the default), for every chosen photo of the validation split (``data/photos/val``; ``--only`` keeps names containing any of the
 given words, for example ``brick,wood,rock``) a periodic tile is synthesised from the photo alone, then sliced
@@ -19,7 +19,7 @@ drawn as a 2D image per slice has the photo's spectrum on every slice, which no 
 against as many draws of random phase noise and of the pixel shuffle (2D output, where the issue asks for it beside
 slices of 3D output).
 
-    python bench/solid_synthesis.py [--only brick,wood,rock] [--size 128] [--planes all] [--out out/bench/solid_synthesis]
+    python -m bench solid-methods [--only brick,wood,rock] [--size 128] [--planes all] [--out out/bench/solid_synthesis]
 
 With ``--method spectral`` the 3D texture measured is instead what ``method = "spectral"`` ships
 (``backend/solid/spectral_solid.py``: random phase noise lifted to a periodic solid with the photo's harmonic part,
@@ -46,21 +46,20 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from omninoise.export import read_rgb  # noqa: E402
-from omninoise.export.atomic import write_json  # noqa: E402
-from omninoise.backend.solid.model import measure_harmonics, resize_rgb, slice_points  # noqa: E402
-from omninoise.backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field  # noqa: E402
-from omninoise.backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3  # noqa: E402
-from omninoise.backend.solid.upright import upright_waves  # noqa: E402
-from omninoise.backend.solid.request import SolidRequest  # noqa: E402
-from omninoise.backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,  # noqa: E402
+from omninoise.export import read_rgb
+from omninoise.export.atomic import write_json
+from omninoise.backend.solid.model import measure_harmonics, resize_rgb, slice_points
+from omninoise.backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field
+from omninoise.backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3
+from omninoise.backend.solid.upright import upright_waves
+from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,
                                      synthesise)
-from omninoise.training.solid import photo_eval as pe  # noqa: E402
-from omninoise.training.solid.photo_set import photo_set  # noqa: E402
+from omninoise.training.solid import photo_eval as pe
+from omninoise.training.solid.photo_set import photo_set
 
 SIZE = 128
 #: the Gaussian solids random phase noise is drawn as in 3D (:func:`random_phase_solid`)
@@ -203,7 +202,7 @@ def main(argv=None) -> int:
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
         if a.dim == 3:      # six cuts at random orientations, against random phase noise's pooled draws (six at
-            # the default two seeds; bench/eval_solid_photos.py draws six where the seeds give another count)
+            # the default two seeds; python -m bench solid-photos draws six where the seeds give another count)
             obl = pe.oblique_slices(field.evaluate, field.px_per_unit)
             r["oblique"], r["oblique_band"] = pe.rounded_swds(pe.level_distances(obl, photo))
         if a.dim == 2:      # the levels drawn, and the mean colour error of whole tiles (what repeats on a surface)

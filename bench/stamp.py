@@ -49,7 +49,8 @@ def stamp(argv: list | None = None) -> dict:
         ort = None
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     args = sys.argv if argv is None else argv
-    return dict(command="python " + " ".join([os.path.relpath(args[0], ROOT)] + list(args[1:])),
+    head = args[0] if args[0].startswith("python -m ") else "python " + os.path.relpath(args[0], ROOT)
+    return dict(command=" ".join([head, *args[1:]]),
                 machine=f"{cpu_name()}, {cores} cores, {platform.system()} {platform.machine()}",
                 python=platform.python_version(), numpy=numpy.__version__, onnxruntime=ort,
                 date=datetime.date.today().isoformat(), commit=commit())

@@ -1,4 +1,4 @@
-"""The training zoo itself at 256²: `python bench/zoo_sheet.py OUT.png [--size 256] [--seed 0]`.
+"""The training zoo itself at 256²: `python -m bench sheet-zoo OUT.png [--size 256] [--seed 0]`.
 
 Every class at its default parameters (what the model is asked to reproduce), labelled, with the orientation
 coherence of each image (1 = one orientation over the whole image): the check that the zoo shows
@@ -7,24 +7,21 @@ each class's structure at full size before the model is blamed for losing it.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
 
-from omninoise.export.atomic import atomic_path  # noqa: E402
+from omninoise.export.atomic import atomic_path
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("out")
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--columns", type=int, default=6)
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     import torch
     from PIL import Image, ImageDraw
 

@@ -46,18 +46,22 @@ def psd():
 
 
 def load_bench_script(name: str):
-    """``bench/<name>.py`` as a module (bench scripts are not a package)."""
+    """``bench.<name>``, the checkout's ``bench`` package imported without putting the checkout on ``sys.path``."""
+    import importlib
     import importlib.util
 
-    spec = importlib.util.spec_from_file_location(name, os.path.join(ROOT, "bench", name + ".py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    here = os.path.join(ROOT, "bench")
+    if os.path.dirname(getattr(sys.modules.get("bench"), "__file__", "") or "") != here:
+        spec = importlib.util.spec_from_file_location("bench", os.path.join(here, "__init__.py"),
+                                                      submodule_search_locations=[here])
+        sys.modules["bench"] = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(sys.modules["bench"])
+    return importlib.import_module("bench." + name)
 
 
 @pytest.fixture
 def bench_script():
-    """A loader of bench scripts: ``bench_script("solid_strokes")`` is bench/solid_strokes.py as a module."""
+    """A loader of bench scripts: ``bench_script("solid_synthesis")`` is ``bench.solid_synthesis``."""
     return load_bench_script
 
 

@@ -1,7 +1,7 @@
 """Write ``docs/benchmarks.md`` from the benchmarks' JSON in ``docs/benchmarks/``: ``python tools/benchmarks_md.py``
 (``make docs``).
 
-Each benchmark writes its figures with a stamp (``bench/stamp.py``: command, machine, software, date, commit); this
+Each benchmark writes its figures with a stamp (:mod:`bench.stamp`: command, machine, software, date, commit); this
 page shows today's figures only, one section per benchmark, each with its stamp. A benchmark whose JSON is missing
 is listed with the command that makes it. ``--check`` exits 1 when the page differs from what the JSON gives.
 """
@@ -89,9 +89,9 @@ def solid(doc: dict) -> list:
 
 #: (JSON file, heading, renderer, the command that makes it)
 BENCHES = (
-    ("wave.json", "Wave noise", wave, "make bench"),
-    ("neural_speed.json", "Neural noise", neural, "python bench/bench_neural.py --sizes 256 512 1024"),
-    ("solid_eval.json", "Solid textures", solid, "python bench/eval_solid.py --only-speed"),
+    ("wave.json", "Wave noise", wave, "python -m bench wave"),
+    ("neural_speed.json", "Neural noise", neural, "python -m bench neural --sizes 256 512 1024"),
+    ("solid_eval.json", "Solid textures", solid, "python -m bench solid --only-speed"),
 )
 
 

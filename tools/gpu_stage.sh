@@ -38,7 +38,7 @@ PY
 if [ -n "${EVAL_CLF:-}" ]; then
     exp=$(mktemp -d)
     $py tools/gpu_export.py "$out" "$exp/run" && $py -m omninoise.training.export_onnx "$exp/run" "$exp/model" > "$out/export.log" 2>&1 \
-      && $py bench/eval_neural.py --model "$exp/model" --eval-size 64 --clf-stages 3 --clf-steps 6000 --clf-threads 2 \
+      && $py -m bench neural-eval --model "$exp/model" --eval-size 64 --clf-stages 3 --clf-steps 6000 --clf-threads 2 \
            --n "${EVAL_N:-32}" --threads "$(nproc)" --classifier-cache "$EVAL_CLF" --sampler dpmpp_2m --steps 10 --spacing truncated \
            --eta 0.3 --no-timing -o "$out/eval.json" > "$out/eval.log" 2>&1
     tail -3 "$out/eval.log"

@@ -27,7 +27,7 @@ and overall:
     locality    a half/half mask blend of two classes: how often the classifier names the
                 right class on crops away from the border (the CutMix ablation of Fig. 13)
 
-Run: ``python bench/eval_neural.py --model models/neural_noise`` (see that script).
+Run: ``python -m bench neural-eval --model models/neural_noise`` (see that script).
 """
 from __future__ import annotations
 

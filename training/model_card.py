@@ -6,7 +6,7 @@
 A maintainer updates ``models/neural_noise/MODEL_CARD.md`` (kept short by hand) from it.
 Everything in the report is read from files the project's own commands wrote:
 the run's log (wall time, final loss), the export's JSON (config, steps, sha256,
-classes) and the evaluation JSON of ``bench/eval_neural.py``.  Runs are not kept,
+classes) and the evaluation JSON of ``python -m bench neural-eval``.  Runs are not kept,
 so the export also records the log's figures (``training`` in its JSON) and the
 card reads them there when no ``--run`` is given; an export made before that
 record existed takes them from ``--wall-minutes`` and ``--final-mse`` (figures
@@ -155,7 +155,7 @@ def card(run: str | None, model: str, ev: dict, ablation: dict | None, train_com
         f"- **Form:** {meta.get('form', 'one-piece')}; **sha256** "
         + ", ".join(f"of `{name}`: `{digest}`" for name, digest in sorted(meta["files"].items())) + ".",
         "",
-        "## Evaluation (`bench/eval_neural.py`)",
+        "## Evaluation (`python -m bench neural-eval`)",
         "",
         f"{ev['model']['n']} samples per class, {_sampler_words(ev)}. The zoo classifier is accurate to "
         f"{ev['zoo_accuracy']} on held-out zoo samples.",
@@ -224,7 +224,7 @@ def main(argv=None) -> int:
     ap.add_argument("--ablation-label", default="", help="text after the ablation's heading sentence")
     ap.add_argument("--ablation-reference", help="evaluation JSON of the CutMix model with the ablation's steps")
     ap.add_argument("--compare-eval", help="evaluation JSON of this model on the previous model's classes "
-                                           "(bench/eval_neural.py --classes ...), when their classes differ")
+                                           "(python -m bench neural-eval --classes ...), when their classes differ")
     ap.add_argument("--note", default="", help="a paragraph after the comparison: why this model replaced the previous")
     ap.add_argument("--keep-from", help="an earlier card whose --keep sections are carried over verbatim")
     ap.add_argument("--keep", action="append", default=[], help="a '## ' heading of --keep-from (repeatable)")

@@ -9,7 +9,7 @@ each overlap), so the sampler sees one image-sized ε:
 
 The network's GroupNorm normalises over each tile instead of the whole image, so
 a tiled image equals a one-piece one in its statistics, not bit for bit
-(bench/bench_neural.py measures both).  Tileable output treats the image as a
+(python -m bench neural measures both).  Tileable output treats the image as a
 torus: tiles wrap around the edges, each runs with zero padding, and the blend
 covers the torus, so the result still tiles.
 

@@ -46,7 +46,7 @@ stand off their neighbours all along) are added where they hold ``FEW_MARGIN`` o
 leaves them out).  The price: a photograph with one straight line across its whole frame (a cable, a crack square
 to the frame) gets it once per frame's width on a solid's walls; ``--no-periodic`` leaves the whole part out.
 ``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
-split (``bench/eval_solid_harmonic.py``, ``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
+split (``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
 39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
 others farther (stripes from chance peaks).  Measured again with main lobes: 11 and 5, 3 and 0; 4 made 25 closer
 and 30 others farther (with peaks in colour: 11 and 5, 3 and 0; 23 and 26).
@@ -67,7 +67,7 @@ one does; plank seams become lines).  A plane wave keeps its frequency on every 
 the texture stays one solid.  This is the placement for scenes with z up (a building's walls face x or y in
 object coordinates); it is not the one the pooled slice evaluation prefers: standing the photo on planes normal
 to z and to y instead (floors exact, faces normal to x in profile) scored 127.7 against 138.8 on the structured
-training photos (``bench/eval_solid_harmonic.py``), because pooled slices ask horizontal cuts to look like the
+training photos (``docs/img/solid_harmonic_tuning.json``), because pooled slices ask horizontal cuts to look like the
 photo too, and there a brick wall's cut lies within one course.  It would put diagonal stripes on every wall
 facing x.
 

@@ -348,7 +348,7 @@ class SolidTextureModel:
             fixed, dec = self.layers(pts, code, seed)
             return fixed, dec, pts
 
-        # read when called: calibration (bench/eval_solid_photos.py --check-seeds) sets them
+        # read when called: calibration (python -m bench solid-photos --check-seeds) sets them
         planes = spectral.WALL_PLANES if rest == "upright" else spectral.CHECK_PLANES
         return choose_mix(layers, _rgb(image), offered, planes)
 

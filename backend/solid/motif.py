@@ -33,7 +33,7 @@ basis of the pattern's translations (two for bricks, tiles and weaves; one for s
 A photo whose lattice lies on the grid (within ``ON_GRID`` bins at every basis vector: a tileable texture) is
 left to harmonic.py as before, whose bins are then exact; so are photos with fewer than ``MIN_PEAKS`` peaks on a
 lattice (fewer peaks drew false stripes on paving and rock photos; see docs/decisions/solid.md, whose evidence
-is ``python bench/solid_motif.py``).
+is ``python -m bench solid_motif``).
 
 Shapes: photos float (3, H, W) with their mean removed; frequencies in cycles per photo along x (columns, fx)
 and y (rows, fy), float64; amplitudes complex128 (K, 3).

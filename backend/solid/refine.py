@@ -17,10 +17,10 @@ and z at seeds 6 and 7); otherwise the encoder's code is returned.  A search on
 one small render finds codes that fit that render's chance: the classical
 statistics this module searched with before (colour quantiles, a radial power
 spectrum and gradient energies of 64² renders) lowered their own distance while
-the patch distance of ``bench/eval_solid_photos.py`` (x, y and z slices pooled)
+the patch distance of ``python -m bench solid-photos`` (x, y and z slices pooled)
 grew by more than 5 % on 39 of 80 training photos and fell on 11; this search,
 40 steps: 5 farther, 7 closer (on the walls, x and y slices: 6 and 15; before 33
-and 17).  ``python bench/eval_solid_photos.py --split train --limit 80 --refine
+and 17).  ``python -m bench solid-photos --split train --limit 80 --refine
 40 --against ENCODER.json``; ``docs/img/solid_refine_train_*.json``.
 
 Photo models carry the exemplar's measured colour (mean and covariance) after

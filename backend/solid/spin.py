@@ -16,7 +16,7 @@ two places:
   without the fixed direction that all octaves shared.  The space model's
   translator stretches octaves 3 and 6 along the same world diagonal for every
   photo (1.45 : 1): unturned, every front slice then leans one way and every
-  floor the other (``bench/solid_strokes.py``).
+  floor the other (measured by the diagonal power of x, y and z slices).
 
 Q_i is uniform on SO(D): in 3D from three hash uniforms by Shoemake's
 quaternion construction (Graphics Gems III, 1992: q = (sqrt(1-u1) sin 2 pi u2,

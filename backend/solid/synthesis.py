@@ -4,7 +4,7 @@ Kwatra et al. 2005, "Texture Optimization for Example-based Synthesis"), numpy o
 In 2D this is what ``method = "synthesis"`` draws (:class:`backend.solid.request.SolidRequest`: ``omninoise solid
 --method synthesis``, job files, the panel's Tileable Image): a periodic image that copies the photo's structure
 (courses, planks, stones), closer than random phase noise on most structured held-out photos.  In 3D it stays a
-research baseline measured by ``bench/solid_synthesis.py`` (its slices disagree and settle into blocks; docs/decisions/solid.md).
+research baseline measured by ``python -m bench solid-methods`` (its slices disagree and settle into blocks; docs/decisions/solid.md).
 
 The neural path (``backend/solid/model.py``) draws a texture from a code in one pass; this module instead
 optimises a periodic tile of voxels so that its slices look like the photo, neighbourhood by neighbourhood

@@ -18,9 +18,8 @@ import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "bench"))
 
-from bench_node import scene  # noqa: E402  (the plane and orthographic camera of the render bench)
+from bench.bench_node import scene  # noqa: E402  (the plane and orthographic camera of the render bench)
 from omninoise.backend.wavenoise.settings import settings_from_dict  # noqa: E402
 from omninoise.blender_addon.compat import eevee_engine, ensure_node_tree, set_multilayer_exr  # noqa: E402
 from omninoise.blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402

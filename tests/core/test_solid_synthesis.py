@@ -1,5 +1,5 @@
 """backend/solid/synthesis.py (Kopf et al. 2007 solid synthesis by optimisation; Kwatra et al. 2005 in 2D) and
-bench/solid_synthesis.py: the tile copies a photo's structure at its frequency and orientation, keeps its colours, wraps around, and reports
+python -m bench solid-methods: the tile copies a photo's structure at its frequency and orientation, keeps its colours, wraps around, and reports
 progress, cancels and bad settings in one line."""
 import json
 

@@ -1,4 +1,4 @@
-"""bench/neural_compare.py: the card's candidate-against-model table from two evaluation JSONs, refused with one line
+"""python -m bench neural-compare: the card's candidate-against-model table from two evaluation JSONs, refused with one line
 when the two were not made with one instrument."""
 import json
 import os
@@ -6,7 +6,6 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SCRIPT = os.path.join(ROOT, "bench", "neural_compare.py")
 
 
 def evaluation(fds, classifier_steps=6000, n=32):
@@ -21,7 +20,8 @@ def run(tmp_path, a, b, *extra):
     pa, pb = tmp_path / "a.json", tmp_path / "b.json"
     pa.write_text(a if isinstance(a, str) else json.dumps(a))
     pb.write_text(b if isinstance(b, str) else json.dumps(b))
-    return subprocess.run([sys.executable, SCRIPT, str(pa), str(pb), *extra], capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "bench", "neural-compare", str(pa), str(pb), *extra],
+                          capture_output=True, text=True, cwd=ROOT)
 
 
 def test_the_table_has_the_medians_their_ratio_the_classes_lower_and_the_worst_class(tmp_path):

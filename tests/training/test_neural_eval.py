@@ -1,4 +1,4 @@
-"""The measuring instrument of bench/eval_neural.py: Fréchet distance, spectra, zoo classifier."""
+"""The measuring instrument of python -m bench neural-eval: Fréchet distance, spectra, zoo classifier."""
 import numpy as np
 import pytest
 

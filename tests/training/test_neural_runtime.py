@@ -142,7 +142,7 @@ def test_generate_any_size_seeded_and_sampler_equals_torch(exported):
         generate(model, cond, tileable=True)
 
 
-# an evaluation document as bench/eval_neural.py writes it, one class, for the card tests
+# an evaluation document as python -m bench neural-eval writes it, one class, for the card tests
 EVAL = dict(classes={"spots": dict(fd=1.5, acc=0.5, psd=0.2, response=0.1, param="scale")}, zoo_accuracy=0.9,
             seam_tileable=1.1, seam_plain=3.0, locality=0.75, model=dict(n=4, steps=5),
             timing=dict(size=64, onnxruntime_s=0.1, torch_s=0.2, ratio=2.0, max_eps_difference=1e-6))
@@ -290,7 +290,7 @@ def test_warm_start_grows_the_class_table_and_parameter_slots():
 
 
 def test_evaluation_at_a_chosen_size_batches_each_sample_with_its_own_seed(exported, tmp_path):
-    """bench/eval_neural.py's evaluate(): at --eval-size (not the training size), with the structure measures;
+    """python -m bench neural-eval's evaluate(): at --eval-size (not the training size), with the structure measures;
     a class's samples, generated as one batch, equal the same seeds generated one by one."""
     from omninoise.backend.neural.sampler import sample
     from omninoise.training.evaluate import evaluate

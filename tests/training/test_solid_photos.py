@@ -448,15 +448,12 @@ def test_features_added_to_an_export_start_as_the_export(tmp_path):
               log=lambda *_: None)
 
 
-def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_path):
-    """bench/eval_solid_photos.py on a tiny space model and two held-out photos: every measure per photo, the
+def test_held_out_photo_evaluation_reports_patch_and_morphology_measures(tmp_path, bench_script):
+    """python -m bench solid-photos on a tiny space model and two held-out photos: every measure per photo, the
     summary's medians, and the photo's own crop nearer to the photo than the pixel shuffle (patches) and random phase (morphology)."""
-    import importlib.util
     import json
 
-    spec = importlib.util.spec_from_file_location("eval_solid_photos", os.path.join(ROOT, "bench", "eval_solid_photos.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = bench_script("eval_solid_photos")
     cfg = dict(name="tiny_eval", mode="space", dim=3, crop=64, batch=2, steps=1, width=16, log_every=1,
                checkpoint_every=1, threads=1, exemplars=ex.photo_set("train")[:2], colour="affine", loss="swd",
                transform="bounded", swd_width=8, swd_levels=2, cellular=1, bricks=1)
@@ -565,12 +562,10 @@ def test_min_spacing_caps_every_octave_lattice_in_training_and_in_the_export(tmp
     assert doc["config"]["min_spacing"] == 8.0
 
 
-def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
+def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path, bench_script):
     """A single-exemplar photo model (``hold_out``): training crops only the left three quarters, the export
     carries the photo's colour (mu, L) so the runtime draws in it without an encoder, and
-    bench/eval_solid_singles.py measures it on the right quarter beside random phase, the shuffle and a space model."""
-    import importlib.util
-
+    python -m bench solid-singles measures it on the right quarter beside random phase, the shuffle and a space model."""
     photo_path = os.path.relpath(ex.photo_set("train")[0], ROOT)
     img = ex.exemplar(os.path.join(ROOT, photo_path))
     cfg = dict(name="tiny_single", mode="single", dim=3, crop=64, batch=2, steps=2, width=16, log_every=1,
@@ -604,10 +599,7 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path):
         SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
     (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(doc))
     # the held-out evaluation: every measure, against the shipped space model given the same training pixels
-    spec = importlib.util.spec_from_file_location("eval_solid_singles",
-                                                  os.path.join(ROOT, "bench", "eval_solid_singles.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = bench_script("eval_solid_singles")
     out = tmp_path / "singles.json"
     assert mod.main(["--models", str(tmp_path / "models"), "--space", os.path.join(ROOT, "models", "solid", "space"),
                      "--prev", str(tmp_path / "models"), "-o", str(out), "--sheet", str(tmp_path / "s.png")]) == 0

@@ -7,7 +7,7 @@ It writes a long report (every model's config, loss, run, evaluation and the sin
 which a maintainer updates ``models/solid/MODEL_CARD.md``; the card itself is kept short by hand.
 Everything in the report is read from files the project's own commands wrote:
 each model's ``solid.json`` (config, steps, sha256), its run's ``log.jsonl``
-(wall time, final loss) and the evaluation JSON of ``bench/eval_solid.py``.
+(wall time, final loss) and the evaluation JSON of ``python -m bench solid``.
 """
 from __future__ import annotations
 
@@ -131,7 +131,7 @@ def keep_other_sections(existing: str, generated: str) -> str:
 
 
 def singles_section(path: str, manifest: str = os.path.join("data", "photos", "manifest.json")) -> list:
-    """Lines of the card's section on single-exemplar photo models, from ``bench/eval_solid_singles.py``'s JSON."""
+    """Lines of the card's section on single-exemplar photo models, from ``python -m bench solid-singles``'s JSON."""
     doc = read_json(path)
     files = {}
     if os.path.isfile(manifest):
@@ -139,7 +139,7 @@ def singles_section(path: str, manifest: str = os.path.join("data", "photos", "m
     rows, s = doc["rows"], doc["summary"]
     L = ["## Single-exemplar photo models", "",
          "Each fitted to one photo of the photo set's training split, never seeing its right quarter; measured "
-         "on that quarter (`python bench/eval_solid_singles.py --prev OLD_MODELS --sheet docs/img/solid_singles.png`, "
+         "on that quarter (`python -m bench solid-singles --prev OLD_MODELS --sheet docs/img/solid_singles.png`, "
          "2 seeds of 128² images; 3D: x, y and z slices pooled, or the two slices through a `fixed_axis`). Patch "
          "distance: sliced Wasserstein distance of 7 × 7 Laplacian-pyramid neighbourhoods (× 1000, lower is "
          "better). Beside it, what an artist could make from the same three quarters instead: the shipped space "
@@ -194,14 +194,14 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "python -m omninoise.training.solid.structure_features --out runs/structnet/net_cmd.pt   # models with a structure term",
          "python -m omninoise.training.solid.train --config configs/solid/photo_singles/NAME.json --out runs/solid/NAME",
          "python -m omninoise.training.solid.export runs/solid/NAME models/solid/NAME",
-         "python bench/eval_solid.py --speed",
-         "python bench/eval_solid_singles.py --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/img/solid_singles.json",
+         "python -m bench solid --speed",
+         "python -m bench solid-singles --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/img/solid_singles.json",
          "python -m omninoise.training.solid.model_card --singles docs/img/solid_singles.json -o models/solid/MODEL_CARD.md",
          "```", "",
          "- **Exemplars:** the single-exemplar models named by a photo were each fitted to one colour photo of "
          "the photo set's training split (`data/photos/`: package, licence, author and sha256 per file in its "
          "`manifest.json`, attribution in `ATTRIBUTION.md`); with `hold_out` training never crops its right "
-         "quarter, which `bench/eval_solid_singles.py` measures on. The one older model, granite_3d, names a "
+         "quarter, which `python -m bench solid-singles` measures on. The one older model, granite_3d, names a "
          "procedural class of `training/solid/exemplars.py` (seed 0 trains, seed 1 is held out). The space model "
          "is trained on the whole training split (\"Photo texture space\" below).",
          "- **Model** (Sec. 3-4, Eq. 5): 8 octaves of lattice value noise, 3 values per lattice point, octave i "
@@ -275,7 +275,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
         L += _compare(prev, q, ["space" if docs[n]["mode"] == "space" else docs[n]["exemplars"][0]
                                 for n in continued if docs[n]["mode"] == "space" or docs[n]["dim"] == 3], rej)
     if q:
-        L += ["## Evaluation (`bench/eval_solid.py`)", "",
+        L += ["## Evaluation (`python -m bench solid`)", "",
               f"{ev.get('n', 8)} samples (seeds) per method at 64² px of the training resolution, compared with the exemplar's "
               "held-out pixels. Style error: Gram distance of an independent random network (other seed, widths "
               "and kernels than the loss) plus the colour term; a real 64 px crop scores about 1 on it because one "
@@ -364,7 +364,7 @@ def main(argv=None) -> int:
     ap.add_argument("--previous-eval", help="evaluation JSON of the models that retrained ones replaced")
     ap.add_argument("--rejected", nargs="*", default=[], metavar="MODEL=EVAL_JSON",
                     help="continued runs that did not beat the shipped model, with their evaluation")
-    ap.add_argument("--singles", help="JSON of bench/eval_solid_singles.py (the photo single-exemplar models)")
+    ap.add_argument("--singles", help="JSON of python -m bench solid-singles (the photo single-exemplar models)")
     ap.add_argument("-o", "--out", default=os.path.join("runs", "cards", "solid.md"))
     a = ap.parse_args(argv)
     rejected = dict(r.split("=", 1) for r in a.rejected)

@@ -6,7 +6,7 @@ a maintainer updates the model card's evaluation.
 
 Reads the candidate's run (``RUN/ckpt.pt`` config, ``RUN/log.jsonl``; or its export's ``solid.json``
 when the run folder is gone), and two
-``bench/eval_solid_photos.py`` JSONs (the model shipped before, the
+``python -m bench solid-photos`` JSONs (the model shipped before, the
 candidate) and writes the section between the markers
 ``<!-- photo-space:begin -->`` / ``<!-- photo-space:end -->`` of the card
 (appended when the card has none), leaving the rest of the card as it is.
@@ -130,7 +130,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          *([f"python -m omninoise.training.solid.average --out {run} {' '.join(f['averaged_runs'])}   # the mean of "
             "their weights"] if f["averaged"] else []),
          f"python -m omninoise.training.solid.export {run if f['averaged'] else 'runs/solid/' + cfg['name']} models/solid/space",
-         "python bench/eval_solid_photos.py --model models/solid/space", "```", "",
+         "python -m bench solid-photos --model models/solid/space", "```", "",
          f"- **Run:** {step} steps, {'the last stage at ' if f['stages'] else ''}batch {cfg['batch']} "
          f"({cfg['crop']}² crops and slices), "
          f"{f['seconds'] / 60:.1f} min wall in all stages, on {f['hardware'] or 'hardware not recorded'}"
@@ -167,7 +167,7 @@ def section(run: str, prev: dict, new: dict, shipped: bool, prev_label: str = "p
          "- **Bounded octave transforms:** T_i = R_i e^{c_i} (I + S_i), S_i symmetric with eigenvalues within "
          "±0.6: stretch up to 4:1, never singular. The previous space model's transforms had singular values "
          "down to 0.0, i.e. noise extruded along a line: the diagonal streaks in all its output.", "",
-         "Held-out photos (`bench/eval_solid_photos.py`: every photo of `data/photos/val`, whole photos training "
+         "Held-out photos (`python -m bench solid-photos`: every photo of `data/photos/val`, whole photos training "
          f"never saw; {ns['photos']} photos, 128² slices normal to x, y and z, two seeds; patch distance = sliced "
          "Wasserstein of 7 x 7 Laplacian-pyramid neighbourhoods x 1000):", "",
          f"| measure | {prev_label} | this model |", "|---|---|---|"]

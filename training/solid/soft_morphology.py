@@ -4,7 +4,7 @@ Random-feature losses hardly tell stones from speckle once the colours are
 right: on a paving photo a Voronoi pavement with the photo's colours beats
 the trained speckle by 7 % in the training loss, and by 11 % in the same
 distance over features of the rank-Gaussianised luminance
-(``bench/solid_arrangement.py``), while the level-set morphology of
+(a probe of optimised 2D images), while the level-set morphology of
 :mod:`.morphology` puts it twice as near.  This module makes that morphology
 a loss.  Per pyramid level of the luminance, each image's luminance is
 mapped through its own rank to a standard normal (:func:`.arrangement.gaussianise`),

@@ -124,7 +124,7 @@ class SolidConfig:
     init_stretch: bool = False      # single mode with fixed_axis: the transforms start scaled along that axis by
                                     # the exemplar's spectral aspect (model.spectral_aspect; grain starts long)
     hold_out: bool = False          # single mode: train on a photo's left three quarters only (its right quarter
-                                    # is the held-out part bench/eval_solid_singles.py measures on)
+                                    # is the held-out part python -m bench solid-singles measures on)
     noise_ramp: int = 0             # the value noise enters the decoder with a gain rising from 0 to 1 over the
                                     # run's first noise_ramp steps, so the shape features (cellular, bricks) draw
                                     # alone at first and the decoder learns to read them (noise_gain); 0: off.
