@@ -43,7 +43,8 @@ def wave_points(dim: int) -> np.ndarray:
 
 
 def wave_values(flags: list) -> np.ndarray:
-    from omninoise.cli.main import build_parser, settings_from_args
+    from omninoise.cli.main import build_parser
+    from omninoise.cli.wave import settings_from_args
     from omninoise.backend.grid import evaluate_points
     from omninoise.backend.wavenoise.settings import compile_noise
 

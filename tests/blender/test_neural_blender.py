@@ -338,7 +338,8 @@ def test_fit_to_image_fills_the_active_swatch_as_the_runtime_fits(scene):
 
 @pytest.mark.parametrize("mode", ["SINGLE", "CORNERS", "MAP"])
 def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
-    from omninoise.cli.main import build_parser, neural_request
+    from omninoise.cli.main import build_parser
+    from omninoise.cli.neural import neural_request
     from omninoise.export.images import write_png
 
     p = scene.omninoise_neural

@@ -158,7 +158,8 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
     Part included); the preview, a colour attribute and a volume are the request's solid read at the same points;
     the panel hides the neural texture's other settings."""
     from omninoise.backend.solid.spectral_solid import SpectralTexture
-    from omninoise.cli.main import build_parser, solid_request
+    from omninoise.cli.main import build_parser
+    from omninoise.cli.solid import solid_request
     from omninoise.export.images import write_png
 
     rgb = np.random.default_rng(4).integers(0, 256, (64, 72, 3)).astype(np.uint8)
@@ -381,7 +382,8 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
     """The panel, the command line and job files build one request (backend.solid.request): equal settings give
     equal keys, an image datablock's pixels count as the file they came from."""
     from omninoise.backend.sources import solid_request_from_dict
-    from omninoise.cli.main import build_parser, solid_request
+    from omninoise.cli.main import build_parser
+    from omninoise.cli.solid import solid_request
     from omninoise.export.images import write_png
 
     p = scene.omninoise_solid

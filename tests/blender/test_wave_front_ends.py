@@ -6,7 +6,8 @@ bpy = pytest.importorskip("bpy")
 
 from omninoise import blender_addon  # noqa: E402
 from omninoise.backend.sources import source_from_dict  # noqa: E402
-from omninoise.cli.main import build_parser, settings_from_args  # noqa: E402
+from omninoise.cli.main import build_parser  # noqa: E402
+from omninoise.cli.wave import settings_from_args  # noqa: E402
 
 CASES = [
     # (flags, job-file table, panel properties)

@@ -143,11 +143,12 @@ def test_bad_custom_profiles(tmp_path, capsys, content, name):
 def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp_path, capsys, monkeypatch):
     """Exit 1 and one line naming the exception for a bug; `omninoise --debug ...` re-raises it."""
     import omninoise.cli.main as cli
+    from omninoise.cli import zoo
 
     def broken(a):
         raise ZeroDivisionError("float division by zero")
 
-    monkeypatch.setattr(cli, "run_zoo", broken)
+    monkeypatch.setattr(zoo, "run", broken)
     assert cli.main(["zoo", "--noise", "perlin", "-o", str(tmp_path / "z.png")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "internal error: ZeroDivisionError: float division by zero" in err[0]

@@ -6,7 +6,8 @@ import os
 import numpy as np
 import pytest
 
-from omninoise.cli.main import build_parser, main, neural_request
+from omninoise.cli.main import build_parser, main
+from omninoise.cli.neural import neural_request
 from omninoise.backend.errors import SettingError
 from omninoise.backend.neural.model import NeuralNoiseModel
 from omninoise.backend.neural.request import NeuralRequest, generate_request

@@ -8,7 +8,8 @@ import pytest
 from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.sources import solid_request_from_dict
-from omninoise.cli.main import build_parser, solid_request
+from omninoise.cli.main import build_parser
+from omninoise.cli.solid import solid_request
 from omninoise.export import read_rgb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

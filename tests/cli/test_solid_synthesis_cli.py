@@ -10,7 +10,8 @@ from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
 from omninoise.backend.sources import solid_request_from_dict
-from omninoise.cli.main import build_parser, main, solid_request
+from omninoise.cli.main import build_parser, main
+from omninoise.cli.solid import solid_request
 from omninoise.export import read_rgb
 from omninoise.export.images import write_png
 

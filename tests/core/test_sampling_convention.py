@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from omninoise.backend import WaveSettings, compile_noise
-from omninoise.cli.main import build_parser, main, settings_from_args
+from omninoise.cli.main import build_parser, main
+from omninoise.cli.wave import settings_from_args
 from omninoise.backend.grid import evaluate_grid
 from omninoise.export import read_volume
 from omninoise.export.images import read_image

@@ -1,0 +1,147 @@
+"""``omninoise bake``: every bake of a TOML job file, here or on a Dask farm (:mod:`.farm`)."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural.precision import PRECISIONS
+
+from .common import Bar, add_command, set_threads
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    """The subcommand's parser, added to ``sub`` (the top parser's subparsers)."""
+    b = add_command(sub, "bake", "run the bakes of a TOML job file",
+                    "Run every bake of a job file (TOML): wave, neural and solid sources into .vdb, .exr, .png and .npy "
+                    "files, numbered sequences included. Outputs that are up to date are skipped. Every bake is checked "
+                    "before any runs. The job-file reference is in docs/guide/jobs.md.",
+                    """omninoise bake job.toml
+omninoise bake job.toml --only clouds --force
+omninoise bake job.toml --dry-run
+omninoise bake job.toml --workers 4""")
+    b.add_argument("job", help="job file (.toml)")
+    b.add_argument("--only", action="append", metavar="NAME", help="bake only these (repeatable)")
+    b.add_argument("--force", action="store_true", help="re-bake outputs that are up to date")
+    b.add_argument("--keep-going", action="store_true", help="after a failed bake, carry on with the others")
+    b.add_argument("--dry-run", action="store_true", help="check the job and list what would be baked")
+    b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (0: all cores)")
+    b.add_argument("--precision", default="fp32", choices=PRECISIONS,
+                   help="neural noise arithmetic (int8: a faster draft on CPUs with int8 dot products)")
+    b.add_argument("--quiet", action="store_true", help="no progress bars")
+    farm = b.add_argument_group("farm (Dask; pip install 'omninoise[farm]')")
+    farm.add_argument("--workers", type=int, metavar="N", help="bake on a local cluster of N worker processes")
+    farm.add_argument("--cluster", metavar="ADDRESS", help="bake on a running Dask scheduler (tcp:// or tls://)")
+    farm.add_argument("--retries", type=int, default=2, help="runs of a failed task after the first")
+    farm.add_argument("--brick-voxels", type=int, help="voxels per brick of a large volume (default: from the "
+                                                       "workers' memory)")
+    farm.add_argument("--tls-ca-file", help="tls://: the CA certificate")
+    farm.add_argument("--tls-cert", help="tls://: this client's certificate")
+    farm.add_argument("--tls-key", help="tls://: this client's private key")
+    return b
+
+
+def run(a: argparse.Namespace) -> int:
+    from omninoise.backend.jobs import JobError, load_job, run_job
+
+    if a.dry_run:
+        entries = load_job(a.job)
+        bad = [s for _, s in entries if isinstance(s, JobError)]
+        for name, spec in entries:
+            if isinstance(spec, JobError):
+                print(f"  invalid  {spec}")
+            else:
+                frames = spec.frame_list()
+                fresh = sum(spec.is_up_to_date(f) for f in frames)
+                state = "up to date" if fresh == len(frames) else "to bake"
+                print(f"  {state:10s} {name}: {list(spec.grid.resolution)} -> {spec.output}"
+                      + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))
+        if bad:
+            print(f"omninoise bake: error: {len(bad)} of {len(entries)} bakes are invalid (listed above)",
+                  file=sys.stderr)
+            return 2
+        return 0
+    set_threads(a.threads, a.precision)
+    if a.workers is not None or a.cluster:
+        return _on_farm(a)
+    now = {}      # the bake in progress: one bar per bake
+
+    def on_bake(name, i, count):
+        now.update(bar=Bar(a.quiet, f"[{i + 1}/{count}] {name} "), i=i, count=count)
+
+    def progress(frac):   # the job's fraction -> this bake's
+        now["bar"](min(1.0, max(0.0, frac * now["count"] - now["i"])))
+
+    outcomes = run_job(a.job, keep_going=a.keep_going, force=a.force, only=a.only, progress=progress,
+                       on_bake=on_bake)
+    failed = [o for o in outcomes if o.status != "baked" and o.status != "up to date"]
+    for o in outcomes:
+        if o.status in ("baked", "up to date") and not a.quiet:
+            print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
+    for o in failed:
+        print(f"omninoise bake: {'cancelled' if o.status == 'cancelled' else 'error'}: {o.message}", file=sys.stderr)
+    # exit status as documented: 2 bad input, 130 interrupted, 1 a failure while running
+    if any(o.status == "invalid" for o in failed):
+        return 2
+    if any(o.status == "cancelled" for o in failed):
+        return 130
+    return 1 if failed else 0
+
+
+def _on_farm(a: argparse.Namespace) -> int:
+    """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (cli/farm.py); exit codes as locally."""
+    from omninoise.backend.jobs import JobError
+
+    if a.workers is not None and a.cluster:
+        raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
+    if a.workers is not None and not 1 <= a.workers <= 512:
+        raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
+    if a.retries < 0:
+        raise SettingError("--retries", f"must be >= 0, got {a.retries}")
+    if a.brick_voxels is not None and a.brick_voxels < 1:
+        raise SettingError("--brick-voxels", f"must be >= 1, got {a.brick_voxels}")
+    if not os.path.isfile(a.job):
+        raise JobError(f"job file not found: {a.job}")
+    try:
+        from . import farm
+    except ImportError as exc:
+        raise SettingError("--workers" if a.workers else "--cluster",
+                           f"needs Dask ({exc}); pip install 'dask[distributed]' or the farm extra") from None
+    try:
+        client = farm.local_client(a.workers) if a.workers else farm.remote_client(a.cluster, a.tls_ca_file,
+                                                                                   a.tls_cert, a.tls_key)
+    except ImportError as exc:
+        raise SettingError("--workers" if a.workers else "--cluster",
+                           f"needs Dask distributed ({exc}); pip install 'dask[distributed]'") from None
+    except OSError as exc:
+        raise SettingError("--cluster", f"cannot reach the scheduler {a.cluster}: {exc}") from None
+    try:
+        if not a.quiet and client.dashboard_link:
+            print(f"omninoise bake: Dask dashboard {client.dashboard_link}", file=sys.stderr)
+
+        def status(done, total, moved, eta):
+            if not a.quiet:
+                sys.stderr.write(f"\r  {done}/{total} tasks, {moved / 2 ** 20:.1f} MiB, ETA {eta:.0f} s   ")
+                if done == total:
+                    sys.stderr.write("\n")
+                sys.stderr.flush()
+
+        outcomes = farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
+                                 retries=a.retries, status=status, precision=a.precision)
+    finally:
+        cluster = getattr(client, "cluster", None)
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    for o in outcomes:
+        if o.status in ("baked", "up to date") and not a.quiet:
+            print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
+    bad = [o for o in outcomes if o.status not in ("baked", "up to date")]
+    for o in bad:
+        print(f"omninoise bake: error: {o.message}", file=sys.stderr)
+    if any(o.status == "invalid" for o in bad):
+        return 2
+    return 1 if bad else 0

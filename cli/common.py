@@ -1,0 +1,81 @@
+"""What the subcommands share: the help formatter, the progress bar, threads, and NAME=VALUE parsing."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from omninoise.backend.errors import SettingError
+
+__all__ = ["Help", "add_command", "class_args", "Bar", "set_threads", "param_items"]
+
+
+class Help(argparse.RawDescriptionHelpFormatter):
+    """Each option's default after its help (unless it has none, is a switch, or the help names it already);
+    descriptions and examples kept as written."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        d = action.default
+        if d is None or isinstance(d, bool) or d == [] or d is argparse.SUPPRESS or "default" in text:
+            return text
+        if action.option_strings or action.nargs in (argparse.OPTIONAL, argparse.ZERO_OR_MORE):
+            return text + " (default: %(default)s)"
+        return text
+
+
+def add_command(sub, name: str, help: str, description: str, examples: str):
+    return sub.add_parser(name, help=help, description=description, formatter_class=Help,
+                          epilog="examples:\n" + "\n".join("  " + ln for ln in examples.strip().splitlines()))
+
+
+def class_args(g) -> None:
+    """The options of one noise class image, shared by ``neural`` and ``zoo``."""
+    g.add_argument("--noise", help="class name (see --list)")
+    g.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a class parameter (repeat)")
+    g.add_argument("--size", type=int, default=256, help="output side in pixels")
+    g.add_argument("--seed", type=int, default=0, help="another seed draws another image")
+    g.add_argument("-o", "--out", help="output: .png, .exr or .npy")
+    g.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
+
+
+class Bar:
+    """A progress bar on standard error: ``bar(fraction)``; silent with ``quiet``."""
+
+    def __init__(self, quiet: bool, label: str = ""):
+        self.quiet, self.t0, self.label, self.done = quiet, time.perf_counter(), label, False
+
+    def __call__(self, frac: float) -> None:
+        if self.quiet or self.done:
+            return
+        self.done = frac >= 1.0
+        n = int(frac * 30)
+        sys.stderr.write(f"\r{self.label}[{'#' * n}{'.' * (30 - n)}] {frac * 100:5.1f}%  "
+                         f"{time.perf_counter() - self.t0:6.1f}s")
+        if frac >= 1.0:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def set_threads(n: int, precision: str = "fp32") -> None:
+    """The CLI's --threads and --precision as the defaults of every model the command loads."""
+    from omninoise.backend.neural.precision import set_default_precision
+    from omninoise.backend.onnx_models import set_default_threads
+
+    if n < 0:
+        raise SettingError("--threads", f"must be >= 0 (0: all cores), got {n}")
+    set_default_threads(n)
+    set_default_precision(precision)
+
+
+def param_items(items: list, flag: str) -> dict:
+    out = {}
+    for item in items:
+        key, sep, val = item.partition("=")
+        if not sep:
+            raise SettingError(flag, f"expected NAME=VALUE, got {item!r}")
+        try:
+            out[key] = float(val)
+        except ValueError:
+            raise SettingError(flag, f"expected NAME=VALUE with a number, got {item!r}") from None
+    return out

@@ -1,0 +1,286 @@
+"""``omninoise neural``: neural noise from the trained diffusion model: one class, blends, painted maps,
+animations between keyframes, and fits to an image."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from omninoise.backend import limits
+from omninoise.backend.errors import SettingError
+from omninoise.backend.neural.animate import LATENT_MODES
+from omninoise.backend.neural.precision import PRECISIONS
+from omninoise.backend.paths import neural_model
+
+from .common import Bar, add_command, class_args, param_items, set_threads
+
+__all__ = ["add_parser", "run", "neural_request"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    """The subcommand's parser, added to ``sub`` (the top parser's subparsers)."""
+    n = add_command(sub, "neural", "neural noise from the trained diffusion model",
+                    "Neural noise (Maesumi et al. 2024): one diffusion model for 23 noise classes and their blends, at "
+                    "any size, on the CPU. One class, a blend through a mask, four corners or a painted map; animated "
+                    "between keyframes; or fitted to an image.",
+                    """omninoise neural --list
+omninoise neural --noise cells_f1 --param scale=12 --size 256 --seed 7 --tileable -o cells.png
+omninoise neural --noise cells_f1 --blend mask.png --noise2 noise --size 256 -o blend.png
+omninoise neural --map painted.png --region '#ff0000=spots' --region '#0000ff=gabor' -o map.png
+omninoise neural --keys anim.toml --frames 1 48 --latent slerp -o morph_####.png
+omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
+    g = n.add_argument_group("noise and output")
+    class_args(g)
+    g.add_argument("--tileable", action="store_true", help="a seamless tile (size a multiple of 8)")
+    g.add_argument("--model", help="another model folder (default: the shipped model)")
+    g.add_argument("--quiet", action="store_true", help="no progress bar")
+    g = n.add_argument_group("blends")
+    g.add_argument("--blend", metavar="MASK", help="a grayscale mask image: white areas take --noise2 / --param2")
+    g.add_argument("--noise2", help="class of the masked area (default: --noise)")
+    g.add_argument("--param2", action="append", default=[], metavar="NAME=VALUE", help="its parameters (repeat)")
+    g.add_argument("--width", type=float, default=32.0, help="blend transition width, px")
+    g.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1: linear)")
+    g.add_argument("--corners", nargs=4, metavar="SPEC",
+                   help="four-corner blend: top-left top-right bottom-left bottom-right, each CLASS[:NAME=V,...]")
+    g.add_argument("--map", metavar="PAINTED", help="a painted map: an indexed, grey or colour-coded image")
+    g.add_argument("--region", action="append", default=[], metavar="KEY=SPEC",
+                   help="--map: a grey index (0-255) or #rrggbb colour = CLASS[:NAME=V,...] (repeat)")
+    g = n.add_argument_group("animation")
+    g.add_argument("--keys", metavar="KEYS.toml", help="keyframes of class and parameters over frames (needs "
+                                                       "--frames)")
+    g.add_argument("--frames", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                   help="write frames FIRST..LAST into -o with '#' for the frame number")
+    g.add_argument("--latent", choices=LATENT_MODES, default="fixed",
+                   help="how the initial latent moves: fixed, slerp between the keys' seeds, or drift")
+    g.add_argument("--drift", type=float, default=0.05, help="--latent drift: radians per frame")
+    g = n.add_argument_group("inverse design")
+    g.add_argument("--fit", metavar="IMAGE", help="find the classes, parameters and seed whose noise looks like "
+                                                  "IMAGE and write that noise to -o")
+    g.add_argument("--report", metavar="FIT.json", help="--fit: write the fitted classes, parameters and seed here")
+    g.add_argument("--fit-size", type=int, default=64, help="--fit: side of the windows compared, px")
+    g = n.add_argument_group("sampling and speed")
+    g.add_argument("--sampler", default=None, help="ddim, dpmpp_2m or heun (default: dpmpp_2m)")
+    g.add_argument("--steps", type=int, default=None, help="model evaluations (default: 10)")
+    g.add_argument("--spacing", default=None,
+                   help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own)")
+    g.add_argument("--eta", type=float, default=None,
+                   help="ddim or dpmpp_2m: fresh noise per step, 0 (deterministic) to 1 (default: 0.3 for "
+                        "dpmpp_2m, 0 for ddim; animation always 0)")
+    g.add_argument("--tile", type=int, default=None,
+                   help="draw in overlapping tiles of this side (default: whole up to 1024 px, else 512 px tiles; "
+                        "0: never)")
+    g.add_argument("--threads", type=int, default=0, help="CPU threads (0: all cores)")
+    g.add_argument("--precision", default="fp32", choices=PRECISIONS,
+                   help="int8: about 1.7x faster steps on CPUs with int8 dot products (VNNI), a draft")
+    return n
+
+
+def _spec_arg(text: str, flag: str) -> tuple:
+    """'cells_f1:scale=8,jitter=0.5' -> ('cells_f1', {'scale': 8.0, 'jitter': 0.5})."""
+    name, _, rest = text.partition(":")
+    return name, param_items([p for p in rest.split(",") if p], flag)
+
+
+def _painted_parts(a: argparse.Namespace) -> tuple:
+    """--map and its --region flags -> (regions int (H, W) into specs, specs)."""
+    from omninoise.export.images import decode
+    from omninoise.backend.neural.request import region_key, regions_from_map
+
+    if not os.path.isfile(a.map):
+        raise SettingError("--map", f"map not found: {a.map}")
+    if not a.region:
+        raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
+    px = decode(a.map)
+    if px.shape[:2] != (a.size, a.size):
+        raise SettingError("--map", f"map is {px.shape[1]}x{px.shape[0]} but --size is {a.size}")
+    keys, specs = [], []
+    for r in a.region:
+        key, sep, spec = r.partition("=")
+        if not sep:
+            raise SettingError("--region", f"expected KEY=SPEC, got {r!r}")
+        keys.append(region_key(key, "--region"))
+        specs.append(_spec_arg(spec, "--region"))
+    return regions_from_map(px, keys, "--map"), specs
+
+
+def neural_request(a: argparse.Namespace, model):
+    """The :class:`backend.neural.request.NeuralRequest` of ``omninoise neural`` flags (checked)."""
+    from omninoise.backend.neural.request import NeuralRequest
+    from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
+        raise SettingError("--blend", "choose one of --blend, --corners and --map")
+    kw = dict(width=a.size, height=a.size, transition=a.width, sharpness=a.sharpness, seed=a.seed,
+              steps=DEFAULT_STEPS if a.steps is None else a.steps, sampler=a.sampler or DEFAULT_SAMPLER,
+              spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=a.tile)
+    spec = (a.noise, param_items(a.param, "--param"))
+    if a.corners:
+        req = NeuralRequest("corners", [_spec_arg(c, "--corners") for c in a.corners], **kw)
+    elif a.map:
+        regions, specs = _painted_parts(a)
+        req = NeuralRequest("painted", specs, regions=regions, **kw)
+    elif a.blend:
+        from omninoise.export.images import read_image
+
+        if not os.path.isfile(a.blend):
+            raise SettingError("--blend", f"mask not found: {a.blend}")
+        mask = read_image(a.blend)
+        if mask.shape != (a.size, a.size):
+            raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
+        spec2 = (a.noise2 or a.noise, param_items(a.param2, "--param2"))
+        req = NeuralRequest("blend", [spec, spec2], mask=mask > 0.5, **kw)
+    else:
+        if a.noise2 or a.param2:
+            raise SettingError("--noise2", "a second noise needs --blend MASK")
+        req = NeuralRequest("uniform", [spec], **kw)
+    try:
+        return req.check(model)
+    except SettingError as exc:  # name the flag where the request's field has one
+        flag = {"noise": "--noise", "map": "--map", "blend": "--blend", "size": "--size", "seed": "--seed",
+                "width": "--width"}.get(exc.setting, exc.setting)
+        raise SettingError(flag, exc.message) from None
+
+
+def run(a: argparse.Namespace) -> int:
+    import json
+
+    from omninoise.backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable
+    from omninoise.backend.neural.request import generate_request
+
+    from omninoise.backend.neural.generate import check_sampler
+    from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+
+    set_threads(a.threads, a.precision)
+    sampler = a.sampler or DEFAULT_SAMPLER
+    steps = DEFAULT_STEPS if a.steps is None else a.steps
+    try:
+        check_sampler(sampler, steps, a.spacing, a.eta)
+    except SettingError as exc:         # named as the flag the user typed
+        raise SettingError(f"--{exc.setting}", exc.message) from None
+    if not 0 <= a.seed < 2 ** 32:
+        raise SettingError("--seed", f"must lie in [0, 2^32), got {a.seed}")
+    limits.check_memory("--size", float(a.size) ** 2 * 4 * 160, f"a {a.size}² neural image (activations)")
+    tile = a.tile
+    if tile is not None and tile < 0:
+        raise SettingError("--tile", f"must be >= 0 (0: never tile), got {tile}")
+    folder = a.model or neural_model()
+    try:
+        model = NeuralNoiseModel(folder)
+    except PrecisionUnavailable as exc:
+        raise SettingError("--precision", str(exc)) from None
+    except ModelError as exc:
+        raise SettingError("--model", f"{exc}; train and export one (see models/README.md) or pass --model") from None
+    if a.list:
+        print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))
+        return 0
+    if a.keys or a.frames:
+        return _animate(a, model, sampler, steps, tile)
+    if a.fit:
+        return _fit(a, model, sampler, steps, tile)
+    if a.report:
+        raise SettingError("--report", "a fit report needs --fit IMAGE")
+    if not (a.noise or a.corners or a.map) or not a.out:
+        raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    req = neural_request(a, model)
+    bar = Bar(a.quiet)
+    img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
+    from omninoise.export.images import write_unit_image
+
+    write_unit_image(a.out, img)
+    return 0
+
+
+def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
+    """``neural --keys KEYS.toml --frames FIRST LAST -o name_####.png``: one file per frame, each written
+    atomically (an interrupted run keeps the frames it finished)."""
+    from omninoise.backend.bake import frame_path, has_frame_field
+    from omninoise.backend.neural.animate import animate, read_keys
+    from omninoise.export.images import write_unit_image
+
+    if not (a.keys and a.frames):
+        raise SettingError("--keys", "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
+    if a.noise or a.corners or a.map or a.blend:
+        raise SettingError("--keys", "the keyframes set the classes; leave out --noise, --corners, --map and --blend")
+    if not a.out or not has_frame_field(a.out):
+        raise SettingError("-o", "an animation writes one file per frame: put '#' for the frame number in the "
+                                 "name, e.g. -o noise_####.png")
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    first, last = a.frames
+    if last < first:
+        raise SettingError("--frames", f"expected FIRST LAST with LAST >= FIRST, got {first} {last}")
+    if last - first >= 100_000:
+        raise SettingError("--frames", f"{last - first + 1} frames is more than the 100000 one run may write")
+    limits.finite("--drift", a.drift)
+    folder = os.path.dirname(os.path.abspath(a.out))
+    if not os.path.isdir(folder):
+        raise SettingError("-o", f"output folder does not exist: {folder}")
+    keys = read_keys(a.keys)
+    n = last - first + 1
+    bar = Bar(a.quiet, "frames ")
+    frames = animate(model, keys, (first, last), a.size, a.size, latent=a.latent, speed=a.drift, steps=steps,
+                     sampler=sampler, spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=tile)
+    for i, (f, img) in enumerate(frames):
+        write_unit_image(frame_path(a.out, f), img)
+        bar((i + 1) / n)
+    return 0
+
+
+def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
+    """``neural --fit IMAGE -o OUT [--report FIT.json]``: inverse design (backend/neural/fit.py), then the fitted
+    noise at --size with the sampler settings."""
+    import json
+
+    from omninoise.export.atomic import write_json
+    from omninoise.export.images import decode, write_unit_image
+    from omninoise.backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
+    from omninoise.backend.neural.generate import generate
+    from omninoise.backend.onnx_models import ModelError
+    from omninoise.backend.paths import fit_bank
+
+    if a.noise or a.corners or a.map or a.blend:
+        raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
+    if not a.out:
+        raise SettingError("-o", "--fit writes the fitted noise: give -o OUT (.png, .exr or .npy)")
+    ext = os.path.splitext(a.out)[1].lower()
+    if ext not in (".png", ".exr", ".npy"):
+        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    if a.size < 8:
+        raise SettingError("--size", f"must be >= 8, got {a.size}")
+    if not os.path.isfile(a.fit):
+        raise SettingError("--fit", f"image not found: {a.fit}")
+    try:
+        img = decode(a.fit)
+    except (OSError, ValueError) as exc:
+        raise SettingError("--fit", f"{a.fit}: not an image we can read ({exc})") from None
+    try:
+        bank = load_bank(fit_bank())
+    except ModelError as exc:  # the fit still works, starting from every class at mid-range parameters
+        print(f"note: no inverse-design bank ({exc}); trying every class", file=sys.stderr)
+        bank = None
+    img = img[..., 0] if img.shape[2] == 1 else img
+    for note in prepare_target(img, model.multiple_of, os.path.basename(a.fit))[1]:  # refuses too small images
+        print("note: " + note, file=sys.stderr)
+    bar = Bar(a.quiet, "fit    ")
+    res = fit(model, img, size=a.fit_size, seed=a.seed, bank=bank, progress=lambda f: bar(0.8 * f))
+    cond = fitted_conditioning(model, res, a.size, a.size)
+    out = generate(model, cond, res.seed, steps, a.tileable, callback=lambda i, n, x0: bar(0.8 + 0.2 * (i + 1) / n),
+                   sampler=sampler, spacing=a.spacing, tile=tile)
+    write_unit_image(a.out, out)
+    report = dict(res.to_json(), image=os.path.abspath(a.fit), output=os.path.abspath(a.out), size=a.size,
+                  model=model.fingerprint)
+    if a.report:
+        write_json(a.report, report)
+    if not a.quiet:
+        print(json.dumps(dict(classes=res.classes, params=res.params, seed=res.seed, command=res.command())))
+    return 0
+
+

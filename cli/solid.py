@@ -1,0 +1,141 @@
+"""``omninoise solid``: solid textures from shipped textures or photos, as an image or a volume."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+from omninoise.backend import limits
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.request import METHODS
+from omninoise.backend.solid.spectral import REST_CHOICES
+
+from .common import Bar, add_command
+
+__all__ = ["add_parser", "run", "solid_request"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    """The subcommand's parser, added to ``sub`` (the top parser's subparsers)."""
+    s = add_command(sub, "solid", "solid textures from shipped textures or photos",
+                    "Solid textures (Henzler et al. 2020): a shipped texture or any photo becomes a 3D texture, written as "
+                    "an image (--dim 2: the plane y = 0 seen from the front, x right, z up) or a volume (--dim 3).",
+                    """omninoise solid --list
+omninoise solid --exemplar wood_3d --dim 3 --size 128 -o wood.vdb
+omninoise solid --exemplar photo.jpg --size 512 -o like.png
+omninoise solid --exemplar gravel --to marble --mix 0.5 -o halfway.png
+omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 128 -o rock.vdb
+omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png""")
+    g = s.add_argument_group("texture and output")
+    g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file")
+    g.add_argument("-o", "--out", help="2D: .png (sRGB), .exr or .npy (linear); 3D: .vdb or .npy (linear)")
+    g.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image; 3: a volume")
+    g.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
+    g.add_argument("--scale", type=float, default=1.0, help="zoom: output pixels per exemplar pixel")
+    g.add_argument("--seed", type=int, default=0, help="another seed gives another texture of the same kind")
+    g.add_argument("--method", default="neural", choices=METHODS,
+                   help="neural: the models' texture, 2D or 3D; spectral: the photo's spectrum and colours on every "
+                        "cut, 2D or 3D, no network; synthesis: a seamless 2D image copied from the photo")
+    g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
+    g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
+                                   "texture-space model)")
+    g.add_argument("--quiet", action="store_true", help="no progress or notes")
+    g = s.add_argument_group("photos (the texture-space model)")
+    g.add_argument("--refine", type=int, default=0, metavar="N", help="improve a photo's code with N search steps")
+    g.add_argument("--to", metavar="EXEMPLAR", help="interpolate towards this exemplar")
+    g.add_argument("--mix", type=float, default=0.5, help="interpolation weight of --to, 0 to 1")
+    g.add_argument("--no-periodic", dest="periodic", action="store_false",
+                   help="leave out the photo's periodic part (courses, plank seams, tile joints)")
+    g.add_argument("--no-gaussian", dest="gaussian", action="store_false",
+                   help="never mix in fine detail drawn from the photo's spectrum (by default mixed in where a "
+                        "check on rendered planes finds it closer)")
+    g.add_argument("--rest", default="auto", choices=REST_CHOICES,
+                   help="that detail's kind: auto (the check chooses), isotropic, or upright (layers and grain "
+                        "kept on walls)")
+    g = s.add_argument_group("--method synthesis")
+    g.add_argument("--tile", type=int, default=256, help="the tile's side, px (a multiple of 4 in [32, 1024])")
+    return s
+
+
+def solid_request(a: argparse.Namespace):
+    """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
+    from omninoise.backend.solid.request import SolidRequest
+
+    return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
+                        a.rest, a.method, a.tile).check("--")
+
+
+def run(a: argparse.Namespace) -> int:
+    import json
+
+    from omninoise.backend.solid.model import load_models
+
+    if a.list:
+        out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
+               for name, m in load_models().items()}
+        print(json.dumps(out, indent=2))
+        return 0
+    if not a.exemplar or not a.out:
+        raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")
+    if a.size < 1:
+        raise SettingError("--size", f"must be >= 1, got {a.size}")
+    limits.positive("--scale", a.scale)
+    limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
+    ext = os.path.splitext(a.out)[1].lower()
+    allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
+    if ext not in allowed:
+        raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
+    if ext == ".vdb":
+        from omninoise.backend.bake import require_vdb
+
+        require_vdb("-o")
+    req = solid_request(a)
+    t0 = time.perf_counter()
+    if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
+        print(f"encoding {a.exemplar} ...", end="", file=sys.stderr, flush=True)
+
+    def report(name, hist):
+        if not a.quiet:
+            kept = len(hist) > 1 and hist[-1] == hist[0] and min(hist) < hist[0]
+            print(f"refined {name}: neighbourhood distance {hist[0]:.4f} -> {min(hist):.4f}"
+                  + (" on the searched planes, not closer on fresh ones: the encoder's code is kept" if kept else ""),
+                  file=sys.stderr)
+
+    def on_code(code):
+        if a.quiet:
+            return
+        if os.path.isfile(a.exemplar):
+            print(f" done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
+        if code.harmonics is not None:
+            h = code.harmonics
+            print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
+                  "(--no-periodic leaves it out)", file=sys.stderr)
+        if code.rest is not None:
+            from omninoise.backend.solid.spectral import KIND_WORDS
+            print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as "
+                  f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian "
+                  "leaves it out)", file=sys.stderr)
+
+    stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid "}[req.method]
+    if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
+        from omninoise.backend.bake import BakeSpec, run_bake
+        from omninoise.backend.sources import BoxGrid, solid_volume
+
+        source, extent = solid_volume(req, a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code)
+        grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
+        run_bake(BakeSpec("solid", source, grid, a.out), Bar(a.quiet), force=True)
+        return 0
+    _write_image(a.out, req.front_image(a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code,
+                                              Bar(a.quiet)))
+    return 0
+
+
+def _write_image(out: str, rgb: np.ndarray) -> None:
+    """A 2D solid texture, sRGB float (H, W, 3) in [0, 1]: .png as it is, .exr and .npy linear."""
+    from omninoise.backend.colour import srgb_to_linear
+    from omninoise.export.images import write_unit_image
+
+    write_unit_image(out, rgb, srgb_to_linear(rgb))
