@@ -1,7 +1,9 @@
 """Blender layer of OmniNoise: the only package that imports ``bpy``.
 
-Registration is cheap: classes and menu entries only.  Engines load when first
-used (building a node imports numpy and the backend, no model is read).
+Registration is cheap: classes and menu entries only.  Each UI module has one ``classes`` tuple and, where it
+adds more than classes (scene settings, menu entries, handlers), an ``attach()``/``detach()`` pair; this package
+registers them all in one loop.  Engines load when first used (building a node imports numpy and the backend, no
+model is read).
 """
 from __future__ import annotations
 
@@ -13,13 +15,25 @@ def _modules():
 
 
 def register():
+    """Every module's ``classes`` registered in order, then what each ``attach()`` adds (scene settings, menu
+    entries, handlers)."""
+    import bpy
+
     for m in _modules():
-        m.register()
+        for cls in m.classes:
+            bpy.utils.register_class(cls)
+        if hasattr(m, "attach"):
+            m.attach()
 
 
 def unregister():
+    import bpy
+
     from . import tasks
 
     tasks.shutdown()  # a bake still running is cancelled and joined, its timer dropped: nothing keeps running
     for m in reversed(_modules()):
-        m.unregister()
+        if hasattr(m, "detach"):
+            m.detach()
+        for cls in reversed(m.classes):
+            bpy.utils.unregister_class(cls)

@@ -22,11 +22,12 @@ from .tasks import TaskOperator
 from .. import backend
 from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
                            transfer_from_color_ramp, world_bounds)
+from .common import Sidebar
 from .preferences import precision, threads
 from .wave_nodes import settings_from_json, tree_settings_json
 from .wave_ui import OMNINOISE_PG_wave, draw_wave_settings
 
-__all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "draw_progress", "register", "unregister"]
+__all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "draw_progress", "classes", "attach", "detach"]
 
 _PRESETS = [(k, k.capitalize(), f"The {k} transfer function") for k in ("clouds", "smoke", "fire", "marble", "crystal")]
 _OUTPUTS = [("real", "Value", "Real part"), ("imag", "Imaginary", "Imaginary part"),
@@ -289,10 +290,8 @@ def draw_progress(layout) -> bool:
     return True
 
 
-class _Panel:
+class _Panel(Sidebar):
     bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "OmniNoise"
 
 
 class OMNINOISE_PT_bake(_Panel, bpy.types.Panel):
@@ -421,20 +420,17 @@ classes = (OMNINOISE_PG_bake, OMNINOISE_OT_bake_volume, OMNINOISE_OT_bake_image,
            OMNINOISE_PT_bake_output, OMNINOISE_PT_bake_job)
 
 
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
+def attach():
+    """What register() adds beyond the classes: the scene's bake settings, the message line, the status bar."""
     bpy.types.Scene.omninoise_bake = PointerProperty(type=OMNINOISE_PG_bake)
     bpy.types.WindowManager.omninoise_message = StringProperty(options={"SKIP_SAVE"})
     bpy.types.STATUSBAR_HT_header.append(_statusbar)
 
 
-def unregister():
+def detach():
     tasks.cancel()
     bpy.types.STATUSBAR_HT_header.remove(_statusbar)
     del bpy.types.WindowManager.omninoise_message
     del bpy.types.Scene.omninoise_bake
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
 
 

@@ -12,7 +12,6 @@ file per frame and loads them as one image sequence on the Image Texture node.
 """
 from __future__ import annotations
 
-import importlib
 import os
 
 import bpy
@@ -23,18 +22,14 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatPrope
 from . import tasks
 from .. import backend
 from .bake_ui import draw_progress
+from .common import Sidebar, backend_module as _mod, image_pixels, neural_model_folder
 from .tasks import TaskOperator
 from .preferences import precision, threads
 
-__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "register", "unregister"]
+__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "attach", "detach"]
 
 _MODEL = {}
 N_PARAMS = 4
-
-
-def _mod(name: str):
-    """A backend submodule, imported on first use (``neural.model``, ``neural.conditioning``...)."""
-    return importlib.import_module(f"{backend.__name__}.{name}")
 
 
 _SAMPLERS = _mod("neural.sampler")  # numpy only: cheap at register time
@@ -51,14 +46,9 @@ def model():
     key = (threads(), precision())
     if _MODEL.get("key") != key:
         _MODEL.clear()
-        _MODEL.update(key=key, m=_mod("neural.model").NeuralNoiseModel(_model_folder(), threads=key[0],
+        _MODEL.update(key=key, m=_mod("neural.model").NeuralNoiseModel(neural_model_folder(), threads=key[0],
                                                                         precision=key[1]))
     return _MODEL["m"]
-
-
-def _model_folder() -> str:
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    return os.path.join(root, "models", "neural_noise")
 
 
 def _class_items(self, context):
@@ -379,17 +369,6 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
         return tasks.start(task, blocking=blocking)
 
 
-def image_pixels(ima) -> np.ndarray:
-    """An image datablock's pixels as float32 (H, W, C), top row first (Blender stores rows bottom-up)."""
-    w, h = ima.size
-    if w == 0 or h == 0:
-        raise backend.SettingError("fit image", f"{ima.name!r} has no pixels (missing file?)")
-    c = ima.channels
-    px = np.empty(w * h * c, np.float32)
-    ima.pixels.foreach_get(px)
-    return np.flipud(px.reshape(h, w, c))
-
-
 class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
     """Find the noise class, parameters and seed that look like the Fit Image (inverse design), and put them
     into the active swatch"""
@@ -404,7 +383,7 @@ class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
         m = model()
         if p.fit_image is None:
             raise backend.SettingError("fit image", "pick an image to fit")
-        px = image_pixels(p.fit_image)
+        px = image_pixels(p.fit_image, "fit image")
         if px.shape[2] == 4:
             px = px[..., :3]
         img, notes = F.prepare_target(px if px.shape[2] > 1 else px[..., 0], m.multiple_of, p.fit_image.name)
@@ -740,21 +719,17 @@ def draw_neural(layout, context) -> None:
     row.operator(OMNINOISE_OT_neural_bake_sequence.bl_idname, icon="RENDER_ANIMATION")
 
 
-class OMNINOISE_PT_neural_image(bpy.types.Panel):
+class OMNINOISE_PT_neural_image(Sidebar, bpy.types.Panel):
     bl_label = "Neural Noise"
     bl_space_type = "IMAGE_EDITOR"
-    bl_region_type = "UI"
-    bl_category = "OmniNoise"
 
     def draw(self, context):
         draw_neural(self.layout, context)
 
 
-class OMNINOISE_PT_neural_shader(bpy.types.Panel):
+class OMNINOISE_PT_neural_shader(Sidebar, bpy.types.Panel):
     bl_label = "Neural Noise"
     bl_space_type = "NODE_EDITOR"
-    bl_region_type = "UI"
-    bl_category = "OmniNoise"
 
     @classmethod
     def poll(cls, context):
@@ -771,13 +746,10 @@ classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, O
            OMNINOISE_PT_neural_image, OMNINOISE_PT_neural_shader)
 
 
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
+def attach():
+    """What register() adds beyond the classes: the scene's neural noise settings."""
     bpy.types.Scene.omninoise_neural = PointerProperty(type=OMNINOISE_PG_neural)
 
 
-def unregister():
+def detach():
     del bpy.types.Scene.omninoise_neural
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)

@@ -66,11 +66,5 @@ class OMNINOISE_AP_preferences(bpy.types.AddonPreferences):
         self.layout.prop(self, "cache_dir")
 
 
-def register():
-    if ROOT_PACKAGE:
-        bpy.utils.register_class(OMNINOISE_AP_preferences)
-
-
-def unregister():
-    if ROOT_PACKAGE:
-        bpy.utils.unregister_class(OMNINOISE_AP_preferences)
+#: the preferences exist where the extension is installed as a package (``__package__`` names its root)
+classes = (OMNINOISE_AP_preferences,) if ROOT_PACKAGE else ()

@@ -30,7 +30,6 @@ and written after on the main thread.
 """
 from __future__ import annotations
 
-import importlib
 import os
 
 import bpy
@@ -41,33 +40,30 @@ from . import tasks
 from .. import backend
 from .compat import ensure_node_tree
 from .bake_ui import draw_progress
+from .common import Sidebar, backend_module as _mod, image_srgb, solid_models_folder, store_srgb_image
 from .tasks import TaskOperator
 from .preferences import threads
 
-__all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "tile_repeats", "register",
-           "unregister"]
+__all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "tile_repeats", "attach",
+           "detach"]
 
-#: where the shipped models live (``backend.solid.model.SHIPPED_MODELS``, computed here without importing the
-#: backend, so register() stays cheap); tests point it elsewhere
-MODELS_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "models", "solid")
+#: another folder of solid texture models than the shipped one (tests point it elsewhere); None: the shipped models
+MODELS_DIR: str | None = None
 _MODELS = {}   # folder path -> model, or the ModelError it raised (an altered folder is read once)
 
 
-def _mod(name: str):
-    return importlib.import_module(f"{backend.__name__}.{name}")
-
-
 def models_dir() -> str:
-    return MODELS_DIR
+    """The folder the panel's solid texture models come from."""
+    return MODELS_DIR or solid_models_folder()
 
 
 def _models() -> dict:
-    """{folder name: model} under :data:`MODELS_DIR`, each loaded once (never at register time)."""
+    """{folder name: model} under :func:`models_dir`, each loaded once (never at register time)."""
     return _mod("solid.model").load_models(models_dir(), threads(), _MODELS)
 
 
 def load_model(name: str):
-    """A model folder under :data:`MODELS_DIR` by name (ModelError if it is missing or altered)."""
+    """A model folder under :func:`models_dir` by name (ModelError if it is missing or altered)."""
     m = _models().get(name)
     if m is None:
         err = _MODELS.get(os.path.join(models_dir(), name))
@@ -157,22 +153,6 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                            description="Where volumes are written ('//' = beside the .blend)")
 
 
-def _image_pixels(ima) -> np.ndarray:
-    """An image datablock's pixels as float32 (H, W, 3) sRGB-encoded values, top row first."""
-    w, h = ima.size
-    if w * h == 0:
-        raise backend.SettingError("image", f"image {ima.name!r} has no pixels (is its file missing?)")
-    px = np.empty(w * h * ima.channels, np.float32)
-    ima.pixels.foreach_get(px)
-    px = px.reshape(h, w, ima.channels)
-    rgb = px[..., :3] if ima.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
-    if ima.is_float:  # float buffers hold scene-linear values; the encoder was trained on sRGB values
-        from .. import export
-
-        rgb = export.linear_to_srgb(rgb)
-    return np.ascontiguousarray(np.flipud(rgb), np.float32)
-
-
 def panel_request(p):
     """The panel's :class:`backend.solid.request.SolidRequest`: the one request of the command line and job
     files, built from the properties (an image's pixels are read here, on the main thread: bpy data)."""
@@ -181,12 +161,12 @@ def panel_request(p):
         if p.image is None:
             raise backend.SettingError("image", "pick an exemplar image (or switch Source to Shipped)")
         if p.method == "SPECTRAL":
-            return SolidRequest(exemplar=_image_pixels(p.image), seed=int(p.seed), periodic=bool(p.periodic),
+            return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), periodic=bool(p.periodic),
                                 method="spectral").check()
         name = _space_model_name()
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
-        return SolidRequest(os.path.join(models_dir(), name), _image_pixels(p.image), refine=int(p.refine),
+        return SolidRequest(os.path.join(models_dir(), name), image_srgb(p.image, "image"), refine=int(p.refine),
                             seed=int(p.seed), periodic=bool(p.periodic), gaussian=bool(p.gaussian),
                             rest=str(p.rest)).check()
     ident = p.texture
@@ -203,7 +183,7 @@ def tile_request(p):
     if p.source != "IMAGE" or p.image is None:
         raise backend.SettingError("image", "a tileable image is synthesised from an exemplar image: set Source to "
                                             "Image and pick one")
-    return _mod("solid.request").SolidRequest(exemplar=_image_pixels(p.image), seed=int(p.seed),
+    return _mod("solid.request").SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed),
                                               method="synthesis", tile=int(p.tile)).check()
 
 
@@ -277,23 +257,6 @@ def _mesh_arrays(context, obj, world: bool, uv: bool):
         eo.to_mesh_clear()
 
 
-def _store_image(name: str, rgb: np.ndarray):
-    """An 8-bit sRGB image datablock (packed into the .blend) holding rgb (H, W, 3) sRGB values, row 0 bottom."""
-    H, W, _ = rgb.shape
-    ima = bpy.data.images.get(name)
-    if ima is None or tuple(ima.size) != (W, H) or ima.is_float:
-        if ima is not None:
-            bpy.data.images.remove(ima)
-        ima = bpy.data.images.new(name, W, H, alpha=False)
-    ima.colorspace_settings.name = "sRGB"
-    rgba = np.ones((H, W, 4), np.float32)
-    rgba[..., :3] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0) / 255.0
-    ima.pixels.foreach_set(rgba.ravel())
-    ima.update()
-    ima.pack()
-    return ima
-
-
 #: how far left of the Principled BSDF the node feeding its Base Color is placed (node editor units)
 _BESIDE_BSDF = 320
 
@@ -340,7 +303,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
 
         def done(result):
             img, info, rest = result
-            _store_image(name, np.flipud(img)).preview_ensure()
+            store_srgb_image(name, np.flipud(img)).preview_ensure()
             p.periodic_info, p.gaussian_info = info, rest
 
         return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
@@ -363,7 +326,7 @@ class OMNINOISE_OT_solid_tileable(TaskOperator, bpy.types.Operator):
             return req.synthesis_field("", progress, cancel).tile    # (N, N, 3), row 0 at the bottom
 
         def done(tile):
-            _store_image(name, tile).preview_ensure()
+            store_srgb_image(name, tile).preview_ensure()
 
         return tasks.start(tasks.Task("Tileable image", work, done, None, threads()), blocking=blocking)
 
@@ -475,7 +438,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
                 return rgb
 
             def done(rgb):
-                ima = _store_image(name, rgb)
+                ima = store_srgb_image(name, rgb)
 
                 def node(nt):
                     n = next((x for x in nt.nodes if x.type == "TEX_IMAGE" and x.image == ima), None)
@@ -600,11 +563,9 @@ def draw_solid(layout, context) -> None:
     row.operator(OMNINOISE_OT_solid_bake.bl_idname, text="Bake", icon="RENDER_STILL")
 
 
-class OMNINOISE_PT_solid(bpy.types.Panel):
+class OMNINOISE_PT_solid(Sidebar, bpy.types.Panel):
     bl_label = "Solid Texture from Image"
     bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "OmniNoise"
 
     def draw(self, context):
         draw_solid(self.layout, context)
@@ -614,13 +575,10 @@ classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_ti
            OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_PT_solid)
 
 
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
+def attach():
+    """What register() adds beyond the classes: the scene's solid texture settings."""
     bpy.types.Scene.omninoise_solid = PointerProperty(type=OMNINOISE_PG_solid)
 
 
-def unregister():
+def detach():
     del bpy.types.Scene.omninoise_solid
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)

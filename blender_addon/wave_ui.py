@@ -21,6 +21,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
     PointerProperty, StringProperty
 
 from .. import backend
+from .common import Sidebar
 from .wave_nodes import add_wave_node, build_wave_group, new_wave_tree, tree_implementation
 
 _SPECTRA = [(k, k.capitalize(), "") for k in ("gaussian", "bandpass", "fractal", "white", "blue", "brown", "twolevel")]
@@ -244,11 +245,9 @@ def new_wave_node_tree(name: str, tree_type: str, scene=None) -> bpy.types.NodeT
     return tree
 
 
-class OMNINOISE_PT_wave_node(bpy.types.Panel):
+class OMNINOISE_PT_wave_node(Sidebar, bpy.types.Panel):
     bl_label = "Wave Noise"
     bl_space_type = "NODE_EDITOR"
-    bl_region_type = "UI"
-    bl_category = "OmniNoise"
 
     @classmethod
     def poll(cls, context):
@@ -321,9 +320,9 @@ MENUS = ("NODE_MT_category_shader_texture", "NODE_MT_category_GEO_TEXTURE")
 classes = (OMNINOISE_PG_wave, OMNINOISE_OT_add_wave_noise, OMNINOISE_OT_add_wave_cellular, OMNINOISE_PT_wave_node)
 
 
-def register():
-    for cls in classes:
-        bpy.utils.register_class(cls)
+def attach():
+    """What register() adds beyond the classes: the node tree's settings, the render-settings handlers, the
+    Add-menu entries."""
     bpy.types.NodeTree.omninoise_wave = PointerProperty(type=OMNINOISE_PG_wave)
     for handlers in _HANDLERS():
         if follow_render_settings not in handlers:
@@ -337,7 +336,7 @@ def register():
             menu.append(_menu)
 
 
-def unregister():
+def detach():
     for handlers in _HANDLERS():
         if follow_render_settings in handlers:
             handlers.remove(follow_render_settings)
@@ -350,5 +349,3 @@ def unregister():
         if menu is not None:
             menu.remove(_menu)
     del bpy.types.NodeTree.omninoise_wave
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)

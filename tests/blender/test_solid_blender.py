@@ -9,11 +9,11 @@ bpy = pytest.importorskip("bpy")
 
 from omninoise import blender_addon  # noqa: E402
 from conftest import Recorder, needs_openvdb  # noqa: E402
-from omninoise.blender_addon import solid_ui, tasks  # noqa: E402
+from omninoise.blender_addon import common, solid_ui, tasks  # noqa: E402
 from omninoise.backend.solid.bake import srgb_to_linear  # noqa: E402
 from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
 
-SHIPPED = solid_ui.MODELS_DIR
+SHIPPED = solid_ui.models_dir()
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
@@ -27,7 +27,7 @@ def addon(tmp_path_factory):
     blender_addon.register()
     yield
     blender_addon.unregister()
-    solid_ui.MODELS_DIR = SHIPPED
+    solid_ui.MODELS_DIR = None
 
 
 @pytest.fixture
@@ -41,7 +41,7 @@ def scene(tmp_path):
 
 
 def _model(name="gravel_3d"):
-    return SolidTextureModel(os.path.join(solid_ui.MODELS_DIR, name))
+    return SolidTextureModel(os.path.join(solid_ui.models_dir(), name))
 
 
 def _pixels(name):
@@ -273,7 +273,7 @@ def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     p.source, p.image, p.tile, p.seed = "IMAGE", ima, 64, 5
     assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
     got = _pixels("Solid Texture Tile")
-    ref = SolidRequest(exemplar=solid_ui._image_pixels(ima), seed=5, method="synthesis",
+    ref = SolidRequest(exemplar=common.image_srgb(ima, "image"), seed=5, method="synthesis",
                        tile=64).synthesis_field().tile
     assert got.shape == (64, 64, 3) and np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
     g = got.mean(2)      # the stripes stay vertical: brightness changes across columns, not down them
@@ -387,13 +387,13 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
     from omninoise.export.images import write_png
 
     p = scene.omninoise_solid
-    space = os.path.join(solid_ui.MODELS_DIR, "space")
+    space = os.path.join(solid_ui.models_dir(), "space")
 
     def flags(*args):
         return solid_request(build_parser().parse_args(["solid", *args, "--seed", "3", "-o", "x.png"]))
 
     p.texture = "single:gravel_3d"
-    gravel = os.path.join(solid_ui.MODELS_DIR, "gravel_3d")
+    gravel = os.path.join(solid_ui.models_dir(), "gravel_3d")
     assert solid_ui.panel_request(p).key() == flags("--model", gravel).key() == \
         solid_request_from_dict({"model": gravel, "seed": 3}).key()
     p.texture = "space:space:grass"

@@ -1,0 +1,81 @@
+"""What the extension's panels and operators share: the backend imported on first use, the sidebar panels'
+place, image pixels read from and written to datablocks, and the shipped models' folders.
+
+Cheap to import (``bpy``, numpy and ``backend.paths``); nothing here loads a model or an engine.
+"""
+from __future__ import annotations
+
+import importlib
+
+import bpy
+import numpy as np
+
+from .. import backend
+from ..backend import paths
+
+__all__ = ["backend_module", "Sidebar", "image_pixels", "image_srgb", "store_srgb_image", "neural_model_folder",
+           "solid_models_folder"]
+
+
+def backend_module(name: str):
+    """A backend submodule (``"neural.model"``, ``"solid.request"``...), imported on first use, so that register()
+    stays cheap."""
+    return importlib.import_module(f"{backend.__name__}.{name}")
+
+
+class Sidebar:
+    """The OmniNoise tab of an editor's sidebar (N panel); a panel sets its ``bl_space_type`` beside this."""
+
+    bl_region_type = "UI"
+    bl_category = "OmniNoise"
+
+
+def image_pixels(ima, setting: str) -> np.ndarray:
+    """An image datablock's pixels as stored, float32 (H, W, C), top row first (Blender keeps rows bottom-up);
+    an image without pixels (a missing file) is a SettingError naming ``setting``."""
+    w, h = ima.size
+    if w * h == 0:
+        raise backend.SettingError(setting, f"image {ima.name!r} has no pixels (is its file missing?)")
+    px = np.empty(w * h * ima.channels, np.float32)
+    ima.pixels.foreach_get(px)
+    return np.flipud(px.reshape(h, w, ima.channels))
+
+
+def image_srgb(ima, setting: str) -> np.ndarray:
+    """An image datablock as sRGB-encoded RGB, float32 (H, W, 3), top row first: float images hold scene-linear
+    values and are encoded; grey images are repeated into three channels."""
+    px = image_pixels(ima, setting)
+    rgb = px[..., :3] if ima.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
+    if ima.is_float:
+        from .. import export
+
+        rgb = export.linear_to_srgb(rgb)
+    return np.ascontiguousarray(rgb, np.float32)
+
+
+def store_srgb_image(name: str, rgb: np.ndarray):
+    """An 8-bit sRGB image datablock ``name`` (replaced if its size or kind differs, packed into the .blend)
+    holding ``rgb`` (H, W, 3) sRGB values in [0, 1], row 0 at the bottom."""
+    H, W, _ = rgb.shape
+    ima = bpy.data.images.get(name)
+    if ima is None or tuple(ima.size) != (W, H) or ima.is_float:
+        if ima is not None:
+            bpy.data.images.remove(ima)
+        ima = bpy.data.images.new(name, W, H, alpha=False)
+    ima.colorspace_settings.name = "sRGB"
+    rgba = np.ones((H, W, 4), np.float32)
+    rgba[..., :3] = np.round(np.clip(rgb, 0.0, 1.0) * 255.0) / 255.0
+    ima.pixels.foreach_set(rgba.ravel())
+    ima.update()
+    ima.pack()
+    return ima
+
+
+def neural_model_folder() -> str:
+    """The shipped neural noise model (``OMNINOISE_MODELS`` overrides the package's ``models`` folder)."""
+    return paths.neural_model()
+
+
+def solid_models_folder() -> str:
+    """The folder of the shipped solid texture models, one subfolder each."""
+    return paths.solid_models()
