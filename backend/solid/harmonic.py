@@ -34,7 +34,7 @@ the axes) stay out (tested).  Chosen on the training split ("lobes" in the same 
 the photo inside its frame but beat beyond it, so where the peaks lie on a lattice off the grid (a photograph
 of bricks, tiles or a weave, whose periods do not divide its frame) the part is read as that lattice's motif
 instead, one wave at each lattice point at its own frequency, wherever it holds at least the share of the photo's
-variance the bins hold (:mod:`backend.solid.motif`; ``motif=False`` reads the bins as before).  A tileable
+variance the bins hold (:mod:`backend.solid.motif`; ``HarmonicConfig(motif=False)`` reads the bins alone).  A tileable
 photo's lattice lies on the grid, and its part is read from the bins as before.  A tile whose pattern repeats
 only two to four times (a texture library's bricks: two courses of two bricks in 256 x 166 px) puts its peaks
 one to three bins apart, each inside the others' rings, and the peak test finds the courses at most; there the
@@ -85,7 +85,8 @@ from ..periodic import periodic_component
 from .motif import box_sums, motif_waves, on_grid
 from .periods import frame_lines, lattice_bins, period_lattice
 
-__all__ = ["Harmonics", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
+__all__ = ["Harmonics", "HarmonicConfig", "PhotoSpectrum", "WaveSet", "photo_spectrum", "choose_waves", "READINGS",
+           "read_peaks", "read_motif", "read_few_repeats", "read_lines", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
            "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW",
            "MIN_CYCLES", "LOBE", "LOBE_DEPTH", "FEW_GRID", "FEW_MARGIN", "FEW_MIN_CYCLES"]
 
@@ -160,16 +161,150 @@ def _main_lobes(idx: np.ndarray, lobe: int, keep: np.ndarray, P: np.ndarray, H: 
     return bins[np.sort(first)]
 
 
-def _few_repeats(u: np.ndarray, P: np.ndarray, window: int, total: float, count: int):
-    """Flat bins of a tileable photo's pattern that repeats too few times for the peak test (periods.py): u (3, H, W)
-    mean-free, P its colour power spectrum (of the periodic component), ``total`` its variance's power; None unless
-    the photo's lattice of periods lies on the grid with a reciprocal vector shorter than ``window`` + 1 bins."""
-    B, _ = period_lattice(u)
-    if B is None or not on_grid(B, FEW_GRID) or np.linalg.norm(B, axis=1).min() >= window + 1:
+@dataclass(frozen=True)
+class HarmonicConfig:
+    """How a photo's harmonic part is read (module doc): the peak test's settings, and a switch per reading that
+    may replace or extend the peaks' part (each left out in turn by the ablation, docs/decisions/solid.md)."""
+    count: int = COUNT              #: at most this many waves from the peaks
+    prominence: float = PROMINENCE  #: a peak's power over the ring's mean
+    window: int = WINDOW            #: the ring's half side, bins
+    min_cycles: int = MIN_CYCLES    #: no peak below this many cycles per photo
+    lobe: int = LOBE                #: each peak brings its main lobe's bins within this many (0: its own alone)
+    detect: str = DETECT            #: the power spectrum peaks are sought in: one of DETECTS
+    motif: bool = True              #: peaks on a lattice off the grid: the lattice's motif (motif.py)
+    periods: bool = True            #: a tile's few repeats: the lattice of its periods (periods.py)
+    lines: bool = True              #: lines straight across the frame that the part leaves (periods.py)
+
+    def __post_init__(self):
+        if self.detect not in DETECTS:
+            raise ValueError(f"detect must be one of {DETECTS}, not {self.detect!r}")
+
+
+@dataclass(frozen=True)
+class PhotoSpectrum:
+    """What every reading of the harmonic part reads, measured once: ``u`` float64 (3, H, W) the photo less its mean
+    colour; ``F`` complex128 (3, H, W) the DFT of its periodic component (Moisan 2011); ``P`` float64 (H, W) the
+    power the peaks are sought in (``detect``); ``kx``, ``ky`` (H, W) each bin's cycles per photo along columns and
+    rows; ``strong`` bool (H, W) the bins a wave may take (one of each conjugate pair, at least ``min_cycles``,
+    above FLOOR); ``total`` the variance's power (F's less the mean's); ``peaks`` int (K,) the flat bins that pass
+    the peak test, strongest first, less JPEG's grid, at most ``count``."""
+    u: np.ndarray
+    F: np.ndarray
+    P: np.ndarray
+    kx: np.ndarray
+    ky: np.ndarray
+    strong: np.ndarray
+    total: float
+    peaks: np.ndarray
+
+    @property
+    def shape(self) -> tuple:
+        return self.P.shape
+
+
+@dataclass(frozen=True)
+class WaveSet:
+    """Waves in the photo's own frame, what every reading returns: ``fx``, ``fy`` float64 (K,) cycles per photo
+    along its columns and rows, ``A`` complex128 (K, 3) amplitudes (the part is sum_j Re(A_j exp(2 pi i (fx_j c / W
+    + fy_j r / H))) at pixel (r, c)), ``share`` the share of the photo's variance they carry."""
+    fx: np.ndarray
+    fy: np.ndarray
+    A: np.ndarray
+    share: float
+
+    def plus(self, other: "WaveSet") -> "WaveSet":
+        return WaveSet(np.concatenate([self.fx, other.fx]), np.concatenate([self.fy, other.fy]),
+                       np.concatenate([self.A, other.A]), self.share + other.share)
+
+
+def photo_spectrum(img: np.ndarray, cfg: HarmonicConfig = HarmonicConfig()) -> PhotoSpectrum:
+    """Stage 1 of the harmonic part: the photo's spectrum and the peak test (module doc) on img float (H, W, 3)."""
+    a = np.asarray(img, np.float64)[..., :3]
+    H, W, _ = a.shape
+    F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
+    P = np.abs(F.mean(0)) ** 2 if cfg.detect == "luminance" else (np.abs(F) ** 2).sum(0)    # (H, W) power
+    ky = np.broadcast_to(np.fft.fftfreq(H, d=1.0 / H)[:, None], (H, W))                # cycles per photo
+    kx = np.broadcast_to(np.fft.fftfreq(W, d=1.0 / W)[None, :], (H, W))
+    peak = np.ones((H, W), bool)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            if dy or dx:
+                peak &= P > np.roll(P, (dy, dx), axis=(0, 1))
+    ring, n = box_sums(P, cfg.window) - box_sums(P, 1), (2 * cfg.window + 1) ** 2 - 9
+    half = (ky > 0) | ((ky == 0) & (kx > 0))                       # one of each conjugate pair
+    far = np.hypot(kx / W, ky / H) * min(H, W) >= cfg.min_cycles
+    strong = half & far & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
+    idx = np.flatnonzero((peak & strong & (P >= cfg.prominence * ring / max(n, 1))).ravel())
+    idx = idx[np.argsort(-P.ravel()[idx], kind="stable")]
+    idx = _without_jpeg_grid(idx, kx.ravel(), ky.ravel(), H, W)[:cfg.count]
+    total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
+    return PhotoSpectrum((a - a.mean((0, 1))).transpose(2, 0, 1), F, P, kx, ky, strong, total, idx)
+
+
+def _bins(s: PhotoSpectrum, flat: np.ndarray) -> WaveSet:
+    """The waves at the flat DFT bins ``flat``, with the share of the variance they hold."""
+    H, W = s.shape
+    Fc = s.F.reshape(3, -1)[:, flat].T                                                 # (K, 3)
+    share = float(2.0 * (np.abs(Fc) ** 2).sum() / s.total) if s.total > 0 else 0.0
+    return WaveSet(s.kx.ravel()[flat], s.ky.ravel()[flat], (2.0 / (H * W)) * Fc, share)
+
+
+# -- the readings: reading(spectrum, config) -> WaveSet, or None where it finds nothing ---------------------------
+def read_peaks(s: PhotoSpectrum, cfg: HarmonicConfig) -> WaveSet:
+    """The peaks standing alone, each with the bins of its main lobe (within ``lobe`` bins)."""
+    H, W = s.shape
+    idx = _main_lobes(s.peaks, cfg.lobe, s.strong.ravel(), s.P.ravel(), H, W) if cfg.lobe else s.peaks
+    return _bins(s, idx)
+
+
+def read_motif(s: PhotoSpectrum, cfg: HarmonicConfig) -> WaveSet | None:
+    """The peaks' lattice off the DFT's grid read as its motif, one wave at each lattice point (motif.py)."""
+    H, W = s.shape
+    found = motif_waves(s.u, s.peaks, s.P.ravel()[s.peaks], cfg.min_cycles, cfg.count, FLOOR)
+    if found is None:
         return None
-    idx = lattice_bins(P, np.round(B), FEW_MIN_CYCLES)
-    idx = idx[P.ravel()[idx] >= FLOOR * total][:count]
-    return idx if len(idx) else None
+    share = float(2.0 * (np.abs(found.dtft) ** 2).sum() * (H * W) ** 2 / s.total)
+    return WaveSet(found.fx, found.fy, 2.0 * found.dtft, share)
+
+
+def read_few_repeats(s: PhotoSpectrum, cfg: HarmonicConfig) -> WaveSet | None:
+    """A tileable photo's pattern that repeats too few times for the peak test (periods.py): the bins of its lattice
+    of periods, where that lattice lies on the grid with a reciprocal vector shorter than ``window`` + 1 bins."""
+    B, _ = period_lattice(s.u)
+    if B is None or not on_grid(B, FEW_GRID) or np.linalg.norm(B, axis=1).min() >= cfg.window + 1:
+        return None
+    idx = lattice_bins(s.P, np.round(B), FEW_MIN_CYCLES)
+    idx = idx[s.P.ravel()[idx] >= FLOOR * s.total][:cfg.count]
+    return _bins(s, idx) if len(idx) else None
+
+
+def read_lines(s: PhotoSpectrum, cfg: HarmonicConfig, part: WaveSet) -> WaveSet | None:
+    """Lines straight across the photo that ``part`` leaves (periods.py), where they hold FEW_MARGIN of it."""
+    H, W = s.shape
+    lx, ly, LA = frame_lines(s.u - _grid_field(part.fx, part.fy, part.A, H, W))
+    keep = (np.abs(LA) ** 2).sum(1) / 2.0 >= 2.0 * FLOOR * s.total / (H * W) ** 2     # as P >= FLOOR total
+    lx, ly, LA = lx[keep][:cfg.count // 2], ly[keep][:cfg.count // 2], LA[keep][:cfg.count // 2]
+    share = float((np.abs(LA) ** 2).sum() / 2.0 * (H * W) ** 2 / s.total)
+    return WaveSet(lx, ly, LA, share) if share >= FEW_MARGIN else None
+
+
+#: the readings that may replace the peaks' part, in turn: (switch in HarmonicConfig, reading, the margin of the
+#: variance's share by which it must hold more than the part so far)
+READINGS = (("motif", read_motif, 0.0), ("periods", read_few_repeats, FEW_MARGIN))
+
+
+def choose_waves(s: PhotoSpectrum, cfg: HarmonicConfig = HarmonicConfig()) -> WaveSet:
+    """Stage 2, the chooser: the peaks' part, replaced by each of READINGS that is switched on where it holds its
+    margin more of the variance, then the lines it leaves added (``lines``)."""
+    part = read_peaks(s, cfg)
+    if s.total <= 0:
+        return part
+    for switch, read, margin in READINGS:
+        other = read(s, cfg) if getattr(cfg, switch) else None
+        if other is not None and other.share >= part.share + margin:
+            part = other
+    lines = read_lines(s, cfg, part) if cfg.lines else None
+    return part if lines is None else part.plus(lines)
 
 
 def _grid_field(fx: np.ndarray, fy: np.ndarray, A: np.ndarray, H: int, W: int) -> np.ndarray:
@@ -180,72 +315,18 @@ def _grid_field(fx: np.ndarray, fy: np.ndarray, A: np.ndarray, H: int, W: int) -
     return np.stack([np.real(ey.T @ (A[:, c, None] * ex)) for c in range(A.shape[1])])
 
 
-def photo_harmonics(img: np.ndarray, px_per_unit: float, count: int = COUNT, prominence: float = PROMINENCE,
-                    window: int = WINDOW, min_cycles: int = MIN_CYCLES, lobe: int = LOBE,
-                    detect: str = DETECT, motif: bool = True, periods: bool = True, lines: bool = True) -> Harmonics:
-    """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc):
-    up to ``count`` peaks, each with the bins of its main lobe (within ``lobe`` bins, above FLOOR; 0: the peak's
-    bin alone); no waves (K = 0, share 0) for a photo without a period.  With ``motif`` (the default), peaks on a
-    lattice off the DFT's grid (a photograph's periods, not a tileable texture's) are read as that lattice's motif
-    instead, where it holds at least the share of the photo's variance the bins hold (:mod:`backend.solid.motif`).
-    With ``periods`` (the default), a tile whose pattern repeats too few times for the peak test is read at the
-    lattice of its periods instead, where that holds ``FEW_MARGIN`` more; with ``lines`` (the default), lines
-    straight across the photo that the part leaves are added where they hold ``FEW_MARGIN`` of it
-    (:mod:`backend.solid.periods`)."""
-    a = np.asarray(img, np.float64)[..., :3]
-    H, W, _ = a.shape
-    F = np.fft.fft2(periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1)))      # (3, H, W)
-    if detect not in DETECTS:
-        raise ValueError(f"detect must be one of {DETECTS}, not {detect!r}")
-    P = np.abs(F.mean(0)) ** 2 if detect == "luminance" else (np.abs(F) ** 2).sum(0)    # (H, W) power
-    ky = np.broadcast_to(np.fft.fftfreq(H, d=1.0 / H)[:, None], (H, W))                # cycles per photo
-    kx = np.broadcast_to(np.fft.fftfreq(W, d=1.0 / W)[None, :], (H, W))
-    peak = np.ones((H, W), bool)
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            if dy or dx:
-                peak &= P > np.roll(P, (dy, dx), axis=(0, 1))
-    ring, n = box_sums(P, window) - box_sums(P, 1), (2 * window + 1) ** 2 - 9
-    half = (ky > 0) | ((ky == 0) & (kx > 0))                       # one of each conjugate pair
-    far = np.hypot(kx / W, ky / H) * min(H, W) >= min_cycles
-    strong = half & far & (P >= FLOOR * max(P.sum() - P[0, 0], 1e-300))
-    idx = np.flatnonzero((peak & strong & (P >= prominence * ring / max(n, 1))).ravel())
-    idx = idx[np.argsort(-P.ravel()[idx], kind="stable")]
-    idx = _without_jpeg_grid(idx, kx.ravel(), ky.ravel(), H, W)[:count]
-    total = float((np.abs(F) ** 2).sum() - (np.abs(F[:, 0, 0]) ** 2).sum())
-    u = (a - a.mean((0, 1))).transpose(2, 0, 1)
-    found = motif_waves(u, idx, P.ravel()[idx], min_cycles, count, FLOOR) if motif and total > 0 else None
-    if lobe:
-        idx = _main_lobes(idx, lobe, strong.ravel(), P.ravel(), H, W)
-
-    def from_bins(flat):        # (fx, fy, A (K, 3), share) of the waves at the flat bins
-        Fc = F.reshape(3, -1)[:, flat].T                                               # (K, 3)
-        share = float(2.0 * (np.abs(Fc) ** 2).sum() / total) if total > 0 else 0.0
-        return kx.ravel()[flat], ky.ravel()[flat], (2.0 / (H * W)) * Fc, share
-
-    fx, fy, A, share = from_bins(idx)
-    if found is not None:       # the lattice's motif (motif.py), where it holds at least what the bins hold
-        motif_share = float(2.0 * (np.abs(found.dtft) ** 2).sum() * (H * W) ** 2 / total)
-        if motif_share >= share:
-            fx, fy, A, share = found.fx, found.fy, 2.0 * found.dtft, motif_share
-    few = _few_repeats(u, P, window, total, count) if periods and total > 0 else None
-    if few is not None:         # a tile's few repeats (periods.py), where they hold more than the others
-        tile = from_bins(few)
-        if tile[3] >= share + FEW_MARGIN:
-            fx, fy, A, share = tile
-    if lines and total > 0:     # lines straight across the photo that the part leaves (periods.py)
-        lx, ly, LA = frame_lines(u - _grid_field(fx, fy, A, H, W))
-        keep = (np.abs(LA) ** 2).sum(1) / 2.0 >= 2.0 * FLOOR * total / (H * W) ** 2     # as P >= FLOOR total
-        lx, ly, LA = lx[keep][:count // 2], ly[keep][:count // 2], LA[keep][:count // 2]
-        line_share = float((np.abs(LA) ** 2).sum() / 2.0 * (H * W) ** 2 / total)
-        if line_share >= FEW_MARGIN:
-            fx, fy = np.concatenate([fx, lx]), np.concatenate([fy, ly])
-            A, share = np.concatenate([A, LA]), share + line_share
+def photo_harmonics(img: np.ndarray, px_per_unit: float, config: HarmonicConfig = HarmonicConfig()) -> Harmonics:
+    """The harmonic part of a photo (H, W, 3) shown at ``px_per_unit`` pixels per texture unit (module doc): its
+    spectrum (:func:`photo_spectrum`), the chooser's waves among the readings (:func:`choose_waves`), placed in
+    texture units; no waves (K = 0, share 0) for a photo without a period."""
+    s = photo_spectrum(img, config)
+    H, W = s.shape
+    w = choose_waves(s, config)
     # pixel (r, c) sits at p = ((c + 1/2) / u, -(r + 1/2) / u): exp(2 pi i (fx c / W + fy r / H)) =
     # exp(i (2 pi f . p - pi (fx / W + fy / H))) with f = u (fx / W, -fy / H); both halves of a pair: 2 Re(.)
-    amp = A * np.exp(-1j * np.pi * (fx / W + fy / H))[:, None]
-    freq = np.stack([px_per_unit * fx / W, -px_per_unit * fy / H], axis=1)
-    return Harmonics(freq.astype(np.float64), amp.astype(np.complex128), min(share, 0.999))
+    amp = w.A * np.exp(-1j * np.pi * (w.fx / W + w.fy / H))[:, None]
+    freq = np.stack([px_per_unit * w.fx / W, -px_per_unit * w.fy / H], axis=1)
+    return Harmonics(freq.astype(np.float64), amp.astype(np.complex128), min(w.share, 0.999))
 
 
 def remove_harmonics(img: np.ndarray, h: Harmonics, px_per_unit: float) -> np.ndarray:

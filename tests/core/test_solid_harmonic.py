@@ -6,7 +6,8 @@ import re
 import numpy as np
 import pytest
 
-from omninoise.backend.solid.harmonic import COUNT, Harmonics, harmonic_field, mix_harmonics, photo_harmonics, seed_shift
+from omninoise.backend.solid.harmonic import (COUNT, HarmonicConfig, Harmonics, harmonic_field, mix_harmonics,
+                                              photo_harmonics, seed_shift)
 from omninoise.backend.solid.model import SolidTextureModel, plane_points
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -66,7 +67,7 @@ def test_aperiodic_photos_have_no_harmonic_part():
         assert photo_harmonics(img, PPU).share < 0.03
     # the peak test sees a ridge, not a peak; a line straight across the whole frame is read by the lines reading
     # (backend/solid/periods.py: a library tile's joint, a plank seam), and only the line
-    assert photo_harmonics(line, PPU, lines=False).share < 0.03
+    assert photo_harmonics(line, PPU, HarmonicConfig(lines=False)).share < 0.03
     h = photo_harmonics(line, PPU)
     assert len(h) > 0 and np.all(h.freq[:, 0] == 0.0)
     back = photo_plane(h, 128, 128).mean(2)
@@ -85,11 +86,11 @@ def test_courses_and_head_joints_are_found():
     assert np.any(np.isclose(np.abs(h.freq[:, 0]), 4.0))
     # every harmonic of the bond that passes the test is kept (64 here: more than the 32 the cap once was), the
     # strongest first, and a lower cap keeps the strongest of them
-    h = photo_harmonics(img, PPU, lobe=0)
+    h = photo_harmonics(img, PPU, HarmonicConfig(lobe=0))
     assert len(h) == 64 and COUNT >= 64
     power = (np.abs(h.amp) ** 2).sum(1)         # the colour power the peaks are ranked by
     assert np.all(np.diff(power) <= 1e-12)
-    h8 = photo_harmonics(img, PPU, count=8, lobe=0)
+    h8 = photo_harmonics(img, PPU, HarmonicConfig(count=8, lobe=0))
     assert len(h8) == 8 and np.array_equal(h8.freq, h.freq[:8]) and h8.share < h.share
 
 
@@ -331,9 +332,9 @@ def test_the_price_of_the_jpeg_rule_stripes_exactly_8_px_apart():
         img = 0.5 + 0.3 * np.cos(2 * np.pi * cycles * c / 256)
         return np.repeat(img[..., None], 3, axis=2)
 
-    assert len(photo_harmonics(stripes(32), PPU, lines=False)) == 0          # 8 px
-    assert photo_harmonics(stripes(16), PPU, lines=False).share > 0.9        # 16 px
-    assert photo_harmonics(stripes(30), PPU, lines=False).share > 0.9        # 8.53 px
+    assert len(photo_harmonics(stripes(32), PPU, HarmonicConfig(lines=False))) == 0          # 8 px
+    assert photo_harmonics(stripes(16), PPU, HarmonicConfig(lines=False)).share > 0.9        # 16 px
+    assert photo_harmonics(stripes(30), PPU, HarmonicConfig(lines=False)).share > 0.9        # 8.53 px
     # stripes straight across the whole frame come back as lines (periods.frame_lines), 8 px apart too
     assert photo_harmonics(stripes(32), PPU).share > 0.9
 
@@ -446,7 +447,8 @@ def test_a_period_between_bins_brings_its_main_lobe():
     r = np.arange(128)[:, None, None]
     img = np.clip(0.5 + 0.2 * np.cos(2 * np.pi * 5.5 * r / 128) * np.array([1.0, 0.8, 0.6])
                   + 0.02 * rng.standard_normal((128, 128, 3)), 0, 1)
-    alone, lobe = photo_harmonics(img, PPU, lobe=0, lines=False), photo_harmonics(img, PPU, lines=False)
+    alone = photo_harmonics(img, PPU, HarmonicConfig(lobe=0, lines=False))
+    lobe = photo_harmonics(img, PPU, HarmonicConfig(lines=False))
     assert LOBE == 1 and 0 < len(alone) < len(lobe) <= 9 * len(alone)
     assert alone.share < 0.4 and lobe.share > 0.5
     rows = img.mean((1, 2)).std()
@@ -456,7 +458,8 @@ def test_a_period_between_bins_brings_its_main_lobe():
     # 1 / LOBE_DEPTH of the peak: noise, and near the axes the periodic component's correction, which removing
     # would add to the photo, not take away)
     assert len(photo_harmonics(waves_photo(), PPU)) == 3
-    assert len(photo_harmonics(brick_photo(), PPU)) == len(photo_harmonics(brick_photo(), PPU, lobe=0))
+    assert len(photo_harmonics(brick_photo(), PPU)) == len(photo_harmonics(brick_photo(), PPU,
+                                                                            HarmonicConfig(lobe=0)))
 
 
 def test_a_motif_of_colours_at_one_luminance_is_found_in_the_colour_spectrum():
@@ -467,13 +470,14 @@ def test_a_motif_of_colours_at_one_luminance_is_found_in_the_colour_spectrum():
     motif = ((np.abs((c % 32) - 16) + np.abs((r % 16) - 8) * 2) < 10).astype(float)      # diamonds, 32 x 16 px
     red, olive = np.array([0.75, 0.10, 0.10]), np.array([0.40, 0.35, 0.20])               # means 0.317, 0.317
     img = np.where(motif[..., None] > 0, red, olive) + 0.004 * rng.standard_normal((128, 128, 3))
-    lum, col = photo_harmonics(img, PPU, detect="luminance"), photo_harmonics(img, PPU, detect="colour")
+    lum = photo_harmonics(img, PPU, HarmonicConfig(detect="luminance"))
+    col = photo_harmonics(img, PPU, HarmonicConfig(detect="colour"))
     assert lum.share < 0.1 and col.share > 0.8
     assert np.any(np.all(np.isclose(np.abs(col.freq), [4.0, 0.0]), axis=1))        # 4 motifs per 128 px
     back = photo_plane(col, 128, 128)
     assert np.corrcoef(back[..., 1].ravel(), img[..., 1].ravel())[0, 1] > 0.9
     with pytest.raises(ValueError, match="detect must be one of"):
-        photo_harmonics(img, PPU, detect="chroma")
+        HarmonicConfig(detect="chroma")
 
 
 def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):

@@ -4,7 +4,7 @@ import os
 
 import numpy as np
 
-from omninoise.backend.solid.harmonic import harmonic_field, photo_harmonics
+from omninoise.backend.solid.harmonic import HarmonicConfig, harmonic_field, photo_harmonics
 from omninoise.backend.solid.model import plane_points
 from omninoise.backend.solid.motif import (MIN_CELLS, MIN_PEAKS, fit_lattice, lattice_points, motif_waves, on_grid,
                                  refine_peaks, windowed_dtft, windowed_magnitude)
@@ -103,7 +103,7 @@ def test_a_brick_wall_framed_off_its_period_keeps_its_bricks_beyond_the_frame():
     full = brick_photo(H=128, W=128, course=16, brick=32)
     img = full[:116, :121]
     lum = img.mean(2) - img.mean()
-    motif, bins = photo_harmonics(img, PPU), photo_harmonics(img, PPU, motif=False)
+    motif, bins = photo_harmonics(img, PPU), photo_harmonics(img, PPU, HarmonicConfig(motif=False))
     assert motif.share > bins.share
     far = {k: field_at(h, 116, 121, dy=160, dx=320).mean(2) for k, h in (("motif", motif), ("bins", bins))}
     corr = {k: np.corrcoef(v.ravel(), lum.ravel())[0, 1] for k, v in far.items()}
@@ -114,14 +114,14 @@ def test_a_brick_wall_framed_off_its_period_keeps_its_bricks_beyond_the_frame():
 
 def test_tileable_photos_and_aperiodic_ones_are_read_as_before():
     for img in (brick_photo(), waves_photo()):      # whole periods in the frame: the bins are exact
-        a, b = photo_harmonics(img, PPU), photo_harmonics(img, PPU, motif=False)
+        a, b = photo_harmonics(img, PPU), photo_harmonics(img, PPU, HarmonicConfig(motif=False))
         assert np.array_equal(a.freq, b.freq) and np.array_equal(a.amp, b.amp) and a.share == b.share
     rng = np.random.default_rng(3)
     F = np.fft.fft2(rng.standard_normal((128, 128)))
     f = np.hypot(*np.meshgrid(np.fft.fftfreq(128), np.fft.fftfreq(128)))
     rock = np.real(np.fft.ifft2(F / np.maximum(f, 1 / 128) ** 1.5))
     rock = np.repeat(((rock - rock.mean()) / rock.std() * 0.1 + 0.5)[..., None], 3, 2)[:117, :123]
-    a, b = photo_harmonics(rock, PPU), photo_harmonics(rock, PPU, motif=False)
+    a, b = photo_harmonics(rock, PPU), photo_harmonics(rock, PPU, HarmonicConfig(motif=False))
     assert np.array_equal(a.freq, b.freq) and a.share == b.share
     # even handed the 24 largest bins of its spectrum (a cluster round zero, not peaks), no lattice is taken:
     # a motif must repeat at least MIN_CELLS times in the photo
@@ -138,7 +138,7 @@ def test_a_photographed_brick_wall_repeats_by_its_own_lattice():
 
     img = read_rgb(BRICK)[8:232, 8:240]
     H, W = img.shape[:2]
-    h, bins = photo_harmonics(img, PPU), photo_harmonics(img, PPU, motif=False)
+    h, bins = photo_harmonics(img, PPU), photo_harmonics(img, PPU, HarmonicConfig(motif=False))
     assert h.share > bins.share + 0.1 and len(h) > 50
     f = np.stack([h.freq[:, 0] / PPU * W, -h.freq[:, 1] / PPU * H], 1)      # back to cycles per photo
     B = fit_lattice(f, (np.abs(h.amp) ** 2).sum(1), tol=1e-6, explained=1.0, explained_count=1.0)

@@ -2,7 +2,7 @@
 and a harmonic part that keeps the head joints of a tile holding two courses of two bricks."""
 import numpy as np
 
-from omninoise.backend.solid.harmonic import harmonic_field, photo_harmonics
+from omninoise.backend.solid.harmonic import HarmonicConfig, harmonic_field, photo_harmonics
 from omninoise.backend.solid.model import plane_points
 from omninoise.backend.solid.motif import on_grid
 from omninoise.backend.solid.periods import autocorrelation, frame_lines, period_lattice, translations
@@ -66,8 +66,8 @@ def test_the_few_repeats_keep_the_head_joints_the_peak_test_misses():
     img, pattern = brick_tile()
     H, W = pattern.shape
     # the lines across the frame (the courses) left out of both: the periods' part against the peaks'
-    with_periods = photo_harmonics(img, PPU, lines=False)
-    peaks = photo_harmonics(img, PPU, periods=False, lines=False)
+    with_periods = photo_harmonics(img, PPU, HarmonicConfig(lines=False))
+    peaks = photo_harmonics(img, PPU, HarmonicConfig(periods=False, lines=False))
     assert with_periods.share > peaks.share + 0.1
     p = pattern - pattern.mean()
     corr = {k: np.corrcoef(field(h, H, W).mean(2).ravel(), p.ravel())[0, 1]
@@ -87,7 +87,7 @@ def test_textures_without_a_lattice_of_periods_have_none():
     rock = np.real(np.fft.ifft2(F / np.maximum(f, 1 / 256) ** 1.5))
     rock = np.repeat(((rock - rock.mean()) / rock.std() * 0.1 + 0.5)[..., None], 3, 2)
     assert period_lattice(mean_free(rock)) == (None, None)
-    a, b = photo_harmonics(rock, PPU), photo_harmonics(rock, PPU, periods=False)
+    a, b = photo_harmonics(rock, PPU), photo_harmonics(rock, PPU, HarmonicConfig(periods=False))
     assert np.array_equal(a.freq, b.freq) and a.share == b.share
     # planks: boards of random tones along x, 50 px wide, no joints across them.  A shift along the boards
     # correlates all the way (a ridge of R, not a peak), so no 2D lattice is taken from its wiggles
@@ -142,7 +142,7 @@ def test_a_tile_framed_by_its_grout_draws_its_joints_and_not_its_face():
     img, mask = floor_tile()
     H, W = mask.shape
     assert period_lattice(mean_free(img)) == (None, None)
-    none, h = photo_harmonics(img, PPU, lines=False), photo_harmonics(img, PPU)
+    none, h = photo_harmonics(img, PPU, HarmonicConfig(lines=False)), photo_harmonics(img, PPU)
     assert len(none) == 0 and len(h) > 0 and h.share > 0.1
     lum = field(h, H, W).mean(2)
     assert np.corrcoef(lum.ravel(), mask.ravel())[0, 1] < -0.9          # dark where the grout is
