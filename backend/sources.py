@@ -326,43 +326,34 @@ class SolidSource:
     chunkable = True
     rgb = True
 
-    def __init__(self, model, exemplar: str | None = None, seed: int = 0, scale: float = 1.0,
-                 density: float = 1.0, refine: int = 0, code=None, to: str | None = None, mix: float = 0.0,
-                 periodic: bool = True, gaussian: bool = True, rest: str = "auto"):
-        """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`;
-        code: a ready :class:`~backend.solid.model.TextureCode` (e.g. from an image Blender holds);
-        to, mix: a space model's second exemplar and the share of it (interpolation, as ``omninoise solid``);
-        periodic: an encoded image keeps its harmonic part (backend/solid/harmonic.py);
-        gaussian: and its Gaussian rest where the check keeps one (backend/solid/spectral.py);
-        rest: which ("auto", "isotropic", "upright": backend/solid/upright.py)."""
+    def __init__(self, model, request=None, scale: float = 1.0, density: float = 1.0, code=None):
+        """model: a model folder or a loaded :class:`~backend.solid.model.SolidTextureModel`; request: the
+        :class:`~backend.solid.request.SolidRequest` (exemplar, ``to`` and ``mix``, refine, seed, periodic, gaussian,
+        rest; None: the model's own texture at seed 0), checked here; code: its ready
+        :class:`~backend.solid.model.TextureCode` (an image Blender holds, a code made once for many bakes), else
+        made here by the request's stages (backend/solid/pipeline.py)."""
         from .onnx_models import ModelError
         from .solid.model import SolidTextureModel
+        from .solid.request import SolidRequest
 
         try:
             self.model = model if isinstance(model, SolidTextureModel) else SolidTextureModel(model)
         except ModelError as exc:
             raise SettingError("source.model", str(exc)) from None
-        scale = limits.positive("source.scale", scale)
-        density = limits.in_range("source.density", density, 0.0, float("inf"))
-        self.dim = self.model.dim
-        self.seed, self.scale, self.density, self.refine = int(seed), float(scale), float(density), int(refine)
-        self.exemplar, self.to, self.mix, self.periodic = exemplar, to, float(mix), bool(periodic)
-        self.gaussian, self.rest = bool(gaussian), rest
-        self.input_sha256 = None
-        if code is not None:
-            self.code = code
-            parts = [np.ravel(code.e), np.ravel(code.T)]
-            if code.harmonics is not None:
-                parts.append(code.harmonics.values())
-            if code.rest is not None:
-                parts.append(code.rest.values())
-            self.input_sha256 = hashlib.sha256(np.concatenate(parts).astype(np.float32).tobytes()).hexdigest()
+        self.scale = limits.positive("source.scale", scale)
+        self.density = limits.in_range("source.density", density, 0.0, float("inf"))
+        self.request = (SolidRequest() if request is None else request).check("source.")
+        self.dim, self.seed = self.model.dim, int(self.request.seed)
+        if code is None:
+            self.code, self.input_sha256 = self.request.code(self.model, "source.")
             return
-        from .solid.request import SolidRequest
-
-        req = SolidRequest(None, exemplar, to, self.mix, self.refine, self.seed, self.periodic,
-                           self.gaussian, rest).check("source.")
-        self.code, self.input_sha256 = req.code(self.model, "source.")
+        self.code = code
+        parts = [np.ravel(code.e), np.ravel(code.T)]
+        if code.harmonics is not None:
+            parts.append(code.harmonics.values())
+        if code.rest is not None:
+            parts.append(code.rest.values())
+        self.input_sha256 = hashlib.sha256(np.concatenate(parts).astype(np.float32).tobytes()).hexdigest()
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
@@ -374,14 +365,15 @@ class SolidSource:
         return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
 
     def to_dict(self) -> dict:
-        d = dict(kind=self.kind, model=self.model.config["files"], exemplar=self.exemplar,
-                 input_sha256=self.input_sha256, refine=self.refine, seed=self.seed, scale=self.scale,
-                 density=self.density)
-        if self.to is not None:
-            d.update(to=self.to, mix=self.mix)
+        r = self.request
+        named = r.exemplar if isinstance(r.exemplar, str) else None    # pixels are in input_sha256
+        d = dict(kind=self.kind, model=self.model.config["files"], exemplar=named, input_sha256=self.input_sha256,
+                 refine=int(r.refine), seed=self.seed, scale=self.scale, density=self.density)
+        if r.to is not None:
+            d.update(to=r.to if isinstance(r.to, str) else None, mix=float(r.mix))
         h = self.code.harmonics     # the harmonic part in use (an encoded photo's, a stored one)
         d["harmonics_sha256"] = None if h is None else hashlib.sha256(h.values().astype("<f8").tobytes()).hexdigest()
-        r = self.code.rest         # the Gaussian rest in use (backend/solid/spectral.py), if the check kept one
+        r = self.code.rest          # the Gaussian rest in use (backend/solid/gaussian_rest.py), if the check kept one
         d["gaussian_rest_sha256"] = None if r is None else hashlib.sha256(r.values().astype("<f8").tobytes()).hexdigest()
         d["gaussian_rest_kind"] = None if r is None else r.kind     # isotropic / upright (backend/solid/upright.py)
         if self.model.spin:        # how the octaves turn with the seed (backend/solid/spin.py): part of the drawing
@@ -505,7 +497,7 @@ def solid_volume(request, size: int, scale: float = 1.0, where: str = "", progre
     if model.dim != 3:
         raise SettingError(f"{where}dim", f"model {model.name!r} is 2D; it cannot fill a volume")
     code, _ = request.code(model, where, progress, report, on_code)
-    return SolidSource(model, seed=int(request.seed), code=code), size / (model.px_per_unit * scale)
+    return SolidSource(model, request, code=code), size / (model.px_per_unit * scale)
 
 
 def _check_keys(d: dict, known: tuple, kind: str) -> None:
@@ -636,8 +628,7 @@ def _solid_from_dict(d: dict, base_dir: str):
         return SynthesisSource(req, d.get("scale", 1.0))
     if req.method == "spectral":
         return SpectralSource(req, d.get("scale", 1.0), d.get("density", 1.0))
-    return SolidSource(req.folder(), req.exemplar, req.seed, d.get("scale", 1.0), d.get("density", 1.0), req.refine,
-                       to=req.to, mix=req.mix, periodic=req.periodic, gaussian=req.gaussian, rest=req.rest)
+    return SolidSource(req.folder(), req, d.get("scale", 1.0), d.get("density", 1.0))
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

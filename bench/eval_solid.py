@@ -120,7 +120,7 @@ def speed_one(engine: str, model: str, run: str, dim: int, size: int) -> dict:
     else:
         import torch
 
-        from omninoise.training.solid.lattice import octave_seeds
+        from omninoise.training.solid.value_noise import octave_seeds
         from omninoise.training.solid.train import SolidConfig, build_model
 
         state = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False)

@@ -67,8 +67,8 @@ import numpy as np
 from omninoise.export.atomic import atomic_path, write_json
 from omninoise.export import read_rgb as read
 from omninoise.backend.solid.model import SolidTextureModel
-from omninoise.backend.solid.refine import exemplar_z
-from omninoise.backend.solid import spectral, upright
+from omninoise.backend.solid.harmonic import HarmonicConfig
+from omninoise.backend.solid.pipeline import PhotoConfig, RestCheck, photo_code
 from omninoise.training.solid import photo_eval as pe
 from omninoise.training.solid.photo_set import photo_set
 from omninoise.training.solid.morphology import morphology_distance
@@ -129,19 +129,15 @@ GROUPED = ("random_phase", "photo_crop")
 
 
 def evaluate(model: SolidTextureModel, files: list, seeds: int = 2, sheet: list | None = None,
-             periodic: bool = True, refine: int = 0, gaussian: bool = True) -> dict:
+             config: PhotoConfig = PhotoConfig()) -> dict:
+    """Every photo's code made by the pipeline's stages with ``config`` (backend/solid/pipeline.py), its x, y and z
+    slices at ``seeds`` seeds, and every measure of them beside the baselines."""
     rows = {}
     for path in files:
         photo = read(path)
         rng = np.random.default_rng(0)
         t = time.time()
-        if refine:      # the add-on's Refine Steps: encode, then search the code (backend/solid/refine.py)
-            z, _, _, h = exemplar_z(model, photo, refine=refine, periodic=periodic)
-            code = model.translate(z, h)
-            if gaussian:
-                code = model.with_gaussian_rest(code, photo)
-        else:
-            code = model.photo_code(photo, periodic, gaussian)
+        code = photo_code(model, photo, config).code
         h = code.harmonics
         imgs = {ax: [slice_image(model, code, ax, s) for s in range(seeds)] for ax in "xyz"}
         seconds = time.time() - t
@@ -307,17 +303,23 @@ def main(argv=None) -> int:
     ap.add_argument("--sheet", help="write a picture of (up to 8) photos and their textures")
     ap.add_argument("--no-periodic", dest="periodic", action="store_false",
                     help="leave out the photos' harmonic part (backend/solid/harmonic.py): the decoder alone")
+    ap.add_argument("--no-motif", dest="motif", action="store_false",
+                    help="read a photographed pattern's peaks as bins, not as its lattice's motif (harmonic.py)")
+    ap.add_argument("--no-periods", dest="periods", action="store_false",
+                    help="leave out the reading of a tile's few repeats (harmonic.py, periods.py)")
+    ap.add_argument("--no-lines", dest="lines", action="store_false",
+                    help="leave out the lines straight across the frame (harmonic.py, periods.py)")
     ap.add_argument("--no-gaussian", dest="gaussian", action="store_false",
-                    help="leave out the Gaussian rest (backend/solid/spectral.py) even where its check keeps one")
+                    help="leave out the Gaussian rest (backend/solid/gaussian_rest.py) even where its check keeps one")
     ap.add_argument("--upright-gate", type=float, metavar="G",
                     help="offer the upright Gaussian rest where a photo's spectral coherence is above G instead of "
                          "backend/solid/upright.py's UPRIGHT_GATE (0: to every photo, above 1: to none)")
     ap.add_argument("--margin", type=float, metavar="M",
                     help="keep a Gaussian rest where the check finds it M times as close as the decoder alone "
-                         "instead of backend/solid/spectral.py's MARGIN (calibration, on the training split)")
+                         "instead of RestCheck's default (calibration, on the training split)")
     ap.add_argument("--check-seeds", type=int, metavar="S",
-                    help="the Gaussian rest's check on x, y and z planes at S seeds instead of backend/solid/"
-                         "spectral.py's CHECK_SEEDS (calibration, on the training split)")
+                    help="the Gaussian rest's check on x, y and z planes at S seeds instead of RestCheck's two "
+                         "(calibration, on the training split)")
     ap.add_argument("--only", nargs="+", metavar="PREFIX", help="only photos whose names start so")
     ap.add_argument("--refine", type=int, default=0, metavar="N",
                     help="refine each photo's code by N search steps first (the add-on's Refine Steps)")
@@ -325,14 +327,11 @@ def main(argv=None) -> int:
                     "photos this one is more than 5 %% closer to or farther from, pooled and on walls")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_photos.json"))
     a = ap.parse_args(argv)
-    if a.upright_gate is not None:
-        upright.UPRIGHT_GATE = a.upright_gate
-    if a.margin is not None:
-        spectral.MARGIN = a.margin
-    if a.check_seeds is not None:
-        spectral.CHECK_SEEDS = tuple(range(6, 6 + a.check_seeds))
-        spectral.CHECK_PLANES = spectral.check_planes(spectral.CHECK_SEEDS)
-        spectral.WALL_PLANES = spectral.wall_planes(spectral.CHECK_PLANES)
+    changed = dict(upright_gate=a.upright_gate, margin=a.margin,
+                   seeds=None if a.check_seeds is None else tuple(range(6, 6 + a.check_seeds)))
+    check = RestCheck(**{k: v for k, v in changed.items() if v is not None})
+    config = PhotoConfig(periodic=a.periodic, refine=a.refine, gaussian=a.gaussian, check=check,
+                         harmonic=HarmonicConfig(motif=a.motif, periods=a.periods, lines=a.lines))
     model = SolidTextureModel(a.model)
     files = photos(a.split)
     if a.only:
@@ -340,10 +339,11 @@ def main(argv=None) -> int:
     if a.limit:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     sheet = [] if a.sheet else None
-    rows = evaluate(model, files, a.seeds, sheet, a.periodic, a.refine, a.gaussian)
+    rows = evaluate(model, files, a.seeds, sheet, config)
     doc = dict(model=a.model, model_sha=model.config["files"], split=a.split, size=SIZE, seeds=a.seeds,
-               periodic=a.periodic, refine=a.refine, gaussian=a.gaussian, upright_gate=upright.UPRIGHT_GATE,
-               margin=spectral.MARGIN, check_seeds=list(spectral.CHECK_SEEDS),
+               periodic=a.periodic, refine=a.refine, gaussian=a.gaussian, upright_gate=check.upright_gate,
+               margin=check.margin, check_seeds=list(check.seeds), motif=a.motif, periods=a.periods,
+               lines=a.lines,
                summary=summary(rows), by_category=by_category(rows), photos=rows)
     if a.against:
         doc["against"] = against(rows, a.against)

@@ -32,6 +32,7 @@ import numpy as np
 from omninoise.export.atomic import atomic_path, write_json
 from omninoise.export.images import read_rgb
 from omninoise.backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models
+from omninoise.backend.solid.pipeline import photo_code
 from omninoise.training.solid import photo_eval as pe
 from omninoise.training.solid.morphology import morphology_distance
 
@@ -87,7 +88,7 @@ def evaluate_model(model: SolidTextureModel, space: SolidTextureModel | None, se
     pics["pixel_shuffle"] = [pe.pixel_shuffle(train, SIZE, rng) for _ in range(n)]
     pics["photo_crop"] = [pe.photo_crop(train, SIZE, rng) for _ in range(n)]
     if space is not None:
-        pics["space"] = like(space, space.photo_code(train))
+        pics["space"] = like(space, photo_code(space, train).code)
     if previous is not None:
         pics["previous"] = like(previous, previous.default_code())
     r = {"photo": model.config["exemplars"][0], "dim": model.dim}

@@ -51,9 +51,11 @@ import numpy as np
 
 from omninoise.export import read_rgb
 from omninoise.export.atomic import write_json
-from omninoise.backend.solid.model import measure_harmonics, resize_rgb, slice_points
+from omninoise.backend.solid.harmonic import measure_harmonics
+from omninoise.backend.solid.model import slice_points
+from omninoise.backend.solid.pixels import resize_rgb
 from omninoise.backend.solid.spectral_solid import ISOTROPIC_ITERATIONS, spectral_field
-from omninoise.backend.solid.spectral import RestField, rest_field, rest_waves, seed_shift3
+from omninoise.backend.solid.gaussian_rest import GaussianRest, rest_field, rest_waves, seed_shift3
 from omninoise.backend.solid.upright import upright_waves
 from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.solid.synthesis import (PLANES, PX_PER_UNIT, SynthesisSettings, TileField, image_settings,
@@ -86,7 +88,7 @@ def random_phase_solid(photo: np.ndarray, kind: str, seeds: int, size: int = SIZ
     m = np.asarray(photo, np.float64).reshape(-1, 3).mean(0)
     if waves is None:       # a flat photo
         return {ax: [np.broadcast_to(m, (size, size, 3)).astype(np.float32)] * seeds for ax in "xyz"}
-    r = RestField(waves[0], waves[1], 1.0)
+    r = GaussianRest(waves[0], waves[1], 1.0)
     return {ax: [np.clip(m + rest_field(slice_points(size, PX_PER_UNIT, ax, pe.SLICE_OFFSETS[ax]), r, s),
                          0.0, 1.0).reshape(size, size, 3).astype(np.float32) for s in range(seeds)] for ax in "xyz"}
 

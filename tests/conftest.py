@@ -25,6 +25,21 @@ def _package_from_checkout():
 
 _package_from_checkout()
 
+#: folders whose every test is long (``make test-long``): Blender's (bpy start-up, renders) and training's (torch)
+LONG_FOLDERS = ("blender", "training")
+#: files whose every test is long: the documents' examples and the installed wheel run whole commands
+LONG_FILES = ("test_doc_examples.py", "test_packaging.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    """``make test`` runs the tests not marked ``long`` (a few minutes on two cores); ``make test-long`` the long
+    integration tests: every test in LONG_FOLDERS and LONG_FILES, and the tests marked ``@pytest.mark.long``."""
+    tests = os.path.join(ROOT, "tests")
+    for item in items:
+        parts = os.path.relpath(str(item.path), tests).split(os.sep)
+        if parts[0] in LONG_FOLDERS or parts[-1] in LONG_FILES:
+            item.add_marker(pytest.mark.long)
+
 
 def radial_psd(img: np.ndarray, extent: float, nbins: int | None = None):
     """Radially averaged power spectrum of a 2D image: (freqs cycles/unit, power)."""

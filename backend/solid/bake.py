@@ -36,11 +36,12 @@ def bake_volume(model: SolidTextureModel, code: TextureCode, grid: BoxGrid, path
     """
     from ..bake import BakeSpec, run_bake
     from ..sources import SolidSource
+    from .request import SolidRequest
 
     grid.validate()
     if grid.rank != 3:
         raise SettingError("resolution", "a volume needs three resolutions (nx, ny, nz)")
     if model.dim != 3:
         raise SettingError("model", f"model {model.name!r} is 2D; a volume needs a 3D model")
-    src = SolidSource(model, seed=seed, scale=scale, density=density, code=code)
+    src = SolidSource(model, SolidRequest(seed=seed), scale, density, code)
     run_bake(BakeSpec(name, src, grid, path, half=half), progress, cancel, force=True)

@@ -9,7 +9,7 @@ and DIRECTIONS random directions of the mean absolute difference of sorted proje
 It is a cousin of the held-out evaluation's distance (``training/solid/photo_eval.py``: 7 x 7 neighbourhoods,
 4096 of them, 256 directions), smaller and cheaper (5 x 5, SAMPLES, DIRECTIONS): the band-pass levels are
 where structure lives.  The box pyramid of ``refine.py``'s search distance is dominated by colour and the
-coarsest level, and picking the Gaussian rest's mix (``spectral.py``) by it made as many training photos farther
+coarsest level, and picking the Gaussian rest's mix (``gaussian_rest.py``) by it made as many training photos farther
 as closer.
 
 Shapes: images float (H, W, 3) sRGB in [0, 1]; numpy only.

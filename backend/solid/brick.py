@@ -1,6 +1,6 @@
 """Staggered-lattice (brick) octave features for neural solid textures.
 
-Value noise and Worley cells (:mod:`backend.solid.lattice`,
+Value noise and Worley cells (:mod:`backend.solid.value_noise`,
 :mod:`backend.solid.cellular`) have no courses: rows of regions of one height
 with joints offset from row to row, as in brick and block walls, plank floors,
 ashlar and setts laid in courses.  Blender's Brick Texture node draws such a
@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lattice import BITS, MASK32, check_feature_octaves, lowbias32, octave_position, salted_seeds
+from .value_noise import BITS, MASK32, check_feature_octaves, lowbias32, octave_position, salted_seeds
 
 __all__ = ["FEATURES", "BRICK_SALT", "brick_seeds", "brick_features"]
 

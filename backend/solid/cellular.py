@@ -1,6 +1,6 @@
 """Cellular (Worley) octave features for neural solid textures.
 
-Value-noise octaves (:mod:`backend.solid.lattice`, Henzler et al. 2020, Eq. 5)
+Value-noise octaves (:mod:`backend.solid.value_noise`, Henzler et al. 2020, Eq. 5)
 have no closed outlines, straight edges or per-region constants, so a
 pointwise decoder over them draws speckle where a photo has stones or
 cobbles (docs/decisions/solid.md).  These
@@ -37,7 +37,7 @@ import itertools
 
 import numpy as np
 
-from .lattice import BITS, MASK32, check_feature_octaves, lowbias32, numba, octave_position, salted_seeds
+from .value_noise import BITS, MASK32, check_feature_octaves, lowbias32, numba, octave_position, salted_seeds
 
 __all__ = ["FEATURES", "CELL_SALT", "cell_seeds", "cellular_features", "cellular_features_numpy"]
 
@@ -92,7 +92,7 @@ def cellular_features_numpy(points, transforms, seed: int, octaves: int) -> np.n
 
 
 if numba is not None:
-    from .lattice import lowbias32_jit, octave_coord
+    from .value_noise import lowbias32_jit, octave_coord
 
     @numba.njit(parallel=True, cache=True, nogil=True)
     def _cell_kernel(x, T, seeds, K, offs, out):

@@ -84,9 +84,11 @@ import numpy as np
 from ..periodic import periodic_component
 from .motif import box_sums, motif_waves, on_grid
 from .periods import frame_lines, lattice_bins, period_lattice
+from .pixels import at_most
 
 __all__ = ["Harmonics", "HarmonicConfig", "PhotoSpectrum", "WaveSet", "photo_spectrum", "choose_waves", "READINGS",
-           "read_peaks", "read_motif", "read_few_repeats", "read_lines", "photo_harmonics", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
+           "read_peaks", "read_motif", "read_few_repeats", "read_lines", "photo_harmonics", "measure_harmonics",
+           "HARMONIC_SIDE", "harmonic_field", "wave_sum", "remove_harmonics", "seed_shift",
            "mix_harmonics", "mix_waves", "to_json", "from_json", "read_waves", "COUNT", "PROMINENCE", "WINDOW",
            "MIN_CYCLES", "LOBE", "LOBE_DEPTH", "FEW_GRID", "FEW_MARGIN", "FEW_MIN_CYCLES"]
 
@@ -100,6 +102,7 @@ LOBE_DEPTH = 16.0   #: ... that hold at least 1 / LOBE_DEPTH of its power
 FEW_GRID = 0.2      #: a lattice of periods within this many bins of whole frequencies is a tile's (periods.py)
 FEW_MARGIN = 0.05   #: ... read there where it holds this much more of the variance than the peaks or the motif
 FEW_MIN_CYCLES = 1  #: its points count from one cycle per photo (the lattice, not a lone peak, says they repeat)
+HARMONIC_SIDE = 1024  #: photos are measured at most this many pixels wide (measure_harmonics)
 DETECTS = ("luminance", "colour")
 DETECT = "colour"     #: peaks are sought in this power spectrum (module doc)
 
@@ -329,6 +332,14 @@ def photo_harmonics(img: np.ndarray, px_per_unit: float, config: HarmonicConfig 
     return Harmonics(freq.astype(np.float64), amp.astype(np.complex128), min(w.share, 0.999))
 
 
+def measure_harmonics(image: np.ndarray, px_per_unit: float,
+                      config: HarmonicConfig = HarmonicConfig()) -> Harmonics:
+    """A photo's harmonic part (:func:`photo_harmonics`) at ``px_per_unit`` pixels per texture unit: image float
+    (H, W, 3) or (H, W) in [0, 1]; a photo over HARMONIC_SIDE px is measured at that size, its waves kept at their
+    frequency in texture units.  The one measurement the runtime, the export and the harmonics tool share."""
+    return photo_harmonics(*at_most(image, px_per_unit, HARMONIC_SIDE), config)
+
+
 def remove_harmonics(img: np.ndarray, h: Harmonics, px_per_unit: float) -> np.ndarray:
     """The photo's indeterministic rest: img float (H, W, 3) less its harmonic part h (as :func:`photo_harmonics`
     measured it from this photo at ``px_per_unit``) at its pixel centres p = ((c + 1/2) / u, -(r + 1/2) / u),
@@ -415,7 +426,7 @@ def to_json(h: Harmonics) -> dict:
 
 def read_waves(d, dim: int, scalar: str, ok, rule: str, what: str) -> tuple:
     """(freq float64 (K, dim), amp complex128 (K, 3), d[scalar]) of stored waves (freq rows of ``dim`` values, amp
-    rows [re R, im R, re G, im G, re B, im B]: harmonic parts here, Gaussian rests in spectral.py); ValueError
+    rows [re R, im R, re G, im G, re B, im B]: harmonic parts here, Gaussian rests in gaussian_rest.py); ValueError
     naming ``what`` unless they hold numbers of those shapes, as many of each, finite, and ``ok(d[scalar])`` (the
     ``rule`` the message states)."""
     try:

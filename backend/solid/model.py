@@ -29,19 +29,17 @@ from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
 from .brick import brick_features
 from .cellular import cellular_features
-from .harmonic import Harmonics, from_json, harmonic_field, photo_harmonics, remove_harmonics
-from .lattice import lattice_noise, octave_seeds
+from .harmonic import HarmonicConfig, Harmonics, from_json, harmonic_field, measure_harmonics, remove_harmonics
+from .pixels import resize_rgb, rgb_pixels
+from .value_noise import value_noise, octave_seeds
 from .spin import check_mode, spun
-from . import spectral
-from .spectral import RENDER, RestField, choose_mix, rest_field, rest_from_json
-from .upright import candidates
+from .gaussian_rest import GaussianRest, rest_field, rest_from_json
 from .waves import wave_features
 
-__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "measure_harmonics"]
+__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "rgb_pixels"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
-HARMONIC_SIDE = 1024      #: photos are measured for their harmonic part at most this many pixels wide
 ENCODE_SIDE = 8           #: the encoder reads at most this many crops along each side of a photo ...
 ENCODE_BATCH = 16         #: ... this many at a time (a 4096 px photo: 64 crops, not 3969 in one 13 GB batch)
 #: the models the extension ships (``models/solid`` beside ``backend``)
@@ -63,16 +61,6 @@ def slice_points(size: int, px_per_unit: float, axis: str, offset=(0.0, 0.0, 0.0
     pts = np.zeros((plane.shape[0], 3))
     pts[:, a], pts[:, b] = plane[:, 0], plane[:, 1]
     return pts + np.asarray(offset, np.float64)
-
-
-def _rgb(image) -> np.ndarray:
-    """An exemplar image (H, W), (H, W, 3) or (H, W, 4) as float32 (H, W, 3); SettingError for other shapes."""
-    img = np.asarray(image, _F)
-    if img.ndim == 2:
-        img = np.repeat(img[..., None], 3, axis=2)
-    if img.ndim != 3 or img.shape[2] not in (3, 4):
-        raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
-    return img[..., :3]
 
 
 def load_models(root: str = SHIPPED_MODELS, threads: int = 0, cache: dict | None = None) -> dict:
@@ -105,14 +93,14 @@ class TextureCode:
     per-octave ``gains`` float32 (m,) measured from the exemplar (:func:`spectral_gains`); for a photo a space model
     encoded, or a single photo model that stores one, the photo's ``harmonics`` (:mod:`backend.solid.harmonic`:
     the periodic part added to the decoder's); for a photo a space model encoded, the Gaussian ``rest``
-    (:mod:`backend.solid.spectral`) mixed with the decoder's part when the encode-time check kept one."""
+    (:mod:`backend.solid.gaussian_rest`) mixed with the decoder's part when the encode-time check kept one."""
     e: np.ndarray
     T: np.ndarray
     mu: np.ndarray | None = None
     L: np.ndarray | None = None
     gains: np.ndarray | None = None
     harmonics: Harmonics | None = None
-    rest: RestField | None = None
+    rest: GaussianRest | None = None
 
 
 def exemplar_category(name: str) -> str:
@@ -124,14 +112,6 @@ def exemplar_category(name: str) -> str:
 def _colour(c: np.ndarray) -> tuple:
     """(mu (3,), L (3, 3)) of a photo model's 12 colour statistics [mu, L row-major] (:func:`colour_stats`)."""
     return c[:3].copy(), c[3:12].reshape(3, 3).copy()
-
-
-def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
-    """Bilinear resize of a float32 image (H, W, 3) to (h, w, 3), channel by channel (Pillow's float mode)."""
-    from PIL import Image
-
-    return np.stack([np.asarray(Image.fromarray(np.ascontiguousarray(img[..., c], np.float32))
-                                .resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
 
 
 def colour_stats(img: np.ndarray, eps: float = 1e-4) -> np.ndarray:
@@ -170,26 +150,6 @@ def spectral_gains(img: np.ndarray, octaves: int = 8, px_per_unit: float = 128.0
     return np.clip(np.sqrt(octaves * e / e.sum()), *GAIN_RANGE).astype(_F)
 
 
-def _measured(image: np.ndarray, px_per_unit: float) -> tuple:
-    """(image float32 (H', W', 3), its px per unit): a photo over HARMONIC_SIDE px resized to that size, its
-    frequencies in texture units unchanged (what the harmonic part and the Gaussian rest are measured on)."""
-    img = _rgb(image)
-    ppu, W = float(px_per_unit), img.shape[1]
-    f = HARMONIC_SIDE / max(img.shape[:2])
-    if f < 1.0:
-        img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
-        ppu *= img.shape[1] / W
-    return img, ppu
-
-
-def measure_harmonics(image: np.ndarray, px_per_unit: float) -> Harmonics:
-    """A photo's harmonic part (:func:`backend.solid.harmonic.photo_harmonics`) at ``px_per_unit`` pixels per
-    texture unit: image float (H, W, 3) or (H, W) in [0, 1]; a photo over HARMONIC_SIDE px is measured at that size,
-    its waves kept at their frequency in texture units.  The one measurement the runtime, the export and the
-    harmonics tool share."""
-    return photo_harmonics(*_measured(image, px_per_unit))
-
-
 class SolidTextureModel:
     def __init__(self, folder: str, threads: int = 0):
         self.config = load_model_json(folder, "solid.json")
@@ -225,7 +185,7 @@ class SolidTextureModel:
         #: a space photo model's named codes' harmonic parts, measured from the photos that name them (export, or
         #: training/solid/harmonics.py): ``code(name)`` draws a name as encoding its photo would
         self.code_harmonics = self._named_parts(c, "code_harmonics", from_json, "a harmonic part")
-        #: ... and their Gaussian rests, where the check kept one for the photo (spectral.py; the same writers)
+        #: ... and their Gaussian rests, where the check kept one for the photo (gaussian_rest.py; the same writers)
         self.code_rests = self._named_parts(c, "code_rests", rest_from_json, "a Gaussian rest")
         #: a space model trained on its photos' rests (photo less harmonic part): it encodes a photo's rest when
         #: the photo's part rides along, and draws it at the rest's own colour covariance (k = 1, harmonic.py)
@@ -286,7 +246,7 @@ class SolidTextureModel:
         if self.mode != "space":
             raise SettingError("exemplar", f"model {self.name!r} was fitted to one exemplar and cannot encode images; "
                                            "use a space model")
-        img = _rgb(image)
+        img = rgb_pixels(image)
         if self.harmonic_rest and harmonics is not None and len(harmonics):
             img = remove_harmonics(img, harmonics, self.px_per_unit)
         S = int(self.config.get("encoder_size", 128))
@@ -313,49 +273,12 @@ class SolidTextureModel:
                                             for c in crops], axis=0)])
         return z.astype(_F)
 
-    def harmonics(self, image: np.ndarray) -> Harmonics | None:
-        """A photo's harmonic part at this model's scale (:func:`measure_harmonics`), for :meth:`translate`; None
-        for models without the photo's colour (the part is added in its colour frame)."""
+    def harmonics(self, image: np.ndarray, config: HarmonicConfig = HarmonicConfig()) -> Harmonics | None:
+        """A photo's harmonic part at this model's scale (:func:`~backend.solid.harmonic.measure_harmonics`), for
+        :meth:`translate`; None for models without the photo's colour (the part is added in its colour frame)."""
         if not self.colour_stats:
             return None
-        return measure_harmonics(image, self.px_per_unit)
-
-    def photo_code(self, image: np.ndarray, periodic: bool = True, gaussian: bool = True,
-                   rest: str = "auto") -> TextureCode:
-        """Space mode: a photo's code as the product makes it before any refinement: the photo's harmonic part
-        (:meth:`harmonics`, unless ``periodic`` is False), the photo encoded with it (:meth:`encode`: a model
-        trained on rests reads the rest), translated with the part riding along, and its Gaussian rest
-        (:meth:`gaussian_rest` of the kind ``rest`` asks for, unless ``gaussian`` is False)."""
-        h = self.harmonics(image) if periodic else None
-        code = self.translate(self.encode(image, h), h)
-        return self.with_gaussian_rest(code, image, rest) if gaussian else code
-
-    def gaussian_rest(self, image: np.ndarray, code: TextureCode, rest: str = "auto") -> RestField | None:
-        """The Gaussian share of a photo's rest to mix into ``code`` (the photo's, without one), or None where the
-        encode-time check keeps the decoder alone (:mod:`backend.solid.spectral`).  ``rest`` (REST_CHOICES):
-        "auto", the check's choice among the rests :func:`~backend.solid.upright.candidates` offers on walls and
-        floors; "isotropic"; "upright", checked on walls alone.  Photo models of 3D space only (the rest is a
-        solid)."""
-        if self.mode != "space" or not self.colour_stats or self.dim != 3 or code.rest is not None:
-            return None
-        img, ppu = _measured(image, self.px_per_unit)
-        h = code.harmonics
-        left = remove_harmonics(img, h, ppu) if h is not None and len(h) else img
-        offered = candidates(left, ppu, rest)      # ValueError naming the choices for another rest
-
-        def layers(seed, axis, offset):
-            pts = slice_points(RENDER, self.px_per_unit, axis, offset)
-            fixed, dec = self.layers(pts, code, seed)
-            return fixed, dec, pts
-
-        # read when called: calibration (python -m bench solid-photos --check-seeds) sets them
-        planes = spectral.WALL_PLANES if rest == "upright" else spectral.CHECK_PLANES
-        return choose_mix(layers, _rgb(image), offered, planes)
-
-    def with_gaussian_rest(self, code: TextureCode, image: np.ndarray, rest: str = "auto") -> TextureCode:
-        """``code`` with :meth:`gaussian_rest` of ``image`` (unchanged where there is none)."""
-        r = self.gaussian_rest(image, code, rest)
-        return code if r is None else dataclasses.replace(code, rest=r)
+        return measure_harmonics(image, self.px_per_unit, config)
 
     def translate(self, z, harmonics: Harmonics | None = None) -> TextureCode:
         """Space mode, translator h(z) -> (e, T) (Sec. 3); ``harmonics`` (:meth:`harmonics`) ride along."""
@@ -401,7 +324,7 @@ class SolidTextureModel:
         ``progress(fraction)`` after each chunk (the one progress contract of the core); ``cancel()`` returning True
         stops early with :class:`Cancelled`.  2D points on a 3D model are
         read on the z = 0 plane.  A code with ``harmonics`` adds the photo's harmonic part (harmonic.py), one with
-        a ``rest`` its Gaussian rest (spectral.py): rgb = mu + k sqrt(1 - t) L d + h(x) + sqrt(t) g(x).
+        a ``rest`` its Gaussian rest (gaussian_rest.py): rgb = mu + k sqrt(1 - t) L d + h(x) + sqrt(t) g(x).
         """
         pts = np.asarray(points)
         if pts.ndim != 2 or pts.shape[1] not in (2, 3):
@@ -437,7 +360,7 @@ class SolidTextureModel:
         T = np.asarray(code.T, _F)
         if self.spin:
             T = spun(T, octave_seeds(seed, self.octaves), self.spin)
-        noise = lattice_noise(pts, T, seed, self.channels)
+        noise = value_noise(pts, T, seed, self.channels)
         if self.spectral_gains:
             if code.gains is None:
                 raise SettingError("code", f"model {self.name!r} needs the exemplar's spectral gains in its code")
@@ -471,7 +394,7 @@ class SolidTextureModel:
         return fixed, dec
 
     def _coloured(self, pts: np.ndarray, d: np.ndarray, code: TextureCode, seed: int) -> np.ndarray:
-        """Photo models: rgb = clip(mu + h(x) + k L d + sqrt(t) g(x)) (harmonic.py, spectral.py): float32 (n, 3)."""
+        """Photo models: rgb = clip(mu + h(x) + k L d + sqrt(t) g(x)) (harmonic.py, gaussian_rest.py): float32 (n, 3)."""
         self._check_colour(code)
         fixed, dec = self._parts(pts, d, code, seed)
         out = fixed + dec

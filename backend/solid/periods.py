@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .motif import box_sums, lattice_points, on_grid
+from .motif import box_sums, lattice_points
 
 __all__ = ["autocorrelation", "translations", "period_lattice", "lattice_bins", "frame_lines", "SIDE", "REACH",
            "CORRELATION", "DIP", "RING", "ISOLATION", "CLOSE", "MIN_REPEATS", "PROMINENCE", "WINDOW", "LINE_SAME",

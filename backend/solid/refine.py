@@ -31,19 +31,12 @@ Shapes: images float32 (H, W, 3) sRGB values in [0, 1].
 """
 from __future__ import annotations
 
-import dataclasses
-import os
-
 import numpy as np
 
-from ... import export
-from ..errors import SettingError
 from ..grid import Cancelled
-from .harmonic import mix_harmonics
-from .spectral import REST_CHOICES, mix_rests
-from .model import resize_rgb
+from .pixels import resize_rgb
 
-__all__ = ["SlicedTarget", "sliced_target", "sliced_distance", "refine_code", "exemplar_z", "RENDER_SIZE",
+__all__ = ["SlicedTarget", "sliced_target", "sliced_distance", "refine_code", "RENDER_SIZE",
            "SEARCH_PLANES", "CHECK_PLANES", "FINAL_PLANES"]
 
 RENDER_SIZE = 128   #: px per rendered plane
@@ -168,98 +161,3 @@ def refine_code(model, z0, exemplar: np.ndarray, steps: int = 40, seed: int = 0,
     if not np.array_equal(z, z0) and cost(z, FINAL_PLANES) >= cost(z0, FINAL_PLANES):
         return z0, hist + [hist[0]]
     return z, hist
-
-
-def exemplar_z(model: "SolidTextureModel", exemplar: str, refine: int = 0, setting: str = "exemplar",
-               progress=None, periodic: bool = True):
-    """A space model's z for a training exemplar's name, an image file or pixels float (H, W, 3) (encoded, then
-    refined by ``refine`` search steps): (z float32 (z_dim,), the image float32 (H, W, 3) or None, refinement
-    distances or [], the image's harmonic part or None (``periodic`` False: None))."""
-    if isinstance(exemplar, np.ndarray):  # pixels already read (the Blender panel): float (H, W, 3) sRGB in [0, 1]
-        img = np.asarray(exemplar, np.float32)
-        if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
-            raise SettingError(setting, f"expected finite RGB pixels (H, W, 3), got shape {img.shape}")
-        return _encoded(model, img, refine, progress, periodic)
-    if exemplar in model.codes:     # a name: its code, with the part of the photo that names it
-        return model.codes[exemplar], None, [], model.code_harmonics.get(exemplar) if periodic else None
-    if exemplar is None or not os.path.isfile(exemplar):
-        raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
-                                    f"({', '.join(model.codes) or 'none'})")
-    try:
-        img = export.read_rgb(exemplar)
-    except ValueError as exc:
-        raise SettingError(setting, str(exc)) from None
-    return _encoded(model, img, refine, progress, periodic)
-
-
-def _encoded(model, img: np.ndarray, refine: int, progress, periodic: bool):
-    """:func:`exemplar_z` of pixels: encode, measure the harmonic part, refine with it."""
-    h = model.harmonics(img) if periodic else None
-    z, hist = model.encode(img, h), []
-    if refine > 0:
-        z, hist = refine_code(model, z, img, steps=refine, progress=progress, harmonics=h)
-    return z, img, hist, h
-
-
-def texture_code(model: "SolidTextureModel", exemplar: str | None = None, to: str | None = None, mix: float = 0.0,
-                 refine: int = 0, where: str = "", progress=None, report=None, periodic: bool = True,
-                 gaussian: bool = True, rest: str = "auto"):
-    """The one place a texture request becomes a code, for the command line, job files and the farm:
-    (TextureCode, the input images' sha256 or None).
-
-    A single-exemplar model gives its own texture (``to``, ``refine`` and an ``exemplar`` other than its own are
-    errors); a space model
-    gives ``exemplar`` (a training exemplar's name or an image file, refined by ``refine`` steps), mixed with
-    ``to`` by ``mix`` in [0, 1] (Henzler et al. 2020, Sec. 4: interpolation in the latent space; an image's harmonic
-    part, :mod:`backend.solid.harmonic`, comes along unless ``periodic`` is False, mixed by
-    :func:`~backend.solid.harmonic.mix_harmonics`; an image's Gaussian rest, :mod:`backend.solid.spectral`, where
-    the check keeps one and ``gaussian`` is True, of the kind ``rest`` asks for (:meth:`~backend.solid.model.
-    SolidTextureModel.gaussian_rest`; a name brings the rest the model stores for it), mixed by
-    :func:`~backend.solid.spectral.mix_rests`). ``where``
-    prefixes the setting names in errors ("source." for job files, "--" for flags); ``report(name, history)``
-    hears each refinement's distances."""
-    import hashlib
-
-    def name(key):
-        return f"{where}{key}"
-
-    if not np.isfinite(mix) or not 0.0 <= mix <= 1.0:
-        raise SettingError(name("mix"), f"must be in [0, 1], got {mix}")
-    if refine < 0:
-        raise SettingError(name("refine"), f"must be >= 0, got {refine}")
-    if rest not in REST_CHOICES:
-        raise SettingError(name("rest"), f"must be one of {', '.join(REST_CHOICES)}, got {rest!r}")
-    if model.mode == "single":  # an exemplar may only name the model's own texture
-        own = {model.name, model.exemplar_label} | {str(e) for e in model.config.get("exemplars", [])}
-        other = exemplar is not None and (not isinstance(exemplar, str) or exemplar not in own)
-        for key, bad, why in (("exemplar", other, "another exemplar"),
-                              ("to", to, "interpolation"), ("refine", refine, "refining")):
-            if bad:
-                raise SettingError(name(key), f"model {model.name!r} holds one texture; {why} needs the space model")
-        return model.default_code(), None
-    if exemplar is None:
-        raise SettingError(name("exemplar"), f"the space model needs an exemplar (one of {', '.join(model.codes)}, "
-                                             "or an image file)")
-    digests = []
-
-    def z_of(ex, key):
-        z, img, hist, h = exemplar_z(model, ex, refine, name(key), progress, periodic)
-        if img is not None:
-            digests.append(hashlib.sha256(np.ascontiguousarray(img).tobytes()).hexdigest())
-        if hist and report is not None:
-            report(ex, hist)
-        if not gaussian:
-            r = None
-        elif img is not None:
-            r = model.gaussian_rest(img, model.translate(z, h), rest)
-        else:       # a name (exemplar_z reads no image only for one): its photo's rest, as the model stores it
-            r = model.code_rests.get(ex)
-        return z, h, r
-
-    z, h, r = z_of(exemplar, "exemplar")
-    if to is not None:
-        z2, h2, r2 = z_of(to, "to")
-        z, h, r = (1.0 - mix) * z + mix * z2, mix_harmonics(h, h2, mix), mix_rests(r, r2, mix)
-    sha = hashlib.sha256("".join(digests).encode()).hexdigest() if digests else None
-    code = model.translate(z, h)
-    return (code if r is None else dataclasses.replace(code, rest=r)), sha

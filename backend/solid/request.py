@@ -6,7 +6,7 @@ always did), an exemplar (a space model's training exemplar by name, an image fi
 holds), an optional second exemplar ``to`` with its share ``mix`` (Henzler et al. 2020, Sec. 4: interpolation in
 the latent space), ``refine`` search steps, ``periodic`` (keep an encoded image's harmonic part,
 :mod:`backend.solid.harmonic`), ``gaussian`` (mix in an encoded image's Gaussian rest where the encode-time check
-finds it closer, :mod:`backend.solid.spectral`) of the kind ``rest`` asks for ("auto", "isotropic" or "upright",
+finds it closer, :mod:`backend.solid.gaussian_rest`) of the kind ``rest`` asks for ("auto", "isotropic" or "upright",
 :mod:`backend.solid.upright`), and the ``seed`` of the noise.  ``method`` "synthesis" asks instead for a periodic
 2D image of ``tile`` px a side synthesised from an image exemplar by texture optimisation
 (:mod:`backend.solid.synthesis`): no model, no code, 2D only; ``method`` "spectral" a periodic Gaussian solid whose
@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import SettingError
 from ..paths import solid_models
-from .spectral import REST_CHOICES
+from .gaussian_rest import REST_CHOICES
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
 
@@ -40,7 +40,7 @@ METHODS = ("neural", "synthesis", "spectral")
 #: the methods that draw from an image exemplar alone, without a model
 IMAGE_METHODS = ("synthesis", "spectral")
 
-MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the lattice hash, backend/solid/lattice.py)
+MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the lattice hash, backend/solid/value_noise.py)
 
 
 def _pixels_sha(x: np.ndarray) -> str:
@@ -68,7 +68,7 @@ class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
     model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
     steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
-    Gaussian rest, where the check keeps one), ``rest`` (which: one of spectral.REST_CHOICES), ``method`` (one of
+    Gaussian rest, where the check keeps one), ``rest`` (which: one of gaussian_rest.REST_CHOICES), ``method`` (one of
     :data:`METHODS`) and, for "synthesis", ``tile`` (px per side of the periodic image)."""
 
     model: str | None = None
@@ -145,13 +145,21 @@ class SolidRequest:
         except ModelError as exc:
             raise SettingError(f"{where}model", f"{exc}; see models/solid/MODEL_CARD.md") from None
 
-    def code(self, model, where: str = "", progress=None, report=None, on_code=None):
-        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.refine.texture_code`;
-        ``on_code(code)`` hears the code once it is made (a front end's note on what the encoding kept)."""
-        from .refine import texture_code
+    def photo_config(self):
+        """The :class:`~backend.solid.pipeline.PhotoConfig` of this request's stages (periodic, refine, gaussian,
+        rest)."""
+        from .pipeline import PhotoConfig
 
-        code, sha = texture_code(model, self.exemplar, self.to, float(self.mix), int(self.refine), where, progress,
-                                 report, bool(self.periodic), bool(self.gaussian), self.rest)
+        return PhotoConfig(periodic=bool(self.periodic), refine=int(self.refine), gaussian=bool(self.gaussian),
+                           rest=self.rest)
+
+    def code(self, model, where: str = "", progress=None, report=None, on_code=None):
+        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.pipeline.texture_code`;
+        ``on_code(code)`` hears the code once it is made (a front end's note on what the encoding kept)."""
+        from .pipeline import texture_code
+
+        code, sha = texture_code(model, self.exemplar, self.to, float(self.mix), self.photo_config(), where,
+                                 progress, report)
         if on_code is not None:
             on_code(code)
         return code, sha
@@ -189,7 +197,7 @@ class SolidRequest:
         ``seed`` (:func:`~backend.solid.spectral_solid.spectral_field`; progress and cancel as
         :func:`~backend.solid.spectral_solid.spectral_tile`'s); SettingError naming the exemplar for an image it
         cannot use."""
-        from .model import measure_harmonics
+        from .harmonic import measure_harmonics
         from .spectral_solid import PX_PER_UNIT, spectral_field
 
         img = np.asarray(self.exemplar_pixels(where), np.float32)

@@ -4,7 +4,7 @@ cross-spectrum as closely as a solid can, numpy only.
 Random phase noise (Galerne, Gousseau & Morel 2011, IEEE T-IP 20(1)) keeps a photo's Fourier amplitudes and draws
 new phases: a stationary Gaussian texture with the photo's power spectrum and colour correlations.  Drawn as a 2D
 image per cut it is closer to the held-out photos than any solid the project had drawn.  The texture-space model's
-Gaussian rest (spectral.py) lifts it to 3D as a sum of 512 plane waves, whose cuts are far from it even on
+Gaussian rest (gaussian_rest.py) lifts it to 3D as a sum of 512 plane waves, whose cuts are far from it even on
 photos without orientation (three rock photos: 88.5, 89.3, 96.4 against 55.1, 59.2, 69.2 by the held-out patch
 distance).  This module lifts it on a grid of every frequency instead (the same photos: 66.4, 67.9 and 98.2, the
 last 72.8 with another draw: a tile holds few of a photo's longest waves, and the distance's low-pass level
@@ -214,7 +214,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, o
     called), of a periodic Gaussian solid
     with zero mean whose axis slices carry ``photo``'s (H, W, 3) colour cross-spectrum (module doc; a photo larger
     than MAX_READ is read from its central crop); add the photo's mean colour to the field :class:`SplineField`
-    reads.  ``harmonics``: the photo's harmonic part (:func:`backend.solid.model.measure_harmonics` at PX_PER_UNIT),
+    reads.  ``harmonics``: the photo's harmonic part (:func:`backend.solid.harmonic.measure_harmonics` at PX_PER_UNIT),
     taken out of the photo first, so the solid draws only the rest (:class:`SplineField` adds the part back).
     ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled.
     ``iterations``, ``isotropic_iterations``: :func:`solid_power`'s."""

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lattice import MASK32, lowbias32
+from .value_noise import MASK32, lowbias32
 
 __all__ = ["SALT", "MODES", "octave_spins", "spun", "check_mode"]
 

@@ -44,7 +44,8 @@ import numpy as np
 
 from ..errors import SettingError
 from ..grid import Cancelled
-from .model import plane_points, resize_rgb
+from .model import plane_points
+from .pixels import resize_rgb
 
 __all__ = ["SynthesisSettings", "synthesise", "TileField", "image_settings", "PLANES", "PX_PER_UNIT", "MIN_TILE",
            "MAX_TILE", "TILE_STEP", "COARSE_SHARPNESS", "FINE_SHARPNESS", "MIN_LEVELS", "COARSEST_PATCHES",

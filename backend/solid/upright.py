@@ -1,6 +1,6 @@
 """The upright Gaussian rest: a photo's orientation kept on walls.
 
-The isotropic Gaussian rest of spectral.py draws every wave in a uniformly random direction, so a wood photo's
+The isotropic Gaussian rest of gaussian_rest.py draws every wave in a uniformly random direction, so a wood photo's
 grain or a cliff's strata become blotches in every cut.  Photos of materials are mostly taken of walls, and the
 structures an artist expects to keep (strata, grain, ripples, planks) stand upright or lie level in the world.
 The upright rest keeps them on walls: each wave takes a photo coefficient's vertical frequency on z and its
@@ -11,15 +11,15 @@ horizontal frequency, turned about z by a uniform angle psi, in the xy-plane:
 so the solid is the same in distribution on every wall (any vertical plane) and each wall shows the photo's
 joint spectrum of (horizontal, vertical) frequency.  A wall shows a horizontal frequency R at R |cos psi|
 (psi measured from the wall's normal's perpendicular), so for each vertical frequency the horizontal magnitudes
-are deprojected from the photo's by Richardson-Lucy with the kernel of :func:`circle_inside` (as spectral.py does
-for plane cuts of a sphere's directions).  Colours, importance weights, phases and MIN_CYCLES are spectral.py's.
+are deprojected from the photo's by Richardson-Lucy with the kernel of :func:`circle_inside` (as gaussian_rest.py does
+for plane cuts of a sphere's directions).  Colours, importance weights, phases and MIN_CYCLES are gaussian_rest.py's.
 
 What it cannot keep: a tilt.  A solid that is the same on every wall is the same on a wall and on its mirror
 image (psi and psi + pi), so strata tilted by 30 degrees in the photo are drawn level; the photo is turned by less
 than 45 degrees before its spectrum is read, so that its dominant direction (:func:`orientation`) lies along its
 rows or columns (diagonal planks become level ones, not a lattice of both diagonals).  And floors: a horizontal
 cut shows only the horizontal frequencies, isotropically, so it loses the photo's layering; the encode-time check
-(spectral.choose_mix) sees floors beside walls and takes the upright rest only where the whole comes closer.
+(gaussian_rest.choose_mix) sees floors beside walls and takes the upright rest only where the whole comes closer.
 
 The gate: the check chooses among the rests it is offered, and each offer is one more chance for the check's
 noise (structure at the scale of its 128² planes) to choose.  The upright rest is offered only where the rest's
@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .spectral import (BINS, COUNT, REST_CHOICES, WAVE_SEED, colour_picks, deproject, rest_spectrum, rest_waves,
+from .gaussian_rest import (BINS, COUNT, REST_CHOICES, WAVE_SEED, colour_picks, deproject, rest_spectrum, rest_waves,
                        wave_amplitudes, wave_sampling)
 
 __all__ = ["circle_inside", "orientation", "spectrum_orientation", "upright_waves", "candidates", "UPRIGHT_GATE"]
@@ -65,7 +65,7 @@ def orientation(rest: np.ndarray) -> tuple:
 
 
 def spectrum_orientation(spectrum) -> tuple:
-    """:func:`orientation` of a rest from its :func:`~backend.solid.spectral.rest_spectrum` (at any scale: the
+    """:func:`orientation` of a rest from its :func:`~backend.solid.gaussian_rest.rest_spectrum` (at any scale: the
     coherence and the angle do not depend on it), (0, 0) for None (a flat photo)."""
     if spectrum is None:
         return 0.0, 0.0
@@ -82,7 +82,7 @@ def upright_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed
     """The upright Gaussian rest of a photo's rest (H, W, 3) (module doc), as :func:`rest_waves`: (freq float64
     (count, 3), amp complex128 (count, 3)) at full variance, None for a flat photo.  The photo is first turned by
     less than 45 degrees so that its dominant direction (:func:`orientation`) lies along its rows or columns.
-    ``spectrum``: :func:`~backend.solid.spectral.rest_spectrum` of the same rest and scale, where the caller has
+    ``spectrum``: :func:`~backend.solid.gaussian_rest.rest_spectrum` of the same rest and scale, where the caller has
     it already (it is the photo's periodic component and FFT: 0.7 s for a 1024² photo)."""
     spec = rest_spectrum(rest, px_per_unit) if spectrum is None else spectrum
     if spec is None:
@@ -112,11 +112,11 @@ def upright_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed
     return freq, wave_amplitudes(F, P, pick, 2.0 * V * share[kb] / (count * q[kb]), rng)
 
 
-def candidates(rest: np.ndarray, px_per_unit: float, choice: str = "auto") -> dict:
-    """The Gaussian rests a photo's rest (H, W, 3) offers the check (spectral.choose_mix): {kind: waves}.  For
-    ``choice`` "auto" the isotropic rest (:func:`~backend.solid.spectral.rest_waves`) always and the upright one
+def candidates(rest: np.ndarray, px_per_unit: float, choice: str = "auto", gate: float = UPRIGHT_GATE) -> dict:
+    """The Gaussian rests a photo's rest (H, W, 3) offers the check (gaussian_rest.choose_mix): {kind: waves}.  For
+    ``choice`` "auto" the isotropic rest (:func:`~backend.solid.gaussian_rest.rest_waves`) always and the upright one
     (:func:`upright_waves`) where the rest's spectrum is oriented (:func:`orientation`'s coherence above
-    UPRIGHT_GATE); for "isotropic" or "upright" (an artist's choice, spectral.REST_CHOICES) that one alone.  {} for
+    ``gate``); for "isotropic" or "upright" (an artist's choice, gaussian_rest.REST_CHOICES) that one alone.  {} for
     a flat photo."""
     if choice not in REST_CHOICES:
         raise ValueError(f"a Gaussian rest is one of {', '.join(REST_CHOICES)}, not {choice!r}")
@@ -124,6 +124,6 @@ def candidates(rest: np.ndarray, px_per_unit: float, choice: str = "auto") -> di
     if spec is None:
         return {}
     out = {} if choice == "upright" else {"isotropic": rest_waves(rest, px_per_unit, spectrum=spec)}
-    if choice == "upright" or (choice == "auto" and spectrum_orientation(spec)[0] > UPRIGHT_GATE):
+    if choice == "upright" or (choice == "auto" and spectrum_orientation(spec)[0] > gate):
         out["upright"] = upright_waves(rest, px_per_unit, spectrum=spec)
     return out

@@ -44,7 +44,7 @@ def test_runtime_never_imports_torch():
     """What the add-on imports (backend, bakes, jobs, export) stays free of torch."""
     code = ("import sys, omninoise.backend, omninoise.backend.bake, omninoise.backend.jobs, omninoise.backend.sources, omninoise.export, omninoise.export.vdb, "
             "omninoise.backend.neural.model, omninoise.backend.neural.conditioning, omninoise.backend.neural.generate, omninoise.backend.neural.sampler, "
-            "omninoise.backend.solid.model, omninoise.backend.solid.bake, omninoise.backend.solid.surface, omninoise.backend.solid.lattice, omninoise.cli.main; "
+            "omninoise.backend.solid.model, omninoise.backend.solid.bake, omninoise.backend.solid.surface, omninoise.backend.solid.value_noise, omninoise.cli.main; "
             "print('torch' in sys.modules)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0 and r.stdout.strip() == "False", r.stderr

@@ -12,6 +12,7 @@ from conftest import Recorder, needs_openvdb  # noqa: E402
 from omninoise.blender_addon import common, solid_ui, tasks  # noqa: E402
 from omninoise.backend.solid.bake import srgb_to_linear  # noqa: E402
 from omninoise.backend.solid.model import SolidTextureModel  # noqa: E402
+from omninoise.backend.solid.pipeline import photo_code  # noqa: E402
 
 SHIPPED = solid_ui.models_dir()
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -219,7 +220,7 @@ def test_image_source_is_encoded_by_the_space_model(scene):
     got = _pixels("Solid Texture Preview")
     m = _model("space")
     pixels = np.flipud(np.round(rgba[..., :3] * 255) / 255)
-    code = m.with_gaussian_rest(m.translate(m.encode(pixels)), pixels)
+    code = photo_code(m, pixels).code                          # the panel's code: the pipeline's stages
     ref = np.flipud(m.image(128, code, seed=3))
     assert np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
     assert p.periodic_info == "Periodic part: none found"      # random pixels have no period

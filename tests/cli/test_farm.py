@@ -121,6 +121,7 @@ def assert_same_outputs(a: str, b: str) -> None:
     assert not left, left  # no partial file
 
 
+@pytest.mark.long
 @needs_openvdb
 def test_a_mixed_job_on_two_workers_equals_the_one_machine_bake(client, reference, tmp_path):
     c, _ = client

@@ -151,6 +151,7 @@ NEURAL_FLAGS = st.lists(st.one_of(
 @settings(FUZZ, max_examples=30)
 @given(flags=NEURAL_FLAGS, size=st.sampled_from(["8", "16", "0", "-8", "7", "100000000", "x"]),
        ext=st.sampled_from([".npy", ".exr", ".png", ".txt", "folder", "missing"]))
+@pytest.mark.long
 def test_fuzz_neural(tmp_path_factory, flags, size, ext):
     with _fresh(tmp_path_factory) as tmp:
         out = output_path(tmp, ext)

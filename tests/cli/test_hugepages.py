@@ -56,6 +56,7 @@ def test_main_reexecutes_a_real_command_line_only(monkeypatch, tmp_path):
     assert cli_main.main(["neural", "--size", "512", "--seed", "-1"]) == 2 and calls == [1]   # argv given: never
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not hp.supported(), reason="needs Linux with glibc >= 2.35 and transparent huge pages")
 def test_a_large_neural_command_runs_again_with_the_tunable(tmp_path):
     """The real thing: the command line (here ``python -c`` around cli.main) re-executes itself once with

@@ -142,13 +142,14 @@ def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
     assert "source.mix: must be in [0, 1], got 1.5" in capsys.readouterr().err
 
 
+@pytest.mark.long
 def test_texture_codes_are_made_in_one_place(models, tmp_path):
     """A file, the same pixels (the panel's input) and a training exemplar's name all go through texture_code."""
     from PIL import Image
 
     from omninoise.backend.errors import SettingError
     from omninoise.backend.solid.model import SolidTextureModel
-    from omninoise.backend.solid.refine import texture_code
+    from omninoise.backend.solid.pipeline import texture_code
     from omninoise.export.images import read_rgb
 
     space, single = SolidTextureModel(models["space3"]), SolidTextureModel(models["single3"])
@@ -171,6 +172,7 @@ def test_texture_codes_are_made_in_one_place(models, tmp_path):
         texture_code(space)
 
 
+@pytest.mark.long
 def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path, capsys):
     """An encoded brick photo keeps its courses (backend/solid/harmonic.py) unless --no-periodic; a job file's
     `periodic = false` gives the volume `--no-periodic` writes."""
@@ -196,8 +198,9 @@ def test_the_periodic_part_is_on_by_default_and_can_be_left_out(models, tmp_path
     np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))
 
 
+@pytest.mark.long
 def test_the_gaussian_rest_is_said_and_can_be_left_out(models, tmp_path, capsys):
-    """A held-out rock face the decoder draws too coarse gets its Gaussian rest (backend/solid/spectral.py), and
+    """A held-out rock face the decoder draws too coarse gets its Gaussian rest (backend/solid/gaussian_rest.py), and
     the command says so; --no-gaussian and a job file's `gaussian = false` leave it out alike."""
     from omninoise.backend.solid.model import SolidTextureModel
 

@@ -66,6 +66,7 @@ def test_what_synthesis_cannot_do_is_named(stripes, flags, table, field, why):
         solid_request_from_dict({"method": "synthesis", "exemplar": stripes, "tile": True})
 
 
+@pytest.mark.long
 def test_command_line_writes_the_tile_seamlessly_repeated(stripes, tmp_path, capsys):
     """At scale 1 the image is the tile's own pixels (top row first), repeated beyond its size: it tiles without a
     seam; the stripes keep their direction."""
@@ -163,6 +164,7 @@ tile = 64
     assert read_rgb(str(tmp_path / "tile.png")).shape == (64, 64, 3)
 
 
+@pytest.mark.long
 def test_the_bake_key_records_the_levels_the_photo_was_drawn_with(monkeypatch):
     """The levels depend on the photo (image_levels): the field keeps the settings it was synthesised with and a job
     file's source writes them into its bake key, so a bake is redone when they change.  The photo file is decoded

@@ -77,6 +77,7 @@ needs_numba = pytest.mark.skipif(not fast.available(), reason="numba (the refere
     (3, 1, 0.3, 0.3, 0.0),         # one sample per row
     (2, 7, 0.0, 0.01, 0.0),        # fewer samples than one vector
 ])
+@pytest.mark.long
 def test_c_kernel_equals_numba(dim, nx, x0, x1, speed):
     noise = _case(dim, x1 - x0, speed=speed)
     xs, others = _row_set(dim, nx, x0, x1)
@@ -154,6 +155,7 @@ def test_switch_off_and_bad_arrays():
                      plan.omega, plan.zeta, plan.ctables, np.float32(1.0), plan.shift, np.empty((4, 16), np.float32))
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the native kernel wheel is built on Linux")
 def test_kernel_wheel_installs_and_loads(tmp_path):
     """The wheel make dist ships (here built with this machine's compiler): valid RECORD, and once installed

@@ -71,6 +71,7 @@ def test_the_shipped_bank_is_checked_and_finds_its_own_images(model, tmp_path):
         load_bank(str(copy))
 
 
+@pytest.mark.long
 def test_the_fit_improves_on_its_start_and_the_cli_gives_the_same(model, tmp_path, capsys):
     target = generate(model, C.uniform(model, ("spots", {"scale": 12.0}), 32, 32), seed=3, steps=6)
     res = fit(model, target, seed=0)  # 32 px: smaller than the bank's 64, so every class is tried

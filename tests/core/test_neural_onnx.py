@@ -136,6 +136,7 @@ def test_painted_maps(tiny):
     assert C.painted(model, idx, {0: ("spots", {}), 3: ("cells_f1", {})}).shape[1:] == (8, 8)
 
 
+@pytest.mark.long
 def test_neural_cli(tiny, tmp_path, capsys):
     out = tiny
     png = str(tmp_path / "n.png")

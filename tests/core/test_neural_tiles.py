@@ -58,6 +58,7 @@ def _peak_of_tiled_image(side: int, tile: int) -> int:
     return int(out.stdout.split()[-1]) * 1024
 
 
+@pytest.mark.long
 def test_tiled_generation_bounds_peak_memory():
     """Tiles bound memory by the tile, not the image: in 256 px tiles, going from a 512² image (9 tiles) to a
     1024² one (36 tiles) adds under 300 bytes a pixel, about what the conditioning grid itself takes (4 bytes per

@@ -9,6 +9,7 @@ from omninoise.backend.errors import SettingError
 from omninoise.backend.jobs import run_job
 from omninoise.backend.solid.bake import srgb_to_linear
 from omninoise.backend.solid.model import SolidTextureModel
+from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.sources import BoxGrid, SolidSource, source_from_dict
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -33,7 +34,7 @@ def _ref(grid: BoxGrid, seed=0, scale=1.0):
 def test_vdb_npy_exr_png(tmp_path):
     from omninoise.export.vdb import read_volume
     grid = BoxGrid((10, 8, 6), ((-1.0, -1.0, -1.0), (1.0, 0.6, 0.2)))
-    src = SolidSource(GRAVEL, seed=2, scale=1.5, density=0.7)
+    src = SolidSource(GRAVEL, SolidRequest(seed=2), scale=1.5, density=0.7)
     ref = _ref(grid, 2, 1.5)
     run_bake(BakeSpec("v", src, grid, str(tmp_path / "a.vdb")))
     np.testing.assert_allclose(read_volume(str(tmp_path / "a.vdb"), "color", grid.shape), ref, atol=1e-6)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from omninoise.backend.solid import cellular as C
-from omninoise.backend.solid.lattice import BITS, MASK32, lowbias32
+from omninoise.backend.solid.value_noise import BITS, MASK32, lowbias32
 
 REF_POINTS = np.array([[0.25, -1.5, 3.75], [1000.125, -2000.5, 0.0], [-0.5, 0.5, -0.5]])
 REF_T = np.stack([np.eye(3) * 0.5, np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]]), np.eye(3)]).astype(np.float32)
@@ -100,7 +100,7 @@ def test_errors_name_what_is_wrong():
 
 @pytest.mark.parametrize("D", [2, 3])
 def test_compiled_equals_numpy(D):
-    from omninoise.backend.solid.lattice import fast_available
+    from omninoise.backend.solid.value_noise import fast_available
     if not fast_available():
         pytest.skip("numba is not installed")
     rng = np.random.default_rng(D)

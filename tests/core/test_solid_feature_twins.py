@@ -11,7 +11,7 @@ def test_torch_twin_matches_runtime(family, D):
     torch = pytest.importorskip("torch")
     from omninoise.training.solid.brick import brick_features
     from omninoise.training.solid.cellular import cellular_features
-    from omninoise.training.solid.lattice import octave_seeds
+    from omninoise.training.solid.value_noise import octave_seeds
     twin, runtime = {"cellular": (cellular_features, cellular.cellular_features),
                      "brick": (brick_features, brick.brick_features)}[family]
     rng = np.random.default_rng(5)

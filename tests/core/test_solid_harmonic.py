@@ -8,6 +8,7 @@ import pytest
 
 from omninoise.backend.solid.harmonic import (COUNT, HarmonicConfig, Harmonics, harmonic_field, mix_harmonics,
                                               photo_harmonics, seed_shift)
+from omninoise.backend.solid.pipeline import PhotoConfig, photo_code
 from omninoise.backend.solid.model import SolidTextureModel, plane_points
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -181,6 +182,7 @@ def test_an_aperiodic_photo_is_left_as_the_decoder_draws_it(space):
     assert h.share < 0.02
 
 
+@pytest.mark.long
 def test_a_large_photo_is_measured_small_at_the_same_scale(space):
     """A photo over HARMONIC_SIDE px is resized before its FFT; its waves keep their frequency in texture units."""
     from omninoise.backend.solid.model import HARMONIC_SIDE
@@ -310,13 +312,15 @@ def test_jpeg_blocks_draw_no_grid_but_a_period_keeps_its_harmonics(monkeypatch):
     assert (0, 32) in kept and (32, 0) in kept                                         # their 2nd harmonics
 
 
+@pytest.mark.long
 def test_bake_keys_know_the_harmonic_part(space):
     """A bake is up to date only for the same harmonic part: an encoded photo with and without it, and a single
     model that stores one, give keys that say so."""
+    from omninoise.backend.solid.request import SolidRequest
     from omninoise.backend.sources import SolidSource
 
-    on = SolidSource(space, exemplar=BRICK).to_dict()
-    off = SolidSource(space, exemplar=BRICK, periodic=False).to_dict()
+    on = SolidSource(space, SolidRequest(exemplar=BRICK)).to_dict()
+    off = SolidSource(space, SolidRequest(exemplar=BRICK, periodic=False)).to_dict()
     assert on["harmonics_sha256"] is not None and off["harmonics_sha256"] is None
     assert on != off
     brick3d = SolidSource(os.path.join(ROOT, "models", "solid", "brick_3d")).to_dict()
@@ -339,10 +343,12 @@ def test_the_price_of_the_jpeg_rule_stripes_exactly_8_px_apart():
     assert photo_harmonics(stripes(32), PPU).share > 0.9
 
 
+@pytest.mark.long
 def test_refinement_renders_with_the_harmonic_part(space):
     """--refine searches the code as the texture will be drawn: with the photo's harmonic part, never worse than
     the encoder's code, and the part stays as measured."""
-    from omninoise.backend.solid.refine import refine_code, texture_code
+    from omninoise.backend.solid.pipeline import texture_code
+    from omninoise.backend.solid.refine import refine_code
     from omninoise.export import read_rgb
 
     photo = read_rgb(BRICK)
@@ -350,7 +356,7 @@ def test_refinement_renders_with_the_harmonic_part(space):
     _, with_h = refine_code(space, z, photo, steps=3, harmonics=h)
     _, without = refine_code(space, z, photo, steps=3)
     assert with_h[0] != without[0] and with_h[-1] <= with_h[0]
-    code, _ = texture_code(space, BRICK, refine=2)
+    code, _ = texture_code(space, BRICK, config=PhotoConfig(refine=2))
     assert code.harmonics is not None and np.array_equal(code.harmonics.freq, h.freq)
 
 
@@ -380,6 +386,7 @@ def test_the_rest_of_a_photo_keeps_no_period():
     np.testing.assert_array_equal(remove_harmonics(img * 1.5, none, PPU), np.clip(img * 1.5, 0, 1).astype(np.float32))
 
 
+@pytest.mark.long
 def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spread(tmp_path):
     """A space model whose solid.json says ``harmonic_rest`` encodes the photo less its part when the part rides
     along (as training saw its photos) and adds its decoder's part unscaled (k = 1: the code's L is the rest's
@@ -403,8 +410,8 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
     np.testing.assert_array_equal(rest.encode(photo), plain.encode(photo))
     np.testing.assert_array_equal(plain.encode(photo, h), plain.encode(photo))     # other models ignore the part
     code = rest.translate(rest.encode(photo, h), h)
-    # photo_code, the benches' one call, is this code; without the part it is the whole photo's
-    made, whole = rest.photo_code(photo), rest.photo_code(photo, periodic=False)
+    # photo_code, the pipeline's stages, is this code; without the part it is the whole photo's
+    made, whole = photo_code(rest, photo).code, photo_code(rest, photo, PhotoConfig(periodic=False)).code
     np.testing.assert_array_equal(made.e, code.e)
     assert np.array_equal(made.harmonics.freq, h.freq) and whole.harmonics is None
     np.testing.assert_array_equal(whole.e, rest.translate(plain.encode(photo)).e)
@@ -480,6 +487,7 @@ def test_a_motif_of_colours_at_one_luminance_is_found_in_the_colour_spectrum():
         HarmonicConfig(detect="chroma")
 
 
+@pytest.mark.long
 def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
     """--exemplar metal (a name of the texture-space model) is the code of the photo that names it, with that
     photo's harmonic part: the plates' seams, as encoding the photo gives them; --no-periodic and mixing carry the
@@ -488,19 +496,19 @@ def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
     import shutil
 
     from omninoise.backend.onnx_models import ModelError
-    from omninoise.backend.solid.refine import texture_code
+    from omninoise.backend.solid.pipeline import texture_code
     from omninoise.export import read_rgb
 
     photo = read_rgb(os.path.join(ROOT, "data", "photos", "train", "metal__metal_plates.jpg"))
-    # with its Gaussian rest (backend/solid/spectral.py), stored to ten and six digits
-    named, encoded = space.code("metal"), space.photo_code(photo)
+    # with its Gaussian rest (backend/solid/gaussian_rest.py), stored to ten and six digits
+    named, encoded = space.code("metal"), photo_code(space, photo).code
     assert named.harmonics is not None and named.harmonics.share > 0.4 and named.rest.mix == encoded.rest.mix
     np.testing.assert_allclose(space.image(64, named, seed=2), space.image(64, encoded, seed=2), atol=1e-4)
     assert space.code("metal", gaussian=False).rest is None
-    code, _ = texture_code(space, "metal", gaussian=False)
+    code, _ = texture_code(space, "metal", config=PhotoConfig(gaussian=False))
     assert code.rest is None and texture_code(space, "metal")[0].rest.mix == 1.0
     assert space.code("grass").harmonics is None                     # its photo has no period
-    code, _ = texture_code(space, "metal", periodic=False)
+    code, _ = texture_code(space, "metal", config=PhotoConfig(periodic=False))
     assert code.harmonics is None
     code, _ = texture_code(space, "metal", to="grass", mix=0.25)
     assert np.isclose(code.harmonics.share, 0.75 * named.harmonics.share)

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from omninoise.backend.solid import spin as S
-from omninoise.backend.solid.lattice import octave_seeds
+from omninoise.backend.solid.value_noise import octave_seeds
 
 # the rotations are part of every model trained with spun lattices: a change here would silently change them
 REF_3D = np.array([[-0.43438676, -0.7625306, -0.47943214], [-0.8624078, 0.19849654, 0.46567357],
@@ -62,14 +62,14 @@ def test_spun_turns_each_octave():
 def test_turned_octaves_draw_the_field_turned():
     """"octave": the field of octave i at x is the unturned field at Q_i^T x (one octave, a point set and its
     preimage)."""
-    from omninoise.backend.solid.lattice import lattice_noise
+    from omninoise.backend.solid.value_noise import value_noise
     rng = np.random.default_rng(2)
     T = rng.normal(size=(1, 3, 3)).astype(np.float32)
     seeds = octave_seeds(5, 1)
     Q = S.octave_spins(seeds, 3)[0].astype(np.float64)
     x = rng.uniform(-2, 2, (500, 3))
-    np.testing.assert_allclose(lattice_noise(x, S.spun(T, seeds, "octave"), 5, 3),
-                               lattice_noise(x @ Q, T, 5, 3), atol=2e-4)
+    np.testing.assert_allclose(value_noise(x, S.spun(T, seeds, "octave"), 5, 3),
+                               value_noise(x @ Q, T, 5, 3), atol=2e-4)
 
 
 def test_bake_keys_know_the_spin():

@@ -43,6 +43,7 @@ def test_2d_tile_copies_the_stripes_period_direction_and_colours():
     assert tile.min() >= photo.min() - 1e-4 and tile.max() <= photo.max() + 1e-4
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("seed", range(3))
 def test_the_products_2d_settings_keep_stripes_whole(seed):
     """image_settings (what method "synthesis" draws): square and sawtooth stripes of a 128² photo stay vertical
@@ -91,6 +92,7 @@ def _bricks(size: int = 256, course: int = 32, width: int = 64, mortar: int = 4)
     return np.stack([v, 0.55 * v + 0.1, 0.4 * v + 0.05], -1).clip(0, 1).astype(np.float32)
 
 
+@pytest.mark.long
 def test_the_products_levels_keep_brick_courses_whole():
     """A 256² brick wall, a 256 px tile: the courses run across the tile, so its row means vary as much as the
     photo's (mortar rows against brick rows).  Drawn with three levels (the product before) the bricks came out as
@@ -143,6 +145,7 @@ def test_isotropic_solid_keeps_the_photos_scale_on_every_slice_family():
         assert _ring_share(img, 3.5, 6.5) > 0.7
 
 
+@pytest.mark.long
 def test_every_voxel_stays_a_mean_of_photo_colours_on_a_small_photo(monkeypatch):
     """Each iteration sets a voxel to a weighted mean of photo colours, so before histogram matching it lies inside
     the photo's colour range.  On a small photo (every neighbourhood searched, exact copies among them) the
@@ -229,6 +232,7 @@ def test_bad_photos_are_refused_in_one_line():
         synthesise(np.zeros((20, 64, 3), np.float32))
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("dim", [2, 3])
 def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_path, dim, capsys):
     out = str(tmp_path / "syn")
@@ -267,6 +271,7 @@ def test_bench_measures_held_out_photos_beside_random_phase(bench_script, tmp_pa
     assert "brick__beige_bricks" in capsys.readouterr().out
 
 
+@pytest.mark.long
 def test_bench_draws_the_products_tiles_by_default_in_2d(bench_script, tmp_path):
     """Without --iterations and --sharpness the 2D bench draws what the product draws from each photo
     (image_settings): it records the levels and the whole tiles' colour error, and the sheet shows two seeds."""
@@ -282,6 +287,7 @@ def test_bench_draws_the_products_tiles_by_default_in_2d(bench_script, tmp_path)
     assert Image.open(out + ".png").size == (5 * 64, 64)     # photo | two tiles | 2 x 2 of the first | random phase
 
 
+@pytest.mark.long
 def test_bench_scales_photos_down_first_with_photo_side(bench_script, tmp_path):
     """--photo-side measures small photos (swatches): the photo is scaled to that short side before synthesis."""
     out = str(tmp_path / "small")
@@ -295,6 +301,7 @@ def test_bench_scales_photos_down_first_with_photo_side(bench_script, tmp_path):
     assert 0 < r["pooled"] < r["pixel_shuffle"]
 
 
+@pytest.mark.long
 def test_bench_measures_the_spectral_solid_without_the_marginals(bench_script, tmp_path, monkeypatch):
     """--method spectral --no-marginals --flat-start measures the Gaussian tile as drawn (the map onto the photo's
     marginals, which the request draws, left out: tests/core/test_spectral_solid.py compares the two) from flat

@@ -10,7 +10,8 @@ import pytest
 
 import omninoise.backend.solid.upright as upright
 from omninoise.backend.solid.model import SolidTextureModel, slice_points
-from omninoise.backend.solid.spectral import (COUNT, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests, rest_field,
+from omninoise.backend.solid.pipeline import PhotoConfig, photo_code
+from omninoise.backend.solid.gaussian_rest import (COUNT, MIXES, RENDER, GaussianRest, deproject, choose_mix, mix_rests, rest_field,
                                     rest_from_json, rest_to_json, rest_waves)
 from omninoise.backend.solid.upright import UPRIGHT_GATE, candidates, circle_inside, orientation, upright_waves
 
@@ -43,7 +44,7 @@ def folded_power(img):
 
 def walls(waves, n=128):
     """x and y cuts (rows along z) of a rest's solid at full variance, two seeds each: (n, n, 3) float32 each."""
-    r = RestField(*waves, 1.0)
+    r = GaussianRest(*waves, 1.0)
     return [rest_field(slice_points(n, PPU, ax, (0.3, 1.7, 2.9)), r, seed).reshape(n, n, 3)
             for ax in "xy" for seed in (1, 2)]
 
@@ -100,7 +101,7 @@ def test_horizontal_frequencies_are_deprojected_so_walls_show_the_photo_s(monkey
     flat = mean_horizontal(walls(upright_waves(img, PPU)))
     assert flat / want < 0.75                                  # measured 0.6
     # a floor of the upright solid sees the horizontal frequencies in every direction: no layers
-    r = RestField(*upright_waves(img, PPU), 1.0)
+    r = GaussianRest(*upright_waves(img, PPU), 1.0)
     floor = rest_field(slice_points(128, PPU, "z", (0.3, 1.7, 2.9)), r, 1).reshape(128, 128, 3)
     assert orientation(floor)[0] < 0.3
 
@@ -150,11 +151,11 @@ def _flat_layers(img):
 def _check_distances(img, offered):
     """The check's band distance of every (kind, t) for a decoder that draws nothing, computed here."""
     from omninoise.backend.solid.band_distance import band_distance
-    from omninoise.backend.solid.spectral import CHECK_PLANES
+    from omninoise.backend.solid.gaussian_rest import CHECK_PLANES
     mean = img.mean((0, 1))
     out = {}
     for kind, waves in offered.items():
-        r = RestField(*waves, 1.0, kind)
+        r = GaussianRest(*waves, 1.0, kind)
         g = [rest_field(slice_points(RENDER, PPU, ax, off), r, s) for s, ax, off in CHECK_PLANES]
         for t in MIXES:
             out[kind, t] = band_distance([np.clip(mean + np.sqrt(t) * x, 0, 1).reshape(RENDER, RENDER, 3)
@@ -162,6 +163,7 @@ def _check_distances(img, offered):
     return out
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("along, kind", [(3, "isotropic"), (20, "upright")])
 def test_the_check_takes_the_kind_and_mix_that_come_closest(along, kind):
     """A decoder that draws nothing; the check weighs floors beside walls.  Thin level layers (along = 3): the
@@ -181,7 +183,7 @@ def test_the_check_takes_the_kind_and_mix_that_come_closest(along, kind):
 
 
 def test_the_kind_is_stored_and_older_rests_read_as_isotropic():
-    r = RestField(*upright_waves(layered_photo(seed=4), PPU), 0.5, "upright")
+    r = GaussianRest(*upright_waves(layered_photo(seed=4), PPU), 0.5, "upright")
     d = json.loads(json.dumps(rest_to_json(r)))
     assert d["kind"] == "upright" and rest_from_json(d).kind == "upright"
     del d["kind"]
@@ -189,11 +191,12 @@ def test_the_kind_is_stored_and_older_rests_read_as_isotropic():
     d["kind"] = "sideways"
     with pytest.raises(ValueError, match="kind 'sideways' is not one of isotropic, upright, mixed"):
         rest_from_json(d)
-    iso = RestField(*rest_waves(layered_photo(seed=4), PPU), 1.0)
+    iso = GaussianRest(*rest_waves(layered_photo(seed=4), PPU), 1.0)
     assert mix_rests(r, iso, 0.5).kind == "mixed" and mix_rests(r, None, 0.5).kind == "upright"
     assert mix_rests(r, r, 0.5).kind == "upright"
 
 
+@pytest.mark.long
 def test_an_artist_may_ask_for_a_kind_and_upright_is_checked_on_walls():
     """photo_code(rest=...): "upright" keeps the layers of a photo whose floors made the check (walls and floors)
     take the isotropic rest, because an artist asking for it is texturing walls; "isotropic" never offers the
@@ -202,9 +205,9 @@ def test_an_artist_may_ask_for_a_kind_and_upright_is_checked_on_walls():
     img = layered_photo(256, turn_deg=90.0, across=(6, 30), along=3).astype(np.float32)
     assert set(candidates(img, PPU, "upright")) == {"upright"}
     assert set(candidates(img, PPU, "isotropic")) == {"isotropic"}
-    up = space.photo_code(img, rest="upright").rest
+    up = photo_code(space, img, PhotoConfig(rest="upright")).rest
     assert up is not None and up.kind == "upright"
-    iso = space.photo_code(img, rest="isotropic").rest
+    iso = photo_code(space, img, PhotoConfig(rest="isotropic")).rest
     assert iso is None or iso.kind == "isotropic"
     with pytest.raises(ValueError, match="one of auto, isotropic, upright, not 'sideways'"):
-        space.photo_code(img, rest="sideways")
+        photo_code(space, img, PhotoConfig(rest="sideways"))

@@ -213,7 +213,7 @@ def test_the_harmonic_part_stands_on_the_walls_and_leaves_the_solid_the_rest(per
     """A photo of level stripes 16 px apart with a little noise: its harmonic part (measured as the neural texture
     measures it) is taken out before the spectrum is read, so the Gaussian solid carries only the noise, and the
     field adds the part back upright: a wall's rows follow the stripes' period along z, not along y."""
-    from omninoise.backend.solid.model import measure_harmonics
+    from omninoise.backend.solid.harmonic import measure_harmonics
 
     rng = np.random.default_rng(3)
     r = np.arange(128)[:, None, None]

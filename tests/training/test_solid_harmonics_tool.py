@@ -41,7 +41,7 @@ def test_the_shipped_part_is_what_the_command_measures():
 
 def test_the_space_models_named_parts_are_what_the_command_measures(tmp_path, capsys):
     """The texture-space model stores a part per named code whose photo has one (metal plates, planks, ...),
-    measured from the photo that names it, and the Gaussian rest its check keeps (backend/solid/spectral.py);
+    measured from the photo that names it, and the Gaussian rest its check keeps (backend/solid/gaussian_rest.py);
     the command rewrites them the same, and refuses a photo set whose photos no longer encode to the stored
     codes."""
     space = os.path.join(ROOT, "models", "solid", "space")

@@ -17,7 +17,7 @@ from omninoise.backend.solid.waves import wave_features as wave_features_np  # n
 from omninoise.training.solid import exemplars as ex  # noqa: E402
 from omninoise.training.solid.export import export  # noqa: E402
 from omninoise.training.solid.features import RandomFeatures, histogram_loss, style_loss  # noqa: E402
-from omninoise.training.solid.lattice import octave_seeds  # noqa: E402
+from omninoise.training.solid.value_noise import octave_seeds  # noqa: E402
 from omninoise.training.solid.model import random_rotations, slice_points  # noqa: E402
 from omninoise.training.solid.train import SolidConfig, build_model, train, training_images  # noqa: E402
 from omninoise.training.solid.waves import photo_waves, wave_features, wave_share  # noqa: E402

@@ -121,6 +121,7 @@ def test_gaussian_noise_has_the_photo_spectrum_on_average_and_varies_per_draw():
 
 
 from omninoise.backend.solid.model import SolidTextureModel, colour_stats  # noqa: E402
+from omninoise.backend.solid.pipeline import photo_code
 from omninoise.backend.solid.refine import refine_code  # noqa: E402
 from omninoise.training.solid import exemplars as ex  # noqa: E402
 from omninoise.training.solid.export import export  # noqa: E402
@@ -179,7 +180,7 @@ def test_bf16_decoder_draws_the_fp32_texture_and_is_recorded(tmp_path):
     within bf16 rounding of fp32's, gradients reach every decoder weight, and the export (traced in fp32) says
     where and how the run trained.  Bad values get a one-line error."""
     from omninoise.training.precision import resolve
-    from omninoise.training.solid.lattice import octave_seeds
+    from omninoise.training.solid.value_noise import octave_seeds
     from omninoise.training.solid.model import spectral_gains
     from omninoise.training.solid.train import hardware_here
 
@@ -260,7 +261,7 @@ def test_photo_space_model_colour_path_export_and_refine(tmp_path):
     m = build_model(SolidConfig.from_dict(state["config"]))
     m.load_state_dict(state["model"])
     pts = np.random.default_rng(0).uniform(-3, 3, (500, 3))
-    from omninoise.training.solid.lattice import octave_seeds
+    from omninoise.training.solid.value_noise import octave_seeds
     with torch.no_grad():
         e, T = m.translator(torch.from_numpy(z[:8])[None])
         ref = m.sample(torch.from_numpy(pts).float()[None], e, T, octave_seeds([5], 8),
@@ -366,7 +367,7 @@ def test_warm_start_from_an_export_rebuilds_the_trained_model(tmp_path, film):
             # standardised input: a crop's colour and contrast do not change its code
             np.testing.assert_allclose(m.encoder(crop * 0.5 + 0.2).numpy(), m.encoder(crop).numpy(), rtol=5e-3, atol=5e-3)
         pts = np.random.default_rng(0).uniform(-3, 3, (300, 3))
-        from omninoise.training.solid.lattice import octave_seeds
+        from omninoise.training.solid.value_noise import octave_seeds
         assert z.shape == (8 + 12 + 8,) and rt.translate(z).gains.shape == (8,)
         with torch.no_grad():
             e, T = m.translator(torch.from_numpy(z[:8])[None])
@@ -415,7 +416,7 @@ def test_features_added_to_an_export_start_as_the_export(tmp_path):
     and ``bricks``): their first-layer columns start at zero, so the grown model draws the export's texture
     exactly, and the continued run trains them; features are not added to an export that has some."""
     from omninoise.backend.onnx_models import fingerprint
-    from omninoise.training.solid.lattice import octave_seeds
+    from omninoise.training.solid.value_noise import octave_seeds
     from omninoise.training.solid.warm_start import exported_weights, warm_start
 
     photos = ex.photo_set("train")[:2]
@@ -640,7 +641,7 @@ def test_harmonic_rest_trains_on_photos_less_their_part_as_the_runtime_encodes_t
     # the name "brick" keeps its photo's part, measured from the photo, not its rest: the name draws the photo's
     # code as encoding the photo would
     assert set(doc["code_harmonics"]) == {"brick"} and rt.code_harmonics["brick"].share > 0.5
-    named, encoded = rt.code("brick"), rt.photo_code(photo)
+    named, encoded = rt.code("brick"), photo_code(rt, photo).code
     np.testing.assert_allclose(named.e, encoded.e, atol=1e-4)
     np.testing.assert_array_equal(named.harmonics.freq, encoded.harmonics.freq)
     # and its Gaussian rest where the check keeps one for the photo (written by the export from the photo)

@@ -5,7 +5,7 @@ reads the same cells at run time.  Gradients reach the transforms T_i through
 the distances F1, F2 (the cell value is piecewise constant).
 
 Shapes: x (B, N, D) float32; T (m, D, D) or (B, m, D, D); seeds int64 (B, m):
-the value noise's octave seeds (``training.solid.lattice.octave_seeds``), from
+the value noise's octave seeds (``training.solid.value_noise.octave_seeds``), from
 which the cells' seeds are derived as at run time; result (B, N, 3 K) float32,
 octave-major.
 """
@@ -14,8 +14,8 @@ from __future__ import annotations
 import torch
 
 from omninoise.backend.solid.cellular import CELL_SALT, FEATURES, offsets
-from omninoise.backend.solid.lattice import BITS, MASK32
-from .lattice import lowbias32_torch, octave_positions, salted_seeds
+from omninoise.backend.solid.value_noise import BITS, MASK32
+from .value_noise import lowbias32_torch, octave_positions, salted_seeds
 
 __all__ = ["cellular_features"]
 

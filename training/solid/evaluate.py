@@ -31,7 +31,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from omninoise.backend.solid.lattice import lattice_noise
+from omninoise.backend.solid.value_noise import value_noise
 from omninoise.backend.solid.model import plane_points
 from . import exemplars as ex
 from .features import RandomFeatures, gram_loss, histogram_loss
@@ -107,7 +107,7 @@ def _fbm(n: int, size: int, octaves: int, dim: int = 2, seed0: int = 0) -> np.nd
     vv, uu = np.meshgrid(u, u, indexing="ij")
     pts = np.stack([uu.ravel(), vv.ravel()], 1)
     T = np.stack([np.eye(dim, dtype=np.float32)] * octaves)
-    return np.stack([lattice_noise(pts + 100.0 * i, T, seed0 + i, 1).reshape(size, size, octaves)
+    return np.stack([value_noise(pts + 100.0 * i, T, seed0 + i, 1).reshape(size, size, octaves)
                      for i in range(n)])
 
 

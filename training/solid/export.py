@@ -25,7 +25,8 @@ from torch import nn
 from omninoise import export as _ex
 from omninoise.backend.onnx_models import sha256_file
 from omninoise.backend.solid.harmonic import to_json
-from omninoise.backend.solid.model import exemplar_category, measure_harmonics
+from omninoise.backend.solid.harmonic import measure_harmonics
+from omninoise.backend.solid.model import exemplar_category
 from ..export_onnx import onnx_export as _onnx
 from . import exemplars as ex
 from .model import COLOUR_STATS, colour_stats, spectral_gains

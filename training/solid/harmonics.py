@@ -2,7 +2,7 @@
 
 A space photo model (the texture-space model) stores one part per named code (``code_harmonics``), measured from
 the training photo that names it (a category's first: the export's rule), and that photo's Gaussian rest where the
-encode-time check keeps one (``code_rests``, ``backend/solid/spectral.py``), so that ``--exemplar NAME`` draws what
+encode-time check keeps one (``code_rests``, ``backend/solid/gaussian_rest.py``), so that ``--exemplar NAME`` draws what
 encoding that photo draws; the export writes them too, this adds them to an export made before.  The photo must
 still encode to the stored code (checked).
 
@@ -32,7 +32,8 @@ from omninoise import export as _ex
 from omninoise.backend.onnx_models import ModelError
 from omninoise.backend.solid.harmonic import to_json
 from omninoise.backend.solid.model import SolidTextureModel, exemplar_category
-from omninoise.backend.solid.spectral import rest_to_json
+from omninoise.backend.solid.gaussian_rest import rest_to_json
+from omninoise.backend.solid.pipeline import gaussian_rest
 
 from .photo_set import expand
 
@@ -57,7 +58,7 @@ def rests_of(m: SolidTextureModel, named: dict) -> dict:
     (names without one are left out)."""
     out = {}
     for key, (photo, h) in named.items():
-        r = m.gaussian_rest(photo, m.translate(m.codes[key], h))
+        r = gaussian_rest(m, photo, m.translate(m.codes[key], h))
         if r is not None:
             out[key] = rest_to_json(r)
     return out

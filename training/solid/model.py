@@ -36,7 +36,7 @@ from omninoise.backend.solid.waves import FEATURES as WAVE_FEATURES
 from ..precision import autocast
 from .brick import brick_features
 from .cellular import cellular_features
-from .lattice import lattice_noise, spun_torch
+from .value_noise import value_noise, spun_torch
 from .waves import wave_features
 
 __all__ = [
@@ -431,7 +431,7 @@ class SolidTexture(nn.Module):
         the photo's waves (B, N, 2 K; ``waves.py``, at x itself: they are the photo's own frequencies)."""
         if self.spin:
             T = spun_torch(T, seeds, self.spin)
-        n = lattice_noise(x, T, seeds, self.channels)
+        n = value_noise(x, T, seeds, self.channels)
         if gains is not None:
             B, N, _ = n.shape
             n = (n.view(B, N, self.octaves, self.channels) * gains.view(B, 1, self.octaves, 1)).view(B, N, -1)

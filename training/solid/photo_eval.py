@@ -41,7 +41,7 @@ import numpy as np
 
 from omninoise.backend.solid.band_distance import laplacian_bands
 from omninoise.backend.solid.cellular import cellular_features_numpy
-from omninoise.backend.solid.lattice import lattice_noise
+from omninoise.backend.solid.value_noise import value_noise
 from omninoise.backend.solid.model import plane_points
 from omninoise import export as _ex
 
@@ -245,7 +245,7 @@ def perlin_hist(photo: np.ndarray, size: int, rng: np.random.Generator, octaves:
     vv, uu = np.meshgrid(u, u, indexing="ij")
     pts = np.stack([uu.ravel(), vv.ravel()], 1) + rng.uniform(0, 1000, 2)
     T = np.stack([np.eye(2, dtype=np.float32)] * octaves)
-    n = lattice_noise(pts, T, int(rng.integers(0, 2 ** 31 - 1)), 1)
+    n = value_noise(pts, T, int(rng.integers(0, 2 ** 31 - 1)), 1)
     return colour_by_rank((n * (0.5 ** np.arange(octaves))).sum(1).reshape(size, size), photo)
 
 

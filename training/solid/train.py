@@ -39,7 +39,7 @@ from ..model_card import cpu_name
 from ..precision import check_precision, resolve as resolve_precision
 from . import exemplars as ex
 from .features import RandomFeatures, histogram_loss, style_loss
-from .lattice import octave_seeds
+from .value_noise import octave_seeds
 from .model import (MAX_STRETCH, SolidTexture, fixed_axis_index, axis_rotations, check_fixed_axis, check_max_stretch,
                     colour_stats, max_scales, shape_features, slice_points, spectral_aspect, spectral_gains)
 from .soft_morphology import soft_morphology_loss

@@ -13,7 +13,7 @@ decoder never sees x itself, only these values.
 
 The hash is ``lowbias32`` (Chris Wellons' 32-bit integer hash) chained over
 the lattice coordinates, computed in int64 with 32-bit masks, so numpy, numba
-and the torch training code (``training.solid.lattice``) produce the
+and the torch training code (``training.solid.value_noise``) produce the
 same lattice values bit for bit.
 
 Shapes: points (N, D) float, D in {2, 3}; transforms (m, D, D) float32;
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MASK32", "BITS", "MAX_CHANNELS", "lowbias32", "octave_seeds", "salted_seeds", "lattice_noise",
+__all__ = ["MASK32", "BITS", "MAX_CHANNELS", "lowbias32", "octave_seeds", "salted_seeds", "value_noise",
            "lattice_noise_numpy", "fast_available", "check_points", "check_feature_octaves", "octave_position"]
 
 MASK32 = 0xFFFFFFFF
@@ -168,7 +168,7 @@ if numba is not None:
                     out[n, i * C + 2] = v2
 
 
-def lattice_noise(points, transforms, seed: int, channels: int = 3) -> np.ndarray:
+def value_noise(points, transforms, seed: int, channels: int = 3) -> np.ndarray:
     """Octave noise n of Eq. 5: points (N, D), transforms (m, D, D) -> float32 (N, m*C).
 
     Uses the compiled kernel when numba is importable (it releases the GIL, so a

@@ -49,7 +49,7 @@ from ..periodic import periodic_component
 from .band_distance import band_distance
 from .harmonic import mix_waves, read_waves, wave_sum
 
-__all__ = ["RestField", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
+__all__ = ["GaussianRest", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
            "rest_spectrum", "deproject", "wave_sampling", "colour_picks", "wave_amplitudes",
            "COUNT", "MIXES", "MARGIN", "CHECK_PLANES", "CHECK_SEEDS", "check_planes", "wall_planes", "WALL_PLANES",
            "BINS", "KINDS", "KIND_WORDS", "REST_CHOICES", "seed_shift3"]
@@ -81,7 +81,7 @@ CHECK_PLANES = check_planes(CHECK_SEEDS)
 WALL_PLANES = wall_planes(CHECK_PLANES)
 WAVE_SEED = 0x72657374  #: the waves' draw (fixed: the same photo gives the same texture)
 MIN_CYCLES = 2          #: no power below this many cycles per photo (shading and vignetting, as harmonic.py)
-KINDS = ("isotropic", "upright", "mixed")   #: RestField.kind
+KINDS = ("isotropic", "upright", "mixed")   #: GaussianRest.kind
 #: what an artist may ask for: the check's choice among the rests offered (upright.py's gate), or one kind
 REST_CHOICES = ("auto", "isotropic", "upright")
 #: what each kind draws, in words for the artist (CLI and panel)
@@ -91,7 +91,7 @@ KIND_WORDS = {"isotropic": "an isotropic Gaussian solid",
 
 
 @dataclass(frozen=True)
-class RestField:
+class GaussianRest:
     """The Gaussian rest as mixed in: ``freq`` float64 (M, 3) cycles per unit, ``amp`` complex128 (M, 3) colour
     amplitudes already scaled by sqrt(mix), ``mix`` in (0, 1] the share t of the rest's variance it carries
     (the decoder's part is scaled by sqrt(1 - t))."""
@@ -207,7 +207,7 @@ def seed_shift3(seed: int) -> np.ndarray:
     return np.random.default_rng([int(seed), 0x72657374]).uniform(0.0, 64.0, 3)
 
 
-def rest_field(points: np.ndarray, r: RestField, seed: int = 0) -> np.ndarray:
+def rest_field(points: np.ndarray, r: GaussianRest, seed: int = 0) -> np.ndarray:
     """sqrt(t) g at points float (N, 3) (module doc), moved by :func:`seed_shift3`: float32 (N, 3)."""
     x = np.asarray(points, np.float64)
     if x.shape[1] == 2:
@@ -215,13 +215,14 @@ def rest_field(points: np.ndarray, r: RestField, seed: int = 0) -> np.ndarray:
     return wave_sum(x + seed_shift3(seed), r.freq, r.amp)
 
 
-def choose_mix(layers, photo: np.ndarray, offered: dict, planes=CHECK_PLANES) -> RestField | None:
+def choose_mix(layers, photo: np.ndarray, offered: dict, planes=CHECK_PLANES, margin: float = MARGIN,
+               mixes: tuple = MIXES) -> GaussianRest | None:
     """The Gaussian rest to mix in, or None (module doc). ``layers(seed, axis, offset)`` gives a check plane's (fixed,
     decoder, points): parts float32 (RENDER^2, 3) (fixed: mean colour plus harmonic part; decoder: k L d) and the
     plane's points float64 (RENDER^2, 3); ``offered`` is :func:`~backend.solid.upright.candidates`' result ({kind:
-    (freq, amp)}, empty: nothing to mix). Every kind at every t of MIXES meets the check; the closest is kept if it
-    is MARGIN closer than the decoder alone (ties go to the kind offered first), on ``planes`` ((seed, axis,
-    offset) as CHECK_PLANES)."""
+    (freq, amp)}, empty: nothing to mix). Every kind at every t of ``mixes`` meets the check; the closest is kept if
+    it is ``margin`` times as close as the decoder alone (ties go to the kind offered first), on ``planes`` ((seed,
+    axis, offset) as CHECK_PLANES)."""
     if not offered:
         return None
     planes = [layers(seed, axis, offset) + (seed,) for seed, axis, offset in planes]
@@ -233,24 +234,24 @@ def choose_mix(layers, photo: np.ndarray, offered: dict, planes=CHECK_PLANES) ->
     base = band_distance(renders([0.0] * len(planes), 0.0), photo)
     best = None
     for kind, (freq, amp) in offered.items():
-        full = RestField(freq, amp, 1.0, kind)
+        full = GaussianRest(freq, amp, 1.0, kind)
         g = [rest_field(pts, full, seed) for _, _, pts, seed in planes]
-        for t in MIXES:
+        for t in mixes:
             dist = band_distance(renders(g, t), photo)
             if best is None or dist < best[0]:
                 best = (dist, kind, t)
     dist, kind, t = best
-    if dist > MARGIN * base:
+    if dist > margin * base:
         return None
     freq, amp = offered[kind]
-    return RestField(freq, amp * np.sqrt(t), float(t), kind)
+    return GaussianRest(freq, amp * np.sqrt(t), float(t), kind)
 
 
 def _digits(a: np.ndarray, n: int) -> list:
     return [float(f"{x:.{n}g}") for x in np.asarray(a, np.float64).ravel()]
 
 
-def rest_to_json(r: RestField) -> dict:
+def rest_to_json(r: GaussianRest) -> dict:
     """A named code's stored Gaussian rest (solid.json "code_rests"): freq rows [f_x, f_y, f_z], amp rows
     [re R, im R, re G, im G, re B, im B], mix; frequencies to ten significant digits (a phase error under 1e-5
     cycles at 100 units for 90 cycles per unit), amplitudes to six (the field to about 1e-5 of its spread)."""
@@ -259,19 +260,19 @@ def rest_to_json(r: RestField) -> dict:
                 amp=np.reshape(_digits(amp, 6), (-1, 6)).tolist(), mix=float(r.mix), kind=r.kind)
 
 
-def rest_from_json(d) -> RestField:
-    """:func:`rest_to_json`'s dict -> RestField; ValueError naming what is wrong (at least one wave; a kind of
+def rest_from_json(d) -> GaussianRest:
+    """:func:`rest_to_json`'s dict -> GaussianRest; ValueError naming what is wrong (at least one wave; a kind of
     KINDS, "isotropic" where none is stored: files written before the upright rest)."""
     kind = d.get("kind", "isotropic") if isinstance(d, dict) else "isotropic"
     if kind not in KINDS:
         raise ValueError(f"a Gaussian rest: kind {kind!r} is not one of {', '.join(KINDS)}")
-    r = RestField(*read_waves(d, 3, "mix", lambda t: 0.0 < t <= 1.0, "a mix in (0, 1]", "a Gaussian rest"), kind)
+    r = GaussianRest(*read_waves(d, 3, "mix", lambda t: 0.0 < t <= 1.0, "a mix in (0, 1]", "a Gaussian rest"), kind)
     if not len(r):
         raise ValueError("a Gaussian rest: no waves")
     return r
 
 
-def mix_rests(a: RestField | None, b: RestField | None, s: float) -> RestField | None:
+def mix_rests(a: GaussianRest | None, b: GaussianRest | None, s: float) -> GaussianRest | None:
     """The Gaussian rest of a code interpolated by ``s`` from a to b: both sets of waves, powers weighted (1 - s)
     and s, the mix interpolating linearly (as :func:`~backend.solid.harmonic.mix_harmonics`); None when both are."""
     parts = [(r, w) for r, w in ((a, 1.0 - s), (b, s)) if r is not None and w > 0.0]
@@ -279,4 +280,4 @@ def mix_rests(a: RestField | None, b: RestField | None, s: float) -> RestField |
     if m is None:
         return None
     kinds = {r.kind for r, _ in parts}
-    return RestField(*m, kinds.pop() if len(kinds) == 1 else "mixed")
+    return GaussianRest(*m, kinds.pop() if len(kinds) == 1 else "mixed")

@@ -1,4 +1,4 @@
-"""Differentiable torch twin of :mod:`backend.solid.lattice` (Henzler et al. 2020, Eq. 5).
+"""Differentiable torch twin of :mod:`backend.solid.value_noise` (Henzler et al. 2020, Eq. 5).
 
 Same hash, same octave seeds, same smoothstep blend, so a model trained here
 reads the same lattice values at run time.  Gradients reach the transforms T_i
@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from omninoise.backend.solid.lattice import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
+from omninoise.backend.solid.value_noise import BITS, MASK32, MAX_CHANNELS, octave_seeds as _np_octave_seeds
 from omninoise.backend.solid.spin import check_mode, octave_spins
 
-__all__ = ["octave_seeds", "salted_seeds", "lattice_noise", "lowbias32_torch", "octave_positions", "spun_torch"]
+__all__ = ["octave_seeds", "salted_seeds", "value_noise", "lowbias32_torch", "octave_positions", "spun_torch"]
 
 _LEVELS = (1 << BITS) - 1
 
@@ -63,7 +63,7 @@ def spun_torch(T: torch.Tensor, seeds: torch.Tensor, mode: str) -> torch.Tensor:
     return out.to(T.dtype)
 
 
-def lattice_noise(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, channels: int = 3) -> torch.Tensor:
+def value_noise(x: torch.Tensor, T: torch.Tensor, seeds: torch.Tensor, channels: int = 3) -> torch.Tensor:
     """Octave noise n_i = noise(T_i 2^(i-1) x | xi_i) (Eq. 5): (B, N, D) -> (B, N, m*C)."""
     if not 1 <= channels <= MAX_CHANNELS:
         raise ValueError(f"channels must be 1..{MAX_CHANNELS}")

@@ -1,4 +1,4 @@
-"""The Gaussian rest of an encoded photo (backend/solid/spectral.py) and the band distance that decides it
+"""The Gaussian rest of an encoded photo (backend/solid/gaussian_rest.py) and the band distance that decides it
 (backend/solid/band_distance.py): cuts of the solid have the photo's radial spectrum, variance and colours; the
 check keeps the decoder where it is as close and mixes the rest in where the decoder is far; seeds, mixing and
 the texture an artist gets."""
@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from omninoise.backend.solid.band_distance import band_distance
+from omninoise.backend.solid.pipeline import PhotoConfig, photo_code
 from omninoise.backend.solid.model import SolidTextureModel, slice_points
-from omninoise.backend.solid.spectral import (COUNT, MARGIN, MIXES, RENDER, RestField, deproject, choose_mix, mix_rests,
+from omninoise.backend.solid.gaussian_rest import (COUNT, MARGIN, MIXES, RENDER, GaussianRest, deproject, choose_mix, mix_rests,
                                     rest_field, rest_waves)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -60,7 +61,7 @@ def test_cuts_of_the_solid_have_the_photo_s_radial_spectrum_variance_and_colour(
     want /= want.sum()
 
     def cuts_of(waves):
-        r = RestField(*waves, 1.0)
+        r = GaussianRest(*waves, 1.0)
         return [rest_field(slice_points(128, PPU, ax, (0.3, 1.7, 2.9)), r, seed).reshape(128, 128, 3)
                 for ax in "xyz" for seed in (1, 2)]
 
@@ -75,7 +76,7 @@ def test_cuts_of_the_solid_have_the_photo_s_radial_spectrum_variance_and_colour(
     assert abs((centre * got).sum() / (centre * want).sum() - 1.0) < 0.03
     assert np.abs(got - want).sum() < 0.25
     # without the deprojection the cuts' spectrum slides down (each wave shows at R sin(theta), pi / 4 R on average)
-    import omninoise.backend.solid.spectral as spectral
+    import omninoise.backend.solid.gaussian_rest as spectral
     monkeypatch.setattr(spectral, "deproject", lambda p2, edges: p2)
     flat = spectrum(cuts_of(rest_waves(img, PPU)))
     assert (centre * flat).sum() / (centre * want).sum() < 0.85 and np.abs(flat - want).sum() > 0.35
@@ -89,7 +90,7 @@ def test_the_waves_are_the_same_for_the_same_photo_and_seeds_move_them():
     img = band_photo(seed=3)
     a, b = rest_waves(img, PPU), rest_waves(img, PPU)
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
-    r = RestField(*a, 1.0)
+    r = GaussianRest(*a, 1.0)
     pts = slice_points(32, PPU, "z")
     assert np.array_equal(rest_field(pts, r, 4), rest_field(pts, r, 4))
     assert np.abs(rest_field(pts, r, 4) - rest_field(pts, r, 5)).mean() > 0.01
@@ -119,6 +120,7 @@ def _layers_from(dec_fn, img):
     return layers
 
 
+@pytest.mark.long
 def test_the_check_mixes_the_rest_in_where_the_decoder_is_far_and_keeps_a_decoder_that_is_close():
     img = band_photo(256)
     waves = rest_waves(img, PPU)
@@ -128,7 +130,7 @@ def test_the_check_mixes_the_rest_in_where_the_decoder_is_far_and_keeps_a_decode
     assert np.allclose(flat.amp, waves[1])                 # t = 1: full amplitude
     # a decoder that draws the same Gaussian texture (another draw of it): no mix is MARGIN closer
     other = rest_waves(img, PPU, seed=99)
-    same = choose_mix(_layers_from(lambda p, s: rest_field(p, RestField(*other, 1.0), s + 50), img), img,
+    same = choose_mix(_layers_from(lambda p, s: rest_field(p, GaussianRest(*other, 1.0), s + 50), img), img,
                       {"isotropic": waves})
     assert same is None
     assert choose_mix(_layers_from(lambda p, s: np.zeros((len(p), 3), np.float32), img), img, {}) is None
@@ -136,8 +138,8 @@ def test_the_check_mixes_the_rest_in_where_the_decoder_is_far_and_keeps_a_decode
 
 
 def test_mixing_rests_weights_powers():
-    a = RestField(np.ones((4, 3)), np.full((4, 3), 2.0 + 0j), 0.5)
-    b = RestField(np.zeros((2, 3)), np.full((2, 3), 1.0 + 0j), 1.0)
+    a = GaussianRest(np.ones((4, 3)), np.full((4, 3), 2.0 + 0j), 0.5)
+    b = GaussianRest(np.zeros((2, 3)), np.full((2, 3), 1.0 + 0j), 1.0)
     m = mix_rests(a, b, 0.25)
     assert len(m) == 6 and np.isclose(m.mix, 0.75 * 0.5 + 0.25 * 1.0)
     assert np.allclose(np.abs(m.amp[:4]) ** 2, 0.75 * 4.0) and np.allclose(np.abs(m.amp[4:]) ** 2, 0.25)
@@ -153,9 +155,9 @@ def space():
 def test_a_code_with_a_rest_is_drawn_as_its_layers_say(space):
     """evaluate = clip(mu + h + sqrt(1 - t) k L d + sqrt(t) g); the decoder's part is what layers gives."""
     img = band_photo(256)
-    code = space.photo_code(img, gaussian=False)
+    code = photo_code(space, img, PhotoConfig(gaussian=False)).code
     waves = rest_waves(img, space.px_per_unit)
-    r = RestField(waves[0], waves[1] * np.sqrt(0.5), 0.5)
+    r = GaussianRest(waves[0], waves[1] * np.sqrt(0.5), 0.5)
     pts = slice_points(48, space.px_per_unit, "x", (1.0, 2.0, 3.0))
     fixed, dec = space.layers(pts, code, seed=3)
     assert np.allclose(space.evaluate(pts, code, seed=3), np.clip(fixed + dec, 0, 1), atol=1e-6)
@@ -167,17 +169,18 @@ def test_a_code_with_a_rest_is_drawn_as_its_layers_say(space):
         space.layers(pts, mixed)
 
 
+@pytest.mark.long
 def test_an_encoded_rock_photo_gets_a_rest_that_brings_it_closer(space):
     """The product's path on a held-out rock face whose middle scales the decoder does not draw: the check mixes
     the Gaussian rest in, and the texture's cuts come closer to the photo on planes the check did not see."""
-    from omninoise.backend.solid.refine import texture_code
+    from omninoise.backend.solid.pipeline import texture_code
     from omninoise.export import read_rgb
 
     path = os.path.join(ROOT, "data", "photos", "val", "rock__rock_grey.jpg")
     photo = read_rgb(path)
     code, _ = texture_code(space, path)
     assert code.rest is not None and code.rest.mix in MIXES
-    plain, _ = texture_code(space, path, gaussian=False)
+    plain, _ = texture_code(space, path, config=PhotoConfig(gaussian=False))
     assert plain.rest is None
 
     def cuts(c):
@@ -193,11 +196,11 @@ def test_bake_keys_know_the_gaussian_rest(space):
     from omninoise.backend.sources import SolidSource
 
     img = band_photo(256)
-    code = space.photo_code(img, gaussian=False)
+    code = photo_code(space, img, PhotoConfig(gaussian=False)).code
     waves = rest_waves(img, space.px_per_unit)
     import dataclasses
     a = SolidSource(space, code=code)
-    b = SolidSource(space, code=dataclasses.replace(code, rest=RestField(waves[0], waves[1], 1.0)))
+    b = SolidSource(space, code=dataclasses.replace(code, rest=GaussianRest(waves[0], waves[1], 1.0)))
     assert a.input_sha256 != b.input_sha256
     assert a.to_dict()["gaussian_rest_sha256"] is None and b.to_dict()["gaussian_rest_sha256"]
 
@@ -206,17 +209,17 @@ def test_tiny_and_flat_photos_encode(space):
     """The check reads photos of a few pixels (its neighbourhoods shrink to fit) and a flat photo has no rest."""
     for n in (1, 3, 7):
         img = np.random.default_rng(n).random((n, n + 2, 3)).astype(np.float32)
-        code = space.photo_code(img)
+        code = photo_code(space, img).code
         assert code.rest is None or code.rest.mix in MIXES
-    assert space.photo_code(np.full((64, 64, 3), 0.4, np.float32)).rest is None
+    assert photo_code(space, np.full((64, 64, 3), 0.4, np.float32)).rest is None
     assert band_distance([np.zeros((128, 128, 3))], np.zeros((2, 2, 3))) >= 0.0
 
 
 def test_stored_rests_round_trip_to_six_digits_and_bad_ones_are_named():
-    from omninoise.backend.solid.spectral import rest_from_json, rest_to_json
+    from omninoise.backend.solid.gaussian_rest import rest_from_json, rest_to_json
 
     img = band_photo(seed=5)
-    r = RestField(*rest_waves(img, PPU), 0.75)
+    r = GaussianRest(*rest_waves(img, PPU), 0.75)
     back = rest_from_json(json.loads(json.dumps(rest_to_json(r))))
     assert back.mix == 0.75 and back.freq.shape == r.freq.shape
     np.testing.assert_allclose(back.freq, r.freq, rtol=6e-10)

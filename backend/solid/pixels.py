@@ -1,0 +1,41 @@
+"""Photos as the solid texture's stages read them: float32 RGB, resized by Pillow's bilinear filter.
+
+Shapes: images float (H, W), (H, W, 3) or (H, W, 4) in; float32 (H, W, 3) sRGB values out.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SettingError
+
+__all__ = ["rgb_pixels", "resize_rgb", "at_most"]
+
+
+def rgb_pixels(image) -> np.ndarray:
+    """An exemplar image (H, W), (H, W, 3) or (H, W, 4) as float32 (H, W, 3); SettingError for other shapes."""
+    img = np.asarray(image, np.float32)
+    if img.ndim == 2:
+        img = np.repeat(img[..., None], 3, axis=2)
+    if img.ndim != 3 or img.shape[2] not in (3, 4):
+        raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
+    return img[..., :3]
+
+
+def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
+    """Bilinear resize of a float32 image (H, W, 3) to (h, w, 3), channel by channel (Pillow's float mode)."""
+    from PIL import Image
+
+    return np.stack([np.asarray(Image.fromarray(np.ascontiguousarray(img[..., c], np.float32))
+                                .resize((w, h), Image.BILINEAR)) for c in range(3)], -1)
+
+
+def at_most(image, px_per_unit: float, side: int) -> tuple:
+    """(image float32 (H', W', 3), its px per unit): a photo over ``side`` px resized to that size, its frequencies
+    in texture units unchanged."""
+    img = rgb_pixels(image)
+    ppu, W = float(px_per_unit), img.shape[1]
+    f = side / max(img.shape[:2])
+    if f < 1.0:
+        img = resize_rgb(img, max(1, round(img.shape[0] * f)), max(1, round(W * f)))
+        ppu *= img.shape[1] / W
+    return img, ppu
