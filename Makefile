@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: all setup kernel demo test test-blender bench docs dist clean
+.PHONY: all setup kernel demo test test-long test-blender bench docs dist clean
 
 all: test
 
@@ -35,8 +35,13 @@ $(VENV)/.train: $(STAMP) requirements-train.txt
 	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt
 	@touch $@
 
+# the quick tests (a few minutes on two cores); test-long: the long integration tests (Blender, training, whole
+# commands); CI runs both, and test-blender
 test: $(STAMP) $(VENV)/.train kernel
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -m "not long"
+
+test-long: $(STAMP) $(VENV)/.train kernel
+	$(BIN)/python -m pytest -q -m long
 
 # The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS and 4.5 LTS
 # (Python 3.11), 5.1 and 5.2 (Python 3.13; Blender 5.1+ runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
