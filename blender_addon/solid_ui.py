@@ -208,7 +208,7 @@ def periodic_info(code) -> str:
 
 
 def gaussian_info(code) -> str:
-    """A line for the panel: the share of the rest a code's Gaussian rest carries (backend/solid/spectral.py)."""
+    """A line for the panel: the share of the rest a code's Gaussian rest carries (backend/solid/gaussian_rest.py)."""
     if not hasattr(code, "rest"):     # a spectral solid is all Gaussian: no share to report
         return ""
     r = code.rest

@@ -11,7 +11,7 @@ import numpy as np
 from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import METHODS
-from omninoise.backend.solid.spectral import REST_CHOICES
+from omninoise.backend.solid.gaussian_rest import REST_CHOICES
 
 from .common import Bar, add_command
 
@@ -114,7 +114,7 @@ def run(a: argparse.Namespace) -> int:
             print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
                   "(--no-periodic leaves it out)", file=sys.stderr)
         if code.rest is not None:
-            from omninoise.backend.solid.spectral import KIND_WORDS
+            from omninoise.backend.solid.gaussian_rest import KIND_WORDS
             print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as "
                   f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian "
                   "leaves it out)", file=sys.stderr)
