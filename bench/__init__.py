@@ -20,6 +20,7 @@ SUITES = {
     "fit": ("eval_fit", "fitting a noise to an image (inverse design) on the zoo's classes"),
     "solid-photos": ("eval_solid_photos", "solid textures on held-out photos against random phase and pixel shuffle"),
     "solid-singles": ("eval_solid_singles", "single-photo solid models on pixels they never saw"),
+    "solid-ablation": ("solid_ablation", "each stage and reading of the solid pipeline left out in turn"),
     "solid-methods": ("solid_synthesis", "the spectral solid and tileable synthesis on held-out photos"),
     "sheet-zoo": ("zoo_sheet", "contact sheet: the training zoo's classes at 256 px"),
     "sheet-samplers": ("neural_sampler_sheet", "contact sheet: the samplers on the same seeds"),
