@@ -8,7 +8,7 @@ import sys
 from omninoise.backend.errors import SettingError
 from omninoise.backend.neural.precision import PRECISIONS
 
-from .common import Bar, add_command, set_threads
+from .common import Bar, add_command, set_threads, shown
 
 __all__ = ["add_parser", "run"]
 
@@ -52,12 +52,12 @@ def run(a: argparse.Namespace) -> int:
         bad = [s for _, s in entries if isinstance(s, JobError)]
         for name, spec in entries:
             if isinstance(spec, JobError):
-                print(f"  invalid  {spec}")
+                print(f"  invalid  {shown(spec)}")
             else:
                 frames = spec.frame_list()
                 fresh = sum(spec.is_up_to_date(f) for f in frames)
                 state = "up to date" if fresh == len(frames) else "to bake"
-                print(f"  {state:10s} {name}: {list(spec.grid.resolution)} -> {spec.output}"
+                print(f"  {state:10s} {shown(name)}: {list(spec.grid.resolution)} -> {shown(spec.output)}"
                       + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))
         if bad:
             print(f"omninoise bake: error: {len(bad)} of {len(entries)} bakes are invalid (listed above)",
@@ -80,9 +80,10 @@ def run(a: argparse.Namespace) -> int:
     failed = [o for o in outcomes if o.status != "baked" and o.status != "up to date"]
     for o in outcomes:
         if o.status in ("baked", "up to date") and not a.quiet:
-            print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
+            print(f"omninoise bake: {shown(o.name)}: {o.status} ({shown(o.message)})", file=sys.stderr)
     for o in failed:
-        print(f"omninoise bake: {'cancelled' if o.status == 'cancelled' else 'error'}: {o.message}", file=sys.stderr)
+        print(f"omninoise bake: {'cancelled' if o.status == 'cancelled' else 'error'}: {shown(o.message)}",
+              file=sys.stderr)
     # exit status as documented: 2 bad input, 130 interrupted, 1 a failure while running
     if any(o.status == "invalid" for o in failed):
         return 2
@@ -138,10 +139,10 @@ def _on_farm(a: argparse.Namespace) -> int:
             cluster.close()
     for o in outcomes:
         if o.status in ("baked", "up to date") and not a.quiet:
-            print(f"omninoise bake: {o.name}: {o.status} ({o.message})", file=sys.stderr)
+            print(f"omninoise bake: {shown(o.name)}: {o.status} ({shown(o.message)})", file=sys.stderr)
     bad = [o for o in outcomes if o.status not in ("baked", "up to date")]
     for o in bad:
-        print(f"omninoise bake: error: {o.message}", file=sys.stderr)
+        print(f"omninoise bake: error: {shown(o.message)}", file=sys.stderr)
     if any(o.status == "invalid" for o in bad):
         return 2
     return 1 if bad else 0

@@ -7,7 +7,9 @@ import time
 
 from omninoise.backend.errors import SettingError
 
-__all__ = ["Help", "add_command", "class_args", "Bar", "set_threads", "param_items"]
+__all__ = ["Help", "add_command", "class_args", "Bar", "set_threads", "param_items", "shown", "SHOWN"]
+
+SHOWN = 400     #: at most this many characters of a message are printed
 
 
 class Help(argparse.RawDescriptionHelpFormatter):
@@ -79,3 +81,10 @@ def param_items(items: list, flag: str) -> dict:
         except ValueError:
             raise SettingError(flag, f"expected NAME=VALUE with a number, got {item!r}") from None
     return out
+
+
+def shown(text: str, limit: int = SHOWN) -> str:
+    """``text`` as it is safe to print on a terminal: control characters (escape codes, line breaks, a job name's
+    terminal title) written as escapes, and cut to ``limit`` characters."""
+    out = "".join(c if c.isprintable() else ascii(c)[1:-1] for c in str(text))
+    return out if len(out) <= limit else out[:limit - 1] + "…"

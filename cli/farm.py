@@ -30,6 +30,7 @@ import json
 import logging
 import os
 import time
+import uuid
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,7 +81,7 @@ def _job_spec(job: str, bake: str) -> BakeSpec:
     return spec
 
 
-def _maybe_crash(path: str) -> None:
+def _maybe_crash(path: str, tag: str) -> None:
     marker = os.environ.get(CRASH_ENV)
     if not marker or not os.path.exists(marker):
         return
@@ -90,7 +91,7 @@ def _maybe_crash(path: str) -> None:
         return  # another worker took it
     from omninoise import export
 
-    partial = os.path.join(os.path.dirname(path), export.partial_prefix(path) + "crash")
+    partial = os.path.join(os.path.dirname(path), export.partial_prefix(path, tag) + "crash")
     with open(partial, "wb") as fh:
         fh.write(b"half a file")
     os._exit(70)
@@ -103,21 +104,25 @@ def _worker_precision(precision: str) -> None:
     set_default_precision(precision)
 
 
-def run_file(job: str, bake: str, frame, precision: str = "fp32") -> dict:
-    """Worker: bake one file (whatever its state) -> :func:`file_record` of it."""
+def run_file(job: str, bake: str, frame, tag: str, precision: str = "fp32") -> dict:
+    """Worker: bake one file (whatever its state), its temporaries under the farm run's ``tag`` -> :func:`file_record`
+    of it."""
+    from omninoise import export
+
     _worker_precision(precision)
     spec = _job_spec(job, bake)
     path = frame_path(spec.output, frame)
-    _maybe_crash(path)
+    _maybe_crash(path, tag)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    return file_record(bake_frame(spec, frame))
+    with export.tagged(tag):
+        return file_record(bake_frame(spec, frame))
 
 
-def run_brick(job: str, bake: str, frame, z0: int, z1: int, precision: str = "fp32") -> dict:
+def run_brick(job: str, bake: str, frame, z0: int, z1: int, tag: str, precision: str = "fp32") -> dict:
     """Worker: the grids of z = z0 .. z1 - 1 of a volume -> {grid name: float32 slab (z1 - z0, ny, nx[, 3])}."""
     _worker_precision(precision)
     spec = _job_spec(job, bake)
-    _maybe_crash(frame_path(spec.output, frame))
+    _maybe_crash(frame_path(spec.output, frame), tag)
     return volume_channels(spec, evaluate_rows(spec.source, spec.grid, spec.frame_time(frame), z0, z1))
 
 
@@ -227,15 +232,16 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
     if bad:
         return [JobOutcome(n, "invalid", str(s)) for n, s in bad]
     manifest = read_manifest(job)
+    tag = f"farm-{uuid.uuid4().hex[:12]}"     # this run's temporaries: the only ones it removes
     tasks, skipped, volumes = plan(entries, force, brick_voxels or brick_voxels_for(client), manifest)
     specs = dict(entries)
     futures = {}
     for t in tasks:
         if t.brick is None:
-            fut = client.submit(run_file, job, t.bake, t.frame, precision, retries=retries, pure=False)
+            fut = client.submit(run_file, job, t.bake, t.frame, tag, precision, retries=retries, pure=False)
         else:
-            fut = client.submit(run_brick, job, t.bake, t.frame, t.brick[0], t.brick[1], precision, retries=retries,
-                                pure=False)
+            fut = client.submit(run_brick, job, t.bake, t.frame, t.brick[0], t.brick[1], tag, precision,
+                                retries=retries, pure=False)
         futures[fut] = t
     writers, bricks_done, failed, written = {}, {}, {}, {}
     done, moved, t0 = 0, 0, time.perf_counter()
@@ -257,7 +263,7 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
             else:
                 moved += rec["bytes"]
                 written[t.path] = dict(rec, bake=t.bake, frame=t.frame, key=spec.key(t.frame))
-            export.remove_partials(t.path)
+            export.remove_partials(t.path, tag)
         elif res is not None and t.path not in failed:
             w = writers.get(t.path)
             if w is None:
@@ -271,8 +277,9 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
             bricks_done[t.path] = bricks_done.get(t.path, 0) + 1
             if bricks_done[t.path] == volumes[t.path][2]:
                 os.makedirs(os.path.dirname(os.path.abspath(t.path)), exist_ok=True)
-                writers.pop(t.path).write(t.path)
-                export.remove_partials(t.path)
+                with export.tagged(tag):
+                    writers.pop(t.path).write(t.path)
+                export.remove_partials(t.path, tag)
                 written[t.path] = dict(file_record(t.path), bake=t.bake, frame=t.frame, key=spec.key(t.frame))
         if progress is not None:
             progress(done / len(tasks))
@@ -280,7 +287,7 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
             rate = (time.perf_counter() - t0) / done
             status(done, len(tasks), moved, rate * (len(tasks) - done))
     for path in failed:
-        export.remove_partials(path)
+        export.remove_partials(path, tag)
     manifest.update({os.path.abspath(p): r for p, r in written.items()})
     for p in failed:
         manifest.pop(os.path.abspath(p), None)

@@ -8,15 +8,17 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 
 from omninoise.backend.errors import SettingError
 from omninoise.export.images import ImageError
 
 from . import bake, hugepages, neural, solid, transfer, wave, zoo
-from .common import Help
+from .common import Help, shown
 
-__all__ = ["main", "build_parser", "COMMANDS"]
+__all__ = ["main", "build_parser", "COMMANDS", "Terminated", "STOP_SIGNALS"]
 
 #: subcommand name -> its module, in the order of ``omninoise --help``
 COMMANDS = {"wave": wave, "bake": bake, "neural": neural, "solid": solid, "zoo": zoo, "transfer": transfer}
@@ -58,6 +60,23 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised where the command is (as Python raises KeyboardInterrupt for SIGINT), so that the
+    write in progress removes its temporary on the way out."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _terminate(signum, frame):
+    raise Terminated(signum)
+
+
+#: the signals that stop a command as Ctrl+C does (exit status 128 + the signal's number)
+STOP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
     a = ap.parse_args(argv)
@@ -66,29 +85,47 @@ def main(argv: list[str] | None = None) -> int:
             hugepages.reexec()
         except OSError:
             pass
+    here = threading.current_thread() is threading.main_thread()
+    before = {sig: signal.signal(sig, _terminate) for sig in STOP_SIGNALS} if here else {}
+    try:
+        return _run(a)
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+
+
+def _run(a: argparse.Namespace) -> int:
+    """The subcommand, with every way it can end mapped to a one-line message and the documented exit status."""
+    def say(what: str) -> None:
+        print(f"omninoise {a.command}: {shown(what)}", file=sys.stderr)
+
     try:
         return COMMANDS[a.command].run(a)
     except (SettingError, FileNotFoundError, PermissionError, IsADirectoryError, ImageError) as exc:
-        print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
+        say(f"error: {exc}")
         return 2
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print("", file=sys.stderr)
+        say(f"{'interrupted' if signum == signal.SIGINT else 'terminated'}; no partial file was left")
+        return 128 + int(signum)
     except Exception as exc:
         from omninoise.backend.grid import Cancelled
         from omninoise.backend.jobs import JobError
+        from omninoise.export import NonFiniteError
 
         if isinstance(exc, JobError):
-            print(f"omninoise {a.command}: error: {exc}", file=sys.stderr)
+            say(f"error: {exc}")
             return 2
         if isinstance(exc, Cancelled):
-            print(f"omninoise {a.command}: cancelled", file=sys.stderr)
+            say("cancelled")
             return 130
+        if isinstance(exc, NonFiniteError):     # the writers' last check: nothing was written
+            say(f"error: {exc}")
+            return 1
         if a.debug:
             raise
         what = str(exc).splitlines()[0] if str(exc) else ""
-        print(f"omninoise {a.command}: internal error: {type(exc).__name__}{': ' + what if what else ''} "
-              "(a bug: please report it with the command; --debug before the command shows the traceback)",
-              file=sys.stderr)
+        say(f"internal error: {type(exc).__name__}{': ' + what if what else ''} (a bug: please report it with the "
+            "command; --debug before the command shows the traceback)")
         return 1
-    except KeyboardInterrupt:
-        print(f"\nomninoise {a.command}: interrupted; no partial file was left", file=sys.stderr)
-        return 130
-    return 1

@@ -5,15 +5,54 @@ earlier result at the target path.  The temporary file is flushed to disk
 (fsync) before the rename, so a power cut leaves either the old file or the
 new one; temporaries that a killed process left behind (``.omninoise-*``
 older than a day) are removed from the folder on the next write there.
+
+A temporary's name fits the file system's 255-byte limit whatever the target's legal name: ``.omninoise-``, the
+target's name (a long one cut, with a digest of the whole), the writer's tag (:func:`tagged`: a farm run's, so that
+it removes its own workers' leftovers and no other process's), then mkstemp's random part and the suffix.
+
+Every writer refuses NaN and infinite values (:func:`require_finite`): no output file ever holds them.
 """
 from __future__ import annotations
 
 import contextlib
+import contextvars
+import hashlib
 import os
 import tempfile
 import time
 
+import numpy as np
+
 STALE_SECONDS = 24 * 3600   #: age after which a leftover ``.omninoise-*`` temporary is removed
+NAME_PART = 96              #: at most this many characters of the target's name in a temporary's
+SUFFIX_PART = 16            #: ... and of its suffix
+_TAG = contextvars.ContextVar("omninoise_temporary_tag", default="")
+
+
+class NonFiniteError(ValueError):
+    """A result holds NaN or infinite values; nothing is written."""
+
+
+def require_finite(array, path: str) -> None:
+    """NonFiniteError naming ``path`` unless every value of ``array`` is finite (the writers' last check)."""
+    a = np.asarray(array)
+    if a.dtype.kind in "fc" and not np.isfinite(a).all():
+        bad = int(a.size - np.count_nonzero(np.isfinite(a)))
+        raise NonFiniteError(f"not writing {os.path.basename(path)}: {bad} of {a.size} values are NaN or infinite "
+                             "(a setting out of range?)")
+
+
+@contextlib.contextmanager
+def tagged(tag: str):
+    """Temporaries made in this context carry ``tag`` in their names (letters, digits, '-' and '_'): a farm's
+    workers write under the farm run's tag, and :func:`remove_partials` with that tag removes only theirs."""
+    if not tag or not all(c.isalnum() or c in "-_" for c in tag) or len(tag) > 32:
+        raise ValueError(f"a temporary's tag is 1 to 32 letters, digits, '-' or '_', got {tag!r}")
+    token = _TAG.set(tag)
+    try:
+        yield
+    finally:
+        _TAG.reset(token)
 
 
 @contextlib.contextmanager
@@ -27,8 +66,8 @@ def atomic_path(path: str, suffix: str | None = None):
     if os.path.isdir(path):
         raise IsADirectoryError(f"output path is a folder, not a file: {path}")
     remove_stale(folder)
-    suffix = suffix if suffix is not None else os.path.splitext(path)[1]
-    fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path), suffix=suffix, dir=folder)
+    suffix = (suffix if suffix is not None else os.path.splitext(path)[1])[-SUFFIX_PART:]
+    fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)
     os.close(fd)
     try:
         yield tmp
@@ -48,9 +87,14 @@ def _fsync(path: str) -> None:
         os.close(fd)
 
 
-def partial_prefix(path: str) -> str:
-    """The name prefix of the temporaries that become ``path``: ``.omninoise-NAME.`` (then random)."""
-    return f".omninoise-{os.path.basename(path)}."
+def partial_prefix(path: str, tag: str = "") -> str:
+    """The name prefix of the temporaries that become ``path``: ``.omninoise-NAME.`` (then random), with the
+    writer's ``tag`` after it where there is one; a name over NAME_PART characters is cut and ends in a digest of
+    the whole."""
+    name = os.path.basename(path)
+    if len(name) > NAME_PART:
+        name = name[:NAME_PART - 9] + "~" + hashlib.sha256(name.encode("utf-8", "surrogateescape")).hexdigest()[:8]
+    return f".omninoise-{name}." + (f"{tag}." if tag else "")
 
 
 def _remove_temporaries(folder: str, prefix: str, max_age: float) -> list:
@@ -72,10 +116,13 @@ def _remove_temporaries(folder: str, prefix: str, max_age: float) -> list:
     return gone
 
 
-def remove_partials(path: str) -> list:
-    """Remove the temporaries of ``path`` left by writers that died (a worker killed mid-write); call it only
-    when no writer of ``path`` can still be running.  Returns their names."""
-    return _remove_temporaries(os.path.dirname(os.path.abspath(path)), partial_prefix(path), -1.0)
+def remove_partials(path: str, tag: str) -> list:
+    """Remove the temporaries of ``path`` that writers under ``tag`` left when they died (a farm's worker killed
+    mid-write); another process's temporaries of the same file carry another tag, or none, and stay.  Returns
+    their names."""
+    if not tag:
+        raise ValueError("remove_partials needs the writers' tag: it removes only their temporaries")
+    return _remove_temporaries(os.path.dirname(os.path.abspath(path)), partial_prefix(path, tag), -1.0)
 
 
 def remove_stale(folder: str, max_age: float = STALE_SECONDS) -> list:

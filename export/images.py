@@ -11,13 +11,14 @@ import zlib
 
 import numpy as np
 
-from .atomic import atomic_path
+from .atomic import atomic_path, require_finite
 
 __all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "write_unit_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
 def write_npy(path: str, array: np.ndarray) -> None:
+    require_finite(array, path)
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
             np.save(fh, np.ascontiguousarray(array, dtype=np.float32))
@@ -82,6 +83,7 @@ def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | 
     import OpenEXR
 
     a = np.asarray(array, dtype=np.float32)
+    require_finite(a, path)
     if a.ndim == 2:
         a = a[:, :, None]
     c = a.shape[2]
@@ -100,6 +102,7 @@ def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | 
 def write_image(path: str, array: np.ndarray) -> None:
     """Dispatch on extension: .npy raw float32, .exr float image, .png 8-bit preview."""
     ext = os.path.splitext(path)[1].lower()
+    require_finite(array, path)
     if ext == ".npy":
         write_npy(path, array)
     elif ext == ".exr":
@@ -115,6 +118,7 @@ def write_unit_image(path: str, img: np.ndarray, linear: np.ndarray | None = Non
     percentile stretch of :func:`write_image`; .exr and .npy float: ``linear`` where given (a colour image's
     scene-linear values), else ``img``."""
     if os.path.splitext(path)[1].lower() == ".png":
+        require_finite(img, path)
         write_png(path, preview_8bit(img, 0.0, 1.0))
     else:
         write_image(path, img if linear is None else linear)

@@ -18,7 +18,7 @@ import sys
 
 import numpy as np
 
-from .atomic import atomic_path
+from .atomic import atomic_path, require_finite
 
 __all__ = ["openvdb_module", "VolumeWriter", "read_volume", "read_vdb_metadata"]
 
@@ -76,6 +76,7 @@ class VolumeWriter:
         """Store ``slab`` float32 (nz, ny, nx) or (nz, ny, nx, 3) at z = z0 ... z0 + nz - 1."""
         g, kind = self.grids[name]
         a = np.asarray(slab, _F)
+        require_finite(a, f"grid {name!r}")
         if kind == "float":
             if a.ndim != 3:
                 raise ValueError(f"grid {name!r} takes (nz, ny, nx) slabs, got {a.shape}")

@@ -1,0 +1,124 @@
+"""What a command leaves behind and prints: temporaries that fit any legal name and are removed by their own
+writers only, no NaN written, SIGTERM and SIGHUP handled as Ctrl+C, control characters escaped."""
+import os
+import signal
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from omninoise import export
+from omninoise.export.images import write_unit_image
+from omninoise.cli.common import shown
+from omninoise.cli.main import main
+
+
+def test_every_legal_output_name_gets_a_temporary_within_the_name_limit(tmp_path):
+    for n in (1, 200, 251):                               # 251 + ".npy": the longest legal name
+        out = tmp_path / ("w" * n + ".npy")
+        assert main(["wave", "--size", "8", "--quiet", "-o", str(out)]) == 0
+        assert np.load(out).shape == (8, 8)
+    a, b = (export.partial_prefix(str(tmp_path / (s * 250 + ".exr")), "farm-0123456789ab") for s in "xy")
+    assert a != b and max(len(a), len(b)) + 8 + export.atomic.SUFFIX_PART <= 160
+    assert export.partial_prefix("x" * 90 + "a.png") != export.partial_prefix("x" * 90 + "b.png")
+
+
+def test_a_tagged_writer_removes_its_own_temporaries_and_no_one_elses(tmp_path):
+    out = str(tmp_path / "cloud.vdb")
+    with export.tagged("farm-1"):
+        with pytest.raises(RuntimeError):
+            with export.atomic_path(out) as tmp:
+                assert os.path.basename(tmp).startswith(export.partial_prefix(out, "farm-1"))
+                raise RuntimeError("stop")
+        assert not os.path.exists(tmp)                    # its own failed write leaves nothing
+    mine = tmp_path / (export.partial_prefix(out, "farm-1") + "dead.vdb")          # a killed worker's
+    theirs = tmp_path / (export.partial_prefix(out) + "live.vdb")                  # another process's, writing now
+    other_farm = tmp_path / (export.partial_prefix(out, "farm-2") + "live.vdb")
+    for p in (mine, theirs, other_farm):
+        p.write_bytes(b"half")
+    assert export.remove_partials(out, "farm-1") == [mine.name]
+    assert theirs.exists() and other_farm.exists()
+    with pytest.raises(ValueError, match="tag"):
+        export.remove_partials(out, "")
+    with pytest.raises(ValueError, match="tag"):
+        with export.tagged("../x"):
+            pass
+
+
+@pytest.mark.parametrize("ext", [".npy", ".exr", ".png"])
+def test_no_writer_writes_nan_or_infinity(tmp_path, ext):
+    out = str(tmp_path / ("x" + ext))
+    bad = np.zeros((4, 4, 3), np.float32)
+    bad[1, 2, 0] = np.nan
+    with pytest.raises(export.NonFiniteError, match="1 of 48 values are NaN or infinite"):
+        export.write_image(out, bad)
+    write = {".png": write_unit_image, ".npy": export.write_npy, ".exr": export.write_exr}[ext]
+    with pytest.raises(export.NonFiniteError):
+        write(out, np.full((4, 4), np.inf, np.float32))
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_volume_writer_refuses_nan_slabs():
+    try:
+        w = export.VolumeWriter((1, 1, 1), (0, 0, 0), {"density": "float"})
+    except RuntimeError:
+        pytest.skip("no OpenVDB module")
+    slab = np.zeros((2, 3, 4), np.float32)
+    slab[0, 0, 0] = -np.inf
+    with pytest.raises(export.NonFiniteError, match="density"):
+        w.add("density", 0, slab)
+
+
+def test_a_command_whose_result_overflows_writes_nothing_and_says_so(tmp_path, capsys):
+    out = tmp_path / "t.npy"
+    assert main(["wave", "--size", "16", "--time", "1e308", "--speed", "1", "--quiet", "-o", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "not writing t.npy" in err and "NaN or infinite" in err and "internal error" not in err
+    assert not out.exists() and os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)])
+def test_sigterm_and_sighup_during_a_write_remove_the_temporary(tmp_path, monkeypatch, capsys, sig, code):
+    """The signal arrives while the output's temporary is half written: the command stops as Ctrl+C stops it,
+    exits 128 + the signal's number, and leaves no file; the handlers before it are restored."""
+    before = signal.getsignal(sig)
+    real = np.save
+
+    def save_then_signal(fh, arr, *a, **k):
+        fh.write(b"\x93NUMPY half")
+        fh.flush()
+        assert any(n.startswith(".omninoise-") for n in os.listdir(tmp_path))     # the temporary is there
+        os.kill(os.getpid(), sig)
+        real(fh, arr, *a, **k)
+
+    monkeypatch.setattr(np, "save", save_then_signal)
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "w.npy")]) == code
+    assert os.listdir(tmp_path) == []
+    assert "terminated; no partial file was left" in capsys.readouterr().err
+    assert signal.getsignal(sig) == before
+
+
+def test_sigterm_stops_a_running_command_with_143(tmp_path):
+    """A real process: SIGTERM while it computes ends it with 143 and nothing in its folder."""
+    code = "import sys; from omninoise.cli.main import main; sys.exit(main())"
+    p = subprocess.Popen([sys.executable, "-c", code, "wave", "--dim", "3", "--size", "320", "--directions", "64",
+                          "--quiet", "-o", str(tmp_path / "v.npy")], stderr=subprocess.PIPE, text=True)
+    try:
+        p.wait(timeout=3)
+        pytest.fail("the command ended before it could be stopped")
+    except subprocess.TimeoutExpired:
+        p.send_signal(signal.SIGTERM)
+    assert p.wait(timeout=120) == 143, p.stderr.read()
+    assert "terminated" in p.stderr.read() and os.listdir(tmp_path) == []
+
+
+def test_names_and_messages_are_printed_with_control_characters_escaped_and_cut(tmp_path, capsys):
+    assert shown("a\x1b]0;owned\x07b\nc") == "a\\x1b]0;owned\\x07b\\nc"
+    assert len(shown("x" * 10_000)) == 400 and shown("x" * 10_000).endswith("…")
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "evil\\u001b]0;title\\u0007"\noutput = "o.npy"\nresolution = [4, 4]\n'
+                   '[bake.source]\nkind = "wave"\n')
+    assert main(["bake", str(job), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\x07" not in out and "evil\\x1b]0;title\\x07" in out
