@@ -5,10 +5,13 @@ reports a one-line error (exit status 2) instead of a traceback, a hang or a
 crash in a compiled kernel (NaN or infinite time would reach the numba row
 kernel and end the process with a segmentation fault).
 
-Limits (documented in the README, "Limits"):
+Limits (each front end names the setting when a value passes one):
 
 MAX_DIRECTIONS     wave directions K (a table per direction; 4096 is far past visible benefit)
 MAX_TABLE_SIZE     samples per wave table
+MAX_FRAMES         frames one bake or animation writes
+MAX_THREADS        CPU threads a command may ask for
+MAX_REFINE         search steps refining a solid texture's code (each renders two planes)
 MEMORY_LIMIT       bytes one request may allocate for its result, OMNINOISE_MEMORY_LIMIT overrides
 """
 from __future__ import annotations
@@ -18,11 +21,14 @@ import os
 
 from .errors import SettingError
 
-__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "memory_limit", "finite", "positive", "in_range", "check_int",
+__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "memory_limit", "finite", "positive", "in_range", "check_int",
            "check_memory", "as_bool"]
 
 MAX_DIRECTIONS = 4096
 MAX_TABLE_SIZE = 1 << 20
+MAX_FRAMES = 100_000
+MAX_THREADS = 1024
+MAX_REFINE = 10_000
 _DEFAULT_MEMORY = 16 << 30
 
 

@@ -217,8 +217,9 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     first, last = a.frames
     if last < first:
         raise SettingError("--frames", f"expected FIRST LAST with LAST >= FIRST, got {first} {last}")
-    if last - first >= 100_000:
-        raise SettingError("--frames", f"{last - first + 1} frames is more than the 100000 one run may write")
+    if last - first >= limits.MAX_FRAMES:
+        raise SettingError("--frames", f"{last - first + 1} frames is more than the {limits.MAX_FRAMES} one run may "
+                                       "write")
     limits.finite("--drift", a.drift)
     folder = os.path.dirname(os.path.abspath(a.out))
     if not os.path.isdir(folder):

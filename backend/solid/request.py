@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SettingError
+from ..limits import MAX_REFINE
 from ..paths import solid_models
 from .gaussian_rest import REST_CHOICES
 
@@ -40,7 +41,7 @@ METHODS = ("neural", "synthesis", "spectral")
 #: the methods that draw from an image exemplar alone, without a model
 IMAGE_METHODS = ("synthesis", "spectral")
 
-MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the lattice hash, backend/solid/value_noise.py)
+MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the value noise hash, backend/solid/value_noise.py)
 
 
 def _pixels_sha(x: np.ndarray) -> str:
@@ -90,8 +91,9 @@ class SolidRequest:
 
         if not isinstance(self.mix, (int, float)) or not np.isfinite(self.mix) or not 0.0 <= self.mix <= 1.0:
             raise bad("mix", f"must be in [0, 1], got {self.mix}")
-        if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) or self.refine < 0:
-            raise bad("refine", f"must be a whole number >= 0, got {self.refine}")
+        if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) \
+                or not 0 <= self.refine <= MAX_REFINE:
+            raise bad("refine", f"must be a whole number in [0, {MAX_REFINE}], got {self.refine}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
             raise bad("seed", f"must be a whole number in [0, {MAX_SEED}], got {self.seed}")
         if not isinstance(self.periodic, (bool, np.bool_)):

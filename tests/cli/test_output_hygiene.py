@@ -122,3 +122,17 @@ def test_names_and_messages_are_printed_with_control_characters_escaped_and_cut(
     assert main(["bake", str(job), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\x07" not in out and "evil\\x1b]0;title\\x07" in out
+
+
+def test_counts_are_capped_before_any_work(tmp_path, capsys):
+    """A job's frames, --threads and --refine have caps: past them, one line naming the setting and exit 2."""
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "long"\noutput = "f_#.npy"\nresolution = [4, 4]\nframes = [1, 30000000]\n'
+                   '[bake.source]\nkind = "wave"\nspeed = 1.0\n')
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    assert "30000000 frames is more than the 100000 one bake may write" in capsys.readouterr().out
+    assert main(["neural", "--noise", "perlin", "--threads", "100000", "-o", str(tmp_path / "n.png")]) == 2
+    assert "--threads: must lie in [0, 1024]" in capsys.readouterr().err
+    assert main(["solid", "--exemplar", "grass", "--refine", "1000000000", "-o", str(tmp_path / "s.png")]) == 2
+    assert "--refine: must be a whole number in [0, 10000]" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == ["job.toml"]
