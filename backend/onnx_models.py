@@ -39,8 +39,12 @@ def load_model_json(folder: str, json_name: str) -> dict:
     path = os.path.join(folder, json_name)
     if not os.path.isfile(path):
         raise ModelError(f"no {json_name} in {folder}")
-    with open(path, encoding="utf-8") as fh:
-        doc = json.load(fh)
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except (OSError, ValueError, RecursionError) as exc:    # unreadable, not UTF-8, not JSON, nested too deep
+        raise ModelError(f"{path} is not a readable model description ({type(exc).__name__}); re-install or "
+                         "re-export the model") from None
     files = doc.get("files") if isinstance(doc, dict) else None
     if not isinstance(files, dict) or not files:
         raise ModelError(f"{path} lists no files with their sha256 ('files'): the model cannot be verified")

@@ -152,6 +152,13 @@ def spectral_gains(img: np.ndarray, octaves: int = 8, px_per_unit: float = 128.0
 
 class SolidTextureModel:
     def __init__(self, folder: str, threads: int = 0):
+        try:
+            self._load(folder, threads)
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:     # a field missing or of the wrong kind
+            raise ModelError(f"{os.path.join(folder, 'solid.json')} is damaged ({type(exc).__name__}: "
+                             f"{str(exc)[:120]}); re-install or re-export the model") from None
+
+    def _load(self, folder: str, threads: int) -> None:
         self.config = load_model_json(folder, "solid.json")
         if self.config.get("model") != "neural_solid_texture":
             raise ModelError(f"{os.path.join(folder, 'solid.json')} is not a neural solid texture model")

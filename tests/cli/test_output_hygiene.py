@@ -136,3 +136,31 @@ def test_counts_are_capped_before_any_work(tmp_path, capsys):
     assert main(["solid", "--exemplar", "grass", "--refine", "1000000000", "-o", str(tmp_path / "s.png")]) == 2
     assert "--refine: must be a whole number in [0, 10000]" in capsys.readouterr().err
     assert os.listdir(tmp_path) == ["job.toml"]
+
+
+@pytest.mark.parametrize("damage", ['{"files": {"decoder.onnx": "0"}, "dim": ', b'\xff\xfe not text',
+                                    "[" * 100_000, '{"model": "neural_solid_texture", "files": {}, "dim": "x"}'])
+def test_a_damaged_model_folder_is_left_out_and_the_others_listed(tmp_path, monkeypatch, capsys, damage):
+    import json
+    import shutil
+
+    from omninoise.backend.paths import solid_models
+
+    root = tmp_path / "models"
+    shutil.copytree(os.path.join(solid_models(), "gravel_3d"), root / "solid" / "gravel_3d")
+    (root / "solid" / "broken").mkdir()
+    (root / "solid" / "broken" / "solid.json").write_bytes(damage if isinstance(damage, bytes) else damage.encode())
+    if "dim" in str(damage) and "files" in str(damage) and '"x"' in str(damage):    # hashes fine, a field wrong
+        doc = json.loads(damage)
+        src = root / "solid" / "gravel_3d"
+        doc["files"] = json.loads((src / "solid.json").read_text())["files"]
+        for name in doc["files"]:
+            shutil.copy(src / name, root / "solid" / "broken" / name)
+        (root / "solid" / "broken" / "solid.json").write_text(json.dumps(doc))
+    monkeypatch.setenv("OMNINOISE_MODELS", str(root))
+    assert main(["solid", "--list"]) == 0
+    assert list(json.loads(capsys.readouterr().out)) == ["gravel_3d"]
+    assert main(["solid", "--model", str(root / "solid" / "broken"), "--exemplar", "x", "-o",
+                 str(tmp_path / "s.png")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "broken" in err[0] and "internal error" not in err[0]
