@@ -31,7 +31,8 @@ import numpy as np
 
 from omninoise.export.atomic import atomic_path, write_json
 from omninoise.export.images import read_rgb
-from omninoise.backend.solid.model import SHIPPED_MODELS, SolidTextureModel, load_models
+from omninoise.backend.paths import solid_models
+from omninoise.backend.solid.model import SolidTextureModel, load_models
 from omninoise.backend.solid.pipeline import photo_code
 from omninoise.training.solid import photo_eval as pe
 from omninoise.training.solid.morphology import morphology_distance
@@ -142,7 +143,7 @@ def summary(rows: dict) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--models", default=SHIPPED_MODELS, help="folder of solid models (default: the shipped ones)")
+    ap.add_argument("--models", default=solid_models(), help="folder of solid models (default: the shipped ones)")
     ap.add_argument("--space", default=None, help="space model folder (default: the models folder's 'space')")
     ap.add_argument("--prev", default=None, help="folder of the previous models of the same names")
     ap.add_argument("--only", default="", help="comma-separated model names")

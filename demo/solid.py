@@ -30,11 +30,12 @@ import bpy  # noqa: E402
 
 from omninoise import blender_addon  # noqa: E402
 from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
-from omninoise.backend.solid.model import SHIPPED_MODELS, load_models, plane_points  # noqa: E402
+from omninoise.backend.paths import solid_models  # noqa: E402
+from omninoise.backend.solid.model import load_models, plane_points  # noqa: E402
 from omninoise.export.atomic import write_json  # noqa: E402
 from omninoise.export.images import preview_8bit, read_rgb, write_png  # noqa: E402
 
-MODELS = SHIPPED_MODELS
+MODELS = solid_models()
 EXEMPLARS = os.path.join(ROOT, "data", "exemplars")
 #: a held-out colour photo (never trained on) that the texture-space model encodes for Suzanne
 PHOTO = os.path.join(ROOT, "data", "photos", "val", "soil__farmland_a.jpg")

@@ -21,7 +21,7 @@ sys.path.insert(0, ROOT)
 
 import bpy  # noqa: E402
 
-from omninoise.backend.solid.model import SHIPPED_MODELS  # noqa: E402
+from omninoise.backend.paths import solid_models  # noqa: E402
 from omninoise.export.atomic import write_json  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -41,7 +41,7 @@ def _cube(x: float, y: float):
 def build_scene(out: str) -> dict:
     sc = cycles_scene(900, 500)
     p = sc.omninoise_solid
-    space = os.path.isfile(os.path.join(SHIPPED_MODELS, "space", "solid.json"))
+    space = os.path.isfile(os.path.join(solid_models(), "space", "solid.json"))
     used = {}
     for i, photo in enumerate(PHOTOS):
         x = SPACING * (i - (len(PHOTOS) - 1) / 2)

@@ -36,14 +36,12 @@ from .spin import check_mode, spun
 from .gaussian_rest import GaussianRest, rest_field, rest_from_json
 from .waves import wave_features
 
-__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "SHIPPED_MODELS", "load_models", "plane_points", "slice_points", "rgb_pixels"]
+__all__ = ["SolidTextureModel", "TextureCode", "exemplar_category", "resize_rgb", "colour_stats", "spectral_gains", "DEFAULT_CHUNK", "load_models", "plane_points", "slice_points", "rgb_pixels"]
 
 _F = np.float32
 DEFAULT_CHUNK = 1 << 16   #: points per decoder call (about 40 MiB of activations)
 ENCODE_SIDE = 8           #: the encoder reads at most this many crops along each side of a photo ...
 ENCODE_BATCH = 16         #: ... this many at a time (a 4096 px photo: 64 crops, not 3969 in one 13 GB batch)
-#: the models the extension ships (``models/solid`` beside ``backend``)
-SHIPPED_MODELS = solid_models()
 
 
 def plane_points(size: int, px_per_unit: float) -> np.ndarray:
@@ -63,9 +61,11 @@ def slice_points(size: int, px_per_unit: float, axis: str, offset=(0.0, 0.0, 0.0
     return pts + np.asarray(offset, np.float64)
 
 
-def load_models(root: str = SHIPPED_MODELS, threads: int = 0, cache: dict | None = None) -> dict:
-    """{folder name: model} of every loadable model folder under ``root`` (incomplete or altered folders
-    are left out), sorted by name.  ``cache`` (path -> model or ModelError) avoids re-reading folders."""
+def load_models(root: str | None = None, threads: int = 0, cache: dict | None = None) -> dict:
+    """{folder name: model} of every loadable model folder under ``root`` (default: the shipped models,
+    ``backend.paths.solid_models``; incomplete, altered or damaged folders are left out), sorted by name.  ``cache``
+    (path -> model or ModelError) avoids re-reading folders."""
+    root = root or solid_models()
     out = {}
     for name in sorted(os.listdir(root)) if os.path.isdir(root) else []:
         path = os.path.join(root, name)

@@ -69,7 +69,7 @@ def test_the_model_is_chosen_as_the_command_line_always_did():
 
 @pytest.mark.parametrize("flags, table, field, why", [
     (["--mix", "1.5", "--to", "grass"], {"mix": 1.5, "to": "grass"}, "mix", "must be in [0, 1]"),
-    (["--refine", "-1"], {"refine": -1}, "refine", "whole number >= 0"),
+    (["--refine", "-1"], {"refine": -1}, "refine", "whole number in [0, 10000]"),
     (["--seed", "-3"], {"seed": -3}, "seed", "whole number in [0, 4294967295]"),
     (["--seed", str(2 ** 32)], {"seed": 2 ** 32}, "seed", "whole number in [0, 4294967295]"),
 ])

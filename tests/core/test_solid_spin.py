@@ -75,11 +75,12 @@ def test_turned_octaves_draw_the_field_turned():
 def test_bake_keys_know_the_spin():
     """A model's spin is part of what it draws: the shipped space model turns its octaves, and a bake's key says so
     (the same weights unturned would draw another texture)."""
-    from omninoise.backend.solid.model import SolidTextureModel, SHIPPED_MODELS
+    from omninoise.backend.paths import solid_models
+    from omninoise.backend.solid.model import SolidTextureModel
     from omninoise.backend.sources import SolidSource
     import os
 
-    space = SolidTextureModel(os.path.join(SHIPPED_MODELS, "space"))
+    space = SolidTextureModel(os.path.join(solid_models(), "space"))
     assert space.spin == "octave"
     code = space.code("sand", gaussian=False)       # the decoder's texture (sand's rest would replace it all)
     turned = SolidSource(space, code=code).to_dict()
