@@ -100,9 +100,50 @@ class VolumeWriter:
             self.vdb.write(tmp, grids=grids, metadata=self.metadata)
 
 
+#: bounds of read_vdb_metadata: the bytes it reads at most, entries, and one entry's name or value
+METADATA_BYTES, METADATA_ENTRIES, METADATA_FIELD = 1 << 20, 1024, 1 << 16
+_VDB_MAGIC = 0x56444220
+
+
 def read_vdb_metadata(path: str) -> dict:
-    """File-level metadata of a .vdb (cheap: no voxels are read)."""
-    return dict(openvdb_module().readMetadata(path))
+    """The string entries of a .vdb file's own metadata (the bake's key among them), read from the file's header
+    with bounds on time and memory (at most METADATA_BYTES, no voxels, no OpenVDB module needed): {} for a file that
+    is not a VDB of format 222 or later, or is damaged (a bake then treats it as out of date).
+
+    The header (OpenVDB's io/File.cc, format 222+): int64 magic, uint32 format version, uint32 x 2 library
+    version, uint8 has-grid-offsets, 36 ASCII bytes of UUID, then uint32 count of metadata entries, each a
+    uint32-length-prefixed name, type name and value."""
+    import struct
+
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(METADATA_BYTES)
+    except OSError:
+        return {}
+    try:
+        magic, version = struct.unpack_from("<qI", data, 0)
+        if magic != _VDB_MAGIC or version < 222:
+            return {}
+        pos = 8 + 4 + 8 + 1 + 36
+        (count,) = struct.unpack_from("<I", data, pos)
+        pos += 4
+        if count > METADATA_ENTRIES:
+            return {}
+        out = {}
+        for _ in range(count):
+            fields = []
+            for _ in range(3):
+                (n,) = struct.unpack_from("<I", data, pos)
+                if n > METADATA_FIELD or pos + 4 + n > len(data):
+                    return {}
+                fields.append(data[pos + 4:pos + 4 + n])
+                pos += 4 + n
+            name, kind, value = fields
+            if kind == b"string":
+                out[name.decode("utf-8", "replace")] = value.decode("utf-8", "replace")
+        return out
+    except struct.error:
+        return {}
 
 
 def read_volume(path: str, name: str, shape: tuple) -> np.ndarray:

@@ -164,3 +164,37 @@ def test_a_damaged_model_folder_is_left_out_and_the_others_listed(tmp_path, monk
                  str(tmp_path / "s.png")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "broken" in err[0] and "internal error" not in err[0]
+
+
+def test_a_damaged_earlier_volume_is_out_of_date_and_read_within_bounds(tmp_path, capsys):
+    """An earlier .vdb at a job's output whose header lies (counts, lengths), is cut short or is noise: its
+    metadata reads as {} at once (bounded bytes, no OpenVDB), so the bake is 'to bake', not a hang."""
+    import struct
+    import time
+
+    from omninoise.export.vdb import read_vdb_metadata
+
+    head = struct.pack("<qIIIB", 0x56444220, 224, 12, 0, 1) + b"0" * 36
+    entry = b"".join(struct.pack("<I", len(x)) + x for x in (b"omninoise_key", b"string", b"abc"))
+    good = head + struct.pack("<I", 1) + entry
+    assert read_vdb_metadata_bytes(tmp_path, good) == {"omninoise_key": "abc"}
+    for bad in (head + struct.pack("<I", 2 ** 31), head + struct.pack("<I", 1) + struct.pack("<I", 2 ** 31),
+                good[:-2], np.random.default_rng(0).bytes(4096), b""):
+        t = time.perf_counter()
+        assert read_vdb_metadata_bytes(tmp_path, bad) == {}
+        assert time.perf_counter() - t < 1.0
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "v"\noutput = "v.vdb"\nresolution = [4, 4, 4]\n[bake.source]\nkind = "wave"\n'
+                   'dim = 3\n')
+    (tmp_path / "v.vdb").write_bytes(head + struct.pack("<I", 2 ** 31))
+    assert main(["bake", str(job), "--dry-run"]) == 0
+    assert "to bake" in capsys.readouterr().out
+    assert read_vdb_metadata(str(tmp_path / "missing.vdb")) == {}
+
+
+def read_vdb_metadata_bytes(folder, data: bytes) -> dict:
+    from omninoise.export.vdb import read_vdb_metadata
+
+    p = folder / "x.vdb"
+    p.write_bytes(data)
+    return read_vdb_metadata(str(p))
