@@ -124,7 +124,7 @@ import tomllib
 from dataclasses import dataclass
 from typing import Callable
 
-from .bake import BakeResult, BakeSpec, Cancelled, run_bake
+from .bake import BakeResult, BakeSpec, Cancelled, frame_path, run_bake
 from . import limits
 from .errors import SettingError
 from .sources import BoxGrid, source_from_dict
@@ -247,13 +247,15 @@ def parse_job(doc: dict, base_dir: str) -> list:
             out.append((name, JobError(f"bake {name!r}: output {spec.output} lies outside the output root {root}; "
                                        "set output_root at the top of the job file to allow that folder")))
             continue
-        # two bakes writing one file (or one numbered sequence) would overwrite each other
-        key = os.path.normcase(os.path.abspath(spec.output))
-        if key in outputs:
-            out.append((name, JobError(f"bake {name!r}: output {spec.output} is also written by bake "
-                                       f"{outputs[key]!r}")))
+        # two bakes writing one file would overwrite each other: every file each writes (a sequence's frames
+        # included), compared where they land (links and '..' resolved)
+        files = [os.path.normcase(os.path.realpath(frame_path(spec.output, f))) for f in spec.frame_list()]
+        clash = next((f for f in files if f in outputs), None)
+        if clash is not None:
+            out.append((name, JobError(f"bake {name!r}: output {os.path.basename(clash)} is also written by bake "
+                                       f"{outputs[clash]!r}")))
             continue
-        outputs[key] = name
+        outputs.update(dict.fromkeys(files, name))
         out.append((name, spec))
     return out
 

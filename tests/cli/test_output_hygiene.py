@@ -198,3 +198,22 @@ def read_vdb_metadata_bytes(folder, data: bytes) -> dict:
     p = folder / "x.vdb"
     p.write_bytes(data)
     return read_vdb_metadata(str(p))
+
+
+def test_two_bakes_writing_one_file_are_refused_through_links_and_overlapping_frames(tmp_path, capsys):
+    """The same file reached through a symlinked folder, or two frame patterns that share frames, are found
+    before anything runs."""
+    (tmp_path / "out").mkdir()
+    os.symlink(tmp_path / "out", tmp_path / "alias")
+    wave = '[bake.source]\nkind = "wave"\nspeed = 1.0\n'
+    job = tmp_path / "job.toml"
+    job.write_text(f'[[bake]]\nname = "a"\noutput = "out/a.npy"\nresolution = [4, 4]\n{wave}'
+                   f'[[bake]]\nname = "b"\noutput = "alias/a.npy"\nresolution = [4, 4]\n{wave}'
+                   f'[[bake]]\nname = "c"\noutput = "out/f_#.npy"\nresolution = [4, 4]\nframes = [1, 12]\n{wave}'
+                   f'[[bake]]\nname = "d"\noutput = "out/f_##.npy"\nresolution = [4, 4]\nframes = [10, 12]\n{wave}'
+                   f'[[bake]]\nname = "e"\noutput = "out/f_##.npy"\nresolution = [4, 4]\nframes = [13, 14]\n{wave}')
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    out = capsys.readouterr().out
+    assert "bake 'b': output a.npy is also written by bake 'a'" in out
+    assert "bake 'd': output f_10.npy is also written by bake 'c'" in out
+    assert "invalid" not in [ln for ln in out.splitlines() if " e:" in ln][0]
