@@ -98,7 +98,10 @@ def _painted_parts(a: argparse.Namespace) -> tuple:
         key, sep, spec = r.partition("=")
         if not sep:
             raise SettingError("--region", f"expected KEY=SPEC, got {r!r}")
-        keys.append(region_key(key, "--region"))
+        k = region_key(key, "--region")
+        if k in keys:
+            raise SettingError("--region", f"{key!r} is given twice; give each colour or index one spec")
+        keys.append(k)
         specs.append(_spec_arg(spec, "--region"))
     return regions_from_map(px, keys, "--map"), specs
 

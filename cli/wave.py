@@ -21,6 +21,8 @@ from .common import Bar, add_command
 
 __all__ = ["add_parser", "run", "settings_from_args"]
 
+FLAGS: set = set()      #: the subcommand's option strings (a backend setting's error is named by its flag)
+
 
 def spectrum_arg(text: str) -> Spectrum:
     """'kind:fmin:fmax[:exponent]' -> Spectrum."""
@@ -103,6 +105,7 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
     g.add_argument("--slice-width", type=float, help="width of a direction's slices in units (default: from the band)")
     g.add_argument("--table-size", type=int, default=1024, help="samples per wave table")
     g.add_argument("--period", type=float, help="table period in units (default: 255 / fmax)")
+    FLAGS.update(o for action in w._actions for o in action.option_strings)
     return w
 
 
@@ -144,13 +147,18 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
         used["example_extent"] = a.example_extent or a.extent
     if a.transition is not None:
         used["transition_length"] = a.transition_length or a.extent
-    return WaveSettings(
+    s = WaveSettings(
         dim=a.dim, spectrum=Spectrum(a.spectrum, a.fmin, a.fmax, a.exponent), directions=a.directions,
         seed=a.seed, output=a.output, speed=a.speed, slice_width=a.slice_width, waveform=a.waveform,
         profile=profile, cellular=a.cellular, cell_size=a.cell_size, stit_probability=a.stit_probability,
         stit_depth=a.stit_depth, anisotropy=a.anisotropy, axis_spectra=tuple(a.axis_spectrum),
         lobes=tuple(a.lobe), spread=a.spread, example=example, example_plane=a.example_plane, sectors=a.sectors,
         transition_to=a.transition, table_size=a.table_size, table_period=a.period, **used)
+    try:
+        return s.validate()
+    except SettingError as exc:     # named as the flag the user typed, where there is one
+        flag = "--" + exc.setting.replace(" ", "-").replace("_", "-")
+        raise SettingError(flag if flag in FLAGS else exc.setting, exc.message) from None
 
 
 def run(a: argparse.Namespace) -> int:

@@ -37,6 +37,8 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("zoo", "give --noise CLASS and -o OUT (or --list)")
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
+    if not 0 <= a.seed < 2 ** 32:
+        raise SettingError("--seed", f"must lie in [0, 2^32), got {a.seed}")
     if os.path.splitext(a.out)[1].lower() not in (".png", ".exr", ".npy"):
         raise SettingError("-o", f"unsupported output type {os.path.splitext(a.out)[1] or a.out!r}; use .png, .exr or .npy")
     limits.check_memory("--size", float(a.size) ** 2 * 4 * 8, f"a {a.size}² zoo image")

@@ -46,6 +46,10 @@ class Spectrum:
             raise SettingError("spectrum", f"unknown kind {self.kind!r}; choose one of {', '.join(SPECTRUM_KINDS)}")
         if not (np.isfinite(self.fmin) and np.isfinite(self.fmax)):
             raise SettingError("fmin/fmax", "must be finite numbers")
+        if not np.isfinite(self.exponent):
+            raise SettingError("exponent", f"must be a finite number, got {self.exponent}")
+        if self.kind == "twolevel" and not np.isfinite(self.ratio):
+            raise SettingError("ratio", f"must be a finite number, got {self.ratio}")
         if self.fmax <= 0:
             raise SettingError("fmax", f"must be positive, got {self.fmax:g}")
         if self.fmin < 0:

@@ -21,9 +21,9 @@ from test_jobs import JOB, RAMP
     (["--period", "0"], "--period"),
     (["--size", "100000000"], "--size"),                     # was MemoryError
     (["--table-size", "1000000000"], "--table-size"),
-    (["--slice-width", "-1"], "slice width"),
-    (["--stit-probability", "2"], "stit probability"),
-    (["--spread", "nan"], "spread"),
+    (["--slice-width", "-1"], "--slice-width"),
+    (["--stit-probability", "2"], "--stit-probability"),
+    (["--spread", "nan"], "--spread"),
 ])
 def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
     out = tmp_path / "x.npy"

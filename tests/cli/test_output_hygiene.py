@@ -217,3 +217,21 @@ def test_two_bakes_writing_one_file_are_refused_through_links_and_overlapping_fr
     assert "bake 'b': output a.npy is also written by bake 'a'" in out
     assert "bake 'd': output f_10.npy is also written by bake 'c'" in out
     assert "invalid" not in [ln for ln in out.splitlines() if " e:" in ln][0]
+
+
+@pytest.mark.parametrize("args, flag", [
+    (["wave", "--seed", "-1", "--size", "8", "-o", "{d}/a.npy"], "--seed: must be a whole number in [0, 2^32)"),
+    (["wave", "--spectrum", "fractal", "--exponent", "nan", "--size", "8", "-o", "{d}/a.npy"],
+     "--exponent: must be a finite number"),
+    (["zoo", "--noise", "perlin", "--seed", "-1", "--size", "8", "-o", "{d}/z.png"], "--seed: must lie in [0, 2^32)"),
+    (["neural", "--map", "{d}/m.png", "--region", "0=perlin", "--region", "0=spots", "--size", "8", "-o",
+      "{d}/n.png"], "--region: '0' is given twice"),
+])
+def test_bad_values_are_named_by_their_flag_before_any_work(tmp_path, capsys, args, flag):
+    from omninoise.export.images import write_png
+
+    write_png(str(tmp_path / "m.png"), np.zeros((8, 8), np.uint8))
+    assert main([x.format(d=tmp_path) for x in args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and flag in err[0], err
+    assert sorted(os.listdir(tmp_path)) == ["m.png"]
