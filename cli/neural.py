@@ -191,7 +191,11 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
     req = neural_request(a, model)
     bar = Bar(a.quiet)
-    img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
+    try:
+        img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
+    except SettingError as exc:     # the generator's checks (tiles, sizes), named as the flags the user typed
+        flag = {"tile": "--tile", "size": "--size"}.get(exc.setting, exc.setting)
+        raise SettingError(flag, exc.message) from None
     from omninoise.export.images import write_unit_image
 
     write_unit_image(a.out, img)
@@ -254,6 +258,9 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
         raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
     if not a.out:
         raise SettingError("-o", "--fit writes the fitted noise: give -o OUT (.png, .exr or .npy)")
+    for flag, path in (("-o", a.out), ("--report", a.report)):
+        if path and not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+            raise SettingError(flag, f"output folder does not exist: {os.path.dirname(os.path.abspath(path))}")
     ext = os.path.splitext(a.out)[1].lower()
     if ext not in (".png", ".exr", ".npy"):
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")

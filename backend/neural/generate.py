@@ -105,9 +105,11 @@ def generate(model, cond: np.ndarray, seed: int = 0, steps: int = DEFAULT_STEPS,
         cond = np.pad(cond, ((0, 0), (0, Hp - H), (0, Wp - W)), mode="edge")
     if tile is None:
         tile = auto_tile(Hp, Wp)
-    if tile and (tile % k or tile < 4 * k or not 0 <= overlap <= tile // 2 or overlap % k):
-        raise SettingError("tile", f"tile must be a multiple of {k} of at least {4 * k} px and overlap a multiple of "
-                           f"{k} of at most half the tile; got tile {tile}, overlap {overlap}")
+    if tile and (tile % k or tile < 4 * k):
+        raise SettingError("tile", f"must be 0 (never tile) or a multiple of {k} of at least {4 * k} px, got {tile}")
+    if tile and (not 0 <= overlap <= tile // 2 or overlap % k):
+        raise SettingError("tile", f"{tile} px tiles are too small for their {overlap} px overlap (at most half a "
+                                   f"tile): use tiles of at least {max(4 * k, 2 * overlap)} px")
     kw = dict(eta=eta, rng=step_noise_rng(seed)) if eta else {}
     eps, _, _ = image_eps(model, cond[None], tileable, tile, overlap)
     if x_T is None:

@@ -235,3 +235,18 @@ def test_bad_values_are_named_by_their_flag_before_any_work(tmp_path, capsys, ar
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and flag in err[0], err
     assert sorted(os.listdir(tmp_path)) == ["m.png"]
+
+
+def test_neural_tiles_and_a_fits_report_folder_are_checked_before_any_work(tmp_path, capsys):
+    assert main(["neural", "--noise", "perlin", "--tile", "32", "--size", "64", "--steps", "1", "--quiet", "-o",
+                 str(tmp_path / "n.png")]) == 2
+    err = capsys.readouterr().err
+    assert "--tile: 32 px tiles are too small for their 64 px overlap" in err and "use tiles of at least 128 px" in err
+    img = tmp_path / "photo.png"
+    from omninoise.export.images import write_png
+
+    write_png(str(img), (np.random.default_rng(0).random((64, 64)) * 255).astype(np.uint8))
+    assert main(["neural", "--fit", str(img), "--report", str(tmp_path / "nodir" / "r.json"), "--quiet", "-o",
+                 str(tmp_path / "f.png")]) == 2
+    assert "--report: output folder does not exist" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["photo.png"]
