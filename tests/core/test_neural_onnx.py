@@ -53,7 +53,7 @@ def test_tiled_generation(tiny):
     inner_x, inner_y = np.abs(np.diff(wrap, axis=1)).mean(), np.abs(np.diff(wrap, axis=0)).mean()
     assert np.abs(wrap[:, 0] - wrap[:, -1]).mean() < 1.5 * inner_x
     assert np.abs(wrap[0] - wrap[-1]).mean() < 1.5 * inner_y
-    for tile, overlap, msg in ((60, 8, "multiple of 8"), (16, 0, "at least 32"), (64, 40, "half the tile")):
+    for tile, overlap, msg in ((60, 8, "multiple of 8"), (16, 0, "at least 32"), (64, 40, "too small for their 40 px overlap")):
         with pytest.raises(SettingError, match=msg):
             generate(model, cond, steps=2, tile=tile, overlap=overlap)
 
@@ -183,7 +183,7 @@ def test_neural_cli(tiny, tmp_path, capsys):
         assert main(base + ["--noise", "spots", "--size", "24", "-o", npy] + extra) == 0
         np.testing.assert_array_equal(np.load(npy), generate(model, cond, seed=0, steps=3, **kw))
     for extra, msg in ((["--sampler", "euler"], "unknown sampler 'euler'"), (["--steps", "0"], "steps: must be"),
-                       (["--threads", "-1"], "--threads: must be >= 0"), (["--tile", "20"], "multiple of 8"),
+                       (["--threads", "-1"], "--threads: must lie in [0, 1024]"), (["--tile", "20"], "multiple of 8"),
                        (["--eta", "2"], "eta: must lie in [0, 1]"), (["--spacing", "odd"], "unknown spacing")):
         assert main(base + ["--noise", "spots", "--size", "24", "-o", npy] + extra) == 2
         err = capsys.readouterr().err
