@@ -173,7 +173,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     size = _check_size(size)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
-    limits.positive("scale", scale)
+    limits.scale("scale", scale)
     limits.check_memory("size", float(size) ** dim * 4 * 4, f"a {size}-sample {dim}D texture")
     if out is not None and _check_out(out, (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy"),
                                       f"a {dim}D texture") == ".vdb":

@@ -340,7 +340,7 @@ class SolidSource:
             self.model = model if isinstance(model, SolidTextureModel) else SolidTextureModel(model)
         except ModelError as exc:
             raise SettingError("source.model", str(exc)) from None
-        self.scale = limits.positive("source.scale", scale)
+        self.scale = limits.scale("source.scale", scale)
         self.density = limits.in_range("source.density", density, 0.0, float("inf"))
         self.request = (SolidRequest() if request is None else request).check("source.")
         self.dim, self.seed = self.model.dim, int(self.request.seed)
@@ -399,7 +399,7 @@ class SynthesisSource:
         ready :class:`~backend.solid.synthesis.TileField` (else synthesised here, with progress and cancel)."""
         import dataclasses
 
-        self.request, self.scale = request, limits.positive("source.scale", scale)
+        self.request, self.scale = request, limits.scale("source.scale", scale)
         # a file is decoded once: its pixels serve the synthesis and the key's sha256 (equal to the key's of the
         # same pixels handed over)
         pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
@@ -453,7 +453,7 @@ class SpectralSource:
         :class:`~backend.solid.spectral_solid.SplineField` (else drawn here, with progress and cancel)."""
         import dataclasses
 
-        self.request, self.scale = request, limits.positive("source.scale", scale)
+        self.request, self.scale = request, limits.scale("source.scale", scale)
         self.density = float(limits.in_range("source.density", density, 0.0, float("inf")))
         pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
         self.field = field if field is not None else pixels.spectral_field("source.", progress, cancel)

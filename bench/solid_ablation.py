@@ -92,13 +92,15 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=os.path.join(ROOT, "models", "solid", "space"))
     ap.add_argument("--split", default="val")
+    ap.add_argument("--folder", help="every image in this folder instead of a split (a texture library's tiles)")
     ap.add_argument("--limit", type=int, default=0, help="every k-th photo, about this many")
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--only", nargs="+", metavar="VARIANT", choices=tuple(VARIANTS), help="these variants alone")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_ablation.json"))
     a = ap.parse_args(argv)
     model = SolidTextureModel(a.model)
-    files = photos(a.split)
+    files = photos(a.split) if not a.folder else sorted(
+        os.path.join(a.folder, n) for n in os.listdir(a.folder) if n.lower().endswith((".jpg", ".jpeg", ".png")))
     if a.limit:
         files = files[::max(1, len(files) // a.limit)][:a.limit]
     variants = {k: v for k, v in VARIANTS.items() if not a.only or k in a.only}
@@ -125,7 +127,9 @@ def main(argv=None) -> int:
             t[f"farther_{key}"] = int(np.sum(with_ > without * 1.02))
         table[v] = t
         print(v, t, flush=True)
-    write_json(a.out, dict(stamp=stamp(), model=os.path.relpath(a.model, ROOT), split=a.split, photos=len(rows),
+    write_json(a.out, dict(stamp=stamp(), model=os.path.relpath(a.model, ROOT),
+                           split=f"folder {os.path.basename(os.path.normpath(a.folder))}" if a.folder else a.split,
+                           photos=len(rows),
                            seeds=a.seeds, seconds=round(time.time() - t0), table=table, rows=rows))
     print("wrote", a.out)
     return 0

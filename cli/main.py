@@ -11,6 +11,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 
 from omninoise.backend.errors import SettingError
 from omninoise.export.images import ImageError
@@ -100,7 +101,9 @@ def _run(a: argparse.Namespace) -> int:
         print(f"omninoise {a.command}: {shown(what)}", file=sys.stderr)
 
     try:
-        return COMMANDS[a.command].run(a)
+        with warnings.catch_warnings():     # numpy's overflow notes: a result they spoil is refused when written
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return COMMANDS[a.command].run(a)
     except (SettingError, FileNotFoundError, PermissionError, IsADirectoryError, ImageError) as exc:
         say(f"error: {exc}")
         return 2

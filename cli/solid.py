@@ -82,7 +82,7 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
-    limits.positive("--scale", a.scale)
+    limits.scale("--scale", a.scale)
     limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     ext = os.path.splitext(a.out)[1].lower()
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")

@@ -82,7 +82,7 @@ class WaveSettings:
 
     def validate(self) -> "WaveSettings":
         if self.dim not in (2, 3, 4):
-            raise SettingError("dim", f"must be 2, 3 or 4, got {self.dim}")
+            raise SettingError("dim", f"must be the number 2, 3 or 4, got {self.dim!r}")
         if not 1 <= int(self.directions) <= limits.MAX_DIRECTIONS:
             raise SettingError("directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {self.directions}")
         limits.finite("speed", self.speed)

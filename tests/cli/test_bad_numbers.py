@@ -162,7 +162,7 @@ def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp
     ('exemplar = "gravel"\nscale = inf', "source.scale: must be a finite number"),  # was baked
     ('exemplar = "gravel"\ndensity = -1', r"source.density: must lie in \[0, inf\]"),
     ('method = "synthesis"\nexemplar = "ex.png"\nscale = "big"', "source.scale: expected a number"),
-    ('method = "synthesis"\nexemplar = "ex.png"\nscale = 0', "source.scale: must be positive"),
+    ('method = "synthesis"\nexemplar = "ex.png"\nscale = 0', r"source.scale: must lie in \[0.0001, 10000\]"),
 ])
 def test_bad_solid_source_numbers_are_named(tmp_path, source, match):
     from omninoise.export.images import write_png

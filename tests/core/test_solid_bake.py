@@ -88,7 +88,7 @@ seed = 4
     ({"kind": "solid", "model": "gravel_3d", "colour": 1}, "unknown solid setting"),
     ({"kind": "solid", "model": "gravel_3d", "exemplar": "x.png"}, "holds one texture"),
     ({"kind": "solid", "model": "nope"}, "no solid.json"),
-    ({"kind": "solid", "model": "gravel_3d", "scale": 0}, "source.scale: must be positive"),
+    ({"kind": "solid", "model": "gravel_3d", "scale": 0}, r"source.scale: must lie in \[0.0001, 10000\]"),
 ])
 def test_bad_sources(tmp_path, source, msg):
     with pytest.raises(SettingError, match=msg):
