@@ -87,11 +87,33 @@ def solid(doc: dict) -> list:
     return out
 
 
+def ablation(doc: dict) -> list:
+    out = [f"Each stage and reading of the solid pipeline (`backend/solid/pipeline.py`) left out in turn, on "
+           f"{doc.get('photos')} images ({doc.get('split')}), {doc.get('seeds')} seeds: the patch distance of x, y "
+           "and z slices pooled (lower is better) and of the walls (x and y slices). A photo counts as closer or "
+           "farther with the entry where the entry changes its distance by more than 2 %; lines: the code the "
+           "entry takes.", "",
+           "| left out | images changed | closer with it | farther with it | median with → without | walls: closer "
+           "/ farther | lines |", "|---|---|---|---|---|---|---|"]
+    for name, t in doc.get("table", {}).items():
+        out.append(f"| {name} | {t['changed']} | {t['closer_pooled']} | {t['farther_pooled']} | "
+                   f"{t['median_pooled']} → {t['median_pooled_without']} | {t['closer_walls']} / "
+                   f"{t['farther_walls']} | {t['lines']} |")
+    return out + [""]
+
+
 #: (JSON file, heading, renderer, the command that makes it)
 BENCHES = (
     ("wave.json", "Wave noise", wave, "python -m bench wave"),
     ("neural_speed.json", "Neural noise", neural, "python -m bench neural --sizes 256 512 1024"),
     ("solid_eval.json", "Solid textures", solid, "python -m bench solid --only-speed"),
+    ("solid_ablation.json", "Solid textures: what each stage is worth, held-out photos", ablation,
+     "python -m bench solid-ablation -o docs/benchmarks/solid_ablation.json"),
+    ("solid_ablation_library.json", "Solid textures: what each stage is worth, a texture library's tiles", ablation,
+     "python -m bench solid-ablation --folder TILES -o docs/benchmarks/solid_ablation_library.json"),
+    ("solid_ablation_crops.json", "Solid textures: what each reading is worth, held-out structured photos cut off their "
+     "period", ablation, "python -m bench solid-ablation --folder CROPS --only 'lattice motif' 'main lobes' "
+     "'few repeats' lines -o docs/benchmarks/solid_ablation_crops.json"),
 )
 
 
