@@ -128,12 +128,12 @@ def deproject(p2: np.ndarray, edges: np.ndarray, iterations: int = ITERATIONS, i
     return p3
 
 
-def rest_spectrum(rest: np.ndarray, px_per_unit: float):
+def rest_spectrum(residual: np.ndarray, px_per_unit: float):
     """The rest's spectrum as both solids draw it: (F complex128 (H W, 3) Fourier coefficients of its periodic
     component (Moisan 2011), scaled so that its variance is the sum of |F|^2; P float64 (H W,) their power summed
     over channels, zero below MIN_CYCLES; fx, fy float64 (H W,) cycles per unit along the photo's columns and rows;
     V the variance), or None for a flat photo."""
-    a = np.asarray(rest, np.float64)[..., :3]
+    a = np.asarray(residual, np.float64)[..., :3]
     H, W, _ = a.shape
     u = periodic_component((a - a.mean((0, 1))).transpose(2, 0, 1))
     F = np.fft.fft2(u).reshape(3, -1).T / (H * W)                 # (H W, 3): mean square = sum |F|^2
@@ -175,11 +175,11 @@ def wave_amplitudes(F, P, pick, weight, rng) -> np.ndarray:
                                                    * np.exp(2j * np.pi * rng.uniform(size=(len(pick), 1))))
 
 
-def rest_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED, spectrum=None):
-    """The isotropic Gaussian rest of a photo's rest (H, W, 3) seen at ``px_per_unit`` px per unit (module doc):
+def rest_waves(residual: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED, spectrum=None):
+    """The isotropic Gaussian rest of a photo's ``residual`` (H, W, 3; the photo less its harmonic part) seen at ``px_per_unit`` px per unit (module doc):
     (freq float64 (count, 3), amp complex128 (count, 3)) at full variance (t = 1); None for a flat photo.
     ``spectrum``: :func:`rest_spectrum` of the same rest and scale where the caller has it already."""
-    spec = rest_spectrum(rest, px_per_unit) if spectrum is None else spectrum
+    spec = rest_spectrum(residual, px_per_unit) if spectrum is None else spectrum
     if spec is None:
         return None
     F, P, fx, fy, V = spec

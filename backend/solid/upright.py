@@ -54,14 +54,14 @@ def circle_inside(a: np.ndarray, R: np.ndarray) -> np.ndarray:
     return (2.0 / np.pi) * np.arccos(np.clip(np.minimum(a, R) / R, 0.0, 1.0))
 
 
-def orientation(rest: np.ndarray) -> tuple:
-    """How strongly a photo's rest (H, W, 3) is oriented, from its power spectrum: (coherence in [0, 1], angle in
+def orientation(residual: np.ndarray) -> tuple:
+    """How strongly a photo's ``residual`` (H, W, 3) is oriented, from its power spectrum: (coherence in [0, 1], angle in
     radians of the dominant frequency direction from the photo's columns axis, counter-clockwise with rows
     pointing down).  The spectrum's structure tensor T = sum P(f) f f^T / |f|^2 (every frequency's direction
     weighted by its power, periodic component, nothing below MIN_CYCLES): coherence (l1 - l2) / (l1 + l2) of its
     eigenvalues, 0 for an isotropic texture, 1 for parallel stripes (Bigun & Granlund 1987 read gradients; the
     spectrum sees strata that gradients of a rough rock face hide)."""
-    return spectrum_orientation(rest_spectrum(rest, 1.0))
+    return spectrum_orientation(rest_spectrum(residual, 1.0))
 
 
 def spectrum_orientation(spectrum) -> tuple:
@@ -78,13 +78,13 @@ def spectrum_orientation(spectrum) -> tuple:
     return float(np.hypot(txx - tyy, 2.0 * txy) / tr), float(0.5 * np.arctan2(2.0 * txy, txx - tyy))
 
 
-def upright_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED, spectrum=None):
-    """The upright Gaussian rest of a photo's rest (H, W, 3) (module doc), as :func:`rest_waves`: (freq float64
+def upright_waves(residual: np.ndarray, px_per_unit: float, count: int = COUNT, seed: int = WAVE_SEED, spectrum=None):
+    """The upright Gaussian rest of a photo's ``residual`` (H, W, 3; the photo less its harmonic part) (module doc), as :func:`rest_waves`: (freq float64
     (count, 3), amp complex128 (count, 3)) at full variance, None for a flat photo.  The photo is first turned by
     less than 45 degrees so that its dominant direction (:func:`orientation`) lies along its rows or columns.
     ``spectrum``: :func:`~backend.solid.gaussian_rest.rest_spectrum` of the same rest and scale, where the caller has
     it already (it is the photo's periodic component and FFT: 0.7 s for a 1024² photo)."""
-    spec = rest_spectrum(rest, px_per_unit) if spectrum is None else spectrum
+    spec = rest_spectrum(residual, px_per_unit) if spectrum is None else spectrum
     if spec is None:
         return None
     F, P, fx, fy, V = spec
@@ -112,18 +112,18 @@ def upright_waves(rest: np.ndarray, px_per_unit: float, count: int = COUNT, seed
     return freq, wave_amplitudes(F, P, pick, 2.0 * V * share[kb] / (count * q[kb]), rng)
 
 
-def candidates(rest: np.ndarray, px_per_unit: float, choice: str = "auto", gate: float = UPRIGHT_GATE) -> dict:
-    """The Gaussian rests a photo's rest (H, W, 3) offers the check (gaussian_rest.choose_mix): {kind: waves}.  For
+def candidates(residual: np.ndarray, px_per_unit: float, choice: str = "auto", gate: float = UPRIGHT_GATE) -> dict:
+    """The Gaussian rests a photo's ``residual`` (H, W, 3; the photo less its harmonic part) offers the check (gaussian_rest.choose_mix): {kind: waves}.  For
     ``choice`` "auto" the isotropic rest (:func:`~backend.solid.gaussian_rest.rest_waves`) always and the upright one
     (:func:`upright_waves`) where the rest's spectrum is oriented (:func:`orientation`'s coherence above
     ``gate``); for "isotropic" or "upright" (an artist's choice, gaussian_rest.REST_CHOICES) that one alone.  {} for
     a flat photo."""
     if choice not in REST_CHOICES:
         raise ValueError(f"a Gaussian rest is one of {', '.join(REST_CHOICES)}, not {choice!r}")
-    spec = rest_spectrum(rest, px_per_unit)            # once, for every kind and the gate
+    spec = rest_spectrum(residual, px_per_unit)            # once, for every kind and the gate
     if spec is None:
         return {}
-    out = {} if choice == "upright" else {"isotropic": rest_waves(rest, px_per_unit, spectrum=spec)}
+    out = {} if choice == "upright" else {"isotropic": rest_waves(residual, px_per_unit, spectrum=spec)}
     if choice == "upright" or (choice == "auto" and spectrum_orientation(spec)[0] > gate):
-        out["upright"] = upright_waves(rest, px_per_unit, spectrum=spec)
+        out["upright"] = upright_waves(residual, px_per_unit, spectrum=spec)
     return out
