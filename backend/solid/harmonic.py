@@ -39,24 +39,14 @@ photo's lattice lies on the grid, and its part is read from the bins as before. 
 only two to four times (a texture library's bricks: two courses of two bricks in 256 x 166 px) puts its peaks
 one to three bins apart, each inside the others' rings, and the peak test finds the courses at most; there the
 part is read at the lattice of the tile's periods, found from its autocorrelation, each bin measured against the
-bins around it that are not lattice points (:mod:`backend.solid.periods`; ``periods=False`` leaves it out),
+bins around it that are not lattice points (:mod:`backend.solid.periods`; ``HarmonicConfig(periods=False)``),
 wherever that holds ``FEW_MARGIN`` more of the photo's variance than the peaks or the motif.  Lines straight
 across the photo that the part leaves (a single floor tile's grout, plank seams, slab joints: rows and columns that
-stand off their neighbours all along) are added where they hold ``FEW_MARGIN`` of its variance (``lines=False``
-leaves them out).  The price: a photograph with one straight line across its whole frame (a cable, a crack square
+stand off their neighbours all along) are added where they hold ``FEW_MARGIN`` of its variance (``lines=False``).  The price: a photograph with one straight line across its whole frame (a cable, a crack square
 to the frame) gets it once per frame's width on a solid's walls; ``--no-periodic`` leaves the whole part out.
-``PROMINENCE`` and ``WINDOW`` were chosen on photos of the training
-split (``docs/img/solid_harmonic_tuning.json``): 16 over a 7 x 7 ring made 13 of
-39 structured photos more than 5 % closer and 4 farther, and 4 and 1 of 75 others; 4 made 23 closer but 10
-others farther (stripes from chance peaks).  Measured again with main lobes: 11 and 5, 3 and 0; 4 made 25 closer
-and 30 others farther (with peaks in colour: 11 and 5, 3 and 0; 23 and 26).
-
-Colour, not luminance: a motif drawn in colours of about one luminance (a held-out carpet's red diamonds on
-olive) leaves almost nothing in the luminance spectrum, where the weave's fine grain outshone it (44 waves, 12 %
-of the variance), while the waves are colour waves anyway (A_j in C^3); its colour spectrum has the motif's
-lattice (150 waves, 63 %).  On the training split the two spectra give the same parts to within 5 % on every
-photo ("detect" in the tuning JSON: none closer, none farther, pooled and on walls); the carpet, found by looking
-at a held-out failure, is the one photo that tells them apart.
+Every constant was chosen on the training split, and each reading's worth is measured by leaving it out
+(docs/decisions/solid.md).  Peaks are sought in the colour spectrum, not luminance: a motif drawn in colours of
+about one luminance (a carpet's red diamonds on olive) leaves almost nothing in the luminance spectrum.
 
 Placement: on 2D points (2D models) q = p, the photo's plane (row 0 at the top as ``model.plane_points``).  On 3D
 points the photo stands upright and is extruded along the horizontal diagonal (1, -1, 0): q(x, y, z) = (x + y, z),
@@ -65,11 +55,8 @@ model, ``model.image``'s front view) shows the harmonic part unchanged, courses 
 photo's pitch, and a horizontal cut shows it in profile (a brick wall's cut takes one course's colour, as a real
 one does; plank seams become lines).  A plane wave keeps its frequency on every plane whose section it is, so
 the texture stays one solid.  This is the placement for scenes with z up (a building's walls face x or y in
-object coordinates); it is not the one the pooled slice evaluation prefers: standing the photo on planes normal
-to z and to y instead (floors exact, faces normal to x in profile) scored 127.7 against 138.8 on the structured
-training photos (``docs/img/solid_harmonic_tuning.json``), because pooled slices ask horizontal cuts to look like the
-photo too, and there a brick wall's cut lies within one course.  It would put diagonal stripes on every wall
-facing x.
+object coordinates), not the one the pooled slice evaluation prefers (floors exact, which would put diagonal
+stripes on every wall facing x; docs/decisions/solid.md).
 
 Shapes: photos float (H, W, 3) sRGB in [0, 1]; points float (N, 2) or (N, 3) in texture units; fields float32
 (N, 3).  Phases are computed in float64 and reduced modulo one cycle before the float32 cosines (at |x| ~ 64 units
