@@ -185,7 +185,7 @@ def test_an_aperiodic_photo_is_left_as_the_decoder_draws_it(space):
 @pytest.mark.long
 def test_a_large_photo_is_measured_small_at_the_same_scale(space):
     """A photo over HARMONIC_SIDE px is resized before its FFT; its waves keep their frequency in texture units."""
-    from omninoise.backend.solid.model import HARMONIC_SIDE
+    from omninoise.backend.solid.harmonic import HARMONIC_SIDE
 
     img = np.tile(brick_photo(), (9, 9, 1))[: HARMONIC_SIDE + 128, : HARMONIC_SIDE + 128]   # 1152 px, period 16 / 32 px
     h = space.harmonics(img)
