@@ -88,7 +88,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
 
     size = _check_size(size)
     limits.positive("extent", extent)
-    limits.finite("time", time)
+    limits.time("time", time)
     if "spectrum" in settings:
         settings["spectrum"] = _spectrum(settings["spectrum"])
     s = WaveSettings(**settings)

@@ -82,8 +82,13 @@ class BakeSpec:
 
     def validate(self) -> "BakeSpec":
         self.grid.validate()
-        limits.finite("time", self.time)
+        limits.time("time", self.time)
         limits.positive("time_step", self.time_step)
+        if self.frames is not None:     # every frame's time within MAX_TIME
+            last = self.time + (float(self.frames[1]) - float(self.frames[0])) * self.time_step
+            if not abs(last) <= limits.MAX_TIME:
+                raise SettingError("time_step", f"the last frame's time, {last:g}, passes {limits.MAX_TIME:g}; use a "
+                                                "smaller time_step or fewer frames")
         ext = os.path.splitext(self.output)[1].lower()
         if ext not in FORMATS:
             raise SettingError("output", f"{self.output!r}: unsupported type {ext or '(none)'}; use {', '.join(FORMATS)}")

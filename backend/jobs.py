@@ -196,10 +196,13 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
     keys = getattr(source, "keys", None)
     if keys:  # animated neural noise: the bake's time is the frame number its keyframes name
         time0, dt = float(frames[0] if frames else keys[0].frame), 1.0
+    half = limits.as_bool("half", d.get("half", False))
+    if half and os.path.splitext(output)[1].lower() not in (".exr", ".vdb"):
+        raise SettingError("half", f"writes 16-bit floats into .exr and .vdb only, not {os.path.basename(output)}")
     return BakeSpec(name=name, source=source, grid=grid, output=output, transfer=tf, frames=frames,
-                    time=limits.finite("time", d.get("time", time0)),
-                    time_step=limits.positive("time_step", d.get("time_step", dt)),
-                    half=limits.as_bool("half", d.get("half", False)), make_folders=True).validate()
+                    time=limits.time("time", d.get("time", time0)),
+                    time_step=limits.positive("time_step", d.get("time_step", dt)), half=half,
+                    make_folders=True).validate()
 
 
 def parse_job(doc: dict, base_dir: str) -> list:

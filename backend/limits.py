@@ -12,6 +12,8 @@ MAX_TABLE_SIZE     samples per wave table
 MAX_FRAMES         frames one bake or animation writes
 MAX_THREADS        CPU threads a command may ask for
 MAX_REFINE         search steps refining a solid texture's code (each renders two planes)
+MAX_TIME           |time| of an animation or 4D coordinate (float32 phases stay finite and meaningful)
+MAX_SPEED          |speed| of animated waves, units per unit time
 SCALE_RANGE        a solid texture's scale, texture units per world unit (past it, points overflow or one texel
                    fills the output)
 MEMORY_LIMIT       bytes one request may allocate for its result, OMNINOISE_MEMORY_LIMIT overrides
@@ -23,7 +25,7 @@ import os
 
 from .errors import SettingError
 
-__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "scale", "memory_limit", "finite", "positive", "in_range", "check_int",
+__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "MAX_TIME", "MAX_SPEED", "scale", "time", "memory_limit", "finite", "positive", "in_range", "check_int",
            "check_memory", "as_bool"]
 
 MAX_DIRECTIONS = 4096
@@ -32,6 +34,8 @@ MAX_FRAMES = 100_000
 MAX_THREADS = 1024
 MAX_REFINE = 10_000
 SCALE_RANGE = (1e-4, 1e4)
+MAX_TIME = 1e9
+MAX_SPEED = 1e6
 _DEFAULT_MEMORY = 16 << 30
 
 
@@ -75,6 +79,11 @@ def in_range(name: str, value, lo: float, hi: float) -> float:
     if not lo <= v <= hi:
         raise SettingError(name, f"must lie in [{lo:g}, {hi:g}], got {v:g}")
     return v
+
+
+def time(name: str, value) -> float:
+    """A time (or 4D coordinate): finite, within MAX_TIME of zero."""
+    return in_range(name, value, -MAX_TIME, MAX_TIME)
 
 
 def scale(name: str, value) -> float:

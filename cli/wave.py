@@ -182,7 +182,7 @@ def run(a: argparse.Namespace) -> int:
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.positive("--extent", a.extent)
-    limits.finite("--time", a.time)
+    limits.time("--time", a.time)
     if a.example_extent is not None:
         limits.positive("--example-extent", a.example_extent)
     limits.check_memory("--size", float(a.size) ** (min(a.dim, 3) if ext in (".npy", ".vdb") else 2)

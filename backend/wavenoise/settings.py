@@ -85,7 +85,7 @@ class WaveSettings:
             raise SettingError("dim", f"must be the number 2, 3 or 4, got {self.dim!r}")
         if not 1 <= int(self.directions) <= limits.MAX_DIRECTIONS:
             raise SettingError("directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {self.directions}")
-        limits.finite("speed", self.speed)
+        limits.in_range("speed", self.speed, -limits.MAX_SPEED, limits.MAX_SPEED)
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2 ** 32:
             raise SettingError("seed", f"must be a whole number in [0, 2^32), got {self.seed!r}")
         for name in ("slice_width", "cell_size", "table_period"):

@@ -70,12 +70,19 @@ def test_a_volume_writer_refuses_nan_slabs():
         w.add("density", 0, slab)
 
 
-def test_a_command_whose_result_overflows_writes_nothing_and_says_so(tmp_path, capsys):
+def test_times_and_speeds_whose_product_overflows_are_refused_before_any_work(tmp_path, capsys):
+    """A time, speed or frame step that would overflow the waves' phases (NaN images before) is refused, named."""
     out = tmp_path / "t.npy"
-    assert main(["wave", "--size", "16", "--time", "1e308", "--speed", "1", "--quiet", "-o", str(out)]) == 1
-    err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert "not writing t.npy" in err and "NaN or infinite" in err and "internal error" not in err
-    assert not out.exists() and os.listdir(tmp_path) == []
+    for args, said in ((["--time", "1e308", "--speed", "1"], "--time: must lie in [-1e+09, 1e+09]"),
+                       (["--time", "1", "--speed", "1e300"], "--speed: must lie in [-1e+06, 1e+06]")):
+        assert main(["wave", "--size", "16", "--quiet", "-o", str(out), *args]) == 2
+        assert said in capsys.readouterr().err
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "t"\noutput = "f_#.npy"\nresolution = [4, 4]\nframes = [1, 3]\n'
+                   'time_step = 1e308\n[bake.source]\nkind = "wave"\nspeed = 1.0\n')
+    assert main(["bake", str(job)]) == 2
+    assert "time_step: the last frame's time, inf, passes 1e+09" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["job.toml"]
 
 
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)])
@@ -250,3 +257,13 @@ def test_neural_tiles_and_a_fits_report_folder_are_checked_before_any_work(tmp_p
                  str(tmp_path / "f.png")]) == 2
     assert "--report: output folder does not exist" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["photo.png"]
+
+
+def test_half_floats_for_a_format_without_them_are_refused_in_a_job_as_on_the_command_line(tmp_path, capsys):
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "h"\noutput = "h.npy"\nresolution = [4, 4]\nhalf = true\n'
+                   '[bake.source]\nkind = "wave"\n')
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    assert "half: writes 16-bit floats into .exr and .vdb only, not h.npy" in capsys.readouterr().out
+    assert main(["wave", "--size", "4", "--half", "-o", str(tmp_path / "h.npy")]) == 2
+    assert "--half: writes 16-bit floats into .exr and .vdb only" in capsys.readouterr().err
