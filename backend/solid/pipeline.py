@@ -36,6 +36,7 @@ from .gaussian_rest import CHECK_SEEDS, MARGIN, MIXES, RENDER, REST_CHOICES, Gau
 from .harmonic import HARMONIC_SIDE, HarmonicConfig, Harmonics, measure_harmonics, mix_harmonics, remove_harmonics
 from .model import SolidTextureModel, TextureCode, slice_points
 from .pixels import at_most, rgb_pixels
+from .refine import refine_code
 from .upright import UPRIGHT_GATE, candidates
 
 __all__ = ["PhotoConfig", "RestCheck", "PhotoCode", "measure_harmonics", "photo_code", "gaussian_rest",
@@ -108,8 +109,6 @@ def gaussian_rest(model: SolidTextureModel, image: np.ndarray, code: TextureCode
 def photo_code(model: SolidTextureModel, image: np.ndarray, config: PhotoConfig = PhotoConfig(), progress=None,
                setting: str = "exemplar") -> PhotoCode:
     """Stages 2 to 6 on a photo's pixels float (H, W, 3) sRGB (space models); ``progress`` hears the refinement."""
-    from .refine import refine_code
-
     img = np.asarray(image, np.float32)
     if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
         raise SettingError(setting, f"expected finite RGB pixels (H, W, 3), got shape {img.shape}")
