@@ -110,9 +110,7 @@ class BakeSpec:
             a, b = self.frames
             if int(a) != a or int(b) != b or b < a:
                 raise SettingError("frames", f"expected [start, end] whole numbers with end >= start, got {list(self.frames)}")
-            if b - a >= limits.MAX_FRAMES:
-                raise SettingError("frames", f"{int(b - a + 1)} frames is more than the {limits.MAX_FRAMES} one bake may "
-                                             "write")
+            limits.frame_count("frames", a, b, "bake")
             if not _FRAME.search(os.path.basename(self.output)):
                 raise SettingError("output", f"{os.path.basename(self.output)}: a frame range needs '#' in the file name "
                                    "(e.g. clouds_####.vdb)")

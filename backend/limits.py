@@ -25,7 +25,7 @@ import os
 
 from .errors import SettingError
 
-__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "MAX_TIME", "MAX_SPEED", "scale", "time", "memory_limit", "finite", "positive", "in_range", "check_int",
+__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "MAX_TIME", "MAX_SPEED", "scale", "time", "frame_count", "memory_limit", "finite", "positive", "in_range", "check_int",
            "check_memory", "as_bool"]
 
 MAX_DIRECTIONS = 4096
@@ -79,6 +79,12 @@ def in_range(name: str, value, lo: float, hi: float) -> float:
     if not lo <= v <= hi:
         raise SettingError(name, f"must lie in [{lo:g}, {hi:g}], got {v:g}")
     return v
+
+
+def frame_count(name: str, first: int, last: int, writer: str) -> None:
+    """At most MAX_FRAMES frames from ``first`` to ``last`` (inclusive) for one ``writer`` ("bake", "run")."""
+    if last - first >= MAX_FRAMES:
+        raise SettingError(name, f"{int(last - first + 1)} frames is more than the {MAX_FRAMES} one {writer} may write")
 
 
 def time(name: str, value) -> float:

@@ -5,6 +5,7 @@ import argparse
 import sys
 import time
 
+from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 
 __all__ = ["Help", "add_command", "class_args", "Bar", "set_threads", "param_items", "shown", "SHOWN"]
@@ -63,8 +64,6 @@ def set_threads(n: int, precision: str = "fp32") -> None:
     """The CLI's --threads and --precision as the defaults of every model the command loads."""
     from omninoise.backend.neural.precision import set_default_precision
     from omninoise.backend.onnx_models import set_default_threads
-
-    from omninoise.backend import limits
 
     if not 0 <= n <= limits.MAX_THREADS:
         raise SettingError("--threads", f"must lie in [0, {limits.MAX_THREADS}] (0: all cores), got {n}")

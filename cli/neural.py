@@ -224,9 +224,7 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     first, last = a.frames
     if last < first:
         raise SettingError("--frames", f"expected FIRST LAST with LAST >= FIRST, got {first} {last}")
-    if last - first >= limits.MAX_FRAMES:
-        raise SettingError("--frames", f"{last - first + 1} frames is more than the {limits.MAX_FRAMES} one run may "
-                                       "write")
+    limits.frame_count("--frames", first, last, "run")
     limits.finite("--drift", a.drift)
     folder = os.path.dirname(os.path.abspath(a.out))
     if not os.path.isdir(folder):

@@ -21,8 +21,6 @@ from .common import Bar, add_command
 
 __all__ = ["add_parser", "run", "settings_from_args"]
 
-FLAGS: set = set()      #: the subcommand's option strings (a backend setting's error is named by its flag)
-
 
 def spectrum_arg(text: str) -> Spectrum:
     """'kind:fmin:fmax[:exponent]' -> Spectrum."""
@@ -105,7 +103,6 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
     g.add_argument("--slice-width", type=float, help="width of a direction's slices in units (default: from the band)")
     g.add_argument("--table-size", type=int, default=1024, help="samples per wave table")
     g.add_argument("--period", type=float, help="table period in units (default: 255 / fmax)")
-    FLAGS.update(o for action in w._actions for o in action.option_strings)
     return w
 
 
@@ -156,9 +153,9 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
         transition_to=a.transition, table_size=a.table_size, table_period=a.period, **used)
     try:
         return s.validate()
-    except SettingError as exc:     # named as the flag the user typed, where there is one
-        flag = "--" + exc.setting.replace(" ", "-").replace("_", "-")
-        raise SettingError(flag if flag in FLAGS else exc.setting, exc.message) from None
+    except SettingError as exc:     # named as the flag the user typed, where the setting has one
+        dest = exc.setting.replace(" ", "_").replace("-", "_")
+        raise SettingError("--" + dest.replace("_", "-") if hasattr(a, dest) else exc.setting, exc.message) from None
 
 
 def run(a: argparse.Namespace) -> int:

@@ -102,12 +102,12 @@ def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | 
 def write_image(path: str, array: np.ndarray) -> None:
     """Dispatch on extension: .npy raw float32, .exr float image, .png 8-bit preview."""
     ext = os.path.splitext(path)[1].lower()
-    require_finite(array, path)
     if ext == ".npy":
         write_npy(path, array)
     elif ext == ".exr":
         write_exr(path, array)
     elif ext == ".png":
+        require_finite(array, path)       # the writers of .npy and .exr check their own; the preview maps NaN away
         write_png(path, preview_8bit(array))
     else:
         raise ValueError(f"unsupported output type {ext!r} (use .npy, .exr or .png)")
