@@ -14,6 +14,14 @@ from omninoise.cli.common import shown
 from omninoise.cli.main import main
 
 
+def wave_job(folder, name: str, output: str, bake: str = "", source: str = "", resolution: str = "[4, 4]"):
+    """A job file of one wave bake: ``bake`` and ``source`` are extra TOML lines of its two tables."""
+    job = folder / "job.toml"
+    job.write_text(f'[[bake]]\nname = "{name}"\noutput = "{output}"\nresolution = {resolution}\n{bake}'
+                   f'[bake.source]\nkind = "wave"\n{source}')
+    return job
+
+
 def test_every_legal_output_name_gets_a_temporary_within_the_name_limit(tmp_path):
     for n in (1, 200, 251):                               # 251 + ".npy": the longest legal name
         out = tmp_path / ("w" * n + ".npy")
@@ -77,9 +85,7 @@ def test_times_and_speeds_whose_product_overflows_are_refused_before_any_work(tm
                        (["--time", "1", "--speed", "1e300"], "--speed: must lie in [-1e+06, 1e+06]")):
         assert main(["wave", "--size", "16", "--quiet", "-o", str(out), *args]) == 2
         assert said in capsys.readouterr().err
-    job = tmp_path / "job.toml"
-    job.write_text('[[bake]]\nname = "t"\noutput = "f_#.npy"\nresolution = [4, 4]\nframes = [1, 3]\n'
-                   'time_step = 1e308\n[bake.source]\nkind = "wave"\nspeed = 1.0\n')
+    job = wave_job(tmp_path, "t", "f_#.npy", 'frames = [1, 3]\ntime_step = 1e308\n', 'speed = 1.0\n')
     assert main(["bake", str(job)]) == 2
     assert "time_step: the last frame's time, inf, passes 1e+09" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["job.toml"]
@@ -123,9 +129,7 @@ def test_sigterm_stops_a_running_command_with_143(tmp_path):
 def test_names_and_messages_are_printed_with_control_characters_escaped_and_cut(tmp_path, capsys):
     assert shown("a\x1b]0;owned\x07b\nc") == "a\\x1b]0;owned\\x07b\\nc"
     assert len(shown("x" * 10_000)) == 400 and shown("x" * 10_000).endswith("…")
-    job = tmp_path / "job.toml"
-    job.write_text('[[bake]]\nname = "evil\\u001b]0;title\\u0007"\noutput = "o.npy"\nresolution = [4, 4]\n'
-                   '[bake.source]\nkind = "wave"\n')
+    job = wave_job(tmp_path, "evil\\u001b]0;title\\u0007", "o.npy")
     assert main(["bake", str(job), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\x07" not in out and "evil\\x1b]0;title\\x07" in out
@@ -133,9 +137,7 @@ def test_names_and_messages_are_printed_with_control_characters_escaped_and_cut(
 
 def test_counts_are_capped_before_any_work(tmp_path, capsys):
     """A job's frames, --threads and --refine have caps: past them, one line naming the setting and exit 2."""
-    job = tmp_path / "job.toml"
-    job.write_text('[[bake]]\nname = "long"\noutput = "f_#.npy"\nresolution = [4, 4]\nframes = [1, 30000000]\n'
-                   '[bake.source]\nkind = "wave"\nspeed = 1.0\n')
+    job = wave_job(tmp_path, "long", "f_#.npy", "frames = [1, 30000000]\n", "speed = 1.0\n")
     assert main(["bake", str(job), "--dry-run"]) == 2
     assert "30000000 frames is more than the 100000 one bake may write" in capsys.readouterr().out
     assert main(["neural", "--noise", "perlin", "--threads", "100000", "-o", str(tmp_path / "n.png")]) == 2
@@ -190,9 +192,7 @@ def test_a_damaged_earlier_volume_is_out_of_date_and_read_within_bounds(tmp_path
         t = time.perf_counter()
         assert read_vdb_metadata_bytes(tmp_path, bad) == {}
         assert time.perf_counter() - t < 1.0
-    job = tmp_path / "job.toml"
-    job.write_text('[[bake]]\nname = "v"\noutput = "v.vdb"\nresolution = [4, 4, 4]\n[bake.source]\nkind = "wave"\n'
-                   'dim = 3\n')
+    job = wave_job(tmp_path, "v", "v.vdb", "", "dim = 3\n", "[4, 4, 4]")
     (tmp_path / "v.vdb").write_bytes(head + struct.pack("<I", 2 ** 31))
     assert main(["bake", str(job), "--dry-run"]) == 0
     assert "to bake" in capsys.readouterr().out
@@ -260,9 +260,7 @@ def test_neural_tiles_and_a_fits_report_folder_are_checked_before_any_work(tmp_p
 
 
 def test_half_floats_for_a_format_without_them_are_refused_in_a_job_as_on_the_command_line(tmp_path, capsys):
-    job = tmp_path / "job.toml"
-    job.write_text('[[bake]]\nname = "h"\noutput = "h.npy"\nresolution = [4, 4]\nhalf = true\n'
-                   '[bake.source]\nkind = "wave"\n')
+    job = wave_job(tmp_path, "h", "h.npy", "half = true\n")
     assert main(["bake", str(job), "--dry-run"]) == 2
     assert "half: writes 16-bit floats into .exr and .vdb only, not h.npy" in capsys.readouterr().out
     assert main(["wave", "--size", "4", "--half", "-o", str(tmp_path / "h.npy")]) == 2
