@@ -102,6 +102,10 @@ class BakeSpec:
         check = getattr(self.source, "check_grid", None)  # a source's own requirements on the grid (named first)
         if check is not None:
             check(self.grid.shape)
+        check = getattr(self.source, "check_extent", None)  # ... and on how far from the origin it reaches
+        if check is not None:
+            last = self.time + (self.frames[1] - self.frames[0]) * self.time_step if self.frames else self.time
+            check(float(np.max(np.abs(self.grid.bounds))), max(abs(self.time), abs(last)))
         if rank == 3 and self.source.dim == 2:
             raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")
         if getattr(self.source, "rgb", False) and self.transfer is not None:

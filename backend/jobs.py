@@ -125,8 +125,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .bake import BakeResult, BakeSpec, Cancelled, frame_path, run_bake
-from . import limits
 from .errors import SettingError
+from .schema import did_you_mean, shown_value
 from .sources import BoxGrid, source_from_dict
 from .transfer import load_transfer, transfer_from_dict
 
@@ -158,25 +158,15 @@ def _merge(base: dict, over: dict) -> dict:
 
 
 def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
+    """One merged ``[[bake]]`` table -> its checked BakeSpec (:data:`~backend.settings_schema.BAKE` first, then
+    its source's table, then the rules that join keys)."""
+    from .settings_schema import BAKE
+
+    d = BAKE.check(d, "")
     name = d.get("name") or f"bake {index + 1}"
-    unknown = sorted(set(d) - set(BAKE_KEYS))
-    if unknown:
-        raise SettingError(unknown[0], f"unknown key; known: {', '.join(BAKE_KEYS)}")
-    for k in ("output", "resolution", "source"):
-        if k not in d:
-            raise SettingError(k, "missing")
-    if not isinstance(d["source"], dict):
-        raise SettingError("source", "expected a [bake.source] table")
     source = source_from_dict(d["source"], base_dir)
-    res = d["resolution"]
-    if not isinstance(res, list):
-        raise SettingError("resolution", f"expected [nx, ny] or [nx, ny, nz], got {res!r}")
-    bounds = d.get("bounds", [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
-    try:
-        bounds = tuple(tuple(float(c) for c in b) for b in bounds)
-    except (TypeError, ValueError):
-        raise SettingError("bounds", f"expected [[x0, y0, z0], [x1, y1, z1]], got {bounds!r}") from None
-    grid = BoxGrid(tuple(res), bounds).validate()
+    bounds = tuple(tuple(b) for b in d.get("bounds", [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]))
+    grid = BoxGrid(tuple(d["resolution"]), bounds).validate()
     tf = d.get("transfer")
     if isinstance(tf, str):
         path = os.path.join(base_dir, tf)
@@ -185,52 +175,43 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
         tf = transfer_from_dict(tf)
     elif tf is not None:
         raise SettingError("transfer", f"expected a preset name, a .json file or a table, got {tf!r}")
-    frames = d.get("frames")
-    if frames is not None:
-        if not (isinstance(frames, list) and len(frames) == 2
-                and all(isinstance(f, int) and not isinstance(f, bool) for f in frames)):
-            raise SettingError("frames", f"expected [start, end], got {frames!r}")
-        frames = (frames[0], frames[1])
-    output = os.path.normpath(os.path.join(base_dir, str(d["output"])))
+    frames = tuple(d["frames"]) if "frames" in d else None
+    output = os.path.normpath(os.path.join(base_dir, d["output"]))
     time0, dt = 0.0, 1.0 / 24.0
     keys = getattr(source, "keys", None)
     if keys:  # animated neural noise: the bake's time is the frame number its keyframes name
         time0, dt = float(frames[0] if frames else keys[0].frame), 1.0
-    half = limits.as_bool("half", d.get("half", False))
+    half = d.get("half", False)
     if half and os.path.splitext(output)[1].lower() not in (".exr", ".vdb"):
         raise SettingError("half", f"writes 16-bit floats into .exr and .vdb only, not {os.path.basename(output)}")
     return BakeSpec(name=name, source=source, grid=grid, output=output, transfer=tf, frames=frames,
-                    time=limits.time("time", d.get("time", time0)),
-                    time_step=limits.positive("time_step", d.get("time_step", dt)), half=half,
+                    time=d.get("time", time0), time_step=d.get("time_step", dt), half=half,
                     make_folders=True).validate()
 
 
 def parse_job(doc: dict, base_dir: str) -> list:
     """Job document -> list of (name, BakeSpec or JobError)."""
-    unknown = sorted(set(doc) - {"defaults", "bake", "output_root"})
-    if unknown:
-        raise JobError(f"unknown top-level key {unknown[0]!r}; a job has output_root, [defaults] and [[bake]] "
-                       "tables")
-    root = doc.get("output_root", ".")
-    if not isinstance(root, str) or not root.strip():
-        raise JobError(f"output_root: expected a folder path (a string), got {root!r}")
-    root = os.path.realpath(os.path.join(base_dir, root))
-    bakes = doc.get("bake")
-    if not isinstance(bakes, list) or not bakes:
-        raise JobError("no [[bake]] tables: nothing to do")
-    defaults = doc.get("defaults", {})
-    if not isinstance(defaults, dict):
-        raise JobError(f"defaults: expected a [defaults] table, got {defaults!r}")
-    bad = [i for i, b in enumerate(bakes) if not isinstance(b, dict)]
-    if bad:
-        raise JobError(f"bake {bad[0] + 1}: expected a [[bake]] table, got {bakes[bad[0]]!r}")
+    from .settings_schema import BAKE, JOB
+
+    try:
+        doc = JOB.check(doc, "")
+        for k in doc.get("defaults", {}):
+            if k not in BAKE.fields:
+                raise SettingError(f"defaults.{k}", f"unknown key{did_you_mean(k, BAKE.fields)}; known: "
+                                                    f"{', '.join(BAKE.fields)}")
+    except SettingError as exc:
+        if exc.setting == "bake" and "bake" not in doc:
+            raise JobError("no [[bake]] tables: nothing to do") from None
+        raise JobError(str(exc)) from None
+    root = os.path.realpath(os.path.join(base_dir, doc.get("output_root", ".")))
+    bakes, defaults = doc["bake"], doc.get("defaults", {})
     out, seen, outputs = [], set(), {}
     for i, b in enumerate(bakes):
         d = _merge(defaults, b)
         name = d.get("name") or f"bake {i + 1}"
         if not isinstance(name, str):
             name = f"bake {i + 1}"
-            out.append((name, JobError(f"{name}: name: expected a string, got {d['name']!r}")))
+            out.append((name, JobError(f"{name}: name: expected a string, got {shown_value(d['name'])}")))
             continue
         if name in seen:
             out.append((name, JobError(f"bake {name!r}: the name is used twice")))

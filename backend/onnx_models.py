@@ -1,12 +1,17 @@
 """Shipped ONNX model folders: a JSON description whose ``files`` map names to sha256, checked on load,
-and onnxruntime sessions created on first use (shared by the neural noise and solid texture runtimes)."""
+and onnxruntime sessions created on first use (shared by the neural noise and solid texture runtimes).
+
+The description itself is sealed: its ``json_sha256`` is the sha256 of the rest of it in canonical form
+(sorted keys, no spaces), so an edited class embedding, schedule or parameter range is refused like an edited
+weight file. Writers seal with :func:`write_model_json`."""
 from __future__ import annotations
 
 import hashlib
 import json
 import os
 
-__all__ = ["ModelError", "sha256_file", "load_model_json", "verify_files", "fingerprint", "SessionCache",
+__all__ = ["ModelError", "sha256_file", "load_model_json", "verify_files", "fingerprint", "SessionCache", "SEAL",
+           "json_seal", "sealed", "write_model_json",
            "set_default_threads"]
 
 _THREADS = {"default": 0}
@@ -34,6 +39,27 @@ def sha256_file(path: str) -> str:
     return h.hexdigest()
 
 
+SEAL = "json_sha256"
+
+
+def json_seal(doc: dict) -> str:
+    """sha256 of ``doc`` less its seal, as canonical JSON (sorted keys, no spaces, ASCII)."""
+    body = {k: v for k, v in doc.items() if k != SEAL}
+    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+
+
+def sealed(doc: dict) -> dict:
+    """``doc`` with its seal (:func:`json_seal`) set."""
+    return {**{k: v for k, v in doc.items() if k != SEAL}, SEAL: json_seal(doc)}
+
+
+def write_model_json(path: str, doc: dict) -> None:
+    """Write a model description, sealed, atomically."""
+    from ..export.atomic import write_json
+
+    write_json(path, sealed(doc))
+
+
 def load_model_json(folder: str, json_name: str) -> dict:
     """``folder/json_name`` after checking every file it lists against its sha256 (ModelError if not)."""
     path = os.path.join(folder, json_name)
@@ -45,7 +71,11 @@ def load_model_json(folder: str, json_name: str) -> dict:
     except (OSError, ValueError, RecursionError) as exc:    # unreadable, not UTF-8, not JSON, nested too deep
         raise ModelError(f"{path} is not a readable model description ({type(exc).__name__}); re-install or "
                          "re-export the model") from None
-    files = doc.get("files") if isinstance(doc, dict) else None
+    if not isinstance(doc, dict) or not isinstance(doc.get(SEAL), str):
+        raise ModelError(f"{path} has no {SEAL} seal: the description cannot be verified; re-export the model")
+    if json_seal(doc) != doc[SEAL]:
+        raise ModelError(f"{path}: {SEAL} does not match its contents (altered or damaged description)")
+    files = doc.get("files")
     if not isinstance(files, dict) or not files:
         raise ModelError(f"{path} lists no files with their sha256 ('files'): the model cannot be verified")
     verify_files(folder, files, json_name)

@@ -138,6 +138,13 @@ class WaveSource:
             self._noise = self._compile(self.settings)
         return self._noise
 
+    def check_extent(self, spatial: float, time: float, names: tuple = ("bounds", "time")) -> None:
+        """Refuse points ``spatial`` world units from the origin at times up to ``time`` when the waves there
+        pass :data:`~backend.limits.MAX_CYCLES` (:meth:`WaveSettings.check_reach`); named by ``names``
+        (space, time), whichever reaches farther."""
+        w = abs(self.w_offset) + time if self.dim == 4 else time * abs(self.settings.speed)
+        self.settings.check_reach(names[1] if w > spatial else names[0], spatial + w)
+
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .grid import evaluate_box
 
@@ -684,10 +691,18 @@ def source_from_dict(d: dict, base_dir: str = ".") -> Source:
     Solid: model (a folder, or a shipped model's name), [exemplar, refine], seed, scale, density
     (see :class:`SolidSource`).
     """
-    d = dict(d)
-    kind = d.pop("kind", "wave")
-    if kind not in SOURCES:
-        raise SettingError("source.kind", f"unknown source {kind!r}; choose one of {', '.join(SOURCES)}")
+    from .schema import did_you_mean, shown_value
+    from .settings_schema import SOURCE_TABLES
+
+    if not isinstance(d, dict):
+        raise SettingError("source", f"expected a [bake.source] table, got {shown_value(d)}")
+    kind = d.get("kind", "wave")
+    if not isinstance(kind, str) or kind not in SOURCES:
+        hint = did_you_mean(kind, SOURCES) if isinstance(kind, str) else ""
+        raise SettingError("source.kind", f"unknown source {shown_value(kind)}{hint}; choose one of "
+                                          f"{', '.join(SOURCES)}")
+    d = dict(SOURCE_TABLES[kind].check(d, "source")) if kind in SOURCE_TABLES else dict(d)
+    d.pop("kind", None)
     return SOURCES[kind](d, base_dir)
 
 

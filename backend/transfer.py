@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import SettingError
+from .schema import AnyOf, Choice, Field, Float, Items, ListOf, Table
 
 __all__ = ["TransferFunction", "PRESETS", "preset", "load_transfer", "transfer_from_dict"]
 
@@ -52,23 +53,24 @@ class TransferFunction:
     temperature: tuple = field(default=())
 
     def validate(self) -> "TransferFunction":
+        """The ramp's values against :data:`TRANSFER` (finite numbers, known modes), then its own rules."""
+        try:
+            TRANSFER.check(self.to_dict(), "")
+        except (TypeError, ValueError) as exc:
+            if isinstance(exc, SettingError):
+                raise
+            raise SettingError("transfer", f"expected numbers in range, stops and temperature ({exc})") from None
         if self.interpolation not in INTERPOLATIONS:
             raise SettingError("interpolation", f"unknown {self.interpolation!r}; choose one of {', '.join(INTERPOLATIONS)}")
-        if len(self.stops) < 1:
-            raise SettingError("stops", "a ramp needs at least one stop")
         pos = [p for p, _ in self.stops]
-        if any(not 0.0 <= p <= 1.0 for p in pos):
-            raise SettingError("stops", f"positions must lie in [0, 1], got {pos}")
         if any(b < a for a, b in zip(pos, pos[1:])):
             raise SettingError("stops", f"positions must be sorted, got {pos}")
         for p, c in self.stops:
             if len(c) != 4:
                 raise SettingError("stops", f"colour at {p:g} needs 4 values (r, g, b, a), got {len(c)}")
         v0, v1 = self.range
-        if not (np.isfinite(v0) and np.isfinite(v1)) or v0 == v1:
-            raise SettingError("range", f"needs two different finite values, got {tuple(self.range)}")
-        if not self.density_scale >= 0:
-            raise SettingError("density_scale", f"must be >= 0, got {self.density_scale:g}")
+        if v0 == v1:
+            raise SettingError("range", f"needs two different values, got {tuple(self.range)}")
         tp = [p for p, _ in self.temperature]
         if any(b < a for a, b in zip(tp, tp[1:])):
             raise SettingError("temperature", f"positions must be sorted, got {tp}")
@@ -160,35 +162,20 @@ def _stop(item, where: str) -> tuple:
         raise SettingError(where, f"expected [position, [r, g, b(, a)]], got {item!r}") from None
 
 
-_KEYS = ("preset", "range", "interpolation", "density_scale", "stops", "temperature")
-
-
 def transfer_from_dict(d: dict, where: str = "transfer") -> TransferFunction:
-    """A ramp from a plain dict (JSON file, job file table).
+    """A ramp from a plain dict (JSON file, job file table), checked against :data:`TRANSFER`.
 
     ``preset = "clouds"`` starts from a preset; any other key overrides it.
     """
-    if not isinstance(d, dict):
-        raise SettingError(where, f"expected a table, got {d!r}")
-    unknown = sorted(set(d) - set(_KEYS))
-    if unknown:
-        raise SettingError(f"{where}.{unknown[0]}", f"unknown key; known: {', '.join(_KEYS)}")
+    d = TRANSFER.check(d, where)
     base = preset(d["preset"]).to_dict() if "preset" in d else {}
     base.update({k: v for k, v in d.items() if k != "preset"})
     if "stops" not in base:
         raise SettingError(where, "needs stops (or a preset)")
-    temp = base.get("temperature") or ()
-    try:
-        temp = tuple((float(p), float(k)) for p, k in temp)
-        rng = tuple(float(v) for v in base.get("range", (-1.5, 1.5)))
-    except (TypeError, ValueError):
-        raise SettingError(where, "range is [v0, v1] and temperature is [[position, kelvin], ...]") from None
-    if len(rng) != 2:
-        raise SettingError(f"{where}.range", f"expected [v0, v1], got {list(rng)}")
     return TransferFunction(
-        stops=tuple(_stop(s, f"{where}.stops") for s in base["stops"]), range=rng,
-        interpolation=str(base.get("interpolation", "linear")).lower(),
-        density_scale=float(base.get("density_scale", 1.0)), temperature=temp).validate()
+        stops=tuple(_stop(s, f"{where}.stops") for s in base["stops"]), range=tuple(base.get("range", (-1.5, 1.5))),
+        interpolation=base.get("interpolation", "linear"), density_scale=float(base.get("density_scale", 1.0)),
+        temperature=tuple((float(p), float(k)) for p, k in base.get("temperature") or ())).validate()
 
 
 def load_transfer(spec: str) -> TransferFunction:
@@ -238,3 +225,21 @@ def preset(name: str) -> TransferFunction:
     p = PRESETS[name]
     return TransferFunction(stops=p["stops"], range=p["range"], interpolation=p["interpolation"],
                             density_scale=p["density_scale"], temperature=p.get("temperature", ())).validate()
+
+
+#: the keys of a ramp table (a job file's ``transfer = {...}``, a ramp .json file)
+COLOR = ListOf(Float(-1e6, 1e6), 3, 4)
+TRANSFER = Table({
+    "preset": Field(Choice(tuple(PRESETS)), "start from a preset; other keys override it"),
+    "range": Field(Items((Float(), Float()), "[v0, v1]"), "noise values mapped to ramp positions 0 and 1",
+                   default="[-1.5, 1.5]"),
+    "interpolation": Field(Choice(INTERPOLATIONS), "how colours blend between stops", default="linear"),
+    "density_scale": Field(Float(0.0, 1e6), "a volume's density is density_scale times alpha", default="1"),
+    "stops": Field(ListOf(AnyOf((Items((Float(0.0, 1.0), COLOR), "[position, [r, g, b(, a)]]"),
+                                 Table({"position": Field(Float(0.0, 1.0), "0 to 1", True),
+                                        "color": Field(COLOR, "[r, g, b(, a)]", True)},
+                                       "{position = P, color = [r, g, b(, a)]}"))), 1, 256),
+                   "the ramp's colour stops, sorted by position"),
+    "temperature": Field(ListOf(Items((Float(0.0, 1.0), Float(0.0, 1e5)), "[position, kelvin]"), 0, 256),
+                         "a volume's temperature grid over the ramp, kelvin"),
+}, "a ramp table")

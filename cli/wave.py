@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import warnings
 
@@ -154,8 +155,20 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
     try:
         return s.validate()
     except SettingError as exc:     # named as the flag the user typed, where the setting has one
-        dest = exc.setting.replace(" ", "_").replace("-", "_")
-        raise SettingError("--" + dest.replace("_", "-") if hasattr(a, dest) else exc.setting, exc.message) from None
+        raise SettingError(_flag(a, exc.setting), exc.message) from None
+
+
+#: settings whose flag has another name
+_FLAGS = {"lobes": "lobe", "axis_spectra": "axis_spectrum", "table_period": "period", "transition_to": "transition"}
+
+
+def _flag(a: argparse.Namespace, setting: str) -> str:
+    """The flag behind a setting's dotted name ("spectrum.fmax" -> --fmax, "lobes[0][1]" -> --lobe), or the
+    name itself."""
+    parts = re.split(r"[.\[]", setting.replace(" ", "_"))
+    dest = parts[-1] if parts[0] == "spectrum" else parts[0]
+    dest = _FLAGS.get(dest, dest)
+    return "--" + dest.replace("_", "-") if hasattr(a, dest) else setting
 
 
 def run(a: argparse.Namespace) -> int:
@@ -188,6 +201,9 @@ def run(a: argparse.Namespace) -> int:
     if not os.path.isdir(folder):
         raise SettingError("-o", f"output folder does not exist: {folder}")
     s = settings_from_args(a)
+    from omninoise.backend.sources import WaveSource
+
+    WaveSource(s).check_extent(a.extent, abs(a.time), ("--extent", "--time"))
     if not a.quiet:
         from omninoise.backend.wavenoise.fast import engine_path
 

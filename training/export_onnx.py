@@ -38,7 +38,7 @@ import sys
 import numpy as np
 import torch
 
-from omninoise import export as _ex
+from omninoise.backend.onnx_models import write_model_json
 
 from omninoise.backend.neural.model import sha256_file
 from . import zoo
@@ -216,7 +216,7 @@ def export_model(model, out: str, meta: dict, one_piece: bool = False) -> dict:
     else:
         doc.update(form="split", blocks=_export_split(model, out, size))
         doc["files"] = {n: sha256_file(os.path.join(out, n)) for n in SPLIT_FILES}
-    _ex.write_json(os.path.join(out, "neural_noise.json"), doc)
+    write_model_json(os.path.join(out, "neural_noise.json"), doc)
     return doc
 
 

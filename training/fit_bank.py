@@ -67,14 +67,15 @@ def main(argv: list | None = None) -> int:
     t = time.perf_counter()
     bank = build_bank(classes, a.size, a.sets, a.seeds, a.offset)
     os.makedirs(a.out, exist_ok=True)
-    from omninoise.export.atomic import atomic_path, write_json
+    from omninoise.backend.onnx_models import write_model_json
+    from omninoise.export.atomic import atomic_path
 
     buf = io.BytesIO()
     np.savez_compressed(buf, **bank)
     with atomic_path(os.path.join(a.out, "bank.npz")) as tmp:
         with open(tmp, "wb") as fh:
             fh.write(buf.getvalue())
-    write_json(os.path.join(a.out, "fit_bank.json"), dict(
+    write_model_json(os.path.join(a.out, "fit_bank.json"), dict(
         kind="omninoise.fit_bank", format=1, classes=classes, size=a.size, sets=a.sets, seeds=a.seeds,
         offset=a.offset, images=int(bank["cls"].shape[0]), zoo="training/zoo.py",
         command=f"python -m omninoise.training.fit_bank --out {a.out} --size {a.size} --sets {a.sets} "

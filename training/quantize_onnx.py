@@ -23,6 +23,7 @@ import tempfile
 import numpy as np
 import torch
 
+from omninoise.backend.onnx_models import write_model_json
 from omninoise import export as _ex
 from omninoise.backend.neural import conditioning as C
 from omninoise.backend.neural.model import NeuralNoiseModel
@@ -117,7 +118,7 @@ def quantize_folder(folder: str, size: int = 64, seed: int = 0, log=print) -> di
     with open(path, encoding="utf-8") as fh:
         doc = json.load(fh)
     doc["int8"] = section
-    _ex.write_json(path, doc)
+    write_model_json(path, doc)
     return section
 
 

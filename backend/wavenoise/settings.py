@@ -11,17 +11,17 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from .byexample import PLANES, example_table
-from .cellular import CELLULAR_MODES, CellularNoise
+from .cellular import CellularNoise
 from .directions import DirectionSet, Domain
 from .. import limits
 from ..errors import SettingError
 from .spectra import Spectrum
-from .tables import DEFAULT_SIZE, WAVEFORMS, build_axis_table, build_table, build_waveform_table
-from .wave import OUTPUTS, Transition, WaveNoise
+from .tables import DEFAULT_SIZE, build_axis_table, build_table, build_waveform_table
+from .schema import ANISOTROPY, WAVE_SETTINGS
+from .wave import Transition, WaveNoise
 
-__all__ = ["WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict"]
+__all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict"]
 
-ANISOTROPY = ("none", "axes", "lobes")
 
 
 @dataclass(frozen=True)
@@ -81,36 +81,35 @@ class WaveSettings:
         return replace(self, **kw)
 
     def validate(self) -> "WaveSettings":
-        if self.dim not in (2, 3, 4):
-            raise SettingError("dim", f"must be the number 2, 3 or 4, got {self.dim!r}")
-        if not 1 <= int(self.directions) <= limits.MAX_DIRECTIONS:
-            raise SettingError("directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {self.directions}")
-        limits.in_range("speed", self.speed, -limits.MAX_SPEED, limits.MAX_SPEED)
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2 ** 32:
-            raise SettingError("seed", f"must be a whole number in [0, 2^32), got {self.seed!r}")
-        for name in ("slice_width", "cell_size", "table_period"):
-            if getattr(self, name) is not None:
-                limits.positive(name.replace("_", " "), getattr(self, name))
-        limits.in_range("stit probability", self.stit_probability, 0.0, 1.0)
-        limits.check_int("stit depth", int(self.stit_depth), 0, 16)
-        limits.check_int("table size", int(self.table_size), 16, limits.MAX_TABLE_SIZE)
-        limits.check_int("sectors", int(self.sectors), 1, 64)
-        limits.positive("example extent", self.example_extent)
-        limits.positive("transition length", self.transition_length)
-        if self.output not in OUTPUTS:
-            raise SettingError("output", f"unknown output {self.output!r}; choose one of {', '.join(OUTPUTS)}")
-        if self.waveform not in WAVEFORMS:
-            raise SettingError("waveform", f"unknown waveform {self.waveform!r}; choose one of {', '.join(WAVEFORMS)}")
-        if self.cellular not in CELLULAR_MODES:
-            raise SettingError("cellular", f"unknown mode {self.cellular!r}; choose one of {', '.join(CELLULAR_MODES)}")
-        if self.anisotropy not in ANISOTROPY:
-            raise SettingError("anisotropy", f"unknown mode {self.anisotropy!r}; choose one of {', '.join(ANISOTROPY)}")
+        """The fields against :data:`backend.wavenoise.schema.WAVE_SETTINGS` (exact types, ranges, known
+        names), then the rules that join fields; SettingError naming the first field that is wrong."""
+        try:
+            d = {k: v for k, v in settings_to_dict(self).items() if v != []}  # () is a tuple setting left unset
+        except (TypeError, ValueError) as exc:  # a tuple field holding something that is not a number
+            raise SettingError("wave settings", f"expected numbers in the tuple settings ({exc})") from None
+        WAVE_SETTINGS.check(d, "")
         if self.example is not None and self.example_plane not in PLANES:
-            raise SettingError("example plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")
-        if not 0.0 < limits.finite("spread", self.spread) <= 90.0:
-            raise SettingError("spread", f"must lie in (0, 90] degrees, got {self.spread:g}")
+            raise SettingError("example_plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")
         self.spectrum.validate()
         return self
+
+    def max_frequency(self) -> float:
+        """The highest frequency any of the noise's spectra (or its by-example image) holds, cycles per unit."""
+        spectra = [self.spectrum, *self.axis_spectra] + ([self.transition_to] if self.transition_to else [])
+        f = max(float(sp.fmax) for sp in spectra)
+        if self.example is not None:
+            f = max(f, max(np.shape(self.example)) / (2.0 * float(self.example_extent)))
+        return f
+
+    def check_reach(self, name: str, reach: float) -> None:
+        """Refuse a request whose farthest point lies ``reach`` world units from the origin (time times speed
+        included) when that is more than :data:`~backend.limits.MAX_CYCLES` waves (or cells) away: float32
+        phases there no longer hold the waves, and the noise would come out as a few flat values."""
+        per_unit = 1.0 / float(self.cell_size) if self.cellular != "none" and self.cell_size else self.max_frequency()
+        if not reach * per_unit <= limits.MAX_CYCLES:
+            raise SettingError(name, f"reaches {reach:g} units from the origin, {reach * per_unit:.3g} "
+                                     f"{'cells' if self.cellular != 'none' else 'waves'} away; keep it within "
+                                     f"{limits.MAX_CYCLES:g} (a smaller extent, time or frequency)")
 
     @property
     def animated(self) -> bool:

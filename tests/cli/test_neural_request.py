@@ -89,7 +89,7 @@ sampler = "ddim"
 
 
 @pytest.mark.parametrize("table, msg", [
-    (dict(corners=["spots", "perlin", "spots"]), "source.corners: expected four class specs"),
+    (dict(corners=["spots", "perlin", "spots"]), "source.corners: expected 4 items, got 3"),
     (dict(regions={"#ff0000": "spots"}), "source.regions: regions name the colours of a painted map"),
     (dict(map="paint.png", corners=["spots"] * 4), "choose one of blend, corners and map"),
     (dict(map="paint.png", regions={"#ff00": "spots"}), "bad colour '#ff00'"),
@@ -97,7 +97,8 @@ sampler = "ddim"
      "the map uses (0, 0, 255) but no spec is given for it"),
     (dict(map="paint.png", regions={"#000000": "spots", "#ff0000": "perlin", "#0000ff": "lava"}), "unknown class 'lava'"),
     (dict(corners=["spots:coverage", "perlin", "spots", "spots"]), "expected NAME=VALUE with a finite number"),
-    (dict(corners=["spots", "perlin", {"noise": "spots", "size": 2}, "spots"]), "expected \"CLASS:NAME=VALUE"),
+    (dict(corners=["spots", "perlin", {"noise": "spots", "size": 2}, "spots"]),
+     "source.corners[2].size: unknown key; known: noise, params"),
 ])
 def test_job_layouts_say_what_is_wrong(table, msg, maps):
     with pytest.raises(SettingError) as e:

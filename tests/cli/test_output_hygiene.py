@@ -12,6 +12,7 @@ from omninoise import export
 from omninoise.export.images import write_unit_image
 from omninoise.cli.common import shown
 from omninoise.cli.main import main
+from omninoise.backend.onnx_models import sealed
 
 
 def wave_job(folder, name: str, output: str, bake: str = "", source: str = "", resolution: str = "[4, 4]"):
@@ -82,12 +83,12 @@ def test_times_and_speeds_whose_product_overflows_are_refused_before_any_work(tm
     """A time, speed or frame step that would overflow the waves' phases (NaN images before) is refused, named."""
     out = tmp_path / "t.npy"
     for args, said in ((["--time", "1e308", "--speed", "1"], "--time: must lie in [-1e+09, 1e+09]"),
-                       (["--time", "1", "--speed", "1e300"], "--speed: must lie in [-1e+06, 1e+06]")):
+                       (["--time", "1", "--speed", "1e300"], "--speed: must lie in [-1000000, 1000000], got 1e+300")):
         assert main(["wave", "--size", "16", "--quiet", "-o", str(out), *args]) == 2
         assert said in capsys.readouterr().err
     job = wave_job(tmp_path, "t", "f_#.npy", 'frames = [1, 3]\ntime_step = 1e308\n', 'speed = 1.0\n')
     assert main(["bake", str(job)]) == 2
-    assert "time_step: the last frame's time, inf, passes 1e+09" in capsys.readouterr().err
+    assert "time_step: must lie in (0, 1000000000], got 1e+308" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["job.toml"]
 
 
@@ -165,7 +166,7 @@ def test_a_damaged_model_folder_is_left_out_and_the_others_listed(tmp_path, monk
         doc["files"] = json.loads((src / "solid.json").read_text())["files"]
         for name in doc["files"]:
             shutil.copy(src / name, root / "solid" / "broken" / name)
-        (root / "solid" / "broken" / "solid.json").write_text(json.dumps(doc))
+        (root / "solid" / "broken" / "solid.json").write_text(json.dumps(sealed(doc)))
     monkeypatch.setenv("OMNINOISE_MODELS", str(root))
     assert main(["solid", "--list"]) == 0
     assert list(json.loads(capsys.readouterr().out)) == ["gravel_3d"]
@@ -173,6 +174,40 @@ def test_a_damaged_model_folder_is_left_out_and_the_others_listed(tmp_path, monk
                  str(tmp_path / "s.png")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "broken" in err[0] and "internal error" not in err[0]
+
+
+def test_a_model_description_is_inside_the_sha256_check(tmp_path, capsys):
+    """Zeroing a class embedding in neural_noise.json (weights untouched) is refused, in one line naming the
+    file; so is a description without its seal. Every shipped description carries a seal that verifies."""
+    import json
+    import shutil
+
+    from omninoise.backend.onnx_models import SEAL, json_seal
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    folder = tmp_path / "tiny"
+    shutil.copytree(os.path.join(root, "tests", "data", "tiny_neural"), folder)
+    doc = json.loads((folder / "neural_noise.json").read_text())
+    doc["class_embedding"][0] = [0.0] * len(doc["class_embedding"][0])
+    out = tmp_path / "n.png"
+    for text, said in ((json.dumps(doc), f"{SEAL} does not match its contents"),
+                       (json.dumps({k: v for k, v in doc.items() if k != SEAL}), f"has no {SEAL} seal")):
+        (folder / "neural_noise.json").write_text(text)
+        assert main(["neural", "--model", str(folder), "--noise", doc["classes"][0], "--size", "16", "--steps", "1",
+                     "--quiet", "-o", str(out)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and said in err[0] and "neural_noise.json" in err[0], err
+        assert not out.exists()
+    (folder / "neural_noise.json").write_text(json.dumps(sealed(doc)))     # sealed again: loads (and differs)
+    assert main(["neural", "--model", str(folder), "--noise", doc["classes"][0], "--size", "16", "--steps", "1",
+                 "--quiet", "-o", str(out)]) == 0
+    shipped = [os.path.join(d, f) for d, _, fs in os.walk(os.path.join(root, "models")) for f in fs
+               if f in ("neural_noise.json", "solid.json", "fit_bank.json")]
+    assert len(shipped) >= 3
+    for path in shipped:
+        with open(path, encoding="utf-8") as fh:
+            d = json.load(fh)
+        assert d[SEAL] == json_seal(d), path
 
 
 def test_a_damaged_earlier_volume_is_out_of_date_and_read_within_bounds(tmp_path, capsys):
@@ -227,7 +262,7 @@ def test_two_bakes_writing_one_file_are_refused_through_links_and_overlapping_fr
 
 
 @pytest.mark.parametrize("args, flag", [
-    (["wave", "--seed", "-1", "--size", "8", "-o", "{d}/a.npy"], "--seed: must be a whole number in [0, 2^32)"),
+    (["wave", "--seed", "-1", "--size", "8", "-o", "{d}/a.npy"], "--seed: must lie in [0, 4294967295], got -1"),
     (["wave", "--spectrum", "fractal", "--exponent", "nan", "--size", "8", "-o", "{d}/a.npy"],
      "--exponent: must be a finite number"),
     (["zoo", "--noise", "perlin", "--seed", "-1", "--size", "8", "-o", "{d}/z.png"], "--seed: must lie in [0, 2^32)"),

@@ -139,7 +139,7 @@ def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
     np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))
     (tmp_path / "job.toml").write_text((tmp_path / "job.toml").read_text().replace("mix = 0.3", "mix = 1.5"))
     assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 2
-    assert "source.mix: must be in [0, 1], got 1.5" in capsys.readouterr().err
+    assert "source.mix: must lie in [0, 1], got 1.5" in capsys.readouterr().err
 
 
 @pytest.mark.long

@@ -85,7 +85,7 @@ seed = 4
 
 @pytest.mark.parametrize("source, msg", [
     ({"kind": "solid"}, "source.exemplar: the space model needs an exemplar"),
-    ({"kind": "solid", "model": "gravel_3d", "colour": 1}, "unknown solid setting"),
+    ({"kind": "solid", "model": "gravel_3d", "colour": 1}, r"source.colour: unknown key; known: kind, method"),
     ({"kind": "solid", "model": "gravel_3d", "exemplar": "x.png"}, "holds one texture"),
     ({"kind": "solid", "model": "nope"}, "no solid.json"),
     ({"kind": "solid", "model": "gravel_3d", "scale": 0}, r"source.scale: must lie in \[0.0001, 10000\]"),

@@ -10,6 +10,7 @@ from omninoise.backend.solid.harmonic import (COUNT, HarmonicConfig, Harmonics, 
                                               photo_harmonics, seed_shift)
 from omninoise.backend.solid.pipeline import PhotoConfig, photo_code
 from omninoise.backend.solid.model import SolidTextureModel, plane_points
+from omninoise.backend.onnx_models import sealed
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SPACE = os.path.join(ROOT, "models", "solid", "space")
@@ -276,7 +277,7 @@ def test_a_single_photo_model_stores_its_harmonic_part(tmp_path):
     doc = json.loads((tmp_path / "tiny" / "solid.json").read_text())
     with open(os.path.join(ROOT, "models", "solid", "brick_3d", "solid.json"), encoding="utf-8") as f:
         doc["harmonics"] = json.load(f)["harmonics"]
-    (tmp_path / "tiny" / "solid.json").write_text(json.dumps(doc))
+    (tmp_path / "tiny" / "solid.json").write_text(json.dumps(sealed(doc)))
     with pytest.raises(ModelError, match="only single photo models"):
         SolidTextureModel(str(tmp_path / "tiny"))
 
@@ -401,7 +402,7 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
 
     shutil.copytree(SPACE, tmp_path / "rest")
     doc = json.loads((tmp_path / "rest" / "solid.json").read_text())
-    (tmp_path / "rest" / "solid.json").write_text(json.dumps(dict(doc, harmonic_rest=True)))
+    (tmp_path / "rest" / "solid.json").write_text(json.dumps(sealed(dict(doc, harmonic_rest=True))))
     plain, rest = SolidTextureModel(SPACE), SolidTextureModel(str(tmp_path / "rest"))
     photo = read_rgb(BRICK)
     h = rest.harmonics(photo)
@@ -426,7 +427,7 @@ def test_a_model_trained_on_rests_encodes_rests_and_draws_them_at_their_own_spre
         np.testing.assert_allclose(got[inside], k * d[inside], atol=2e-4)
     single = json.loads(open(os.path.join(ROOT, "tests", "data", "tiny_solid", "single3", "solid.json")).read())
     shutil.copytree(os.path.join(ROOT, "tests", "data", "tiny_solid", "single3"), tmp_path / "single")
-    (tmp_path / "single" / "solid.json").write_text(json.dumps(dict(single, harmonic_rest=True)))
+    (tmp_path / "single" / "solid.json").write_text(json.dumps(sealed(dict(single, harmonic_rest=True))))
     with pytest.raises(ModelError, match="trained on harmonic rests"):
         SolidTextureModel(str(tmp_path / "single"))
 
@@ -516,16 +517,16 @@ def test_a_named_code_draws_what_encoding_its_photo_draws(space, tmp_path):
     shutil.copytree(SPACE, folder)
     doc = json.loads((folder / "solid.json").read_text())
     doc["code_harmonics"]["cork"] = doc["code_harmonics"]["metal"]
-    (folder / "solid.json").write_text(json.dumps(doc))
+    (folder / "solid.json").write_text(json.dumps(sealed(doc)))
     with pytest.raises(ModelError, match="stores a harmonic part for code 'cork'"):
         SolidTextureModel(str(folder))
     del doc["code_harmonics"]["cork"]
     doc["code_rests"]["cork"] = doc["code_rests"]["metal"]
-    (folder / "solid.json").write_text(json.dumps(doc))
+    (folder / "solid.json").write_text(json.dumps(sealed(doc)))
     with pytest.raises(ModelError, match="stores a Gaussian rest for code 'cork'"):
         SolidTextureModel(str(folder))
     del doc["code_rests"]["cork"]
     doc["code_rests"]["metal"]["mix"] = 0.0
-    (folder / "solid.json").write_text(json.dumps(doc))
+    (folder / "solid.json").write_text(json.dumps(sealed(doc)))
     with pytest.raises(ModelError, match="code 'metal': a Gaussian rest: 512 frequencies, 512 amplitudes, mix 0.0"):
         SolidTextureModel(str(folder))

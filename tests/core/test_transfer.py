@@ -45,8 +45,8 @@ def test_density_scale_and_temperature():
     (dict(RAMP, range=[1, 1]), "different"),
     (dict(RAMP, interpolation="b_spline"), "interpolation"),
     (dict(RAMP, colour=[1]), "unknown key"),
-    (dict(RAMP, stops=[[0.0, [0, 0]]]), "needs 4 values"),
-    (dict(preset="lava"), "unknown 'lava'"),
+    (dict(RAMP, stops=[[0.0, [0, 0]]]), r"stops\[0\]\[1\]: expected 3 to 4 items, got 2"),
+    (dict(preset="lava"), "preset: expected one of clouds, smoke, fire, marble, crystal, got 'lava'"),
     (dict(range=[0, 1]), "needs stops"),
 ])
 def test_bad_ramps_fail_with_a_reason(bad, match):
@@ -59,8 +59,11 @@ def test_json_round_trip_and_files(tmp_path):
     again = transfer_from_dict(json.loads(json.dumps(tf.to_dict())))
     assert again == tf
     path = tmp_path / "ramp.json"
-    path.write_text(json.dumps(dict(RAMP, interpolation="EASE")))
+    path.write_text(json.dumps(dict(RAMP, interpolation="ease")))
     assert load_transfer(str(path)).interpolation == "ease"
+    path.write_text(json.dumps(dict(RAMP, interpolation="EASE")))  # names are exact, with a hint
+    with pytest.raises(SettingError, match=r"ramp.json.interpolation: .*\(did you mean ease\?\), got 'EASE'"):
+        load_transfer(str(path))
     assert load_transfer("smoke") == preset("smoke")
     path.write_text("{not json")
     with pytest.raises(SettingError, match="not valid JSON"):
@@ -92,5 +95,5 @@ def test_presets_fill_part_of_a_wave_volume(name):
 
 
 def test_validates_as_a_dataclass():
-    with pytest.raises(SettingError, match="needs at least one stop"):
+    with pytest.raises(SettingError, match=r"stops: expected 1 to 256 items, got 0"):
         TransferFunction(stops=()).validate()

@@ -18,6 +18,7 @@ from omninoise.backend.onnx_models import fingerprint  # noqa: E402
 from omninoise.training.export_onnx import export, reexport  # noqa: E402
 from omninoise.training.train import TrainConfig, build_model, train  # noqa: E402
 from omninoise.training.unet import set_circular  # noqa: E402
+from omninoise.backend.onnx_models import sealed
 
 from tiny_run import TINY  # noqa: E402  (the run itself: the `exported` fixture of tests/training/conftest.py)
 
@@ -75,7 +76,7 @@ def test_model_json_must_declare_what_the_runtime_runs(exported, tmp_path):
     for change, msg in ((dict(form="sideways"), "unknown model form"), (dict(prediction="v"), "epsilon only"),
                         (dict(schedule=dict(kind="linear")), "unsupported noise schedule"),
                         (dict(files={"encoder.onnx": doc["files"]["encoder.onnx"]}), "no sha256 for denoiser.onnx")):
-        (tmp_path / "neural_noise.json").write_text(json.dumps(dict(doc, **change)))
+        (tmp_path / "neural_noise.json").write_text(json.dumps(sealed(dict(doc, **change))))
         with pytest.raises(ModelError, match=msg):
             NeuralNoiseModel(str(tmp_path))
 
@@ -193,7 +194,7 @@ def test_model_card_without_the_run(exported, tmp_path):
     shutil.copytree(out, old)
     doc = json.loads((old / "neural_noise.json").read_text())
     del doc["training"]
-    (old / "neural_noise.json").write_text(json.dumps(doc))
+    (old / "neural_noise.json").write_text(json.dumps(sealed(doc)))
     with pytest.raises(ValueError, match="give --wall-minutes and --final-mse"):
         run_figures(None, doc)
     ev = tmp_path / "ev.json"

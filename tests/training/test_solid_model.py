@@ -21,6 +21,7 @@ from omninoise.training.solid.value_noise import octave_seeds  # noqa: E402
 from omninoise.training.solid.model import random_rotations, slice_points  # noqa: E402
 from omninoise.training.solid.train import SolidConfig, build_model, train, training_images  # noqa: E402
 from omninoise.training.solid.waves import photo_waves, wave_features, wave_share  # noqa: E402
+from omninoise.backend.onnx_models import sealed
 
 
 def _tiny(tmp_path, mode="single", dim=3, steps=4, **kw):
@@ -288,10 +289,10 @@ def test_runtime_refuses_altered_and_bad_input(tmp_path):
     with pytest.raises(Cancelled):
         rt.evaluate(np.zeros((10, 2)), rt.default_code(), cancel=lambda: True)
     doc = json.loads((out / "solid.json").read_text())
-    (out / "solid.json").write_text(json.dumps(dict(doc, spin="world")))
+    (out / "solid.json").write_text(json.dumps(sealed(dict(doc, spin="world"))))
     with pytest.raises(ModelError, match="spin must be one of .* got 'world'"):
         SolidTextureModel(str(out))
-    (out / "solid.json").write_text(json.dumps(doc))
+    (out / "solid.json").write_text(json.dumps(sealed(doc)))
     with open(out / "decoder.onnx", "ab") as fh:
         fh.write(b"x")
     with pytest.raises(ModelError, match="sha256 does not match"):

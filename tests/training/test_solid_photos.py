@@ -128,6 +128,7 @@ from omninoise.training.solid.export import export  # noqa: E402
 from omninoise.training.solid.model import bounded_transform, colour_stats as colour_stats_t, random_rotations  # noqa: E402
 from omninoise.training.solid.swd import SlicedFeatures, swd_loss  # noqa: E402
 from omninoise.training.solid.train import SolidConfig, build_model, train  # noqa: E402
+from omninoise.backend.onnx_models import sealed
 
 
 def test_colour_stats_twins_agree_and_rebuild_the_covariance():
@@ -594,11 +595,11 @@ def test_single_photo_model_holds_out_a_quarter_and_ships_its_colour(tmp_path, b
     # an export without the colour it draws in is refused when loaded, with a one-line reason
     broken = dict(json.loads((tmp_path / "models" / "tiny_single" / "solid.json").read_text()))
     del broken["colour_code"]
-    (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(broken))
+    (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(sealed(broken)))
     from omninoise.backend.onnx_models import ModelError
     with pytest.raises(ModelError, match="colour_code"):
         SolidTextureModel(str(tmp_path / "models" / "tiny_single"))
-    (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(doc))
+    (tmp_path / "models" / "tiny_single" / "solid.json").write_text(json.dumps(sealed(doc)))
     # the held-out evaluation: every measure, against the shipped space model given the same training pixels
     mod = bench_script("eval_solid_singles")
     out = tmp_path / "singles.json"

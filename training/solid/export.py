@@ -22,7 +22,7 @@ import sys
 import torch
 from torch import nn
 
-from omninoise import export as _ex
+from omninoise.backend.onnx_models import write_model_json
 from omninoise.backend.onnx_models import sha256_file
 from omninoise.backend.solid.harmonic import to_json
 from omninoise.backend.solid.harmonic import measure_harmonics
@@ -151,7 +151,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
     doc["files"] = files
     doc.update(extra or {})
     path = os.path.join(out, "solid.json")
-    _ex.write_json(path, doc)
+    write_model_json(path, doc)
     if cfg.mode == "space" and cfg.colour == "affine" and cfg.dim == 3:
         # each name's Gaussian rest, as the runtime's check keeps it for its photo (it renders the export itself)
         from omninoise.backend.solid.model import SolidTextureModel
@@ -161,7 +161,7 @@ def export(run: str, out: str, extra: dict | None = None) -> dict:
         rests = rests_of(SolidTextureModel(out), named)
         if rests:
             doc["code_rests"] = rests
-            _ex.write_json(path, doc)
+            write_model_json(path, doc)
     return doc
 
 

@@ -29,7 +29,7 @@ import tempfile
 import numpy as np
 
 from omninoise import export as _ex
-from omninoise.backend.onnx_models import ModelError
+from omninoise.backend.onnx_models import ModelError, write_model_json
 from omninoise.backend.solid.harmonic import to_json
 from omninoise.backend.solid.model import SolidTextureModel, exemplar_category
 from omninoise.backend.solid.gaussian_rest import rest_to_json
@@ -109,7 +109,7 @@ def main(argv=None) -> int:
         with tempfile.TemporaryDirectory() as tmp:   # the folder as it will be, measured before it is written
             staged = os.path.join(tmp, "model")
             shutil.copytree(a.folder, staged)
-            _ex.write_json(os.path.join(staged, "solid.json"), doc)
+            write_model_json(os.path.join(staged, "solid.json"), doc)
             if not a.remove and space:
                 doc["code_harmonics"], doc["code_rests"] = measure_codes(staged, a.root)
             elif not a.remove:
@@ -117,7 +117,7 @@ def main(argv=None) -> int:
     except (OSError, ValueError, ModelError) as exc:
         print(f"solid harmonics: error: {exc}", file=sys.stderr)
         return 2
-    _ex.write_json(path, doc)
+    write_model_json(path, doc)
     if space:
         parts, rests = doc.get("code_harmonics", {}), doc.get("code_rests", {})
         print(f"{path}: " + (", ".join(f"{k} {len(h['freq'])} waves ({h['share']:.3f})" for k, h in parts.items())
