@@ -89,6 +89,7 @@ docs: $(STAMP)
 	@for f in $(README_PICTURES); do test -f out/demo/$$f || { echo "make docs: out/demo/$$f is missing: run make demo first"; exit 2; }; done
 	cp $(addprefix out/demo/,$(README_PICTURES)) docs/img/
 	$(BIN)/python tools/benchmarks_md.py
+	$(BIN)/python -m tools.job_reference
 
 # installable extension zips (linux-x64, windows-x64, macos-arm64) in dist/, built and validated
 # with Blender's own extension builder from the bpy wheel; Zig (PyPI's ziglang) cross-compiles the

@@ -120,11 +120,11 @@ from __future__ import annotations
 
 import copy
 import os
-import tomllib
 from dataclasses import dataclass
 from typing import Callable
 
 from .bake import BakeResult, BakeSpec, Cancelled, frame_path, run_bake
+from .documents import read_document
 from .errors import SettingError
 from .schema import did_you_mean, shown_value
 from .sources import BoxGrid, source_from_dict
@@ -245,13 +245,12 @@ def parse_job(doc: dict, base_dir: str) -> list:
 
 
 def load_job(path: str) -> list:
-    if not os.path.isfile(path):
+    if not os.path.exists(path):
         raise JobError(f"job file not found: {path}")
     try:
-        with open(path, "rb") as fh:
-            doc = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise JobError(f"{os.path.basename(path)}: not valid TOML ({exc})") from None
+        doc = read_document(path, "job file", "toml")
+    except SettingError as exc:
+        raise JobError(exc.message) from None
     return parse_job(doc, os.path.dirname(os.path.abspath(path)))
 
 

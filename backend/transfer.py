@@ -19,7 +19,6 @@ JSON form (``--transfer RAMP.json``, job files)::
 """
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 
@@ -182,13 +181,11 @@ def load_transfer(spec: str) -> TransferFunction:
     """A preset name or a JSON ramp file."""
     if spec in PRESETS:
         return preset(spec)
-    if not os.path.isfile(spec):
+    if not os.path.exists(spec):
         raise SettingError("transfer", f"{spec!r} is neither a preset ({', '.join(PRESETS)}) nor a file")
-    try:
-        with open(spec, encoding="utf-8") as fh:
-            d = json.load(fh)
-    except json.JSONDecodeError as exc:
-        raise SettingError("transfer", f"{spec}: not valid JSON ({exc.msg}, line {exc.lineno})") from None
+    from .documents import read_document
+
+    d = read_document(spec, "transfer", "json")
     return transfer_from_dict(d, os.path.basename(spec))
 
 

@@ -201,6 +201,9 @@ def run(a: argparse.Namespace) -> int:
     if not os.path.isdir(folder):
         raise SettingError("-o", f"output folder does not exist: {folder}")
     s = settings_from_args(a)
+    tf = load_transfer(a.transfer) if a.transfer else None
+    if tf is not None and a.range:
+        tf = tf.with_range(*a.range)
     from omninoise.backend.sources import WaveSource
 
     WaveSource(s).check_extent(a.extent, abs(a.time), ("--extent", "--time"))
@@ -212,19 +215,16 @@ def run(a: argparse.Namespace) -> int:
     if a.fmax > nyq and a.cellular == "none" and not a.quiet:
         print(f"omninoise wave: warning: --fmax {a.fmax:g} is above the grid's Nyquist {nyq:g}; "
               "the image will alias", file=sys.stderr)
-    return _bake(a, s, ext)
+    return _bake(a, s, tf, ext)
 
 
-def _bake(a: argparse.Namespace, s: WaveSettings, ext: str) -> int:
+def _bake(a: argparse.Namespace, s: WaveSettings, tf, ext: str) -> int:
     """``wave``, every output type, through the bake pipeline: one sampling convention (docs/conventions.md:
     sample centres (i + 1/2) E / N over [0, E)^d; .npy indexed [y, x] / [z, y, x]; images with +y up), the
     ramp, an atomic write."""
     from omninoise.backend.bake import BakeSpec, run_bake
     from omninoise.backend.sources import BoxGrid, WaveSource
 
-    tf = load_transfer(a.transfer) if a.transfer else None
-    if tf is not None and a.range:
-        tf = tf.with_range(*a.range)
     rank = 3 if ext == ".vdb" or (ext == ".npy" and a.dim > 2) else 2
     grid = BoxGrid((a.size,) * rank, ((0.0, 0.0, 0.0), (a.extent,) * 3))
     spec = BakeSpec("wave", WaveSource(s), grid, a.out, tf, time=a.time, half=a.half)

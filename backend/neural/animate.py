@@ -30,7 +30,6 @@ Shapes: conditioning float32 (E + P, H, W), latents float32 (H', W'), images flo
 """
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
 from typing import Callable, Iterator
 
@@ -112,14 +111,9 @@ def even_keys(specs: list, first: int, last: int, seed: int = 0) -> list:
 
 def read_keys(path: str) -> list:
     """Keyframes of a TOML file (see the module doc)."""
-    try:
-        with open(path, "rb") as fh:
-            doc = tomllib.load(fh)
-    except FileNotFoundError:
-        raise SettingError("--keys", f"keyframe file not found: {path}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SettingError("--keys", f"{path}: not valid TOML ({exc})") from None
-    return parse_keys(doc, "--keys")
+    from ..documents import read_document
+
+    return parse_keys(read_document(path, "--keys", "toml"), "--keys")
 
 
 def frame_weight(keys: list, frame: float) -> tuple:

@@ -8,7 +8,10 @@ numbers. Every run must end in one of two ways:
 - exit 0 and the output file exists and is not empty, or
 - exit 2 with a one-line error (the last line of stderr, starting ``omninoise``) and no traceback;
 
-never a traceback, a signal or a hang (each example is stopped after ``LIMIT_S`` seconds). Sizes are drawn
+never a traceback, a signal or a hang (each example is stopped after ``LIMIT_S`` seconds). A sweep over the
+settings schema (``backend/settings_schema.py``) gives every key of a job file the values its type refuses
+(wrong kinds, NaN and infinities, numbers past its range, lists past their counts) and expects exit 2 naming
+that key. Sizes are drawn
 from tiny valid values and absurd ones, never from the slow middle, so a valid run takes milliseconds and the
 whole file stays within about a minute on 2 cores. ``derandomize`` keeps CI reproducible: the same examples
 every run (set ``OMNINOISE_FUZZ_SEED`` to explore others locally).
@@ -296,3 +299,80 @@ def test_the_broken_file_corpus_is_refused_by_every_image_input(tmp_path):
             lines = err.getvalue().strip().splitlines()
             assert rc == 2 and len(lines) == 1 and os.path.basename(path) in lines[0], (argv, err.getvalue())
             assert not os.path.exists(out)
+
+
+# -- every key of the settings schema, each with the values its type refuses ---------------------------------
+
+def wrong_values(t) -> list:
+    """Values of the wrong kind, non-finite, past the range or past the count of schema type ``t``."""
+    from omninoise.backend import schema as S
+
+    if isinstance(t, S.AnyOf):
+        return [5 if not any(isinstance(o, (S.Int, S.Float)) for o in t.options) else None, True]
+    if isinstance(t, S.Int):
+        return [1.5, True, "7", t.lo - 1, t.hi + 1, 10 ** 30]
+    if isinstance(t, S.Float):
+        return [math.nan, math.inf, "1", True] + ([t.hi * 10 + 1] if math.isfinite(t.hi) else []) + \
+            ([t.lo - 1 if t.lo <= 0 else t.lo / 10] if math.isfinite(t.lo) else [])
+    if isinstance(t, S.Bool):
+        return ["false", 1, 0]
+    if isinstance(t, S.Text):
+        return [3, "", ["x"]]
+    if isinstance(t, S.Choice):
+        return ["bogus", [t.options[0]]] + ([str(t.options[0])] if isinstance(t.options[0], int) else [3])
+    if isinstance(t, S.ListOf):
+        return [5, "x"] + ([[]] if t.lo > 0 else [])
+    if isinstance(t, S.Items):
+        return [5, []]
+    if isinstance(t, (S.Table, S.MapOf)):
+        return [5, "x"]
+    raise TypeError(t)
+
+
+def schema_cases() -> list:
+    """(id, bake table) for every key of the [[bake]] table and of each source kind's table."""
+    from omninoise.backend.settings_schema import BAKE, SOURCE_TABLES
+
+    base = {"name": "b", "output": "out/b.npy", "resolution": [8, 8]}
+    sources = {"wave": {"kind": "wave"}, "neural": {"kind": "neural", "noise": "perlin", "steps": 1},
+               "solid": {"kind": "solid", "model": "gravel_3d"}}
+    cases = []
+    for key, f in BAKE.fields.items():
+        if key in ("name", "source"):
+            continue
+        for v in filter(lambda v: v is not None, wrong_values(f.type)):
+            cases.append((f"{key}={v!r}", key, dict(base, source=sources["wave"], **{key: v})))
+    for kind, table in SOURCE_TABLES.items():
+        for key, f in table.fields.items():
+            if key == "kind":
+                continue
+            for v in filter(lambda v: v is not None, wrong_values(f.type)):
+                cases.append((f"{kind}.{key}={v!r}", f"source.{key}", dict(base, source=dict(sources[kind], **{key: v}))))
+    return cases
+
+
+SCHEMA_CASES = schema_cases()
+
+
+def test_the_schema_sweep_covers_every_key():
+    from omninoise.backend.settings_schema import BAKE, SOURCE_TABLES
+
+    named = {c[1] for c in SCHEMA_CASES}
+    assert {k for k in BAKE.fields if k not in ("name", "source")} <= named
+    for table in SOURCE_TABLES.values():
+        assert {f"source.{k}" for k in table.fields if k != "kind"} <= named
+    assert len(SCHEMA_CASES) > 250
+
+
+@pytest.mark.parametrize("label, key, bake", SCHEMA_CASES, ids=[c[0][:60] for c in SCHEMA_CASES])
+def test_every_key_refuses_wrong_types_non_finite_numbers_and_values_past_its_caps(tmp_path, label, key, bake):
+    """Exit 2 before any work, one line naming the bake and the key (``bake 'b': source.seed: ...``)."""
+    job = tmp_path / "job.toml"
+    job.write_text(job_text({"bake": [bake]}))
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        rc = main(["bake", str(job), "--quiet"])
+    lines = err.getvalue().strip().splitlines()
+    assert rc == 2 and len(lines) == 1, (label, rc, lines)
+    assert lines[0].startswith(f"omninoise bake: error: bake 'b': {key}"), (label, lines)
+    assert not (tmp_path / "out").exists()

@@ -300,3 +300,24 @@ def test_half_floats_for_a_format_without_them_are_refused_in_a_job_as_on_the_co
     assert "half: writes 16-bit floats into .exr and .vdb only, not h.npy" in capsys.readouterr().out
     assert main(["wave", "--size", "4", "--half", "-o", str(tmp_path / "h.npy")]) == 2
     assert "--half: writes 16-bit floats into .exr and .vdb only" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv", [["bake", "{f}"], ["neural", "--keys", "{f}", "--frames", "1", "2", "--size", "16",
+                                                     "-o", "{d}/k_#.png"],
+                                  ["wave", "--size", "8", "--transfer", "{f}", "-o", "{d}/w.png"]])
+def test_documents_are_read_within_bounds(tmp_path, capsys, argv):
+    """A job, keyframe or ramp file that is a FIFO, a device, not UTF-8 or nested past the parser's depth is
+    refused in one line before any work (a FIFO blocked forever, /dev/zero grew until MemoryError)."""
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    toml = argv[0] != "wave"
+    cases = {str(fifo): "is not a regular file", "/dev/zero": "is not a regular file",
+             "bad": "not UTF-8 text", "deep": "nested too deeply to read"}
+    (tmp_path / "bad").write_bytes(b'a = "\xff"\n' if toml else b'{"stops": "\xff"}')
+    (tmp_path / "deep").write_text("a = " + "[" * 100_000 if toml else '{"a":' * 100_000)
+    for name, said in cases.items():
+        path = name if name.startswith("/") else str(tmp_path / name)
+        assert main([x.format(f=path, d=tmp_path) for x in argv] + ["--quiet"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and said in err[0], (name, err)
+    assert sorted(os.listdir(tmp_path)) == ["bad", "deep", "fifo"]
