@@ -123,6 +123,16 @@ class BakeSpec:
         folder = os.path.dirname(os.path.abspath(self.output))
         if not self.make_folders and not os.path.isdir(folder):
             raise SettingError("output", f"folder does not exist: {folder}")
+        from ..export.atomic import check_target
+
+        try:      # what writing would refuse, refused now: the longest name, and a folder in any frame's place
+            frames = self.frame_list()
+            check_target(frame_path(self.output, frames[-1]), folder_made=self.make_folders)
+            for f in frames if os.path.isdir(folder) else ():
+                if os.path.isdir(frame_path(self.output, f)):
+                    raise IsADirectoryError(f"output path is a folder, not a file: {frame_path(self.output, f)}")
+        except OSError as exc:
+            raise SettingError("output", str(exc)) from None
         return self
 
     def frame_list(self) -> list:

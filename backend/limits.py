@@ -14,6 +14,7 @@ MAX_THREADS        CPU threads a command may ask for
 MAX_REFINE         search steps refining a solid texture's code (each renders two planes)
 MAX_TIME           |time| of an animation or 4D coordinate (float32 phases stay finite and meaningful)
 MAX_SPEED          |speed| of animated waves, units per unit time
+MIN_LENGTH         the shortest length a setting may give (a slice width, a table period, an extent), world units
 MAX_COORD          |world coordinate| of a grid's bounds, an image's extent, an origin or a length, world units
 MAX_FREQUENCY      a wave spectrum's frequencies, cycles per world unit
 MAX_CYCLES         wave cycles (or cellular cells) from the origin to the farthest point a request reaches: the
@@ -30,7 +31,7 @@ import os
 
 from .errors import SettingError
 
-__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "MAX_TIME", "MAX_SPEED", "MAX_COORD", "MAX_FREQUENCY", "MAX_CYCLES", "scale", "time", "frame_count", "memory_limit", "finite", "positive", "in_range", "check_int",
+__all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "MAX_TIME", "MAX_SPEED", "MIN_LENGTH", "MAX_COORD", "MAX_FREQUENCY", "MAX_CYCLES", "scale", "time", "frame_count", "memory_limit", "finite", "positive", "in_range", "check_int",
            "check_memory", "as_bool"]
 
 MAX_DIRECTIONS = 4096
@@ -41,6 +42,7 @@ MAX_REFINE = 10_000
 SCALE_RANGE = (1e-4, 1e4)
 MAX_TIME = 1e9
 MAX_SPEED = 1e6
+MIN_LENGTH = 1e-6
 MAX_COORD = 1e7
 MAX_FREQUENCY = 1e5
 MAX_CYCLES = 1e8

@@ -50,6 +50,9 @@ class BoxGrid:
             raise SettingError("bounds", f"must be finite numbers, got {self.bounds}")
         if not np.all(hi[:n] > lo[:n]):
             raise SettingError("bounds", f"max must exceed min on x, y{', z' if n == 3 else ''}: {self.bounds}")
+        if not np.all(hi[:n] - lo[:n] >= limits.MIN_LENGTH):
+            raise SettingError("bounds", f"the box must be at least {limits.MIN_LENGTH:g} units wide on x, "
+                                         f"y{', z' if n == 3 else ''}: {self.bounds}")
         if np.prod(np.asarray(res, np.float64)) > 2 ** 34:
             raise SettingError("resolution", f"{list(res)} is more than 2^34 voxels")
         # the baked field (float32), with RGBA colour four times that

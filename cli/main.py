@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import signal
 import sys
 import threading
 import warnings
 
 from omninoise.backend.errors import SettingError
+from omninoise.export.atomic import OutputNameError
 from omninoise.export.images import ImageError
 
 from . import bake, hugepages, neural, solid, transfer, wave, zoo
@@ -95,16 +97,33 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(sig, handler)
 
 
+def _check_outputs(a: argparse.Namespace) -> None:
+    """The files a command will write (-o, --report), checked before any work: a name past the file system's
+    limit (a frame pattern's '#' counted as the widest frame number) or a folder in the file's place."""
+    from omninoise.export.atomic import check_target
+
+    for flag, attr in (("-o", "out"), ("--report", "report")):
+        path = getattr(a, attr, None)
+        if isinstance(path, str) and path:
+            try:
+                check_target(re.sub(r"#+", lambda m: "0" * max(len(m.group()), 10), path), folder_made=True)
+                if os.path.isdir(path):
+                    raise IsADirectoryError(f"output path is a folder, not a file: {path}")
+            except OSError as exc:
+                raise SettingError(flag, str(exc)) from None
+
+
 def _run(a: argparse.Namespace) -> int:
     """The subcommand, with every way it can end mapped to a one-line message and the documented exit status."""
     def say(what: str) -> None:
         print(f"omninoise {a.command}: {shown(what)}", file=sys.stderr)
 
     try:
+        _check_outputs(a)
         with warnings.catch_warnings():     # numpy's overflow notes: a result they spoil is refused when written
             warnings.simplefilter("ignore", RuntimeWarning)
             return COMMANDS[a.command].run(a)
-    except (SettingError, FileNotFoundError, PermissionError, IsADirectoryError, ImageError) as exc:
+    except (SettingError, FileNotFoundError, PermissionError, IsADirectoryError, OutputNameError, ImageError) as exc:
         say(f"error: {exc}")
         return 2
     except KeyboardInterrupt as exc:

@@ -191,7 +191,7 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("--half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
-    limits.positive("--extent", a.extent)
+    limits.in_range("--extent", a.extent, limits.MIN_LENGTH, limits.MAX_COORD)
     limits.time("--time", a.time)
     if a.example_extent is not None:
         limits.positive("--example-extent", a.example_extent)

@@ -55,16 +55,48 @@ def tagged(tag: str):
         _TAG.reset(token)
 
 
+class OutputNameError(OSError):
+    """An output's file name is longer than its file system allows."""
+
+
+def name_limit(folder: str) -> int:
+    """Bytes a file name may take in ``folder`` (or its nearest existing parent): the file system's limit, 255
+    where it does not say."""
+    while folder and not os.path.isdir(folder):
+        parent = os.path.dirname(folder)
+        if parent == folder:
+            break
+        folder = parent
+    try:
+        return int(os.pathconf(folder or ".", "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError):
+        return 255
+
+
+def check_target(path: str, folder_made: bool = False) -> None:
+    """Raise now what writing ``path`` would raise later: a name past the file system's limit
+    (OutputNameError), a folder in the file's place (IsADirectoryError), and unless ``folder_made`` (a job makes
+    its folders) a missing or read-only folder (FileNotFoundError, PermissionError)."""
+    folder = os.path.dirname(os.path.abspath(path)) or "."
+    name = os.path.basename(path)
+    size, limit = len(os.fsencode(name)), name_limit(folder)
+    if size > limit:
+        raise OutputNameError(f"output name is {size} bytes, more than the {limit} this file system allows: "
+                              f"{name[:40]}...")
+    if os.path.isdir(path):
+        raise IsADirectoryError(f"output path is a folder, not a file: {path}")
+    if not folder_made:
+        if not os.path.isdir(folder):
+            raise FileNotFoundError(f"output folder does not exist: {folder}")
+        if not os.access(folder, os.W_OK):
+            raise PermissionError(f"output folder is not writable: {folder}")
+
+
 @contextlib.contextmanager
 def atomic_path(path: str, suffix: str | None = None):
     """Yield a temporary path in the target's folder; rename it onto ``path`` on success."""
     folder = os.path.dirname(os.path.abspath(path)) or "."
-    if not os.path.isdir(folder):
-        raise FileNotFoundError(f"output folder does not exist: {folder}")
-    if not os.access(folder, os.W_OK):
-        raise PermissionError(f"output folder is not writable: {folder}")
-    if os.path.isdir(path):
-        raise IsADirectoryError(f"output path is a folder, not a file: {path}")
+    check_target(path)
     remove_stale(folder)
     suffix = (suffix if suffix is not None else os.path.splitext(path)[1])[-SUFFIX_PART:]
     fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)

@@ -18,7 +18,7 @@ __all__ = ["ANISOTROPY", "SEED", "COORD", "LENGTH", "FREQUENCY", "SPECTRUM", "WA
 ANISOTROPY = ("none", "axes", "lobes")
 SEED = Int(0, 2 ** 32 - 1)
 COORD = Float(-limits.MAX_COORD, limits.MAX_COORD)
-LENGTH = Float(0.0, limits.MAX_COORD, above=True)
+LENGTH = Float(limits.MIN_LENGTH, limits.MAX_COORD)
 FREQUENCY = Float(0.0, limits.MAX_FREQUENCY)
 VECTOR = ListOf(COORD, 2, 4)
 

@@ -321,3 +321,25 @@ def test_documents_are_read_within_bounds(tmp_path, capsys, argv):
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and said in err[0], (name, err)
     assert sorted(os.listdir(tmp_path)) == ["bad", "deep", "fifo"]
+
+
+def test_outputs_that_cannot_be_written_are_refused_before_any_work(tmp_path, capsys):
+    """A name past the file system's limit, or a folder where a file (or one frame of a sequence) goes: exit 2
+    in one line, before any work, on the command line and in a job file; the longest legal name is written."""
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / ("a" * 252 + ".npy"))]) == 2
+    assert "-o: output name is 256 bytes, more than the 255" in capsys.readouterr().err
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / ("a" * 251 + ".npy"))]) == 0
+    (tmp_path / "d.npy").mkdir()
+    assert main(["neural", "--noise", "perlin", "--size", "16", "--steps", "1", "--quiet", "-o",
+                 str(tmp_path / "d.npy")]) == 2
+    assert "-o: output path is a folder, not a file" in capsys.readouterr().err
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "f_2.npy").mkdir()
+    (tmp_path / "out" / "v.npy").mkdir()
+    for output in ("out/v.npy", "out/f_#.npy"):
+        job = wave_job(tmp_path, "j", output, 'frames = [1, 3]\n' if "#" in output else "", "speed = 1.0\n")
+        for dry in ([], ["--dry-run"]):
+            assert main(["bake", str(job), "--quiet", *dry]) == 2
+            text = capsys.readouterr()
+            assert "output path is a folder, not a file" in text.err + text.out, text
+        assert sorted(os.listdir(tmp_path / "out")) == ["f_2.npy", "v.npy"]
