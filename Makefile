@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: all setup kernel demo test test-long test-blender bench docs dist clean
+.PHONY: all setup kernel demo test test-long test-blender bench docs assets dist clean
 
 all: test
 
@@ -90,6 +90,12 @@ docs: $(STAMP)
 	cp $(addprefix out/demo/,$(README_PICTURES)) docs/img/
 	$(BIN)/python tools/benchmarks_md.py
 	$(BIN)/python -m tools.job_reference
+	$(BIN)/python -m tools.make_presets
+
+# the shipped asset library (blender_addon/assets) and its sheet (docs/img/assets.png), saved by the oldest
+# supported Blender so that every newer one opens it
+assets: .venv-bpy42/.installed kernel
+	.venv-bpy42/bin/python -m tools.make_assets
 
 # installable extension zips (linux-x64, windows-x64, macos-arm64) in dist/, built and validated
 # with Blender's own extension builder from the bpy wheel; Zig (PyPI's ziglang) cross-compiles the

@@ -235,7 +235,7 @@ TRANSFER = Table({
     "stops": Field(ListOf(AnyOf((Items((Float(0.0, 1.0), COLOR), "[position, [r, g, b(, a)]]"),
                                  Table({"position": Field(Float(0.0, 1.0), "0 to 1", True),
                                         "color": Field(COLOR, "[r, g, b(, a)]", True)},
-                                       "{position = P, color = [r, g, b(, a)]}"))), 1, 256),
+                                       "{position = P, color = [r, g, b(, a)]}"))), 1, 4096),
                    "the ramp's colour stops, sorted by position"),
     "temperature": Field(ListOf(Items((Float(0.0, 1.0), Float(0.0, 1e5)), "[position, kelvin]"), 0, 256),
                          "a volume's temperature grid over the ramp, kelvin"),

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 
 def _modules():
-    from . import bake_ui, neural_ui, preferences, solid_ui, wave_ui
+    from . import bake_ui, menus, neural_ui, preferences, presets, solid_ui, wave_ui
 
-    return (preferences, wave_ui, bake_ui, neural_ui, solid_ui)
+    return (preferences, presets, wave_ui, bake_ui, neural_ui, solid_ui, menus)
 
 
 def register():

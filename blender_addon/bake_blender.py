@@ -12,7 +12,7 @@ from mathutils import Vector
 from .. import backend
 from .compat import ensure_node_tree
 
-__all__ = ["ramp_node", "transfer_from_color_ramp", "apply_preset", "world_bounds", "load_volume",
+__all__ = ["ramp_node", "transfer_from_color_ramp", "apply_preset", "set_ramp", "world_bounds", "load_volume",
            "load_image", "RAMP_GROUP"]
 
 RAMP_GROUP = ".OmniNoise Ramp"  # leading dot: hidden from the node-group lists
@@ -58,7 +58,11 @@ def transfer_from_color_ramp(ramp, value_range, density_scale: float = 1.0, temp
 
 def apply_preset(ramp, name: str) -> "backend.transfer.TransferFunction":
     """Set a Blender Color Ramp to preset ``name``; returns the preset."""
-    tf = backend.transfer.preset(name)
+    return set_ramp(ramp, backend.transfer.preset(name))
+
+
+def set_ramp(ramp, tf) -> "backend.transfer.TransferFunction":
+    """Set a Blender Color Ramp to the stops and interpolation of transfer function ``tf``; returns ``tf``."""
     ramp.color_mode = "RGB"
     ramp.interpolation = tf.interpolation.upper()
     els = ramp.elements

@@ -11,25 +11,28 @@ operators run to completion before returning.
 from __future__ import annotations
 
 import importlib
+import json
 import os
 
 import bpy
+from bl_operators.presets import AddPresetBase
+from bl_ui.utils import PresetPanel
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
     IntVectorProperty, PointerProperty, StringProperty
 
 from . import tasks
 from .tasks import TaskOperator
 from .. import backend
-from .bake_blender import (apply_preset, load_image, load_volume, output_folder, ramp_node,
-                           transfer_from_color_ramp, world_bounds)
+from .bake_blender import (load_image, load_volume, output_folder, ramp_node,
+                           set_ramp, transfer_from_color_ramp, world_bounds)
 from .common import Sidebar
+from .presets import SUBDIRS, transfer_preset_text
 from .preferences import precision, threads
 from .wave_nodes import settings_from_json, tree_settings_json
-from .wave_ui import OMNINOISE_PG_wave, draw_wave_settings
+from .wave_ui import OMNINOISE_PG_wave, draw_wave_presets, draw_wave_settings
 
-__all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "draw_progress", "classes", "attach", "detach"]
+__all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "apply_transfer", "draw_progress", "classes", "attach", "detach"]
 
-_PRESETS = [(k, k.capitalize(), f"The {k} transfer function") for k in ("clouds", "smoke", "fire", "marble", "crystal")]
 _OUTPUTS = [("real", "Value", "Real part"), ("imag", "Imaginary", "Imaginary part"),
             ("modulus", "Modulus", "Ridged: |noise|"), ("phase", "Phase", "Phasor: angle in radians")]
 _CELLULAR = [("none", "None", "Plain wave noise"), ("polytope", "Polytope", "Distance to random polytope borders"),
@@ -47,14 +50,15 @@ def _with_precision(fn):
         return fn(progress, cancel)
     return work
 
-def _apply_preset(self, context) -> None:
-    node = ramp_node()
-    tf = apply_preset(node.color_ramp, self.preset)
-    self.range_min, self.range_max = tf.range
-    self.density_scale = tf.density_scale
-    self.use_temperature = tf.has_temperature
+def apply_transfer(p, tf) -> None:
+    """Set the bake panel's ramp, range, density and temperature to transfer function ``tf`` (the panel's
+    temperature is one rise, from 0 K at its start to its maximum at the ramp's end)."""
+    set_ramp(ramp_node().color_ramp, tf)
+    p.range_min, p.range_max = tf.range
+    p.density_scale = tf.density_scale
+    p.use_temperature = tf.has_temperature
     if tf.has_temperature:
-        self.temperature_start, self.temperature_max = tf.temperature[0][0], tf.temperature[-1][1]
+        p.temperature_start, p.temperature_max = tf.temperature[0][0], tf.temperature[-1][1]
 
 
 def _is_wave_group(self, tree) -> bool:
@@ -64,33 +68,40 @@ def _is_wave_group(self, tree) -> bool:
 class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
     """Bake settings of a scene."""
 
-    source: EnumProperty(name="Source", items=[
+    source: EnumProperty(name="Source", description="Where the wave noise settings come from", items=[
         ("SETTINGS", "Wave Noise", "Wave noise with the settings below"),
         ("NODE", "Wave Noise Node", "The settings of a Wave Noise node group in this file")], default="SETTINGS")
-    wave: PointerProperty(type=OMNINOISE_PG_wave)
-    node_group: PointerProperty(name="Node Group", type=bpy.types.NodeTree, poll=_is_wave_group)
-    output: EnumProperty(name="Output", items=_OUTPUTS, default="real")
-    cellular: EnumProperty(name="Cellular", items=_CELLULAR, default="none")
+    wave: PointerProperty(type=OMNINOISE_PG_wave, name="Wave Noise", description="The wave noise the bake samples")
+    node_group: PointerProperty(name="Node Group", type=bpy.types.NodeTree, poll=_is_wave_group,
+                                description="A Wave Noise node group of this file whose settings the bake uses")
+    output: EnumProperty(name="Output", items=_OUTPUTS, default="real",
+                         description="Which value of the noise is baked")
+    cellular: EnumProperty(name="Cellular", items=_CELLULAR, default="none",
+                           description="Bake cells cut by the waves' planes instead of the noise itself")
     # grid
-    bounds_mode: EnumProperty(name="Bounds", items=[
+    bounds_mode: EnumProperty(name="Bounds", description="The box in the scene that the bake fills", items=[
         ("OBJECT", "Active Object", "The active object's world bounding box"),
         ("CUSTOM", "Custom", "The box below")], default="OBJECT")
-    bounds_min: FloatVectorProperty(name="Min", size=3, default=(-1.0, -1.0, -1.0), subtype="XYZ")
-    bounds_max: FloatVectorProperty(name="Max", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ")
-    volume_resolution: IntVectorProperty(name="Resolution", size=3, default=(128, 128, 128), min=1, max=4096)
-    image_resolution: IntVectorProperty(name="Resolution", size=2, default=(1024, 1024), min=1, max=16384)
+    bounds_min: FloatVectorProperty(name="Min", size=3, default=(-1.0, -1.0, -1.0), subtype="XYZ",
+                                    description="The box's lowest corner, in scene units")
+    bounds_max: FloatVectorProperty(name="Max", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ",
+                                    description="The box's highest corner, in scene units")
+    volume_resolution: IntVectorProperty(name="Resolution", size=3, default=(128, 128, 128), min=1, max=4096,
+                                         description="Voxels along X, Y and Z; memory grows with their product")
+    image_resolution: IntVectorProperty(name="Resolution", size=2, default=(1024, 1024), min=1, max=16384,
+                                        description="Image width and height in pixels")
     # time
     animated: BoolProperty(name="Animated", description="Bake a numbered sequence over a frame range "
                            "(needs wave speed, or 4D noise)", default=False)
-    frame_start: IntProperty(name="Start", default=1, min=0)
-    frame_end: IntProperty(name="End", default=24, min=0)
+    frame_start: IntProperty(name="Start", default=1, min=0, description="First frame of the baked sequence")
+    frame_end: IntProperty(name="End", default=24, min=0, description="Last frame of the baked sequence")
     time: FloatProperty(name="Time", description="Time (4D: W) of the single bake, or of the first frame",
                         default=0.0)
-    time_per_frame: FloatProperty(name="Time per Frame", default=1.0 / 24.0, min=0.0, soft_max=1.0, precision=4)
+    time_per_frame: FloatProperty(name="Time per Frame", default=1.0 / 24.0, min=0.0, soft_max=1.0, precision=4,
+                                  description="How far the noise moves on from one frame to the next")
     # transfer function
     use_ramp: BoolProperty(name="Use Ramp", description="Map values through the ramp (off: raw values)",
                            default=True)
-    preset: EnumProperty(name="Preset", items=_PRESETS, default="clouds", update=_apply_preset)
     range_min: FloatProperty(name="From", description="Noise value at the ramp's left end", default=-0.2)
     range_max: FloatProperty(name="To", description="Noise value at the ramp's right end", default=1.6)
     density_scale: FloatProperty(name="Density", description="Density = alpha x this", default=4.0, min=0.0,
@@ -105,12 +116,15 @@ class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
     folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise/",
                            description="Where baked files go ('//' = beside the .blend, or the cache "
                                        "folder while the file is unsaved)")
-    name: StringProperty(name="Name", default="Noise")
+    name: StringProperty(name="Name", default="Noise",
+                         description="Name of the baked files, and of the Volume object or image they load into")
     image_format: EnumProperty(name="Format", items=[("EXR", "OpenEXR", "Float image"),
-                                                     ("PNG", "PNG", "8-bit preview")], default="EXR")
+                                                     ("PNG", "PNG", "8-bit preview")], default="EXR",
+                               description="File type of the baked image")
     half: BoolProperty(name="Half Float", description="EXR: 16-bit half floats", default=False)
     # batch
-    job_file: StringProperty(name="Job File", subtype="FILE_PATH", default="")
+    job_file: StringProperty(name="Job File", subtype="FILE_PATH", default="",
+                             description="A TOML job file listing bakes (the same files as `omninoise bake`)")
     keep_going: BoolProperty(name="Keep Going", description="After a failed bake, carry on with the others")
     force: BoolProperty(name="Force", description="Re-bake outputs that are up to date")
 
@@ -180,7 +194,7 @@ def _message(text: str) -> None:
 
 
 class _BakeOperator(TaskOperator):
-    bl_options = {"REGISTER"}
+    bl_options = {"REGISTER", "UNDO"}
     target = "VOLUME"
 
     def _start(self, context, blocking: bool):
@@ -232,6 +246,7 @@ class OMNINOISE_OT_cancel(bpy.types.Operator):
 
     bl_idname = "omninoise.cancel"
     bl_label = "Cancel Bake"
+    bl_options = {"REGISTER", "INTERNAL"}
 
     @classmethod
     def poll(cls, context):
@@ -247,10 +262,33 @@ class OMNINOISE_OT_run_job(TaskOperator, bpy.types.Operator):
 
     bl_idname = "omninoise.run_job"
     bl_label = "Run Bake Job"
+    bl_options = {"REGISTER"}      # writes files only: nothing in the .blend to undo
 
-    filepath: StringProperty(name="Job File", subtype="FILE_PATH", default="")
-    keep_going: BoolProperty(name="Keep Going", default=False)
-    force: BoolProperty(name="Force", default=False)
+    filepath: StringProperty(name="Job File", subtype="FILE_PATH", default="",
+                             description="The TOML job file to run (empty: the panel's Job File)")
+    keep_going: BoolProperty(name="Keep Going", default=False,
+                             description="After a failed bake, carry on with the others")
+    force: BoolProperty(name="Force", default=False, description="Re-bake outputs that are up to date")
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+
+    def invoke(self, context, event):
+        """From a menu with no job file chosen: the file browser first, then the job in the background."""
+        if not (self.filepath or context.scene.omninoise_bake.job_file) and not bpy.app.background:
+            self._browsed = True
+            context.window_manager.fileselect_add(self)
+            return {"RUNNING_MODAL"}
+        return super().invoke(context, event)
+
+    def execute(self, context):
+        if getattr(self, "_browsed", False):      # the file browser's confirm: run it as invoke would
+            self._browsed = False
+            context.scene.omninoise_bake.job_file = self.filepath
+            self._task = self._begin(context, blocking=False)
+            if self._task is None:
+                return {"CANCELLED"}
+            context.window_manager.modal_handler_add(self)
+            return {"RUNNING_MODAL"}
+        return super().execute(context)
 
     def _start(self, context, blocking):
         p = context.scene.omninoise_bake
@@ -297,6 +335,11 @@ class _Panel(Sidebar):
 class OMNINOISE_PT_bake(_Panel, bpy.types.Panel):
     bl_label = "Bake Noise"
 
+    def draw_header_preset(self, context):
+        p = context.scene.omninoise_bake
+        if p.source == "SETTINGS":
+            draw_wave_presets(self.layout, p.wave)
+
     def draw(self, context):
         p = context.scene.omninoise_bake
         layout = self.layout
@@ -318,11 +361,13 @@ class OMNINOISE_PT_bake_ramp(_Panel, bpy.types.Panel):
     def draw_header(self, context):
         self.layout.prop(context.scene.omninoise_bake, "use_ramp", text="")
 
+    def draw_header_preset(self, context):
+        OMNINOISE_PT_transfer_presets.draw_panel_header(self.layout)
+
     def draw(self, context):
         p = context.scene.omninoise_bake
         layout = self.layout
         layout.active = p.use_ramp
-        layout.prop(p, "preset")
         node = ramp_node(create=False)
         if node is None:
             layout.operator(OMNINOISE_OT_init_ramp.bl_idname, icon="COLOR")
@@ -341,14 +386,14 @@ class OMNINOISE_PT_bake_ramp(_Panel, bpy.types.Panel):
 
 
 class OMNINOISE_OT_init_ramp(bpy.types.Operator):
-    """Create the ramp the bake panel edits (from the selected preset)"""
+    """Create the ramp the bake panel edits (the clouds preset, to start from)"""
 
     bl_idname = "omninoise.init_ramp"
     bl_label = "Create Ramp"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
     def execute(self, context):
-        _apply_preset(context.scene.omninoise_bake, context)
+        apply_transfer(context.scene.omninoise_bake, backend.transfer.preset("clouds"))
         return {"FINISHED"}
 
 
@@ -406,6 +451,55 @@ class OMNINOISE_PT_bake_job(_Panel, bpy.types.Panel):
         op.filepath = p.job_file
 
 
+# -- transfer function presets (Blender's preset menu in the Transfer Function panel's header) ------------
+
+class OMNINOISE_OT_set_transfer(bpy.types.Operator):
+    """Set the bake panel's ramp, range, density and temperature from a transfer function (a preset's JSON)"""
+
+    bl_idname = "omninoise.set_transfer"
+    bl_label = "Set Transfer Function"
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
+
+    transfer: StringProperty(name="Transfer Function", description="The ramp as JSON: range, interpolation, "
+                             "density_scale, stops and temperature (as in a job file)", options={"SKIP_SAVE"})
+
+    def execute(self, context):
+        try:
+            tf = backend.transfer.transfer_from_dict(json.loads(self.transfer), "preset")
+        except (ValueError, backend.SettingError) as exc:
+            self.report({"ERROR"}, f"transfer function preset: {exc}")
+            return {"CANCELLED"}
+        apply_transfer(context.scene.omninoise_bake, tf)
+        return {"FINISHED"}
+
+
+class OMNINOISE_PT_transfer_presets(PresetPanel, bpy.types.Panel):
+    bl_label = "Transfer Function Presets"
+    preset_subdir = SUBDIRS["transfer"]
+    preset_operator = "script.execute_preset"
+    preset_add_operator = "omninoise.transfer_preset_add"
+
+
+class OMNINOISE_OT_transfer_preset_add(AddPresetBase, bpy.types.Operator):
+    """Add or remove a transfer function preset (the ramp, its range, density and temperature)"""
+
+    bl_idname = "omninoise.transfer_preset_add"
+    bl_label = "Add Transfer Function Preset"
+    preset_menu = "OMNINOISE_PT_transfer_presets"
+    preset_subdir = SUBDIRS["transfer"]
+
+    def add(self, context, filepath):
+        p = context.scene.omninoise_bake
+        use = p.use_ramp
+        p.use_ramp = True
+        try:
+            text = transfer_preset_text(transfer(p))
+        finally:
+            p.use_ramp = use
+        with open(filepath, "w", encoding="utf-8") as fh:
+            fh.write(text)
+
+
 def _statusbar(self, context):
     task = tasks.current()
     if task is None:
@@ -417,7 +511,8 @@ def _statusbar(self, context):
 
 classes = (OMNINOISE_PG_bake, OMNINOISE_OT_bake_volume, OMNINOISE_OT_bake_image, OMNINOISE_OT_cancel,
            OMNINOISE_OT_run_job, OMNINOISE_OT_init_ramp, OMNINOISE_PT_bake, OMNINOISE_PT_bake_ramp,
-           OMNINOISE_PT_bake_output, OMNINOISE_PT_bake_job)
+           OMNINOISE_PT_bake_output, OMNINOISE_PT_bake_job, OMNINOISE_OT_set_transfer, OMNINOISE_PT_transfer_presets,
+           OMNINOISE_OT_transfer_preset_add)
 
 
 def attach():

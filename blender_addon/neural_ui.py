@@ -15,6 +15,8 @@ from __future__ import annotations
 import os
 
 import bpy
+from bl_operators.presets import AddPresetBase
+from bl_ui.utils import PresetPanel
 import numpy as np
 from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty, \
     IntProperty, PointerProperty, StringProperty
@@ -22,11 +24,12 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatPrope
 from . import tasks
 from .. import backend
 from .bake_ui import draw_progress
+from .presets import NEURAL_VALUES, SUBDIRS
 from .common import Sidebar, backend_module as _mod, image_pixels, neural_model_folder
 from .tasks import TaskOperator
 from .preferences import precision, threads
 
-__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "preset_dict", "apply_preset", "thumbnail_name", "attach", "detach"]
+__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "thumbnail_name", "attach", "detach"]
 
 _MODEL = {}
 N_PARAMS = 4
@@ -36,7 +39,7 @@ _SAMPLERS = _mod("neural.sampler")  # numpy only: cheap at register time
 DEFAULT_SAMPLER, DEFAULT_STEPS = _SAMPLERS.DEFAULT_SAMPLER, _SAMPLERS.DEFAULT_STEPS
 #: the samplers of backend.neural.sampler, as the panel lists them
 SAMPLER_ITEMS = [("dpmpp_2m", "DPM-Solver++(2M)", "Second-order multistep: the fewest steps for a clean image"),
-                 ("ddim", "DDIM", "First order; the sampler of earlier OmniNoise versions (30 steps)"),
+                 ("ddim", "DDIM", "First order: needs more steps for the same detail (about 30)"),
                  ("heun", "Heun", "Second order, two model evaluations per step")]
 
 
@@ -69,13 +72,15 @@ def _reset_params(self, context) -> None:
 
 
 class OMNINOISE_PG_swatch(bpy.types.PropertyGroup):
-    noise: EnumProperty(name="Noise", items=_class_items, update=_reset_params)
-    p0: FloatProperty(name="Parameter 1")
-    p1: FloatProperty(name="Parameter 2")
-    p2: FloatProperty(name="Parameter 3")
-    p3: FloatProperty(name="Parameter 4")
-    color: FloatVectorProperty(name="Colour", subtype="COLOR", size=3, min=0.0, max=1.0, default=(1.0, 0.0, 0.0),
-                               description="The colour that paints this swatch into the blend map")
+    noise: EnumProperty(name="Noise", items=_class_items, update=_reset_params,
+                        description="The kind of noise this swatch draws (choosing one resets its parameters)")
+    p0: FloatProperty(name="Parameter 1", description="The noise class's first parameter (named in the panel); "
+                                                       "a value outside the class's range is refused at bake")
+    p1: FloatProperty(name="Parameter 2", description="The noise class's second parameter (named in the panel)")
+    p2: FloatProperty(name="Parameter 3", description="The noise class's third parameter (named in the panel)")
+    p3: FloatProperty(name="Parameter 4", description="The noise class's fourth parameter (named in the panel)")
+    color: FloatVectorProperty(name="Color", subtype="COLOR", size=3, min=0.0, max=1.0, default=(1.0, 0.0, 0.0),
+                               description="The color that paints this swatch into the blend map")
 
     def spec(self) -> tuple:
         params = model().class_params[self.noise]["params"][:N_PARAMS]
@@ -86,29 +91,36 @@ _PALETTE = [(1, 0, 0), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 0, 1), (0, 1, 1), (1
 
 
 class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
-    swatches: CollectionProperty(type=OMNINOISE_PG_swatch)
-    active: IntProperty(default=0)
-    mode: EnumProperty(name="Layout", items=[
+    swatches: CollectionProperty(type=OMNINOISE_PG_swatch, name="Swatches",
+                                 description="The noises to draw or blend, each with its parameters and paint color")
+    active: IntProperty(default=0, name="Active Swatch", description="The swatch shown and edited below the list")
+    mode: EnumProperty(name="Layout", description="How the swatches share the image", items=[
         ("SINGLE", "Single", "The active swatch everywhere"),
         ("GRADIENT", "Left to Right", "The first swatch on the left blending into the second on the right"),
-        ("CORNERS", "Four Corners", "Swatches 1-4 at the corners, blended bilinearly (Fig. 4)"),
-        ("MAP", "Painted Map", "Each pixel of the blend map takes the swatch of its colour")], default="SINGLE")
-    blend_map: PointerProperty(name="Blend Map", type=bpy.types.Image)
+        ("CORNERS", "Four Corners", "Swatches 1 to 4 at the corners, blended across the image"),
+        ("MAP", "Painted Map", "Each pixel of the blend map takes the swatch of its color")], default="SINGLE")
+    blend_map: PointerProperty(name="Blend Map", type=bpy.types.Image,
+                               description="An image painted in the swatches' colors: each pixel takes the swatch "
+                                           "of its color")
     width: FloatProperty(name="Transition", description="Width of painted transitions, pixels", default=32.0,
                          min=1.0, soft_max=256.0)
     sharpness: FloatProperty(name="Sharpness", description="Transition exponent (1 = linear)", default=1.0,
                              min=0.1, soft_max=8.0)
-    size: IntProperty(name="Size", default=512, min=8, soft_max=4096, max=16384)
+    size: IntProperty(name="Size", default=512, min=8, soft_max=4096, max=16384,
+                      description="Width and height of the baked image in pixels (time and memory grow with its "
+                                  "area)")
     sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default=DEFAULT_SAMPLER,
                           description="How the image is denoised; DPM-Solver++(2M) needs the fewest steps")
     steps: IntProperty(name="Steps", default=DEFAULT_STEPS, min=2, max=1000,
                        description="Sampler timesteps (model evaluations: the same, twice for Heun)")
-    seed: IntProperty(name="Seed", default=0, min=0)
+    seed: IntProperty(name="Seed", default=0, min=0, description="Another seed draws another image of the same noise")
     tileable: BoolProperty(name="Tileable", description="Seamless tile (the size becomes a multiple of 8)")
-    depth: EnumProperty(name="Depth", items=[("8", "8-bit", ""), ("16", "16-bit half", ""), ("32", "32-bit float", "")],
-                        default="32")
-    name: StringProperty(name="Name", default="Neural Noise")
-    save: EnumProperty(name="Save", items=[("NONE", "Pack Only", "Keep the image packed in the .blend"),
+    depth: EnumProperty(name="Depth", items=[("8", "8-bit", "256 levels: small, may band in smooth gradients"),
+                                             ("16", "16-bit Half", "Half floats: smooth gradients at half the size"),
+                                             ("32", "32-bit Float", "Full float precision")],
+                        default="32", description="Precision of the stored image")
+    name: StringProperty(name="Name", default="Neural Noise", description="Name of the image (and of saved files)")
+    save: EnumProperty(name="Save", description="Keep the image inside the .blend only, or also write a file", items=[("NONE", "Pack Only", "Keep the image packed in the .blend"),
                                            ("EXR", "OpenEXR", "Also write an EXR (half for 16-bit, float for 32-bit)"),
                                            ("PNG", "PNG", "Also write an 8-bit PNG")], default="NONE")
     folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise/",
@@ -118,13 +130,14 @@ class OMNINOISE_PG_neural(bpy.types.PropertyGroup):
     # animation: an image sequence whose classes and parameters move between keyframes (Fig. 11)
     frame_start: IntProperty(name="Start", default=1, min=0, description="First frame of the sequence")
     frame_end: IntProperty(name="End", default=48, min=0, description="Last frame of the sequence")
-    key_source: EnumProperty(name="Keyframes", items=[
+    key_source: EnumProperty(name="Keyframes", description="What sets the noise on each keyframe", items=[
         ("SWATCHES", "Swatches", "Swatch 1 on the first frame, the last swatch on the last frame, the others "
                                  "evenly between (swatch i uses seed + i)"),
         ("FILE", "Keyframe File", "A TOML keyframe file, as the command line's --keys")], default="SWATCHES")
-    keys_file: StringProperty(name="Keyframe File", subtype="FILE_PATH", description="[[key]] tables with frame, "
-                              "noise, params and seed (see backend/neural/animate.py)")
-    latent: EnumProperty(name="Latent", items=[
+    keys_file: StringProperty(name="Keyframe File", subtype="FILE_PATH",
+                              description="A TOML file of keys, each with a frame, a noise, its parameters and a seed "
+                                          "(the format of `omninoise neural --keys`)")
+    latent: EnumProperty(name="Motion", description="How the noise's random start moves from frame to frame", items=[
         ("fixed", "Fixed", "One initial latent for every frame: only the classes and parameters move"),
         ("slerp", "Between Seeds", "The latent moves along the sphere between the keyframes' seeds"),
         ("drift", "Drift", "The latent circles at a constant speed, so the noise flows even between keys")],
@@ -205,7 +218,7 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
 
     bl_idname = "omninoise.neural_bake"
     bl_label = "Bake Neural Noise"
-    bl_options = {"REGISTER"}
+    bl_options = {"REGISTER", "UNDO"}
 
     preview: BoolProperty(name="Preview", description="A quick 64 px, 10-step preview", default=False,
                           options={"SKIP_SAVE"})
@@ -304,8 +317,8 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
     on disk, loaded as one sequence image"""
 
     bl_idname = "omninoise.neural_bake_sequence"
-    bl_label = "Bake Sequence"
-    bl_options = {"REGISTER"}
+    bl_label = "Bake Neural Noise Sequence"
+    bl_options = {"REGISTER", "UNDO"}
 
     def _start(self, context, blocking: bool):
         from .bake_blender import output_folder
@@ -374,7 +387,7 @@ class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
     into the active swatch"""
 
     bl_idname = "omninoise.neural_fit"
-    bl_label = "Fit to Image"
+    bl_label = "Fit Neural Noise to Image"
     bl_options = {"REGISTER", "UNDO"}
 
     def _start(self, context, blocking: bool):
@@ -421,7 +434,7 @@ class OMNINOISE_OT_swatch_add(bpy.types.Operator):
 
     bl_idname = "omninoise.swatch_add"
     bl_label = "Add Swatch"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
     def execute(self, context):
         p = context.scene.omninoise_neural
@@ -440,7 +453,7 @@ class OMNINOISE_OT_swatch_remove(bpy.types.Operator):
 
     bl_idname = "omninoise.swatch_remove"
     bl_label = "Remove Swatch"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
     @classmethod
     def poll(cls, context):
@@ -454,11 +467,11 @@ class OMNINOISE_OT_swatch_remove(bpy.types.Operator):
 
 
 class OMNINOISE_OT_blend_map_new(bpy.types.Operator):
-    """Create a blend map to paint: filled with the first swatch's colour, the second's on the right half"""
+    """Create a blend map to paint: the first swatch's color, with the second's on the right half"""
 
     bl_idname = "omninoise.blend_map_new"
     bl_label = "New Blend Map"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
     def execute(self, context):
         p = context.scene.omninoise_neural
@@ -478,120 +491,6 @@ class OMNINOISE_OT_blend_map_new(bpy.types.Operator):
         return {"FINISHED"}
 
 
-# -- presets: the swatch set and layout as a shareable JSON file ---------------------------------
-
-PRESET_FORMAT = 1
-_PRESET_KEYS = ("mode", "width", "sharpness", "size", "sampler", "steps", "seed", "tileable", "depth", "frame_start",
-                "frame_end", "key_source", "latent", "drift")
-
-
-def preset_dict(p) -> dict:
-    """The scene's swatches (class, named parameters, colour) and bake settings as plain JSON types."""
-    sw = []
-    for s in p.swatches:
-        name, params = s.spec()
-        sw.append(dict(noise=name, params=params, color=[round(float(c), 6) for c in s.color]))
-    d = dict(format=PRESET_FORMAT, kind="omninoise.neural_preset", swatches=sw)
-    d.update({k: getattr(p, k) for k in _PRESET_KEYS})
-    return d
-
-
-def apply_preset(p, d: dict) -> None:
-    """Replace the scene's swatches and settings by a preset; SettingError naming the first bad entry
-    (checked before anything changes)."""
-    if not isinstance(d, dict) or d.get("kind") != "omninoise.neural_preset":
-        raise backend.SettingError("preset", "not an OmniNoise neural-noise preset (no kind 'omninoise.neural_preset')")
-    if d.get("format") != PRESET_FORMAT:
-        raise backend.SettingError("preset", f"preset format {d.get('format')!r} is not {PRESET_FORMAT}")
-    m = model()
-    trained = m.config["trained_classes"]
-    checked = []
-    for i, s in enumerate(d.get("swatches", [])):
-        if s.get("noise") not in trained:
-            raise backend.SettingError("preset", f"swatch {i + 1}: class {s.get('noise')!r} is not in the shipped model "
-                                                 f"({', '.join(trained)})")
-        m.param_vector(s["noise"], s.get("params", {}))     # names and ranges, or SettingError
-        col = s.get("color", (1.0, 0.0, 0.0))
-        if len(col) != 3 or not all(0.0 <= float(c) <= 1.0 for c in col):
-            raise backend.SettingError("preset", f"swatch {i + 1}: colour must be three numbers in [0, 1]")
-        checked.append(s)
-    p.swatches.clear()
-    for s in checked:
-        sw = p.swatches.add()
-        sw.noise = s["noise"]
-        _reset_params(sw, None)
-        spec = m.class_params[s["noise"]]["params"][:N_PARAMS]
-        for j, prm in enumerate(spec):
-            if prm["name"] in s.get("params", {}):
-                setattr(sw, f"p{j}", float(s["params"][prm["name"]]))
-        sw.color = tuple(float(c) for c in s["color"])
-    p.active = 0
-    for k in _PRESET_KEYS:
-        if k in d:
-            setattr(p, k, d[k])
-
-
-class OMNINOISE_OT_neural_preset_save(bpy.types.Operator):
-    """Save the swatches and bake settings as a preset file to share"""
-
-    bl_idname = "omninoise.neural_preset_save"
-    bl_label = "Save Neural Preset"
-    filepath: StringProperty(subtype="FILE_PATH")
-    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
-
-    def invoke(self, context, event):
-        self.filepath = bpy.path.clean_name(context.scene.omninoise_neural.name) + ".json"
-        context.window_manager.fileselect_add(self)
-        return {"RUNNING_MODAL"}
-
-    def execute(self, context):
-        import json
-
-        from .. import export
-
-        path = bpy.path.ensure_ext(bpy.path.abspath(self.filepath), ".json")
-        try:
-            text = json.dumps(preset_dict(context.scene.omninoise_neural), indent=1)
-            with export.atomic_path(path) as tmp:
-                with open(tmp, "w", encoding="utf-8") as fh:
-                    fh.write(text)
-        except (OSError, backend.SettingError) as exc:
-            self.report({"ERROR"}, f"preset not saved: {exc}")
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"saved {path}")
-        return {"FINISHED"}
-
-
-class OMNINOISE_OT_neural_preset_load(bpy.types.Operator):
-    """Load swatches and bake settings from a preset file"""
-
-    bl_idname = "omninoise.neural_preset_load"
-    bl_label = "Load Neural Preset"
-    bl_options = {"REGISTER", "UNDO"}
-    filepath: StringProperty(subtype="FILE_PATH")
-    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
-
-    def invoke(self, context, event):
-        context.window_manager.fileselect_add(self)
-        return {"RUNNING_MODAL"}
-
-    def execute(self, context):
-        import json
-
-        path = bpy.path.abspath(self.filepath)
-        try:
-            with open(path, encoding="utf-8") as fh:
-                d = json.load(fh)
-            apply_preset(context.scene.omninoise_neural, d)
-        except json.JSONDecodeError as exc:
-            self.report({"ERROR"}, f"{os.path.basename(path)}: not JSON ({exc.msg}, line {exc.lineno})")
-            return {"CANCELLED"}
-        except (OSError, backend.SettingError) as exc:
-            self.report({"ERROR"}, f"{os.path.basename(path)}: {exc}")
-            return {"CANCELLED"}
-        return {"FINISHED"}
-
-
 # -- thumbnails: a small sample of each swatch from the model ---------------------------------
 
 THUMB_SIZE, THUMB_STEPS = 32, 10
@@ -606,7 +505,7 @@ class OMNINOISE_OT_swatch_thumbnails(TaskOperator, bpy.types.Operator):
 
     bl_idname = "omninoise.swatch_thumbnails"
     bl_label = "Update Thumbnails"
-    bl_options = {"REGISTER"}
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_neural
@@ -650,8 +549,21 @@ class OMNINOISE_UL_swatches(bpy.types.UIList):
         row.label(text=item.noise.replace("_", " ").title())
 
 
+def _split(layout):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout
+
+
+def _idle_row(layout):
+    row = layout.row(align=True)
+    row.enabled = tasks.current() is None
+    return row
+
+
 def draw_neural(layout, context) -> None:
-    """The panel body (shared by the Image Editor and the Shader Editor)."""
+    """The Neural Noise panel's body: the swatches, the layout, the size and seed, and the bakes (the other
+    settings are in the sub-panels below it, :data:`SECTIONS`)."""
     p = context.scene.omninoise_neural
     draw_progress(layout)
     row = layout.row()
@@ -661,11 +573,9 @@ def draw_neural(layout, context) -> None:
     col.operator(OMNINOISE_OT_swatch_remove.bl_idname, icon="REMOVE", text="")
     col.separator()
     col.operator(OMNINOISE_OT_swatch_thumbnails.bl_idname, icon="IMAGE_DATA", text="")
-    col.operator(OMNINOISE_OT_neural_preset_load.bl_idname, icon="IMPORT", text="")
-    col.operator(OMNINOISE_OT_neural_preset_save.bl_idname, icon="EXPORT", text="")
     if p.swatches:
         sw = p.swatches[min(p.active, len(p.swatches) - 1)]
-        box = layout.box()
+        box = _split(layout.box())
         box.prop(sw, "noise")
         box.prop(sw, "color")
         try:
@@ -674,76 +584,141 @@ def draw_neural(layout, context) -> None:
             box.label(text=str(exc), icon="ERROR")
             spec = []
         for i, prm in enumerate(spec[:N_PARAMS]):
-            box.prop(sw, f"p{i}", text=f"{prm['name']} [{prm['min']:g}, {prm['max']:g}]")
-    row = layout.row(align=True)
-    row.prop(p, "fit_image", text="")
-    sub = row.row(align=True)
-    sub.enabled = tasks.current() is None
-    sub.operator(OMNINOISE_OT_neural_fit.bl_idname, icon="EYEDROPPER")
+            box.prop(sw, f"p{i}", text=prm["name"].replace("_", " ").title())
+    _split(layout)
     layout.prop(p, "mode")
     if p.mode == "MAP":
         row = layout.row(align=True)
-        row.prop(p, "blend_map", text="")
+        row.prop(p, "blend_map", text="Blend Map")
         row.operator(OMNINOISE_OT_blend_map_new.bl_idname, icon="ADD", text="")
-        layout.prop(p, "width")
-        layout.prop(p, "sharpness")
-    col = layout.column(align=True)
-    col.prop(p, "size")
-    col.prop(p, "sampler", text="")
-    col.prop(p, "steps")
-    col.prop(p, "seed")
+    layout.prop(p, "size")
+    layout.prop(p, "seed")
+    row = _idle_row(layout)
+    row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Preview", icon="HIDE_OFF").preview = True
+    row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Bake", icon="RENDER_STILL")
+
+
+def _draw_transitions(layout, p) -> None:
+    layout.prop(p, "width")
+    layout.prop(p, "sharpness")
+
+
+def _draw_sampling(layout, p) -> None:
+    layout.prop(p, "sampler")
+    layout.prop(p, "steps")
     layout.prop(p, "tileable")
-    layout.prop(p, "depth")
+
+
+def _draw_output(layout, p) -> None:
     layout.prop(p, "name")
+    layout.prop(p, "depth")
     layout.prop(p, "save")
     if p.save != "NONE":
         layout.prop(p, "folder")
     layout.prop(p, "add_node")
-    row = layout.row(align=True)
-    row.enabled = tasks.current() is None
-    row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Preview", icon="HIDE_OFF").preview = True
-    row.operator(OMNINOISE_OT_neural_bake.bl_idname, icon="RENDER_STILL")
-    box = layout.box()
-    box.label(text="Animation", icon="RENDER_ANIMATION")
-    row = box.row(align=True)
-    row.prop(p, "frame_start")
-    row.prop(p, "frame_end")
-    box.prop(p, "key_source")
+
+
+def _draw_animation(layout, p) -> None:
+    col = layout.column(align=True)
+    col.prop(p, "frame_start", text="Frame Start")
+    col.prop(p, "frame_end", text="End")
+    layout.prop(p, "key_source")
     if p.key_source == "FILE":
-        box.prop(p, "keys_file")
-    box.prop(p, "latent")
+        layout.prop(p, "keys_file")
+    layout.prop(p, "latent")
     if p.latent == "drift":
-        box.prop(p, "drift")
-    row = box.row()
-    row.enabled = tasks.current() is None
-    row.operator(OMNINOISE_OT_neural_bake_sequence.bl_idname, icon="RENDER_ANIMATION")
+        layout.prop(p, "drift")
+    _idle_row(layout).operator(OMNINOISE_OT_neural_bake_sequence.bl_idname, text="Bake Sequence",
+                               icon="RENDER_ANIMATION")
 
 
-class OMNINOISE_PT_neural_image(Sidebar, bpy.types.Panel):
-    bl_label = "Neural Noise"
-    bl_space_type = "IMAGE_EDITOR"
+def _draw_fit(layout, p) -> None:
+    layout.prop(p, "fit_image", text="Image")
+    _idle_row(layout).operator(OMNINOISE_OT_neural_fit.bl_idname, text="Fit to Image", icon="EYEDROPPER")
 
-    def draw(self, context):
+
+#: the Neural Noise panel's sub-panels, closed at first: (name, label, draw(layout, settings), shown when)
+SECTIONS = (("transitions", "Transitions", _draw_transitions, lambda p: p.mode != "SINGLE"),
+            ("sampling", "Sampling", _draw_sampling, None),
+            ("output", "Output", _draw_output, None),
+            ("animation", "Animation", _draw_animation, None),
+            ("fit", "Fit to Image", _draw_fit, None))
+
+
+def draw_neural_all(layout, context) -> None:
+    """The panel and every sub-panel in one layout (scripts and tests that look at everything the panel offers)."""
+    draw_neural(layout, context)
+    p = context.scene.omninoise_neural
+    for _, _, draw, shown in SECTIONS:
+        if shown is None or shown(p):
+            draw(_split(layout), p)
+
+
+def _panels(space: str, prefix: str, poll=None) -> tuple:
+    """The Neural Noise panel and its sub-panels for one editor (the Image Editor's and the Shader Editor's
+    sidebars show the same settings)."""
+    def parent_draw(self, context):
         draw_neural(self.layout, context)
 
+    def header_preset(self, context):
+        OMNINOISE_PT_neural_presets.draw_panel_header(self.layout)
 
-class OMNINOISE_PT_neural_shader(Sidebar, bpy.types.Panel):
-    bl_label = "Neural Noise"
-    bl_space_type = "NODE_EDITOR"
+    parent_id = f"OMNINOISE_PT_neural_{prefix}"
+    ns = dict(bl_label="Neural Noise", bl_space_type=space, draw=parent_draw, draw_header_preset=header_preset)
+    if poll is not None:
+        ns["poll"] = classmethod(poll)
+    out = [type(parent_id, (Sidebar, bpy.types.Panel), ns)]
+    for name, label, draw, shown in SECTIONS:
+        ns = dict(bl_label=label, bl_space_type=space, bl_parent_id=parent_id, bl_options={"DEFAULT_CLOSED"},
+                  draw=_draw_for(draw))
+        if shown is not None:
+            ns["poll"] = classmethod(_poll_for(shown))
+        out.append(type(f"{parent_id}_{name}", (Sidebar, bpy.types.Panel), ns))
+    return tuple(out)
 
-    @classmethod
+
+class OMNINOISE_PT_neural_presets(PresetPanel, bpy.types.Panel):
+    bl_label = "Neural Noise Presets"
+    preset_subdir = SUBDIRS["neural"]
+    preset_operator = "script.execute_preset"
+    preset_add_operator = "omninoise.neural_preset_add"
+
+
+class OMNINOISE_OT_neural_preset_add(AddPresetBase, bpy.types.Operator):
+    """Add or remove a neural noise preset (the swatches, their layout and the sampler)"""
+
+    bl_idname = "omninoise.neural_preset_add"
+    bl_label = "Add Neural Noise Preset"
+    preset_menu = "OMNINOISE_PT_neural_presets"
+    preset_subdir = SUBDIRS["neural"]
+    preset_defines = ["p = bpy.context.scene.omninoise_neural"]
+    preset_values = NEURAL_VALUES
+
+
+def _draw_for(draw):
+    def sub_draw(self, context):
+        draw(_split(self.layout), context.scene.omninoise_neural)
+    return sub_draw
+
+
+def _poll_for(shown):
     def poll(cls, context):
-        return getattr(context.space_data, "tree_type", "") == "ShaderNodeTree"
+        return shown(context.scene.omninoise_neural)
+    return poll
 
-    def draw(self, context):
-        draw_neural(self.layout, context)
+
+def _shader_editor(cls, context):
+    return getattr(context.space_data, "tree_type", "") == "ShaderNodeTree"
+
+
+PANELS = _panels("IMAGE_EDITOR", "image") + _panels("NODE_EDITOR", "shader", _shader_editor)
 
 
 classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_neural_bake_sequence,
            OMNINOISE_OT_neural_fit, OMNINOISE_OT_swatch_add,
-           OMNINOISE_OT_neural_preset_save, OMNINOISE_OT_neural_preset_load, OMNINOISE_OT_swatch_thumbnails,
-           OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches,
-           OMNINOISE_PT_neural_image, OMNINOISE_PT_neural_shader)
+           OMNINOISE_OT_swatch_thumbnails,
+           OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches, OMNINOISE_PT_neural_presets,
+           OMNINOISE_OT_neural_preset_add) + PANELS
 
 
 def attach():

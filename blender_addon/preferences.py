@@ -1,4 +1,6 @@
-"""Extension preferences: CPU threads for bakes, the neural denoiser's precision and the cache folder.
+"""Extension preferences: CPU threads for bakes, the neural denoiser's precision, the cache folder, and the
+shipped asset library (added to Blender's asset libraries with one click, as Blender leaves the user's
+preferences to the user).
 
 The cache defaults to Blender's per-extension user folder
 (``bpy.utils.extension_path_user``), never the extension's own folder.
@@ -38,6 +40,58 @@ def precision() -> str:
     return prefs.neural_precision if prefs is not None else "fp32"
 
 
+#: the folder of the shipped asset library (materials and node groups, ``tools/make_assets.py``)
+ASSETS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets")
+LIBRARY_NAME = "OmniNoise"
+
+
+def asset_library():
+    """The entry of Blender's asset libraries that points at the shipped assets, or None."""
+    for lib in bpy.context.preferences.filepaths.asset_libraries:
+        if os.path.normcase(os.path.normpath(bpy.path.abspath(lib.path))) == os.path.normcase(os.path.normpath(ASSETS)):
+            return lib
+    return None
+
+
+class OMNINOISE_OT_asset_library_add(bpy.types.Operator):
+    """List OmniNoise's ready materials and node groups in the Asset Browser (an asset library named OmniNoise,
+    dragged assets are appended)"""
+
+    bl_idname = "omninoise.asset_library_add"
+    bl_label = "Add OmniNoise Asset Library"
+    bl_options = {"REGISTER", "INTERNAL"}
+
+    def execute(self, context):
+        if asset_library() is not None:
+            self.report({"INFO"}, "the OmniNoise asset library is already listed")
+            return {"FINISHED"}
+        if not os.path.isfile(os.path.join(ASSETS, "omninoise_assets.blend")):
+            self.report({"ERROR"}, f"no assets in {ASSETS}: reinstall the extension")
+            return {"CANCELLED"}
+        lib = context.preferences.filepaths.asset_libraries.new(name=LIBRARY_NAME, directory=ASSETS)
+        try:                                    # a dragged material is the artist's own copy
+            lib.import_method = "APPEND_REUSE"  # reusing what an earlier drag appended (before Blender 5.0)
+        except TypeError:
+            lib.import_method = "APPEND"
+        context.preferences.is_dirty = True
+        return {"FINISHED"}
+
+
+class OMNINOISE_OT_asset_library_remove(bpy.types.Operator):
+    """Take OmniNoise's asset library out of the Asset Browser (what was appended stays in your files)"""
+
+    bl_idname = "omninoise.asset_library_remove"
+    bl_label = "Remove OmniNoise Asset Library"
+    bl_options = {"REGISTER", "INTERNAL"}
+
+    def execute(self, context):
+        lib = asset_library()
+        if lib is not None:
+            context.preferences.filepaths.asset_libraries.remove(lib)
+            context.preferences.is_dirty = True
+        return {"FINISHED"}
+
+
 def get():
     if not ROOT_PACKAGE:
         return None
@@ -61,10 +115,19 @@ class OMNINOISE_AP_preferences(bpy.types.AddonPreferences):
                                           "extension user folder)")
 
     def draw(self, context):
-        self.layout.prop(self, "threads")
-        self.layout.prop(self, "neural_precision")
-        self.layout.prop(self, "cache_dir")
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(self, "threads")
+        layout.prop(self, "neural_precision")
+        layout.prop(self, "cache_dir")
+        row = layout.row()
+        if asset_library() is None:
+            row.operator(OMNINOISE_OT_asset_library_add.bl_idname, icon="ASSET_MANAGER")
+        else:
+            row.label(text="Asset library: listed in the Asset Browser as OmniNoise", icon="CHECKMARK")
+            row.operator(OMNINOISE_OT_asset_library_remove.bl_idname, text="", icon="X")
 
 
 #: the preferences exist where the extension is installed as a package (``__package__`` names its root)
-classes = (OMNINOISE_AP_preferences,) if ROOT_PACKAGE else ()
+classes = (OMNINOISE_OT_asset_library_add, OMNINOISE_OT_asset_library_remove) + \
+    ((OMNINOISE_AP_preferences,) if ROOT_PACKAGE else ())

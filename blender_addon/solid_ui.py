@@ -1,4 +1,4 @@
-"""Solid Texture from Image (Henzler et al. 2020) in Blender: preview, and bakes onto the active object.
+"""Solid textures from photos (Henzler et al. 2020) in Blender: preview, and bakes onto the active object.
 
 Settings live on the scene (``Scene.omninoise_solid``).  The texture comes from
 a shipped single-exemplar model (``models/solid/<name>``), from an exemplar
@@ -97,31 +97,28 @@ def _space_model_name():
 
 
 class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
-    source: EnumProperty(name="Source", items=[
+    source: EnumProperty(name="Source", description="Start from a ready texture or from a photo", items=[
         ("SHIPPED", "Shipped", "A texture that ships with OmniNoise"),
         ("IMAGE", "Image", "Any image: the texture-space model encodes it into a texture code")], default="SHIPPED")
-    texture: EnumProperty(name="Texture", items=_texture_items)
-    method: EnumProperty(name="Method", items=[
-        ("NEURAL", "Neural Texture", "The texture-space model encodes the image into a texture code (with its "
-                                     "periodic part and Gaussian rest)"),
-        ("SPECTRAL", "Spectral Solid", "Random phase noise of the image lifted to a solid: its spectrum and colours "
-                                       "on every cut, its periodic part upright on walls, no stones (closer to rock, "
-                                       "sand and soil photos on cuts; repeats every 128 image px; about 6 s to "
-                                       "draw)")], default="NEURAL")
+    texture: EnumProperty(name="Texture", items=_texture_items, description="Which ready texture to use")
+    method: EnumProperty(name="Method", description="How the photo becomes a solid texture", items=[
+        ("NEURAL", "Neural Texture", "A network trained on many materials draws a solid that looks like the photo "
+                                     "(stones, grains, speckles)"),
+        ("SPECTRAL", "Spectral Solid", "The photo's colors and feature sizes on every cut, but no separate stones: "
+                                       "often closer for rock, sand and soil; repeats every 128 photo pixels; about "
+                                       "6 s to draw")], default="NEURAL")
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
                            description="A photo of the material (at least 128 px; a large one is read in at most 8 x 8 crops)")
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
-                        description="Improve the encoded image's code by a search against its colour neighbourhoods, "
-                                    "each step checked on planes the search does not see (about 0.1 s a step)")
+                        description="Search steps that bring the texture closer to the photo (about 0.1 s a step; "
+                                    "0 is usually enough)")
     periodic: BoolProperty(name="Periodic Part", default=True,
-                           description="Keep the image's periodic part (brick courses, plank seams, weaves: its "
-                                       "isolated spectral peaks) on top of the model's texture; upright on faces "
-                                       "normal to X and to Y, in profile on floors")
-    gaussian: BoolProperty(name="Gaussian Rest", default=True,
-                           description="Where a check on rendered planes finds it closer to the image, mix in the "
-                                       "image's Gaussian rest: random phase noise of what the periodic part leaves, "
-                                       "drawn as a solid (rock faces, sand, wood grain the model draws too coarse)")
-    rest: EnumProperty(name="Rest Kind", items=[
+                           description="Keep the photo's regular pattern (brick courses, plank seams, weaves) on top "
+                                       "of the texture: upright on walls, seen from above on floors")
+    gaussian: BoolProperty(name="Fine Detail", default=True,
+                           description="Mix in fine detail drawn from the photo's own frequencies where that brings "
+                                       "the texture closer to the photo (rock faces, sand, wood grain)")
+    rest: EnumProperty(name="Detail Direction", description="Whether the fine detail has a direction", items=[
         ("auto", "Auto", "The check chooses: the upright rest is offered for layered images"),
         ("isotropic", "Isotropic", "The same in every direction: no layers on any face"),
         ("upright", "Upright", "The image's layers, grain or strata kept on faces normal to X and to Y (walls, "
@@ -129,26 +126,27 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
     scale: FloatProperty(name="Scale", default=1.0, min=1e-4, soft_max=100.0,
                          description="Texture units per Blender unit: larger means smaller features")
     seed: IntProperty(name="Seed", default=0, min=0, description="Another seed gives another texture of the same kind")
-    coords: EnumProperty(name="Coordinates", items=[
+    coords: EnumProperty(name="Coordinates", description="Which positions the texture is read at", items=[
         ("OBJECT", "Object", "Object-local positions: the texture moves with the object"),
         ("WORLD", "World", "World positions: objects share one block of material")], default="OBJECT")
-    target: EnumProperty(name="Bake To", items=[
-        ("UV_IMAGE", "UV Image", "An image over the active UV map, each texel coloured at its 3D surface point"),
-        ("COLOR_ATTRIBUTE", "Colour Attribute", "A colour attribute on the mesh vertices"),
-        ("VOLUME", "Volume", "An OpenVDB volume over the object's bounds (colour and density grids)")],
+    target: EnumProperty(name="Bake To", description="What the bake writes onto the active object", items=[
+        ("UV_IMAGE", "UV Image", "An image over the active UV map, each pixel colored at its 3D surface point"),
+        ("COLOR_ATTRIBUTE", "Color Attribute", "A color attribute on the mesh vertices"),
+        ("VOLUME", "Volume", "An OpenVDB volume over the object's bounds (color and density grids)")],
         default="UV_IMAGE")
-    size: IntProperty(name="Image Size", default=1024, min=8, soft_max=8192)
+    size: IntProperty(name="Image Size", default=1024, min=8, soft_max=8192,
+                      description="Width and height of the baked UV image in pixels")
     margin: IntProperty(name="Margin", default=4, min=0, max=64, description="Texels padded past each UV island")
     voxels: IntProperty(name="Voxels", default=128, min=4, soft_max=512, description="Voxels along the longest side")
     tile: IntProperty(name="Tile Size", default=256, min=32, max=1024, step=4,
-                      description="Side of the tileable image synthesised from the exemplar, px (a multiple of 4; "
-                                  "powers of two let large structures come out whole; about 3 s at 256 on two "
-                                  "cores, 16 times that at 1024)")
-    periodic_info: StringProperty(name="Periodic Part Found", default="", options={"SKIP_SAVE"},
-                                  description="What the last preview measured of the image's periodic part")
-    gaussian_info: StringProperty(name="Gaussian Rest Found", default="", options={"SKIP_SAVE"},
-                                  description="How much of the rest the last preview's check mixed in")
-    name: StringProperty(name="Name", default="Solid Texture")
+                      description="Width and height of the tileable image in pixels (a multiple of 4; powers of "
+                                  "two keep large structures whole; 1024 takes about 16 times as long as 256)")
+    periodic_info: StringProperty(name="Pattern Found", default="", options={"SKIP_SAVE"},
+                                  description="What the last preview found of the photo's regular pattern")
+    gaussian_info: StringProperty(name="Fine Detail Found", default="", options={"SKIP_SAVE"},
+                                  description="How much fine detail the last preview mixed in")
+    name: StringProperty(name="Name", default="Solid Texture",
+                         description="Name of the baked image, color attribute, volume and material")
     folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise_bakes",
                            description="Where volumes are written ('//' = beside the .blend)")
 
@@ -203,8 +201,8 @@ def periodic_info(code) -> str:
     that there is none."""
     h = code.harmonics
     if h is None:
-        return "Periodic part: none found"
-    return f"Periodic part: {len(h)} waves, {100 * h.share:.0f} % of the variance"
+        return "Pattern: none found"
+    return f"Pattern: {len(h)} waves, {100 * h.share:.0f} % of the variance"
 
 
 def gaussian_info(code) -> str:
@@ -213,8 +211,8 @@ def gaussian_info(code) -> str:
         return ""
     r = code.rest
     if r is None:
-        return "Gaussian rest: not closer, the model's texture alone"
-    return f"Gaussian rest: {100 * r.mix:.0f} % of the rest's variance, {r.kind}"
+        return "Fine detail: none (the texture alone is closer)"
+    return f"Fine detail: {100 * r.mix:.0f} % of the variance, {r.kind}"
 
 
 def _vertex_positions(me, obj, world: bool) -> np.ndarray:
@@ -248,7 +246,7 @@ def _mesh_arrays(context, obj, world: bool, uv: bool):
             layer = me.uv_layers.active
             if layer is None:
                 raise backend.SettingError("uv", f"{obj.name!r} has no UV map; add one (UV > Smart UV Project) "
-                                                 "or bake to a colour attribute")
+                                                 "or bake to a color attribute")
             a = np.empty(L * 2, np.float32)
             layer.data.foreach_get("uv", a)
             uvs = a.reshape(L, 2)[tri].reshape(T, 3, 2).astype(np.float64)
@@ -288,7 +286,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
 
     bl_idname = "omninoise.solid_preview"
     bl_label = "Preview Solid Texture"
-    bl_options = {"REGISTER"}
+    bl_options = {"REGISTER", "UNDO"}
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_solid
@@ -310,12 +308,12 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
 
 
 class OMNINOISE_OT_solid_tileable(TaskOperator, bpy.types.Operator):
-    """Synthesise a seamless tileable image from the exemplar image by texture optimisation: its pieces rearranged
-    (courses, planks, stones), for Image Texture nodes on UV-mapped surfaces"""
+    """Make a seamless tileable image from the photo by rearranging its pieces (courses, planks, stones), for Image
+    Texture nodes on UV-mapped surfaces"""
 
     bl_idname = "omninoise.solid_tileable"
-    bl_label = "Tileable Image"
-    bl_options = {"REGISTER"}
+    bl_label = "Make Tileable Image"
+    bl_options = {"REGISTER", "UNDO"}
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_solid
@@ -395,7 +393,7 @@ class OMNINOISE_OT_solid_tile_material(bpy.types.Operator):
             self.report({"ERROR"}, "select a mesh to project the tile onto")
             return {"CANCELLED"}
         if ima is None:
-            self.report({"ERROR"}, f"no tileable image {name!r} yet: synthesise one with Tileable Image first")
+            self.report({"ERROR"}, f"no tileable image {name!r} yet: make one with Make Tileable Image first")
             return {"CANCELLED"}
         repeats = tile_repeats(p.scale, ima.size[0])
         _material_with(obj, name, lambda nt: _project_tile(nt, ima, repeats, p.coords == "WORLD"))
@@ -403,11 +401,11 @@ class OMNINOISE_OT_solid_tile_material(bpy.types.Operator):
 
 
 class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
-    """Bake the solid texture onto the active object: UV image, colour attribute or volume"""
+    """Bake the solid texture onto the active object: a UV image, a color attribute or a volume"""
 
     bl_idname = "omninoise.solid_bake"
     bl_label = "Bake Solid Texture"
-    bl_options = {"REGISTER"}
+    bl_options = {"REGISTER", "UNDO"}
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_solid
@@ -512,67 +510,122 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
         return tasks.start(tasks.Task(f"Solid {name}", work, done, None, threads()), blocking=blocking)
 
 
+def _split(layout):
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout
+
+
+def _idle_row(layout):
+    row = layout.row(align=True)
+    row.enabled = tasks.current() is None
+    return row
+
+
 def draw_solid(layout, context) -> None:
+    """The Solid Texture panel's body: where the texture comes from, its scale and seed, preview and bake (the
+    other settings are in the sub-panels below it, :data:`SECTIONS`)."""
     p = context.scene.omninoise_solid
     draw_progress(layout)
-    layout.prop(p, "source", expand=True)
+    layout.row().prop(p, "source", expand=True)
+    _split(layout)
     if p.source == "SHIPPED":
         layout.prop(p, "texture")
     else:
         layout.template_ID(p, "image", open="image.open")
         layout.prop(p, "method")
-        if p.method == "NEURAL":
-            layout.prop(p, "refine")
-        layout.prop(p, "periodic")
-        if p.periodic and p.periodic_info:
-            layout.label(text=p.periodic_info)
-        if p.method == "NEURAL":
-            layout.prop(p, "gaussian")
-            if p.gaussian:
-                layout.prop(p, "rest")
-            if p.gaussian and p.gaussian_info:
-                layout.label(text=p.gaussian_info)
-        row = layout.row(align=True)
-        row.prop(p, "tile")
-        sub = row.row(align=True)
-        sub.enabled = tasks.current() is None
-        sub.operator(OMNINOISE_OT_solid_tileable.bl_idname, text="Tileable Image", icon="IMAGE_DATA")
-        if bpy.data.images.get(f"{p.name} Tile") is not None:
-            layout.operator(OMNINOISE_OT_solid_tile_material.bl_idname, text="Project Tile onto Object",
-                            icon="MOD_UVPROJECT")
     for suffix in ("Preview", "Tile"):
         prev = bpy.data.images.get(f"{p.name} {suffix}")
         if prev is not None and prev.preview is not None:
             layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)
-    col = layout.column(align=True)
-    col.prop(p, "scale")
-    col.prop(p, "seed")
-    layout.prop(p, "coords")
-    layout.prop(p, "target")
-    if p.target == "UV_IMAGE":
-        col = layout.column(align=True)
-        col.prop(p, "size")
-        col.prop(p, "margin")
-    elif p.target == "VOLUME":
-        layout.prop(p, "voxels")
-        layout.prop(p, "folder")
-    layout.prop(p, "name")
-    row = layout.row(align=True)
-    row.enabled = tasks.current() is None
+    layout.prop(p, "scale")
+    layout.prop(p, "seed")
+    row = _idle_row(layout)
     row.operator(OMNINOISE_OT_solid_preview.bl_idname, text="Preview", icon="HIDE_OFF")
     row.operator(OMNINOISE_OT_solid_bake.bl_idname, text="Bake", icon="RENDER_STILL")
 
 
+def _draw_photo(layout, p) -> None:
+    if p.method == "NEURAL":
+        layout.prop(p, "refine")
+    layout.prop(p, "periodic")
+    if p.periodic and p.periodic_info:
+        layout.label(text=p.periodic_info)
+    if p.method == "NEURAL":
+        layout.prop(p, "gaussian")
+        if p.gaussian:
+            layout.prop(p, "rest")
+        if p.gaussian and p.gaussian_info:
+            layout.label(text=p.gaussian_info)
+
+
+def _draw_bake(layout, p) -> None:
+    layout.prop(p, "target")
+    layout.prop(p, "coords")
+    if p.target == "UV_IMAGE":
+        layout.prop(p, "size")
+        layout.prop(p, "margin")
+    elif p.target == "VOLUME":
+        layout.prop(p, "voxels")
+        layout.prop(p, "folder")
+    layout.prop(p, "name")
+
+
+def _draw_tile(layout, p) -> None:
+    layout.prop(p, "tile")
+    row = _idle_row(layout)
+    row.operator(OMNINOISE_OT_solid_tileable.bl_idname, text="Make Tileable Image", icon="IMAGE_DATA")
+    if bpy.data.images.get(f"{p.name} Tile") is not None:
+        layout.operator(OMNINOISE_OT_solid_tile_material.bl_idname, text="Project Tile onto Object",
+                        icon="MOD_UVPROJECT")
+
+
+def _from_photo(p) -> bool:
+    return p.source == "IMAGE"
+
+
+#: the Solid Texture panel's sub-panels: (name, label, draw(layout, settings), shown when, closed at first)
+SECTIONS = (("photo", "Photo Options", _draw_photo, _from_photo, True),
+            ("bake", "Bake", _draw_bake, None, False),
+            ("tile", "Tileable Image", _draw_tile, _from_photo, True))
+
+
+def draw_solid_all(layout, context) -> None:
+    """The panel and every sub-panel in one layout (scripts and tests that look at everything the panel offers)."""
+    draw_solid(layout, context)
+    p = context.scene.omninoise_solid
+    for _, _, draw, shown, _ in SECTIONS:
+        if shown is None or shown(p):
+            draw(_split(layout), p)
+
+
 class OMNINOISE_PT_solid(Sidebar, bpy.types.Panel):
-    bl_label = "Solid Texture from Image"
+    bl_label = "Solid Texture"
     bl_space_type = "VIEW_3D"
 
     def draw(self, context):
         draw_solid(self.layout, context)
 
 
+def _section_panel(name, label, draw, shown, closed):
+    def panel_draw(self, context):
+        draw(_split(self.layout), context.scene.omninoise_solid)
+
+    ns = dict(bl_label=label, bl_space_type="VIEW_3D", bl_parent_id="OMNINOISE_PT_solid", draw=panel_draw)
+    if closed:
+        ns["bl_options"] = {"DEFAULT_CLOSED"}
+    if shown is not None:
+        def poll(cls, context):
+            return shown(context.scene.omninoise_solid)
+        ns["poll"] = classmethod(poll)
+    return type(f"OMNINOISE_PT_solid_{name}", (Sidebar, bpy.types.Panel), ns)
+
+
+PANELS = (OMNINOISE_PT_solid,) + tuple(_section_panel(*section) for section in SECTIONS)
+
+
 classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable,
-           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_PT_solid)
+           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake) + PANELS
 
 
 def attach():

@@ -16,21 +16,30 @@ engine or the OSL switch changes in the interface.
 from __future__ import annotations
 
 import bpy
+from bl_operators.presets import AddPresetBase
+from bl_ui.utils import PresetPanel
 from bpy.app.handlers import persistent
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
     PointerProperty, StringProperty
 
 from .. import backend
 from .common import Sidebar
+from .presets import LOADING, SUBDIRS, WAVE_VALUES, loading
 from .wave_nodes import add_wave_node, build_wave_group, new_wave_tree, tree_implementation
 
-_SPECTRA = [(k, k.capitalize(), "") for k in ("gaussian", "bandpass", "fractal", "white", "blue", "brown", "twolevel")]
+_SPECTRA = [("gaussian", "Gaussian", "Feature sizes spread smoothly around the middle of the band"),
+            ("bandpass", "Band-Pass", "Every frequency of the band equally strong: even, busy detail"),
+            ("fractal", "Fractal", "Large features strongest, detail fading by the exponent (clouds, terrain)"),
+            ("white", "White", "Every frequency up to the top of the band: grainy"),
+            ("blue", "Blue", "High frequencies strongest: fine, even grain"),
+            ("brown", "Brown", "Low frequencies much the strongest: soft, rolling"),
+            ("twolevel", "Two-Level", "Two separate bands: coarse shapes with fine detail")]
 _WAVEFORMS = [("gaussian", "Gaussian", "Random-phase waves (Gaussian noise)"),
               ("crystal", "Crystal", "Stepped waveform: faceted, crystal-like"),
               ("wired", "Wired", "Impulse waveform: thin wires")]
 _ANISO = [("none", "Isotropic", "Directions over the whole (half) sphere"),
-          ("lobes", "Lobe", "Directions within a cone around an axis (Fig. 5 right)"),
-          ("axes", "Per Axis", "One band per axis, interpolated by direction (Fig. 5 left)")]
+          ("lobes", "Lobe", "Directions within a cone around an axis: streaks along it"),
+          ("axes", "Per Axis", "Its own frequency band along each axis: stretched features")]
 _IMPLEMENTATIONS = [
     ("AUTO", "Automatic", "The OSL script where the scene renders with Cycles and Open Shading Language, "
      "Blender's nodes everywhere else"),
@@ -75,9 +84,16 @@ def rebuild_tree(props, scene) -> None:
 
 
 def _rebuild(self, context) -> None:
-    if not self.is_wave or getattr(self.id_data, "is_evaluated", False):
+    if loading(self):       # a preset is setting the values one by one: it rebuilds once, after the last
         return
-    rebuild_tree(self, getattr(context, "scene", None))
+    rebuild(self, context)
+
+
+def rebuild(props, context) -> None:
+    """Rebuild the node group holding ``props`` (nothing for the bake panel's settings, which no tree holds)."""
+    if not props.is_wave or getattr(props.id_data, "is_evaluated", False):
+        return
+    rebuild_tree(props, getattr(context, "scene", None))
 
 
 _last_scene_state = [None]
@@ -112,28 +128,39 @@ class OMNINOISE_PG_wave(bpy.types.PropertyGroup):
     cell_size: FloatProperty(name="Cell Size", description="Distance between the planes of one family (cellular)",
                              default=0.5, min=0.001, soft_max=10.0, update=_rebuild)
     error: StringProperty(default="", options={"HIDDEN"})
-    dimensions: EnumProperty(name="Dimensions", items=[("2", "2D", ""), ("3", "3D", ""), ("4", "4D", "")],
-                             default="3", update=_rebuild)
+    dimensions: EnumProperty(name="Dimensions", items=[("2", "2D", "Noise over a plane (X, Y)"),
+                                                       ("3", "3D", "Noise through space (X, Y, Z)"),
+                                                       ("4", "4D", "Space plus W: animate W for noise that changes "
+                                                                   "in place")],
+                             default="3", update=_rebuild, description="How many coordinates the noise varies over")
     directions: IntProperty(name="Directions", description="Number of wave directions (cost grows linearly)",
                             default=16, min=1, soft_max=64, max=256, update=_rebuild)
-    spectrum: EnumProperty(name="Spectrum", items=_SPECTRA, default="gaussian", update=_rebuild)
+    spectrum: EnumProperty(name="Spectrum", items=_SPECTRA, default="gaussian", update=_rebuild,
+                           description="How strong each feature size is within the frequency band")
     fmin: FloatProperty(name="Min Frequency", description="Lower band limit, cycles per unit (after Scale)",
                         default=2.0, min=0.0, soft_max=64.0, update=_rebuild)
     fmax: FloatProperty(name="Max Frequency", description="Upper band limit, cycles per unit (after Scale)",
                         default=8.0, min=0.01, soft_max=64.0, update=_rebuild)
     exponent: FloatProperty(name="Exponent", description="Fractal spectrum falls as 1/f^exponent",
                             default=1.0, min=0.0, max=4.0, update=_rebuild)
-    waveform: EnumProperty(name="Waveform", items=_WAVEFORMS, default="gaussian", update=_rebuild)
-    anisotropy: EnumProperty(name="Anisotropy", items=_ANISO, default="none", update=_rebuild)
-    axis: FloatVectorProperty(name="Axis", size=3, default=(1.0, 0.0, 0.0), update=_rebuild)
+    waveform: EnumProperty(name="Waveform", items=_WAVEFORMS, default="gaussian", update=_rebuild,
+                           description="The profile of each wave, which sets the noise's character")
+    anisotropy: EnumProperty(name="Anisotropy", items=_ANISO, default="none", update=_rebuild,
+                             description="Whether the noise has a direction")
+    axis: FloatVectorProperty(name="Axis", size=3, default=(1.0, 0.0, 0.0), update=_rebuild,
+                              description="The direction the lobe's waves run along")
     spread: FloatProperty(name="Spread", description="Half-angle of the lobe, degrees", default=20.0,
                           min=1.0, max=90.0, update=_rebuild)
     axis_scale: FloatVectorProperty(name="Axis Frequency", description="Band limits scaled per axis",
                                     size=3, default=(1.0, 2.0, 0.5), min=0.05, soft_max=8.0, update=_rebuild)
-    seed: IntProperty(name="Seed", default=0, min=0, max=(1 << 24) - 1, update=_rebuild)
-    speed: FloatProperty(name="Speed", description="Wave speed for animation with the Time input (Eq. 9); "
-                         "0 = static", default=0.0, soft_min=-10.0, soft_max=10.0, update=_rebuild)
-    implementation: EnumProperty(name="Implementation", items=_IMPLEMENTATIONS, default="AUTO", update=_rebuild)
+    seed: IntProperty(name="Seed", default=0, min=0, max=(1 << 24) - 1, update=_rebuild,
+                      description="Another seed gives another noise of the same look")
+    speed: FloatProperty(name="Speed", description="How fast the waves travel as the Time input grows, units per "
+                         "unit of time; 0 keeps the noise still", default=0.0, soft_min=-10.0, soft_max=10.0,
+                         update=_rebuild)
+    implementation: EnumProperty(name="Implementation", items=_IMPLEMENTATIONS, default="AUTO", update=_rebuild,
+                                 description="How the node computes the noise: from Blender's nodes or as one OSL "
+                                             "script")
 
     def to_settings(self, node: bool = True):
         """WaveSettings; ``node`` checks the live node's limits (bakes take any number of directions)."""
@@ -193,7 +220,7 @@ class _AddGroupNode:
 
 
 class OMNINOISE_OT_add_wave_noise(_AddGroupNode, bpy.types.Operator):
-    """Add a Wave Noise node (Guehl et al. 2025) built from Blender's own nodes"""
+    """Add a Wave Noise node: a sum of randomly oriented waves, editable like Blender's own textures"""
 
     bl_idname = "node.omninoise_add_wave_noise"
     bl_label = "Wave Noise"
@@ -204,7 +231,7 @@ class OMNINOISE_OT_add_wave_noise(_AddGroupNode, bpy.types.Operator):
 
 
 class OMNINOISE_OT_add_wave_cellular(_AddGroupNode, bpy.types.Operator):
-    """Add a Wave Cellular node: random-plane polytopes (Guehl et al. 2025, Alg. 2) from Blender's own nodes"""
+    """Add a Wave Cellular node: cells cut by random planes (cracked, faceted and tiled looks)"""
 
     bl_idname = "node.omninoise_add_wave_cellular"
     bl_label = "Wave Cellular"
@@ -253,9 +280,18 @@ class OMNINOISE_PT_wave_node(Sidebar, bpy.types.Panel):
     def poll(cls, context):
         return _wave_tree(context) is not None
 
+    def draw_header_preset(self, context):
+        draw_wave_presets(self.layout, _wave_tree(context).omninoise_wave)
+
     def draw(self, context):
         self.layout.use_property_split = True
         draw_wave_settings(self.layout, _wave_tree(context).omninoise_wave)
+
+
+def draw_wave_presets(layout, props) -> None:
+    """The wave preset menu (+ and −) for the settings ``props`` (a node tree's, or the bake panel's)."""
+    layout.context_pointer_set("omninoise_wave", props)
+    OMNINOISE_PT_wave_presets.draw_panel_header(layout)
 
 
 def draw_wave_settings(layout, props) -> None:
@@ -283,9 +319,9 @@ def draw_wave_settings(layout, props) -> None:
         if props.id_data.bl_idname == "ShaderNodeTree":
             layout.prop(props, "implementation")
             form = tree_implementation(props.id_data)
-            hint = ("OSL script (Cycles with Open Shading Language)" if form == "osl" else
-                    "Nodes (faster: Cycles > Open Shading Language)" if props.implementation == "AUTO" else "Nodes")
-            layout.label(text=f"In use: {hint}", icon="INFO")
+            layout.label(text="In use: OSL script" if form == "osl" else "In use: Blender's nodes", icon="INFO")
+            if form != "osl" and props.implementation == "AUTO":
+                layout.label(text="Cycles with Open Shading Language runs it faster")
     if props.error:
         layout.label(text=props.error, icon="ERROR")
 
@@ -316,8 +352,44 @@ def _subscribe(*_args) -> None:
         bpy.msgbus.subscribe_rna(key=key, owner=_MSGBUS_OWNER, args=(), notify=follow_render_settings)
 
 
+# -- wave noise presets (Blender's preset menu in the Wave Noise and Bake Noise panels' headers) ----------
+
+def _wave_reset(context, filepath) -> None:
+    props = getattr(context, "omninoise_wave", None)
+    if props is not None:
+        LOADING.add(props.as_pointer())
+
+
+def _wave_post(context, filepath) -> None:
+    props = getattr(context, "omninoise_wave", None)
+    if props is not None:
+        LOADING.discard(props.as_pointer())
+        rebuild(props, context)
+
+
+class OMNINOISE_PT_wave_presets(PresetPanel, bpy.types.Panel):
+    bl_label = "Wave Noise Presets"
+    preset_subdir = SUBDIRS["wave"]
+    preset_operator = "script.execute_preset"
+    preset_add_operator = "omninoise.wave_preset_add"
+    reset_cb = staticmethod(_wave_reset)
+    post_cb = staticmethod(_wave_post)
+
+
+class OMNINOISE_OT_wave_preset_add(AddPresetBase, bpy.types.Operator):
+    """Add or remove a wave noise preset (spectrum, waveform, directions, anisotropy and speed)"""
+
+    bl_idname = "omninoise.wave_preset_add"
+    bl_label = "Add Wave Noise Preset"
+    preset_menu = "OMNINOISE_PT_wave_presets"
+    preset_subdir = SUBDIRS["wave"]
+    preset_defines = ["props = bpy.context.omninoise_wave"]
+    preset_values = WAVE_VALUES
+
+
 MENUS = ("NODE_MT_category_shader_texture", "NODE_MT_category_GEO_TEXTURE")
-classes = (OMNINOISE_PG_wave, OMNINOISE_OT_add_wave_noise, OMNINOISE_OT_add_wave_cellular, OMNINOISE_PT_wave_node)
+classes = (OMNINOISE_PG_wave, OMNINOISE_OT_add_wave_noise, OMNINOISE_OT_add_wave_cellular, OMNINOISE_PT_wave_node,
+           OMNINOISE_PT_wave_presets, OMNINOISE_OT_wave_preset_add)
 
 
 def attach():

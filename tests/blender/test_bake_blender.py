@@ -14,6 +14,7 @@ from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 from omninoise.backend.bake import BakeSpec, run_bake  # noqa: E402
 from omninoise.backend.sources import BoxGrid, WaveSource  # noqa: E402
 from omninoise.backend.transfer import preset  # noqa: E402
+from omninoise.blender_addon.bake_ui import apply_transfer  # noqa: E402
 from omninoise.export import read_volume  # noqa: E402
 
 
@@ -72,7 +73,7 @@ def test_presets_set_the_ramp(scene):
 
     p = scene.omninoise_bake
     for name in ("fire", "marble", "clouds"):
-        p.preset = name
+        apply_transfer(p, preset(name))
         cr = ramp_node().color_ramp
         ref = preset(name)
         assert [round(e.position, 5) for e in cr.elements] == [round(x, 5) for x, _ in ref.stops]
@@ -84,7 +85,7 @@ def test_presets_set_the_ramp(scene):
 @needs_openvdb
 def test_bake_volume_operator_makes_a_renderable_volume(scene, tmp_path):
     p = scene.omninoise_bake
-    p.preset = "smoke"  # dark smoke: absorbs the white world where it is dense
+    apply_transfer(p, preset("smoke"))  # dark smoke: absorbs the white world where it is dense
     p.density_scale = 20.0
     p.name = "Clouds"
     assert bpy.ops.omninoise.bake_volume() == {"FINISHED"}
@@ -142,7 +143,7 @@ def test_animated_volume_is_a_sequence(scene, tmp_path):
     p.wave.speed = 2.0
     p.animated, p.frame_start, p.frame_end = True, 3, 5
     p.name = "Anim"
-    p.preset = "fire"
+    apply_transfer(p, preset("fire"))
     assert bpy.ops.omninoise.bake_volume() == {"FINISHED"}
     assert sorted(os.listdir(tmp_path)) == ["Anim_0003.vdb", "Anim_0004.vdb", "Anim_0005.vdb"]
     vol = bpy.data.objects["Anim"].data
@@ -159,7 +160,7 @@ def test_animated_volume_is_a_sequence(scene, tmp_path):
 def test_bake_image_operator(scene, tmp_path):
     p = scene.omninoise_bake
     p.name = "Marble"
-    p.preset = "marble"
+    apply_transfer(p, preset("marble"))
     assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
     img = bpy.data.images["Marble"]
     assert tuple(img.size) == (32, 24)
@@ -261,5 +262,5 @@ def test_job_in_blender_matches_the_command_line(tmp_path):
     np.testing.assert_array_equal(read_volume(str(tmp_path / "cli" / "vol.vdb"), "density", (8, 16, 16)),
                                   read_volume(str(tmp_path / "bpy" / "vol.vdb"), "density", (8, 16, 16)))
     (tmp_path / "bpy" / "job.toml").write_text(JOB.replace("seed = 9", "sed = 9"))
-    with pytest.raises(RuntimeError, match="bake 'vol': sed: unknown wave setting"):
+    with pytest.raises(RuntimeError, match=r"bake 'vol': source.sed: unknown key \(did you mean seed\?\)"):
         bpy.ops.omninoise.run_job(filepath=str(tmp_path / "bpy" / "job.toml"))

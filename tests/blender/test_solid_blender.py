@@ -175,9 +175,9 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
     assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
     ref = np.flipud(SpectralTexture(req).image(128, field))
     assert np.abs(_pixels("Solid Texture Preview") - ref).max() <= 0.5 / 255 + 1e-4
-    assert p.periodic_info == "Periodic part: none found" and p.gaussian_info == ""   # random pixels: no period
+    assert p.periodic_info == "Pattern: none found" and p.gaussian_info == ""   # random pixels: no period
     log = []
-    solid_ui.draw_solid(Recorder(log), bpy.context)
+    solid_ui.draw_solid_all(Recorder(log), bpy.context)
     props = {a for n, a, t in log if n == "prop"}
     assert {"method", "periodic"} <= props and not {"refine", "gaussian", "rest"} & props
     p.periodic = False      # the Periodic Part box is --no-periodic here too
@@ -223,8 +223,8 @@ def test_image_source_is_encoded_by_the_space_model(scene):
     code = photo_code(m, pixels).code                          # the panel's code: the pipeline's stages
     ref = np.flipud(m.image(128, code, seed=3))
     assert np.abs(got - ref).max() <= 0.5 / 255 + 1e-4
-    assert p.periodic_info == "Periodic part: none found"      # random pixels have no period
-    assert p.gaussian_info == solid_ui.gaussian_info(code) and p.gaussian_info.startswith("Gaussian rest: ")
+    assert p.periodic_info == "Pattern: none found"      # random pixels have no period
+    assert p.gaussian_info == solid_ui.gaussian_info(code) and p.gaussian_info.startswith("Fine detail: ")
 
 
 def test_the_preview_shows_the_periodic_part_it_found(scene):
@@ -236,9 +236,9 @@ def test_the_preview_shows_the_periodic_part_it_found(scene):
     p = scene.omninoise_solid
     p.source, p.image, p.seed = "IMAGE", bpy.data.images.load(path), 0
     assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
-    assert p.periodic_info == "Periodic part: 73 waves, 85 % of the variance"
+    assert p.periodic_info == "Pattern: 73 waves, 85 % of the variance"
     log = []
-    solid_ui.draw_solid(Recorder(log), bpy.context)
+    solid_ui.draw_solid_all(Recorder(log), bpy.context)
     assert ("label", None, p.periodic_info) in [(n, None, t) for n, a, t in log]
     lum = read_rgb(path)[:128, :128].mean(2).ravel()
     with_part = np.flipud(_pixels("Solid Texture Preview")).mean(2).ravel()
@@ -280,8 +280,8 @@ def test_tileable_image_is_the_requests_synthesis(scene, tmp_path):
     g = got.mean(2)      # the stripes stay vertical: brightness changes across columns, not down them
     assert np.abs(np.diff(g, axis=1)).mean() > 10.0 * np.abs(np.diff(g, axis=0)).mean()
     log = []
-    solid_ui.draw_solid(Recorder(log), bpy.context)
-    assert "Tileable Image" in [t for n, a, t in log if n == "operator"] and "tile" in [a for n, a, t in log]
+    solid_ui.draw_solid_all(Recorder(log), bpy.context)
+    assert "Make Tileable Image" in [t for n, a, t in log if n == "operator"] and "tile" in [a for n, a, t in log]
 
 
 def test_the_tile_is_box_projected_onto_a_mesh_without_uvs_at_the_photos_scale(scene, tmp_path):
@@ -295,7 +295,7 @@ def test_the_tile_is_box_projected_onto_a_mesh_without_uvs_at_the_photos_scale(s
     cube = bpy.context.active_object
     while cube.data.uv_layers:
         cube.data.uv_layers.remove(cube.data.uv_layers[0])
-    with pytest.raises(RuntimeError, match="synthesise one with Tileable Image first"):
+    with pytest.raises(RuntimeError, match="make one with Make Tileable Image first"):
         bpy.ops.omninoise.solid_tile_material()
     p.source, p.image, p.tile, p.seed, p.scale = "IMAGE", _stripes_image(), 64, 5, 2.0
     assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
@@ -373,7 +373,7 @@ def test_worker_bake_cancels_and_leaves_nothing(scene):
 
 def test_panel_draws(scene):
     log = []
-    solid_ui.draw_solid(Recorder(log), bpy.context)
+    solid_ui.draw_solid_all(Recorder(log), bpy.context)
     props = [a for n, a, t in log if n == "prop"]
     assert {"source", "texture", "scale", "seed", "coords", "target", "size", "margin", "name"} <= set(props)
     assert [t for n, a, t in log if n == "operator"] == ["Preview", "Bake"]

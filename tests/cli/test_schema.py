@@ -60,7 +60,7 @@ COERCIONS = [
     ("transfer = {preset = \"fire\", density_scale = inf}\n", "", None,
      "transfer.density_scale: must be a finite number, got inf"),
     ("transfer = {stops = [[0, [1, 0, 0, nan]]]}\n", "", None, "transfer.stops[0][1][3]: must be a finite number"),
-    ("transfer = {stops = 5}\n", "", None, "transfer.stops: expected a list of 1 to 256 items"),
+    ("transfer = {stops = 5}\n", "", None, "transfer.stops: expected a list of 1 to 4096 items"),
     ("resolution = [true, 16]\n", "", None, "resolution[0]: expected a whole number, got True"),
     ("resolution = [\"a\", 16]\n", "", None, "resolution[0]: expected a whole number, got 'a'"),
     ("resolution = [nan, 16]\n", "", None, "resolution[0]: expected a whole number, got nan"),

@@ -95,5 +95,5 @@ def test_presets_fill_part_of_a_wave_volume(name):
 
 
 def test_validates_as_a_dataclass():
-    with pytest.raises(SettingError, match=r"stops: expected 1 to 256 items, got 0"):
+    with pytest.raises(SettingError, match=r"stops: expected 1 to 4096 items, got 0"):
         TransferFunction(stops=()).validate()

@@ -1,0 +1,59 @@
+"""Presets through Blender's own preset system: the preset menu with + and − in the headers of the Transfer
+Function, Wave Noise and Neural Noise panels.
+
+Presets are Python files, as Blender's own are. The extension's folder holds the shipped ones
+(``presets/omninoise/<kind>/``, written by ``python -m tools.make_presets``), registered with
+``bpy.utils.register_preset_path``; Blender keeps them read-only and writes an artist's own presets into the user
+scripts folder. A wave preset sets ``bpy.context.omninoise_wave``, which each panel points at the settings it
+shows (a node tree's or the bake panel's), so one set of presets serves both.
+
+Each preset menu and its + operator live with the panel they serve (:mod:`.bake_ui`, :mod:`.wave_ui`,
+:mod:`.neural_ui`); this module holds what they share.
+"""
+from __future__ import annotations
+
+import json
+import os
+
+import bpy
+
+__all__ = ["ROOT", "SUBDIRS", "WAVE_VALUES", "NEURAL_VALUES", "LOADING", "loading", "transfer_preset_text",
+           "classes", "attach", "detach"]
+
+#: the folder that holds ``presets/omninoise/...`` (this package's own folder)
+ROOT = os.path.dirname(os.path.abspath(__file__))
+SUBDIRS = {"transfer": "omninoise/transfer", "wave": "omninoise/wave", "neural": "omninoise/neural"}
+
+#: what a wave preset keeps: the look, not the seed
+WAVE_VALUES = ["props.dimensions", "props.directions", "props.spectrum", "props.fmin", "props.fmax",
+               "props.exponent", "props.waveform", "props.anisotropy", "props.axis", "props.spread",
+               "props.axis_scale", "props.speed"]
+#: what a neural preset keeps: the swatches and their layout and sampling, not the size, seed or output
+NEURAL_VALUES = ["p.swatches", "p.mode", "p.width", "p.sharpness", "p.sampler", "p.steps", "p.tileable"]
+
+
+def transfer_preset_text(tf) -> str:
+    """The preset file of transfer function ``tf``: one call of :class:`OMNINOISE_OT_set_transfer`."""
+    return ("import bpy\n"
+            f"bpy.ops.omninoise.set_transfer(transfer={json.dumps(json.dumps(tf.to_dict(), sort_keys=True))})\n")
+
+
+#: wave settings whose node group a preset is setting value by value (rebuilt once, after the last)
+LOADING = set()
+
+
+def loading(props) -> bool:
+    """True while a preset sets ``props`` value by value (its node group is rebuilt once, after the last)."""
+    return props.as_pointer() in LOADING
+
+
+classes = ()
+
+
+def attach():
+    """The shipped presets' folder on Blender's preset path."""
+    bpy.utils.register_preset_path(ROOT)
+
+
+def detach():
+    bpy.utils.unregister_preset_path(ROOT)
