@@ -21,10 +21,15 @@ NOT_IN_THE_UI = re.compile(r"\bEq\.|\bFig\.|\bAlg\.|et al\.|Guehl|Henzler|Maesum
 
 @pytest.fixture(scope="module", autouse=True)
 def addon(tmp_path_factory):
+    old = os.environ.get("BLENDER_USER_SCRIPTS")
     os.environ["BLENDER_USER_SCRIPTS"] = str(tmp_path_factory.mktemp("user_scripts"))  # user presets go here
     blender_addon.register()
     yield
     blender_addon.unregister()
+    if old is None:
+        del os.environ["BLENDER_USER_SCRIPTS"]
+    else:
+        os.environ["BLENDER_USER_SCRIPTS"] = old
 
 
 @pytest.fixture
