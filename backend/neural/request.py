@@ -92,12 +92,12 @@ class NeuralRequest:
             if self.regions.min() < 0 or self.regions.max() >= len(self.specs):
                 raise SettingError("map", f"region indices must lie in [0, {len(self.specs)}), "
                                           f"got {self.regions.min()}..{self.regions.max()}")
-        if not (np.isfinite(self.transition) and self.transition > 0 and np.isfinite(self.sharpness)
-                and self.sharpness > 0):
-            raise SettingError("width", f"transition width and sharpness must be positive, got {self.transition:g} "
-                                        f"and {self.sharpness:g}")
-        if not 0 <= self.seed < 2 ** 32:
-            raise SettingError("seed", f"must lie in [0, 2^32), got {self.seed}")
+        from ..settings_schema import NEURAL_SOURCE     # the job file's rules, whichever front end asks
+
+        f = NEURAL_SOURCE.fields
+        for key, value in (("width", self.transition), ("sharpness", self.sharpness), ("seed", self.seed),
+                           ("tileable", self.tileable)):
+            f[key].type.check(value, key)
         check_sampler(self.sampler, self.steps, self.spacing, self.eta)
         k = model.multiple_of
         if self.tileable and (self.width % k or self.height % k):

@@ -28,9 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SettingError
-from ..limits import MAX_REFINE
 from ..paths import solid_models
-from .gaussian_rest import REST_CHOICES
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
 
@@ -86,24 +84,15 @@ class SolidRequest:
 
     def check(self, where: str = "") -> "SolidRequest":
         """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
+        from ..settings_schema import SOLID_SOURCE     # the job file's rules, whichever front end asks
+
         def bad(key, why):
             return SettingError(f"{where}{key}", why)
 
-        if not isinstance(self.mix, (int, float)) or not np.isfinite(self.mix) or not 0.0 <= self.mix <= 1.0:
-            raise bad("mix", f"must be in [0, 1], got {self.mix}")
-        if isinstance(self.refine, bool) or not isinstance(self.refine, (int, np.integer)) \
-                or not 0 <= self.refine <= MAX_REFINE:
-            raise bad("refine", f"must be a whole number in [0, {MAX_REFINE}], got {self.refine}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
-            raise bad("seed", f"must be a whole number in [0, {MAX_SEED}], got {self.seed}")
-        if not isinstance(self.periodic, (bool, np.bool_)):
-            raise bad("periodic", f"must be true or false, got {self.periodic!r}")
-        if not isinstance(self.gaussian, (bool, np.bool_)):
-            raise bad("gaussian", f"must be true or false, got {self.gaussian!r}")
-        if not isinstance(self.rest, str) or self.rest not in REST_CHOICES:
-            raise bad("rest", f"must be one of {', '.join(REST_CHOICES)}, got {self.rest!r}")
-        if not isinstance(self.method, str) or self.method not in METHODS:
-            raise bad("method", f"must be one of {', '.join(METHODS)}, got {self.method!r}")
+        f = SOLID_SOURCE.fields
+        for key in ("mix", "refine", "seed", "periodic", "gaussian", "rest", "method"):
+            value = getattr(self, key)
+            f[key].type.check(bool(value) if isinstance(value, np.bool_) else value, f"{where}{key}")
         if self.method in IMAGE_METHODS:
             m, ex = self.method, self.exemplar
             if isinstance(ex, str) and not os.path.isfile(ex):

@@ -90,7 +90,7 @@ def test_space_model_encode_and_interpolate(models, tmp_path, capsys):
 @pytest.mark.parametrize("args, msg", [
     (["--exemplar", "gravel"], "give --exemplar"),
     (["--exemplar", "gravel", "--size", "0", "-o", "x.png"], "--size: must be >= 1"),
-    (["--exemplar", "gravel", "--mix", "2", "-o", "x.png"], "--mix: must be in [0, 1]"),
+    (["--exemplar", "gravel", "--mix", "2", "-o", "x.png"], "--mix: must lie in [0, 1]"),
     (["--exemplar", "gravel", "--dim", "3", "-o", "x.png"], "a 3D result is written as .vdb, .npy"),
     (["--exemplar", "gravel", "--to", "grass", "-o", "x.png"], "interpolation needs the space model"),
 ])

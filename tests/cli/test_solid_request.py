@@ -51,13 +51,13 @@ def test_a_file_and_its_pixels_are_one_exemplar():
 
 
 def test_periodic_and_gaussian_must_be_a_yes_or_no():
-    with pytest.raises(SettingError, match="source.periodic: must be true or false"):
+    with pytest.raises(SettingError, match="source.periodic: expected true or false"):
         solid_request_from_dict(dict(exemplar=PHOTO, periodic="yes"))
-    with pytest.raises(SettingError, match="source.gaussian: must be true or false"):
+    with pytest.raises(SettingError, match="source.gaussian: expected true or false"):
         solid_request_from_dict(dict(exemplar=PHOTO, gaussian=1))
-    with pytest.raises(SettingError, match="source.rest: must be one of auto, isotropic, upright, got 'sideways'"):
+    with pytest.raises(SettingError, match="source.rest: expected one of auto, isotropic, upright, got 'sideways'"):
         solid_request_from_dict(dict(exemplar=PHOTO, rest="sideways"))
-    with pytest.raises(SettingError, match="rest: must be one of"):
+    with pytest.raises(SettingError, match="rest: expected one of"):
         SolidRequest(exemplar=PHOTO, rest=None).check()
 
 
@@ -68,10 +68,10 @@ def test_the_model_is_chosen_as_the_command_line_always_did():
 
 
 @pytest.mark.parametrize("flags, table, field, why", [
-    (["--mix", "1.5", "--to", "grass"], {"mix": 1.5, "to": "grass"}, "mix", "must be in [0, 1]"),
-    (["--refine", "-1"], {"refine": -1}, "refine", "whole number in [0, 10000]"),
-    (["--seed", "-3"], {"seed": -3}, "seed", "whole number in [0, 4294967295]"),
-    (["--seed", str(2 ** 32)], {"seed": 2 ** 32}, "seed", "whole number in [0, 4294967295]"),
+    (["--mix", "1.5", "--to", "grass"], {"mix": 1.5, "to": "grass"}, "mix", "must lie in [0, 1]"),
+    (["--refine", "-1"], {"refine": -1}, "refine", "must lie in [0, 10000]"),
+    (["--seed", "-3"], {"seed": -3}, "seed", "must lie in [0, 4294967295]"),
+    (["--seed", str(2 ** 32)], {"seed": 2 ** 32}, "seed", "must lie in [0, 4294967295]"),
 ])
 def test_the_same_errors_in_each_front_ends_terms(flags, table, field, why):
     with pytest.raises(SettingError) as e1:
