@@ -14,7 +14,7 @@ from .neural.animate import LATENT_MODES
 from .neural.sampler import SAMPLERS
 from .schema import AnyOf, Bool, Choice, Field, Float, Int, Items, ListOf, MapOf, Table, Text
 from .solid.gaussian_rest import REST_CHOICES
-from .solid.request import METHODS
+from .solid.methods import METHODS
 from .solid.synthesis import MAX_TILE, MIN_TILE
 from .transfer import TRANSFER
 from .wavenoise.schema import COORD, FREQUENCY, SEED, SPECTRUM, WAVE_SETTINGS

@@ -29,15 +29,9 @@ import numpy as np
 
 from ..errors import SettingError
 from ..paths import solid_models
+from .methods import IMAGE_METHODS, METHODS
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
-
-#: how the texture is made: "neural" (a model's texture, the default), "synthesis" (a periodic 2D image optimised
-#: from an image exemplar, :mod:`backend.solid.synthesis`) or "spectral" (a periodic Gaussian solid with the image
-#: exemplar's spectrum on its slices, :mod:`backend.solid.spectral_solid`)
-METHODS = ("neural", "synthesis", "spectral")
-#: the methods that draw from an image exemplar alone, without a model
-IMAGE_METHODS = ("synthesis", "spectral")
 
 MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the value noise hash, backend/solid/value_noise.py)
 
