@@ -84,8 +84,8 @@ class BakeSpec:
         self.grid.validate()
         limits.time("time", self.time)
         limits.positive("time_step", self.time_step)
+        last = self.time + (float(self.frames[1]) - float(self.frames[0])) * self.time_step if self.frames else self.time
         if self.frames is not None:     # every frame's time within MAX_TIME
-            last = self.time + (float(self.frames[1]) - float(self.frames[0])) * self.time_step
             if not abs(last) <= limits.MAX_TIME:
                 raise SettingError("time_step", f"the last frame's time, {last:g}, passes {limits.MAX_TIME:g}; use a "
                                                 "smaller time_step or fewer frames")
@@ -104,7 +104,6 @@ class BakeSpec:
             check(self.grid.shape)
         check = getattr(self.source, "check_extent", None)  # ... and on how far from the origin it reaches
         if check is not None:
-            last = self.time + (self.frames[1] - self.frames[0]) * self.time_step if self.frames else self.time
             check(float(np.max(np.abs(self.grid.bounds))), max(abs(self.time), abs(last)))
         if rank == 3 and self.source.dim == 2:
             raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")

@@ -130,9 +130,8 @@ from .schema import did_you_mean, shown_value
 from .sources import BoxGrid, source_from_dict
 from .transfer import load_transfer, transfer_from_dict
 
-__all__ = ["JobError", "load_job", "parse_job", "run_job", "select_bakes", "JobOutcome", "BAKE_KEYS"]
+__all__ = ["JobError", "load_job", "parse_job", "run_job", "select_bakes", "JobOutcome"]
 
-BAKE_KEYS = ("name", "output", "resolution", "bounds", "transfer", "frames", "time", "time_step", "half", "source")
 
 
 class JobError(ValueError):

@@ -32,7 +32,7 @@ import os
 from .errors import SettingError
 
 __all__ = ["MAX_DIRECTIONS", "MAX_TABLE_SIZE", "MAX_FRAMES", "MAX_THREADS", "MAX_REFINE", "SCALE_RANGE", "MAX_TIME", "MAX_SPEED", "MIN_LENGTH", "MAX_COORD", "MAX_FREQUENCY", "MAX_CYCLES", "scale", "time", "frame_count", "memory_limit", "finite", "positive", "in_range", "check_int",
-           "check_memory", "as_bool"]
+           "check_memory"]
 
 MAX_DIRECTIONS = 4096
 MAX_TABLE_SIZE = 1 << 20
@@ -121,10 +121,3 @@ def check_memory(name: str, n_bytes: float, what: str) -> None:
     if n_bytes > limit:
         raise SettingError(name, f"{what} needs {n_bytes / 2 ** 30:.1f} GiB, above the limit of "
                                  f"{limit / 2 ** 30:.1f} GiB (set OMNINOISE_MEMORY_LIMIT to raise it)")
-
-
-def as_bool(name: str, value) -> bool:
-    """A strict boolean: TOML true/false only (the string "no" is not false, and not true either)."""
-    if not isinstance(value, bool):
-        raise SettingError(name, f"expected true or false, got {value!r}")
-    return value

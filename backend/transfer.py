@@ -59,8 +59,6 @@ class TransferFunction:
             if isinstance(exc, SettingError):
                 raise
             raise SettingError("transfer", f"expected numbers in range, stops and temperature ({exc})") from None
-        if self.interpolation not in INTERPOLATIONS:
-            raise SettingError("interpolation", f"unknown {self.interpolation!r}; choose one of {', '.join(INTERPOLATIONS)}")
         pos = [p for p, _ in self.stops]
         if any(b < a for a, b in zip(pos, pos[1:])):
             raise SettingError("stops", f"positions must be sorted, got {pos}")

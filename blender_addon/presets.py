@@ -15,8 +15,6 @@ from __future__ import annotations
 import json
 import os
 
-import bpy
-
 __all__ = ["ROOT", "SUBDIRS", "WAVE_VALUES", "NEURAL_VALUES", "LOADING", "loading", "transfer_preset_text",
            "classes", "attach", "detach"]
 
@@ -52,8 +50,12 @@ classes = ()
 
 def attach():
     """The shipped presets' folder on Blender's preset path."""
+    import bpy      # here, not at the top: tools/make_presets.py reads this module's tables without Blender
+
     bpy.utils.register_preset_path(ROOT)
 
 
 def detach():
+    import bpy
+
     bpy.utils.unregister_preset_path(ROOT)

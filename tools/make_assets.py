@@ -60,7 +60,7 @@ def _ramp(nt, stops, x=-300):
     return ramp
 
 
-def _material(name: str, description: str):
+def _material(name: str):
     mat = bpy.data.materials.new(name)
     nt = ensure_node_tree(mat)
     bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
@@ -73,10 +73,10 @@ def _object_positions(nt, x=-900):
     return tc.outputs["Object"]
 
 
-def _wave_material(name, description, tree, stops, roughness, bump=0.0, output="Value", value_range=(-1.5, 1.5)):
+def _wave_material(name, tree, stops, roughness, bump=0.0, output="Value", value_range=(-1.5, 1.5)):
     """A material whose Base Color is ``stops`` over the group's ``output``, mapped from ``value_range`` to the
     ramp's 0 to 1 (wave noise spreads about -1.5 to 1.5; a cell code is 0 to 1)."""
-    mat, nt, bsdf = _material(name, description)
+    mat, nt, bsdf = _material(name)
     node = add_wave_node(nt, tree, (-900, 0))
     nt.links.new(_object_positions(nt, -1200), node.inputs["Vector"])
     rng = nt.nodes.new("ShaderNodeMapRange")
@@ -99,16 +99,15 @@ def _wave_material(name, description, tree, stops, roughness, bump=0.0, output="
 def marble():
     tree = _props(wave_ui.new_wave_node_tree("Marble Veins", "ShaderNodeTree"), dimensions="3", spectrum="fractal",
                   fmin=0.8, fmax=10.0, exponent=1.3, directions=16, seed=3)
-    return _wave_material("Wave Noise Marble", "White marble with grey veins that run on through the object",
-                          tree, [(0.0, (0.9, 0.89, 0.87)), (0.47, (0.93, 0.92, 0.9)), (0.5, (0.35, 0.35, 0.38)),
-                                 (0.53, (0.93, 0.92, 0.9)), (1.0, (0.82, 0.81, 0.8))], 0.15)
+    return _wave_material("Wave Noise Marble", tree,
+                          [(0.0, (0.9, 0.89, 0.87)), (0.47, (0.93, 0.92, 0.9)), (0.5, (0.35, 0.35, 0.38)),
+                           (0.53, (0.93, 0.92, 0.9)), (1.0, (0.82, 0.81, 0.8))], 0.15)
 
 
 def veined_stone():
     tree = _props(wave_ui.new_wave_node_tree("Stone", "ShaderNodeTree"), dimensions="3", spectrum="fractal",
                   fmin=1.5, fmax=16.0, exponent=1.0, directions=16, seed=7)
-    return _wave_material("Veined Stone", "Dark stone crossed by thin light veins (a ramp's narrow light band "
-                          "over fractal wave noise)", tree,
+    return _wave_material("Veined Stone", tree,
                           [(0.0, (0.12, 0.11, 0.1)), (0.47, (0.2, 0.19, 0.17)), (0.5, (0.85, 0.83, 0.78)),
                            (0.53, (0.2, 0.19, 0.17)), (1.0, (0.1, 0.1, 0.09))], 0.45, bump=0.2)
 
@@ -116,8 +115,8 @@ def veined_stone():
 def cellular_tiles():
     tree = wave_ui.new_cellular_node_tree("Tiles", "ShaderNodeTree")
     _props(tree, cell_size=0.35, seed=5)
-    return _wave_material("Cellular Tiles", "Irregular tiles: cells cut by random planes, each its own shade",
-                          tree, [(0.0, (0.45, 0.2, 0.12)), (0.5, (0.65, 0.35, 0.2)), (1.0, (0.8, 0.55, 0.35))], 0.6,
+    return _wave_material("Cellular Tiles", tree,
+                          [(0.0, (0.45, 0.2, 0.12)), (0.5, (0.65, 0.35, 0.2)), (1.0, (0.8, 0.55, 0.35))], 0.6,
                           bump=0.3, output="Cell", value_range=(0.0, 1.0))
 
 
@@ -165,7 +164,7 @@ def neural_blend():
     p.mode, p.size, p.steps, p.seed, p.name, p.add_node, p.save = "CORNERS", 256, 10, 0, "Neural Blend", False, "NONE"
     assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
     ima = bpy.data.images["Neural Blend"]
-    mat, nt, bsdf = _material("Neural Noise Blend", "")
+    mat, nt, bsdf = _material("Neural Noise Blend")
     tex = nt.nodes.new("ShaderNodeTexImage")
     tex.image, tex.projection, tex.projection_blend, tex.location = ima, "BOX", 0.2, (-600, 0)
     nt.links.new(_object_positions(nt), tex.inputs["Vector"])
@@ -182,7 +181,7 @@ def solid_tile():
     assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
     ima = bpy.data.images["Brick Tile"]
     bpy.data.images.remove(p.image)
-    mat, nt, bsdf = _material("Solid Texture Brick", "")
+    mat, nt, bsdf = _material("Solid Texture Brick")
     solid_ui._project_tile(nt, ima, solid_ui.tile_repeats(2.0, 128), world=False)
     nt.links.new(nt.nodes["OmniNoise Tile"].outputs["Color"], bsdf.inputs["Base Color"])
     bsdf.inputs["Roughness"].default_value = 0.8

@@ -17,11 +17,12 @@ import sys
 
 from omninoise.backend.paths import neural_model
 from omninoise.backend.transfer import PRESETS, preset
+from omninoise.blender_addon.presets import NEURAL_VALUES, WAVE_VALUES, transfer_preset_text
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FOLDER = os.path.join(ROOT, "blender_addon", "presets", "omninoise")
 
-#: wave looks: the values a wave preset sets (blender_addon/presets.py WAVE_VALUES), by file name
+#: wave looks: the values a wave preset sets (WAVE_VALUES), by file name
 WAVE_BASE = dict(dimensions="3", directions=16, spectrum="gaussian", fmin=2.0, fmax=8.0, exponent=1.0,
                  waveform="gaussian", anisotropy="none", axis=(1.0, 0.0, 0.0), spread=20.0,
                  axis_scale=(1.0, 2.0, 0.5), speed=0.0)
@@ -42,16 +43,10 @@ BLENDS = {"blend_cells_to_perlin": ("GRADIENT", ["cells_f1", "perlin"]),
           "blend_four_corners": ("CORNERS", ["cells_f1", "perlin", "spots", "damascus"])}
 
 
-def transfer_text(name: str) -> str:
-    tf = preset(name)
-    return ("import bpy\n"
-            f"bpy.ops.omninoise.set_transfer(transfer={json.dumps(json.dumps(tf.to_dict(), sort_keys=True))})\n")
-
-
 def wave_text(look: dict) -> str:
     v = dict(WAVE_BASE, **look)
     lines = ["import bpy", "props = bpy.context.omninoise_wave", ""]
-    lines += [f"props.{k} = {tuple(x) if isinstance(x, tuple) else x!r}" for k, x in v.items()]
+    lines += [f"{path} = {v[path.split('.')[1]]!r}" for path in WAVE_VALUES]
     return "\n".join(lines) + "\n"
 
 
@@ -65,7 +60,7 @@ def neural_text(layout: str, classes: list, class_params: dict) -> str:
             lines.append(f"item_sub_1.p{j} = {float(value)!r}")
         lines.append(f"item_sub_1.color = {PALETTE[i % len(PALETTE)]!r}")
     lines.append(f"p.mode = {layout!r}")
-    lines += [f"p.{k} = {v!r}" for k, v in NEURAL_SETTINGS.items()]
+    lines += [f"{path} = {NEURAL_SETTINGS[path.split('.')[1]]!r}" for path in NEURAL_VALUES[2:]]
     return "\n".join(lines) + "\n"
 
 
@@ -73,7 +68,7 @@ def presets() -> dict:
     """{path relative to FOLDER: text} of every shipped preset."""
     with open(os.path.join(neural_model(), "neural_noise.json"), encoding="utf-8") as fh:
         config = json.load(fh)
-    out = {f"transfer/{name}.py": transfer_text(name) for name in PRESETS}
+    out = {f"transfer/{name}.py": transfer_preset_text(preset(name)) for name in PRESETS}
     out.update({f"wave/{name}.py": wave_text(look) for name, look in WAVE.items()})
     out.update({f"neural/{name}.py": neural_text("SINGLE", [name], config["class_params"])
                 for name in config["trained_classes"]})
