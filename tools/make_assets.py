@@ -11,6 +11,7 @@ Nodes all render them, and they carry their settings, so the Wave Noise panel ed
 from __future__ import annotations
 
 import os
+import shutil
 import sys
 import tempfile
 
@@ -21,6 +22,7 @@ from omninoise import blender_addon
 from omninoise.blender_addon import solid_ui, wave_ui
 from omninoise.blender_addon.compat import ensure_node_tree
 from omninoise.blender_addon.wave_nodes import add_wave_node
+from omninoise.export.atomic import atomic_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FOLDER = os.path.join(ROOT, "blender_addon", "assets")
@@ -121,9 +123,11 @@ def cellular_tiles():
 
 
 def cloud_volume(folder: str):
-    """A Volume object holding a baked (packed) OpenVDB cloud: a wave noise volume through the clouds transfer
-    function (``omninoise bake``; a live procedural volume shader would be exact but renders minutes slower in the
-    Cycles of Blender 5.0 and later), with a Principled Volume material reading its density and color."""
+    """A Volume object reading a baked OpenVDB cloud: a wave noise volume through the clouds transfer function
+    (``omninoise bake``; a live procedural volume shader would be exact but renders minutes slower in the Cycles
+    of Blender 5.0 and later), with a Principled Volume material reading its density and color. Blender reads a
+    volume's grids from its file only (a packed copy is not read), so ``build`` ships ``cloud.vdb`` beside the
+    .blend and the volume names it by a relative path."""
     import subprocess
 
     job = os.path.join(folder, "cloud.toml")
@@ -341,14 +345,25 @@ def build(out_blend: str = BLEND, sheet: str | None = SHEET) -> list:
         if idb.asset_data is not None:
             idb.use_fake_user = True
     bpy.data.orphans_purge(do_local_ids=True, do_linked_ids=True, do_recursive=True)
-    bpy.ops.file.pack_all()       # images and the cloud's OpenVDB file travel inside the .blend
-    os.makedirs(os.path.dirname(out_blend), exist_ok=True)
+    for img in bpy.data.images:
+        if img.packed_file is None:
+            img.pack()            # images travel inside the .blend
+    folder = os.path.dirname(os.path.abspath(out_blend))
+    os.makedirs(folder, exist_ok=True)
+    for vol in bpy.data.volumes:  # OpenVDB files beside it, named relatively (remapped when saved)
+        name = os.path.basename(vol.filepath)
+        with atomic_path(os.path.join(folder, name)) as part:
+            shutil.copyfile(bpy.path.abspath(vol.filepath), part)
+        vol.filepath = os.path.join(folder, name)
     with open(os.path.join(os.path.dirname(out_blend), "blender_assets.cats.txt"), "w", encoding="utf-8") as fh:
         fh.write(_catalog_file())
-    bpy.ops.wm.save_as_mainfile(filepath=out_blend, compress=True, copy=True)
+    bpy.context.preferences.filepaths.save_version = 0          # no .blend1 backup beside the shipped file
+    bpy.ops.wm.save_as_mainfile(filepath=out_blend, compress=True, copy=True, relative_remap=True)
     if sheet:
         _sheet(pngs, sheet)
     blender_addon.unregister()
+    bpy.ops.wm.read_homefile(use_empty=True)      # free the volume's grids before their folder goes
+    shutil.rmtree(tmp, ignore_errors=True)
     return names
 
 
@@ -376,4 +391,6 @@ def _sheet(pngs: list, path: str) -> None:
 if __name__ == "__main__":
     got = build()
     print(f"wrote {os.path.relpath(BLEND, ROOT)}: {', '.join(got)} ({os.path.getsize(BLEND) / 2 ** 20:.1f} MiB)")
-    sys.exit(0)
+    sys.stdout.flush()
+    os._exit(0)     # bpy 4.2.23 crashes at interpreter exit once an add-on has been unregistered
+    # (tests/blender_scripts/bpy42_exit_crash.py); everything is written by now

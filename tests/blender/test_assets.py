@@ -51,7 +51,9 @@ def test_every_asset_appends_with_its_preview_description_and_catalog():
     with open(os.path.join(preferences.ASSETS, "blender_assets.cats.txt"), encoding="utf-8") as fh:
         catalogs = {line.split(":")[0]: line.split(":")[1] for line in fh if line[:1].isalnum() and ":" in line}
     cloud = dst.objects[0]
-    assert cloud.type == "VOLUME" and cloud.data.packed_file is not None        # the OpenVDB file travels inside
+    # Blender reads a volume's grids from its file only: the OpenVDB file ships beside the .blend
+    assert cloud.type == "VOLUME" and cloud.data.packed_file is None
+    assert os.path.samefile(bpy.path.abspath(cloud.data.filepath), os.path.join(preferences.ASSETS, "cloud.vdb"))
     cloud.data.grids.load()
     assert {"density", "color"} <= {g.name for g in cloud.data.grids}
     for idb in list(dst.materials) + list(dst.node_groups) + list(dst.objects):
