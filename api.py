@@ -156,7 +156,8 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     float pixels ``(H, W, 3)`` in [0, 1]).
 
     ``method`` is ``"neural"`` (the models' texture, 2D or 3D), ``"spectral"`` (the photo's spectrum and colours
-    on every cut, 2D or 3D) or ``"synthesis"`` (a seamless 2D image); ``scale`` is output pixels per exemplar
+    on every cut, 2D or 3D), ``"procedural"`` (rings, layers, cells or bricks fitted to the photo, 2D or 3D) or
+    ``"synthesis"`` (a seamless 2D image); ``scale`` is output pixels per exemplar
     pixel; ``refine`` search steps improve a photo's code; ``periodic`` keeps a photo's courses and planks.
 
     Returns scene-linear RGB float32: ``(size, size, 3)`` for ``dim=2`` (the front view: x right, z up, top row

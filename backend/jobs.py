@@ -104,7 +104,8 @@ texture optimisation (``backend/solid/synthesis.py``; 2D grids only, as ``omnino
 
 With ``method = "spectral"`` it bakes random phase noise of an image exemplar lifted to a solid
 (``backend/solid/spectral_solid.py``: a periodic Gaussian solid with the image's spectrum and colours on every cut;
-2D and 3D grids, as ``omninoise solid --method spectral``)::
+2D and 3D grids, as ``omninoise solid --method spectral``); with ``method = "procedural"`` a procedural solid
+(rings, layers, cells or bonds, ``backend/solid/procedural/``) fitted to the image, the same way::
 
     [bake.source]
     kind = "solid"

@@ -419,7 +419,7 @@ class SynthesisSource:
     def check_grid(self, shape) -> None:
         if len(shape) != 2:
             raise SettingError("source.method", "synthesis makes 2D images; a 3D grid needs the neural texture "
-                                                "(method = \"neural\") or method = \"spectral\"")
+                                                "(method = \"neural\"), method = \"spectral\" or \"procedural\"")
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
         from .colour import srgb_to_linear
@@ -447,7 +447,8 @@ class SynthesisSource:
 
 class SpectralSource:
     """A solid source with ``method = "spectral"``: a periodic Gaussian solid whose slices carry an image
-    exemplar's spectrum (:mod:`backend.solid.spectral_solid`: random phase noise lifted to 3D), drawn when the
+    exemplar's spectrum (:mod:`backend.solid.spectral_solid`: random phase noise lifted to 3D), or with ``method =
+    "procedural"``: a procedural solid fitted to the image (:mod:`backend.solid.procedural`), drawn when the
     source is made, then read at the grid's points, ``scale`` times the texture's own size (the photo's pixels at
     PX_PER_UNIT per unit, as the neural texture).  2D grids read a plane of constant z; 3D grids fill volumes
     (with a constant ``density``, as :class:`SolidSource`)."""
@@ -459,14 +460,14 @@ class SpectralSource:
     dim = 3
 
     def __init__(self, request, scale: float = 1.0, density: float = 1.0, field=None, progress=None, cancel=None):
-        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "spectral"; field: its ready
-        :class:`~backend.solid.spectral_solid.SplineField` (else drawn here, with progress and cancel)."""
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "spectral" or "procedural";
+        field: its ready field (``request.solid_field()``; else drawn here, with progress and cancel)."""
         import dataclasses
 
         self.request, self.scale = request, limits.scale("source.scale", scale)
         self.density = float(limits.in_range("source.density", density, 0.0, float("inf")))
         pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
-        self.field = field if field is not None else pixels.spectral_field("source.", progress, cancel)
+        self.field = field if field is not None else pixels.solid_field("source.", progress, cancel)
         self.input_sha256 = pixels.key()["exemplar"]
 
     def check_grid(self, shape) -> None:
@@ -481,7 +482,7 @@ class SpectralSource:
 
     def to_dict(self) -> dict:
         r = self.request
-        return dict(kind=self.kind, method="spectral", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+        return dict(kind=self.kind, method=r.method, exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
                     input_sha256=self.input_sha256, seed=int(r.seed), scale=self.scale, density=self.density)
 
 
@@ -499,10 +500,15 @@ def solid_volume(request, size: int, scale: float = 1.0, where: str = "", progre
     :meth:`~backend.solid.request.SolidRequest.front_image`.  SettingError for a 2D model or method synthesis."""
     if request.method == "synthesis":
         raise SettingError(f"{where}method", f"synthesis makes 2D images ({where}dim 2); volumes come from the "
-                                             f"neural texture or {where}method spectral")
-    if request.method == "spectral":
-        field = request.spectral_field(where, progress)
+                                             f"neural texture or {where}method spectral or procedural")
+    if request.method in ("spectral", "procedural"):
+        field = request.solid_field(where, progress)
         return SpectralSource(request, field=field), size / (field.px_per_unit * scale)
+    if request.method == "auto":
+        c = request.choose(where, progress, report, on_code)
+        if c.method == "procedural":
+            return SpectralSource(c.request, field=c.field), size / (c.field.px_per_unit * scale)
+        return SolidSource(c.model, c.request, code=c.code), size / (c.model.px_per_unit * scale)
     model = request.load(where)
     if model.dim != 3:
         raise SettingError(f"{where}dim", f"model {model.name!r} is 2D; it cannot fill a volume")
@@ -636,8 +642,13 @@ def _solid_from_dict(d: dict, base_dir: str):
     req = solid_request_from_dict(d, base_dir)
     if req.method == "synthesis":
         return SynthesisSource(req, d.get("scale", 1.0))
-    if req.method == "spectral":
+    if req.method in ("spectral", "procedural"):
         return SpectralSource(req, d.get("scale", 1.0), d.get("density", 1.0))
+    if req.method == "auto":
+        c = req.choose("source.")
+        if c.method == "procedural":
+            return SpectralSource(c.request, d.get("scale", 1.0), d.get("density", 1.0), field=c.field)
+        return SolidSource(c.model, c.request, d.get("scale", 1.0), d.get("density", 1.0), code=c.code)
     return SolidSource(req.folder(), req, d.get("scale", 1.0), d.get("density", 1.0))
 
 

@@ -143,8 +143,9 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--photo-side", type=int, default=0, help="scale each photo to this many px (at least 128) on its "
                                                                 "short side first (small photos: swatches, game textures)")
-    ap.add_argument("--method", default="synthesis", choices=("synthesis", "spectral"),
-                    help="what is measured in 3D: the synthesised tile, or the spectral solid the product draws")
+    ap.add_argument("--method", default="synthesis", choices=("synthesis", "spectral", "procedural"),
+                    help="what is measured in 3D: the synthesised tile, or the spectral or procedural solid the "
+                         "product draws")
     ap.add_argument("--no-marginals", action="store_true",
                     help="--method spectral: the Gaussian tile's values as drawn, not mapped onto the photo's "
                          "marginals")
@@ -157,8 +158,8 @@ def main(argv=None) -> int:
     ap.add_argument("--sheet", action="store_true")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solid_synthesis"))
     a = ap.parse_args(argv)
-    if a.method == "spectral" and a.dim != 3:
-        ap.error("--method spectral is measured in 3D (--dim 3): its 2D image is a floor slice of the same solid")
+    if a.method in ("spectral", "procedural") and a.dim != 3:
+        ap.error(f"--method {a.method} is measured in 3D (--dim 3): its 2D image is a slice of the same solid")
     if a.photo_side and a.photo_side < SIZE:
         ap.error(f"--photo-side must be at least {SIZE} (the measured images are {SIZE}² px)")
     words = [w for w in a.only.split(",") if w]
@@ -192,6 +193,10 @@ def main(argv=None) -> int:
             else:
                 field = req.spectral_field()
             imgs = slices(field, a.seeds)
+        elif a.dim == 3 and a.method == "procedural":     # as the product draws it, through the request
+            field = SolidRequest(exemplar=photo, method="procedural").check().procedural_field()
+            r_fit = dict(family=field.family)
+            imgs = slices(field, a.seeds)
         elif a.dim == 3:
             field = TileField(synthesise(photo, settings), PX_PER_UNIT)
             imgs = slices(field, a.seeds)
@@ -203,6 +208,8 @@ def main(argv=None) -> int:
         seconds = time.time() - t
         r = measure(photo, imgs, np.random.default_rng(0))
         r["seconds"] = round(seconds, 1)
+        if a.method == "procedural":
+            r.update(r_fit)
         if a.dim == 3:      # six cuts at random orientations, against random phase noise's pooled draws (six at
             # the default two seeds; python -m bench solid-photos draws six where the seeds give another count)
             obl = pe.oblique_slices(field.evaluate, field.px_per_unit)

@@ -55,6 +55,7 @@ class OMNINOISE_MT_object(bpy.types.Menu):
         layout.operator("omninoise.solid_bake", icon="RENDER_STILL")
         layout.operator("omninoise.solid_preview", icon="HIDE_OFF")
         layout.operator("omninoise.solid_tile_material", icon="MOD_UVPROJECT")
+        layout.operator("omninoise.solid_procedural_node", icon="NODETREE")
         layout.separator()
         layout.operator("omninoise.bake_volume", icon="VOLUME_DATA")
         layout.operator("omninoise.bake_image", icon="IMAGE_DATA")

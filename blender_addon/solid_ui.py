@@ -106,7 +106,12 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                                      "(stones, grains, speckles)"),
         ("SPECTRAL", "Spectral Solid", "The photo's colors and feature sizes on every cut, but no separate stones: "
                                        "often closer for rock, sand and soil; repeats every 128 photo pixels; about "
-                                       "6 s to draw")], default="NEURAL")
+                                       "6 s to draw"),
+        ("PROCEDURAL", "Procedural Solid", "Rings, layers, cells or bricks fitted to the photo: structure that runs "
+                                           "on through the object (wood, veins, stones, courses); also a live node "
+                                           "group; about 30 s to fit"),
+        ("AUTO", "Auto", "The procedural solid where it is closer to the photo than the neural texture, else the "
+                         "neural texture")], default="NEURAL")
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
                            description="A photo of the material (at least 128 px; a large one is read in at most 8 x 8 crops)")
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
@@ -161,12 +166,14 @@ def panel_request(p):
         if p.method == "SPECTRAL":
             return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), periodic=bool(p.periodic),
                                 method="spectral").check()
+        if p.method == "PROCEDURAL":
+            return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), method="procedural").check()
         name = _space_model_name()
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
         return SolidRequest(os.path.join(models_dir(), name), image_srgb(p.image, "image"), refine=int(p.refine),
                             seed=int(p.seed), periodic=bool(p.periodic), gaussian=bool(p.gaussian),
-                            rest=str(p.rest)).check()
+                            rest=str(p.rest), method="auto" if p.method == "AUTO" else "neural").check()
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
@@ -189,16 +196,25 @@ def texture(p):
     """(model, code_fn) for the panel's settings; code_fn(progress, cancel) runs on the worker (it may encode an
     image, or draw a spectral solid, about 6 s, with progress and cancel)."""
     req = panel_request(p)
-    if req.method == "spectral":     # no model: the "code" is the drawn solid (backend.solid.spectral_solid)
+    if req.method in ("spectral", "procedural"):     # no model: the "code" is the drawn or fitted solid
         return (_mod("solid.spectral_solid").SpectralTexture(req),
-                lambda progress=None, cancel=None: req.spectral_field("", progress, cancel))
+                lambda progress=None, cancel=None: req.solid_field("", progress, cancel))
+    if req.method == "auto":         # the "code" is the choice (backend.solid.choose)
+        return (_mod("solid.choose").AutoTexture(req),
+                lambda progress=None, cancel=None: req.choose("", progress))
     m = load_model(os.path.basename(req.model))
     return m, lambda progress=None, cancel=None: req.code(m)[0]
 
 
 def periodic_info(code) -> str:
     """A line for the panel: the harmonic part a code (or a spectral solid) carries (backend/solid/harmonic.py), or
-    that there is none."""
+    that there is none; for a procedural solid its family, and for method Auto what it chose."""
+    if hasattr(code, "distances"):      # method Auto's choice (backend/solid/choose.py)
+        d = code.distances
+        kept = code.field.family if code.method == "procedural" else "neural texture"
+        return f"Auto: {kept} (distance {d['procedural']:.0f} procedural, {d['neural']:.0f} neural)"
+    if hasattr(code, "family"):         # a procedural solid (backend/solid/procedural)
+        return f"Fitted: {code.family}"
     h = code.harmonics
     if h is None:
         return "Pattern: none found"
@@ -207,7 +223,7 @@ def periodic_info(code) -> str:
 
 def gaussian_info(code) -> str:
     """A line for the panel: the share of the rest a code's Gaussian rest carries (backend/solid/gaussian_rest.py)."""
-    if not hasattr(code, "rest"):     # a spectral solid is all Gaussian: no share to report
+    if not hasattr(code, "rest"):     # a spectral solid is all Gaussian, a procedural one has none: no share
         return ""
     r = code.rest
     if r is None:
@@ -493,13 +509,16 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
             bake = _mod("solid.bake")
 
             def work(progress, cancel):
-                code = code_fn(None, cancel)
-                if isinstance(m, _mod("solid.spectral_solid").SpectralTexture):    # the job files' source
-                    src = _mod("sources").SpectralSource(m.request, scale, field=code)
+                code, model = code_fn(None, cancel), m
+                if isinstance(model, _mod("solid.choose").AutoTexture):      # what Auto chose
+                    model, code = ((_mod("solid.spectral_solid").SpectralTexture(code.request), code.field)
+                                   if code.method == "procedural" else (code.model, code.code))
+                if isinstance(model, _mod("solid.spectral_solid").SpectralTexture):    # the job files' source
+                    src = _mod("sources").SpectralSource(model.request, scale, field=code)
                     bake_mod = _mod("bake")
                     bake_mod.run_bake(bake_mod.BakeSpec("solid", src, grid, path), progress, cancel, force=True)
                 else:
-                    bake.bake_volume(m, code, grid, path, seed, scale, progress=progress, cancel=cancel)
+                    bake.bake_volume(model, code, grid, path, seed, scale, progress=progress, cancel=cancel)
                 return path
 
             def done(path):
@@ -508,6 +527,54 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
                     vol.matrix_world = obj.matrix_world.copy()
 
         return tasks.start(tasks.Task(f"Solid {name}", work, done, None, threads()), blocking=blocking)
+
+
+class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
+    """Fit a procedural solid to the photo and give the active object a material drawing it live from nodes: a node
+    group whose inputs (spacing, sizes, turbulence...) can be edited afterwards"""
+
+    bl_idname = "omninoise.solid_procedural_node"
+    bl_label = "Procedural Node Group"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def _start(self, context, blocking: bool):
+        import dataclasses
+
+        p = context.scene.omninoise_solid
+        obj = context.active_object
+        if obj is None or obj.type != "MESH":
+            raise backend.SettingError("object", "select a mesh to give the procedural material to")
+        req = panel_request(p)
+        req = dataclasses.replace(req, method="procedural") if req.method != "procedural" else req
+        if req.exemplar is None or isinstance(req.exemplar, str):
+            raise backend.SettingError("image", "a procedural solid is fitted to a photo: set Source to Image")
+        scale, world, name = float(p.scale), p.coords == "WORLD", p.name
+
+        def work(progress, cancel):
+            return req.procedural_field("", progress, cancel)
+
+        def done(field):
+            from .procedural_nodes import add_procedural_node, build_procedural_group
+
+            group = build_procedural_group(field, name=f"{name} Procedural")
+            p.periodic_info = periodic_info(field)
+
+            def node(nt):
+                n = add_procedural_node(nt, group, (-400.0, 0.0))
+                n.inputs["Scale"].default_value = scale
+                if world:
+                    nt.links.new(_world_position(nt), n.inputs["Vector"])
+                return n
+
+            _material_with(obj, f"{name} Procedural", node)
+
+        return tasks.start(tasks.Task(f"Procedural {name}", work, done, None, threads()), blocking=blocking)
+
+
+def _world_position(nt):
+    """A Geometry node's Position output (world space) in ``nt``."""
+    geo = next((n for n in nt.nodes if n.type == "NEW_GEOMETRY"), None) or nt.nodes.new("ShaderNodeNewGeometry")
+    return geo.outputs["Position"]
 
 
 def _split(layout):
@@ -546,12 +613,17 @@ def draw_solid(layout, context) -> None:
 
 
 def _draw_photo(layout, p) -> None:
-    if p.method == "NEURAL":
+    if p.method in ("NEURAL", "AUTO"):
         layout.prop(p, "refine")
+    if p.method == "PROCEDURAL":
+        if p.periodic_info:
+            layout.label(text=p.periodic_info)
+        _idle_row(layout).operator(OMNINOISE_OT_solid_procedural_node.bl_idname, icon="NODETREE")
+        return
     layout.prop(p, "periodic")
-    if p.periodic and p.periodic_info:
+    if p.periodic_info and (p.periodic or p.method == "AUTO"):
         layout.label(text=p.periodic_info)
-    if p.method == "NEURAL":
+    if p.method in ("NEURAL", "AUTO"):
         layout.prop(p, "gaussian")
         if p.gaussian:
             layout.prop(p, "rest")
@@ -625,7 +697,7 @@ PANELS = (OMNINOISE_PT_solid,) + tuple(_section_panel(*section) for section in S
 
 
 classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable,
-           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake) + PANELS
+           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_OT_solid_procedural_node) + PANELS
 
 
 def attach():

@@ -28,6 +28,7 @@ omninoise solid --exemplar wood_3d --dim 3 --size 128 -o wood.vdb
 omninoise solid --exemplar photo.jpg --size 512 -o like.png
 omninoise solid --exemplar gravel --to marble --mix 0.5 -o halfway.png
 omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 128 -o rock.vdb
+omninoise solid --method procedural --exemplar bricks.jpg --dim 3 --size 128 -o wall.vdb
 omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png""")
     g = s.add_argument_group("texture and output")
     g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file")
@@ -38,7 +39,9 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
     g.add_argument("--seed", type=int, default=0, help="another seed gives another texture of the same kind")
     g.add_argument("--method", default="neural", choices=METHODS,
                    help="neural: the models' texture, 2D or 3D; spectral: the photo's spectrum and colours on every "
-                        "cut, 2D or 3D, no network; synthesis: a seamless 2D image copied from the photo")
+                        "cut, 2D or 3D, no network; procedural: rings, layers, cells or bricks fitted to the photo, "
+                        "2D or 3D, no network; auto: procedural where it is closer to the photo than neural, else "
+                        "neural; synthesis: a seamless 2D image copied from the photo")
     g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
     g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
                                    "texture-space model)")
@@ -119,7 +122,8 @@ def run(a: argparse.Namespace) -> int:
                   f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian "
                   "leaves it out)", file=sys.stderr)
 
-    stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid "}[req.method]
+    stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid ",
+             "procedural": "procedural fit ", "auto": "procedural fit "}[req.method]
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
         from omninoise.backend.bake import BakeSpec, run_bake
         from omninoise.backend.sources import BoxGrid, solid_volume

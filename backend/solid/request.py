@@ -11,7 +11,10 @@ finds it closer, :mod:`backend.solid.gaussian_rest`) of the kind ``rest`` asks f
 2D image of ``tile`` px a side synthesised from an image exemplar by texture optimisation
 (:mod:`backend.solid.synthesis`): no model, no code, 2D only; ``method`` "spectral" a periodic Gaussian solid whose
 slices carry the image's spectrum (random phase noise lifted to 3D, :mod:`backend.solid.spectral_solid`): no model,
-2D and 3D, with the image's harmonic part where ``periodic``.  Where the texture is read (grid, zoom, scale)
+2D and 3D, with the image's harmonic part where ``periodic``; ``method`` "procedural" a procedural solid (rings,
+layers, cells or bonds) fitted to the image (:mod:`backend.solid.procedural`): no model, 2D and 3D; ``method``
+"auto" that procedural solid where it is closer to the image than the neural texture, else the neural texture
+(:mod:`backend.solid.choose`).  Where the texture is read (grid, zoom, scale)
 belongs to the bake, not to the texture.
 :meth:`SolidRequest.check` raises :class:`~backend.errors.SettingError` naming the field, with the front-end's
 prefix (``--`` for flags, ``source.`` for job files); :meth:`SolidRequest.key` is a JSON summary (images by
@@ -97,6 +100,12 @@ class SolidRequest:
                 raise bad("to", f"interpolation needs the neural texture (method neural); {m} draws one texture")
             if self.refine:
                 raise bad("refine", f"refinement searches a neural texture's code; {m} has none")
+        if self.method == "auto":
+            ex = self.exemplar
+            if not isinstance(ex, np.ndarray) and not (isinstance(ex, str) and os.path.isfile(ex)):
+                raise bad("exemplar", f"auto chooses for a photo: an image file or pixels, got {ex!r}")
+            if self.to is not None:
+                raise bad("to", "interpolation needs the neural texture (method neural); auto draws one texture")
         if self.method == "synthesis":
             from .synthesis import MAX_TILE, MIN_TILE, TILE_STEP
 
@@ -192,6 +201,32 @@ class SolidRequest:
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
 
+    def procedural_field(self, where: str = "", progress=None, cancel=None):
+        """Method "procedural": the :class:`~backend.solid.procedural.field.ProceduralField` fitted to the exemplar
+        with ``seed`` (:func:`~backend.solid.procedural.fit.fit_procedural`; progress and cancel as its own);
+        SettingError naming the exemplar for an image it cannot use."""
+        from .procedural.fit import ProceduralConfig, fit_procedural
+
+        img = np.asarray(self.exemplar_pixels(where), np.float32)
+        try:
+            return fit_procedural(img, ProceduralConfig(seed=int(self.seed)), progress, cancel).field
+        except SettingError as exc:
+            raise SettingError(f"{where}exemplar", exc.message) from None
+
+    def solid_field(self, where: str = "", progress=None, cancel=None):
+        """The field of a solid image method (spectral or procedural): :meth:`spectral_field` or
+        :meth:`procedural_field`."""
+        if self.method == "procedural":
+            return self.procedural_field(where, progress, cancel)
+        return self.spectral_field(where, progress, cancel)
+
+    def choose(self, where: str = "", progress=None, report=None, on_code=None):
+        """Method "auto": the :class:`~backend.solid.choose.Choice` between the procedural solid and the neural
+        texture (:func:`~backend.solid.choose.choose`)."""
+        from .choose import choose
+
+        return choose(self, where, progress, report, on_code)
+
     def front_image(self, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
                     on_code=None, draw_progress=None) -> np.ndarray:
         """The texture's 2D image: the plane y = 0 seen from the front (x right, z up), as the command line's
@@ -201,10 +236,17 @@ class SolidRequest:
         code before it is drawn (the neural texture only)."""
         if self.method == "synthesis":
             return self.synthesis_field(where, progress).image(size, scale)
-        if self.method == "spectral":
+        if self.method in ("spectral", "procedural"):
             from .spectral_solid import SpectralTexture
 
-            return SpectralTexture(self).image(size, self.spectral_field(where, progress), scale=scale)
+            return SpectralTexture(self).image(size, self.solid_field(where, progress), scale=scale)
+        if self.method == "auto":
+            c = self.choose(where, progress, report, on_code)
+            if c.method == "procedural":
+                from .spectral_solid import SpectralTexture
+
+                return SpectralTexture(c.request).image(size, c.field, scale=scale)
+            return c.model.image(size, c.code, int(self.seed), scale=scale, progress=draw_progress)
         model = self.load(where)
         code, _ = self.code(model, where, progress, report, on_code)
         return model.image(size, code, int(self.seed), scale=scale, progress=draw_progress)
@@ -212,8 +254,8 @@ class SolidRequest:
     def key(self) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
         kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone); for
-        methods "synthesis" and "spectral" only what they read (exemplar, seed and tile, or periodic, the
-        spectral solid's map onto the photo's marginals and its power's isotropic start)."""
+        methods "synthesis", "spectral" and "procedural" only what they read (exemplar, seed and tile, or periodic, the
+        spectral solid's map onto the photo's marginals and its power's isotropic start; or the families tried)."""
         if self.method == "synthesis":
             return dict(method="synthesis", exemplar=_digest(self.exemplar), seed=int(self.seed),
                         tile=int(self.tile))
@@ -222,6 +264,16 @@ class SolidRequest:
             # is found from an isotropic start (spectral_solid.solid_power); a bake keyed before either is redone
             return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed),
                         periodic=bool(self.periodic), marginals=True, start="isotropic")
+        if self.method == "procedural":
+            from .procedural.field import FAMILIES
+
+            return dict(method="procedural", exemplar=_digest(self.exemplar), seed=int(self.seed),
+                        families=list(FAMILIES))
+        if self.method == "auto":
+            import dataclasses
+
+            return dict(method="auto", procedural=dataclasses.replace(self, method="procedural").key(),
+                        neural=dataclasses.replace(self, method="neural").key())
         return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),

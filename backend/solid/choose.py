@@ -1,0 +1,91 @@
+"""Method "auto": a photo's procedural solid where it is closer to the photo than the neural texture, the neural
+texture otherwise.
+
+    1. fit     the procedural solid (:func:`~backend.solid.procedural.fit.fit_procedural`)
+    2. encode  the neural texture's code (backend/solid/pipeline.py, as method "neural" makes it)
+    3. check   both drawn on :data:`PLANES` (walls, floors and oblique cuts none of the fit's planes) and measured by
+               the runtime's band distance (band_distance.py); the procedural solid is kept only where it is
+               closer, so a photo it does not suit keeps the neural texture
+
+Shapes: photos float32 (H, W, 3) sRGB in [0, 1].
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .band_distance import band_distance
+from .procedural.fit import oblique_points
+
+__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE"]
+
+SIDE = 128     #: px per side of each plane drawn for the check
+#: the check's planes (normal, a point on it), units: two of each wall, a floor, two oblique cuts
+PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((0.0, 1.0, 0.0), (-3.3, 4.45, -2.6)),
+          ((1.0, 0.0, 0.0), (-4.6, 2.35, -3.9)), ((0.0, 1.0, 0.0), (2.8, -4.2, 4.3)),
+          ((0.0, 0.0, 1.0), (3.6, 3.1, -4.4)), ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)),
+          ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)))
+
+
+@dataclass(frozen=True)
+class Choice:
+    """``method``: "procedural" or "neural"; ``request``: the request as that method (what a bake's key reads);
+    ``field`` the procedural solid (always fitted); ``model`` and ``code`` the neural texture; ``distances``
+    {method: its check distance}."""
+    method: str
+    request: object
+    field: object
+    model: object
+    code: object
+    distances: dict
+
+
+def choose(request, where: str = "", progress=None, report=None, on_code=None) -> Choice:
+    """The stages (module doc) for a checked request with method "auto" and an image exemplar."""
+    img = np.asarray(request.exemplar_pixels(where), np.float32)
+    proc = dataclasses.replace(request, method="procedural")
+    field = proc.procedural_field(where, progress)                                     # 1. fit
+    neural = dataclasses.replace(request, method="neural")
+    model = neural.load(where)
+    code, _ = neural.code(model, where, None, report, on_code)                          # 2. encode
+    ppu = model.px_per_unit
+    planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
+    drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
+             "neural": [model.evaluate(p, code, int(request.seed)).reshape(SIDE, SIDE, 3) for p in planes]}
+    d = {k: round(band_distance(v, img), 2) for k, v in drawn.items()}
+    keep = "procedural" if d["procedural"] < d["neural"] else "neural"
+    return Choice(keep, proc if keep == "procedural" else neural, field, model, code, d)
+
+
+class AutoTexture:
+    """Method "auto" seen as a texture model (what the Blender panel's preview and surface bakes call of
+    :class:`~backend.solid.model.SolidTextureModel`): its "code" is the :class:`Choice`; points are drawn by the
+    procedural solid or by the neural texture, whichever was chosen."""
+
+    dim = 3
+    name = "auto"
+
+    def __init__(self, request):
+        from .procedural.field import PX_PER_UNIT
+
+        self.request = request
+        self.px_per_unit = PX_PER_UNIT
+
+    def evaluate(self, points, code: Choice, seed: int = 0, chunk: int = 1 << 16, progress=None,
+                 cancel=None) -> np.ndarray:
+        """points float (N, 2 or 3) in texture units -> sRGB float32 (N, 3)."""
+        if code.method == "procedural":
+            return code.field.evaluate(points, chunk, progress, cancel)
+        return code.model.evaluate(points, code.code, seed, progress=progress, cancel=cancel)
+
+    def image(self, size: int, code: Choice, seed: int = 0, scale: float = 1.0, offset=(0.0, 0.0, 0.0),
+              axis: str = "y", **kw) -> np.ndarray:
+        """A (size, size, 3) image of the plane through ``offset`` normal to ``axis`` (the front view, "y", by
+        default)."""
+        from .model import slice_points
+
+        ppu = code.field.px_per_unit if code.method == "procedural" else code.model.px_per_unit
+        pts = slice_points(size, ppu * scale, axis, offset)
+        return self.evaluate(pts, code, seed, **kw).reshape(size, size, 3)

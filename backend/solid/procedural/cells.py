@@ -1,0 +1,89 @@
+"""Cells: stones, pebbles, flakes and spots as the cells of a jittered grid (Worley 1996, "A cellular texture
+basis function": F1 and F2, the distances to the nearest and second nearest feature point), hashed by Blender's
+White Noise Texture (4D), so the node group draws them from White Noise nodes exactly (Blender's Voronoi node
+changed its hash in 5.0 and cannot be matched on every version).
+
+Space is cut into cubes of side ``size`` (``stretch`` times as tall along z); cube c holds one feature point at
+c + ``jitter`` x h, h the Color of the White Noise of (c, W = 4 seed' + 0) (three hashes, wavenoise.wave
+.white_color4), seed' = seed mod 2^22 (W stays an exact float32); a point belongs to its nearest feature point's
+cell, whose value h3, the White Noise of (c, W = 4 seed' + 1), picks its colour.  Where F2 - F1 < gap (in
+cube sides) a point is in the gap between cells and takes the gap's value, -1; the cell's own value is reached at
+twice that:
+
+    e = clip((F2 - F1) / gap - 1, 0, 1),    s = e (1 + h3 + turbulence * T(p)) - 1
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...wavenoise.hashing import white_noise4
+from ...wavenoise.wave import white_color4
+from .family import Family, Param
+from .turbulence import turbulence
+
+__all__ = ["Cells", "voronoi", "cell_w", "NEIGHBOURS"]
+
+#: the 27 cubes around a point's, x fastest
+NEIGHBOURS = np.stack(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1], indexing="ij"), -1).reshape(-1, 3)[:, ::-1]
+
+
+def cell_w(seed: int, k: int) -> np.float32:
+    """The White Noise W of hash k (0: the feature point's offset, three channels of the Color; 1: the cell's
+    value)."""
+    return np.float32(4 * (int(seed) % (1 << 22)) + k)
+
+
+def voronoi(q: np.ndarray, jitter: float, seed: int) -> tuple:
+    """F1 and F2 (float32 (P,)) at points q (P, 3) in cube units, and the nearest cell's cube (float32 (P, 3));
+    computed in float32, as the node group does."""
+    q = np.asarray(q, np.float32)
+    base = np.floor(q)
+    local = q - base
+    f1 = np.full(len(q), 8.0, np.float32)
+    f2 = np.full(len(q), 8.0, np.float32)
+    best = np.zeros_like(base)
+    rnd = np.float32(jitter)
+    cubes, back = np.unique(base, axis=0, return_inverse=True)      # points share cubes: hash each cube once
+    back = back.reshape(-1)
+    for n in NEIGHBOURS.astype(np.float32):
+        c = cubes + n
+        h = np.stack([white_color4(c[:, 0], c[:, 1], c[:, 2], cell_w(seed, 0), k) for k in range(3)], -1)
+        h, c = h[back].astype(np.float32), c[back]
+        d = np.sqrt(np.sum(np.square(n + h * rnd - local), axis=1, dtype=np.float32))
+        nearer = d < f1
+        f2 = np.where(nearer, f1, np.minimum(f2, d))
+        best = np.where(nearer[:, None], c, best)
+        f1 = np.minimum(f1, d)
+    return f1, f2, best
+
+
+class Cells(Family):
+    name = "cells"
+    doc = "cells of a jittered grid with their own colours and gaps: stones, pebbles, flakes, spots"
+    PARAMS = (Param("size", 0.01, 1.5, log=True, doc="a cell's side, units"),
+              Param("stretch", 0.3, 3.0, log=True, doc="a cell's height over its width (along z)"),
+              Param("jitter", 0.0, 1.0, doc="how far feature points move within their cube, in sides"),
+              Param("gap", 0.0, 0.45, doc="the gap between cells, in cell sides"))
+
+    def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        pts = np.asarray(points, np.float64)
+        q = pts / (p["size"] * np.array([1.0, 1.0, p["stretch"]]))
+        f1, f2, cell = voronoi(q, p["jitter"], seed)
+        r = white_noise4(cell[:, 0], cell[:, 1], cell[:, 2], cell_w(seed, 1)).astype(np.float64)
+        e = np.clip((f2.astype(np.float64) - f1) / max(p["gap"], 1e-9) - 1.0, 0.0, 1.0)
+        inner = 1.0 + r
+        if p["turbulence"] > 0:
+            inner = inner + p["turbulence"] * turbulence(pts, p["turb_freq"], seed)
+        return e * inner - 1.0
+
+    def starts(self, est) -> list:
+        """Cells the size of the photo's repeats (along its wave, across, up), thin and wide gaps, each ramp order."""
+        out = []
+        for size in sorted({round(float(np.clip(s, 0.012, 1.4)), 4) for s in (est.spacing, est.spacing_x, est.spacing_z)}):
+            for gap in (0.04, 0.15):
+                for flip in (False, True):
+                    out.append(dict(size=size, stretch=float(np.clip(est.spacing_z / max(est.spacing_x, 1e-6),
+                                                                     0.31, 2.9)),
+                                    jitter=0.9, gap=gap, turbulence=0.2, detail=0.1,
+                                    turb_freq=float(np.clip(1.0 / size, 0.3, 15.0)), flip=flip))
+        return out

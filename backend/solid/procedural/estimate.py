@@ -1,0 +1,76 @@
+"""What the photo says before any search: the orientation of its structure and its repeat lengths, the starts of
+every family's search.
+
+- **Orientation**: the structure tensor of the luminance's gradient (Bigün & Granlund 1987; summed over the
+  photo): its main eigenvector is the direction across the stripes, the wave vector's.
+- **Repeats**: the autocorrelation of the luminance band-passed between BAND px (a difference of Gaussians, which
+  keeps neither the JPEG blocks' edges nor the photo's layout; Wiener-Khinchin: the inverse FFT of its power), read
+  along x, along z and along the wave vector: its highest peak beyond MIN_LAG px (a course's height, a plank's
+  width), or, where it has none above PEAK, CORRELATION_SCALE times the distance over which it falls to a half (a
+  stone's, a blotch's size).
+
+Shapes: photo float (H, W, 3) sRGB, top row first; the photo stands on the wall x-z (x right, z up).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .ramp import luminance
+
+__all__ = ["Estimates", "estimate", "repeat_length", "CORRELATION_SCALE"]
+
+CORRELATION_SCALE = 4.0    #: a repeat where the autocorrelation has no peak: this many of its half-fall lengths
+BAND = (1.5, 24.0)         #: the band-pass's Gaussians, sigma in px
+MIN_LAG = 6                #: shorter repeats are grain
+PEAK = 0.1                 #: a peak lower than this is chance
+
+
+@dataclass(frozen=True)
+class Estimates:
+    """``spacing`` (units) along, and ``angle`` (radians from +x towards +z) of, the wave vector across the
+    photo's stripes; ``spacing_x`` and ``spacing_z``: the repeats along x and along z, units."""
+    spacing: float
+    angle: float
+    spacing_x: float
+    spacing_z: float
+
+
+def repeat_length(profile: np.ndarray) -> float:
+    """The repeat of a 1D autocorrelation (lag 0 first, normalised to 1 there), in lags (module doc)."""
+    c = np.asarray(profile, np.float64)
+    inner = c[1:-1]
+    peaks = np.flatnonzero((inner > c[:-2]) & (inner >= c[2:]) & (inner > PEAK)) + 1
+    peaks = peaks[peaks >= MIN_LAG]
+    if len(peaks):
+        return float(peaks[np.argmax(c[peaks])])
+    half = np.flatnonzero(c < 0.5)
+    return float(CORRELATION_SCALE * (half[0] if len(half) else len(c)))
+
+
+def _ray(ac: np.ndarray, angle: float, n: int) -> np.ndarray:
+    """The autocorrelation (centred at [0, 0], wrapping) along a ray at ``angle`` (z up = rows up), n lags."""
+    t = np.arange(n)
+    r = np.round(-t * np.sin(angle)).astype(np.int64) % ac.shape[0]
+    c = np.round(t * np.cos(angle)).astype(np.int64) % ac.shape[1]
+    return ac[r, c]
+
+
+def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
+    """The :class:`Estimates` of a photo at ``px_per_unit`` photo pixels per texture unit."""
+    lum = luminance(photo)
+    lum = lum - lum.mean()
+    H, W = lum.shape
+    gz, gx = -np.gradient(lum, axis=0), np.gradient(lum, axis=1)          # z up
+    tensor = np.array([[np.sum(gx * gx), np.sum(gx * gz)], [np.sum(gx * gz), np.sum(gz * gz)]])
+    w, v = np.linalg.eigh(tensor)
+    angle = float(np.arctan2(v[1, 1], v[0, 1]))
+    fy, fx = np.fft.fftfreq(H)[:, None], np.fft.fftfreq(W)[None, :]
+    f2 = (2 * np.pi) ** 2 * (fy ** 2 + fx ** 2)
+    band = np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)     # the DoG's transfer
+    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
+    ac /= max(ac[0, 0], 1e-12)
+    n = min(H, W) // 2
+    return Estimates(repeat_length(_ray(ac, angle, n)) / px_per_unit, angle,
+                     repeat_length(ac[0, :W // 2]) / px_per_unit, repeat_length(ac[:H // 2, 0]) / px_per_unit)

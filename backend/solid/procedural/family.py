@@ -1,0 +1,99 @@
+"""What a procedural solid family is: named parameters with their ranges, starts read off the photo, and a value
+s at every point of space that the fitted ramp (ramp.py) turns into the photo's colours.
+
+Every family takes the same shared settings: ``turbulence`` (amplitude, in the family's own units of s) and
+``turb_freq`` (cycles per unit) of the wave noise that bends it (turbulence.py), ``detail`` (the amplitude of a
+fine wave noise from DETAIL_FREQ cycles per unit added to s: a photo's grain within stones, bricks and rings) and
+``flip`` (the ramp's order).
+The search (search.py) moves each parameter within its range, scale parameters on a log axis.
+
+Shapes: points float (P, 3) in texture units (x right, y back, z up; the photo stands on the walls, x right and
+z up); values float64 (P,).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...wavenoise.hashing import white_noise4
+from .turbulence import turbulence
+
+__all__ = ["Param", "Family", "cell_random", "axis_vector", "SHARED", "DETAIL_FREQ"]
+
+DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
+
+
+@dataclass(frozen=True)
+class Param:
+    """A parameter ``name`` in [lo, hi] (``log``: searched on a log axis); ``doc`` says what it is and its unit."""
+    name: str
+    lo: float
+    hi: float
+    log: bool = False
+    doc: str = ""
+
+    def to_unit(self, v: float) -> float:
+        """The value as a search coordinate in [0, 1]."""
+        if self.log:
+            return float(np.log(v / self.lo) / np.log(self.hi / self.lo))
+        return float((v - self.lo) / (self.hi - self.lo))
+
+    def from_unit(self, u: float) -> float:
+        """A search coordinate (clipped to [0, 1]) as the value."""
+        u = min(max(float(u), 0.0), 1.0)
+        return float(self.lo * (self.hi / self.lo) ** u) if self.log else float(self.lo + u * (self.hi - self.lo))
+
+
+#: the settings every family shares
+SHARED = (Param("turbulence", 0.0, 2.0, doc="how far the wave noise moves the value (the family's units of s)"),
+          Param("turb_freq", 0.25, 16.0, log=True, doc="the wave noise's lowest frequency, cycles per unit"),
+          Param("detail", 0.0, 1.0, doc="the fine noise's amplitude (the family's units of s)"))
+
+
+class Family:
+    """A procedural solid family: ``name``, ``PARAMS`` (its own, then :data:`SHARED`), ``starts(est)`` (a few
+    parameter dicts read off the photo's :class:`~.estimate.Estimates`) and ``shape(params, points, seed)``, the family's value before the detail noise."""
+    name = ""
+    PARAMS: tuple = ()
+    doc = ""
+
+    def params(self) -> tuple:
+        return tuple(self.PARAMS) + SHARED
+
+    def starts(self, est) -> list:
+        raise NotImplementedError
+
+    def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        raise NotImplementedError
+
+    def values(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        """The value s at points float (P, 3) -> float64 (P,): the family's shape plus the detail noise."""
+        s = self.shape(p, points, seed)
+        if p.get("detail", 0.0) > 0:
+            s = s + p["detail"] * turbulence(points, DETAIL_FREQ, seed + 2)
+        return s
+
+    def check(self, p: dict) -> dict:
+        """``p`` with every parameter present and within its range (ValueError naming one that is not)."""
+        out = {}
+        for q in self.params():
+            if q.name not in p:
+                raise ValueError(f"{self.name}: parameter {q.name!r} is missing")
+            v = float(p[q.name])
+            if not (np.isfinite(v) and q.lo <= v <= q.hi):
+                raise ValueError(f"{self.name}: {q.name} must be in [{q.lo}, {q.hi}], got {v!r}")
+            out[q.name] = v
+        return out
+
+
+def cell_random(i, j, k, seed: int) -> np.ndarray:
+    """A number in [0, 1] per integer cell (i, j, k) and seed: Blender's White Noise of (i, j, k, seed), so the node
+    group draws the same (wavenoise/hashing.py)."""
+    return white_noise4(np.asarray(i, np.float32), np.asarray(j, np.float32), np.asarray(k, np.float32),
+                        np.float32(int(seed) % (1 << 24))).astype(np.float64)
+
+
+def axis_vector(tilt: float, azimuth: float) -> np.ndarray:
+    """The unit vector ``tilt`` radians from +z, turned ``azimuth`` radians about z from +x: float64 (3,)."""
+    return np.array([np.sin(tilt) * np.cos(azimuth), np.sin(tilt) * np.sin(azimuth), np.cos(tilt)])

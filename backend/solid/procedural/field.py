@@ -1,0 +1,85 @@
+"""A fitted procedural solid as a colour field over texture space: a family, its parameters, the ramp and the
+seed, evaluated anywhere (it does not repeat), and written to and read from JSON (a bake's key, the node group's
+inputs).
+
+Shapes: points float (P, 2 or 3) in texture units (2D points lie on z = 0) -> float32 (P, 3) sRGB in [0, 1].
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import SettingError
+from ...grid import Cancelled
+from .bonds import Bonds
+from .cells import Cells
+from .layers import PROFILES, Layers
+from .ramp import Ramp
+from .rings import Rings
+
+__all__ = ["FAMILIES", "ProceduralField", "PX_PER_UNIT"]
+
+PX_PER_UNIT = 128.0    #: photo pixels per texture unit, as the other image methods read a photo
+
+#: the families by name
+FAMILIES = {f.name: f for f in (Rings(), Layers(), Cells(), Bonds())}
+
+
+class ProceduralField:
+    """``family`` (a name of :data:`FAMILIES`), ``params`` (its parameters, with ``flip`` and, for layers,
+    ``profile``), ``ramp`` (:class:`~.ramp.Ramp`) and ``seed``; ``px_per_unit`` the photo's pixels per unit."""
+
+    dim = 3
+
+    def __init__(self, family: str, params: dict, ramp: Ramp, seed: int = 0, px_per_unit: float = PX_PER_UNIT):
+        if family not in FAMILIES:
+            raise SettingError("family", f"unknown procedural family {family!r}; known: {', '.join(FAMILIES)}")
+        fam = FAMILIES[family]
+        try:
+            p = fam.check(params)
+        except ValueError as exc:
+            raise SettingError("params", str(exc)) from None
+        p["flip"] = bool(params.get("flip", False))
+        if family == "layers":
+            if params.get("profile") not in PROFILES:
+                raise SettingError("params", f"layers: profile must be one of {', '.join(PROFILES)}")
+            p["profile"] = params["profile"]
+        self.family, self.params, self.ramp, self.seed = family, p, ramp, int(seed)
+        self.px_per_unit = float(px_per_unit)
+
+    def values(self, points: np.ndarray) -> np.ndarray:
+        """The family's value s at points float (P, 3) -> float64 (P,)."""
+        return FAMILIES[self.family].values(self.params, points, self.seed)
+
+    def evaluate(self, points: np.ndarray, chunk: int = 1 << 16, progress=None, cancel=None) -> np.ndarray:
+        """points float (P, 2 or 3) -> float32 (P, 3), in chunks: ``progress(fraction)`` after each, ``cancel()``
+        returning True raises Cancelled."""
+        pts = np.asarray(points, np.float64)
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+            raise SettingError("points", f"points must have shape (P, 2) or (P, 3), got {pts.shape}")
+        if pts.shape[1] == 2:
+            pts = np.concatenate([pts, np.zeros((len(pts), 1))], axis=1)
+        out = np.empty((len(pts), 3), np.float32)
+        for a in range(0, len(pts), chunk):
+            if cancel is not None and cancel():
+                raise Cancelled("cancelled")
+            out[a:a + chunk] = self.ramp(self.values(pts[a:a + chunk]))
+            if progress is not None:
+                progress(min(1.0, (a + chunk) / len(pts)))
+        return np.clip(out, 0.0, 1.0)
+
+    def image(self, size: int, scale: float = 1.0, axis: str = "y", offset=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """A (size, size, 3) image of the plane through ``offset`` normal to ``axis`` ("y": the front view, x right
+        and z up) at ``scale`` output pixels per photo pixel."""
+        from ..model import slice_points
+
+        pts = slice_points(size, self.px_per_unit * scale, axis, offset)
+        return self.evaluate(pts).reshape(size, size, 3)
+
+    def to_dict(self) -> dict:
+        return dict(family=self.family, params=dict(self.params), ramp=self.ramp.to_dict(), seed=self.seed,
+                    px_per_unit=self.px_per_unit)
+
+    @staticmethod
+    def from_dict(d: dict) -> "ProceduralField":
+        return ProceduralField(d["family"], d["params"], Ramp.from_dict(d["ramp"]), d.get("seed", 0),
+                               d.get("px_per_unit", PX_PER_UNIT))

@@ -1,0 +1,162 @@
+"""A photo becomes a procedural solid: the stages in order.
+
+    1. read      the photo's pixels, at most ``fit_side`` px a side (its frequencies in texture units unchanged)
+    2. estimate  its strongest wave and its spacings across and up (estimate.py)
+    3. start     every family's starts (rings, layers, cells, bonds), each as it comes and textured (TEXTURED:
+                 more turbulence and detail, at a higher frequency), drawn on the fit's planes and scored
+    4. search    the best start of the FINALISTS best families refined by Nelder-Mead (search.py) over its
+                 parameters, ``budget`` calls each
+    5. ramp      the winner's colour ramp from its values over a block of space (ramp.py)
+    6. check     every finalist drawn on held-out planes (:data:`CHECK_PLANES`) and scored as in the search, with
+                 other draws; the closest kept
+
+Every score draws the slices through :data:`FIT_PLANES` (four walls, a floor and an oblique cut) with the ramp
+fitted to those slices' values, and measures them by :class:`~.loss.SliceLoss` (the photo's patch statistics over
+a Laplacian pyramid; the ramp matches its colour distribution).  The settings are one frozen
+:class:`ProceduralConfig`.
+
+Shapes: photo float (H, W, 3) sRGB in [0, 1], top row first.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import SettingError
+from ..model import slice_points
+from ..pixels import at_most, rgb_pixels
+from .estimate import estimate
+from .field import FAMILIES, PX_PER_UNIT, ProceduralField
+from .loss import SliceLoss
+from .ramp import fit_ramp, photo_colours
+from .search import minimise
+
+__all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "FIT_PLANES", "CHECK_PLANES", "oblique_points"]
+
+#: a start's textured twin: turbulence and detail amplitudes, and the factor on its turbulence's frequency
+TEXTURED = (0.35, 0.35, 4.0)
+#: the fit's planes: (normal, a point on it), in units.  Two thirds are walls (normal to x or y), on which the
+#: photo stands as it was taken; a floor and an oblique cut keep the solid's other sides in view
+FIT_PLANES = (((1.0, 0.0, 0.0), (0.31, 0.17, -0.4)), ((0.0, 1.0, 0.0), (-0.6, 0.23, 0.5)),
+              ((1.0, 0.0, 0.0), (-0.83, 0.6, 0.35)), ((0.0, 1.0, 0.0), (0.45, -0.71, -0.2)),
+              ((0.0, 0.0, 1.0), (0.2, -0.35, 0.29)), ((0.6, 0.5, 0.62), (1.1, -0.9, 0.7)))
+#: the check's planes, none of the fit's, in the same proportions (twice as many: each shows few courses or
+#: stones, so one plane's distance is a noisy figure)
+CHECK_PLANES = (((1.0, 0.0, 0.0), (-1.7, 2.1, 0.9)), ((0.0, 1.0, 0.0), (1.3, -2.6, -1.1)),
+                ((1.0, 0.0, 0.0), (2.45, -1.3, 0.2)), ((0.0, 1.0, 0.0), (-2.1, 1.85, 1.4)),
+                ((1.0, 0.0, 0.0), (0.77, -3.1, 2.6)), ((0.0, 1.0, 0.0), (3.3, 0.9, -2.75)),
+                ((1.0, 0.0, 0.0), (-3.05, -0.35, -1.9)), ((0.0, 1.0, 0.0), (-0.45, 3.4, 3.1)),
+                ((0.0, 0.0, 1.0), (-0.8, 1.4, -2.3)), ((0.0, 0.0, 1.0), (2.9, -2.2, 1.15)),
+                ((-0.3, 0.8, 0.5), (2.2, 0.4, -1.6)), ((0.7, -0.2, 0.7), (-2.4, -1.2, 1.9)))
+
+
+@dataclass(frozen=True)
+class ProceduralConfig:
+    """``side`` px per slice, ``budget`` search calls per finalist, ``finalists`` families searched, ``seed`` of
+    the solid (cells', units' and turbulence's random numbers), ``fit_side``: a larger photo is fitted at this side
+    (its frequencies in texture units unchanged), ``textured``: each start's textured twin is tried too (stage 3)."""
+    side: int = 96
+    budget: int = 48
+    finalists: int = 2
+    seed: int = 0
+    fit_side: int = 256
+    textured: bool = True
+
+
+@dataclass(frozen=True)
+class ProceduralFit:
+    """The fitted ``field``; ``scores`` {family: its check distance} of the finalists; ``tried`` the number of
+    solids drawn."""
+    field: ProceduralField
+    scores: dict
+    tried: int
+
+
+def oblique_points(size: int, px_per_unit: float, normal, origin) -> np.ndarray:
+    """Pixel centres of a size x size image of the plane through ``origin`` normal to ``normal`` (row 0 at the
+    top): float64 (size*size, 3) in units.  Axis normals give model.slice_points' orientation."""
+    n = np.asarray(normal, np.float64)
+    n = n / np.linalg.norm(n)
+    for axis, k in (("x", 0), ("y", 1), ("z", 2)):
+        if abs(n[k]) == 1.0:
+            return slice_points(size, px_per_unit, axis, origin)
+    u = np.cross((0.0, 0.0, 1.0), n)
+    u /= np.linalg.norm(u)
+    v = np.cross(n, u)
+    t = (np.arange(size) + 0.5) / px_per_unit
+    vv, uu = np.meshgrid(t, t, indexing="ij")
+    return np.asarray(origin, np.float64) + uu.reshape(-1, 1) * u - vv.reshape(-1, 1) * v
+
+
+def _draw(family: str, params: dict, planes: list, seed: int, colours: np.ndarray, side: int,
+          ppu: float) -> tuple:
+    """(slices, field): the solid drawn on ``planes`` (point arrays) with the ramp of those slices' values."""
+    fam = FAMILIES[family]
+    vals = [fam.values(params, pts, seed) for pts in planes]
+    ramp = fit_ramp(np.concatenate(vals), colours, params.get("flip", False))
+    return [np.clip(ramp(v), 0.0, 1.0).reshape(side, side, 3) for v in vals], ramp
+
+
+def _textured(p: dict) -> dict:
+    """A start's textured twin (:data:`TEXTURED`)."""
+    turb, detail, k = TEXTURED
+    return dict(p, turbulence=turb, detail=detail, turb_freq=float(min(k * p["turb_freq"], 15.9)))
+
+
+def _pack(fam, p: dict) -> np.ndarray:
+    return np.array([q.to_unit(p[q.name]) for q in fam.params()])
+
+
+def _unpack(fam, x: np.ndarray, fixed: dict) -> dict:
+    p = {q.name: q.from_unit(u) for q, u in zip(fam.params(), x)}
+    p.update({k: v for k, v in fixed.items() if k in ("flip", "profile")})
+    return p
+
+
+def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfig(), progress=None,
+                   cancel=None) -> ProceduralFit:
+    """The stages (module doc) on a photo float (H, W, 3) sRGB; ``progress(fraction)`` after each solid drawn,
+    ``cancel()`` returning True stops the search with the best so far."""
+    img = rgb_pixels(photo)                                                                 # 1. read
+    if img.shape[0] < 16 or img.shape[1] < 16:
+        raise SettingError("exemplar", f"a procedural solid is fitted to a photo of at least 16 x 16 px, got "
+                                       f"{img.shape[1]} x {img.shape[0]}")
+    img, ppu = at_most(img, PX_PER_UNIT, config.fit_side)
+    est = estimate(img, ppu)                                                                # 2. estimate
+    side, seed = config.side, config.seed
+    planes = [oblique_points(side, ppu, n, o) for n, o in FIT_PLANES]
+    loss = SliceLoss(img, side, len(planes))
+    colours = photo_colours(img)
+    starts = [(name, t) for name, fam in FAMILIES.items() for s in fam.starts(est)
+              for t in ((s, _textured(s)) if config.textured else (s,))]
+    total = len(starts) + config.finalists * config.budget
+    tried = [0]
+
+    def score(name, p):
+        tried[0] += 1
+        if progress is not None:
+            progress(min(1.0, tried[0] / total))
+        return loss(_draw(name, p, planes, seed, colours, side, ppu)[0])
+
+    scored = sorted(((score(n, s), n, s) for n, s in starts), key=lambda t: t[0])          # 3. start
+    best = {}
+    for d, n, s in scored:
+        best.setdefault(n, (d, s))
+    finalists = sorted(best, key=lambda n: best[n][0])[:config.finalists]
+    results = {}
+    for name in finalists:                                                                  # 4. search
+        fam, (d0, s0) = FAMILIES[name], best[name]
+        x, d = minimise(lambda x: score(name, _unpack(fam, x, s0)), _pack(fam, s0), 0.08, config.budget, cancel)
+        results[name] = _unpack(fam, x, s0) if d < d0 else s0
+    block = np.random.default_rng(seed).uniform(-2.0, 2.0, (1 << 15, 3))                  # 5. ramp
+    fields = {}
+    for name, p in results.items():
+        ramp = fit_ramp(FAMILIES[name].values(p, block, seed), colours, p["flip"])
+        fields[name] = ProceduralField(name, p, ramp, seed, PX_PER_UNIT)
+    check = [oblique_points(side, ppu, n, o) for n, o in CHECK_PLANES]                    # 6. check
+    held_out = SliceLoss(img, side, len(check), seed=1)
+    scores = {name: round(held_out([f.evaluate(c).reshape(side, side, 3) for c in check]), 2)
+              for name, f in fields.items()}
+    win = min(scores, key=scores.get)
+    return ProceduralFit(fields[win], scores, tried[0])

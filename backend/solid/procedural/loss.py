@@ -1,0 +1,58 @@
+"""The fit's distance: how far slices of a solid are from the photo, cheap enough to call a hundred times.
+
+The runtime's band distance (band_distance.py: sliced Wasserstein between 5 x 5 colour neighbourhoods on each band
+of a Laplacian pyramid, normalised by the photo's spread per band) with fewer neighbourhoods and directions, and
+with its random draws fixed once per photo (common random numbers): the same slices always score the same, so the
+search compares parameters, not draws.
+
+Shapes: photo float (H, W, 3) sRGB; slices a list of float (h, w, 3).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..band_distance import LEVELS, PATCH, REFERENCE_SIDE, _central, laplacian_bands
+
+__all__ = ["SliceLoss", "SAMPLES", "DIRECTIONS"]
+
+SAMPLES = 768      #: neighbourhoods per level
+DIRECTIONS = 32    #: projections per level
+
+
+class SliceLoss:
+    """``loss(slices)``: the distance of the pooled slices from the photo, x 1000 (0 for the same
+    distributions).  Every slice has the side ``side``."""
+
+    def __init__(self, photo: np.ndarray, side: int, count: int, seed: int = 0):
+        rng = np.random.default_rng(seed)
+        ref = laplacian_bands(_central(np.asarray(photo, np.float64)[..., :3], REFERENCE_SIDE))
+        self.side, self.count = int(side), int(count)
+        self.levels = []
+        probe = laplacian_bands(np.zeros((side, side, 3)))
+        dy, dx = np.mgrid[0:PATCH, 0:PATCH]
+        per = -(-SAMPLES // count)
+        for lvl in range(LEVELS):
+            k = min(PATCH, *ref[lvl].shape[:2], *probe[lvl].shape[:2])
+            dy, dx = np.mgrid[0:k, 0:k]
+            H, W = ref[lvl].shape[:2]
+            ys, xs = rng.integers(0, H - k + 1, SAMPLES), rng.integers(0, W - k + 1, SAMPLES)
+            r = ref[lvl][ys[:, None, None] + dy, xs[:, None, None] + dx].reshape(SAMPLES, -1, 3)
+            mu, sd = r.mean(axis=(0, 1)), r.std(axis=(0, 1)) + 1e-8
+            v = rng.standard_normal((k * k * 3, DIRECTIONS))
+            v /= np.linalg.norm(v, axis=0, keepdims=True)
+            h, w = probe[lvl].shape[:2]
+            where = [(rng.integers(0, h - k + 1, per), rng.integers(0, w - k + 1, per)) for _ in range(count)]
+            ref_sorted = np.sort(((r - mu) / sd).reshape(SAMPLES, -1) @ v, axis=0)
+            self.levels.append((k, dy, dx, mu, sd, v, where, ref_sorted))
+
+    def __call__(self, slices: list) -> float:
+        if len(slices) != self.count:
+            raise ValueError(f"expected {self.count} slices, got {len(slices)}")
+        pyrs = [laplacian_bands(s) for s in slices]
+        total = 0.0
+        for lvl, (k, dy, dx, mu, sd, v, where, ref_sorted) in enumerate(self.levels):
+            o = np.concatenate([p[lvl][ys[:, None, None] + dy, xs[:, None, None] + dx].reshape(len(ys), -1, 3)
+                                for p, (ys, xs) in zip(pyrs, where)])[:SAMPLES]
+            proj = np.sort(((o - mu) / sd).reshape(len(o), -1) @ v, axis=0)
+            total += float(np.abs(ref_sorted - proj).mean())
+        return 1000.0 * total / LEVELS

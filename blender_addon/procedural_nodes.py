@@ -1,0 +1,285 @@
+"""A fitted procedural solid as a live node group: the engine's family, turbulence and ramp built from Blender's own
+nodes (backend/solid/procedural), so Cycles, EEVEE and Geometry Nodes draw what the engine draws, and the fitted
+parameters are the group's inputs for an artist to turn.
+
+* the point p = Vector x Scale (texture units; Scale is texture units per Blender unit);
+* the family's value s from math nodes: rings (distance from the axis through Centre along Axis, in Spacings),
+  layers (height along Normal, in Spacings, through the saw or triangle profile), cells (F1, F2 and the nearest
+  cell's value over the 27 cubes around p / (Size, Size, Size x Stretch), one sub-group each, a feature point's
+  offset from one White Noise Texture's Color (4D) and the cell's value from another's), bonds (courses, units and joints, a unit's number from the White Noise Texture, 4D,
+  W = seed);
+* turbulence, grain and detail: Wave Noise groups (:func:`.wave_nodes.build_wave_group`) of the engine's
+  turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input;
+* the ramp as a sum of clamped Map Range nodes (one per stop interval: exact piecewise-linear colours; a Color Ramp
+  node is sampled into a 256-entry table in Cycles).
+
+The field's JSON is stored on the tree (``tree["omninoise_procedural"]``) so the panel can rebuild it.
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from .wave_nodes import NodeBuilder, build_wave_group, new_group
+
+__all__ = ["build_procedural_group", "add_procedural_node", "PARAMETERS", "FIELD_KEY"]
+
+FIELD_KEY = "omninoise_procedural"
+
+#: per family: (socket name, type, the engine's parameter or how it is read off the field)
+PARAMETERS = {
+    "rings": (("Spacing", "spacing"), ("Axis", "axis"), ("Centre", "centre"), ("Grain", "grain")),
+    "layers": (("Spacing", "spacing"), ("Normal", "normal")),
+    "cells": (("Size", "size"), ("Stretch", "stretch"), ("Jitter", "jitter"), ("Gap", "gap")),
+    "bonds": (("Length", "length"), ("Height", "height"), ("Offset", "offset"), ("Joint", "joint")),
+}
+SHARED = (("Turbulence", "turbulence"), ("Turbulence Frequency", "turb_freq"), ("Detail", "detail"))
+TIPS = {"Spacing": "Distance between rings or layers (texture units)",
+        "Axis": "Direction of the rings' axis", "Centre": "A point on the rings' axis (texture units)",
+        "Grain": "Streaks along the axis", "Normal": "Direction across the layers",
+        "Size": "A cell's width (texture units)", "Stretch": "A cell's height over its width",
+        "Jitter": "How far cells leave a regular grid (0 to 1)", "Gap": "Gap between cells, in cell widths",
+        "Length": "A brick's length (texture units)", "Height": "A course's height (texture units)",
+        "Offset": "Each course's shift, in brick lengths (0.5: running bond, 0: stack bond)",
+        "Joint": "Joint width, in course heights", "Turbulence": "How far the noise bends the pattern",
+        "Turbulence Frequency": "The bending noise's frequency (cycles per texture unit)",
+        "Detail": "Fine noise within the pattern", "Scale": "Texture units per Blender unit"}
+
+
+def _socket_values(field) -> dict:
+    """{socket name: its default} of a field's parameters (vectors for the rings' axis and centre and the
+    layers' normal)."""
+    from ..backend.solid.procedural.family import axis_vector
+    from ..backend.solid.procedural.field import FAMILIES
+
+    p = field.params
+    out = {}
+    if field.family == "rings":
+        d, c = FAMILIES["rings"].geometry(p)
+        out.update(Axis=tuple(d), Centre=tuple(c))
+    if field.family == "layers":
+        out["Normal"] = tuple(axis_vector(p["tilt"], p["azimuth"]))
+    for name, key in PARAMETERS[field.family] + SHARED:
+        if key in p:
+            out[name] = p[key]
+    return out
+
+
+def _interface(tree, field) -> None:
+    values = _socket_values(field)
+    for name in ["Vector", "Scale"] + [n for n, _ in PARAMETERS[field.family] + SHARED]:
+        vector = name in ("Vector", "Axis", "Centre", "Normal")
+        s = tree.interface.new_socket(name, in_out="INPUT",
+                                      socket_type="NodeSocketVector" if vector else "NodeSocketFloat")
+        s.description = TIPS.get(name, "")
+        if name == "Vector":
+            s.hide_value = True
+        elif name == "Scale":
+            s.default_value = 1.0
+        else:
+            s.default_value = values[name]
+            if not vector:
+                s.min_value = 0.0
+    tree.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
+    tree.interface.new_socket("sRGB", in_out="OUTPUT", socket_type="NodeSocketColor")
+    tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")
+
+
+def _frac(b, x):
+    return b.math("SUBTRACT", x, b.math("FLOOR", x))
+
+
+def _turbulence(b, groups: dict, seed: int, vector, frequency):
+    """The Value of a Wave Noise group of the turbulence settings for ``seed`` at ``vector`` x ``frequency``."""
+    from ..backend.solid.procedural.turbulence import turbulence_settings
+
+    if seed not in groups:
+        groups[seed] = build_wave_group(turbulence_settings(seed), b.tree.bl_idname,
+                                        name=f".{b.tree.name} turbulence {seed}")
+    node = b.new("GeometryNodeGroup" if b.geo else "ShaderNodeGroup")
+    node.node_tree = groups[seed]
+    b.put(node.inputs["Vector"], vector)
+    b.put(node.inputs["Scale"], frequency)
+    return node.outputs["Value"]
+
+
+def _rings(b, gi, p, seed, groups):
+    d = b.vmath("NORMALIZE", gi.outputs["Axis"])
+    rel = b.vmath("SUBTRACT", p, gi.outputs["Centre"])
+    along = b.vmath("DOT_PRODUCT", rel, d)
+    r = b.vmath("LENGTH", b.vmath("SUBTRACT", rel, b.vmath("SCALE", d, scale=along)))
+    s = b.math("DIVIDE", r, gi.outputs["Spacing"])
+    s = b.math("MULTIPLY_ADD", gi.outputs["Turbulence"],
+               _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"]), s)
+    from ..backend.solid.procedural.rings import GRAIN_STRETCH
+
+    squash = b.vmath("SUBTRACT", p, b.vmath("SCALE", d, scale=b.math(
+        "MULTIPLY", b.vmath("DOT_PRODUCT", p, d), 1.0 - 1.0 / GRAIN_STRETCH)))
+    grain = _turbulence(b, groups, seed + 1, squash, b.math("MULTIPLY", gi.outputs["Turbulence Frequency"], 4.0))
+    return _frac(b, b.math("MULTIPLY_ADD", gi.outputs["Grain"], grain, s))
+
+
+def _layers(b, gi, p, seed, groups, profile):
+    h = b.math("DIVIDE", b.vmath("DOT_PRODUCT", p, b.vmath("NORMALIZE", gi.outputs["Normal"])), gi.outputs["Spacing"])
+    h = b.math("MULTIPLY_ADD", gi.outputs["Turbulence"],
+               _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"]), h)
+    f = _frac(b, h)
+    return b.math("ABSOLUTE", b.math("MULTIPLY_ADD", f, 2.0, -1.0)) if profile == "tri" else f
+
+
+def _inner(b, gi, p, seed, groups, r):
+    """1 + r + turbulence: a cell's or a unit's own value."""
+    t = _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"])
+    return b.math("MULTIPLY_ADD", gi.outputs["Turbulence"], t, b.math("ADD", r, 1.0))
+
+
+def _edge(b, gi, dist, width):
+    """clip(dist / max(width, 1e-9) - 1, 0, 1)."""
+    return b.math("SUBTRACT", b.math("DIVIDE", dist, b.math("MAXIMUM", width, 1e-9)), 1.0, clamp=True)
+
+
+def _white(b, vector, w):
+    """A White Noise Texture (4D) at (``vector``, ``w``) -> its Color (three hashes: backend.wavenoise.wave
+    .white_color4).  Only the Color is read: an unread Color output would hold three floats of Cycles' SVM stack for
+    the whole shader."""
+    wn = b.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
+    b.put(wn.inputs["Vector"], vector)
+    wn.inputs["W"].default_value = float(w)
+    return wn.outputs["Color"]
+
+
+def _cell_group(tree_type: str, name: str, offset, seed: int):
+    """A sub-group for one of the 27 neighbouring cubes: F1, F2 and the nearest cell's value updated with this cube's
+    feature point (cells.voronoi's loop body, from White Noise nodes)."""
+    from ..backend.solid.procedural.cells import cell_w
+
+    g = new_group(name, tree_type, (("F1", "NodeSocketFloat", None), ("F2", "NodeSocketFloat", None),
+                                    ("Value", "NodeSocketFloat", None), ("Base", "NodeSocketVector", None),
+                                    ("Local", "NodeSocketVector", None), ("Jitter", "NodeSocketFloat", None)),
+                  (("F1", "NodeSocketFloat"), ("F2", "NodeSocketFloat"), ("Value", "NodeSocketFloat")))
+    b = NodeBuilder(g)
+    gi, go = b.new("NodeGroupInput"), b.new("NodeGroupOutput")
+    # floor(F1 / 16) is 0 (F1 <= 8), but it makes this cube wait for the previous one: Cycles compiles every node
+    # whose inputs are ready in one pass, and 27 cubes' values at once overflow its SVM stack
+    wait = b.math("FLOOR", b.math("MULTIPLY", gi.outputs["F1"], 0.0625))
+    c = b.vmath("ADD", b.vmath("ADD", gi.outputs["Base"], b.combine(wait, wait, wait)),
+                tuple(float(v) for v in offset))
+    point = b.vmath("MULTIPLY_ADD", _white(b, c, cell_w(seed, 0)), gi.outputs["Jitter"],
+                    tuple(float(v) for v in offset))
+    value = b.channel(_white(b, c, cell_w(seed, 1)), 0)
+    d = b.vmath("DISTANCE", point, gi.outputs["Local"])
+    nearer = b.math("LESS_THAN", d, gi.outputs["F1"])
+    further = b.math("SUBTRACT", 1.0, nearer)
+    b.put(go.inputs["F2"], b.math("MULTIPLY_ADD", nearer, gi.outputs["F1"],
+                                  b.math("MULTIPLY", further, b.math("MINIMUM", gi.outputs["F2"], d))))
+    b.put(go.inputs["Value"], b.math("MULTIPLY_ADD", nearer, value, b.math("MULTIPLY", further, gi.outputs["Value"])))
+    b.put(go.inputs["F1"], b.math("MINIMUM", gi.outputs["F1"], d))
+    return g
+
+
+def _cells(b, gi, p, seed, groups):
+    from ..backend.solid.procedural.cells import NEIGHBOURS
+
+    size = gi.outputs["Size"]
+    q = b.vmath("DIVIDE", p, b.combine(size, size, b.math("MULTIPLY", size, gi.outputs["Stretch"])))
+    base = b.vmath("FLOOR", q)
+    local = b.vmath("SUBTRACT", q, base)
+    f1, f2, r = 8.0, 8.0, 0.0
+    kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
+    for i, n in enumerate(NEIGHBOURS):
+        node = b.new(kind)
+        node.node_tree = _cell_group(b.tree.bl_idname, f".{b.tree.name} cell {i + 1}", n, seed)
+        for name, v in (("F1", f1), ("F2", f2), ("Value", r), ("Base", base), ("Local", local),
+                        ("Jitter", gi.outputs["Jitter"])):
+            b.put(node.inputs[name], v)
+        f1, f2, r = node.outputs["F1"], node.outputs["F2"], node.outputs["Value"]
+    e = _edge(b, gi, b.math("SUBTRACT", f2, f1), gi.outputs["Gap"])
+    return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, r), -1.0)
+
+
+def _bonds(b, gi, p, seed, groups):
+    x, y, z = b.separate(p)
+    length, height = gi.outputs["Length"], gi.outputs["Height"]
+    w = b.math("DIVIDE", z, height)
+    row = b.math("FLOOR", w)
+    shift = b.math("MULTIPLY", gi.outputs["Offset"], row)
+    u = b.math("ADD", b.math("DIVIDE", x, length), shift)
+    v = b.math("ADD", b.math("DIVIDE", y, length), shift)
+
+    def face(t):
+        f = _frac(b, t)
+        return b.math("MINIMUM", f, b.math("SUBTRACT", 1.0, f))
+
+    d = b.math("MINIMUM", b.math("MULTIPLY", face(w), height),
+               b.math("MULTIPLY", b.math("MINIMUM", face(u), face(v)), length))
+    half = b.math("MULTIPLY", b.math("MULTIPLY", gi.outputs["Joint"], height), 0.5)
+    white = b.channel(_white(b, b.combine(b.math("FLOOR", u), b.math("FLOOR", v), row),
+                             np.float32(int(seed) % (1 << 24))), 0)
+    e = _edge(b, gi, d, half)
+    return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, white), -1.0)
+
+
+def _ramp(b, s, ramp):
+    """Piecewise-linear colours of ``ramp`` at value socket ``s``: c0 + sum_k (c_k+1 - c_k) clamp(t_k, 0, 1)."""
+    x = np.asarray(ramp.positions, np.float64)
+    c = np.asarray(ramp.colours, np.float64)
+    acc = tuple(c[0])
+    for k in range(len(x) - 1):
+        m = b.new("ShaderNodeMapRange", data_type="FLOAT", interpolation_type="LINEAR", clamp=True)
+        b.put(m.inputs["Value"], s)
+        m.inputs["From Min"].default_value, m.inputs["From Max"].default_value = float(x[k]), float(x[k + 1])
+        m.inputs["To Min"].default_value, m.inputs["To Max"].default_value = 0.0, 1.0
+        acc = b.vmath("MULTIPLY_ADD", m.outputs["Result"], tuple(c[k + 1] - c[k]), acc)
+    return acc
+
+
+def _to_linear(b, c):
+    """The sRGB transfer function undone (IEC 61966-2-1), as backend.colour.srgb_to_linear: c / 12.92 up to 0.04045,
+    ((c + 0.055) / 1.055)^2.4 above."""
+    low = b.math("DIVIDE", c, 12.92)
+    high = b.math("POWER", b.math("DIVIDE", b.math("ADD", c, 0.055), 1.055), 2.4)
+    above = b.math("GREATER_THAN", c, 0.04045)
+    return b.math("MULTIPLY_ADD", above, b.math("SUBTRACT", high, low), low)
+
+
+def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str | None = None):
+    """A node group drawing ``field`` (a backend ProceduralField): Vector, Scale and the family's parameters in;
+    Color (scene-linear, for a shader's Base Color), sRGB (the engine's values) and Value (s) out."""
+    tree = new_group(name or f"Procedural {field.family.title()}", tree_type, (), ())
+    _interface(tree, field)
+    tree[FIELD_KEY] = json.dumps(field.to_dict())
+    b = NodeBuilder(tree)
+    gi, go = b.new("NodeGroupInput"), b.new("NodeGroupOutput")
+    p = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
+    seed, groups = field.seed, {}
+    fam = field.family
+    if fam == "rings":
+        s = _rings(b, gi, p, seed, groups)
+    elif fam == "layers":
+        s = _layers(b, gi, p, seed, groups, field.params["profile"])
+    elif fam == "cells":
+        s = _cells(b, gi, p, seed, groups)
+    else:
+        s = _bonds(b, gi, p, seed, groups)
+    from ..backend.solid.procedural.family import DETAIL_FREQ
+
+    s = b.math("MULTIPLY_ADD", gi.outputs["Detail"], _turbulence(b, groups, seed + 2, p, DETAIL_FREQ), s)
+    colour = _ramp(b, s, field.ramp)
+    srgb = b.vmath("MINIMUM", b.vmath("MAXIMUM", colour, (0.0, 0.0, 0.0)), (1.0, 1.0, 1.0))
+    b.put(go.inputs["sRGB"], srgb)
+    b.put(go.inputs["Color"], b.combine(*(_to_linear(b, c) for c in b.separate(srgb))))
+    b.put(go.inputs["Value"], s)
+    return tree
+
+
+def add_procedural_node(node_tree, group, location=(0.0, 0.0)):
+    """A group node of ``group`` in ``node_tree`` with a Texture Coordinate node's Object output on its Vector (a
+    solid texture of the object's local space) -> the node."""
+    node = node_tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.location = location
+    tc = node_tree.nodes.new("ShaderNodeTexCoord")
+    tc.location = (location[0] - 220.0, location[1])
+    node_tree.links.new(tc.outputs["Object"], node.inputs["Vector"])
+    return node

@@ -1,0 +1,166 @@
+"""The procedural solids' live node group (blender_addon/procedural_nodes.py) against the engine
+(backend/solid/procedural), in Geometry Nodes fields and in a Cycles bake, and the Solid Texture panel's
+Procedural Solid: its preview and its node group operator."""
+import os
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+from omninoise import blender_addon  # noqa: E402
+from omninoise.backend.colour import srgb_to_linear  # noqa: E402
+from omninoise.backend.solid.procedural import fit  # noqa: E402
+from omninoise.backend.solid.procedural.field import ProceduralField  # noqa: E402
+from omninoise.backend.solid.procedural.ramp import fit_ramp  # noqa: E402
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
+from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
+from omninoise.blender_addon.procedural_nodes import FIELD_KEY, add_procedural_node, build_procedural_group  # noqa: E402,E501
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+FAMILY_PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centre_v=-0.5, grain=0.2),
+                 "layers": dict(spacing=0.21, tilt=1.2, azimuth=0.3, profile="tri"),
+                 "cells": dict(size=0.2, stretch=1.4, jitter=0.9, gap=0.08),
+                 "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15)}
+
+
+def _field(family: str) -> ProceduralField:
+    rng = np.random.default_rng(0)
+    p = dict(FAMILY_PARAMS[family], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
+    draft = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 8), rng.uniform(0, 1, (16, 3))), seed=3)
+    values = draft.values(rng.uniform(-2, 2, (4000, 3)))
+    return ProceduralField(family, p, fit_ramp(values, rng.uniform(0, 1, (16, 3))), seed=3)
+
+
+@pytest.mark.parametrize("family", list(FAMILY_PARAMS))
+def test_geometry_nodes_field_equals_engine(family):
+    f = _field(family)
+    grp = build_procedural_group(f, "GeometryNodeTree")
+    pts = np.random.default_rng(1).uniform(-1.5, 1.5, (2000, 3)).astype(np.float32)
+
+    def output(name, channel=None):
+        def build(tree, pos):
+            g = tree.nodes.new("GeometryNodeGroup")
+            g.node_tree = grp
+            tree.links.new(pos, g.inputs["Vector"])
+            if channel is None:
+                return g.outputs[name]
+            sep = tree.nodes.new("ShaderNodeSeparateXYZ")
+            tree.links.new(g.outputs[name], sep.inputs[0])
+            return sep.outputs[channel]
+        return evaluate_field(pts, build)
+
+    try:
+        value = output("Value")
+        srgb = np.stack([output("sRGB", c) for c in range(3)], 1)
+        linear = np.stack([output("Color", c) for c in range(3)], 1)
+    finally:
+        bpy.data.node_groups.remove(grp)
+    ref = f.evaluate(pts.astype(np.float64))
+    assert np.abs(value - f.values(pts.astype(np.float64))).max() < 1e-4
+    assert np.abs(srgb - ref).max() < 1e-3 and np.median(np.abs(srgb - ref)) < 1e-5
+    assert np.abs(linear - srgb_to_linear(ref)).max() < 1e-3
+    assert ref.std(0).min() > 0.05                      # a pattern, not a constant
+
+
+def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
+    f = _field("rings")
+    grp = build_procedural_group(f)
+    try:
+        names = [s.name for s in grp.interface.items_tree if s.in_out == "INPUT"]
+        assert names == ["Vector", "Scale", "Spacing", "Axis", "Centre", "Grain", "Turbulence",
+                         "Turbulence Frequency", "Detail"]
+        assert grp.interface.items_tree["Spacing"].default_value == pytest.approx(0.13)
+        assert all(s.description for s in grp.interface.items_tree if s.in_out == "INPUT" and s.name != "Vector")
+        assert ProceduralField.from_dict(__import__("json").loads(grp[FIELD_KEY])).to_dict() == f.to_dict()
+    finally:
+        bpy.data.node_groups.remove(grp)
+
+
+def _bake(ob, nt, size):
+    img = bpy.data.images.new("bake", size, size, alpha=False, float_buffer=True)
+    img.colorspace_settings.name = "Non-Color"
+    it = nt.nodes.new("ShaderNodeTexImage")
+    it.image = img
+    nt.nodes.active = it
+    bpy.context.view_layer.objects.active = ob
+    ob.select_set(True)
+    bpy.ops.object.bake(type="EMIT", margin=0)
+    px = np.array(img.pixels[:], np.float32).reshape(size, size, 4)
+    nt.nodes.remove(it)
+    bpy.data.images.remove(img)
+    return px
+
+
+@pytest.mark.parametrize("family", ["rings", "layers", "bonds", "cells"])
+def test_cycles_bake_equals_engine(family):
+    """A plane baked in Cycles through the group's sRGB output, at the shading positions Cycles used (baked too):
+    within 1e-3 of the engine on all but the pixels a float32 position puts across an edge."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device, scene.cycles.samples = "CPU", 1
+    f = _field(family)
+    mesh = bpy.data.meshes.new("plane")
+    mesh.from_pydata([(-1, -1, 0.1), (1, -1, 0.1), (1, 1, 0.1), (-1, 1, 0.1)], [], [(0, 1, 2, 3)])
+    uv = mesh.uv_layers.new(name="UV")
+    for i, c in enumerate([(0, 0), (1, 0), (1, 1), (0, 1)]):
+        uv.data[i].uv = c
+    ob = bpy.data.objects.new("plane", mesh)
+    scene.collection.objects.link(ob)
+    mat = bpy.data.materials.new("procedural")
+    ob.data.materials.append(mat)
+    nt = ensure_node_tree(mat)
+    nt.nodes.clear()
+    g = add_procedural_node(nt, build_procedural_group(f))
+    em = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(g.outputs["sRGB"], em.inputs["Color"])
+    nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
+    vals = _bake(ob, nt, 48)[..., :3].reshape(-1, 3)
+    nt.links.new(g.inputs["Vector"].links[0].from_node.outputs["Object"], em.inputs["Color"])
+    pos = _bake(ob, nt, 48)[..., :3].reshape(-1, 3)
+    assert np.abs(pos[:, :2]).max() > 0.9
+    d = np.abs(vals - f.evaluate(pos.astype(np.float64))).max(1)
+    assert np.percentile(d, 99) < 1e-3 and np.median(d) < 1e-4, (np.percentile(d, 99), d.max())
+
+
+@pytest.fixture
+def small_fit(monkeypatch):
+    """A quick fit (small slices, a short search): the same stages, a tenth of the work."""
+    import functools
+
+    monkeypatch.setattr(fit, "ProceduralConfig", functools.partial(fit.ProceduralConfig, side=32, budget=6,
+                                                                   finalists=1, fit_side=64))
+
+
+def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path):
+    from omninoise.backend.solid.request import SolidRequest
+    from omninoise.export import read_rgb
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        path = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+        p = bpy.context.scene.omninoise_solid
+        p.source, p.image, p.method, p.seed, p.scale = "IMAGE", bpy.data.images.load(path), "PROCEDURAL", 2, 1.5
+        assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+        assert p.periodic_info.startswith("Fitted: ")
+        ima = bpy.data.images["Solid Texture Preview"]
+        px = np.empty(ima.size[0] * ima.size[1] * 4, np.float32)
+        ima.pixels.foreach_get(px)
+        got = np.flipud(px.reshape(128, 128, 4)[..., :3])
+        pixels = np.round(read_rgb(path) * 255) / 255
+        field = SolidRequest(exemplar=pixels, method="procedural", seed=2).check().procedural_field()
+        assert np.abs(got - field.image(128)).max() <= 0.5 / 255 + 1e-4     # the command line's solid
+        bpy.ops.mesh.primitive_cube_add()
+        assert bpy.ops.omninoise.solid_procedural_node() == {"FINISHED"}
+        mat = bpy.context.active_object.active_material
+        node = next(n for n in mat.node_tree.nodes if n.type == "GROUP")
+        assert node.inputs["Scale"].default_value == pytest.approx(1.5)
+        assert node.node_tree.name.startswith("Solid Texture Procedural")
+        bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+        assert bsdf.inputs["Base Color"].links[0].from_node == node
+        assert [n for n, _ in field.to_dict().items()] and node.node_tree[FIELD_KEY]
+        bpy.ops.ed.undo_push(message="check")
+    finally:
+        blender_addon.unregister()

@@ -1,0 +1,112 @@
+"""Methods "procedural" and "auto" (backend/solid/procedural, backend/solid/choose.py) in the command line, job files
+and the Python API: one request from flags, job tables and pixels; the same image and volume from each; one-line
+errors for what they cannot do.  A short fit (small slices, a short search) keeps it to seconds: the same stages."""
+import functools
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.procedural import fit
+from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.sources import solid_request_from_dict
+from omninoise.cli.main import build_parser, main
+from omninoise.cli.solid import solid_request
+from omninoise.export import read_rgb
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+PHOTO = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+
+
+@pytest.fixture(autouse=True)
+def small_fit(monkeypatch):
+    monkeypatch.setattr(fit, "ProceduralConfig", functools.partial(fit.ProceduralConfig, side=32, budget=6,
+                                                                   finalists=1, fit_side=64))
+
+
+def cli(*args):
+    return solid_request(build_parser().parse_args(["solid", *args, "-o", "x.png"]))
+
+
+def test_flags_job_tables_and_pixels_give_one_request():
+    a = cli("--method", "procedural", "--exemplar", PHOTO, "--seed", "4")
+    b = solid_request_from_dict({"method": "procedural", "exemplar": PHOTO, "seed": 4})
+    c = SolidRequest(exemplar=read_rgb(PHOTO), method="procedural", seed=4).check()
+    assert a.key() == b.key() == c.key()
+    assert set(a.key()) == {"method", "exemplar", "seed", "families"}
+    assert a.key() != cli("--method", "procedural", "--exemplar", PHOTO).key()
+    auto = cli("--method", "auto", "--exemplar", PHOTO, "--seed", "4")
+    assert auto.key()["procedural"] == a.key() and auto.key()["neural"]["model"] == "space"
+    assert auto.key() == solid_request_from_dict({"method": "auto", "exemplar": PHOTO, "seed": 4}).key()
+
+
+@pytest.mark.parametrize("method, flags, table, field, why", [
+    ("procedural", ["--exemplar", "gravel"], {"exemplar": "gravel"}, "exemplar", "procedural works from an image"),
+    ("procedural", ["--to", "grass"], {"to": "grass"}, "to", "interpolation needs the neural texture"),
+    ("procedural", ["--refine", "3"], {"refine": 3}, "refine", "procedural has none"),
+    ("auto", ["--exemplar", "gravel"], {"exemplar": "gravel"}, "exemplar", "auto chooses for a photo"),
+    ("auto", ["--to", "grass"], {"to": "grass"}, "to", "auto draws one texture"),
+])
+def test_what_they_cannot_do_is_named(method, flags, table, field, why):
+    with pytest.raises(SettingError) as e1:
+        cli("--method", method, "--exemplar", PHOTO, *flags)
+    with pytest.raises(SettingError) as e2:
+        solid_request_from_dict(dict({"method": method, "exemplar": PHOTO}, **table))
+    assert e1.value.setting == "--" + field and e2.value.setting == "source." + field
+    assert why in str(e1.value) and why in str(e2.value)
+
+
+def test_an_image_and_a_volume_from_the_command_line_a_job_file_and_the_api(tmp_path):
+    from omninoise import api
+    from omninoise.backend.colour import srgb_to_linear
+    from omninoise.backend.solid.model import slice_points
+    from omninoise.backend.solid.procedural.field import PX_PER_UNIT
+
+    out = str(tmp_path / "a.npy")
+    assert main(["solid", "--quiet", "--method", "procedural", "--exemplar", PHOTO, "--size", "48", "--seed", "1",
+                 "-o", out]) == 0
+    field = SolidRequest(exemplar=PHOTO, method="procedural", seed=1).check().procedural_field()
+    front = field.evaluate(slice_points(48, PX_PER_UNIT, "y")).reshape(48, 48, 3)
+    np.testing.assert_allclose(np.load(out), srgb_to_linear(front), atol=1e-5)
+    np.testing.assert_allclose(api.solid(PHOTO, 48, method="procedural", seed=1), np.load(out), atol=1e-6)
+
+    vol_out = str(tmp_path / "cli.npy")
+    assert main(["solid", "--quiet", "--method", "procedural", "--exemplar", PHOTO, "--dim", "3", "--size", "16",
+                 "--seed", "1", "-o", vol_out]) == 0
+    vol = np.load(vol_out)
+    assert vol.shape == (16, 16, 16, 3) and np.isfinite(vol).all() and vol.std() > 0.01
+    e = 16 / PX_PER_UNIT
+    shutil.copy(PHOTO, tmp_path / "bricks.jpg")
+    job = tmp_path / "job.toml"
+    job.write_text(f"""
+[[bake]]
+name = "wall"
+output = "job.npy"
+resolution = [16, 16, 16]
+bounds = [[0, 0, 0], [{e!r}, {e!r}, {e!r}]]
+[bake.source]
+kind = "solid"
+method = "procedural"
+exemplar = "bricks.jpg"
+seed = 1
+""")
+    assert main(["bake", str(job), "--quiet"]) == 0
+    np.testing.assert_allclose(np.load(tmp_path / "job.npy"), vol, atol=2e-5)
+
+
+def test_auto_keeps_what_its_check_finds_closer(tmp_path):
+    """Auto's choice is the closer of the two on its planes; its image is that texture's."""
+    req = SolidRequest(exemplar=PHOTO, method="auto", seed=2).check()
+    c = req.choose()
+    assert c.method == min(c.distances, key=c.distances.get) and set(c.distances) == {"procedural", "neural"}
+    assert c.request.method == c.method
+    img = req.front_image(32)
+    if c.method == "procedural":
+        np.testing.assert_allclose(img, c.field.image(32), atol=1e-6)
+    else:
+        np.testing.assert_allclose(img, c.model.image(32, c.code, 2), atol=1e-6)
+    out = str(tmp_path / "auto.png")
+    assert main(["solid", "--quiet", "--method", "auto", "--exemplar", PHOTO, "--size", "32", "-o", out]) == 0
+    assert os.path.getsize(out) > 0

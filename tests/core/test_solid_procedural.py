@@ -1,0 +1,181 @@
+"""The procedural solids (backend/solid/procedural): each family's geometry, the ramp's colours, the photo's
+estimates, the search, the field's JSON, and a fit that finds the family and sizes a photo was drawn with."""
+import numpy as np
+import pytest
+
+from omninoise.backend.errors import SettingError
+from omninoise.backend.grid import Cancelled
+from omninoise.backend.solid.model import slice_points
+from omninoise.backend.solid.procedural.bonds import Bonds
+from omninoise.backend.solid.procedural.cells import Cells, voronoi
+from omninoise.backend.solid.procedural.estimate import estimate, repeat_length
+from omninoise.backend.solid.procedural.family import Param, axis_vector
+from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
+from omninoise.backend.solid.procedural.fit import ProceduralConfig, fit_procedural, oblique_points
+from omninoise.backend.solid.procedural.layers import Layers
+from omninoise.backend.solid.procedural.ramp import Ramp, fit_ramp, luminance, photo_colours
+from omninoise.backend.solid.procedural.rings import Rings
+from omninoise.backend.solid.procedural.search import minimise
+
+CALM = dict(turbulence=0.0, turb_freq=1.0, detail=0.0)
+
+
+def _points(n=4000, seed=0, extent=2.0):
+    return np.random.default_rng(seed).uniform(-extent, extent, (n, 3))
+
+
+def test_a_parameter_maps_to_the_unit_interval_and_back():
+    lin, log = Param("a", -2.0, 6.0), Param("b", 0.01, 1.0, log=True)
+    for q, v in ((lin, 1.5), (log, 0.1)):
+        assert q.from_unit(q.to_unit(v)) == pytest.approx(v)
+    assert log.to_unit(0.1) == pytest.approx(0.5)             # half way on the log axis
+    assert lin.from_unit(-3.0) == -2.0 and lin.from_unit(7.0) == 6.0     # clipped
+
+
+def test_the_ramp_reads_linearly_between_stops_and_holds_beyond():
+    r = Ramp((0.0, 1.0, 3.0), ((0, 0, 0), (1, 0.5, 0), (1, 1, 1)))
+    np.testing.assert_allclose(r(np.array([-1.0, 0.5, 2.0, 9.0])),
+                               [[0, 0, 0], [0.5, 0.25, 0], [1, 0.75, 0.5], [1, 1, 1]], atol=1e-7)
+    assert Ramp.from_dict(r.to_dict()) == r
+
+
+def test_the_ramp_gives_the_photo_s_colours_in_the_photo_s_proportions():
+    rng = np.random.default_rng(1)
+    photo = np.concatenate([np.full((64, 32, 3), (0.1, 0.2, 0.6)), np.full((64, 32, 3), (0.9, 0.7, 0.2))], 1)
+    photo += rng.normal(0, 0.02, photo.shape)
+    values = rng.uniform(-3.0, 5.0, 20000)                    # any distribution of s
+    out = fit_ramp(values, photo_colours(photo))(values)
+    assert abs((luminance(out) > 0.5).mean() - 0.5) < 0.02   # half bright, half dark, as the photo
+    np.testing.assert_allclose(out.mean(0), photo.reshape(-1, 3).mean(0), atol=0.02)
+    flipped = fit_ramp(values, photo_colours(photo), flip=True)(values)
+    assert np.corrcoef(luminance(out), values)[0, 1] > 0.8 > -0.8 > np.corrcoef(luminance(flipped), values)[0, 1]
+    tied = fit_ramp(np.zeros(100), photo_colours(photo))       # one value everywhere: positions still increase
+    assert np.all(np.diff(tied.positions) > 0)
+
+
+def test_rings_are_circles_about_their_axis():
+    p = dict(spacing=0.1, tilt=0.0, azimuth=0.0, centre_u=0.0, centre_v=0.0, grain=0.0, **CALM)
+    rings, d = Rings(), None
+    d, c = rings.geometry(p)
+    np.testing.assert_allclose(d, (0, 0, 1), atol=1e-12)
+    angles = np.linspace(0, 2 * np.pi, 50)
+    for z in (-1.0, 0.7):         # points at one distance from the axis share one value, at any height
+        pts = c + np.stack([0.234 * np.cos(angles), 0.234 * np.sin(angles), np.full(50, z)], 1)
+        v = rings.values(p, pts, 0)
+        np.testing.assert_allclose(v, v[0], atol=1e-9)
+    assert rings.values(p, c[None] + [[0.234, 0, 0]], 0)[0] == pytest.approx(0.34)      # frac(0.234 / 0.1)
+
+
+def test_layers_are_constant_on_planes_normal_to_theirs():
+    p = dict(spacing=0.3, tilt=0.6, azimuth=1.1, profile="tri", **CALM)
+    n = axis_vector(0.6, 1.1)
+    u = np.cross(n, (0, 0, 1.0))
+    pts = 0.17 * n + np.outer(np.linspace(-2, 2, 40), u)
+    v = Layers().values(p, pts, 0)
+    np.testing.assert_allclose(v, v[0], atol=1e-9)
+    saw = Layers().values(dict(p, profile="saw"), _points(), 0)
+    assert saw.min() >= 0 and saw.max() < 1
+
+
+def test_cells_take_one_value_each_and_gaps_take_the_lowest():
+    p = dict(size=0.25, stretch=1.0, jitter=0.8, gap=0.0, **CALM)
+    pts = _points(6000)
+    _, _, cell = voronoi(pts / 0.25, 0.8, 0)
+    v = Cells().values(p, pts, 0)
+    keys = cell[:, 0].astype(np.int64) * 1000003 + cell[:, 1].astype(np.int64) * 1009 + cell[:, 2].astype(np.int64)
+    for k in np.unique(keys)[:40]:
+        np.testing.assert_allclose(v[keys == k], v[keys == k][0], atol=1e-12)
+    gapped = Cells().values(dict(p, gap=0.2), pts, 0)
+    assert gapped.min() == -1.0 and 0.05 < (gapped == -1.0).mean() < 0.9
+
+
+def test_running_bond_courses_shift_by_half_a_unit_and_meet_at_the_corner():
+    p = dict(length=0.4, height=0.1, offset=0.5, joint=0.2, **CALM)
+    b = Bonds()
+    x = np.linspace(0.0, 0.8, 801)
+    row0 = b.values(p, np.stack([x, np.full_like(x, 0.013), np.full_like(x, 0.05)], 1), 0)
+    row1 = b.values(p, np.stack([x, np.full_like(x, 0.013), np.full_like(x, 0.15)], 1), 0)
+    j0, j1 = x[row0 == -1.0], x[row1 == -1.0]
+    assert np.all(np.min(np.abs(j0[:, None] - [0.0, 0.4, 0.8]), 1) < 0.011)      # head joints every unit
+    assert np.all(np.min(np.abs(j1[:, None] - [0.2, 0.6]), 1) < 0.011)           # the next course: half a unit on
+    # the x wall and the y wall show their bed joints at the same heights (courses continue round a corner)
+    front = b.values(p, slice_points(64, 128.0, "y", (0, 0.013, 0)), 0).reshape(64, 64)
+    side = b.values(p, slice_points(64, 128.0, "x", (0.013, 0, 0)), 0).reshape(64, 64)
+    np.testing.assert_array_equal((front == -1).all(1), (side == -1).all(1))
+    assert (front == -1).all(1).sum() >= 4
+
+
+def test_estimates_read_a_stripe_photo_s_period_and_direction():
+    H = W = 256
+    r, c = np.mgrid[0:H, 0:W]
+    for period, angle in ((24.0, 0.0), (16.0, np.pi / 2), (20.0, np.pi / 4)):
+        # a wave whose vector points at ``angle`` (x right, z up = rows up)
+        phase = (c * np.cos(angle) - r * np.sin(angle)) / period
+        photo = np.repeat((0.5 + 0.4 * np.sin(2 * np.pi * phase))[..., None], 3, 2)
+        e = estimate(photo, PX_PER_UNIT)
+        assert e.spacing * PX_PER_UNIT == pytest.approx(period, abs=1.5), (period, angle)
+        assert abs(np.sin(e.angle - angle)) < 0.05
+    assert repeat_length(np.exp(-np.arange(100) / 10.0)) == pytest.approx(4 * 7, abs=1)   # no peak: 4 x half-fall
+
+
+def test_nelder_mead_finds_a_bowl_s_bottom_within_its_budget():
+    calls = []
+
+    def f(x):
+        calls.append(x)
+        return float(np.sum((x - [0.3, 0.7, 0.55]) ** 2))
+
+    x, fx = minimise(f, [0.5, 0.5, 0.5], 0.1, budget=120)
+    assert fx < 1e-4 and len(calls) <= 120 + 3
+    x, _ = minimise(lambda x: float(np.sum((x - 2.0) ** 2)), [0.5, 0.5], 0.1, budget=60)   # the bottom outside
+    np.testing.assert_allclose(x, [1.0, 1.0], atol=1e-3)
+
+
+def test_a_field_reads_back_from_json_and_refuses_bad_parameters():
+    p = dict(length=0.4, height=0.1, offset=0.5, joint=0.2, turbulence=0.3, turb_freq=2.0, detail=0.2, flip=True)
+    ramp = Ramp((-1.0, 0.0, 2.0), ((0.2, 0.1, 0.1), (0.5, 0.3, 0.2), (0.8, 0.6, 0.5)))
+    f = ProceduralField("bonds", p, ramp, seed=3)
+    g = ProceduralField.from_dict(f.to_dict())
+    pts = _points(3000)
+    a = f.evaluate(pts)
+    np.testing.assert_array_equal(a, g.evaluate(pts))
+    assert a.dtype == np.float32 and np.isfinite(a).all() and a.min() >= 0 and a.max() <= 1
+    np.testing.assert_array_equal(f.evaluate(pts[:, :2]), f.evaluate(np.c_[pts[:, :2], np.zeros(3000)]))
+    with pytest.raises(SettingError, match="unknown procedural family 'tiles'"):
+        ProceduralField("tiles", p, ramp)
+    with pytest.raises(SettingError, match=r"height must be in \[0.01, 1.0\]"):
+        ProceduralField("bonds", dict(p, height=float("nan")), ramp)
+    with pytest.raises(SettingError, match="profile must be one of saw, tri"):
+        ProceduralField("layers", dict(spacing=0.2, tilt=0.0, azimuth=0.0, **CALM), ramp)
+    with pytest.raises(Cancelled):
+        f.evaluate(pts, chunk=100, cancel=lambda: True)
+
+
+def test_oblique_planes_are_square_grids_of_photo_pixels():
+    pts = oblique_points(8, 128.0, (0.6, 0.5, 0.62), (1.0, 2.0, 3.0)).reshape(8, 8, 3)
+    n = np.array([0.6, 0.5, 0.62]) / np.linalg.norm([0.6, 0.5, 0.62])
+    np.testing.assert_allclose((pts - [1.0, 2.0, 3.0]) @ n, 0.0, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(pts[0, 1] - pts[0, 0]), 1 / 128.0)
+    np.testing.assert_allclose(np.linalg.norm(pts[1, 0] - pts[0, 0]), 1 / 128.0)
+    np.testing.assert_allclose(oblique_points(8, 128.0, (0, 1, 0), (0, 0.5, 0)), slice_points(8, 128.0, "y", (0, 0.5, 0)))
+
+
+def test_a_photo_drawn_by_a_family_is_fitted_by_that_family():
+    """Bricks drawn with known sizes: the fit picks bonds and finds the course height within 15 %, and its
+    slices are closer to the photo than the start's."""
+    truth = ProceduralField("bonds", dict(length=0.375, height=0.125, offset=0.5, joint=0.2, turbulence=0.1,
+                                          turb_freq=2.0, detail=0.1, flip=True),
+                            Ramp((-1.0, 0.0, 2.0), ((0.1, 0.1, 0.1), (0.55, 0.25, 0.2), (0.75, 0.4, 0.3))), seed=5)
+    photo = truth.image(192, offset=(0.0, 0.1, 0.0))      # a wall through the bricks, not along a joint
+    fit = fit_procedural(photo, ProceduralConfig(side=64, budget=24, finalists=2, seed=1))
+    assert fit.field.family == "bonds", fit.scores
+    assert fit.field.params["height"] == pytest.approx(0.125, rel=0.15)
+    assert fit.tried == 2 * sum(len(f.starts(estimate(photo, PX_PER_UNIT))) for f in FAMILIES.values()) + 2 * 24
+
+
+def test_a_flat_or_tiny_photo():
+    flat = fit_procedural(np.full((64, 64, 3), 0.4, np.float32), ProceduralConfig(side=32, budget=6, finalists=1))
+    img = flat.field.image(32)
+    assert np.isfinite(img).all() and np.abs(img - 0.4).max() < 1e-5
+    with pytest.raises(SettingError, match="at least 16 x 16 px, got 12 x 40"):
+        fit_procedural(np.zeros((40, 12, 3)))
