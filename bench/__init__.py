@@ -13,6 +13,8 @@ SUITES = {
     "solid": ("eval_solid", "the shipped solid textures: figures and speed (solid_eval.json with --only-speed)"),
     "farm": ("bench_farm", "a farm bake's speed-up over one process"),
     "node": ("bench_node", "Cycles render time of the Wave Noise node against Blender's own textures (needs bpy)"),
+    "procedural-node": ("bench_procedural_node", "Cycles render time of the procedural solids' node groups against "
+                                                 "Blender's Wave Texture (needs bpy)"),
     "int8": ("neural_int8", "int8 against fp32 neural denoisers: speed and difference"),
     "neural-eval": ("eval_neural", "a neural noise model's evaluation: Fréchet distances, spectra, classifier"),
     "neural-compare": ("neural_compare", "two neural evaluations side by side (the model card's table)"),
@@ -22,6 +24,7 @@ SUITES = {
     "solid-singles": ("eval_solid_singles", "single-photo solid models on pixels they never saw"),
     "solid-ablation": ("solid_ablation", "each stage and reading of the solid pipeline left out in turn"),
     "solid-methods": ("solid_synthesis", "the spectral solid and tileable synthesis on held-out photos"),
+    "solid-procedural": ("eval_procedural", "procedural solids and method auto on held-out structured photos"),
     "sheet-zoo": ("zoo_sheet", "contact sheet: the training zoo's classes at 256 px"),
     "sheet-samplers": ("neural_sampler_sheet", "contact sheet: the samplers on the same seeds"),
     "sheet-structure": ("neural_structure_sheet", "contact sheet: long-range structure of models at 256 px"),

@@ -102,6 +102,43 @@ def ablation(doc: dict) -> list:
     return out + [""]
 
 
+def procedural(doc: dict) -> list:
+    s = doc.get("summary", {})
+    n = s.get("photos", 0)
+    out = [f"Procedural solids (`backend/solid/procedural`) on {n} held-out {doc.get('set')} photos: the patch "
+           "distance (lower is better) of the x, y and z cuts (`axes`, two seeds) and of six cuts at random "
+           "orientations (`oblique`), for the procedural solid, method auto (the procedural solid where its own check "
+           "finds it closer, else the neural texture), the neural texture (the default) and random phase noise drawn "
+           "as a solid. Counts are photos closer than the named texture.", "",
+           "| texture | median axes | median oblique | closer than random phase solid (axes / oblique) | closer "
+           "than the neural texture (axes / oblique) | farther than the neural texture (axes / oblique) |",
+           "|---|---|---|---|---|---|"]
+    for who, label in (("procedural", "procedural"), ("auto", "auto"), ("neural", "neural (default)"),
+                       ("random_phase_solid", "random phase solid")):
+        rp = (f"{s.get(f'{who}_beats_random_phase_solid_axes', '—')} / "
+              f"{s.get(f'{who}_beats_random_phase_solid_oblique', '—')}") if who in ("procedural", "auto", "neural") \
+            else "—"
+        nb = (f"{s.get(f'{who}_beats_neural_axes')} / {s.get(f'{who}_beats_neural_oblique')}"
+              if who in ("procedural", "auto") else "—")
+        nf = (f"{s.get(f'{who}_farther_than_neural_axes')} / {s.get(f'{who}_farther_than_neural_oblique')}"
+              if who in ("procedural", "auto") else "—")
+        out.append(f"| {label} | {s.get(f'median_{who}_axes')} | {s.get(f'median_{who}_oblique')} | {rp} | {nb} | {nf} |")
+    fams = ", ".join(f"{k} {v}" for k, v in s.get("families", {}).items())
+    out += ["", f"Families fitted: {fams}; auto kept the procedural solid on {s.get('chosen_procedural')} of {n}. "
+            f"Median fit time {s.get('median_fit_seconds')} s per photo on this machine.", ""]
+    return out
+
+
+def procedural_node(doc: dict) -> list:
+    out = [f"Cycles render time of the procedural solids' live node groups against Blender's Wave Texture: a plane "
+           f"filling a {doc.get('res')}² px frame, emission, CPU; nanoseconds per pixel-sample from {doc.get('samples')} "
+           f"and {2 * doc.get('samples', 0)} samples.", "", "| shader | ns per pixel-sample | vs Wave Texture | nodes |",
+           "|---|---|---|---|"]
+    for name, r in doc.get("results", {}).items():
+        out.append(f"| {name} | {r['ns_per_pixel_sample']} | {r['vs_wave_texture']}x | {r['nodes']} |")
+    return out + [""]
+
+
 #: (JSON file, heading, renderer, the command that makes it)
 BENCHES = (
     ("wave.json", "Wave noise", wave, "python -m bench wave"),
@@ -111,6 +148,12 @@ BENCHES = (
      "python -m bench solid-ablation -o docs/benchmarks/solid_ablation.json"),
     ("solid_ablation_library.json", "Solid textures: what each stage is worth, a texture library's tiles", ablation,
      "python -m bench solid-ablation --folder TILES -o docs/benchmarks/solid_ablation_library.json"),
+    ("solid_procedural.json", "Procedural solids: held-out structured photos", procedural,
+     "python -m bench solid-procedural --set structured --sheet -o docs/benchmarks/solid_procedural"),
+    ("solid_procedural_stochastic.json", "Procedural solids: held-out stochastic photos (method auto)", procedural,
+     "python -m bench solid-procedural --set stochastic -o docs/benchmarks/solid_procedural_stochastic"),
+    ("procedural_node.json", "Procedural solids: node group render time", procedural_node,
+     "python -m bench procedural-node"),
     ("solid_ablation_crops.json", "Solid textures: what each reading is worth, held-out structured photos cut off their "
      "period", ablation, "python -m bench solid-ablation --folder CROPS --only 'lattice motif' 'main lobes' "
      "'few repeats' lines -o docs/benchmarks/solid_ablation_crops.json"),

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["band_distance", "laplacian_bands", "PATCH", "LEVELS", "SAMPLES", "DIRECTIONS", "REFERENCE_SIDE"]
+__all__ = ["band_distance", "laplacian_bands", "central_crop", "PATCH", "LEVELS", "SAMPLES", "DIRECTIONS", "REFERENCE_SIDE"]
 
 PATCH = 5             #: neighbourhood side, px
 LEVELS = 4            #: Laplacian levels (three bands and the low-pass residue)
@@ -57,7 +57,8 @@ def _neighbourhoods(level: np.ndarray, n: int, rng: np.random.Generator, k: int)
     return level[ys[:, None, None] + dy, xs[:, None, None] + dx].reshape(n, k * k, 3)
 
 
-def _central(photo: np.ndarray, side: int) -> np.ndarray:
+def central_crop(photo: np.ndarray, side: int) -> np.ndarray:
+    """The central side x side crop of a photo (H, W, C) (the whole photo where it is smaller)."""
     H, W = photo.shape[:2]
     y, x = max(0, (H - side) // 2), max(0, (W - side) // 2)
     return photo[y:y + side, x:x + side]
@@ -69,7 +70,7 @@ def band_distance(images: list, photo: np.ndarray, seed: int = 0) -> float:
     if not images:
         raise ValueError("band_distance needs at least one image")
     rng = np.random.default_rng(seed)
-    ref = laplacian_bands(_central(np.asarray(photo, np.float64), REFERENCE_SIDE))
+    ref = laplacian_bands(central_crop(np.asarray(photo, np.float64), REFERENCE_SIDE))
     pyrs = [laplacian_bands(im) for im in images]
     per = -(-SAMPLES // len(pyrs))
     total = 0.0

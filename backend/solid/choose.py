@@ -3,9 +3,11 @@ texture otherwise.
 
     1. fit     the procedural solid (:func:`~backend.solid.procedural.fit.fit_procedural`)
     2. encode  the neural texture's code (backend/solid/pipeline.py, as method "neural" makes it)
-    3. check   both drawn on :data:`PLANES` (walls, floors and oblique cuts none of the fit's planes) and measured by
+    3. check   both drawn on :data:`PLANES` (axis and oblique cuts, none of the fit's planes) and measured by
                the runtime's band distance (band_distance.py); the procedural solid is kept only where it is
-               closer, so a photo it does not suit keeps the neural texture
+               closer by the margin the Gaussian rest's check asks (gaussian_rest.MARGIN: at most 0.92 times the
+               neural texture's distance: one draw's distance is a noisy figure), so a photo it does not suit keeps
+               the neural texture
 
 Shapes: photos float32 (H, W, 3) sRGB in [0, 1].
 """
@@ -17,16 +19,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from .band_distance import band_distance
+from .gaussian_rest import MARGIN
 from .procedural.fit import oblique_points
 
 __all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
-#: the check's planes (normal, a point on it), units: two of each wall, a floor, two oblique cuts
+#: the check's planes (normal, a point on it), units: a cut normal to each axis and three at orientations drawn once
+#: (as a cube's faces and a mesh's faces cut a solid), none of the fit's
 PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((0.0, 1.0, 0.0), (-3.3, 4.45, -2.6)),
-          ((1.0, 0.0, 0.0), (-4.6, 2.35, -3.9)), ((0.0, 1.0, 0.0), (2.8, -4.2, 4.3)),
           ((0.0, 0.0, 1.0), (3.6, 3.1, -4.4)), ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)),
-          ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)))
+          ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)), ((0.2, 0.9, -0.4), (-4.2, 2.7, 1.3)))
 
 
 @dataclass(frozen=True)
@@ -42,11 +45,12 @@ class Choice:
     distances: dict
 
 
-def choose(request, where: str = "", progress=None, report=None, on_code=None) -> Choice:
-    """The stages (module doc) for a checked request with method "auto" and an image exemplar."""
+def choose(request, where: str = "", progress=None, report=None, on_code=None, field=None) -> Choice:
+    """The stages (module doc) for a checked request with method "auto" and an image exemplar; ``field``: its
+    procedural solid when it is fitted already (the evaluation measures it on its own too)."""
     img = np.asarray(request.exemplar_pixels(where), np.float32)
     proc = dataclasses.replace(request, method="procedural")
-    field = proc.procedural_field(where, progress)                                     # 1. fit
+    field = field if field is not None else proc.procedural_field(where, progress)       # 1. fit
     neural = dataclasses.replace(request, method="neural")
     model = neural.load(where)
     code, _ = neural.code(model, where, None, report, on_code)                          # 2. encode
@@ -55,7 +59,7 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None) -
     drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
              "neural": [model.evaluate(p, code, int(request.seed)).reshape(SIDE, SIDE, 3) for p in planes]}
     d = {k: round(band_distance(v, img), 2) for k, v in drawn.items()}
-    keep = "procedural" if d["procedural"] < d["neural"] else "neural"
+    keep = "procedural" if d["procedural"] <= MARGIN * d["neural"] else "neural"
     return Choice(keep, proc if keep == "procedural" else neural, field, model, code, d)
 
 

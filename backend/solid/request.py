@@ -220,12 +220,12 @@ class SolidRequest:
             return self.procedural_field(where, progress, cancel)
         return self.spectral_field(where, progress, cancel)
 
-    def choose(self, where: str = "", progress=None, report=None, on_code=None):
-        """Method "auto": the :class:`~backend.solid.choose.Choice` between the procedural solid and the neural
-        texture (:func:`~backend.solid.choose.choose`)."""
+    def choose(self, where: str = "", progress=None, report=None, on_code=None, field=None):
+        """Method "auto": the :class:`~backend.solid.choose.Choice` between the procedural solid (``field`` where
+        it is fitted already) and the neural texture (:func:`~backend.solid.choose.choose`)."""
         from .choose import choose
 
-        return choose(self, where, progress, report, on_code)
+        return choose(self, where, progress, report, on_code, field)
 
     def front_image(self, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
                     on_code=None, draw_progress=None) -> np.ndarray:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..band_distance import LEVELS, PATCH, REFERENCE_SIDE, _central, laplacian_bands
+from ..band_distance import LEVELS, PATCH, REFERENCE_SIDE, central_crop, laplacian_bands
 
 __all__ = ["SliceLoss", "SAMPLES", "DIRECTIONS"]
 
@@ -25,7 +25,7 @@ class SliceLoss:
 
     def __init__(self, photo: np.ndarray, side: int, count: int, seed: int = 0):
         rng = np.random.default_rng(seed)
-        ref = laplacian_bands(_central(np.asarray(photo, np.float64)[..., :3], REFERENCE_SIDE))
+        ref = laplacian_bands(central_crop(np.asarray(photo, np.float64)[..., :3], REFERENCE_SIDE))
         self.side, self.count = int(side), int(count)
         self.levels = []
         probe = laplacian_bands(np.zeros((side, side, 3)))

@@ -1,0 +1,83 @@
+"""Cycles render time of the procedural solids' node groups (blender_addon/procedural_nodes.py) against Blender's
+own Wave Texture, the node artists build wood and marble from by hand.
+
+The scene of ``python -m bench node`` (a plane filling an orthographic camera's R x R frame, emission shader,
+Cycles on the CPU), one group per family with the settings of the parity tests
+(tests/blender/test_procedural_blender.py), each rendered once to compile and then timed; nanoseconds per
+pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
+Texture and the node count (sub-groups included).  Writes docs/benchmarks/procedural_node.json.
+
+    python -m bench procedural-node [--res 128] [--samples 4] [--repeat 2]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: F401  (the scene below is Blender's)
+import numpy as np
+
+from bench.bench_node import _timed, scene, shade, texture
+from bench.stamp import stamp
+from omninoise.backend.solid.procedural.field import ProceduralField
+from omninoise.backend.solid.procedural.ramp import fit_ramp
+from omninoise.blender_addon.procedural_nodes import build_procedural_group
+from omninoise.export.atomic import write_json
+
+#: the families' settings (the parity tests')
+PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centre_v=-0.5, grain=0.2),
+          "layers": dict(spacing=0.21, tilt=1.2, azimuth=0.3, profile="tri"),
+          "cells": dict(size=0.2, stretch=1.4, jitter=0.9, gap=0.08),
+          "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15)}
+
+
+def procedural(family: str):
+    def make(nt):
+        rng = np.random.default_rng(0)
+        p = dict(PARAMS[family], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
+        f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3)
+        grp = build_procedural_group(f)
+        n = nt.nodes.new("ShaderNodeGroup")
+        n.node_tree = grp
+
+        def count(tree):
+            return sum(1 + (count(x.node_tree) if x.bl_idname == "ShaderNodeGroup" else 0) for x in tree.nodes)
+
+        return (n.inputs["Vector"], n.outputs["Value"]), count(grp)
+    return make
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--res", type=int, default=128)
+    ap.add_argument("--samples", type=int, default=4)
+    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "procedural_node.json"))
+    a = ap.parse_args(argv)
+    cases = [("Blender Wave Texture", texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0))]
+    cases += [(f"Procedural {f}", procedural(f)) for f in PARAMS]
+    res = {}
+    for name, make in cases:
+        times = {}
+        for spp in (a.samples, 2 * a.samples):
+            sc, mat = scene(a.res, spp)
+            nodes = shade(mat, make)
+            bpy.ops.render.render()      # compile and warm up
+            times[spp] = min(_timed() for _ in range(a.repeat))
+        per = (times[2 * a.samples] - times[a.samples]) / (a.res * a.res * a.samples)
+        res[name] = dict(ns_per_pixel_sample=round(per * 1e9, 1), nodes=nodes)
+    ref = res["Blender Wave Texture"]["ns_per_pixel_sample"]
+    for r in res.values():
+        r["vs_wave_texture"] = round(r["ns_per_pixel_sample"] / ref, 1)
+    print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
+    for name, r in res.items():
+        print(f"  {name:24s} {r['ns_per_pixel_sample']:10.1f} ns  {r['vs_wave_texture']:6.1f}x  {r['nodes']:5d} nodes")
+    write_json(a.out, dict(stamp=stamp(), res=a.res, samples=a.samples, results=res))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,165 @@
+"""Procedural solids on held-out photos: ``python -m bench solid-procedural [--set structured|stochastic]``.
+
+For every photo of the set, the procedural solid the product fits (method "procedural",
+:mod:`backend.solid.procedural`), the neural texture the product draws by default (method "neural"), random phase
+noise drawn as a solid (``bench.solid_synthesis.random_phase_solid``: the closer of the isotropic and upright
+Gaussian solids, figure by figure) and what method "auto" delivers (:mod:`backend.solid.choose`: the procedural
+solid where its own check finds it closer than the neural texture by a margin, else the neural texture) are cut by
+the same planes and measured by the held-out patch distance (``training.solid.photo_eval``: 7 x 7 Laplacian-pyramid
+neighbourhoods, sliced Wasserstein, x 1000; lower is better):
+
+- ``axes``: the mean of the x, y and z cuts' distances (``photo_eval.SLICE_OFFSETS``, two seeds each, grouped as
+  ``photo_eval.grouped_swd`` groups them), what each face of a cube shows;
+- ``oblique``: six cuts at random orientations (``photo_eval.OBLIQUE_NORMALS``), as a mesh's faces cut the solid.
+
+Sets: ``structured``, the photo set's held-out brick, paving, tile and wood photos and the structured photos
+(``data/structured``, ``tools/build_structured_set.py``); ``stochastic``, every ``--every``-th other held-out
+photo (grass, rock, soil, sand, snow...), where "auto" is to keep the neural texture.  Writes OUT.json (per photo,
+and the counts of the summary: photos where the procedural solid and "auto" are closer than random phase noise
+as a solid and than the neural texture, per figure; photos where "auto" is farther than the neural texture) and,
+with ``--sheet``, OUT.png: photo | neural front | procedural front, x and z cuts, per photo.  Also the seconds
+each fit took on this machine.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import glob
+import os
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+import numpy as np
+
+from bench.solid_synthesis import SOLIDS, random_phase_solid, slices
+from bench.stamp import stamp
+from omninoise.backend.solid.gaussian_rest import GaussianRest, rest_field, rest_waves
+from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.solid.synthesis import PX_PER_UNIT
+from omninoise.backend.solid.upright import upright_waves
+from omninoise.export import read_rgb
+from omninoise.export.atomic import write_json
+from omninoise.training.solid import photo_eval as pe
+from omninoise.training.solid.photo_set import photo_set
+
+STRUCTURED = ("brick", "paving", "tile", "wood", "marble", "rust")   #: the photo set's structured categories
+SEEDS = 2
+
+
+class _Field:
+    """A texture as :func:`bench.solid_synthesis.slices` reads it: ``evaluate(points)``, ``px_per_unit``."""
+
+    def __init__(self, evaluate, px_per_unit: float):
+        self.evaluate, self.px_per_unit = evaluate, px_per_unit
+
+
+def photos(which: str, every: int) -> list:
+    val = photo_set("val", os.path.join(ROOT, "data", "photos"))
+    if which == "structured":
+        return [f for f in val if os.path.basename(f).split("__")[0] in STRUCTURED] + sorted(
+            glob.glob(os.path.join(ROOT, "data", "structured", "*.jpg")))
+    return [f for f in val if os.path.basename(f).split("__")[0] not in STRUCTURED][::every]
+
+
+def figures(field: _Field, photo: np.ndarray) -> dict:
+    """axes and oblique distances of a texture."""
+    g = pe.grouped_swd(slices(field, SEEDS), photo)
+    obl = pe.oblique_slices(field.evaluate, field.px_per_unit)
+    return {"axes": g["axes"], "pooled": g["pooled"], "oblique": pe.rounded_swds(pe.level_distances(obl, photo))[0]}
+
+
+def gaussian_solid(photo: np.ndarray, kind: str) -> _Field:
+    """random_phase_solid's Gaussian solid as a field (the oblique cuts read it anywhere)."""
+    waves = (rest_waves if kind == "isotropic" else upright_waves)(photo, PX_PER_UNIT)
+    m = np.asarray(photo, np.float64).reshape(-1, 3).mean(0)
+    if waves is None:
+        return _Field(lambda pts: np.broadcast_to(m, (len(pts), 3)).astype(np.float32), PX_PER_UNIT)
+    r = GaussianRest(waves[0], waves[1], 1.0)
+    return _Field(lambda pts: np.clip(m + rest_field(pts, r, 0), 0.0, 1.0).astype(np.float32), PX_PER_UNIT)
+
+
+def measure(path: str) -> dict:
+    photo = read_rgb(path)
+    req = SolidRequest(exemplar=photo, method="auto").check()
+    t = time.time()
+    field = dataclasses.replace(req, method="procedural").procedural_field()
+    seconds = time.time() - t
+    choice = req.choose(field=field)
+    model, code = choice.model, choice.code
+    neural = _Field(lambda pts: model.evaluate(pts, code, 0), model.px_per_unit)
+    r = {"family": field.family, "seconds": round(seconds, 1), "chosen": choice.method,
+         "choice_distances": choice.distances}
+    for name, f in (("procedural", field), ("neural", neural)):
+        r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
+    for k in ("axes", "pooled"):        # random phase as a solid: the closer kind, figure by figure, as solid-methods
+        r[f"random_phase_solid_{k}"] = min(pe.grouped_swd(random_phase_solid(photo, kind, SEEDS), photo)[k]
+                                           for kind in SOLIDS)
+    r["random_phase_solid_oblique"] = min(
+        pe.rounded_swds(pe.level_distances(pe.oblique_slices(gaussian_solid(photo, kind).evaluate, PX_PER_UNIT),
+                                           photo))[0] for kind in SOLIDS)
+    for k in ("axes", "pooled", "oblique"):
+        r[f"auto_{k}"] = r[f"{choice.method}_{k}"]
+    return r, field, neural, photo
+
+
+def summary(rows: dict) -> dict:
+    s = {"photos": len(rows), "median_fit_seconds": float(np.median([r["seconds"] for r in rows.values()])),
+         "chosen_procedural": sum(r["chosen"] == "procedural" for r in rows.values())}
+    for who in ("procedural", "auto"):
+        for k in ("axes", "oblique"):
+            s[f"{who}_beats_random_phase_solid_{k}"] = sum(r[f"{who}_{k}"] < r[f"random_phase_solid_{k}"]
+                                                          for r in rows.values())
+            s[f"{who}_beats_neural_{k}"] = sum(r[f"{who}_{k}"] < r[f"neural_{k}"] for r in rows.values())
+            s[f"{who}_farther_than_neural_{k}"] = sum(r[f"{who}_{k}"] > r[f"neural_{k}"] for r in rows.values())
+    for k in ("axes", "oblique"):
+        s[f"neural_beats_random_phase_solid_{k}"] = sum(r[f"neural_{k}"] < r[f"random_phase_solid_{k}"]
+                                                        for r in rows.values())
+        for who in ("procedural", "neural", "random_phase_solid", "auto"):
+            s[f"median_{who}_{k}"] = round(float(np.median([r[f"{who}_{k}"] for r in rows.values()])), 1)
+    s["families"] = {f: sum(r["family"] == f for r in rows.values()) for f in sorted({r["family"] for r in rows.values()})}
+    return s
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--set", default="structured", choices=("structured", "stochastic"))
+    ap.add_argument("--every", type=int, default=3, help="stochastic: every N-th photo")
+    ap.add_argument("--limit", type=int, default=0)
+    ap.add_argument("--sheet", action="store_true")
+    ap.add_argument("-o", "--out", default=None, help="default: out/bench/solid_procedural_SET")
+    a = ap.parse_args(argv)
+    out = a.out or os.path.join(ROOT, "out", "bench", f"solid_procedural_{a.set}")
+    files = photos(a.set, a.every)
+    files = files[:a.limit] if a.limit else files
+    rows, sheet = {}, []
+    print(f"{'photo':40s} {'family':7s} {'chosen':10s} {'proc':>6s} {'neural':>6s} {'rp':>6s}  (axes)  "
+          f"{'proc':>6s} {'neural':>6s} {'rp':>6s}  (oblique)   s")
+    for path in files:
+        name = os.path.basename(path)
+        r, field, neural, photo = measure(path)
+        rows[name] = r
+        print(f"{name[:40]:40s} {r['family']:7s} {r['chosen']:10s} {r['procedural_axes']:6.1f} {r['neural_axes']:6.1f} "
+              f"{r['random_phase_solid_axes']:6.1f}          {r['procedural_oblique']:6.1f} {r['neural_oblique']:6.1f} "
+              f"{r['random_phase_solid_oblique']:6.1f}  {r['seconds']:5.1f}", flush=True)
+        if a.sheet:
+            from omninoise.backend.solid.model import slice_points
+
+            cut = [neural.evaluate(slice_points(128, PX_PER_UNIT, "y", (0.0, 0.37, 0.0))).reshape(128, 128, 3)]
+            cut += [field.evaluate(slice_points(128, PX_PER_UNIT, ax, o)).reshape(128, 128, 3)
+                    for ax, o in (("y", (0.0, 0.37, 0.0)), ("x", (0.37, 0.0, 0.0)), ("z", (0.0, 0.0, 0.37)))]
+            sheet.append(np.concatenate([photo[:128, :128]] + cut, 1))
+    s = summary(rows)
+    print(s)
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    write_json(out + ".json", {"stamp": stamp(), "set": a.set, "seeds": SEEDS, "summary": s, "photos": rows})
+    if a.sheet and sheet:
+        from omninoise.export.images import write_png
+
+        write_png(out + ".png", np.round(np.concatenate(sheet, 0) * 255).astype(np.uint8))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

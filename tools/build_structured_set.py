@@ -1,0 +1,122 @@
+"""Rebuild the held-out structured photos of the procedural solids: ``python tools/build_structured_set.py``.
+
+Photos whose structure runs through the material (planks, grain, tiles, cobbles), from the packages and under the
+licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or
+Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold: neither model training
+nor any tuning read them.  Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the
+centre CROP px square) but without its stationarity filter, which would drop exactly these.  The evaluation of the
+procedural solids (``python -m bench solid-methods --method procedural --structured``) reads them beside the photo
+set's held-out brick, paving, tile and wood photos.
+
+``data/structured/manifest.json`` lists per crop: package, version, path, licence, authors, the source's sha256,
+the crop box and the crop's sha256; ``data/structured/ATTRIBUTION.md`` is the attribution the licences ask for.
+"""
+from __future__ import annotations
+
+import argparse
+import fnmatch
+import io
+import os
+import sys
+import zipfile
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
+from tools.build_photo_set import CROP, LICENCES, SOURCE_SIDE, _sha, _version, fetch, parse_dep5  # noqa: E402
+
+OUT = os.path.join(ROOT, "data", "structured")
+#: (package, path inside it, category): the structured photos the packages hold under the licences
+SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
+           ("supertuxkart-data", "data/textures/japanRedWood.png", "wood"),
+           ("supertuxkart-data", "data/textures/bow_tile.jpg", "paving"),
+           ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile01.png", "tile"),
+           ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile02.png", "tile"),
+           ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile03.png", "tile"))
+
+
+def _read(unpacked: str, pkg: str, path: str) -> tuple:
+    """(bytes, licence, authors) of a package's file."""
+    if pkg == "ufoai-textures":
+        root = os.path.join(unpacked, pkg)
+        lic = parse_dep5(open(os.path.join(root, "usr/share/doc/ufoai-textures/copyright"), encoding="utf-8").read())
+        pk3, name = path.split(":", 1)
+        with zipfile.ZipFile(os.path.join(root, "usr/share/games/ufoai", pk3)) as z:
+            data = z.read(name)
+        return (data,) + lic[pk3.replace("0textures.pk3", "") + name]
+    root = os.path.join(unpacked, pkg)
+    lic = parse_dep5(open(os.path.join(root, "usr/share/doc/supertuxkart-data/copyright"), encoding="utf-8").read())
+    L = lic.get(path) or next(v for k, v in lic.items() if any(ch in k for ch in "*?[") and fnmatch.fnmatch(path, k))
+    with open(os.path.join(root, "usr/share/games/supertuxkart", path), "rb") as fh:
+        return (fh.read(),) + L
+
+
+def centre_crop(data: bytes) -> tuple:
+    """Source bytes -> (crop uint8 (CROP, CROP, 3), box in the scaled source), as the photo set cuts them."""
+    from PIL import Image
+
+    with Image.open(io.BytesIO(data)) as im:
+        rgb = im.convert("RGB")
+    f = SOURCE_SIDE / min(rgb.size)
+    if f < 1.0:
+        rgb = rgb.resize((max(CROP, round(rgb.size[0] * f)), max(CROP, round(rgb.size[1] * f))), Image.LANCZOS)
+    W, H = rgb.size
+    x0, y0 = (W - CROP) // 2, (H - CROP) // 2
+    return np.asarray(rgb)[y0:y0 + CROP, x0:x0 + CROP], [x0, y0, CROP, CROP, W, H]
+
+
+def build(unpacked: str, out: str, deb_dir: str) -> dict:
+    from PIL import Image
+
+    entries = []
+    for pkg, path, cat in SOURCES:
+        data, licence, authors = _read(unpacked, pkg, path)
+        if licence not in LICENCES:
+            raise SystemExit(f"{pkg}: {path} is {licence}, not one of {', '.join(LICENCES)}")
+        a, box = centre_crop(data)
+        stem = os.path.basename(path.split(":", 1)[-1]).rsplit(".", 1)[0].lower()
+        fname = f"{cat}__{stem}.jpg"
+        buf = io.BytesIO()
+        Image.fromarray(a).save(buf, "JPEG", quality=90, subsampling=0)
+        with atomic_path(os.path.join(out, fname)) as tmp:
+            with open(tmp, "wb") as fh:
+                fh.write(buf.getvalue())
+        entries.append(dict(file=fname, category=cat, package=pkg, version=_version(deb_dir, pkg), path=path,
+                            licence=licence, authors=authors, source_sha256=_sha(data), crop=box,
+                            sha256=_sha(buf.getvalue())))
+    manifest = dict(description="held-out structured photos of the procedural solids "
+                                "(tools/build_structured_set.py); crop = [x, y, w, h, scaled source W, H]",
+                    crop=CROP, source_side=SOURCE_SIDE, photos=entries)
+    write_json(os.path.join(out, "manifest.json"), manifest)
+    lines = ["# Attribution of the structured photos", "",
+             "Crops of textures from Debian's packages, under the licences below. Rebuilt by "
+             "`python tools/build_structured_set.py`; `manifest.json` has the package version, path, crop and "
+             "sha256 of each file.", "", "| file | licence | authors | source |", "|---|---|---|---|"]
+    lines += [f"| {e['file']} | {e['licence']} | {e['authors'] or '—'} | {e['package']} {e['version']}: "
+              f"`{e['path']}` |" for e in entries]
+    with atomic_path(os.path.join(out, "ATTRIBUTION.md")) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write("\n".join(lines) + "\n")
+    return manifest
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cache", default=os.path.expanduser("~/.cache/omninoise/debs"),
+                    help="where the .deb files are downloaded and unpacked")
+    ap.add_argument("--from", dest="unpacked", help="a folder with the packages already unpacked (one folder each)")
+    ap.add_argument("-o", "--out", default=OUT)
+    a = ap.parse_args(argv)
+    unpacked = a.unpacked or fetch(a.cache)
+    deb_dir = os.path.dirname(os.path.abspath(unpacked)) if a.unpacked else a.cache
+    os.makedirs(a.out, exist_ok=True)
+    m = build(unpacked, a.out, deb_dir)
+    print(f"{len(m['photos'])} structured photos in {os.path.relpath(a.out, ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
