@@ -108,7 +108,7 @@ def procedural(doc: dict) -> list:
     out = [f"Procedural solids (`backend/solid/procedural`) on {n} held-out {doc.get('set')} photos: the patch "
            "distance (lower is better) of the x, y and z cuts (`axes`, two seeds) and of six cuts at random "
            "orientations (`oblique`), for the procedural solid, method auto (the procedural solid where its own check "
-           "finds it closer, else the neural texture), the neural texture (the default) and random phase noise drawn "
+           "finds it closer by a margin, else the neural texture), the neural texture (the default) and random phase noise drawn "
            "as a solid. Counts are photos closer than the named texture.", "",
            "| texture | median axes | median oblique | closer than random phase solid (axes / oblique) | closer "
            "than the neural texture (axes / oblique) | farther than the neural texture (axes / oblique) |",
@@ -124,8 +124,10 @@ def procedural(doc: dict) -> list:
               if who in ("procedural", "auto") else "—")
         out.append(f"| {label} | {s.get(f'median_{who}_axes')} | {s.get(f'median_{who}_oblique')} | {rp} | {nb} | {nf} |")
     fams = ", ".join(f"{k} {v}" for k, v in s.get("families", {}).items())
-    out += ["", f"Families fitted: {fams}; auto kept the procedural solid on {s.get('chosen_procedural')} of {n}. "
-            f"Median fit time {s.get('median_fit_seconds')} s per photo on this machine.", ""]
+    timing = (f" Median fit time {s.get('median_fit_seconds')} s per photo on this machine."
+              if doc.get("set") == "structured" else "")
+    out += ["", f"Families fitted: {fams}; auto kept the procedural solid on {s.get('chosen_procedural')} of "
+            f"{n}.{timing}", ""]
     return out
 
 
