@@ -60,7 +60,7 @@ def test_what_synthesis_cannot_do_is_named(stripes, flags, table, field, why):
         solid_request_from_dict(dict({"method": "synthesis", "exemplar": stripes}, **table))
     assert e1.value.setting == "--" + field and e2.value.setting == "source." + field
     assert why in str(e1.value) and why in str(e2.value)
-    with pytest.raises(SettingError, match="source.method: expected one of neural, synthesis, spectral, got 'quilt'"):
+    with pytest.raises(SettingError, match="source.method: expected one of neural, synthesis, spectral, procedural, auto, got 'quilt'"):
         solid_request_from_dict({"method": "quilt", "exemplar": stripes})
     with pytest.raises(SettingError, match="source.tile"):
         solid_request_from_dict({"method": "synthesis", "exemplar": stripes, "tile": True})
