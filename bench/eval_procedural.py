@@ -33,12 +33,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np
 
-from bench.solid_synthesis import SOLIDS, random_phase_solid, slices
+from bench.solid_synthesis import SOLIDS, gaussian_solid, random_phase_solid, slices
 from bench.stamp import stamp
-from omninoise.backend.solid.gaussian_rest import GaussianRest, rest_field, rest_waves
+from omninoise.backend.solid.gaussian_rest import rest_field
 from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
-from omninoise.backend.solid.upright import upright_waves
 from omninoise.export import read_rgb
 from omninoise.export.atomic import write_json
 from omninoise.training.solid import photo_eval as pe
@@ -70,13 +69,11 @@ def figures(field: _Field, photo: np.ndarray) -> dict:
     return {"axes": g["axes"], "pooled": g["pooled"], "oblique": pe.rounded_swds(pe.level_distances(obl, photo))[0]}
 
 
-def gaussian_solid(photo: np.ndarray, kind: str) -> _Field:
+def gaussian_field(photo: np.ndarray, kind: str) -> _Field:
     """random_phase_solid's Gaussian solid as a field (the oblique cuts read it anywhere)."""
-    waves = (rest_waves if kind == "isotropic" else upright_waves)(photo, PX_PER_UNIT)
-    m = np.asarray(photo, np.float64).reshape(-1, 3).mean(0)
-    if waves is None:
+    m, r = gaussian_solid(photo, kind)
+    if r is None:
         return _Field(lambda pts: np.broadcast_to(m, (len(pts), 3)).astype(np.float32), PX_PER_UNIT)
-    r = GaussianRest(waves[0], waves[1], 1.0)
     return _Field(lambda pts: np.clip(m + rest_field(pts, r, 0), 0.0, 1.0).astype(np.float32), PX_PER_UNIT)
 
 
@@ -97,7 +94,7 @@ def measure(path: str) -> dict:
         r[f"random_phase_solid_{k}"] = min(pe.grouped_swd(random_phase_solid(photo, kind, SEEDS), photo)[k]
                                            for kind in SOLIDS)
     r["random_phase_solid_oblique"] = min(
-        pe.rounded_swds(pe.level_distances(pe.oblique_slices(gaussian_solid(photo, kind).evaluate, PX_PER_UNIT),
+        pe.rounded_swds(pe.level_distances(pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT),
                                            photo))[0] for kind in SOLIDS)
     for k in ("axes", "pooled", "oblique"):
         r[f"auto_{k}"] = r[f"{choice.method}_{k}"]

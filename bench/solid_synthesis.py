@@ -77,6 +77,14 @@ def slices(field: TileField, seeds: int, size: int = SIZE) -> dict:
     return out
 
 
+def gaussian_solid(photo: np.ndarray, kind: str) -> tuple:
+    """(the photo's mean colour float64 (3,), the runtime's Gaussian solid of the whole photo or None for a flat
+    photo): ``kind`` "isotropic" (``spectral.rest_waves``) or "upright" (``upright.upright_waves``)."""
+    waves = (rest_waves if kind == "isotropic" else upright_waves)(photo, PX_PER_UNIT)
+    m = np.asarray(photo, np.float64).reshape(-1, 3).mean(0)
+    return m, (None if waves is None else GaussianRest(waves[0], waves[1], 1.0))
+
+
 def random_phase_solid(photo: np.ndarray, kind: str, seeds: int, size: int = SIZE) -> dict:
     """Random phase noise as a solid, sliced as :func:`slices` slices a tile: {axis: [one (size, size, 3) slice per
     seed]}.  The photo's mean colour plus the runtime's Gaussian solid of the whole photo (``kind`` "isotropic":
@@ -84,11 +92,9 @@ def random_phase_solid(photo: np.ndarray, kind: str, seeds: int, size: int = SIZ
     ``upright.upright_waves``, the walls have its horizontal and vertical frequencies).  Unlike random phase noise
     drawn as a 2D image per slice, a solid can be cut this way, so it is the Gaussian baseline a solid can reach
     (``photo_eval.axis_imbalance``)."""
-    waves = (rest_waves if kind == "isotropic" else upright_waves)(photo, PX_PER_UNIT)
-    m = np.asarray(photo, np.float64).reshape(-1, 3).mean(0)
-    if waves is None:       # a flat photo
+    m, r = gaussian_solid(photo, kind)
+    if r is None:       # a flat photo
         return {ax: [np.broadcast_to(m, (size, size, 3)).astype(np.float32)] * seeds for ax in "xyz"}
-    r = GaussianRest(waves[0], waves[1], 1.0)
     return {ax: [np.clip(m + rest_field(slice_points(size, PX_PER_UNIT, ax, pe.SLICE_OFFSETS[ax]), r, s),
                          0.0, 1.0).reshape(size, size, 3).astype(np.float32) for s in range(seeds)] for ax in "xyz"}
 

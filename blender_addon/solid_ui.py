@@ -544,8 +544,7 @@ class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
         obj = context.active_object
         if obj is None or obj.type != "MESH":
             raise backend.SettingError("object", "select a mesh to give the procedural material to")
-        req = panel_request(p)
-        req = dataclasses.replace(req, method="procedural") if req.method != "procedural" else req
+        req = dataclasses.replace(panel_request(p), method="procedural")
         if req.exemplar is None or isinstance(req.exemplar, str):
             raise backend.SettingError("image", "a procedural solid is fitted to a photo: set Source to Image")
         scale, world, name = float(p.scale), p.coords == "WORLD", p.name

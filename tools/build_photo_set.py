@@ -168,9 +168,17 @@ def sources(unpacked: str):
     yield from _stk(unpacked)
 
 
-def _stk(unpacked: str):
+def stk_licence(lic: dict, rel: str, globs: list | None = None):
+    """(licence, authors) of a supertuxkart-data file from its DEP-5 paragraphs ``lic``: its own, else the first
+    pattern that matches it (``globs``: lic's patterns, when a caller reads many files), else None."""
     import fnmatch
 
+    if globs is None:
+        globs = [(k, v) for k, v in lic.items() if any(ch in k for ch in "*?[")]
+    return lic.get(rel) or next((v for k, v in globs if fnmatch.fnmatch(rel, k)), None)
+
+
+def _stk(unpacked: str):
     root = os.path.join(unpacked, "supertuxkart-data")
     lic = parse_dep5(open(os.path.join(root, "usr/share/doc/supertuxkart-data/copyright"), encoding="utf-8").read())
     globs = [(k, v) for k, v in lic.items() if any(ch in k for ch in "*?[")]
@@ -180,7 +188,7 @@ def _stk(unpacked: str):
         if not rel.endswith((".png", ".jpg")):
             continue
         cat = category(os.path.basename(rel).rsplit(".", 1)[0])
-        L = lic.get(rel) or next((v for k, v in globs if fnmatch.fnmatch(rel, k)), None)
+        L = stk_licence(lic, rel, globs)
         if cat and L and L[0] in LICENCES:
             with open(path, "rb") as fh:
                 yield "supertuxkart-data", rel, fh.read(), L[0], L[1], cat
@@ -199,14 +207,22 @@ def crop(data: bytes):
             if (alpha < 250).mean() > 0.02:
                 return None, "transparent"
         rgb = im.convert("RGB")
+    a, box = scaled_centre(rgb)
+    ok, why = stationary(a.astype(np.float32) / 255.0)
+    return (a, box) if ok else (None, why)
+
+
+def scaled_centre(rgb) -> tuple:
+    """A PIL RGB image scaled so that its short side is SOURCE_SIDE px (never enlarged) -> (its centre CROP px square
+    uint8 (CROP, CROP, 3), the box [x, y, w, h, scaled W, H])."""
+    from PIL import Image
+
     f = SOURCE_SIDE / min(rgb.size)
     if f < 1.0:
         rgb = rgb.resize((max(CROP, round(rgb.size[0] * f)), max(CROP, round(rgb.size[1] * f))), Image.LANCZOS)
     W, H = rgb.size
     x0, y0 = (W - CROP) // 2, (H - CROP) // 2
-    a = np.asarray(rgb)[y0:y0 + CROP, x0:x0 + CROP]
-    ok, why = stationary(a.astype(np.float32) / 255.0)
-    return (a, [x0, y0, CROP, CROP, W, H]) if ok else (None, why)
+    return np.asarray(rgb)[y0:y0 + CROP, x0:x0 + CROP], [x0, y0, CROP, CROP, W, H]
 
 
 def build(unpacked: str, out: str, deb_dir: str) -> dict:
@@ -248,12 +264,17 @@ def build(unpacked: str, out: str, deb_dir: str) -> dict:
 
 
 def _attribution(out: str, manifest: dict) -> None:
-    lines = ["# Attribution of the photo set", "",
-             "Crops of textures from Debian's packages, under the licences below (the set as a whole, and the "
-             "models trained on it, under CC-BY-SA-3.0). Rebuilt by `python tools/build_photo_set.py`; "
-             "`manifest.json` has the package version, path, crop and sha256 of each file.", "",
-             "| file | licence | authors | source |", "|---|---|---|---|"]
-    for e in manifest["photos"]:
+    write_attribution(out, "the photo set", "Crops of textures from Debian's packages, under the licences below (the "
+                      "set as a whole, and the models trained on it, under CC-BY-SA-3.0). Rebuilt by `python "
+                      "tools/build_photo_set.py`; `manifest.json` has the package version, path, crop and sha256 of "
+                      "each file.", manifest["photos"])
+
+
+def write_attribution(out: str, what: str, intro: str, entries: list) -> None:
+    """``out``/ATTRIBUTION.md: a heading naming ``what``, ``intro`` and a row per manifest entry (file, licence,
+    authors, package, version and path)."""
+    lines = [f"# Attribution of {what}", "", intro, "", "| file | licence | authors | source |", "|---|---|---|---|"]
+    for e in entries:
         lines.append(f"| {e['file']} | {e['licence']} | {e['authors'] or '—'} | {e['package']} {e['version']}: "
                      f"`{e['path']}` |")
     with atomic_path(os.path.join(out, "ATTRIBUTION.md")) as tmp:
@@ -261,15 +282,21 @@ def _attribution(out: str, manifest: dict) -> None:
             fh.write("\n".join(lines) + "\n")
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def package_arguments(description: str, out: str, argv=None) -> tuple:
+    """(arguments, the unpacked packages' folder, the .deb files' folder) of a tool that reads the packages:
+    ``--cache`` (fetched there), ``--from`` (unpacked already) and ``-o``."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--cache", default=os.path.expanduser("~/.cache/omninoise/debs"),
                     help="where the .deb files are downloaded and unpacked")
     ap.add_argument("--from", dest="unpacked", help="a folder with the packages already unpacked (one folder each)")
-    ap.add_argument("-o", "--out", default=OUT)
+    ap.add_argument("-o", "--out", default=out)
     a = ap.parse_args(argv)
     unpacked = a.unpacked or fetch(a.cache)
-    deb_dir = os.path.dirname(os.path.abspath(unpacked)) if a.unpacked else a.cache
+    return a, unpacked, os.path.dirname(os.path.abspath(unpacked)) if a.unpacked else a.cache
+
+
+def main(argv=None) -> int:
+    a, unpacked, deb_dir = package_arguments(__doc__.split("\n")[0], OUT, argv)
     for old in glob.glob(os.path.join(a.out, "*", "*.jpg")):
         os.remove(old)
     for split in ("train", "val"):

@@ -13,20 +13,17 @@ the crop box and the crop's sha256; ``data/structured/ATTRIBUTION.md`` is the at
 """
 from __future__ import annotations
 
-import argparse
-import fnmatch
 import io
 import os
 import sys
 import zipfile
 
-import numpy as np
-
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from omninoise.export.atomic import atomic_path, write_json  # noqa: E402
-from tools.build_photo_set import CROP, LICENCES, SOURCE_SIDE, _sha, _version, fetch, parse_dep5  # noqa: E402
+from tools.build_photo_set import (CROP, LICENCES, SOURCE_SIDE, _sha, _version, package_arguments,  # noqa: E402
+                                   parse_dep5, scaled_centre, stk_licence, write_attribution)
 
 OUT = os.path.join(ROOT, "data", "structured")
 #: (package, path inside it, category): the structured photos the packages hold under the licences
@@ -49,7 +46,7 @@ def _read(unpacked: str, pkg: str, path: str) -> tuple:
         return (data,) + lic[pk3.replace("0textures.pk3", "") + name]
     root = os.path.join(unpacked, pkg)
     lic = parse_dep5(open(os.path.join(root, "usr/share/doc/supertuxkart-data/copyright"), encoding="utf-8").read())
-    L = lic.get(path) or next(v for k, v in lic.items() if any(ch in k for ch in "*?[") and fnmatch.fnmatch(path, k))
+    L = stk_licence(lic, path)
     with open(os.path.join(root, "usr/share/games/supertuxkart", path), "rb") as fh:
         return (fh.read(),) + L
 
@@ -59,13 +56,7 @@ def centre_crop(data: bytes) -> tuple:
     from PIL import Image
 
     with Image.open(io.BytesIO(data)) as im:
-        rgb = im.convert("RGB")
-    f = SOURCE_SIDE / min(rgb.size)
-    if f < 1.0:
-        rgb = rgb.resize((max(CROP, round(rgb.size[0] * f)), max(CROP, round(rgb.size[1] * f))), Image.LANCZOS)
-    W, H = rgb.size
-    x0, y0 = (W - CROP) // 2, (H - CROP) // 2
-    return np.asarray(rgb)[y0:y0 + CROP, x0:x0 + CROP], [x0, y0, CROP, CROP, W, H]
+        return scaled_centre(im.convert("RGB"))
 
 
 def build(unpacked: str, out: str, deb_dir: str) -> dict:
@@ -91,27 +82,14 @@ def build(unpacked: str, out: str, deb_dir: str) -> dict:
                                 "(tools/build_structured_set.py); crop = [x, y, w, h, scaled source W, H]",
                     crop=CROP, source_side=SOURCE_SIDE, photos=entries)
     write_json(os.path.join(out, "manifest.json"), manifest)
-    lines = ["# Attribution of the structured photos", "",
-             "Crops of textures from Debian's packages, under the licences below. Rebuilt by "
-             "`python tools/build_structured_set.py`; `manifest.json` has the package version, path, crop and "
-             "sha256 of each file.", "", "| file | licence | authors | source |", "|---|---|---|---|"]
-    lines += [f"| {e['file']} | {e['licence']} | {e['authors'] or '—'} | {e['package']} {e['version']}: "
-              f"`{e['path']}` |" for e in entries]
-    with atomic_path(os.path.join(out, "ATTRIBUTION.md")) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write("\n".join(lines) + "\n")
+    write_attribution(out, "the structured photos", "Crops of textures from Debian's packages, under the licences "
+                      "below. Rebuilt by `python tools/build_structured_set.py`; `manifest.json` has the package "
+                      "version, path, crop and sha256 of each file.", entries)
     return manifest
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--cache", default=os.path.expanduser("~/.cache/omninoise/debs"),
-                    help="where the .deb files are downloaded and unpacked")
-    ap.add_argument("--from", dest="unpacked", help="a folder with the packages already unpacked (one folder each)")
-    ap.add_argument("-o", "--out", default=OUT)
-    a = ap.parse_args(argv)
-    unpacked = a.unpacked or fetch(a.cache)
-    deb_dir = os.path.dirname(os.path.abspath(unpacked)) if a.unpacked else a.cache
+    a, unpacked, deb_dir = package_arguments(__doc__.split("\n")[0], OUT, argv)
     os.makedirs(a.out, exist_ok=True)
     m = build(unpacked, a.out, deb_dir)
     print(f"{len(m['photos'])} structured photos in {os.path.relpath(a.out, ROOT)}")

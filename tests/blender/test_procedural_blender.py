@@ -17,6 +17,7 @@ from omninoise.backend.solid.procedural.ramp import fit_ramp  # noqa: E402
 from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
 from omninoise.blender_addon.procedural_nodes import FIELD_KEY, add_procedural_node, build_procedural_group  # noqa: E402,E501
+from test_wave_node import _bake  # noqa: E402  (the Cycles EMIT bake of the Wave Noise tests)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FAMILY_PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centre_v=-0.5, grain=0.2),
@@ -76,21 +77,6 @@ def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
         assert ProceduralField.from_dict(__import__("json").loads(grp[FIELD_KEY])).to_dict() == f.to_dict()
     finally:
         bpy.data.node_groups.remove(grp)
-
-
-def _bake(ob, nt, size):
-    img = bpy.data.images.new("bake", size, size, alpha=False, float_buffer=True)
-    img.colorspace_settings.name = "Non-Color"
-    it = nt.nodes.new("ShaderNodeTexImage")
-    it.image = img
-    nt.nodes.active = it
-    bpy.context.view_layer.objects.active = ob
-    ob.select_set(True)
-    bpy.ops.object.bake(type="EMIT", margin=0)
-    px = np.array(img.pixels[:], np.float32).reshape(size, size, 4)
-    nt.nodes.remove(it)
-    bpy.data.images.remove(img)
-    return px
 
 
 @pytest.mark.parametrize("family", ["rings", "layers", "bonds", "cells"])

@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .family import Family, Param, cell_random
-from .turbulence import turbulence
+from .family import Family, Param, cell_random, gapped
 
 __all__ = ["Bonds"]
 
@@ -39,11 +38,8 @@ class Bonds(Family):
         u = pts[:, 0] / p["length"] + p["offset"] * row
         v = pts[:, 1] / p["length"] + p["offset"] * row
         d = np.minimum(_to_face(w) * p["height"], np.minimum(_to_face(u), _to_face(v)) * p["length"])
-        e = np.clip(d / max(0.5 * p["joint"] * p["height"], 1e-9) - 1.0, 0.0, 1.0)
-        inner = 1.0 + cell_random(np.floor(u), np.floor(v), row, seed)
-        if p["turbulence"] > 0:
-            inner = inner + p["turbulence"] * turbulence(pts, p["turb_freq"], seed)
-        return e * inner - 1.0
+        return gapped(d, 0.5 * p["joint"] * p["height"], cell_random(np.floor(u), np.floor(v), row, seed), p, pts,
+                      seed)
 
     def starts(self, est) -> list:
         """Units the photo's repeat across; courses its repeat up (stack bond) or half of it (running bond, which

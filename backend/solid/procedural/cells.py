@@ -18,8 +18,7 @@ import numpy as np
 
 from ...wavenoise.hashing import white_noise4
 from ...wavenoise.wave import white_color4
-from .family import Family, Param
-from .turbulence import turbulence
+from .family import Family, Param, gapped
 
 __all__ = ["Cells", "voronoi", "cell_w", "NEIGHBOURS"]
 
@@ -70,11 +69,7 @@ class Cells(Family):
         q = pts / (p["size"] * np.array([1.0, 1.0, p["stretch"]]))
         f1, f2, cell = voronoi(q, p["jitter"], seed)
         r = white_noise4(cell[:, 0], cell[:, 1], cell[:, 2], cell_w(seed, 1)).astype(np.float64)
-        e = np.clip((f2.astype(np.float64) - f1) / max(p["gap"], 1e-9) - 1.0, 0.0, 1.0)
-        inner = 1.0 + r
-        if p["turbulence"] > 0:
-            inner = inner + p["turbulence"] * turbulence(pts, p["turb_freq"], seed)
-        return e * inner - 1.0
+        return gapped(f2.astype(np.float64) - f1, p["gap"], r, p, pts, seed)
 
     def starts(self, est) -> list:
         """Cells the size of the photo's repeats (along its wave, across, up), thin and wide gaps, each ramp order."""

@@ -19,7 +19,7 @@ import numpy as np
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
-__all__ = ["Param", "Family", "cell_random", "axis_vector", "SHARED", "DETAIL_FREQ"]
+__all__ = ["Param", "Family", "cell_random", "axis_vector", "gapped", "SHARED", "DETAIL_FREQ"]
 
 DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
 
@@ -85,6 +85,19 @@ class Family:
                 raise ValueError(f"{self.name}: {q.name} must be in [{q.lo}, {q.hi}], got {v!r}")
             out[q.name] = v
         return out
+
+
+def gapped(dist: np.ndarray, half: float, r: np.ndarray, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+    """The value of cells and units with gaps between them: -1 in a gap (``dist`` < ``half`` from its edge), the
+    unit's own 1 + r + turbulence beyond 2 ``half``, linear between:
+
+        e = clip(dist / half - 1, 0, 1),    s = e (1 + r + turbulence * T(p)) - 1
+    """
+    e = np.clip(np.asarray(dist, np.float64) / max(half, 1e-9) - 1.0, 0.0, 1.0)
+    inner = 1.0 + r
+    if p["turbulence"] > 0:
+        inner = inner + p["turbulence"] * turbulence(points, p["turb_freq"], seed)
+    return e * inner - 1.0
 
 
 def cell_random(i, j, k, seed: int) -> np.ndarray:
