@@ -18,7 +18,8 @@ photo (grass, rock, soil, sand, snow...), where "auto" is to keep the neural tex
 and the counts of the summary: photos where the procedural solid and "auto" are closer than random phase noise
 as a solid and than the neural texture, per figure; photos where "auto" is farther than the neural texture) and,
 with ``--sheet``, OUT.png: photo | neural front | procedural front, x and z cuts, per photo.  Also the seconds
-each fit took on this machine.
+each fit took on this machine, and each fitted solid (``field``: ``ProceduralField.to_dict``), which the docs'
+sheet (``tools/procedural_sheet.py``) renders.
 """
 from __future__ import annotations
 
@@ -87,7 +88,7 @@ def measure(path: str) -> dict:
     model, code = choice.model, choice.code
     neural = _Field(lambda pts: model.evaluate(pts, code, 0), model.px_per_unit)
     r = {"family": field.family, "seconds": round(seconds, 1), "chosen": choice.method,
-         "choice_distances": choice.distances}
+         "choice_distances": choice.distances, "field": field.to_dict()}
     for name, f in (("procedural", field), ("neural", neural)):
         r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
     for k in ("axes", "pooled"):        # random phase as a solid: the closer kind, figure by figure, as solid-methods

@@ -4,11 +4,13 @@ One row per photo: the photo | the neural texture's front (today's default) | th
 cube, a sphere and a carved bowl in Cycles, each twice: the neural texture (evaluated at the vertices of a dense
 mesh, a colour attribute) and the procedural solid (its live node group, blender_addon/procedural_nodes.py, no
 bake).  A solid continues through the object, so the rings, veins and courses run on across the cube's edges and
-through the bowl's cut rim.  The photos: the structured ones of the evaluation that each family won on
-(``python -m bench solid-procedural``), named in PHOTOS.
+through the bowl's cut rim.  The photos: every structured held-out photo of the evaluation, each with the
+procedural solid the evaluation fitted and measured (``python -m bench solid-procedural``, its ``field`` in
+:data:`BENCH`), in the evaluation's order.
 """
 from __future__ import annotations
 
+import json
 import os
 import sys
 
@@ -17,9 +19,8 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "docs", "img", "solid_procedural.png")
-PHOTOS = ("data/photos/val/brick__beige_bricks.jpg", "data/photos/val/paving__aegean_anatolia_paving_02.jpg",
-          "data/photos/val/wood__tex_material_wood003.jpg", "data/structured/wood__japanwoodbridge.jpg",
-          "data/structured/tile__tile02.jpg")
+BENCH = os.path.join(ROOT, "docs", "benchmarks", "solid_procedural.json")
+FOLDERS = ("data/photos/val", "data/structured")     #: where the evaluation's photos are
 SIDE = 128          #: px per tile
 SAMPLES = 16        #: Cycles samples per render
 
@@ -104,6 +105,7 @@ def _material(name: str, colour_socket) -> bpy.types.Material:
 
 def main() -> int:
     from omninoise.backend.colour import srgb_to_linear
+    from omninoise.backend.solid.procedural.field import ProceduralField
     from omninoise.backend.solid.request import SolidRequest
     from omninoise.blender_addon.procedural_nodes import add_procedural_node, build_procedural_group
     from omninoise.export import read_rgb
@@ -115,10 +117,13 @@ def main() -> int:
     tmp = os.path.join(ROOT, "out", "procedural_sheet")
     os.makedirs(tmp, exist_ok=True)
     rows = []
-    for rel in PHOTOS:
+    with open(BENCH) as f:
+        measured = json.load(f)["photos"]
+    for name, row in measured.items():
+        rel = next(os.path.join(d, name) for d in FOLDERS if os.path.exists(os.path.join(ROOT, d, name)))
         photo = read_rgb(os.path.join(ROOT, rel))
         req = SolidRequest(exemplar=photo, method="auto").check()
-        c = req.choose()
+        c = req.choose(field=ProceduralField.from_dict(row["field"]))
         field, model, code = c.field, c.model, c.code
         tiles = [photo[:SIDE, :SIDE], model.image(SIDE, code, 0), field.image(SIDE)]
         group = build_procedural_group(field)

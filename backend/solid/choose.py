@@ -3,8 +3,9 @@ texture otherwise.
 
     1. fit     the procedural solid (:func:`~backend.solid.procedural.fit.fit_procedural`)
     2. encode  the neural texture's code (backend/solid/pipeline.py, as method "neural" makes it)
-    3. check   both drawn on :data:`PLANES` (axis and oblique cuts, none of the fit's planes) and measured by
-               the runtime's band distance (band_distance.py); the procedural solid is kept only where it is
+    3. check   both drawn on :data:`PLANES` (two cuts across each axis and two oblique, none of the fit's planes)
+               and measured by the runtime's band distance (band_distance.py), group by group
+               (:func:`check_distance`); the procedural solid is kept only where it is
                closer by the margin the Gaussian rest's check asks (gaussian_rest.MARGIN: at most 0.92 times the
                neural texture's distance: one draw's distance is a noisy figure), so a photo it does not suit keeps
                the neural texture
@@ -20,16 +21,27 @@ import numpy as np
 
 from .band_distance import band_distance
 from .gaussian_rest import MARGIN
-from .procedural.fit import oblique_points
+from .procedural.fit import oblique_points, plane_group
 
-__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE"]
+__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_distance"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
-#: the check's planes (normal, a point on it), units: a cut normal to each axis and three at orientations drawn once
-#: (as a cube's faces and a mesh's faces cut a solid), none of the fit's
-PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((0.0, 1.0, 0.0), (-3.3, 4.45, -2.6)),
-          ((0.0, 0.0, 1.0), (3.6, 3.1, -4.4)), ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)),
-          ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)), ((0.2, 0.9, -0.4), (-4.2, 2.7, 1.3)))
+#: the check's planes (normal, a point on it), units: two across each axis and two at orientations drawn once (as a
+#: cube's faces and a mesh's faces cut a solid), none of the fit's
+PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((1.0, 0.0, 0.0), (-3.6, 2.2, -4.7)),
+          ((0.0, 1.0, 0.0), (-3.3, 4.45, -2.6)), ((0.0, 1.0, 0.0), (2.7, -4.3, 3.5)),
+          ((0.0, 0.0, 1.0), (3.6, 3.1, -4.4)), ((0.0, 0.0, 1.0), (-4.5, -2.8, 4.2)),
+          ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)), ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)))
+
+
+def check_distance(images: list, photo: np.ndarray) -> float:
+    """The check's distance of ``images`` (one per plane of :data:`PLANES`) from the photo: the band distance of
+    each group of planes (across x, y, z, oblique: ``plane_group``), averaged, as the held-out evaluation weighs a
+    cube's faces alike."""
+    groups = {}
+    for img, (n, _) in zip(images, PLANES):
+        groups.setdefault(plane_group(n), []).append(img)
+    return float(np.mean([band_distance(g, photo) for g in groups.values()]))
 
 
 @dataclass(frozen=True)
@@ -58,7 +70,7 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
     planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
     drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
              "neural": [model.evaluate(p, code, int(request.seed)).reshape(SIDE, SIDE, 3) for p in planes]}
-    d = {k: round(band_distance(v, img), 2) for k, v in drawn.items()}
+    d = {k: round(check_distance(v, img), 2) for k, v in drawn.items()}
     keep = "procedural" if d["procedural"] <= MARGIN * d["neural"] else "neural"
     return Choice(keep, proc if keep == "procedural" else neural, field, model, code, d)
 

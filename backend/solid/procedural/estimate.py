@@ -5,8 +5,9 @@ every family's search.
   photo): its main eigenvector is the direction across the stripes, the wave vector's.
 - **Repeats**: the autocorrelation of the luminance band-passed between BAND px (a difference of Gaussians, which
   keeps neither the JPEG blocks' edges nor the photo's layout; Wiener-Khinchin: the inverse FFT of its power), read
-  along x, along z and along the wave vector: its highest peak beyond MIN_LAG px (a course's height, a plank's
-  width), or, where it has none above PEAK, CORRELATION_SCALE times the distance over which it falls to a half (a
+  along x, along z and along the wave vector: its first peak beyond MIN_LAG px within FUNDAMENTAL of the highest
+  (a course's height, a plank's width, a tile's side: a lattice correlates again at every multiple of its repeat,
+  and the highest of those peaks is as often two tiles as one), or, where it has none above PEAK, CORRELATION_SCALE times the distance over which it falls to a half (a
   stone's, a blotch's size).
 
 Shapes: photo float (H, W, 3) sRGB, top row first; the photo stands on the wall x-z (x right, z up).
@@ -25,6 +26,7 @@ CORRELATION_SCALE = 4.0    #: a repeat where the autocorrelation has no peak: th
 BAND = (1.5, 24.0)         #: the band-pass's Gaussians, sigma in px
 MIN_LAG = 6                #: shorter repeats are grain
 PEAK = 0.1                 #: a peak lower than this is chance
+FUNDAMENTAL = 0.8          #: the repeat is the first peak at least this share of the highest
 
 
 @dataclass(frozen=True)
@@ -44,17 +46,24 @@ def repeat_length(profile: np.ndarray) -> float:
     peaks = np.flatnonzero((inner > c[:-2]) & (inner >= c[2:]) & (inner > PEAK)) + 1
     peaks = peaks[peaks >= MIN_LAG]
     if len(peaks):
-        return float(peaks[np.argmax(c[peaks])])
+        return float(peaks[np.argmax(c[peaks] >= FUNDAMENTAL * c[peaks].max())])
     half = np.flatnonzero(c < 0.5)
     return float(CORRELATION_SCALE * (half[0] if len(half) else len(c)))
 
 
 def _ray(ac: np.ndarray, angle: float, n: int) -> np.ndarray:
-    """The autocorrelation (centred at [0, 0], wrapping) along a ray at ``angle`` (z up = rows up), n lags."""
+    """The autocorrelation (centred at [0, 0], wrapping) along a ray at ``angle`` (z up = rows up), n lags one px
+    apart, read bilinearly (rounded positions would wobble the lags and raise false peaks)."""
     t = np.arange(n)
-    r = np.round(-t * np.sin(angle)).astype(np.int64) % ac.shape[0]
-    c = np.round(t * np.cos(angle)).astype(np.int64) % ac.shape[1]
-    return ac[r, c]
+    r, c = -t * np.sin(angle), t * np.cos(angle)
+    r0, c0 = np.floor(r), np.floor(c)
+    fr, fc = r - r0, c - c0
+    h, w = ac.shape
+
+    def at(dr, dc):
+        return ac[(r0.astype(np.int64) + dr) % h, (c0.astype(np.int64) + dc) % w]
+
+    return ((1 - fr) * ((1 - fc) * at(0, 0) + fc * at(0, 1)) + fr * ((1 - fc) * at(1, 0) + fc * at(1, 1)))
 
 
 def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:

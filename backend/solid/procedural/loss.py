@@ -1,11 +1,12 @@
 """The fit's distance: how far slices of a solid are from the photo, cheap enough to call a hundred times.
 
 The runtime's band distance (band_distance.py: sliced Wasserstein between 5 x 5 colour neighbourhoods on each band
-of a Laplacian pyramid, normalised by the photo's spread per band) with fewer neighbourhoods and directions, and
-with its random draws fixed once per photo (common random numbers): the same slices always score the same, so the
+of a Laplacian pyramid, normalised by the photo's spread per band) with fewer neighbourhoods and directions, taken
+per group of slices (the cuts across x, across y, across z, oblique) and averaged, and with its random draws fixed
+once per photo (common random numbers): the same slices always score the same, so the
 search compares parameters, not draws.
 
-Shapes: photo float (H, W, 3) sRGB; slices a list of float (h, w, 3).
+Shapes: photo float (H, W, 3) sRGB; slices a list of float (side, side, 3), one per entry of ``groups``.
 """
 from __future__ import annotations
 
@@ -15,22 +16,24 @@ from ..band_distance import LEVELS, PATCH, REFERENCE_SIDE, central_crop, laplaci
 
 __all__ = ["SliceLoss", "SAMPLES", "DIRECTIONS"]
 
-SAMPLES = 768      #: neighbourhoods per level
+SAMPLES = 768      #: neighbourhoods per level and group
 DIRECTIONS = 32    #: projections per level
 
 
 class SliceLoss:
-    """``loss(slices)``: the distance of the pooled slices from the photo, x 1000 (0 for the same
-    distributions).  Every slice has the side ``side``."""
+    """``loss(slices)``: the distance of the slices from the photo, x 1000 (0 for the same distributions).  Every
+    slice has the side ``side``; ``groups`` names each slice's group (one name per slice: the axis it is cut across,
+    or "oblique"), and the loss is the mean over the groups of each group's pooled distance, as the held-out
+    evaluation weighs the x, y and z cuts alike (a solid whose walls match and whose floor does not is no match)."""
 
-    def __init__(self, photo: np.ndarray, side: int, count: int, seed: int = 0):
+    def __init__(self, photo: np.ndarray, side: int, groups, seed: int = 0):
         rng = np.random.default_rng(seed)
         ref = laplacian_bands(central_crop(np.asarray(photo, np.float64)[..., :3], REFERENCE_SIDE))
-        self.side, self.count = int(side), int(count)
-        self.levels = []
+        self.side, self.groups = int(side), tuple(groups)
+        names = sorted(set(self.groups))
+        self.members = [[i for i, g in enumerate(self.groups) if g == name] for name in names]
         probe = laplacian_bands(np.zeros((side, side, 3)))
-        dy, dx = np.mgrid[0:PATCH, 0:PATCH]
-        per = -(-SAMPLES // count)
+        self.levels = []
         for lvl in range(LEVELS):
             k = min(PATCH, *ref[lvl].shape[:2], *probe[lvl].shape[:2])
             dy, dx = np.mgrid[0:k, 0:k]
@@ -41,18 +44,23 @@ class SliceLoss:
             v = rng.standard_normal((k * k * 3, DIRECTIONS))
             v /= np.linalg.norm(v, axis=0, keepdims=True)
             h, w = probe[lvl].shape[:2]
-            where = [(rng.integers(0, h - k + 1, per), rng.integers(0, w - k + 1, per)) for _ in range(count)]
+            where = [None] * len(self.groups)
+            for m in self.members:
+                per = -(-SAMPLES // len(m))
+                for i in m:
+                    where[i] = (rng.integers(0, h - k + 1, per), rng.integers(0, w - k + 1, per))
             ref_sorted = np.sort(((r - mu) / sd).reshape(SAMPLES, -1) @ v, axis=0)
             self.levels.append((k, dy, dx, mu, sd, v, where, ref_sorted))
 
     def __call__(self, slices: list) -> float:
-        if len(slices) != self.count:
-            raise ValueError(f"expected {self.count} slices, got {len(slices)}")
+        if len(slices) != len(self.groups):
+            raise ValueError(f"expected {len(self.groups)} slices, got {len(slices)}")
         pyrs = [laplacian_bands(s) for s in slices]
         total = 0.0
         for lvl, (k, dy, dx, mu, sd, v, where, ref_sorted) in enumerate(self.levels):
-            o = np.concatenate([p[lvl][ys[:, None, None] + dy, xs[:, None, None] + dx].reshape(len(ys), -1, 3)
-                                for p, (ys, xs) in zip(pyrs, where)])[:SAMPLES]
-            proj = np.sort(((o - mu) / sd).reshape(len(o), -1) @ v, axis=0)
-            total += float(np.abs(ref_sorted - proj).mean())
-        return 1000.0 * total / LEVELS
+            for m in self.members:
+                o = np.concatenate([pyrs[i][lvl][where[i][0][:, None, None] + dy, where[i][1][:, None, None] + dx]
+                                    .reshape(len(where[i][0]), -1, 3) for i in m])[:SAMPLES]
+                proj = np.sort(((o - mu) / sd).reshape(len(o), -1) @ v, axis=0)
+                total += float(np.abs(ref_sorted - proj).mean())
+        return 1000.0 * total / (LEVELS * len(self.members))
