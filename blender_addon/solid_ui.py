@@ -212,7 +212,9 @@ def periodic_info(code) -> str:
     if hasattr(code, "distances"):      # method Auto's choice (backend/solid/choose.py)
         d = code.distances
         kept = code.field.family if code.method == "procedural" else "neural texture"
-        return f"Auto: {kept} (distance {d['procedural']:.0f} procedural, {d['neural']:.0f} neural)"
+        p, n = d["procedural"], d["neural"]
+        return (f"Auto: {kept} (procedural {p['axes']:.0f} / {p['oblique']:.0f}, neural {n['axes']:.0f} / "
+                f"{n['oblique']:.0f}: axis / oblique cuts)")
     if hasattr(code, "family"):         # a procedural solid (backend/solid/procedural)
         return f"Fitted: {code.family}"
     h = code.harmonics

@@ -4,11 +4,11 @@ texture otherwise.
     1. fit     the procedural solid (:func:`~backend.solid.procedural.fit.fit_procedural`)
     2. encode  the neural texture's code (backend/solid/pipeline.py, as method "neural" makes it)
     3. check   both drawn on :data:`PLANES` (two cuts across each axis and two oblique, none of the fit's planes)
-               and measured by the runtime's band distance (band_distance.py), group by group
-               (:func:`check_distance`); the procedural solid is kept only where it is
-               closer by the margin the Gaussian rest's check asks (gaussian_rest.MARGIN: at most 0.92 times the
-               neural texture's distance: one draw's distance is a noisy figure), so a photo it does not suit keeps
-               the neural texture
+               and measured by the runtime's band distance (band_distance.py) as the evaluation measures them: the
+               axis cuts group by group, and the oblique cuts (:func:`check_figures`); the procedural solid is kept
+               only where it is closer on both figures by the margin the Gaussian rest's check asks
+               (gaussian_rest.MARGIN: at most 0.92 times the neural texture's figure: one draw's distance is a noisy
+               figure), so a photo it does not suit, or suits only on a cube's faces, keeps the neural texture
 
 Shapes: photos float32 (H, W, 3) sRGB in [0, 1].
 """
@@ -23,7 +23,7 @@ from .band_distance import band_distance
 from .gaussian_rest import MARGIN
 from .procedural.fit import oblique_points, plane_group
 
-__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_distance"]
+__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
 #: the check's planes (normal, a point on it), units: two across each axis and two at orientations drawn once (as a
@@ -34,21 +34,22 @@ PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((1.0, 0.0, 0.0), (-3.6, 2.2, -4.
           ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)), ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)))
 
 
-def check_distance(images: list, photo: np.ndarray) -> float:
-    """The check's distance of ``images`` (one per plane of :data:`PLANES`) from the photo: the band distance of
-    each group of planes (across x, y, z, oblique: ``plane_group``), averaged, as the held-out evaluation weighs a
-    cube's faces alike."""
+def check_figures(images: list, photo: np.ndarray) -> dict:
+    """The check's figures of ``images`` (one per plane of :data:`PLANES`) against the photo, as the held-out
+    evaluation gives them: ``axes``, the mean of the band distances of the cuts across x, across y and across z
+    (each group pooled: ``plane_group``), and ``oblique``, the band distance of the oblique cuts; rounded to 0.01."""
     groups = {}
     for img, (n, _) in zip(images, PLANES):
         groups.setdefault(plane_group(n), []).append(img)
-    return float(np.mean([band_distance(g, photo) for g in groups.values()]))
+    d = {g: band_distance(v, photo) for g, v in groups.items()}
+    return {"axes": round(float(np.mean([d[g] for g in "xyz"])), 2), "oblique": round(d["oblique"], 2)}
 
 
 @dataclass(frozen=True)
 class Choice:
     """``method``: "procedural" or "neural"; ``request``: the request as that method (what a bake's key reads);
     ``field`` the procedural solid (always fitted); ``model`` and ``code`` the neural texture; ``distances``
-    {method: its check distance}."""
+    {method: {"axes": figure, "oblique": figure}} of the check."""
     method: str
     request: object
     field: object
@@ -70,8 +71,9 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
     planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
     drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
              "neural": [model.evaluate(p, code, int(request.seed)).reshape(SIDE, SIDE, 3) for p in planes]}
-    d = {k: round(check_distance(v, img), 2) for k, v in drawn.items()}
-    keep = "procedural" if d["procedural"] <= MARGIN * d["neural"] else "neural"
+    d = {k: check_figures(v, img) for k, v in drawn.items()}
+    closer = all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
+    keep = "procedural" if closer else "neural"
     return Choice(keep, proc if keep == "procedural" else neural, field, model, code, d)
 
 

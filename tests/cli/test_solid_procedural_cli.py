@@ -97,14 +97,17 @@ seed = 1
 
 
 def test_auto_keeps_what_its_check_finds_closer(tmp_path):
-    """Auto keeps the procedural solid where its planes find it closer by the margin; its image is that texture's."""
+    """Auto keeps the procedural solid where its planes find it closer by the margin on both the axis and the oblique
+    cuts; its image is that texture's."""
     from omninoise.backend.solid.gaussian_rest import MARGIN
 
     req = SolidRequest(exemplar=PHOTO, method="auto", seed=2).check()
     c = req.choose()
     d = c.distances
     assert set(d) == {"procedural", "neural"}
-    assert c.method == ("procedural" if d["procedural"] <= MARGIN * d["neural"] else "neural")
+    assert all(set(d[m]) == {"axes", "oblique"} for m in d)
+    closer = all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
+    assert c.method == ("procedural" if closer else "neural")
     assert c.request.method == c.method
     img = req.front_image(32)
     if c.method == "procedural":

@@ -209,16 +209,19 @@ def test_a_flat_or_tiny_photo():
         fit_procedural(np.zeros((40, 12, 3)))
 
 
-def test_auto_s_check_averages_its_groups_of_cuts():
-    """choose.check_distance: the band distance of each group of PLANES (across x, y, z, oblique), averaged."""
+def test_auto_s_check_gives_the_evaluation_s_two_figures():
+    """choose.check_figures: ``axes``, the mean band distance of the groups of PLANES across x, y and z, and
+    ``oblique``, that of the oblique cuts."""
     from omninoise.backend.solid.band_distance import band_distance
-    from omninoise.backend.solid.choose import PLANES, check_distance
+    from omninoise.backend.solid.choose import PLANES, check_figures
 
     rng = np.random.default_rng(4)
     photo = np.clip(0.5 + 0.2 * rng.standard_normal((96, 96, 3)), 0, 1)
     images = [np.clip(0.5 + (0.2 if plane_group(n) != "z" else 0.02) * rng.standard_normal((32, 32, 3)), 0, 1)
               for n, _ in PLANES]
-    groups = [[im for im, (n, _) in zip(images, PLANES) if plane_group(n) == g] for g in ("x", "y", "z", "oblique")]
-    assert all(len(g) == 2 for g in groups)
-    assert check_distance(images, photo) == pytest.approx(np.mean([band_distance(g, photo) for g in groups]))
-    assert band_distance(groups[2], photo) > 2 * band_distance(groups[0], photo)      # the faint floor counts
+    groups = {g: [im for im, (n, _) in zip(images, PLANES) if plane_group(n) == g] for g in ("x", "y", "z", "oblique")}
+    assert all(len(g) == 2 for g in groups.values())
+    f = check_figures(images, photo)
+    assert f["axes"] == pytest.approx(np.mean([band_distance(groups[g], photo) for g in "xyz"]), abs=0.01)
+    assert f["oblique"] == pytest.approx(band_distance(groups["oblique"], photo), abs=0.01)
+    assert band_distance(groups["z"], photo) > 2 * band_distance(groups["x"], photo)      # the faint floor counts
