@@ -103,7 +103,7 @@ def measure(path: str) -> dict:
 
 
 def summary(rows: dict) -> dict:
-    s = {"photos": len(rows), "median_fit_seconds": float(np.median([r["seconds"] for r in rows.values()])),
+    s = {"photos": len(rows), "median_fit_seconds": round(float(np.median([r["seconds"] for r in rows.values()])), 1),
          "chosen_procedural": sum(r["chosen"] == "procedural" for r in rows.values())}
     for who in ("procedural", "auto"):
         for k in ("axes", "oblique"):
