@@ -103,13 +103,23 @@ def _material(name: str, colour_socket) -> bpy.types.Material:
     return mat
 
 
+def write_sheet(path: str, rgb: np.ndarray) -> None:
+    """The sheet uint8 (H, W, 3) as a PNG of 256 colours (median cut, dithered): a quarter of the bytes of the full
+    colours for a page of the docs, and no tile shows bands."""
+    from PIL import Image
+
+    from omninoise.export.atomic import atomic_path
+
+    with atomic_path(path) as tmp:
+        Image.fromarray(rgb).quantize(256, method=Image.Quantize.MEDIANCUT).save(tmp, format="PNG", optimize=True)
+
+
 def main() -> int:
     from omninoise.backend.colour import srgb_to_linear
     from omninoise.backend.solid.procedural.field import ProceduralField
     from omninoise.backend.solid.request import SolidRequest
     from omninoise.blender_addon.procedural_nodes import add_procedural_node, build_procedural_group
     from omninoise.export import read_rgb
-    from omninoise.export.images import write_png
 
     bpy.ops.wm.read_homefile(use_empty=True)
     sc = _scene()
@@ -149,7 +159,7 @@ def main() -> int:
                                      os.path.join(tmp, f"{os.path.basename(rel)}_{kind}_{name}.png")))
         rows.append(np.concatenate([np.clip(t, 0.0, 1.0) for t in tiles], 1))
         print(f"{rel}: {field.family}, auto kept {c.method} ({c.distances})", flush=True)
-    write_png(OUT, np.round(np.concatenate(rows, 0) * 255).astype(np.uint8))
+    write_sheet(OUT, np.round(np.concatenate(rows, 0) * 255).astype(np.uint8))
     print(f"wrote {os.path.relpath(OUT, ROOT)}")
     return 0
 
