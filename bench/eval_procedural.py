@@ -37,6 +37,7 @@ import numpy as np
 from bench.solid_synthesis import SOLIDS, gaussian_solid, random_phase_solid, slices
 from bench.stamp import stamp
 from omninoise.backend.solid.gaussian_rest import rest_field
+from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
 from omninoise.export import read_rgb
@@ -78,12 +79,16 @@ def gaussian_field(photo: np.ndarray, kind: str) -> _Field:
     return _Field(lambda pts: np.clip(m + rest_field(pts, r, 0), 0.0, 1.0).astype(np.float32), PX_PER_UNIT)
 
 
-def measure(path: str) -> dict:
+def measure(path: str, fitted: dict | None = None) -> dict:
+    """The figures of one photo; ``fitted``: its row of an earlier run, whose solid and fit seconds are taken."""
     photo = read_rgb(path)
     req = SolidRequest(exemplar=photo, method="auto").check()
     t = time.time()
-    field = dataclasses.replace(req, method="procedural").procedural_field()
-    seconds = time.time() - t
+    if fitted is None:
+        field = dataclasses.replace(req, method="procedural").procedural_field()
+        seconds = time.time() - t
+    else:
+        field, seconds = ProceduralField.from_dict(fitted["field"]), fitted["seconds"]
     choice = req.choose(field=field)
     model, code = choice.model, choice.code
     neural = _Field(lambda pts: model.evaluate(pts, code, 0), model.px_per_unit)
@@ -126,8 +131,16 @@ def main(argv=None) -> int:
     ap.add_argument("--every", type=int, default=3, help="stochastic: every N-th photo")
     ap.add_argument("--limit", type=int, default=0)
     ap.add_argument("--sheet", action="store_true")
+    ap.add_argument("--fields", default=None, help="an earlier run's JSON: measure its fitted solids (and keep its fit "
+                                                  "seconds) instead of fitting, as when auto's check changes")
     ap.add_argument("-o", "--out", default=None, help="default: out/bench/solid_procedural_SET")
     a = ap.parse_args(argv)
+    fitted = {}
+    if a.fields:
+        import json
+
+        with open(a.fields) as f:
+            fitted = json.load(f)["photos"]
     out = a.out or os.path.join(ROOT, "out", "bench", f"solid_procedural_{a.set}")
     files = photos(a.set, a.every)
     files = files[:a.limit] if a.limit else files
@@ -136,7 +149,7 @@ def main(argv=None) -> int:
           f"{'proc':>6s} {'neural':>6s} {'rp':>6s}  (oblique)   s")
     for path in files:
         name = os.path.basename(path)
-        r, field, neural, photo = measure(path)
+        r, field, neural, photo = measure(path, fitted.get(name) if a.fields else None)
         rows[name] = r
         print(f"{name[:40]:40s} {r['family']:7s} {r['chosen']:10s} {r['procedural_axes']:6.1f} {r['neural_axes']:6.1f} "
               f"{r['random_phase_solid_axes']:6.1f}          {r['procedural_oblique']:6.1f} {r['neural_oblique']:6.1f} "

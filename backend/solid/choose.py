@@ -3,7 +3,7 @@ texture otherwise.
 
     1. fit     the procedural solid (:func:`~backend.solid.procedural.fit.fit_procedural`)
     2. encode  the neural texture's code (backend/solid/pipeline.py, as method "neural" makes it)
-    3. check   both drawn on :data:`PLANES` (two cuts across each axis and two oblique, none of the fit's planes)
+    3. check   both drawn on :data:`PLANES` (two cuts across each axis and six oblique, none of the fit's planes)
                and measured by the runtime's band distance (band_distance.py) as the evaluation measures them: the
                axis cuts group by group, and the oblique cuts (:func:`check_figures`); the procedural solid is kept
                only where it is closer on both figures by the margin the Gaussian rest's check asks
@@ -26,12 +26,15 @@ from .procedural.fit import oblique_points, plane_group
 __all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
-#: the check's planes (normal, a point on it), units: two across each axis and two at orientations drawn once (as a
-#: cube's faces and a mesh's faces cut a solid), none of the fit's
+#: the check's planes (normal, a point on it), units: two across each axis and six at orientations drawn once (as a
+#: cube's faces and a mesh's faces cut a solid; a solid and a neural texture differ most from cut to cut on oblique
+#: ones), none of the fit's
 PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((1.0, 0.0, 0.0), (-3.6, 2.2, -4.7)),
           ((0.0, 1.0, 0.0), (-3.3, 4.45, -2.6)), ((0.0, 1.0, 0.0), (2.7, -4.3, 3.5)),
           ((0.0, 0.0, 1.0), (3.6, 3.1, -4.4)), ((0.0, 0.0, 1.0), (-4.5, -2.8, 4.2)),
-          ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)), ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)))
+          ((0.45, -0.6, 0.66), (-2.9, -3.4, 3.8)), ((-0.7, 0.1, 0.7), (3.9, -2.5, -3.1)),
+          ((0.93, 0.36, -0.1), (-3.48, 1.38, 3.18)), ((0.66, 0.44, 0.6), (-0.26, -0.76, -1.36)),
+          ((-0.19, 0.92, -0.35), (-1.0, 0.36, 1.65)), ((-0.62, 0.52, -0.59), (3.16, 3.95, -4.38)))
 
 
 def check_figures(images: list, photo: np.ndarray) -> dict:
