@@ -149,7 +149,7 @@ def main(argv=None) -> int:
           f"{'proc':>6s} {'neural':>6s} {'rp':>6s}  (oblique)   s")
     for path in files:
         name = os.path.basename(path)
-        r, field, neural, photo = measure(path, fitted.get(name) if a.fields else None)
+        r, field, neural, photo = measure(path, fitted.get(name))
         rows[name] = r
         print(f"{name[:40]:40s} {r['family']:7s} {r['chosen']:10s} {r['procedural_axes']:6.1f} {r['neural_axes']:6.1f} "
               f"{r['random_phase_solid_axes']:6.1f}          {r['procedural_oblique']:6.1f} {r['neural_oblique']:6.1f} "

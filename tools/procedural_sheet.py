@@ -20,7 +20,6 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "docs", "img", "solid_procedural.png")
 BENCH = os.path.join(ROOT, "docs", "benchmarks", "solid_procedural.json")
-FOLDERS = ("data/photos/val", "data/structured")     #: where the evaluation's photos are
 SIDE = 128          #: px per tile
 SAMPLES = 16        #: Cycles samples per render
 
@@ -116,6 +115,7 @@ def write_sheet(path: str, rgb: np.ndarray) -> None:
 
 def main() -> int:
     from omninoise.backend.colour import srgb_to_linear
+    from bench.eval_procedural import photos
     from omninoise.backend.solid.procedural.field import ProceduralField
     from omninoise.backend.solid.request import SolidRequest
     from omninoise.blender_addon.procedural_nodes import add_procedural_node, build_procedural_group
@@ -129,9 +129,10 @@ def main() -> int:
     rows = []
     with open(BENCH) as f:
         measured = json.load(f)["photos"]
+    paths = {os.path.basename(p): p for p in photos("structured", 1)}
     for name, row in measured.items():
-        rel = next(os.path.join(d, name) for d in FOLDERS if os.path.exists(os.path.join(ROOT, d, name)))
-        photo = read_rgb(os.path.join(ROOT, rel))
+        rel = os.path.relpath(paths[name], ROOT)
+        photo = read_rgb(paths[name])
         req = SolidRequest(exemplar=photo, method="auto").check()
         c = req.choose(field=ProceduralField.from_dict(row["field"]))
         field, model, code = c.field, c.model, c.code

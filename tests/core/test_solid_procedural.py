@@ -11,7 +11,8 @@ from omninoise.backend.solid.procedural.cells import Cells, voronoi
 from omninoise.backend.solid.procedural.estimate import estimate, repeat_length
 from omninoise.backend.solid.procedural.family import Param, axis_vector
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
-from omninoise.backend.solid.procedural.fit import FIT_PLANES, ProceduralConfig, fit_procedural, oblique_points, plane_group
+from omninoise.backend.solid.procedural.fit import (FIT_PLANES, ProceduralConfig, fit_procedural, oblique_points,
+                                                   plane_group)
 from omninoise.backend.solid.procedural.loss import SliceLoss
 from omninoise.backend.solid.procedural.layers import Layers
 from omninoise.backend.solid.procedural.ramp import Ramp, fit_ramp, luminance, photo_colours

@@ -7,8 +7,8 @@ every family's search.
   keeps neither the JPEG blocks' edges nor the photo's layout; Wiener-Khinchin: the inverse FFT of its power), read
   along x, along z and along the wave vector: its first peak beyond MIN_LAG px within FUNDAMENTAL of the highest
   (a course's height, a plank's width, a tile's side: a lattice correlates again at every multiple of its repeat,
-  and the highest of those peaks is as often two tiles as one), or, where it has none above PEAK, CORRELATION_SCALE times the distance over which it falls to a half (a
-  stone's, a blotch's size).
+  and the highest of those peaks is as often two tiles as one), or, where it has none above PEAK,
+  CORRELATION_SCALE times the distance over which it falls to a half (a stone's, a blotch's size).
 
 Shapes: photo float (H, W, 3) sRGB, top row first; the photo stands on the wall x-z (x right, z up).
 """
@@ -58,10 +58,11 @@ def _ray(ac: np.ndarray, angle: float, n: int) -> np.ndarray:
     r, c = -t * np.sin(angle), t * np.cos(angle)
     r0, c0 = np.floor(r), np.floor(c)
     fr, fc = r - r0, c - c0
+    i, j = r0.astype(np.int64), c0.astype(np.int64)
     h, w = ac.shape
 
     def at(dr, dc):
-        return ac[(r0.astype(np.int64) + dr) % h, (c0.astype(np.int64) + dc) % w]
+        return ac[(i + dr) % h, (j + dc) % w]
 
     return ((1 - fr) * ((1 - fc) * at(0, 0) + fc * at(0, 1)) + fr * ((1 - fc) * at(1, 0) + fc * at(1, 1)))
 
