@@ -64,12 +64,14 @@ class Choice:
 def choose(request, where: str = "", progress=None, report=None, on_code=None, field=None) -> Choice:
     """The stages (module doc) for a checked request with method "auto" and an image exemplar; ``field``: its
     procedural solid when it is fitted already (the evaluation measures it on its own too)."""
-    img = np.asarray(request.exemplar_pixels(where), np.float32)
+    img = np.asarray(request.exemplar_pixels(where), np.float32)     # a file is read once: every stage takes these
     proc = dataclasses.replace(request, method="procedural")
-    field = field if field is not None else proc.procedural_field(where, progress)       # 1. fit
+    if field is None:                                                                   # 1. fit
+        field = dataclasses.replace(proc, exemplar=img).procedural_field(where, progress)
     neural = dataclasses.replace(request, method="neural")
     model = neural.load(where)
-    code, _ = neural.code(model, where, None, report, on_code)                          # 2. encode
+    named = None if report is None else (lambda _, history: report(request.exemplar, history))
+    code, _ = dataclasses.replace(neural, exemplar=img).code(model, where, None, named, on_code)     # 2. encode
     ppu = model.px_per_unit
     planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
     drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
