@@ -151,14 +151,16 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
 
 def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: str = "neural", seed: int = 0,
           scale: float = 1.0, refine: int = 0, periodic: bool = True, model: str | None = None,
-          out: str | None = None, progress: Progress = None):
+          families: tuple | None = None, out: str | None = None, progress: Progress = None):
     """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, or sRGB
     float pixels ``(H, W, 3)`` in [0, 1]).
 
     ``method`` is ``"neural"`` (the models' texture, 2D or 3D), ``"spectral"`` (the photo's spectrum and colours
     on every cut, 2D or 3D), ``"procedural"`` (rings, layers, cells or bricks fitted to the photo, 2D or 3D) or
     ``"synthesis"`` (a seamless 2D image); ``scale`` is output pixels per exemplar
-    pixel; ``refine`` search steps improve a photo's code; ``periodic`` keeps a photo's courses and planks.
+    pixel; ``refine`` search steps improve a photo's code; ``periodic`` keeps a photo's courses and planks;
+    ``families`` are the kinds of solid a procedural fit tries (of ``"rings"``, ``"layers"``, ``"cells"``,
+    ``"bonds"`` and ``"herringbone"``; all but ``"herringbone"`` by default).
 
     Returns scene-linear RGB float32: ``(size, size, 3)`` for ``dim=2`` (the front view: x right, z up, top row
     first) or ``(size, size, size, 3)`` indexed ``[z, y, x]`` for ``dim=3``; or, with ``out``, writes it as
@@ -181,7 +183,8 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         from .backend.bake import require_vdb
 
         require_vdb("out")
-    req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method).check()
+    kinds = {} if families is None else dict(families=tuple(families) if isinstance(families, list) else families)
+    req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake
         from .backend.sources import BoxGrid, solid_volume

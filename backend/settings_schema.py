@@ -15,6 +15,7 @@ from .neural.sampler import SAMPLERS
 from .schema import AnyOf, Bool, Choice, Field, Float, Int, Items, ListOf, MapOf, Table, Text
 from .solid.gaussian_rest import REST_CHOICES
 from .solid.methods import METHODS
+from .solid.procedural.field import DEFAULT_KINDS, KINDS
 from .solid.synthesis import MAX_TILE, MIN_TILE
 from .transfer import TRANSFER
 from .wavenoise.schema import COORD, FREQUENCY, SEED, SPECTRUM, WAVE_SETTINGS
@@ -81,6 +82,9 @@ SOLID_SOURCE = Table({
     "rest": Field(Choice(REST_CHOICES), "the kind of Gaussian rest", default="auto"),
     "tile": Field(Int(MIN_TILE, MAX_TILE), "synthesis: the periodic image's side, px (a multiple of 4)",
                   default="256"),
+    "families": Field(ListOf(Choice(KINDS), 1, len(KINDS)),
+                      "procedural and auto: the kinds of solid the fit tries (herringbone: bricks laid in a "
+                      "herringbone)", default=f"[{', '.join(map(repr, DEFAULT_KINDS))}]".replace("'", '"')),
     "scale": Field(Float(*limits.SCALE_RANGE), "texture units per world unit", default="1"),
     "density": Field(Float(0.0, 1e6), "a volume's constant density", default="1"),
 }, "a solid source")

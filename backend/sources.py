@@ -487,7 +487,7 @@ class SpectralSource:
 
 
 _SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
-               "rest", "method", "tile")
+               "rest", "method", "tile", "families")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
                 "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
 
@@ -635,7 +635,17 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     mix = d.get("mix", 0.5)
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
-                        d.get("rest", "auto"), d.get("method", "neural"), d.get("tile", 256)).check("source.")
+                        d.get("rest", "auto"), d.get("method", "neural"), d.get("tile", 256),
+                        _families(d.get("families"))).check("source.")
+
+
+def _families(value):
+    """A job's ``families`` (a list, checked by SolidRequest.check) as the request's tuple; the default where absent."""
+    from .solid.procedural.field import DEFAULT_KINDS
+
+    if value is None:
+        return DEFAULT_KINDS
+    return tuple(value) if isinstance(value, list) else value
 
 
 def _solid_from_dict(d: dict, base_dir: str):

@@ -6,8 +6,9 @@ parameters are the group's inputs for an artist to turn.
 * the family's value s from math nodes: rings (distance from the axis through Centre along Axis, in Spacings),
   layers (height along Normal, in Spacings, through the saw or triangle profile), cells (F1, F2 and the nearest
   cell's value over the 27 cubes around p / (Size, Size, Size x Stretch), one sub-group each, a feature point's
-  offset from one White Noise Texture's Color (4D) and the cell's value from another's), bonds (courses, units and joints, a unit's number from the White Noise Texture, 4D,
-  W = seed);
+  offset from one White Noise Texture's Color (4D) and the cell's value from another's), bonds (courses or a
+  herringbone's units, and joints, a unit's number from the White Noise Texture, 4D, W = seed; the pattern is
+  the group's own);
 * turbulence, grain and detail: Wave Noise groups (:func:`.wave_nodes.build_wave_group`) of the engine's
   turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input;
 * the ramp as a sum of clamped Map Range nodes (one per stop interval: exact piecewise-linear colours; a Color Ramp
@@ -40,8 +41,10 @@ TIPS = {"Spacing": "Distance between rings or layers (texture units)",
         "Grain": "Streaks along the axis", "Normal": "Direction across the layers",
         "Size": "A cell's width (texture units)", "Stretch": "A cell's height over its width",
         "Jitter": "How far cells leave a regular grid (0 to 1)", "Gap": "Gap between cells, in cell widths",
-        "Length": "A brick's length (texture units)", "Height": "A course's height (texture units)",
-        "Offset": "Each course's shift, in brick lengths (0.5: running bond, 0: stack bond)",
+        "Length": "A brick's length (texture units; a herringbone's: a whole number of widths)",
+        "Height": "A course's height (texture units; a herringbone's: a brick's width)",
+        "Offset": "Each course's shift, in brick lengths (0.5: running bond, 0: stack bond; herringbone: "
+                  "each slab's)",
         "Joint": "Joint width, in course heights", "Turbulence": "How far the noise bends the pattern",
         "Turbulence Frequency": "The bending noise's frequency (cycles per texture unit)",
         "Detail": "Fine noise within the pattern", "Scale": "Texture units per Blender unit"}
@@ -198,7 +201,14 @@ def _cells(b, gi, p, seed, groups):
     return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, r), -1.0)
 
 
-def _bonds(b, gi, p, seed, groups):
+def _face(b, t):
+    """Distance from t to the nearest integer (bonds._to_face)."""
+    f = _frac(b, t)
+    return b.math("MINIMUM", f, b.math("SUBTRACT", 1.0, f))
+
+
+def _courses(b, gi, p):
+    """(distance to the unit's nearest face, the unit's three integers) of the courses pattern."""
     x, y, z = b.separate(p)
     length, height = gi.outputs["Length"], gi.outputs["Height"]
     w = b.math("DIVIDE", z, height)
@@ -206,16 +216,45 @@ def _bonds(b, gi, p, seed, groups):
     shift = b.math("MULTIPLY", gi.outputs["Offset"], row)
     u = b.math("ADD", b.math("DIVIDE", x, length), shift)
     v = b.math("ADD", b.math("DIVIDE", y, length), shift)
+    d = b.math("MINIMUM", b.math("MULTIPLY", _face(b, w), height),
+               b.math("MULTIPLY", b.math("MINIMUM", _face(b, u), _face(b, v)), length))
+    return d, (b.math("FLOOR", u), b.math("FLOOR", v), row)
 
-    def face(t):
-        f = _frac(b, t)
-        return b.math("MINIMUM", f, b.math("SUBTRACT", 1.0, f))
 
-    d = b.math("MINIMUM", b.math("MULTIPLY", face(w), height),
-               b.math("MULTIPLY", b.math("MINIMUM", face(u), face(v)), length))
-    half = b.math("MULTIPLY", b.math("MULTIPLY", gi.outputs["Joint"], height), 0.5)
-    white = b.channel(_white(b, b.combine(b.math("FLOOR", u), b.math("FLOOR", v), row),
-                             np.float32(int(seed) % (1 << 24))), 0)
+def _herringbone(b, gi, p, turned: bool):
+    """(distance, the unit's three integers) of the herringbone patterns (bonds.herringbone, in widths)."""
+    x, y, z = b.separate(p)
+    width = gi.outputs["Height"]
+    n = b.math("MAXIMUM", b.math("FLOOR", b.math("ADD", b.math("DIVIDE", gi.outputs["Length"], width), 0.5)), 1.0)
+    slab = b.math("DIVIDE", y, b.math("MULTIPLY", n, width))
+    m = b.math("FLOOR", slab)
+    x = b.math("MULTIPLY_ADD", b.math("MULTIPLY", gi.outputs["Offset"], n), m, b.math("DIVIDE", x, width))
+    z = b.math("DIVIDE", z, width)
+    if turned:
+        x, z = (b.math("MULTIPLY", b.math("SUBTRACT", x, z), float(np.sqrt(0.5))),
+                b.math("MULTIPLY", b.math("ADD", x, z), float(np.sqrt(0.5))))
+    i, j = b.math("FLOOR", x), b.math("FLOOR", z)
+    k = b.math("FLOOR", b.math("DIVIDE", b.math("ADD", b.math("SUBTRACT", j, i), b.math("SUBTRACT", n, 1.0)),
+                                b.math("MULTIPLY", n, 2.0)))
+    nk = b.math("MULTIPLY", n, k)
+    xl, zl = b.math("ADD", x, nk), b.math("SUBTRACT", z, nk)
+    il, jl = b.math("ADD", i, nk), b.math("SUBTRACT", j, nk)
+    across = b.math("GREATER_THAN", b.math("SUBTRACT", jl, il), 0.5)
+    t = b.math("MULTIPLY_ADD", across, b.math("SUBTRACT", il, jl), jl)
+    long_x = b.math("MULTIPLY", b.math("SUBTRACT", 1.0, across), b.math("SUBTRACT", n, 1.0))
+    fx = b.math("MINIMUM", b.math("SUBTRACT", xl, t),
+                b.math("SUBTRACT", b.math("ADD", b.math("ADD", t, 1.0), long_x), xl))
+    fz = b.math("MINIMUM", b.math("SUBTRACT", b.math("SUBTRACT", zl, t), across),
+                b.math("SUBTRACT", b.math("MULTIPLY_ADD", across, n, b.math("ADD", t, 1.0)), zl))
+    d = b.math("MULTIPLY", b.math("MINIMUM", b.math("MINIMUM", fx, fz), b.math("MULTIPLY", _face(b, slab), n)),
+               width)
+    return d, (b.math("MULTIPLY_ADD", t, 2.0, across), k, m)
+
+
+def _bonds(b, gi, p, seed, groups, pattern):
+    d, unit = _courses(b, gi, p) if pattern == "courses" else _herringbone(b, gi, p, pattern == "herringbone45")
+    half = b.math("MULTIPLY", b.math("MULTIPLY", gi.outputs["Joint"], gi.outputs["Height"]), 0.5)
+    white = b.channel(_white(b, b.combine(*unit), np.float32(int(seed) % (1 << 24))), 0)
     e = _edge(b, gi, d, half)
     return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, white), -1.0)
 
@@ -261,7 +300,7 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
     elif fam == "cells":
         s = _cells(b, gi, p, seed, groups)
     else:
-        s = _bonds(b, gi, p, seed, groups)
+        s = _bonds(b, gi, p, seed, groups, field.params.get("pattern", "courses"))
     from ..backend.solid.procedural.family import DETAIL_FREQ
 
     s = b.math("MULTIPLY_ADD", gi.outputs["Detail"], _turbulence(b, groups, seed + 2, p, DETAIL_FREQ), s)

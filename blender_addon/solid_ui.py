@@ -112,6 +112,15 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                                            "group; about 40 s to fit"),
         ("AUTO", "Auto", "The procedural solid where it is closer to the photo than the neural texture, else the "
                          "neural texture")], default="NEURAL")
+    families: EnumProperty(name="Kinds", options={"ENUM_FLAG"},
+                           description="The kinds of procedural solid the fit tries", items=[
+        ("RINGS", "Rings", "Growth rings around an axis: ring-cut wood, knots"),
+        ("LAYERS", "Layers", "A profile along a bent direction: marble veins, strata, straight grain"),
+        ("CELLS", "Cells", "Stones, pebbles, flakes and spots with gaps between them"),
+        ("BONDS", "Bonds", "Bricks and tiles in courses: running, stack and raking bonds"),
+        ("HERRINGBONE", "Herringbone", "Bricks laid in a herringbone, straight or turned 45 degrees (tried only "
+                                       "when picked)")],
+                           default={"RINGS", "LAYERS", "CELLS", "BONDS"})
     image: PointerProperty(name="Exemplar", type=bpy.types.Image,
                            description="A photo of the material (at least 128 px; a large one is read in at most 8 x 8 crops)")
     refine: IntProperty(name="Refine Steps", default=0, min=0, soft_max=200,
@@ -166,14 +175,19 @@ def panel_request(p):
         if p.method == "SPECTRAL":
             return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), periodic=bool(p.periodic),
                                 method="spectral").check()
+        kinds = tuple(k.lower() for k in ("RINGS", "LAYERS", "CELLS", "BONDS", "HERRINGBONE") if k in p.families)
+        if not kinds and p.method in ("PROCEDURAL", "AUTO"):
+            raise backend.SettingError("families", "pick at least one kind of procedural solid")
         if p.method == "PROCEDURAL":
-            return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), method="procedural").check()
+            return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), method="procedural",
+                                families=kinds).check()
         name = _space_model_name()
         if name is None:
             raise backend.SettingError("model", f"no texture-space model in {models_dir()} to encode images")
         return SolidRequest(os.path.join(models_dir(), name), image_srgb(p.image, "image"), refine=int(p.refine),
                             seed=int(p.seed), periodic=bool(p.periodic), gaussian=bool(p.gaussian),
-                            rest=str(p.rest), method="auto" if p.method == "AUTO" else "neural").check()
+                            rest=str(p.rest), method="auto" if p.method == "AUTO" else "neural",
+                            **(dict(families=kinds) if p.method == "AUTO" else {})).check()
     ident = p.texture
     if ident == "NONE" or ":" not in ident:
         raise backend.SettingError("texture", f"no solid texture models in {models_dir()}")
@@ -216,7 +230,8 @@ def periodic_info(code) -> str:
         return (f"Auto: {kept} (procedural {p['axes']:.0f} / {p['oblique']:.0f}, neural {n['axes']:.0f} / "
                 f"{n['oblique']:.0f}: axis / oblique cuts)")
     if hasattr(code, "family"):         # a procedural solid (backend/solid/procedural)
-        return f"Fitted: {code.family}"
+        pattern = code.params.get("pattern", "courses")
+        return f"Fitted: {code.family}" + ("" if pattern == "courses" else f" ({pattern})")
     h = code.harmonics
     if h is None:
         return "Pattern: none found"
@@ -616,6 +631,9 @@ def draw_solid(layout, context) -> None:
 def _draw_photo(layout, p) -> None:
     if p.method in ("NEURAL", "AUTO"):
         layout.prop(p, "refine")
+    if p.method in ("PROCEDURAL", "AUTO"):
+        layout.label(text="Procedural Kinds:")
+        layout.row(align=True).prop(p, "families", expand=True)
     if p.method == "PROCEDURAL":
         if p.periodic_info:
             layout.label(text=p.periodic_info)

@@ -12,10 +12,16 @@ from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import METHODS
 from omninoise.backend.solid.gaussian_rest import REST_CHOICES
+from omninoise.backend.solid.procedural.field import DEFAULT_KINDS, KINDS
 
 from .common import Bar, add_command
 
 __all__ = ["add_parser", "run", "solid_request"]
+
+
+def _kinds(text: str) -> tuple:
+    """``--families`` "cells,bonds" as a tuple of names (SolidRequest.check names one it does not know)."""
+    return tuple(k.strip() for k in text.split(","))
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -58,6 +64,10 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
     g.add_argument("--rest", default="auto", choices=REST_CHOICES,
                    help="that detail's kind: auto (the check chooses), isotropic, or upright (layers and grain "
                         "kept on walls)")
+    g = s.add_argument_group("--method procedural and auto")
+    g.add_argument("--families", type=_kinds, default=DEFAULT_KINDS, metavar="KIND,...",
+                   help=f"the kinds of solid the fit tries, of {', '.join(KINDS)} (default: "
+                        f"{','.join(DEFAULT_KINDS)}; herringbone: bricks laid in a herringbone)")
     g = s.add_argument_group("--method synthesis")
     g.add_argument("--tile", type=int, default=256, help="the tile's side, px (a multiple of 4 in [32, 1024])")
     return s
@@ -68,7 +78,7 @@ def solid_request(a: argparse.Namespace):
     from omninoise.backend.solid.request import SolidRequest
 
     return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
-                        a.rest, a.method, a.tile).check("--")
+                        a.rest, a.method, a.tile, a.families).check("--")
 
 
 def run(a: argparse.Namespace) -> int:

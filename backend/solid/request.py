@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import SettingError
 from ..paths import solid_models
 from .methods import IMAGE_METHODS, METHODS
+from .procedural.field import DEFAULT_KINDS
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
 
@@ -65,7 +66,8 @@ class SolidRequest:
     model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
     steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
     Gaussian rest, where the check keeps one), ``rest`` (which: one of gaussian_rest.REST_CHOICES), ``method`` (one of
-    :data:`METHODS`) and, for "synthesis", ``tile`` (px per side of the periodic image)."""
+    :data:`METHODS`), for "synthesis" ``tile`` (px per side of the periodic image) and for "procedural" and "auto"
+    ``families`` (the kinds of solid the fit tries: procedural.field.KINDS)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)
@@ -78,6 +80,7 @@ class SolidRequest:
     rest: str = "auto"
     method: str = "neural"
     tile: int = 256
+    families: tuple = DEFAULT_KINDS
 
     def check(self, where: str = "") -> "SolidRequest":
         """SettingError naming the field (``where`` + name) when a value is out of range; the request when not."""
@@ -90,6 +93,11 @@ class SolidRequest:
         for key in ("mix", "refine", "seed", "periodic", "gaussian", "rest", "method"):
             value = getattr(self, key)
             f[key].type.check(bool(value) if isinstance(value, np.bool_) else value, f"{where}{key}")
+        kinds = self.families
+        f["families"].type.check(list(kinds) if isinstance(kinds, (list, tuple)) else kinds, f"{where}families")
+        twice = sorted({k for k in kinds if list(kinds).count(k) > 1})
+        if twice:
+            raise bad("families", f"names {', '.join(twice)} more than once")
         if self.method in IMAGE_METHODS:
             m, ex = self.method, self.exemplar
             if isinstance(ex, str) and not os.path.isfile(ex):
@@ -209,7 +217,8 @@ class SolidRequest:
 
         img = np.asarray(self.exemplar_pixels(where), np.float32)
         try:
-            return fit_procedural(img, ProceduralConfig(seed=int(self.seed)), progress, cancel).field
+            config = ProceduralConfig(seed=int(self.seed), families=tuple(self.families))
+            return fit_procedural(img, config, progress, cancel).field
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
 
@@ -265,10 +274,8 @@ class SolidRequest:
             return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed),
                         periodic=bool(self.periodic), marginals=True, start="isotropic")
         if self.method == "procedural":
-            from .procedural.field import FAMILIES
-
             return dict(method="procedural", exemplar=_digest(self.exemplar), seed=int(self.seed),
-                        families=list(FAMILIES))
+                        families=list(self.families))
         if self.method == "auto":
             import dataclasses
 

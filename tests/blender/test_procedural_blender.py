@@ -23,12 +23,15 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 FAMILY_PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centre_v=-0.5, grain=0.2),
                  "layers": dict(spacing=0.21, tilt=1.2, azimuth=0.3, profile="tri"),
                  "cells": dict(size=0.2, stretch=1.4, jitter=0.9, gap=0.08),
-                 "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15)}
+                 "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15),
+                 "herringbone": dict(length=0.3, height=0.11, offset=0.5, joint=0.15, pattern="herringbone"),
+                 "herringbone45": dict(length=0.5, height=0.16, offset=0.3, joint=0.15, pattern="herringbone45")}
 
 
-def _field(family: str) -> ProceduralField:
+def _field(case: str) -> ProceduralField:
     rng = np.random.default_rng(0)
-    p = dict(FAMILY_PARAMS[family], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
+    family = "bonds" if case.startswith("herringbone") else case
+    p = dict(FAMILY_PARAMS[case], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
     draft = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 8), rng.uniform(0, 1, (16, 3))), seed=3)
     values = draft.values(rng.uniform(-2, 2, (4000, 3)))
     return ProceduralField(family, p, fit_ramp(values, rng.uniform(0, 1, (16, 3))), seed=3)
@@ -79,7 +82,7 @@ def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
         bpy.data.node_groups.remove(grp)
 
 
-@pytest.mark.parametrize("family", ["rings", "layers", "bonds", "cells"])
+@pytest.mark.parametrize("family", ["rings", "layers", "bonds", "cells", "herringbone", "herringbone45"])
 def test_cycles_bake_equals_engine(family):
     """A plane baked in Cycles through the group's sRGB output, at the shading positions Cycles used (baked too):
     within 1e-3 of the engine on all but the pixels a float32 position puts across an edge."""
@@ -163,6 +166,20 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         p.method = "AUTO"                     # auto says what it kept
         assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
         assert p.periodic_info.startswith("Auto: ") and "procedural" in p.periodic_info
+        from omninoise.backend.errors import SettingError
+        from omninoise.blender_addon import solid_ui
+        from omninoise.cli.main import build_parser
+        from omninoise.cli.solid import solid_request
+
+        p.method, p.families = "PROCEDURAL", {"HERRINGBONE"}       # the kinds the fit tries: the command line's
+        flags = build_parser().parse_args(["solid", "--method", "procedural", "--exemplar", path, "--seed", "2",
+                                           "--families", "herringbone", "-o", "x.png"])
+        assert solid_ui.panel_request(p).key() == solid_request(flags).key()
+        assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+        assert p.periodic_info in ("Fitted: bonds (herringbone)", "Fitted: bonds (herringbone45)")
+        p.families = set()
+        with pytest.raises(SettingError, match="pick at least one kind"):
+            solid_ui.panel_request(p)
     finally:
         blender_addon.unregister()
 

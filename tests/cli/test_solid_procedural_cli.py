@@ -40,6 +40,11 @@ def test_flags_job_tables_and_pixels_give_one_request():
     auto = cli("--method", "auto", "--exemplar", PHOTO, "--seed", "4")
     assert auto.key()["procedural"] == a.key() and auto.key()["neural"]["model"] == "space"
     assert auto.key() == solid_request_from_dict({"method": "auto", "exemplar": PHOTO, "seed": 4}).key()
+    assert a.key()["families"] == ["rings", "layers", "cells", "bonds"]        # herringbones only where asked
+    kinds = cli("--method", "procedural", "--exemplar", PHOTO, "--seed", "4", "--families", "bonds,herringbone")
+    assert kinds.key() == solid_request_from_dict({"method": "procedural", "exemplar": PHOTO, "seed": 4,
+                                                   "families": ["bonds", "herringbone"]}).key() != a.key()
+    assert kinds.key()["families"] == ["bonds", "herringbone"]
 
 
 @pytest.mark.parametrize("method, flags, table, field, why", [
@@ -48,6 +53,9 @@ def test_flags_job_tables_and_pixels_give_one_request():
     ("procedural", ["--refine", "3"], {"refine": 3}, "refine", "procedural has none"),
     ("auto", ["--exemplar", "gravel"], {"exemplar": "gravel"}, "exemplar", "auto chooses for a photo"),
     ("auto", ["--to", "grass"], {"to": "grass"}, "to", "auto draws one texture"),
+    ("procedural", ["--families", "cells,tiles"], {"families": ["cells", "tiles"]}, "families[1]",
+     "expected one of rings, layers, cells, bonds, herringbone, got 'tiles'"),
+    ("auto", ["--families", "bonds,bonds"], {"families": ["bonds", "bonds"]}, "families", "names bonds more than once"),
 ])
 def test_what_they_cannot_do_is_named(method, flags, table, field, why):
     with pytest.raises(SettingError) as e1:
@@ -71,6 +79,13 @@ def test_an_image_and_a_volume_from_the_command_line_a_job_file_and_the_api(tmp_
     front = field.evaluate(slice_points(48, PX_PER_UNIT, "y")).reshape(48, 48, 3)
     np.testing.assert_allclose(np.load(out), srgb_to_linear(front), atol=1e-5)
     np.testing.assert_allclose(api.solid(PHOTO, 48, method="procedural", seed=1), np.load(out), atol=1e-6)
+    herring = api.solid(PHOTO, 16, method="procedural", seed=1, families=["herringbone"])
+    field = SolidRequest(exemplar=PHOTO, method="procedural", seed=1, families=("herringbone",)).check() \
+        .procedural_field()
+    assert field.params["pattern"] in ("herringbone", "herringbone45")
+    np.testing.assert_allclose(herring, srgb_to_linear(field.image(16)), atol=1e-6)
+    with pytest.raises(SettingError, match="families"):
+        api.solid(PHOTO, 16, method="procedural", families="bonds")
 
     vol_out = str(tmp_path / "cli.npy")
     assert main(["solid", "--quiet", "--method", "procedural", "--exemplar", PHOTO, "--dim", "3", "--size", "16",
@@ -101,8 +116,14 @@ def test_auto_keeps_what_its_check_finds_closer(tmp_path):
     cuts; its image is that texture's."""
     from omninoise.backend.solid.gaussian_rest import MARGIN
 
+    from omninoise import export
+
     req = SolidRequest(exemplar=PHOTO, method="auto", seed=2).check()
-    c = req.choose()
+    reads = []
+    with pytest.MonkeyPatch.context() as mp:       # the fit, the encoding and the check share one read of the file
+        mp.setattr(export, "read_rgb", lambda path: reads.append(path) or read_rgb(path))
+        c = req.choose()
+    assert reads == [PHOTO]
     d = c.distances
     assert set(d) == {"procedural", "neural"}
     assert all(set(d[m]) == {"axes", "oblique"} for m in d)

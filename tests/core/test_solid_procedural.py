@@ -6,7 +6,7 @@ import pytest
 from omninoise.backend.errors import SettingError
 from omninoise.backend.grid import Cancelled
 from omninoise.backend.solid.model import slice_points
-from omninoise.backend.solid.procedural.bonds import Bonds
+from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
 from omninoise.backend.solid.procedural.cells import Cells, voronoi
 from omninoise.backend.solid.procedural.estimate import estimate, repeat_length
 from omninoise.backend.solid.procedural.family import Param, axis_vector
@@ -107,6 +107,43 @@ def test_running_bond_courses_shift_by_half_a_unit_and_meet_at_the_corner():
     assert (front == -1).all(1).sum() >= 4
 
 
+@pytest.mark.parametrize("n", [1.0, 2.0, 4.0])
+def test_a_herringbone_tiles_the_plane_with_units_n_long_half_along_half_across(n):
+    """Every point lies in its unit's rectangle (1 by n widths, along x or across it), one unit has one
+    rectangle, and the units along and across cover the plane alike."""
+    x, z = np.random.default_rng(0).uniform(-30.0, 30.0, (2, 40000))
+    d, t, k, across = herringbone(x, z, n)
+    lo_x, lo_z = t - n * k, t + across + n * k
+    hi_x, hi_z = lo_x + 1.0 + (1.0 - across) * (n - 1.0), lo_z + 1.0 + across * (n - 1.0)
+    assert ((x >= lo_x) & (x <= hi_x) & (z >= lo_z) & (z <= hi_z)).all()
+    np.testing.assert_allclose(d, np.minimum.reduce([x - lo_x, hi_x - x, z - lo_z, hi_z - z]), atol=1e-12)
+    _, unit = np.unique(np.stack([t, k, across], 1), axis=0, return_inverse=True)
+    rect = np.stack([lo_x, lo_z, hi_x, hi_z], 1)
+    first = np.full(unit.max() + 1, -1)
+    first[unit.ravel()[::-1]] = np.arange(len(x))[::-1]
+    np.testing.assert_array_equal(rect, rect[first[unit.ravel()]])
+    assert abs(across.mean() - 0.5) < 0.02
+
+
+def test_herringbone_bonds_zigzag_on_the_wall_and_refuse_an_unknown_pattern():
+    """The 90-degree herringbone's wall holds as many units along x as across; the turned one's zigzag repeats
+    along x every sqrt(2) widths; a field without a pattern is laid in courses."""
+    b = Bonds()
+    p = dict(length=0.2, height=0.1, offset=0.5, joint=0.2, **CALM)
+    wall = slice_points(128, 128.0, "y", (0.013, 0.031, 0.017))
+    flat = b.values(dict(p, pattern="herringbone"), wall, 0).reshape(128, 128)
+    turned = b.values(dict(p, pattern="herringbone45"), wall, 0).reshape(128, 128)
+    assert 0.15 < (flat == -1).mean() < 0.5 and 0.15 < (turned == -1).mean() < 0.5
+    step = int(round(np.sqrt(2.0) * 0.1 * 128))                                  # 18 px: one repeat along x
+    same = (turned[:, step:] == -1) == (turned[:, :-step] == -1)
+    assert same.mean() > 0.95 and ((flat[:, step:] == -1) == (flat[:, :-step] == -1)).mean() < 0.85
+    ramp = Ramp((-1.0, 2.0), ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)))
+    np.testing.assert_array_equal(ProceduralField("bonds", p, ramp).values(wall), b.values(p, wall, 0))
+    assert ProceduralField("bonds", p, ramp).params["pattern"] == "courses"
+    with pytest.raises(SettingError, match="pattern must be one of courses, herringbone, herringbone45"):
+        ProceduralField("bonds", dict(p, pattern="basket"), ramp)
+
+
 def test_estimates_read_a_stripe_photo_s_period_and_direction():
     H = W = 256
     r, c = np.mgrid[0:H, 0:W]
@@ -200,6 +237,29 @@ def test_a_photo_drawn_by_a_family_is_fitted_by_that_family():
     assert fit.field.family == "cells", fit.scores
     assert fit.field.params["size"] == pytest.approx(0.2, rel=0.5)
     assert fit.tried == 2 * sum(len(f.starts(estimate(photo, PX_PER_UNIT))) for f in FAMILIES.values()) + 2 * 24
+
+
+@pytest.mark.parametrize("pattern", ["herringbone", "herringbone45"])
+def test_a_herringbone_photo_asked_for_herringbones_is_fitted_by_its_own(pattern):
+    """A wall drawn as a herringbone, fitted with families=("herringbone",): the fit finds the herringbone's turn
+    and the repeat the wall shows along x (the straight one's 2 n widths, the turned one's sqrt(2) widths) within
+    30 %.  The units' length in widths it does not always find: near one another, one draw's loss ranks n = 2 and
+    3 either way (a cut across x or z that meets a joint plane changes its figure more)."""
+    ramp = Ramp((-1.0, 0.0, 2.0), ((0.25, 0.25, 0.25), (0.55, 0.25, 0.2), (0.8, 0.45, 0.3)))
+    truth = ProceduralField("bonds", dict(length=0.213, height=0.1067, offset=0.5, joint=0.15, turbulence=0.1,
+                                          turb_freq=2.0, detail=0.1, pattern=pattern), ramp, seed=5)
+    photo = truth.image(160, offset=(0.0, 0.1, 0.0))
+    fit = fit_procedural(photo, ProceduralConfig(side=64, budget=16, families=("herringbone",))).field
+    assert (fit.family, fit.params["pattern"]) == ("bonds", pattern), fit.params
+    n = round(fit.params["length"] / fit.params["height"])
+    assert n in (2, 3, 4) and fit.params["length"] == pytest.approx(n * fit.params["height"])
+    widths = 2.0 * n if pattern == "herringbone" else np.sqrt(2.0)
+    assert widths * fit.params["height"] == pytest.approx((4.0 if pattern == "herringbone" else np.sqrt(2.0)) * 0.1067,
+                                                          rel=0.3), fit.params
+    with pytest.raises(SettingError, match="families"):
+        ProceduralConfig(families=("tiles",))
+    with pytest.raises(SettingError, match="families"):
+        ProceduralConfig(families=())
 
 
 def test_a_flat_or_tiny_photo():

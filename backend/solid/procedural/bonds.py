@@ -1,8 +1,23 @@
-"""Bonds: bricks and tiles laid in courses, in 3D (a wall's corner shows its courses meeting).
+"""Bonds: bricks and tiles laid in courses or in a herringbone, in 3D (a wall's corner shows its courses meeting).
 
-Courses of ``height`` run along z; within a course, units ``length`` long along x and along y (square in plan),
-each course moved along both by ``offset`` of a unit (0: stack bond, 1/2: running bond, 1/3 or 1/4: raking
-bonds).  Joints of width ``joint`` (in course heights) take the value -1, units their own random number r
+Pattern "courses": courses of ``height`` run along z; within a course, units ``length`` long along x and along y
+(square in plan), each course moved along both by ``offset`` of a unit (0: stack bond, 1/2: running bond, 1/3 or
+1/4: raking bonds).
+
+Patterns "herringbone" and "herringbone45": in the wall (x, z), units ``height`` wide and n = max(1,
+round(length / height)) widths long, laid alternately along and across (the 90-degree herringbone, its zigzag on
+the diagonal) or the same turned 45 degrees (zigzags along x, as a herringbone wall or path shows them).  In
+widths (X, Z), a cell (i, j) on diagonal d = j - i belongs to band k = floor((d + n - 1) / 2n) (the tiling repeats
+by n (1, -1)); within the band, d' = d - 2nk, a unit lies along X from t = j - nk where d' <= 0 and across it from
+t = i + nk where d' > 0:
+
+    along:   X - nk in [t, t + n],    Z + nk in [t, t + 1]
+    across:  X - nk in [t, t + 1],    Z + nk in [t + 1, t + 1 + n]
+
+(X + nk and Z - nk in the band's own coordinates; see :func:`herringbone`).  Along y the wall is slabs n widths
+deep, each moved along x by ``offset`` of a unit.
+
+Joints of width ``joint`` (in course heights or unit widths) take the value -1, units their own random number r
 (family.cell_random of the unit), reached linearly over as far again from the joint:
 
     d = the distance to the unit's nearest face,    e = clip(d / (joint height / 2) - 1, 0, 1),
@@ -14,7 +29,9 @@ import numpy as np
 
 from .family import Family, Param, cell_random, gapped
 
-__all__ = ["Bonds"]
+__all__ = ["Bonds", "PATTERNS", "herringbone", "units_long"]
+
+PATTERNS = ("courses", "herringbone", "herringbone45")
 
 
 def _to_face(u: np.ndarray) -> np.ndarray:
@@ -23,28 +40,74 @@ def _to_face(u: np.ndarray) -> np.ndarray:
     return np.minimum(f, 1.0 - f)
 
 
+def units_long(p: dict) -> float:
+    """A herringbone unit's length in widths: max(1, round(length / height))."""
+    return float(max(1.0, np.floor(p["length"] / p["height"] + 0.5)))
+
+
+def herringbone(x: np.ndarray, z: np.ndarray, n: float) -> tuple:
+    """The herringbone of units 1 wide and ``n`` long (a whole number) at (x, z) in widths -> (distance to the
+    unit's nearest face in widths, the unit's integer coordinates t, k and its direction: 0 along x, 1 across)."""
+    i, j = np.floor(x), np.floor(z)
+    k = np.floor((j - i + n - 1.0) / (2.0 * n))
+    xl, zl = x + n * k, z - n * k
+    il, jl = i + n * k, j - n * k
+    across = (jl - il > 0.5).astype(np.float64)
+    t = np.where(across > 0, il, jl)
+    fx = np.minimum(xl - t, t + 1.0 + (1.0 - across) * (n - 1.0) - xl)
+    fz = np.minimum(zl - t - across, t + 1.0 + across * n - zl)
+    return np.minimum(fx, fz), t, k, across
+
+
 class Bonds(Family):
     name = "bonds"
-    doc = "bricks and tiles in courses: running, stack and raking bonds"
+    doc = "bricks and tiles in courses (running, stack and raking bonds) or in a herringbone"
     PARAMS = (Param("length", 0.02, 2.0, log=True, doc="a unit's length along x and y, units"),
-              Param("height", 0.01, 1.0, log=True, doc="a course's height along z, units"),
-              Param("offset", 0.0, 1.0, doc="each course's shift along x and y, in unit lengths"),
+              Param("height", 0.01, 1.0, log=True, doc="a course's height along z (herringbone: a unit's width), "
+                                                        "units"),
+              Param("offset", 0.0, 1.0, doc="each course's (herringbone: each slab's) shift, in unit lengths"),
               Param("joint", 0.0, 0.5, doc="the joints' width, in course heights"))
 
     def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         pts = np.asarray(points, np.float64)
-        w = pts[:, 2] / p["height"]
-        row = np.floor(w)
-        u = pts[:, 0] / p["length"] + p["offset"] * row
-        v = pts[:, 1] / p["length"] + p["offset"] * row
-        d = np.minimum(_to_face(w) * p["height"], np.minimum(_to_face(u), _to_face(v)) * p["length"])
-        return gapped(d, 0.5 * p["joint"] * p["height"], cell_random(np.floor(u), np.floor(v), row, seed), p, pts,
-                      seed)
+        pattern = p.get("pattern", "courses")
+        if pattern == "courses":
+            w = pts[:, 2] / p["height"]
+            row = np.floor(w)
+            u = pts[:, 0] / p["length"] + p["offset"] * row
+            v = pts[:, 1] / p["length"] + p["offset"] * row
+            d = np.minimum(_to_face(w) * p["height"], np.minimum(_to_face(u), _to_face(v)) * p["length"])
+            r = cell_random(np.floor(u), np.floor(v), row, seed)
+        else:
+            n, width = units_long(p), p["height"]
+            slab = pts[:, 1] / (n * width)
+            m = np.floor(slab)
+            x = pts[:, 0] / width + p["offset"] * n * m
+            z = pts[:, 2] / width
+            if pattern == "herringbone45":
+                x, z = (x - z) * np.sqrt(0.5), (x + z) * np.sqrt(0.5)
+            dist, t, k, across = herringbone(x, z, n)
+            d = np.minimum(dist, _to_face(slab) * n) * width
+            r = cell_random(2.0 * t + across, k, m, seed)
+        return gapped(d, 0.5 * p["joint"] * p["height"], r, p, pts, seed)
 
     def starts(self, est) -> list:
-        """Units the photo's repeat across; courses its repeat up (stack bond) or half of it (running bond, which
-        repeats every second course); each ramp order."""
+        """Courses: units the photo's repeat across; courses its repeat up (stack bond) or half of it (running
+        bond, which repeats every second course); each ramp order."""
         length = float(np.clip(est.spacing_x, 0.021, 1.9))
         return [dict(length=length, height=float(np.clip(k * est.spacing_z, 0.011, 0.95)), offset=off, joint=0.15,
-                     turbulence=0.1, detail=0.1, turb_freq=float(np.clip(0.5 / length, 0.3, 15.0)), flip=flip)
+                     turbulence=0.1, detail=0.1, turb_freq=float(np.clip(0.5 / length, 0.3, 15.0)), flip=flip,
+                     pattern="courses")
                 for k, off in ((0.5, 0.5), (1.0, 0.0)) for flip in (False, True)]
+
+    def herringbone_starts(self, est) -> list:
+        """Herringbones of units 2, 3 and 4 widths long: the 90-degree one repeats every 2 n widths along x, the
+        turned one every sqrt(2) widths; each ramp order."""
+        out = []
+        for n in (2.0, 3.0, 4.0):
+            for pattern, widths in (("herringbone", 2.0 * n), ("herringbone45", np.sqrt(2.0))):
+                width = float(np.clip(est.spacing_x / widths, 0.011, 0.45))
+                out += [dict(length=n * width, height=width, offset=0.5, joint=0.15, turbulence=0.1, detail=0.1,
+                             turb_freq=float(np.clip(0.5 / (n * width), 0.3, 15.0)), flip=flip, pattern=pattern)
+                        for flip in (False, True)]
+        return out

@@ -10,23 +10,29 @@ import numpy as np
 
 from ...errors import SettingError
 from ...grid import Cancelled
-from .bonds import Bonds
+from .bonds import PATTERNS, Bonds
 from .cells import Cells
 from .layers import PROFILES, Layers
 from .ramp import Ramp
 from .rings import Rings
 
-__all__ = ["FAMILIES", "ProceduralField", "PX_PER_UNIT"]
+__all__ = ["FAMILIES", "ProceduralField", "PX_PER_UNIT", "KINDS", "DEFAULT_KINDS"]
 
 PX_PER_UNIT = 128.0    #: photo pixels per texture unit, as the other image methods read a photo
 
 #: the families by name
 FAMILIES = {f.name: f for f in (Rings(), Layers(), Cells(), Bonds())}
+#: what a fit can try (its ``families`` setting): each family, and "herringbone", bonds laid in herringbones
+KINDS = (*FAMILIES, "herringbone")
+#: what a fit tries unless asked: every family, bonds in courses.  A herringbone is closer under the fit's loss than
+#: courses on a running-bond wall whose courses it does not draw, so it is tried where asked
+DEFAULT_KINDS = tuple(FAMILIES)
 
 
 class ProceduralField:
-    """``family`` (a name of :data:`FAMILIES`), ``params`` (its parameters, with ``flip`` and, for layers,
-    ``profile``), ``ramp`` (:class:`~.ramp.Ramp`) and ``seed``; ``px_per_unit`` the photo's pixels per unit."""
+    """``family`` (a name of :data:`FAMILIES`), ``params`` (its parameters, with ``flip``, for layers
+    ``profile`` and for bonds ``pattern``, "courses" where it is absent), ``ramp`` (:class:`~.ramp.Ramp`) and
+    ``seed``; ``px_per_unit`` the photo's pixels per unit."""
 
     dim = 3
 
@@ -43,6 +49,10 @@ class ProceduralField:
             if params.get("profile") not in PROFILES:
                 raise SettingError("params", f"layers: profile must be one of {', '.join(PROFILES)}")
             p["profile"] = params["profile"]
+        if family == "bonds":
+            if params.get("pattern", "courses") not in PATTERNS:
+                raise SettingError("params", f"bonds: pattern must be one of {', '.join(PATTERNS)}")
+            p["pattern"] = params.get("pattern", "courses")
         self.family, self.params, self.ramp, self.seed = family, p, ramp, int(seed)
         self.px_per_unit = float(px_per_unit)
 

@@ -2,9 +2,10 @@
 
     1. read      the photo's pixels, at most ``fit_side`` px a side (its frequencies in texture units unchanged)
     2. estimate  its strongest wave and its spacings across and up (estimate.py)
-    3. start     every family's starts (rings, layers, cells, bonds), each as it comes and textured (TEXTURED:
-                 more turbulence and detail, at a higher frequency), drawn on the fit's planes and scored
-    4. search    the best start of the FINALISTS best families refined by Nelder-Mead (search.py) over its
+    3. start     the starts of every kind tried (``families``: rings, layers, cells, bonds in courses by default;
+                 herringbone where asked), each as it comes and textured (TEXTURED: more turbulence and detail, at
+                 a higher frequency), drawn on the fit's planes and scored
+    4. search    the best start of the ``finalists`` best kinds refined by Nelder-Mead (search.py) over its
                  parameters, ``budget`` calls each
     5. ramp      the winner's colour ramp from its values over a block of space (ramp.py)
     6. check     every finalist drawn on held-out planes (:data:`CHECK_PLANES`) and scored as in the search, with
@@ -27,13 +28,14 @@ from ...errors import SettingError
 from ..model import slice_points
 from ..pixels import at_most, rgb_pixels
 from .estimate import estimate
-from .field import FAMILIES, PX_PER_UNIT, ProceduralField
+from .bonds import units_long
+from .field import DEFAULT_KINDS, FAMILIES, KINDS, PX_PER_UNIT, ProceduralField
 from .loss import SliceLoss
 from .ramp import fit_ramp, photo_colours
 from .search import minimise
 
 __all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "FIT_PLANES", "CHECK_PLANES", "oblique_points",
-           "plane_group"]
+           "plane_group", "KINDS", "DEFAULT_KINDS", "kind_starts"]
 
 #: a start's textured twin: turbulence and detail amplitudes, and the factor on its turbulence's frequency
 TEXTURED = (0.35, 0.35, 4.0)
@@ -63,18 +65,25 @@ def plane_group(normal) -> str:
 class ProceduralConfig:
     """``side`` px per slice, ``budget`` search calls per finalist, ``finalists`` families searched, ``seed`` of
     the solid (cells', units' and turbulence's random numbers), ``fit_side``: a larger photo is fitted at this side
-    (its frequencies in texture units unchanged), ``textured``: each start's textured twin is tried too (stage 3)."""
+    (its frequencies in texture units unchanged), ``textured``: each start's textured twin is tried too (stage 3),
+    ``families``: the kinds tried (names of :data:`KINDS`; :data:`DEFAULT_KINDS` by default)."""
     side: int = 80
     budget: int = 48
     finalists: int = 2
     seed: int = 0
     fit_side: int = 256
     textured: bool = True
+    families: tuple = DEFAULT_KINDS
+
+    def __post_init__(self):
+        if not self.families or any(f not in KINDS for f in self.families):
+            raise SettingError("families", f"must name one or more of {', '.join(KINDS)}, got "
+                                           f"{', '.join(map(str, self.families)) or 'none'}")
 
 
 @dataclass(frozen=True)
 class ProceduralFit:
-    """The fitted ``field``; ``scores`` {family: its check distance} of the finalists; ``tried`` the number of
+    """The fitted ``field``; ``scores`` {kind: its check distance} of the finalists; ``tried`` the number of
     solids drawn."""
     field: ProceduralField
     scores: dict
@@ -117,9 +126,20 @@ def _pack(fam, p: dict) -> np.ndarray:
 
 
 def _unpack(fam, x: np.ndarray, fixed: dict) -> dict:
+    """The parameters at search coordinates ``x``, with the start's (``fixed``) discrete settings; a herringbone's
+    units keep the start's whole number of widths (its length follows its width)."""
     p = {q.name: q.from_unit(u) for q, u in zip(fam.params(), x)}
-    p.update({k: v for k, v in fixed.items() if k in ("flip", "profile")})
+    p.update({k: v for k, v in fixed.items() if k in ("flip", "profile", "pattern")})
+    if p.get("pattern", "courses") != "courses":
+        p["length"] = float(np.clip(units_long(fixed) * p["height"], 0.02, 2.0))
     return p
+
+
+def kind_starts(kind: str, est) -> list:
+    """[(family, start parameters)] of a kind of :data:`KINDS` for the photo's estimates."""
+    if kind == "herringbone":
+        return [("bonds", s) for s in FAMILIES["bonds"].herringbone_starts(est)]
+    return [(kind, s) for s in FAMILIES[kind].starts(est)]
 
 
 def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfig(), progress=None,
@@ -136,7 +156,7 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     planes = [oblique_points(side, ppu, n, o) for n, o in FIT_PLANES]
     loss = SliceLoss(img, side, [plane_group(n) for n, _ in FIT_PLANES])
     colours = photo_colours(img)
-    starts = [(name, t) for name, fam in FAMILIES.items() for s in fam.starts(est)
+    starts = [(kind, name, t) for kind in config.families for name, s in kind_starts(kind, est)
               for t in ((s, _textured(s)) if config.textured else (s,))]
     total = len(starts) + config.finalists * config.budget
     tried = [0]
@@ -147,21 +167,22 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
             progress(min(1.0, tried[0] / total))
         return loss(_draw(name, p, planes, seed, colours, side, ppu)[0])
 
-    scored = sorted(((score(n, s), n, s) for n, s in starts), key=lambda t: t[0])          # 3. start
+    scored = sorted(((score(n, s), k, n, s) for k, n, s in starts), key=lambda t: t[0])    # 3. start
     best = {}
-    for d, n, s in scored:
-        best.setdefault(n, (d, s))
-    finalists = sorted(best, key=lambda n: best[n][0])[:config.finalists]
+    for d, k, n, s in scored:
+        best.setdefault(k, (d, n, s))
+    finalists = sorted(best, key=lambda k: best[k][0])[:config.finalists]
     results = {}
-    for name in finalists:                                                                  # 4. search
-        fam, (d0, s0) = FAMILIES[name], best[name]
+    for kind in finalists:                                                                  # 4. search
+        d0, name, s0 = best[kind]
+        fam = FAMILIES[name]
         x, d = minimise(lambda x: score(name, _unpack(fam, x, s0)), _pack(fam, s0), 0.08, config.budget, cancel)
-        results[name] = _unpack(fam, x, s0) if d < d0 else s0
+        results[kind] = (name, _unpack(fam, x, s0) if d < d0 else s0)
     block = np.random.default_rng(seed).uniform(-2.0, 2.0, (1 << 15, 3))                  # 5. ramp
     fields = {}
-    for name, p in results.items():
+    for kind, (name, p) in results.items():
         ramp = fit_ramp(FAMILIES[name].values(p, block, seed), colours, p["flip"])
-        fields[name] = ProceduralField(name, p, ramp, seed, PX_PER_UNIT)
+        fields[kind] = ProceduralField(name, p, ramp, seed, PX_PER_UNIT)
     check = [oblique_points(side, ppu, n, o) for n, o in CHECK_PLANES]                    # 6. check
     held_out = SliceLoss(img, side, [plane_group(n) for n, _ in CHECK_PLANES], seed=1)
     scores = {name: round(held_out([f.evaluate(c).reshape(side, side, 3) for c in check]), 2)
