@@ -5,7 +5,7 @@ The scene of ``python -m bench node`` (a plane filling an orthographic camera's 
 Cycles on the CPU), one group per family with the settings of the parity tests
 (tests/blender/test_procedural_blender.py), each rendered once to compile and then timed; nanoseconds per
 pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
-Texture and the node count (sub-groups included).  Writes docs/benchmarks/procedural_node.json.
+Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone.  Writes docs/benchmarks/procedural_node.json.
 
     python -m bench procedural-node [--res 128] [--samples 4] [--repeat 2]
 """
@@ -31,13 +31,15 @@ from omninoise.export.atomic import write_json
 PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centre_v=-0.5, grain=0.2),
           "layers": dict(spacing=0.21, tilt=1.2, azimuth=0.3, profile="tri"),
           "cells": dict(size=0.2, stretch=1.4, jitter=0.9, gap=0.08),
-          "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15)}
+          "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15),
+          "herringbone": dict(length=0.5, height=0.16, offset=0.3, joint=0.15, pattern="herringbone45")}
 
 
-def procedural(family: str):
+def procedural(case: str):
     def make(nt):
         rng = np.random.default_rng(0)
-        p = dict(PARAMS[family], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
+        family = "bonds" if case == "herringbone" else case
+        p = dict(PARAMS[case], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
         f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3)
         grp = build_procedural_group(f)
         n = nt.nodes.new("ShaderNodeGroup")
