@@ -63,7 +63,7 @@ def plane_group(normal) -> str:
 
 @dataclass(frozen=True)
 class ProceduralConfig:
-    """``side`` px per slice, ``budget`` search calls per finalist, ``finalists`` families searched, ``seed`` of
+    """``side`` px per slice, ``budget`` search calls per finalist, ``finalists`` kinds searched, ``seed`` of
     the solid (cells', units' and turbulence's random numbers), ``fit_side``: a larger photo is fitted at this side
     (its frequencies in texture units unchanged), ``textured``: each start's textured twin is tried too (stage 3),
     ``families``: the kinds tried (names of :data:`KINDS`; :data:`DEFAULT_KINDS` by default)."""
