@@ -23,6 +23,12 @@ def test_every_package_folder_is_listed_under_omninoise():
     on_disk = {"omninoise." + os.path.relpath(d, ROOT).replace(os.sep, ".")
                for top in LAYERS for d, _, files in os.walk(os.path.join(ROOT, top)) if "__init__.py" in files}
     assert on_disk | {"omninoise"} == listed, (sorted(on_disk - listed), sorted(listed - on_disk - {"omninoise"}))
+    # a folder of modules without __init__.py imports from a checkout (a namespace package) but is left out of the
+    # wheel; Blender's presets are data (package-data), not modules
+    presets = os.path.join(ROOT, "blender_addon", "presets")
+    loose = [os.path.relpath(d, ROOT) for top in LAYERS for d, _, files in os.walk(os.path.join(ROOT, top))
+             if any(f.endswith(".py") for f in files) and "__init__.py" not in files and not d.startswith(presets)]
+    assert not loose, loose
     assert _pyproject()["tool"]["setuptools"]["package-dir"] == {"omninoise": "."}
 
 
