@@ -183,7 +183,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         from .backend.bake import require_vdb
 
         require_vdb("out")
-    kinds = {} if families is None else dict(families=tuple(families) if isinstance(families, list) else families)
+    kinds = {} if families is None else dict(families=families)
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake

@@ -9,6 +9,8 @@ tables.
 """
 from __future__ import annotations
 
+import json
+
 from . import limits
 from .neural.animate import LATENT_MODES
 from .neural.sampler import SAMPLERS
@@ -84,7 +86,7 @@ SOLID_SOURCE = Table({
                   default="256"),
     "families": Field(ListOf(Choice(KINDS), 1, len(KINDS)),
                       "procedural and auto: the kinds of solid the fit tries (herringbone: bricks laid in a "
-                      "herringbone)", default=f"[{', '.join(map(repr, DEFAULT_KINDS))}]".replace("'", '"')),
+                      "herringbone)", default=json.dumps(list(DEFAULT_KINDS))),
     "scale": Field(Float(*limits.SCALE_RANGE), "texture units per world unit", default="1"),
     "density": Field(Float(0.0, 1e6), "a volume's constant density", default="1"),
 }, "a solid source")

@@ -624,6 +624,7 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     the job file; ``model`` a folder, a shipped model's name, or left out as on the command line)."""
     import os
 
+    from .solid.procedural.field import DEFAULT_KINDS
     from .solid.request import SolidRequest
 
     _check_keys(d, _SOLID_KEYS, "solid")
@@ -636,16 +637,7 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
                         d.get("rest", "auto"), d.get("method", "neural"), d.get("tile", 256),
-                        _families(d.get("families"))).check("source.")
-
-
-def _families(value):
-    """A job's ``families`` (a list, checked by SolidRequest.check) as the request's tuple; the default where absent."""
-    from .solid.procedural.field import DEFAULT_KINDS
-
-    if value is None:
-        return DEFAULT_KINDS
-    return tuple(value) if isinstance(value, list) else value
+                        d.get("families", DEFAULT_KINDS)).check("source.")
 
 
 def _solid_from_dict(d: dict, base_dir: str):

@@ -175,7 +175,7 @@ def panel_request(p):
         if p.method == "SPECTRAL":
             return SolidRequest(exemplar=image_srgb(p.image, "image"), seed=int(p.seed), periodic=bool(p.periodic),
                                 method="spectral").check()
-        kinds = tuple(k.lower() for k in ("RINGS", "LAYERS", "CELLS", "BONDS", "HERRINGBONE") if k in p.families)
+        kinds = tuple(k for k in _mod("solid.procedural.field").KINDS if k.upper() in p.families)
         if not kinds and p.method in ("PROCEDURAL", "AUTO"):
             raise backend.SettingError("families", "pick at least one kind of procedural solid")
         if p.method == "PROCEDURAL":

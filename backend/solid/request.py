@@ -67,7 +67,7 @@ class SolidRequest:
     steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
     Gaussian rest, where the check keeps one), ``rest`` (which: one of gaussian_rest.REST_CHOICES), ``method`` (one of
     :data:`METHODS`), for "synthesis" ``tile`` (px per side of the periodic image) and for "procedural" and "auto"
-    ``families`` (the kinds of solid the fit tries: procedural.field.KINDS)."""
+    ``families`` (the kinds of solid the fit tries, a list or tuple of procedural.field.KINDS)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)

@@ -35,7 +35,7 @@ from .ramp import fit_ramp, photo_colours
 from .search import minimise
 
 __all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "FIT_PLANES", "CHECK_PLANES", "oblique_points",
-           "plane_group", "KINDS", "DEFAULT_KINDS", "kind_starts"]
+           "plane_group", "kind_starts"]
 
 #: a start's textured twin: turbulence and detail amplitudes, and the factor on its turbulence's frequency
 TEXTURED = (0.35, 0.35, 4.0)
