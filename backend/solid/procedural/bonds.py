@@ -101,14 +101,14 @@ class Bonds(Family):
                 for k, off in ((0.5, 0.5), (1.0, 0.0)) for flip in (False, True)]
 
     def herringbone_starts(self, est) -> list:
-        """Herringbones, each ramp order.  The 90-degree one repeats every 2 n widths along x and along z alike, so
-        its photo does not tell n: units 2, 3 and 4 widths long are tried.  The turned one repeats every sqrt(2)
-        widths along x and sqrt(2) n along z, so n = round(spacing_z / spacing_x), within [2, 4]."""
-        n45 = float(np.clip(np.floor(est.spacing_z / max(est.spacing_x, 1e-9) + 0.5), 2.0, 4.0))
-        laid = [(n, "herringbone", 2.0 * n) for n in (2.0, 3.0, 4.0)] + [(n45, "herringbone45", np.sqrt(2.0))]
+        """Herringbones of units n widths long, each ramp order.  The turned one repeats every sqrt(2) widths along
+        x and sqrt(2) n along z; the 90-degree one is the same turned back, so it repeats every sqrt(2) widths along
+        one diagonal and sqrt(2) n along the other.  So n = round(longer / shorter), within [2, 4]."""
         out = []
-        for n, pattern, widths in laid:
-            width = float(np.clip(est.spacing_x / widths, 0.011, 0.45))
+        for pattern, repeats in (("herringbone", est.diagonals), ("herringbone45", (est.spacing_x, est.spacing_z))):
+            short, long = sorted(repeats)
+            n = float(np.clip(np.floor(long / max(short, 1e-9) + 0.5), 2.0, 4.0))
+            width = float(np.clip(short / np.sqrt(2.0), 0.011, 0.45))
             out += [dict(length=n * width, height=width, offset=0.5, joint=0.15, turbulence=0.1, detail=0.1,
                          turb_freq=float(np.clip(0.5 / (n * width), 0.3, 15.0)), flip=flip, pattern=pattern)
                     for flip in (False, True)]

@@ -5,10 +5,11 @@ every family's search.
   photo): its main eigenvector is the direction across the stripes, the wave vector's.
 - **Repeats**: the autocorrelation of the luminance band-passed between BAND px (a difference of Gaussians, which
   keeps neither the JPEG blocks' edges nor the photo's layout; Wiener-Khinchin: the inverse FFT of its power), read
-  along x, along z and along the wave vector: its first peak beyond MIN_LAG px within FUNDAMENTAL of the highest
-  (a course's height, a plank's width, a tile's side: a lattice correlates again at every multiple of its repeat,
-  and the highest of those peaks is as often two tiles as one), or, where it has none above PEAK,
-  CORRELATION_SCALE times the distance over which it falls to a half (a stone's, a blotch's size).
+  along x, along z, along the wave vector and along both diagonals (a herringbone's): its first peak beyond MIN_LAG
+  px within FUNDAMENTAL of the highest (a course's height, a plank's width, a tile's side: a lattice correlates
+  again at every multiple of its repeat, and the highest of those peaks is as often two tiles as one), or, where it
+  has none above PEAK, CORRELATION_SCALE times the distance over which it falls to a half (a stone's, a blotch's
+  size).
 
 Shapes: photo float (H, W, 3) sRGB, top row first; the photo stands on the wall x-z (x right, z up).
 """
@@ -32,11 +33,13 @@ FUNDAMENTAL = 0.8          #: the repeat is the first peak at least this share o
 @dataclass(frozen=True)
 class Estimates:
     """``spacing`` (units) along, and ``angle`` (radians from +x towards +z) of, the wave vector across the
-    photo's stripes; ``spacing_x`` and ``spacing_z``: the repeats along x and along z, units."""
+    photo's stripes; ``spacing_x`` and ``spacing_z``: the repeats along x and along z, units; ``diagonals``: the
+    shorter and the longer of the repeats along the two diagonals (45 and 135 degrees from +x), units."""
     spacing: float
     angle: float
     spacing_x: float
     spacing_z: float
+    diagonals: tuple = (0.0, 0.0)
 
 
 def repeat_length(profile: np.ndarray) -> float:
@@ -82,5 +85,7 @@ def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
     ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
     ac /= max(ac[0, 0], 1e-12)
     n = min(H, W) // 2
+    diagonals = sorted(repeat_length(_ray(ac, a, n)) / px_per_unit for a in (0.25 * np.pi, 0.75 * np.pi))
     return Estimates(repeat_length(_ray(ac, angle, n)) / px_per_unit, angle,
-                     repeat_length(ac[0, :W // 2]) / px_per_unit, repeat_length(ac[:H // 2, 0]) / px_per_unit)
+                     repeat_length(ac[0, :W // 2]) / px_per_unit, repeat_length(ac[:H // 2, 0]) / px_per_unit,
+                     tuple(diagonals))
