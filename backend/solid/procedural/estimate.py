@@ -34,12 +34,12 @@ FUNDAMENTAL = 0.8          #: the repeat is the first peak at least this share o
 class Estimates:
     """``spacing`` (units) along, and ``angle`` (radians from +x towards +z) of, the wave vector across the
     photo's stripes; ``spacing_x`` and ``spacing_z``: the repeats along x and along z, units; ``diagonals``: the
-    shorter and the longer of the repeats along the two diagonals (45 and 135 degrees from +x), units."""
+    repeats along the diagonals at 45 and 135 degrees from +x, units."""
     spacing: float
     angle: float
     spacing_x: float
     spacing_z: float
-    diagonals: tuple = (0.0, 0.0)
+    diagonals: tuple
 
 
 def repeat_length(profile: np.ndarray) -> float:
@@ -85,7 +85,6 @@ def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
     ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
     ac /= max(ac[0, 0], 1e-12)
     n = min(H, W) // 2
-    diagonals = sorted(repeat_length(_ray(ac, a, n)) / px_per_unit for a in (0.25 * np.pi, 0.75 * np.pi))
     return Estimates(repeat_length(_ray(ac, angle, n)) / px_per_unit, angle,
                      repeat_length(ac[0, :W // 2]) / px_per_unit, repeat_length(ac[:H // 2, 0]) / px_per_unit,
-                     tuple(diagonals))
+                     tuple(repeat_length(_ray(ac, a, n)) / px_per_unit for a in (0.25 * np.pi, 0.75 * np.pi)))
