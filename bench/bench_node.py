@@ -26,6 +26,7 @@ import bpy
 import numpy as np
 
 from omninoise.backend import Spectrum, WaveSettings
+from omninoise.blender_addon.compat import ensure_node_tree
 from omninoise.blender_addon.wave_nodes import build_wave_group
 
 
@@ -53,6 +54,7 @@ def scene(res: int, samples: int, osl: bool = False):
     sc.collection.objects.link(co)
     sc.camera = co
     mat = bpy.data.materials.new("m")
+    ensure_node_tree(mat)
     ob.data.materials.append(mat)
     return sc, mat
 

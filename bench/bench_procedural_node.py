@@ -5,7 +5,9 @@ The scene of ``python -m bench node`` (a plane filling an orthographic camera's 
 Cycles on the CPU), one group per family with the settings of the parity tests
 (tests/blender/test_procedural_blender.py), each rendered once to compile and then timed; nanoseconds per
 pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
-Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone.  Writes docs/benchmarks/procedural_node.json.
+Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone, and each family
+also with its noises' amplitudes (Turbulence, Grain, Detail) at 0, which Cycles folds away.  Writes
+docs/benchmarks/procedural_node.json, with Blender's version.
 
     python -m bench procedural-node [--res 128] [--samples 4] [--repeat 2]
 """
@@ -35,11 +37,14 @@ PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centr
           "herringbone": dict(length=0.5, height=0.16, offset=0.3, joint=0.15, pattern="herringbone45")}
 
 
-def procedural(case: str):
+def procedural(case: str, noise: bool = True):
+    """A group of the family ``case`` (a key of PARAMS); ``noise`` False: Turbulence, Grain and Detail at 0."""
     def make(nt):
         rng = np.random.default_rng(0)
         family = "bonds" if case == "herringbone" else case
         p = dict(PARAMS[case], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
+        if not noise:
+            p.update(turbulence=0.0, detail=0.0, **({"grain": 0.0} if "grain" in p else {}))
         f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3)
         grp = build_procedural_group(f)
         n = nt.nodes.new("ShaderNodeGroup")
@@ -61,6 +66,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     cases = [("Blender Wave Texture", texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0))]
     cases += [(f"Procedural {f}", procedural(f)) for f in PARAMS]
+    cases += [(f"Procedural {f}, noises at 0", procedural(f, noise=False)) for f in PARAMS if f != "herringbone"]
     res = {}
     for name, make in cases:
         times = {}
@@ -77,7 +83,7 @@ def main(argv=None) -> int:
     print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
     for name, r in res.items():
         print(f"  {name:24s} {r['ns_per_pixel_sample']:10.1f} ns  {r['vs_wave_texture']:6.1f}x  {r['nodes']:5d} nodes")
-    write_json(a.out, dict(stamp=stamp(), res=a.res, samples=a.samples, results=res))
+    write_json(a.out, dict(stamp=stamp(), blender=bpy.app.version_string, res=a.res, samples=a.samples, results=res))
     return 0
 
 

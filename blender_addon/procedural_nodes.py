@@ -10,7 +10,8 @@ parameters are the group's inputs for an artist to turn.
   herringbone's units, and joints, a unit's number from the White Noise Texture, 4D, W = seed; the pattern is
   the group's own);
 * turbulence, grain and detail: Wave Noise groups (:func:`.wave_nodes.build_wave_group`) of the engine's
-  turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input;
+  turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input
+  and weighed by its amplitude input (an amplitude of 0 leaves its group out of a Cycles render: :func:`_plus`);
 * the ramp as a sum of clamped Map Range nodes (one per stop interval: exact piecewise-linear colours; a Color Ramp
   node is sampled into a 256-entry table in Cycles).
 
@@ -89,6 +90,13 @@ def _interface(tree, field) -> None:
     tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")
 
 
+def _plus(b, amplitude, noise, base):
+    """base + amplitude x noise as a Multiply and an Add, not one Multiply Add: Cycles folds a product with a
+    constant 0 (an artist's Turbulence, Grain or Detail of 0) and leaves out the Wave Noise group it reads, which
+    is most of the group's render time; it does not fold a Multiply Add."""
+    return b.math("ADD", b.math("MULTIPLY", amplitude, noise), base)
+
+
 def _frac(b, x):
     return b.math("SUBTRACT", x, b.math("FLOOR", x))
 
@@ -113,20 +121,18 @@ def _rings(b, gi, p, seed, groups):
     along = b.vmath("DOT_PRODUCT", rel, d)
     r = b.vmath("LENGTH", b.vmath("SUBTRACT", rel, b.vmath("SCALE", d, scale=along)))
     s = b.math("DIVIDE", r, gi.outputs["Spacing"])
-    s = b.math("MULTIPLY_ADD", gi.outputs["Turbulence"],
-               _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"]), s)
+    s = _plus(b, gi.outputs["Turbulence"], _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"]), s)
     from ..backend.solid.procedural.rings import GRAIN_STRETCH
 
     squash = b.vmath("SUBTRACT", p, b.vmath("SCALE", d, scale=b.math(
         "MULTIPLY", b.vmath("DOT_PRODUCT", p, d), 1.0 - 1.0 / GRAIN_STRETCH)))
     grain = _turbulence(b, groups, seed + 1, squash, b.math("MULTIPLY", gi.outputs["Turbulence Frequency"], 4.0))
-    return _frac(b, b.math("MULTIPLY_ADD", gi.outputs["Grain"], grain, s))
+    return _frac(b, _plus(b, gi.outputs["Grain"], grain, s))
 
 
 def _layers(b, gi, p, seed, groups, profile):
     h = b.math("DIVIDE", b.vmath("DOT_PRODUCT", p, b.vmath("NORMALIZE", gi.outputs["Normal"])), gi.outputs["Spacing"])
-    h = b.math("MULTIPLY_ADD", gi.outputs["Turbulence"],
-               _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"]), h)
+    h = _plus(b, gi.outputs["Turbulence"], _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"]), h)
     f = _frac(b, h)
     return b.math("ABSOLUTE", b.math("MULTIPLY_ADD", f, 2.0, -1.0)) if profile == "tri" else f
 
@@ -134,7 +140,7 @@ def _layers(b, gi, p, seed, groups, profile):
 def _inner(b, gi, p, seed, groups, r):
     """1 + r + turbulence: a cell's or a unit's own value."""
     t = _turbulence(b, groups, seed, p, gi.outputs["Turbulence Frequency"])
-    return b.math("MULTIPLY_ADD", gi.outputs["Turbulence"], t, b.math("ADD", r, 1.0))
+    return _plus(b, gi.outputs["Turbulence"], t, b.math("ADD", r, 1.0))
 
 
 def _edge(b, gi, dist, width):
@@ -303,7 +309,7 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
         s = _bonds(b, gi, p, seed, groups, field.params.get("pattern", "courses"))
     from ..backend.solid.procedural.family import DETAIL_FREQ
 
-    s = b.math("MULTIPLY_ADD", gi.outputs["Detail"], _turbulence(b, groups, seed + 2, p, DETAIL_FREQ), s)
+    s = _plus(b, gi.outputs["Detail"], _turbulence(b, groups, seed + 2, p, DETAIL_FREQ), s)
     colour = _ramp(b, s, field.ramp)
     srgb = b.vmath("MINIMUM", b.vmath("MAXIMUM", colour, (0.0, 0.0, 0.0)), (1.0, 1.0, 1.0))
     b.put(go.inputs["sRGB"], srgb)

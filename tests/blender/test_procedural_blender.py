@@ -82,6 +82,28 @@ def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
         bpy.data.node_groups.remove(grp)
 
 
+@pytest.mark.parametrize("family", ["rings", "layers", "cells", "bonds"])
+def test_each_noise_is_read_through_a_multiply_by_its_amplitude(family):
+    """Cycles folds a Multiply by a constant 0 and drops the Wave Noise group behind it (a Multiply Add it does not
+    fold): so every noise's value reaches the pattern only through a Multiply by its amplitude input, and an
+    artist's Turbulence, Grain or Detail of 0 leaves that noise out of the render."""
+    f = _field(family)
+    grp = build_procedural_group(f)
+    try:
+        amplitudes = {"Turbulence", "Grain", "Detail"}
+        noises = [n for n in grp.nodes if n.bl_idname == "ShaderNodeGroup" and "turbulence" in n.node_tree.name]
+        assert len(noises) == {"rings": 3}.get(family, 2)
+        for n in noises:
+            users = [link.to_node for link in n.outputs["Value"].links]
+            assert users and all(u.bl_idname == "ShaderNodeMath" and u.operation == "MULTIPLY" for u in users)
+            for u in users:
+                other = [link.from_socket for sock in u.inputs[:2] for link in sock.links if link.from_node != n]
+                assert len(other) == 1 and other[0].node.bl_idname == "NodeGroupInput"
+                assert other[0].name in amplitudes
+    finally:
+        bpy.data.node_groups.remove(grp)
+
+
 @pytest.mark.parametrize("family", ["rings", "layers", "bonds", "cells", "herringbone", "herringbone45"])
 def test_cycles_bake_equals_engine(family):
     """A plane baked in Cycles through the group's sRGB output, at the shading positions Cycles used (baked too):
