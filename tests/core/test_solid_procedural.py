@@ -7,7 +7,7 @@ from omninoise.backend.errors import SettingError
 from omninoise.backend.grid import Cancelled
 from omninoise.backend.solid.model import slice_points
 from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
-from omninoise.backend.solid.procedural.cells import Cells, voronoi
+from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_cubes, cell_w, voronoi
 from omninoise.backend.solid.procedural.estimate import estimate, repeat_length
 from omninoise.backend.solid.procedural.family import Param, axis_vector
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
@@ -89,6 +89,35 @@ def test_cells_take_one_value_each_and_gaps_take_the_lowest():
         np.testing.assert_allclose(v[keys == k], v[keys == k][0], atol=1e-12)
     gapped = Cells().values(dict(p, gap=0.2), pts, 0)
     assert gapped.min() == -1.0 and 0.05 < (gapped == -1.0).mean() < 0.9
+
+
+@pytest.mark.parametrize("scale", [3.0, 1e7])
+def test_cells_find_each_point_s_nearest_and_second_nearest_feature_point(scale):
+    """Against every feature point of the 27 cubes around each point, one point at a time; 1e7 cubes apart, the
+    cubes are told apart by rows, not by one key."""
+    from omninoise.backend.wavenoise.wave import white_color4
+
+    q = np.random.default_rng(4).uniform(-scale, scale, (300, 3)).astype(np.float32)
+    f1, f2, cell = voronoi(q, 0.9, 5)
+    for i in range(len(q)):
+        base = np.floor(q[i])
+        cubes = (base + NEIGHBOURS).astype(np.float32)
+        h = np.stack([white_color4(cubes[:, 0], cubes[:, 1], cubes[:, 2], cell_w(5, 0), k) for k in range(3)], 1)
+        d = np.linalg.norm(NEIGHBOURS + 0.9 * h - (q[i] - base), axis=1)     # from the point, within its cube
+        order = np.argsort(d)
+        assert f1[i] == pytest.approx(d[order[0]], abs=1e-5) and f2[i] == pytest.approx(d[order[1]], abs=1e-5)
+        np.testing.assert_array_equal(cell[i], cubes[order[0]])
+
+
+def test_cubes_are_found_once_each_as_numpy_finds_them():
+    rng = np.random.default_rng(2)
+    for base in (np.floor(rng.uniform(-40, 40, (5000, 3))), np.floor(rng.uniform(-2e6, 2e6, (5000, 3)))):
+        base = base.astype(np.float32)
+        cubes, back = _unique_cubes(base)
+        want = np.unique(base, axis=0)
+        assert len(cubes) == len(want)
+        np.testing.assert_array_equal(cubes[np.lexsort(cubes.T[::-1])], want)
+        np.testing.assert_array_equal(cubes[back], base)
 
 
 def test_running_bond_courses_shift_by_half_a_unit_and_meet_at_the_corner():
