@@ -106,13 +106,13 @@ def oblique_points(size: int, px_per_unit: float, normal, origin) -> np.ndarray:
     return np.asarray(origin, np.float64) + uu.reshape(-1, 1) * u - vv.reshape(-1, 1) * v
 
 
-def _draw(family: str, params: dict, planes: list, seed: int, colours: np.ndarray, side: int,
+def _draw(family: str, params: dict, planes: np.ndarray, seed: int, colours: np.ndarray, side: int,
           ppu: float) -> tuple:
-    """(slices, field): the solid drawn on ``planes`` (point arrays) with the ramp of those slices' values."""
-    fam = FAMILIES[family]
-    vals = [fam.values(params, pts, seed) for pts in planes]
-    ramp = fit_ramp(np.concatenate(vals), colours, params.get("flip", False))
-    return [np.clip(ramp(v), 0.0, 1.0).reshape(side, side, 3) for v in vals], ramp
+    """(slices, ramp): the solid drawn on ``planes`` (the planes' points one after the other, float (N side^2, 3):
+    one call draws them all) with the ramp of those slices' values."""
+    vals = FAMILIES[family].values(params, planes, seed)
+    ramp = fit_ramp(vals, colours, params.get("flip", False))
+    return [np.clip(ramp(v), 0.0, 1.0).reshape(side, side, 3) for v in np.split(vals, len(vals) // (side * side))], ramp
 
 
 def _textured(p: dict) -> dict:
@@ -153,7 +153,7 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     img, ppu = at_most(img, PX_PER_UNIT, config.fit_side)
     est = estimate(img, ppu)                                                                # 2. estimate
     side, seed = config.side, config.seed
-    planes = [oblique_points(side, ppu, n, o) for n, o in FIT_PLANES]
+    planes = np.concatenate([oblique_points(side, ppu, n, o) for n, o in FIT_PLANES])
     loss = SliceLoss(img, side, [plane_group(n) for n, _ in FIT_PLANES])
     colours = photo_colours(img)
     starts = [(kind, name, t) for kind in config.families for name, s in kind_starts(kind, est)
