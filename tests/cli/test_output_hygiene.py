@@ -116,7 +116,7 @@ def test_sigterm_and_sighup_during_a_write_remove_the_temporary(tmp_path, monkey
 def test_sigterm_stops_a_running_command_with_143(tmp_path):
     """A real process: SIGTERM while it computes ends it with 143 and nothing in its folder."""
     code = "import sys; from omninoise.cli.main import main; sys.exit(main())"
-    p = subprocess.Popen([sys.executable, "-c", code, "wave", "--dim", "3", "--size", "320", "--directions", "64",
+    p = subprocess.Popen([sys.executable, "-c", code, "wave", "--dim", "3", "--size", "512", "--directions", "64",
                           "--quiet", "-o", str(tmp_path / "v.npy")], stderr=subprocess.PIPE, text=True)
     try:
         p.wait(timeout=3)
