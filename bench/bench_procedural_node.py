@@ -44,7 +44,9 @@ def procedural(case: str, noise: bool = True):
         family = "bonds" if case == "herringbone" else case
         p = dict(PARAMS[case], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
         if not noise:
-            p.update(turbulence=0.0, detail=0.0, **({"grain": 0.0} if "grain" in p else {}))
+            p.update(turbulence=0.0, detail=0.0)
+            if "grain" in p:
+                p["grain"] = 0.0
         f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3)
         grp = build_procedural_group(f)
         n = nt.nodes.new("ShaderNodeGroup")

@@ -106,8 +106,7 @@ def oblique_points(size: int, px_per_unit: float, normal, origin) -> np.ndarray:
     return np.asarray(origin, np.float64) + uu.reshape(-1, 1) * u - vv.reshape(-1, 1) * v
 
 
-def _draw(family: str, params: dict, planes: np.ndarray, seed: int, colours: np.ndarray, side: int,
-          ppu: float) -> tuple:
+def _draw(family: str, params: dict, planes: np.ndarray, seed: int, colours: np.ndarray, side: int) -> tuple:
     """(slices, ramp): the solid drawn on ``planes`` (the planes' points one after the other, float (N side^2, 3):
     one call draws them all) with the ramp of those slices' values."""
     vals = FAMILIES[family].values(params, planes, seed)
@@ -165,7 +164,7 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
         tried[0] += 1
         if progress is not None:
             progress(min(1.0, tried[0] / total))
-        return loss(_draw(name, p, planes, seed, colours, side, ppu)[0])
+        return loss(_draw(name, p, planes, seed, colours, side)[0])
 
     scored = sorted(((score(n, s), k, n, s) for k, n, s in starts), key=lambda t: t[0])    # 3. start
     best = {}
