@@ -7,8 +7,8 @@ parameters are the group's inputs for an artist to turn.
   layers (height along Normal, in Spacings, through the saw or triangle profile), cells (F1, F2 and the nearest
   cell's value over the 27 cubes around p / (Size, Size, Size x Stretch), one sub-group each, a feature point's
   offset from one White Noise Texture's Color (4D) and the cell's value from another's), bonds (courses or a
-  herringbone's units, and joints, a unit's number from the White Noise Texture, 4D, W = seed; the pattern is
-  the group's own);
+  herringbone's units, and joints; a unit's number, and how far each row of units is moved into the wall, from
+  the White Noise Texture, 4D, W = seed; the pattern is the group's own);
 * turbulence, grain and detail: Wave Noise groups (:func:`.wave_nodes.build_wave_group`) of the engine's
   turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input
   and weighed by its amplitude input (an amplitude of 0 leaves its group out of a Cycles render: :func:`_plus`);
@@ -213,18 +213,20 @@ def _face(b, t):
     return b.math("MINIMUM", f, b.math("SUBTRACT", 1.0, f))
 
 
-def _courses(b, gi, p):
-    """(distance to the unit's nearest face, the unit's three integers) of the courses pattern."""
+def _courses(b, gi, p, seed):
+    """(distance to the unit's nearest face, the unit's three integers) of the courses pattern, each row of units
+    into the wall moved by its own random fraction (bonds.Bonds.shape)."""
     x, y, z = b.separate(p)
     length, height = gi.outputs["Length"], gi.outputs["Height"]
     w = b.math("DIVIDE", z, height)
     row = b.math("FLOOR", w)
-    shift = b.math("MULTIPLY", gi.outputs["Offset"], row)
-    u = b.math("ADD", b.math("DIVIDE", x, length), shift)
-    v = b.math("ADD", b.math("DIVIDE", y, length), shift)
+    u = b.math("ADD", b.math("DIVIDE", x, length), b.math("MULTIPLY", gi.outputs["Offset"], row))
+    i = b.math("FLOOR", u)
+    sigma = b.channel(_white(b, b.combine(i, row, 0.5), np.float32(int(seed) % (1 << 24))), 0)
+    v = b.math("ADD", b.math("DIVIDE", y, length), sigma)
     d = b.math("MINIMUM", b.math("MULTIPLY", _face(b, w), height),
                b.math("MULTIPLY", b.math("MINIMUM", _face(b, u), _face(b, v)), length))
-    return d, (b.math("FLOOR", u), b.math("FLOOR", v), row)
+    return d, (i, b.math("FLOOR", v), row)
 
 
 def _herringbone(b, gi, p, turned: bool):
@@ -258,7 +260,7 @@ def _herringbone(b, gi, p, turned: bool):
 
 
 def _bonds(b, gi, p, seed, groups, pattern):
-    d, unit = _courses(b, gi, p) if pattern == "courses" else _herringbone(b, gi, p, pattern == "herringbone45")
+    d, unit = _courses(b, gi, p, seed) if pattern == "courses" else _herringbone(b, gi, p, pattern == "herringbone45")
     half = b.math("MULTIPLY", b.math("MULTIPLY", gi.outputs["Joint"], gi.outputs["Height"]), 0.5)
     white = b.channel(_white(b, b.combine(*unit), np.float32(int(seed) % (1 << 24))), 0)
     e = _edge(b, gi, d, half)

@@ -124,16 +124,33 @@ def test_running_bond_courses_shift_by_half_a_unit_and_meet_at_the_corner():
     p = dict(length=0.4, height=0.1, offset=0.5, joint=0.2, **CALM)
     b = Bonds()
     x = np.linspace(0.0, 0.8, 801)
-    row0 = b.values(p, np.stack([x, np.full_like(x, 0.013), np.full_like(x, 0.05)], 1), 0)
-    row1 = b.values(p, np.stack([x, np.full_like(x, 0.013), np.full_like(x, 0.15)], 1), 0)
-    j0, j1 = x[row0 == -1.0], x[row1 == -1.0]
-    assert np.all(np.min(np.abs(j0[:, None] - [0.0, 0.4, 0.8]), 1) < 0.011)      # head joints every unit
-    assert np.all(np.min(np.abs(j1[:, None] - [0.2, 0.6]), 1) < 0.011)           # the next course: half a unit on
+    for y in np.linspace(-1.0, 1.0, 9):                                          # at every depth
+        row0 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.05)], 1), 0)
+        row1 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.15)], 1), 0)
+        assert (row0[np.min(np.abs(x[:, None] - [0.0, 0.4, 0.8]), 1) < 0.0095] == -1.0).all()  # head joints
+        assert (row1[np.min(np.abs(x[:, None] - [0.2, 0.6]), 1) < 0.0095] == -1.0).all()       # half a unit on
     # the x wall and the y wall show their bed joints at the same heights (courses continue round a corner)
     front = b.values(p, slice_points(64, 128.0, "y", (0, 0.013, 0)), 0).reshape(64, 64)
     side = b.values(p, slice_points(64, 128.0, "x", (0.013, 0, 0)), 0).reshape(64, 64)
     np.testing.assert_array_equal((front == -1).all(1), (side == -1).all(1))
     assert (front == -1).all(1).sum() >= 4
+
+
+def test_a_wall_cut_along_a_depth_joint_shows_scattered_units_not_a_face_of_mortar():
+    """A stack bond of units 1/2 long cut along y at every depth through one unit: each row of units is moved
+    into the wall by its own fraction, so no cut shows more than a few units' depth joints (a cut at y = 0, a
+    cube's face at -1 or 1, showed nothing but joint when every unit's depth joints lay in one plane), and the
+    cuts show joint on the same share of their area on average as cuts anywhere."""
+    b = Bonds()
+    p = dict(length=0.5, height=0.25, offset=0.0, joint=0.15, **CALM)
+    xz = np.random.default_rng(1).uniform(-2.0, 2.0, (20000, 2))
+    shares = []
+    for y in np.linspace(0.0, 0.5, 101):
+        wall = np.stack([xz[:, 0], np.full(len(xz), y), xz[:, 1]], 1)
+        shares.append((b.values(p, wall, 3) == -1.0).mean())
+    anywhere = (b.values(p, np.random.default_rng(0).uniform(-2.0, 2.0, (40000, 3)), 3) == -1.0).mean()
+    assert max(shares) < 0.4, (max(shares), anywhere)
+    assert np.mean(shares) == pytest.approx(anywhere, abs=0.02)
 
 
 @pytest.mark.parametrize("n", [1.0, 2.0, 4.0])
@@ -192,6 +209,22 @@ def test_estimates_read_a_stripe_photo_s_period_and_direction():
     tiles[18] = 0.2                                        # one tile's peak too low: it is no repeat, two tiles are
     tiles[17] = tiles[19] = 0.1
     assert repeat_length(tiles) == pytest.approx(36, abs=1)
+
+
+def test_gaps_take_the_ramp_s_end_that_the_photo_s_grout_shows():
+    """A grid of tiles with dark grout skews the photo's luminance dark, with pale mortar bright: the gapped
+    families start with their gaps at that end of the ramp (flip off for dark), the others try both orders."""
+    r, c = np.mgrid[0:128, 0:128]
+    grout = ((r % 32) < 3) | ((c % 32) < 3)
+    tiles = 0.55 + 0.1 * np.random.default_rng(0).standard_normal((128, 128))
+    for colour, dark in ((0.1, True), (0.95, False)):
+        photo = np.repeat(np.where(grout, colour, tiles)[..., None], 3, 2)
+        est = estimate(photo, PX_PER_UNIT)
+        assert est.dark_gaps is dark
+        for starts in (Cells().starts(est), Bonds().starts(est), Bonds().herringbone_starts(est)):
+            assert {s["flip"] for s in starts} == {not dark}
+        assert {s["flip"] for s in Layers().starts(est)} == {False, True}
+        assert {s["flip"] for s in Rings().starts(est)} == {False, True}
 
 
 def test_nelder_mead_finds_a_bowl_s_bottom_within_its_budget():

@@ -1,8 +1,13 @@
 """Bonds: bricks and tiles laid in courses or in a herringbone, in 3D (a wall's corner shows its courses meeting).
 
 Pattern "courses": courses of ``height`` run along z; within a course, units ``length`` long along x and along y
-(square in plan), each course moved along both by ``offset`` of a unit (0: stack bond, 1/2: running bond, 1/3 or
-1/4: raking bonds).
+(square in plan), each course moved along x by ``offset`` of a unit (0: stack bond, 1/2: running bond, 1/3 or
+1/4: raking bonds).  Along y (into the wall) each row of units, one course and one unit along x, is moved by its
+own random fraction of a unit, sigma = cell_random(i, row, 1/2): a wall cut along y then crosses the depth joints
+of scattered units, as many as a cut anywhere, not every unit of a course (or of every course, in a stack bond)
+at once.
+
+    w = z / height,  row = floor(w),  u = x / length + offset row,  i = floor(u),  v = y / length + sigma
 
 Patterns "herringbone" and "herringbone45": in the wall (x, z), units ``height`` wide and n = max(1,
 round(length / height)) widths long, laid alternately along and across (the 90-degree herringbone, its zigzag on
@@ -75,9 +80,10 @@ class Bonds(Family):
             w = pts[:, 2] / p["height"]
             row = np.floor(w)
             u = pts[:, 0] / p["length"] + p["offset"] * row
-            v = pts[:, 1] / p["length"] + p["offset"] * row
+            i = np.floor(u)
+            v = pts[:, 1] / p["length"] + cell_random(i, row, 0.5, seed)
             d = np.minimum(_to_face(w) * p["height"], np.minimum(_to_face(u), _to_face(v)) * p["length"])
-            r = cell_random(np.floor(u), np.floor(v), row, seed)
+            r = cell_random(i, np.floor(v), row, seed)
         else:
             n, width = units_long(p), p["height"]
             slab = pts[:, 1] / (n * width)
@@ -93,23 +99,24 @@ class Bonds(Family):
 
     def starts(self, est) -> list:
         """Courses: units the photo's repeat across; courses its repeat up (stack bond) or half of it (running
-        bond, which repeats every second course); each ramp order."""
+        bond, which repeats every second course); joints dark or pale as the photo's are (``est.dark_gaps``)."""
         length = float(np.clip(est.spacing_x, 0.021, 1.9))
         return [dict(length=length, height=float(np.clip(k * est.spacing_z, 0.011, 0.95)), offset=off, joint=0.15,
-                     turbulence=0.1, detail=0.1, turb_freq=float(np.clip(0.5 / length, 0.3, 15.0)), flip=flip,
-                     pattern="courses")
-                for k, off in ((0.5, 0.5), (1.0, 0.0)) for flip in (False, True)]
+                     turbulence=0.1, detail=0.1, turb_freq=float(np.clip(0.5 / length, 0.3, 15.0)),
+                     flip=not est.dark_gaps, pattern="courses")
+                for k, off in ((0.5, 0.5), (1.0, 0.0))]
 
     def herringbone_starts(self, est) -> list:
-        """Herringbones of units n widths long, each ramp order.  The turned one repeats every sqrt(2) widths along
-        x and sqrt(2) n along z; the 90-degree one is the same turned back, so it repeats every sqrt(2) widths along
-        one diagonal and sqrt(2) n along the other.  So n = round(longer / shorter), within [2, 4]."""
+        """Herringbones of units n widths long, joints dark or pale as the photo's are.  The turned one repeats
+        every sqrt(2) widths along x and sqrt(2) n along z; the 90-degree one is the same turned back, so it repeats
+        every sqrt(2) widths along one diagonal and sqrt(2) n along the other.  So n = round(longer / shorter),
+        within [2, 4]."""
         out = []
         for pattern, repeats in (("herringbone", est.diagonals), ("herringbone45", (est.spacing_x, est.spacing_z))):
             short, long = sorted(repeats)
             n = float(np.clip(np.floor(long / max(short, 1e-9) + 0.5), 2.0, 4.0))
             width = float(np.clip(short / np.sqrt(2.0), 0.011, 0.45))
-            out += [dict(length=n * width, height=width, offset=0.5, joint=0.15, turbulence=0.1, detail=0.1,
-                         turb_freq=float(np.clip(0.5 / (n * width), 0.3, 15.0)), flip=flip, pattern=pattern)
-                    for flip in (False, True)]
+            out.append(dict(length=n * width, height=width, offset=0.5, joint=0.15, turbulence=0.1, detail=0.1,
+                            turb_freq=float(np.clip(0.5 / (n * width), 0.3, 15.0)), flip=not est.dark_gaps,
+                            pattern=pattern))
         return out

@@ -95,13 +95,12 @@ class Cells(Family):
         return gapped(f2.astype(np.float64) - f1, p["gap"], r, p, pts, seed)
 
     def starts(self, est) -> list:
-        """Cells the size of the photo's repeats (along its wave, across, up), thin and wide gaps, each ramp order."""
+        """Cells the size of the photo's repeats (along its wave, across, up), thin and wide gaps, dark or pale as
+        the photo's are (``est.dark_gaps``)."""
         out = []
         for size in sorted({round(float(np.clip(s, 0.012, 1.4)), 4) for s in (est.spacing, est.spacing_x, est.spacing_z)}):
             for gap in (0.04, 0.15):
-                for flip in (False, True):
-                    out.append(dict(size=size, stretch=float(np.clip(est.spacing_z / max(est.spacing_x, 1e-6),
-                                                                     0.31, 2.9)),
-                                    jitter=0.9, gap=gap, turbulence=0.2, detail=0.1,
-                                    turb_freq=float(np.clip(1.0 / size, 0.3, 15.0)), flip=flip))
+                out.append(dict(size=size, stretch=float(np.clip(est.spacing_z / max(est.spacing_x, 1e-6), 0.31, 2.9)),
+                                jitter=0.9, gap=gap, turbulence=0.2, detail=0.1,
+                                turb_freq=float(np.clip(1.0 / size, 0.3, 15.0)), flip=not est.dark_gaps))
         return out
