@@ -3,8 +3,9 @@
 
 One row per brick or tile photo the evaluation holds out: the photo (a crop at its own pixel scale) | the solid the
 default kinds fit (the evaluation's, ``field`` in docs/benchmarks/solid_procedural.json) | the solid fitted with
-``families = ["bonds"]``: its front (the wall, y), side (x) and top (z) cuts through one point, at the photo's
-scale.  The side and top show what the front's courses become round a corner and on a floor.
+``families = ["bonds"]``: its front (the wall, y) and side (x) cuts through POINT and its top (z) cut through the
+middle of the course that holds POINT (a cut along a bed joint shows nothing but joint), at the photo's scale.  The
+side and top show what the front's courses become round a corner and on a floor.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ OUT = os.path.join(ROOT, "docs", "img", "solid_procedural_kinds.png")
 BENCH = os.path.join(ROOT, "docs", "benchmarks", "solid_procedural.json")
 PHOTOS = ("brick__tex_trak_trak4_brick2a.jpg", "brick__beige_bricks.jpg", "tile__tile02.jpg", "tile__tile01.jpg")
 SIDE = 160                        #: px per tile
-POINT = (0.031, 0.043, 0.027)     #: the point the cuts pass through, texture units
+POINT = (0.353, 0.617, 0.241)     #: the point the cuts pass through, texture units
 
 
 def crop(img: np.ndarray, side: int) -> np.ndarray:
@@ -48,7 +49,9 @@ def main() -> int:
         bonds = fit_procedural(img, ProceduralConfig(families=("bonds",))).field
         print(f"{name}: {default.family} by default; bonds {bonds.params}", flush=True)
         tiles = [crop(img, SIDE), default.image(SIDE, offset=POINT)]
-        tiles += [bonds.image(SIDE, axis=axis, offset=POINT) for axis in "yxz"]
+        mid = (np.floor(POINT[2] / bonds.params["height"]) + 0.5) * bonds.params["height"]
+        tiles += [bonds.image(SIDE, axis="y", offset=POINT), bonds.image(SIDE, axis="x", offset=POINT),
+                  bonds.image(SIDE, axis="z", offset=(POINT[0], POINT[1], mid))]
         rows.append(np.concatenate(tiles, axis=1))
     write_sheet(OUT, (np.clip(np.concatenate(rows, axis=0), 0.0, 1.0) * 255 + 0.5).astype(np.uint8))
     print(f"wrote {OUT}")
