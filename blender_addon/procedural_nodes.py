@@ -213,16 +213,16 @@ def _face(b, t):
     return b.math("MINIMUM", f, b.math("SUBTRACT", 1.0, f))
 
 
-def _courses(b, gi, p, seed):
+def _courses(b, gi, p, w_seed):
     """(distance to the unit's nearest face, the unit's three integers) of the courses pattern, each row of units
-    into the wall moved by its own random fraction (bonds.Bonds.shape)."""
+    into the wall moved by its own random fraction (bonds.Bonds.shape); ``w_seed`` the White Noise's W."""
     x, y, z = b.separate(p)
     length, height = gi.outputs["Length"], gi.outputs["Height"]
     w = b.math("DIVIDE", z, height)
     row = b.math("FLOOR", w)
     u = b.math("ADD", b.math("DIVIDE", x, length), b.math("MULTIPLY", gi.outputs["Offset"], row))
     i = b.math("FLOOR", u)
-    sigma = b.channel(_white(b, b.combine(i, row, 0.5), np.float32(int(seed) % (1 << 24))), 0)
+    sigma = b.channel(_white(b, b.combine(i, row, 0.5), w_seed), 0)
     v = b.math("ADD", b.math("DIVIDE", y, length), sigma)
     d = b.math("MINIMUM", b.math("MULTIPLY", _face(b, w), height),
                b.math("MULTIPLY", b.math("MINIMUM", _face(b, u), _face(b, v)), length))
@@ -260,9 +260,10 @@ def _herringbone(b, gi, p, turned: bool):
 
 
 def _bonds(b, gi, p, seed, groups, pattern):
-    d, unit = _courses(b, gi, p, seed) if pattern == "courses" else _herringbone(b, gi, p, pattern == "herringbone45")
+    w_seed = np.float32(int(seed) % (1 << 24))          # family.cell_random's W
+    d, unit = _courses(b, gi, p, w_seed) if pattern == "courses" else _herringbone(b, gi, p, pattern == "herringbone45")
     half = b.math("MULTIPLY", b.math("MULTIPLY", gi.outputs["Joint"], gi.outputs["Height"]), 0.5)
-    white = b.channel(_white(b, b.combine(*unit), np.float32(int(seed) % (1 << 24))), 0)
+    white = b.channel(_white(b, b.combine(*unit), w_seed), 0)
     e = _edge(b, gi, d, half)
     return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, white), -1.0)
 
