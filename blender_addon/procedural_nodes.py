@@ -70,8 +70,29 @@ def _socket_values(field) -> dict:
     return out
 
 
+#: the parameters whose range is a share (of a unit, a cube, a course): the group's sockets stop at its top; a cell's
+#: feature point beyond its cube (Jitter over 1) would lie outside the 27 cubes the group searches
+SHARES = ("offset", "jitter", "gap", "joint")
+
+
+def _bounds(family: str) -> dict:
+    """{socket name: (min, max or None)} of a family's float parameters: a length, size or frequency (searched on a
+    log axis) at least the engine's least, so no slider reaches a division by 0; a share within the engine's range;
+    the noises' amplitudes at least 0."""
+    from ..backend.solid.procedural.field import FAMILIES
+
+    ranges = {q.name: q for q in FAMILIES[family].params()}
+    out = {}
+    for name, key in PARAMETERS[family] + SHARED:
+        q = ranges.get(key)
+        if q is not None:
+            out[name] = (q.lo if q.log else 0.0, q.hi if key in SHARES else None)
+    return out
+
+
 def _interface(tree, field) -> None:
     values = _socket_values(field)
+    bounds = _bounds(field.family)
     for name in ["Vector", "Scale"] + [n for n, _ in PARAMETERS[field.family] + SHARED]:
         vector = name in ("Vector", "Axis", "Centre", "Normal")
         s = tree.interface.new_socket(name, in_out="INPUT",
@@ -83,8 +104,10 @@ def _interface(tree, field) -> None:
             s.default_value = 1.0
         else:
             s.default_value = values[name]
-            if not vector:
-                s.min_value = 0.0
+            if name in bounds:
+                s.min_value, top = bounds[name]
+                if top is not None:
+                    s.max_value = top
     tree.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
     tree.interface.new_socket("sRGB", in_out="OUTPUT", socket_type="NodeSocketColor")
     tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")

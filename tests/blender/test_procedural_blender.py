@@ -82,6 +82,28 @@ def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
         bpy.data.node_groups.remove(grp)
 
 
+def test_the_group_s_sliders_stop_where_the_engine_s_parameters_do():
+    """Lengths, sizes and frequencies stop at the engine's least (no slider reaches a division by 0), shares at
+    their range's top (a cell's Jitter over 1 would leave the cubes the group searches), amplitudes at 0."""
+    want = {"cells": {"Size": (0.01, None), "Stretch": (0.3, None), "Jitter": (0.0, 1.0), "Gap": (0.0, 0.45),
+                      "Turbulence Frequency": (0.25, None), "Detail": (0.0, None)},
+            "bonds": {"Length": (0.02, None), "Height": (0.01, None), "Offset": (0.0, 1.0), "Joint": (0.0, 0.5),
+                      "Turbulence": (0.0, None)},
+            "rings": {"Spacing": (0.005, None), "Grain": (0.0, None)}}
+    for family, bounds in want.items():
+        grp = build_procedural_group(_field(family))
+        try:
+            for name, (lo, hi) in bounds.items():
+                s = grp.interface.items_tree[name]
+                assert s.min_value == pytest.approx(lo), (family, name, s.min_value)
+                if hi is None:
+                    assert s.max_value > 1e30, (family, name, s.max_value)
+                else:
+                    assert s.max_value == pytest.approx(hi), (family, name, s.max_value)
+        finally:
+            bpy.data.node_groups.remove(grp)
+
+
 @pytest.mark.parametrize("family", ["rings", "layers", "cells", "bonds"])
 def test_each_noise_is_read_through_a_multiply_by_its_amplitude(family):
     """Cycles folds a Multiply by a constant 0 and drops the Wave Noise group behind it (a Multiply Add it does not
