@@ -76,9 +76,9 @@ SHARES = ("offset", "jitter", "gap", "joint")
 
 
 def _bounds(family: str) -> dict:
-    """{socket name: (min, max or None)} of a family's float parameters: a length, size or frequency (searched on a
-    log axis) at least the engine's least, so no slider reaches a division by 0; a share within the engine's range;
-    the noises' amplitudes at least 0."""
+    """{socket name: (min, max or None)} of a family's float parameters: a length, size or frequency (the engine
+    searches it on a log axis) no smaller than the engine's smallest, so no slider reaches a division by 0; a share
+    within the engine's range; a noise's amplitude no smaller than 0."""
     from ..backend.solid.procedural.field import FAMILIES
 
     ranges = {q.name: q for q in FAMILIES[family].params()}
