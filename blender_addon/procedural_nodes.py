@@ -13,7 +13,8 @@ parameters are the group's inputs for an artist to turn.
   turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input
   and weighed by its amplitude input (an amplitude of 0 leaves its group out of a Cycles render: :func:`_plus`);
 * the ramp as a sum of clamped Map Range nodes (one per stop interval: exact piecewise-linear colours; a Color Ramp
-  node is sampled into a 256-entry table in Cycles).
+  node is sampled into a 256-entry table in Cycles);
+* for cells and bonds, the Gap Mask: 1 less how far p lies inside its cell or unit (family.inside).
 
 The field's JSON is stored on the tree (``tree["omninoise_procedural"]``) so the panel can rebuild it.
 """
@@ -48,7 +49,9 @@ TIPS = {"Spacing": "Distance between rings or layers (texture units)",
                   "each slab's)",
         "Joint": "Joint width, in course heights", "Turbulence": "How far the noise bends the pattern",
         "Turbulence Frequency": "The bending noise's frequency (cycles per texture unit)",
-        "Detail": "Fine noise within the pattern", "Scale": "Texture units per Blender unit"}
+        "Detail": "Fine noise within the pattern", "Scale": "Texture units per Blender unit",
+        "Gap Mask": "1 in the joints and gaps, 0 on the bricks and cells, between at their edges (into a Bump "
+                    "node's Height with Invert on, the mortar sinks)"}
 
 
 def _socket_values(field) -> dict:
@@ -91,6 +94,8 @@ def _bounds(family: str) -> dict:
 
 
 def _interface(tree, field) -> None:
+    from ..backend.solid.procedural.field import FAMILIES
+
     values = _socket_values(field)
     bounds = _bounds(field.family)
     for name in ["Vector", "Scale"] + [n for n, _ in PARAMETERS[field.family] + SHARED]:
@@ -111,6 +116,9 @@ def _interface(tree, field) -> None:
     tree.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
     tree.interface.new_socket("sRGB", in_out="OUTPUT", socket_type="NodeSocketColor")
     tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")
+    if FAMILIES[field.family].GAPPED:
+        s = tree.interface.new_socket("Gap Mask", in_out="OUTPUT", socket_type="NodeSocketFloat")
+        s.description = TIPS["Gap Mask"]
 
 
 def _plus(b, amplitude, noise, base):
@@ -227,7 +235,7 @@ def _cells(b, gi, p, seed, groups):
             b.put(node.inputs[name], v)
         f1, f2, r = node.outputs["F1"], node.outputs["F2"], node.outputs["Value"]
     e = _edge(b, gi, b.math("SUBTRACT", f2, f1), gi.outputs["Gap"])
-    return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, r), -1.0)
+    return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, r), -1.0), e
 
 
 def _face(b, t):
@@ -288,7 +296,7 @@ def _bonds(b, gi, p, seed, groups, pattern):
     half = b.math("MULTIPLY", b.math("MULTIPLY", gi.outputs["Joint"], gi.outputs["Height"]), 0.5)
     white = b.channel(_white(b, b.combine(*unit), w_seed), 0)
     e = _edge(b, gi, d, half)
-    return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, white), -1.0)
+    return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, white), -1.0), e
 
 
 def _ramp(b, s, ramp):
@@ -316,7 +324,8 @@ def _to_linear(b, c):
 
 def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str | None = None):
     """A node group drawing ``field`` (a backend ProceduralField): Vector, Scale and the family's parameters in;
-    Color (scene-linear, for a shader's Base Color), sRGB (the engine's values) and Value (s) out."""
+    Color (scene-linear, for a shader's Base Color), sRGB (the engine's values), Value (s) and for cells and bonds
+    Gap Mask (ProceduralField.gaps) out."""
     tree = new_group(name or f"Procedural {field.family.title()}", tree_type, (), ())
     _interface(tree, field)
     tree[FIELD_KEY] = json.dumps(field.to_dict())
@@ -324,15 +333,17 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
     gi, go = b.new("NodeGroupInput"), b.new("NodeGroupOutput")
     p = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
     seed, groups = field.seed, {}
-    fam = field.family
+    fam, inside = field.family, None
     if fam == "rings":
         s = _rings(b, gi, p, seed, groups)
     elif fam == "layers":
         s = _layers(b, gi, p, seed, groups, field.params["profile"])
     elif fam == "cells":
-        s = _cells(b, gi, p, seed, groups)
+        s, inside = _cells(b, gi, p, seed, groups)
     else:
-        s = _bonds(b, gi, p, seed, groups, field.params.get("pattern", "courses"))
+        s, inside = _bonds(b, gi, p, seed, groups, field.params.get("pattern", "courses"))
+    if inside is not None:
+        b.put(go.inputs["Gap Mask"], b.math("SUBTRACT", 1.0, inside))
     from ..backend.solid.procedural.family import DETAIL_FREQ
 
     s = _plus(b, gi.outputs["Detail"], _turbulence(b, groups, seed + 2, p, DETAIL_FREQ), s)

@@ -55,14 +55,20 @@ def test_geometry_nodes_field_equals_engine(family):
             return sep.outputs[channel]
         return evaluate_field(pts, build)
 
+    gapped = f.family in ("cells", "bonds")
     try:
         value = output("Value")
         srgb = np.stack([output("sRGB", c) for c in range(3)], 1)
         linear = np.stack([output("Color", c) for c in range(3)], 1)
+        gaps = output("Gap Mask") if gapped else None
+        assert ("Gap Mask" in grp.interface.items_tree) == gapped
     finally:
         bpy.data.node_groups.remove(grp)
     ref = f.evaluate(pts.astype(np.float64))
     assert np.abs(value - f.values(pts.astype(np.float64))).max() < 1e-4
+    if gapped:
+        want = f.gaps(pts.astype(np.float64))
+        assert np.abs(gaps - want).max() < 1e-4 and 0.05 < want.mean() < 0.6
     assert np.abs(srgb - ref).max() < 1e-3 and np.median(np.abs(srgb - ref)) < 1e-5
     assert np.abs(linear - srgb_to_linear(ref)).max() < 1e-3
     assert ref.std(0).min() > 0.05                      # a pattern, not a constant

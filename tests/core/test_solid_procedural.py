@@ -153,6 +153,25 @@ def test_a_wall_cut_along_a_depth_joint_shows_scattered_units_not_a_face_of_mort
     assert np.mean(shares) == pytest.approx(anywhere, abs=0.02)
 
 
+@pytest.mark.parametrize("family, params", [
+    ("bonds", dict(length=0.4, height=0.1, offset=0.5, joint=0.2)),
+    ("bonds", dict(length=0.3, height=0.1, offset=0.5, joint=0.2, pattern="herringbone45")),
+    ("cells", dict(size=0.2, stretch=1.0, jitter=0.9, gap=0.1))])
+def test_the_gap_mask_is_1_in_the_joints_0_inside_the_units_and_linear_between(family, params):
+    """ProceduralField.gaps (the node group's Gap Mask): 1 where the value is the gap's -1, 0 where a unit or cell
+    has its own value, and 1 - e between, e the value's share of the unit's own (turbulence and detail at 0)."""
+    ramp = Ramp((-1.0, 2.0), ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0)))
+    f = ProceduralField(family, dict(params, **CALM), ramp, seed=2)
+    pts = np.random.default_rng(3).uniform(-1.0, 1.0, (20000, 3))
+    g, s = f.gaps(pts), f.values(pts)
+    d, r = (FAMILIES[family].units if family == "bonds" else FAMILIES[family].cells)(f.params, pts, 2)
+    np.testing.assert_allclose(s, (1.0 - g) * (1.0 + r) - 1.0, atol=1e-12)
+    assert ((g == 1.0) == (s == -1.0)).all() and ((g == 0.0) == np.isclose(s, r)).all()
+    assert 0.05 < (g == 1.0).mean() < 0.6 and 0.2 < (g == 0.0).mean() < 0.9 and ((g > 0) & (g < 1)).mean() > 0.02
+    with pytest.raises(SettingError, match="layers have no gaps: a gap mask is drawn for cells, bonds"):
+        ProceduralField("layers", dict(spacing=0.2, tilt=0.0, azimuth=0.0, profile="saw", **CALM), ramp).gaps(pts)
+
+
 @pytest.mark.parametrize("n", [1.0, 2.0, 4.0])
 def test_a_herringbone_tiles_the_plane_with_units_n_long_half_along_half_across(n):
     """Every point lies in its unit's rectangle (1 by n widths, along x or across it), one unit has one

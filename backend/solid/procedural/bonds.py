@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .family import Family, Param, cell_random, gapped
+from .family import Family, Param, cell_random, gapped, inside
 
 __all__ = ["Bonds", "PATTERNS", "herringbone", "units_long"]
 
@@ -73,7 +73,11 @@ class Bonds(Family):
               Param("offset", 0.0, 1.0, doc="each course's (herringbone: each slab's) shift, in unit lengths"),
               Param("joint", 0.0, 0.5, doc="the joints' width, in course heights"))
 
-    def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+    GAPPED = True
+
+    def units(self, p: dict, points: np.ndarray, seed: int) -> tuple:
+        """(the distance to the unit's nearest face float64 (P,), units; the unit's random number r float64 (P,))
+        at points (P, 3)."""
         pts = np.asarray(points, np.float64)
         pattern = p.get("pattern", "courses")
         if pattern == "courses":
@@ -95,7 +99,14 @@ class Bonds(Family):
             dist, t, k, across = herringbone(x, z, n)
             d = np.minimum(dist, _to_face(slab) * n) * width
             r = cell_random(2.0 * t + across, k, m, seed)
-        return gapped(d, 0.5 * p["joint"] * p["height"], r, p, pts, seed)
+        return d, r
+
+    def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        d, r = self.units(p, points, seed)
+        return gapped(d, 0.5 * p["joint"] * p["height"], r, p, np.asarray(points, np.float64), seed)
+
+    def gaps(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        return 1.0 - inside(self.units(p, points, seed)[0], 0.5 * p["joint"] * p["height"])
 
     def starts(self, est) -> list:
         """Courses: units the photo's repeat across; courses its repeat up (stack bond) or half of it (running

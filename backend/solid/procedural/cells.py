@@ -18,7 +18,7 @@ import numpy as np
 
 from ...wavenoise.hashing import white_noise4
 from ...wavenoise.wave import white_color4
-from .family import Family, Param, gapped
+from .family import Family, Param, gapped, inside
 
 __all__ = ["Cells", "voronoi", "cell_w", "NEIGHBOURS"]
 
@@ -87,12 +87,21 @@ class Cells(Family):
               Param("jitter", 0.0, 1.0, doc="how far feature points move within their cube, in sides"),
               Param("gap", 0.0, 0.45, doc="the gap between cells, in cell sides"))
 
-    def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
-        pts = np.asarray(points, np.float64)
-        q = pts / (p["size"] * np.array([1.0, 1.0, p["stretch"]]))
+    GAPPED = True
+
+    def cells(self, p: dict, points: np.ndarray, seed: int) -> tuple:
+        """(F2 - F1 in cube sides float64 (P,), the nearest cell's value r float64 (P,)) at points (P, 3)."""
+        q = np.asarray(points, np.float64) / (p["size"] * np.array([1.0, 1.0, p["stretch"]]))
         f1, f2, cell = voronoi(q, p["jitter"], seed)
         r = white_noise4(cell[:, 0], cell[:, 1], cell[:, 2], cell_w(seed, 1)).astype(np.float64)
-        return gapped(f2.astype(np.float64) - f1, p["gap"], r, p, pts, seed)
+        return f2.astype(np.float64) - f1, r
+
+    def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        dist, r = self.cells(p, points, seed)
+        return gapped(dist, p["gap"], r, p, np.asarray(points, np.float64), seed)
+
+    def gaps(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        return 1.0 - inside(self.cells(p, points, seed)[0], p["gap"])
 
     def starts(self, est) -> list:
         """Cells the size of the photo's repeats (along its wave, across, up), thin and wide gaps, dark or pale as

@@ -19,7 +19,7 @@ import numpy as np
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
-__all__ = ["Param", "Family", "cell_random", "axis_vector", "gapped", "SHARED", "DETAIL_FREQ"]
+__all__ = ["Param", "Family", "cell_random", "axis_vector", "gapped", "inside", "SHARED", "DETAIL_FREQ"]
 
 DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
 
@@ -57,6 +57,7 @@ class Family:
     name = ""
     PARAMS: tuple = ()
     doc = ""
+    GAPPED = False      #: whether its cells or units have gaps between them (:meth:`gaps`)
 
     def params(self) -> tuple:
         return tuple(self.PARAMS) + SHARED
@@ -66,6 +67,11 @@ class Family:
 
     def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         raise NotImplementedError
+
+    def gaps(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+        """The gap mask at points float (P, 3) -> float64 (P,): 1 in a gap or joint, 0 inside a cell or unit,
+        1 - :func:`inside` between; only for the families with gaps (``GAPPED``)."""
+        raise NotImplementedError(f"{self.name} has no gaps")
 
     def values(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         """The value s at points float (P, 3) -> float64 (P,): the family's shape plus the detail noise."""
@@ -87,13 +93,19 @@ class Family:
         return out
 
 
-def gapped(dist: np.ndarray, half: float, r: np.ndarray, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
-    """The value of cells and units with gaps between them: -1 in a gap (``dist`` < ``half`` from its edge), the
-    unit's own 1 + r + turbulence beyond 2 ``half``, linear between:
+def inside(dist: np.ndarray, half: float) -> np.ndarray:
+    """How far a point lies inside its cell or unit, float64 in [0, 1]: 0 in a gap (``dist`` < ``half`` from its
+    edge), 1 beyond 2 ``half``, linear between: e = clip(dist / half - 1, 0, 1)."""
+    return np.clip(np.asarray(dist, np.float64) / max(half, 1e-9) - 1.0, 0.0, 1.0)
 
-        e = clip(dist / half - 1, 0, 1),    s = e (1 + r + turbulence * T(p)) - 1
+
+def gapped(dist: np.ndarray, half: float, r: np.ndarray, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
+    """The value of cells and units with gaps between them: -1 in a gap, the unit's own 1 + r + turbulence where
+    :func:`inside` is 1, linear between:
+
+        e = inside(dist, half),    s = e (1 + r + turbulence * T(p)) - 1
     """
-    e = np.clip(np.asarray(dist, np.float64) / max(half, 1e-9) - 1.0, 0.0, 1.0)
+    e = inside(dist, half)
     inner = 1.0 + r
     if p["turbulence"] > 0:
         inner = inner + p["turbulence"] * turbulence(points, p["turb_freq"], seed)

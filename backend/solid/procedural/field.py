@@ -60,6 +60,16 @@ class ProceduralField:
         """The family's value s at points float (P, 3) -> float64 (P,)."""
         return FAMILIES[self.family].values(self.params, points, self.seed)
 
+    def gaps(self, points: np.ndarray) -> np.ndarray:
+        """The gap mask of cells and bonds at points float (P, 3) -> float64 (P,): 1 in the gaps and joints, 0
+        inside the cells and units, linear between (the node group's Gap Mask: into a Bump node's Height with
+        Invert on, the mortar sinks).  Rings and layers have no gaps (SettingError)."""
+        fam = FAMILIES[self.family]
+        if not fam.GAPPED:
+            raise SettingError("family", f"{self.family} have no gaps: a gap mask is drawn for "
+                                         f"{', '.join(n for n, f in FAMILIES.items() if f.GAPPED)}")
+        return fam.gaps(self.params, np.asarray(points, np.float64), self.seed)
+
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 16, progress=None, cancel=None) -> np.ndarray:
         """points float (P, 2 or 3) -> float32 (P, 3), in chunks: ``progress(fraction)`` after each, ``cancel()``
         returning True raises Cancelled."""
