@@ -4,8 +4,9 @@
 One row per brick or tile photo the evaluation holds out: the photo (a crop at its own pixel scale) | the solid the
 default kinds fit (the evaluation's, ``field`` in docs/benchmarks/solid_procedural.json) | the solid fitted with
 ``families = ["bonds"]``: its front (the wall, y) and side (x) cuts through POINT and its top (z) cut through the
-middle of the course that holds POINT (a cut along a bed joint shows nothing but joint), at the photo's scale.  The
-side and top show what the front's courses become round a corner and on a floor.
+middle of the course that holds POINT (a cut along a bed joint shows nothing but joint), at the photo's scale, and
+the front's gap mask (``ProceduralField.gaps``, the node group's Gap Mask: white in the joints).  The side and top
+show what the front's courses become round a corner and on a floor.
 """
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ def crop(img: np.ndarray, side: int) -> np.ndarray:
 
 def main() -> int:
     from bench.eval_procedural import photos
+    from omninoise.backend.solid.model import slice_points
     from omninoise.backend.solid.procedural.field import ProceduralField
     from omninoise.backend.solid.procedural.fit import ProceduralConfig, fit_procedural
     from omninoise.export import read_rgb
@@ -52,6 +54,8 @@ def main() -> int:
         mid = (np.floor(POINT[2] / bonds.params["height"]) + 0.5) * bonds.params["height"]
         tiles += [bonds.image(SIDE, axis="y", offset=POINT), bonds.image(SIDE, axis="x", offset=POINT),
                   bonds.image(SIDE, axis="z", offset=(POINT[0], POINT[1], mid))]
+        front = slice_points(SIDE, bonds.px_per_unit, "y", POINT)
+        tiles.append(np.repeat(bonds.gaps(front).reshape(SIDE, SIDE, 1), 3, axis=2))
         rows.append(np.concatenate(tiles, axis=1))
     write_sheet(OUT, (np.clip(np.concatenate(rows, axis=0), 0.0, 1.0) * 255 + 0.5).astype(np.uint8))
     print(f"wrote {OUT}")
