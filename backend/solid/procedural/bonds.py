@@ -45,6 +45,11 @@ def _to_face(u: np.ndarray) -> np.ndarray:
     return np.minimum(f, 1.0 - f)
 
 
+def _half_joint(p: dict) -> float:
+    """Half a joint's width, units (``joint`` is in course heights)."""
+    return 0.5 * p["joint"] * p["height"]
+
+
 def units_long(p: dict) -> float:
     """A herringbone unit's length in widths: max(1, round(length / height))."""
     return float(max(1.0, np.floor(p["length"] / p["height"] + 0.5)))
@@ -103,10 +108,10 @@ class Bonds(Family):
 
     def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         d, r = self.units(p, points, seed)
-        return gapped(d, 0.5 * p["joint"] * p["height"], r, p, np.asarray(points, np.float64), seed)
+        return gapped(d, _half_joint(p), r, p, np.asarray(points, np.float64), seed)
 
     def gaps(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
-        return 1.0 - inside(self.units(p, points, seed)[0], 0.5 * p["joint"] * p["height"])
+        return 1.0 - inside(self.units(p, points, seed)[0], _half_joint(p))
 
     def starts(self, est) -> list:
         """Courses: units the photo's repeat across; courses its repeat up (stack bond) or half of it (running
