@@ -246,7 +246,7 @@ def _face(b, t):
 
 def _courses(b, gi, p, w_seed):
     """(distance to the unit's nearest face, the unit's three integers) of the courses pattern, each row of units
-    into the wall moved by its own random fraction (bonds.Bonds.shape); ``w_seed`` the White Noise's W."""
+    into the wall moved by its own random fraction (bonds.Bonds.units); ``w_seed`` the White Noise's W."""
     x, y, z = b.separate(p)
     length, height = gi.outputs["Length"], gi.outputs["Height"]
     w = b.math("DIVIDE", z, height)
