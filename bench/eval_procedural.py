@@ -10,7 +10,9 @@ neighbourhoods, sliced Wasserstein, x 1000; lower is better):
 
 - ``axes``: the mean of the x, y and z cuts' distances (``photo_eval.SLICE_OFFSETS``, two seeds each, grouped as
   ``photo_eval.grouped_swd`` groups them), what each face of a cube shows;
-- ``oblique``: six cuts at random orientations (``photo_eval.OBLIQUE_NORMALS``), as a mesh's faces cut the solid.
+- ``oblique``: six cuts at random orientations (``photo_eval.OBLIQUE_NORMALS``), as a mesh's faces cut the solid;
+- ``axes_band`` and ``oblique_band``: the same over the band-pass levels alone (``photo_eval.band_swd``), without
+  the low-pass residue, where the photo's own crops score worst.
 
 Sets: ``structured``, the photo set's held-out brick, paving, tile and wood photos and the structured photos
 (``data/structured``, ``tools/build_structured_set.py``); ``stochastic``, every ``--every``-th other held-out
@@ -47,6 +49,9 @@ from omninoise.training.solid.photo_set import photo_set
 
 STRUCTURED = ("brick", "paving", "tile", "wood", "marble", "rust")   #: the photo set's structured categories
 SEEDS = 2
+#: the figures per texture: the patch distance of the axis cuts, of all of them pooled and of the oblique cuts, and
+#: the axis and oblique ones over the band-pass levels alone (``photo_eval.band_swd``)
+FIGURES = ("axes", "pooled", "oblique", "axes_band", "oblique_band")
 
 
 class _Field:
@@ -67,8 +72,9 @@ def photos(which: str, every: int) -> list:
 def figures(field: _Field, photo: np.ndarray) -> dict:
     """axes and oblique distances of a texture."""
     g = pe.grouped_swd(slices(field, SEEDS), photo)
-    obl = pe.oblique_slices(field.evaluate, field.px_per_unit)
-    return {"axes": g["axes"], "pooled": g["pooled"], "oblique": pe.rounded_swds(pe.level_distances(obl, photo))[0]}
+    obl = pe.rounded_swds(pe.level_distances(pe.oblique_slices(field.evaluate, field.px_per_unit), photo))
+    return {"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
+            "oblique_band": obl[1]}
 
 
 def gaussian_field(photo: np.ndarray, kind: str) -> _Field:
@@ -96,13 +102,16 @@ def measure(path: str, fitted: dict | None = None) -> dict:
          "choice_distances": choice.distances, "field": field.to_dict()}
     for name, f in (("procedural", field), ("neural", neural)):
         r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
-    for k in ("axes", "pooled"):        # random phase as a solid: the closer kind, figure by figure, as solid-methods
-        r[f"random_phase_solid_{k}"] = min(pe.grouped_swd(random_phase_solid(photo, kind, SEEDS), photo)[k]
-                                           for kind in SOLIDS)
-    r["random_phase_solid_oblique"] = min(
-        pe.rounded_swds(pe.level_distances(pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT),
-                                           photo))[0] for kind in SOLIDS)
-    for k in ("axes", "pooled", "oblique"):
+    rp = []             # random phase as a solid: the closer kind, figure by figure, as solid-methods
+    for kind in SOLIDS:
+        g = pe.grouped_swd(random_phase_solid(photo, kind, SEEDS), photo)
+        obl = pe.rounded_swds(pe.level_distances(pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT),
+                                                 photo))
+        rp.append({"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
+                   "oblique_band": obl[1]})
+    for k in FIGURES:
+        r[f"random_phase_solid_{k}"] = min(f[k] for f in rp)
+    for k in FIGURES:
         r[f"auto_{k}"] = r[f"{choice.method}_{k}"]
     return r, field, neural, photo
 
@@ -111,12 +120,12 @@ def summary(rows: dict) -> dict:
     s = {"photos": len(rows), "median_fit_seconds": round(float(np.median([r["seconds"] for r in rows.values()])), 1),
          "chosen_procedural": sum(r["chosen"] == "procedural" for r in rows.values())}
     for who in ("procedural", "auto"):
-        for k in ("axes", "oblique"):
+        for k in ("axes", "oblique", "axes_band", "oblique_band"):
             s[f"{who}_beats_random_phase_solid_{k}"] = sum(r[f"{who}_{k}"] < r[f"random_phase_solid_{k}"]
                                                           for r in rows.values())
             s[f"{who}_beats_neural_{k}"] = sum(r[f"{who}_{k}"] < r[f"neural_{k}"] for r in rows.values())
             s[f"{who}_farther_than_neural_{k}"] = sum(r[f"{who}_{k}"] > r[f"neural_{k}"] for r in rows.values())
-    for k in ("axes", "oblique"):
+    for k in ("axes", "oblique", "axes_band", "oblique_band"):
         s[f"neural_beats_random_phase_solid_{k}"] = sum(r[f"neural_{k}"] < r[f"random_phase_solid_{k}"]
                                                         for r in rows.values())
         for who in ("procedural", "neural", "random_phase_solid", "auto"):

@@ -109,24 +109,29 @@ def procedural(doc: dict) -> list:
            "distance (lower is better) of the x, y and z cuts (`axes`, two seeds) and of six cuts at random "
            "orientations (`oblique`), for the procedural solid, method auto (the procedural solid where its own check "
            "finds it closer by a margin, else the neural texture), the neural texture (the default) and random phase noise drawn "
-           "as a solid. Counts are photos closer than the named texture.", "",
-           "| texture | median axes | median oblique | closer than random phase solid (axes / oblique) | closer "
-           "than the neural texture (axes / oblique) | farther than the neural texture (axes / oblique) |",
-           "|---|---|---|---|---|---|"]
-    for who, label in (("procedural", "procedural"), ("auto", "auto"), ("neural", "neural (default)"),
-                       ("random_phase_solid", "random phase solid")):
-        rp = (f"{s.get(f'{who}_beats_random_phase_solid_axes', '—')} / "
-              f"{s.get(f'{who}_beats_random_phase_solid_oblique', '—')}") if who in ("procedural", "auto", "neural") \
-            else "—"
-        nb = (f"{s.get(f'{who}_beats_neural_axes')} / {s.get(f'{who}_beats_neural_oblique')}"
-              if who in ("procedural", "auto") else "—")
-        nf = (f"{s.get(f'{who}_farther_than_neural_axes')} / {s.get(f'{who}_farther_than_neural_oblique')}"
-              if who in ("procedural", "auto") else "—")
-        out.append(f"| {label} | {s.get(f'median_{who}_axes')} | {s.get(f'median_{who}_oblique')} | {rp} | {nb} | {nf} |")
+           "as a solid. Counts are photos closer than the named texture.", ""]
+    for sfx, title in (("", None), ("_band", "The same over the band-pass levels alone (`photo_eval.band_swd`: "
+                                              "without the low-pass residue, where a photo's own crops score worst):")):
+        if f"median_procedural_axes{sfx}" not in s:
+            continue
+        out += ([title, ""] if title else []) + [
+            "| texture | median axes | median oblique | closer than random phase solid (axes / oblique) | closer "
+            "than the neural texture (axes / oblique) | farther than the neural texture (axes / oblique) |",
+            "|---|---|---|---|---|---|"]
+        for who, label in (("procedural", "procedural"), ("auto", "auto"), ("neural", "neural (default)"),
+                           ("random_phase_solid", "random phase solid")):
+            def pair(what):
+                return f"{s.get(f'{who}_{what}_axes{sfx}')} / {s.get(f'{who}_{what}_oblique{sfx}')}"
+            rp = pair("beats_random_phase_solid") if who != "random_phase_solid" else "—"
+            nb = pair("beats_neural") if who in ("procedural", "auto") else "—"
+            nf = pair("farther_than_neural") if who in ("procedural", "auto") else "—"
+            out.append(f"| {label} | {s.get(f'median_{who}_axes{sfx}')} | {s.get(f'median_{who}_oblique{sfx}')} | "
+                       f"{rp} | {nb} | {nf} |")
+        out.append("")
     fams = ", ".join(f"{k} {v}" for k, v in s.get("families", {}).items())
     timing = (f" Median fit time {s.get('median_fit_seconds')} s per photo on this machine."
               if doc.get("set") == "structured" else "")
-    out += ["", f"Families fitted: {fams}; auto kept the procedural solid on {s.get('chosen_procedural')} of "
+    out += [f"Families fitted: {fams}; auto kept the procedural solid on {s.get('chosen_procedural')} of "
             f"{n}.{timing}", ""]
     return out
 
