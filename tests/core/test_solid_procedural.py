@@ -320,6 +320,25 @@ def test_a_photo_drawn_by_a_family_is_fitted_by_that_family():
     assert fit.tried == 2 * sum(len(f.starts(estimate(photo, PX_PER_UNIT))) for f in FAMILIES.values()) + 2 * 24
 
 
+@pytest.mark.parametrize("length, height, offset", [(0.5, 0.25, 0.5), (0.3, 0.3, 0.0), (0.4, 0.2, 0.25),
+                                                    (0.36, 0.18, 1 / 3)])
+def test_a_wall_s_courses_are_read_off_the_photo_and_kept_by_the_fit(length, height, offset):
+    """A wall drawn in courses (a running bond, a stack bond of square tiles, bonds shifted by a quarter and a
+    third of a unit): the estimate reads the units' length, and the courses' height and shift, and a fit asked for
+    bonds keeps them (the fit's loss does not see which way a lattice's units line up)."""
+    ramp = Ramp((-1.0, 0.0, 2.0), ((0.9, 0.9, 0.85), (0.45, 0.2, 0.15), (0.6, 0.3, 0.2)))
+    truth = ProceduralField("bonds", dict(length=length, height=height, offset=offset, joint=0.12, turbulence=0.05,
+                                          turb_freq=2.0, detail=0.05, flip=True), ramp, seed=3)
+    photo = truth.image(256, offset=(0.0, 0.0, 0.0))
+    est = estimate(photo, PX_PER_UNIT)
+    assert est.spacing_x == pytest.approx(length, abs=1.5 / PX_PER_UNIT)
+    assert est.courses[0] == pytest.approx(height, abs=1.5 / PX_PER_UNIT)
+    assert min(abs(est.courses[1] - offset), 1 - abs(est.courses[1] - offset)) < 0.03, est.courses
+    fit = fit_procedural(photo, ProceduralConfig(side=64, budget=8, families=("bonds",))).field
+    assert (fit.params["length"], fit.params["height"], fit.params["offset"]) == (
+        Bonds().starts(est)[0]["length"], est.courses[0], est.courses[1])
+
+
 @pytest.mark.parametrize("pattern, n", [("herringbone", 2), ("herringbone", 3), ("herringbone45", 2),
                                         ("herringbone45", 3)])
 def test_a_herringbone_photo_asked_for_herringbones_is_fitted_by_its_own(pattern, n):

@@ -114,13 +114,14 @@ class Bonds(Family):
         return 1.0 - inside(self.units(p, points, seed)[0], _half_joint(p))
 
     def starts(self, est) -> list:
-        """Courses: units the photo's repeat across; courses its repeat up (stack bond) or half of it (running
-        bond, which repeats every second course); joints dark or pale as the photo's are (``est.dark_gaps``)."""
+        """Courses: units the photo's repeat across long, courses as high and shifted as the photo's
+        (``est.courses``: a running bond's courses are half its repeat up, each shifted half a unit); joints dark
+        or pale as the photo's are (``est.dark_gaps``)."""
         length = float(np.clip(est.spacing_x, 0.021, 1.9))
-        return [dict(length=length, height=float(np.clip(k * est.spacing_z, 0.011, 0.95)), offset=off, joint=0.15,
+        height, offset = est.courses
+        return [dict(length=length, height=float(np.clip(height, 0.011, 0.95)), offset=float(offset), joint=0.15,
                      turbulence=0.1, detail=0.1, turb_freq=float(np.clip(0.5 / length, 0.3, 15.0)),
-                     flip=not est.dark_gaps, pattern="courses")
-                for k, off in ((0.5, 0.5), (1.0, 0.0))]
+                     flip=not est.dark_gaps, pattern="courses")]
 
     def herringbone_starts(self, est) -> list:
         """Herringbones of units n widths long, joints dark or pale as the photo's are.  The turned one repeats

@@ -10,6 +10,12 @@ every family's search.
   again at every multiple of its repeat, and the highest of those peaks is as often two tiles as one), or, where it
   has none above PEAK, CORRELATION_SCALE times the distance over which it falls to a half (a stone's, a blotch's
   size).
+- **Courses**: how the units of a wall repeat up, read off the same autocorrelation.  A stack bond repeats every
+  course, straight up: its peak at (0, spacing_z) is the course's.  A running bond repeats straight up every second
+  course, and every course half a unit along; a raking bond by a third every third.  So where the autocorrelation
+  a third (else a half) of the repeat up, at its highest along a unit's length, is at least FUNDAMENTAL of that at
+  (0, spacing_z), the courses are that high, each shifted along x by where that highest is, else they are
+  spacing_z high and stacked (as where the photo has no peak up: no courses to read).
 - **Dark gaps**: whether the luminance's skewness (its third standardised moment) is negative, its long thin tail
   dark.  Grout, mortar, cracks and the gaps between stones are a minority of the photo's pixels: dark grout skews
   it dark, pale mortar bright.  The gapped families (cells, bonds) give their gaps the ramp's dark end where it is
@@ -25,25 +31,28 @@ import numpy as np
 
 from .ramp import luminance
 
-__all__ = ["Estimates", "estimate", "repeat_length", "CORRELATION_SCALE"]
+__all__ = ["Estimates", "estimate", "repeat_length", "courses", "CORRELATION_SCALE"]
 
 CORRELATION_SCALE = 4.0    #: a repeat where the autocorrelation has no peak: this many of its half-fall lengths
 BAND = (1.5, 24.0)         #: the band-pass's Gaussians, sigma in px
 MIN_LAG = 6                #: shorter repeats are grain
 PEAK = 0.1                 #: a peak lower than this is chance
 FUNDAMENTAL = 0.8          #: the repeat is the first peak at least this share of the highest
+COURSES = (3, 2)           #: the courses a wall's repeat up may hold, most first (raking bonds, running bonds)
 
 
 @dataclass(frozen=True)
 class Estimates:
     """``spacing`` (units) along, and ``angle`` (radians from +x towards +z) of, the wave vector across the
     photo's stripes; ``spacing_x`` and ``spacing_z``: the repeats along x and along z, units; ``diagonals``: the
-    repeats along the diagonals at 45 and 135 degrees from +x, units; ``dark_gaps``: the luminance skews dark."""
+    repeats along the diagonals at 45 and 135 degrees from +x, units; ``courses``: (a course's height, units; each
+    course's shift along x, in units of ``spacing_x``, in [0, 1)); ``dark_gaps``: the luminance skews dark."""
     spacing: float
     angle: float
     spacing_x: float
     spacing_z: float
     diagonals: tuple
+    courses: tuple
     dark_gaps: bool
 
 
@@ -59,20 +68,38 @@ def repeat_length(profile: np.ndarray) -> float:
     return float(CORRELATION_SCALE * (half[0] if len(half) else len(c)))
 
 
-def _ray(ac: np.ndarray, angle: float, n: int) -> np.ndarray:
-    """The autocorrelation (centred at [0, 0], wrapping) along a ray at ``angle`` (z up = rows up), n lags one px
-    apart, read bilinearly (rounded positions would wobble the lags and raise false peaks)."""
-    t = np.arange(n)
-    r, c = -t * np.sin(angle), t * np.cos(angle)
+def _at(ac: np.ndarray, dx, dz) -> np.ndarray:
+    """The autocorrelation (centred at [0, 0], wrapping) at lags (dx, dz) px, z up = rows up, read bilinearly
+    (rounded positions would wobble the lags and raise false peaks)."""
+    r, c = np.broadcast_arrays(-np.asarray(dz, np.float64), np.asarray(dx, np.float64))
     r0, c0 = np.floor(r), np.floor(c)
     fr, fc = r - r0, c - c0
     i, j = r0.astype(np.int64), c0.astype(np.int64)
     h, w = ac.shape
 
-    def at(dr, dc):
-        return ac[(i + dr) % h, (j + dc) % w]
+    def at(dr, dcol):
+        return ac[(i + dr) % h, (j + dcol) % w]
 
-    return ((1 - fr) * ((1 - fc) * at(0, 0) + fc * at(0, 1)) + fr * ((1 - fc) * at(1, 0) + fc * at(1, 1)))
+    return (1 - fr) * ((1 - fc) * at(0, 0) + fc * at(0, 1)) + fr * ((1 - fc) * at(1, 0) + fc * at(1, 1))
+
+
+def _ray(ac: np.ndarray, angle: float, n: int) -> np.ndarray:
+    """The autocorrelation along a ray at ``angle`` (radians from +x towards +z), n lags one px apart."""
+    t = np.arange(n)
+    return _at(ac, t * np.cos(angle), t * np.sin(angle))
+
+
+def courses(ac: np.ndarray, across: float, up: float) -> tuple:
+    """(a course's height, each course's shift along x in units of ``across``, in [0, 1)) from the
+    autocorrelation ``ac`` and the repeats ``across`` and ``up``, px (module doc): the height in px."""
+    top = float(_at(ac, 0.0, up))
+    lags = np.arange(max(int(round(across)), 1), dtype=np.float64)
+    for k in COURSES:
+        row = _at(ac, lags, up / k)
+        if up / k >= MIN_LAG and top > PEAK and row.max() >= FUNDAMENTAL * top:
+            # a course up, the photo reads as itself shifted back by the courses' shift: the peak is at -shift
+            return up / k, float(-lags[int(np.argmax(row))] / max(across, 1.0)) % 1.0
+    return up, 0.0
 
 
 def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
@@ -91,7 +118,8 @@ def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
     ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
     ac /= max(ac[0, 0], 1e-12)
     n = min(H, W) // 2
-    return Estimates(repeat_length(_ray(ac, angle, n)) / px_per_unit, angle,
-                     repeat_length(ac[0, :W // 2]) / px_per_unit, repeat_length(ac[:H // 2, 0]) / px_per_unit,
+    across, up = repeat_length(ac[0, :W // 2]), repeat_length(ac[:H // 2, 0])
+    height, shift = courses(ac, across, up)
+    return Estimates(repeat_length(_ray(ac, angle, n)) / px_per_unit, angle, across / px_per_unit, up / px_per_unit,
                      tuple(repeat_length(_ray(ac, a, n)) / px_per_unit for a in (0.25 * np.pi, 0.75 * np.pi)),
-                     dark_gaps)
+                     (height / px_per_unit, shift), dark_gaps)

@@ -39,6 +39,10 @@ __all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "FIT_PLANES", 
 
 #: a start's textured twin: turbulence and detail amplitudes, and the factor on its turbulence's frequency
 TEXTURED = (0.35, 0.35, 4.0)
+#: what the photo measures and the search keeps, by pattern: bonds in courses keep the units' length, the courses'
+#: height and shift read off the photo's autocorrelation (estimate.py); the fit's loss, patch statistics, does not
+#: see which way a lattice's units line up, and moved tile grids' courses into running bonds
+MEASURED = {"courses": ("length", "height", "offset")}
 #: the fit's planes: (normal, a point on it), in units, two across each axis and two oblique: the loss weighs the
 #: groups alike (loss.py), as the held-out evaluation weighs a cube's faces and a mesh's oblique cuts
 FIT_PLANES = (((1.0, 0.0, 0.0), (0.31, 0.17, -0.4)), ((1.0, 0.0, 0.0), (-0.83, 0.6, 0.35)),
@@ -120,14 +124,21 @@ def _textured(p: dict) -> dict:
     return dict(p, turbulence=turb, detail=detail, turb_freq=float(min(k * p["turb_freq"], 15.9)))
 
 
+def _searched(fam, start: dict) -> tuple:
+    """The parameters the search moves from ``start``: all of the family's but those the photo measured
+    (:data:`MEASURED`)."""
+    return tuple(q for q in fam.params() if q.name not in MEASURED.get(start.get("pattern"), ()))
+
+
 def _pack(fam, p: dict) -> np.ndarray:
-    return np.array([q.to_unit(p[q.name]) for q in fam.params()])
+    return np.array([q.to_unit(p[q.name]) for q in _searched(fam, p)])
 
 
 def _unpack(fam, x: np.ndarray, fixed: dict) -> dict:
-    """The parameters at search coordinates ``x``, with the start's (``fixed``) discrete settings; a herringbone's
-    units keep the start's whole number of widths (its length follows its width)."""
-    p = {q.name: q.from_unit(u) for q, u in zip(fam.params(), x)}
+    """The parameters at search coordinates ``x``, with the start's (``fixed``) measured and discrete settings; a
+    herringbone's units keep the start's whole number of widths (its length follows its width)."""
+    p = {q.name: fixed[q.name] for q in fam.params()}
+    p.update({q.name: q.from_unit(u) for q, u in zip(_searched(fam, fixed), x)})
     p.update({k: v for k, v in fixed.items() if k in ("flip", "profile", "pattern")})
     if p.get("pattern", "courses") != "courses":
         p["length"] = float(np.clip(units_long(fixed) * p["height"], 0.02, 2.0))
