@@ -192,6 +192,32 @@ def solid_tile():
     return mat
 
 
+def procedural(name: str, photo: str, kinds: tuple):
+    """A material drawing a procedural solid of ``kinds`` fitted to ``photo`` (a path under the repository) live
+    from its node group, in object space; the joints of cells and bricks sunk by their Gap Mask."""
+    from omninoise.backend.solid.procedural.fit import ProceduralConfig, fit_procedural
+    from omninoise.blender_addon.procedural_nodes import add_procedural_node, build_procedural_group
+    from omninoise.export import read_rgb
+
+    field = fit_procedural(read_rgb(os.path.join(ROOT, photo)), ProceduralConfig(families=kinds)).field
+    mat, nt, bsdf = _material(name)
+    node = add_procedural_node(nt, build_procedural_group(field, name=name), (-600, 0))
+    nt.links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
+    bsdf.inputs["Roughness"].default_value = 0.6
+    if "Gap Mask" in node.outputs:
+        b = nt.nodes.new("ShaderNodeBump")
+        b.location, b.invert = (-300, -300), True
+        b.inputs["Strength"].default_value = 0.4
+        nt.links.new(node.outputs["Gap Mask"], b.inputs["Height"])
+        nt.links.new(b.outputs["Normal"], bsdf.inputs["Normal"])
+    return mat
+
+
+def _procedural(name, photo, kinds):
+    return lambda: procedural(name, photo, kinds)
+
+
+_EDIT = "; its sizes, turbulence and seed are the node group's inputs"
 #: (builder, catalog, description, tags, preview shape)
 MATERIALS = [
     (marble, "OmniNoise/Materials", "White marble with grey veins that run on through the object (wave noise)",
@@ -206,6 +232,15 @@ MATERIALS = [
      "Perlin, spots, Damascus), projected without UVs", ["neural noise", "blend"], "sphere"),
     (solid_tile, "OmniNoise/Materials", "A seamless brick tile made from a photo (data/exemplars/brick.png, CC0), "
      "projected without UVs", ["brick", "solid texture", "photo"], "sphere"),
+    (_procedural("Procedural Brick Wall", "data/photos/val/brick__tex_trak_trak4_brick2a.jpg", ("bonds",)),
+     "OmniNoise/Materials", "Bricks in a running bond whose courses run on round corners: a procedural solid fitted "
+     "to a photo (trak4_brick2a by Georges Grondin, Expat licence)" + _EDIT, ["brick", "procedural solid"], "sphere"),
+    (_procedural("Procedural Tile Grid", "data/structured/tile__tile03.jpg", ("bonds",)),
+     "OmniNoise/Materials", "Square tiles stacked in a grid, in 3D: a procedural solid fitted to a photo (ufoai "
+     "tile03, public domain)" + _EDIT, ["tiles", "procedural solid"], "sphere"),
+    (_procedural("Procedural Wood Grain", "data/exemplars/wood.png", ("layers",)),
+     "OmniNoise/Materials", "Straight-grained wood whose grain runs through the object: a procedural solid fitted "
+     "to the project's generated wood exemplar" + _EDIT, ["wood", "grain", "procedural solid"], "sphere"),
 ]
 
 
@@ -368,7 +403,7 @@ def build(out_blend: str = BLEND, sheet: str | None = SHEET) -> list:
 
 
 def _sheet(pngs: list, path: str) -> None:
-    """The previews side by side, each named, as one PNG (numpy and Blender's image API only)."""
+    """The previews side by side, four to a row, as one PNG (numpy and Blender's image API only)."""
     from omninoise.export.images import write_png
 
     tiles = []
@@ -381,7 +416,8 @@ def _sheet(pngs: list, path: str) -> None:
         bpy.data.images.remove(ima)
     cols = 4
     rows = -(-len(tiles) // cols)
-    sheet = np.ones((rows * PREVIEW, cols * PREVIEW, 3), np.float32)
+    sheet = np.empty((rows * PREVIEW, cols * PREVIEW, 3), np.float32)
+    sheet[:] = tiles[0][0, 0]           # a free cell is the previews' background
     for i, t in enumerate(tiles):
         r, c = divmod(i, cols)
         sheet[r * PREVIEW:(r + 1) * PREVIEW, c * PREVIEW:(c + 1) * PREVIEW] = t

@@ -18,7 +18,8 @@ from asset_scene import render_assets  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BLEND = os.path.join(preferences.ASSETS, "omninoise_assets.blend")
-MATERIALS = ["Wave Noise Marble", "Veined Stone", "Cellular Tiles", "Neural Noise Blend", "Solid Texture Brick"]
+MATERIALS = ["Wave Noise Marble", "Veined Stone", "Cellular Tiles", "Neural Noise Blend", "Solid Texture Brick",
+             "Procedural Brick Wall", "Procedural Tile Grid", "Procedural Wood Grain"]
 GROUPS = ["Wave Noise", "Wave Cellular"]
 OBJECTS = ["Cloud Volume"]
 REQUIRED = os.environ.get("OMNINOISE_REQUIRE_EEVEE") == "1"
@@ -66,6 +67,15 @@ def test_every_asset_appends_with_its_preview_description_and_catalog():
     marble = bpy.data.materials["Wave Noise Marble"]
     tree = next(n.node_tree for n in marble.node_tree.nodes if n.type == "GROUP")
     assert tree.omninoise_wave.is_wave and not tree.omninoise_wave.error   # the Wave Noise panel edits it
+    # the procedural solids draw their fitted field live: a running bond, a stack bond of tiles, straight grain
+    from omninoise.blender_addon.procedural_nodes import FIELD_KEY
+
+    for name, family, offset in (("Procedural Brick Wall", "bonds", 0.5), ("Procedural Tile Grid", "bonds", 0.0),
+                                 ("Procedural Wood Grain", "layers", None)):
+        group = next(n.node_tree for n in bpy.data.materials[name].node_tree.nodes if n.type == "GROUP")
+        assert json.loads(group[FIELD_KEY])["family"] == family, name
+        if offset is not None:
+            assert group.interface.items_tree["Offset"].default_value == pytest.approx(offset, abs=1e-6), name
     for idb in list(dst.objects):
         bpy.data.objects.remove(idb)
     for idb in list(dst.materials) + list(dst.node_groups):
