@@ -1,5 +1,7 @@
 """The procedural solids (backend/solid/procedural): each family's geometry, the ramp's colours, the photo's
 estimates, the search, the field's JSON, and a fit that finds the family and sizes a photo was drawn with."""
+import os
+
 import numpy as np
 import pytest
 
@@ -19,6 +21,7 @@ from omninoise.backend.solid.procedural.ramp import Ramp, fit_ramp, luminance, p
 from omninoise.backend.solid.procedural.rings import Rings
 from omninoise.backend.solid.procedural.search import minimise
 
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CALM = dict(turbulence=0.0, turb_freq=1.0, detail=0.0)
 
 
@@ -337,6 +340,22 @@ def test_a_wall_s_courses_are_read_off_the_photo_and_kept_by_the_fit(length, hei
     fit = fit_procedural(photo, ProceduralConfig(side=64, budget=8, families=("bonds",))).field
     assert (fit.params["length"], fit.params["height"], fit.params["offset"]) == (
         Bonds().starts(est)[0]["length"], est.courses[0], est.courses[1])
+
+
+@pytest.mark.parametrize("photo, length, height, offset", [
+    ("photos/val/brick__tex_trak_trak4_brick2a.jpg", 64, 32, 0.5),     # a running bond of 64 x 32 px bricks
+    ("structured/tile__tile01.jpg", 64, 64, 0.0),                      # grids of square tiles
+    ("structured/tile__tile02.jpg", 37, 37, 0.0),
+    ("structured/tile__tile03.jpg", 43, 43, 0.0)])
+def test_held_out_walls_are_read_as_they_are_laid(photo, length, height, offset):
+    """The courses of photos the evaluation holds out (their sizes counted by eye in px): a running bond, and tile
+    grids as stack bonds, not running bonds of half-height units."""
+    from omninoise.export import read_rgb
+
+    est = estimate(read_rgb(os.path.join(ROOT, "data", photo)), PX_PER_UNIT)
+    assert est.spacing_x * PX_PER_UNIT == pytest.approx(length, abs=2)
+    assert est.courses[0] * PX_PER_UNIT == pytest.approx(height, abs=2)
+    assert min(abs(est.courses[1] - offset), 1 - abs(est.courses[1] - offset)) < 0.05, est.courses
 
 
 @pytest.mark.parametrize("pattern, n", [("herringbone", 2), ("herringbone", 3), ("herringbone45", 2),
