@@ -117,7 +117,9 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
         ("RINGS", "Rings", "Growth rings around an axis: ring-cut wood, knots"),
         ("LAYERS", "Layers", "A profile along a bent direction: marble veins, strata, straight grain"),
         ("CELLS", "Cells", "Stones, pebbles, flakes and spots with gaps between them"),
-        ("BONDS", "Bonds", "Bricks and tiles in courses: running, stack and raking bonds"),
+        ("BONDS", "Bonds", "Bricks and tiles in courses (running, stack and raking bonds), as long, high and "
+                           "shifted as the photo's. Pick it alone for a brick wall or a tile grid: with the other "
+                           "kinds the fit often draws stones or blotches there"),
         ("HERRINGBONE", "Herringbone", "Bricks laid in a herringbone, straight or turned 45 degrees (tried only "
                                        "when picked)")],
                            default={"RINGS", "LAYERS", "CELLS", "BONDS"})
