@@ -69,12 +69,17 @@ def photos(which: str, every: int) -> list:
     return [f for f in val if os.path.basename(f).split("__")[0] not in STRUCTURED][::every]
 
 
-def figures(field: _Field, photo: np.ndarray) -> dict:
-    """axes and oblique distances of a texture."""
-    g = pe.grouped_swd(slices(field, SEEDS), photo)
-    obl = pe.rounded_swds(pe.level_distances(pe.oblique_slices(field.evaluate, field.px_per_unit), photo))
+def _figures(axes: dict, oblique: list, photo: np.ndarray) -> dict:
+    """:data:`FIGURES` of a texture's axis cuts ({axis: [images]}) and oblique cuts ([images])."""
+    g = pe.grouped_swd(axes, photo)
+    obl = pe.rounded_swds(pe.level_distances(oblique, photo))
     return {"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
             "oblique_band": obl[1]}
+
+
+def figures(field: _Field, photo: np.ndarray) -> dict:
+    """:data:`FIGURES` of a texture drawn anywhere."""
+    return _figures(slices(field, SEEDS), pe.oblique_slices(field.evaluate, field.px_per_unit), photo)
 
 
 def gaussian_field(photo: np.ndarray, kind: str) -> _Field:
@@ -102,13 +107,9 @@ def measure(path: str, fitted: dict | None = None) -> dict:
          "choice_distances": choice.distances, "field": field.to_dict()}
     for name, f in (("procedural", field), ("neural", neural)):
         r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
-    rp = []             # random phase as a solid: the closer kind, figure by figure, as solid-methods
-    for kind in SOLIDS:
-        g = pe.grouped_swd(random_phase_solid(photo, kind, SEEDS), photo)
-        obl = pe.rounded_swds(pe.level_distances(pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT),
-                                                 photo))
-        rp.append({"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
-                   "oblique_band": obl[1]})
+    # random phase as a solid: the closer kind, figure by figure, as solid-methods
+    rp = [_figures(random_phase_solid(photo, kind, SEEDS),
+                   pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT), photo) for kind in SOLIDS]
     for k in FIGURES:
         r[f"random_phase_solid_{k}"] = min(f[k] for f in rp)
     for k in FIGURES:
