@@ -2,11 +2,13 @@
 own Wave Texture, the node artists build wood and marble from by hand.
 
 The scene of ``python -m bench node`` (a plane filling an orthographic camera's R x R frame, emission shader,
-Cycles on the CPU), one group per family with the settings of the parity tests
+Cycles on the CPU), one group per family read through its sRGB output (the ramp's colours, as the Wave Texture's
+Color is read) with the settings of the parity tests
 (tests/blender/test_procedural_blender.py), each rendered once to compile and then timed; nanoseconds per
 pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
-Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone, and each family
-also with its noises' amplitudes (Turbulence, Grain, Detail) at 0, which Cycles folds away.  Writes
+Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone, layers also with
+a tint (backend/solid/procedural/tint.py: one more Wave Noise group), and each family also with its noises'
+amplitudes (Turbulence, Grain, Detail, Tint) at 0, which Cycles folds away.  Writes
 docs/benchmarks/procedural_node.json, with Blender's version.
 
     python -m bench procedural-node [--res 128] [--samples 4] [--repeat 2]
@@ -26,6 +28,7 @@ from bench.bench_node import _timed, scene, shade, texture
 from bench.stamp import stamp
 from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.procedural.ramp import fit_ramp
+from omninoise.backend.solid.procedural.tint import fit_tint
 from omninoise.blender_addon.procedural_nodes import build_procedural_group
 from omninoise.export.atomic import write_json
 
@@ -37,8 +40,9 @@ PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centr
           "herringbone": dict(length=0.5, height=0.16, offset=0.3, joint=0.15, pattern="herringbone45")}
 
 
-def procedural(case: str, noise: bool = True):
-    """A group of the family ``case`` (a key of PARAMS); ``noise`` False: Turbulence, Grain and Detail at 0."""
+def procedural(case: str, noise: bool = True, tint: bool = False):
+    """A group of the family ``case`` (a key of PARAMS); ``noise`` False: Turbulence, Grain, Detail and Tint at 0;
+    ``tint``: with a tint (a random photo's, at 2 cycles per unit, as the parity tests draw it)."""
     def make(nt):
         rng = np.random.default_rng(0)
         family = "bonds" if case == "herringbone" else case
@@ -47,15 +51,18 @@ def procedural(case: str, noise: bool = True):
             p.update(turbulence=0.0, detail=0.0)
             if "grain" in p:
                 p["grain"] = 0.0
-        f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3)
+        t = fit_tint(rng.uniform(0, 1, (32, 32, 3)), 2.0, 3) if tint else None
+        f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3, tint=t)
         grp = build_procedural_group(f)
         n = nt.nodes.new("ShaderNodeGroup")
         n.node_tree = grp
+        if tint and not noise:
+            n.inputs["Tint"].default_value = 0.0
 
         def count(tree):
             return sum(1 + (count(x.node_tree) if x.bl_idname == "ShaderNodeGroup" else 0) for x in tree.nodes)
 
-        return (n.inputs["Vector"], n.outputs["Value"]), count(grp)
+        return (n.inputs["Vector"], n.outputs["sRGB"]), count(grp)
     return make
 
 
@@ -68,7 +75,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     cases = [("Blender Wave Texture", texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0))]
     cases += [(f"Procedural {f}", procedural(f)) for f in PARAMS]
+    cases += [("Procedural layers, tinted", procedural("layers", tint=True))]
     cases += [(f"Procedural {f}, noises at 0", procedural(f, noise=False)) for f in PARAMS if f != "herringbone"]
+    cases += [("Procedural layers, tinted, noises at 0", procedural("layers", noise=False, tint=True))]
     res = {}
     for name, make in cases:
         times = {}

@@ -14,6 +14,9 @@ parameters are the group's inputs for an artist to turn.
   and weighed by its amplitude input (an amplitude of 0 leaves its group out of a Cycles render: :func:`_plus`);
 * the ramp as a sum of clamped Map Range nodes (one per stop interval: exact piecewise-linear colours; a Color Ramp
   node is sampled into a 256-entry table in Cycles);
+* where the field has a tint (backend/solid/procedural/tint.py), a Wave Noise group for seed + tint.SEED_OFFSET read
+  at Tint Frequency through the tint's levels (Map Range nodes again), times Tint (a Multiply: a Tint of 0 leaves
+  the group out of a Cycles render), along the tint's colour axis, added to the colour;
 * for cells and bonds, the Gap Mask: 1 less how far p lies inside its cell or unit (family.inside).
 
 The field's JSON is stored on the tree (``tree["omninoise_procedural"]``) so the panel can rebuild it.
@@ -38,6 +41,8 @@ PARAMETERS = {
     "bonds": (("Length", "length"), ("Height", "height"), ("Offset", "offset"), ("Joint", "joint")),
 }
 SHARED = (("Turbulence", "turbulence"), ("Turbulence Frequency", "turb_freq"), ("Detail", "detail"))
+#: the sockets of a field with a tint: its amount (1 draws the photo's) and its noise's frequency
+TINT = ("Tint", "Tint Frequency")
 TIPS = {"Spacing": "Distance between rings or layers (texture units)",
         "Axis": "Direction of the rings' axis", "Centre": "A point on the rings' axis (texture units)",
         "Grain": "Streaks along the axis", "Normal": "Direction across the layers",
@@ -50,6 +55,9 @@ TIPS = {"Spacing": "Distance between rings or layers (texture units)",
         "Joint": "Joint width, in course heights", "Turbulence": "How far the noise bends the pattern",
         "Turbulence Frequency": "The bending noise's frequency (cycles per texture unit)",
         "Detail": "Fine noise within the pattern", "Scale": "Texture units per Blender unit",
+        "Tint": "How much of the photo's colour variation that brightness does not explain is drawn, in patches of "
+                "its own (1: the photo's, 0: none)",
+        "Tint Frequency": "The tint's patches' frequency (cycles per texture unit)",
         "Gap Mask": "1 in the joints and gaps, 0 on the bricks and cells, between at their edges (into a Bump "
                     "node's Height with Invert on, the mortar sinks)"}
 
@@ -70,6 +78,8 @@ def _socket_values(field) -> dict:
     for name, key in PARAMETERS[field.family] + SHARED:
         if key in p:
             out[name] = p[key]
+    if field.tint is not None:
+        out.update({"Tint": 1.0, "Tint Frequency": field.tint.frequency})
     return out
 
 
@@ -98,7 +108,10 @@ def _interface(tree, field) -> None:
 
     values = _socket_values(field)
     bounds = _bounds(field.family)
-    for name in ["Vector", "Scale"] + [n for n, _ in PARAMETERS[field.family] + SHARED]:
+    if field.tint is not None:
+        bounds.update({"Tint": (0.0, None), "Tint Frequency": (0.01, None)})
+    tint = TINT if field.tint is not None else ()
+    for name in ["Vector", "Scale"] + [n for n, _ in PARAMETERS[field.family] + SHARED] + list(tint):
         vector = name in ("Vector", "Axis", "Centre", "Normal")
         s = tree.interface.new_socket(name, in_out="INPUT",
                                       socket_type="NodeSocketVector" if vector else "NodeSocketFloat")
@@ -299,17 +312,21 @@ def _bonds(b, gi, p, seed, groups, pattern):
     return b.math("MULTIPLY_ADD", e, _inner(b, gi, p, seed, groups, white), -1.0), e
 
 
-def _ramp(b, s, ramp):
-    """Piecewise-linear colours of ``ramp`` at value socket ``s``: c0 + sum_k (c_k+1 - c_k) clamp(t_k, 0, 1)."""
-    x = np.asarray(ramp.positions, np.float64)
-    c = np.asarray(ramp.colours, np.float64)
-    acc = tuple(c[0])
+def _ramp(b, s, positions, values):
+    """Piecewise linear ``values`` (K,) or colours (K, 3) at stops ``positions`` (K,) read at value socket ``s``:
+    c0 + sum_k (c_k+1 - c_k) clamp(t_k, 0, 1), t_k = (s - x_k) / (x_k+1 - x_k); constant beyond the ends."""
+    x = np.asarray(positions, np.float64)
+    c = np.asarray(values, np.float64)
+    acc = tuple(c[0]) if c.ndim == 2 else float(c[0])
     for k in range(len(x) - 1):
         m = b.new("ShaderNodeMapRange", data_type="FLOAT", interpolation_type="LINEAR", clamp=True)
         b.put(m.inputs["Value"], s)
         m.inputs["From Min"].default_value, m.inputs["From Max"].default_value = float(x[k]), float(x[k + 1])
         m.inputs["To Min"].default_value, m.inputs["To Max"].default_value = 0.0, 1.0
-        acc = b.vmath("MULTIPLY_ADD", m.outputs["Result"], tuple(c[k + 1] - c[k]), acc)
+        if c.ndim == 2:
+            acc = b.vmath("MULTIPLY_ADD", m.outputs["Result"], tuple(c[k + 1] - c[k]), acc)
+        else:
+            acc = b.math("MULTIPLY_ADD", m.outputs["Result"], float(c[k + 1] - c[k]), acc)
     return acc
 
 
@@ -347,7 +364,14 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
     from ..backend.solid.procedural.family import DETAIL_FREQ
 
     s = _plus(b, gi.outputs["Detail"], _turbulence(b, groups, seed + 2, p, DETAIL_FREQ), s)
-    colour = _ramp(b, s, field.ramp)
+    colour = _ramp(b, s, field.ramp.positions, field.ramp.colours)
+    if field.tint is not None:
+        from ..backend.solid.procedural.tint import SEED_OFFSET
+
+        t = field.tint
+        u = _turbulence(b, groups, seed + SEED_OFFSET, p, gi.outputs["Tint Frequency"])
+        amount = b.math("MULTIPLY", gi.outputs["Tint"], _ramp(b, u, t.positions, t.levels))
+        colour = b.vmath("MULTIPLY_ADD", b.combine(amount, amount, amount), tuple(t.axis), colour)
     srgb = b.vmath("MINIMUM", b.vmath("MAXIMUM", colour, (0.0, 0.0, 0.0)), (1.0, 1.0, 1.0))
     b.put(go.inputs["sRGB"], srgb)
     b.put(go.inputs["Color"], b.combine(*(_to_linear(b, c) for c in b.separate(srgb))))

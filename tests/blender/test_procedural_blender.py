@@ -14,6 +14,7 @@ from omninoise.backend.colour import srgb_to_linear  # noqa: E402
 from omninoise.backend.solid.procedural import fit  # noqa: E402
 from omninoise.backend.solid.procedural.field import ProceduralField  # noqa: E402
 from omninoise.backend.solid.procedural.ramp import fit_ramp  # noqa: E402
+from omninoise.backend.solid.procedural.tint import fit_tint  # noqa: E402
 from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
 from omninoise.blender_addon.procedural_nodes import FIELD_KEY, add_procedural_node, build_procedural_group  # noqa: E402,E501
@@ -26,6 +27,8 @@ FAMILY_PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3
                  "bonds": dict(length=0.4, height=0.13, offset=0.5, joint=0.15),
                  "herringbone": dict(length=0.3, height=0.11, offset=0.5, joint=0.15, pattern="herringbone"),
                  "herringbone45": dict(length=0.5, height=0.16, offset=0.3, joint=0.15, pattern="herringbone45")}
+#: the cases drawn with a tint (tint.py): a random photo's, at 2 cycles per unit
+TINTED = ("layers", "cells")
 
 
 def _field(case: str) -> ProceduralField:
@@ -34,7 +37,8 @@ def _field(case: str) -> ProceduralField:
     p = dict(FAMILY_PARAMS[case], turbulence=0.3, turb_freq=2.0, detail=0.2, flip=False)
     draft = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 8), rng.uniform(0, 1, (16, 3))), seed=3)
     values = draft.values(rng.uniform(-2, 2, (4000, 3)))
-    return ProceduralField(family, p, fit_ramp(values, rng.uniform(0, 1, (16, 3))), seed=3)
+    tint = fit_tint(rng.uniform(0, 1, (32, 32, 3)), 2.0, 3) if case in TINTED else None
+    return ProceduralField(family, p, fit_ramp(values, rng.uniform(0, 1, (16, 3))), seed=3, tint=tint)
 
 
 @pytest.mark.parametrize("family", list(FAMILY_PARAMS))
@@ -86,6 +90,15 @@ def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
         assert ProceduralField.from_dict(__import__("json").loads(grp[FIELD_KEY])).to_dict() == f.to_dict()
     finally:
         bpy.data.node_groups.remove(grp)
+    f = _field("cells")                                           # a tinted field: its amount and frequency too
+    grp = build_procedural_group(f)
+    try:
+        names = [s.name for s in grp.interface.items_tree if s.in_out == "INPUT"]
+        assert names[-2:] == ["Tint", "Tint Frequency"]
+        assert grp.interface.items_tree["Tint"].default_value == 1.0
+        assert grp.interface.items_tree["Tint Frequency"].default_value == pytest.approx(f.tint.frequency)
+    finally:
+        bpy.data.node_groups.remove(grp)
 
 
 def test_the_group_s_sliders_stop_where_the_engine_s_parameters_do():
@@ -110,24 +123,40 @@ def test_the_group_s_sliders_stop_where_the_engine_s_parameters_do():
             bpy.data.node_groups.remove(grp)
 
 
+def _summed(node):
+    """(the nodes reading it, the last node) of the chain of Multiply Adds that sums the intervals of the Map Range
+    ``node`` and the others on its chain."""
+    n = node.outputs["Result"].links[0].to_node
+    while n.outputs[0].links and all(lk.to_node.bl_idname == "ShaderNodeMath" and lk.to_node.operation ==
+                                     "MULTIPLY_ADD" for lk in n.outputs[0].links):
+        n = n.outputs[0].links[0].to_node
+    return [lk.to_node for lk in n.outputs[0].links], n
+
+
 @pytest.mark.parametrize("family", ["rings", "layers", "cells", "bonds"])
 def test_each_noise_is_read_through_a_multiply_by_its_amplitude(family):
     """Cycles folds a Multiply by a constant 0 and drops the Wave Noise group behind it (a Multiply Add it does not
     fold): so every noise's value reaches the pattern only through a Multiply by its amplitude input, and an
-    artist's Turbulence, Grain or Detail of 0 leaves that noise out of the render."""
+    artist's Turbulence, Grain, Detail or Tint of 0 leaves that noise out of the render (the tint's noise through
+    its levels' Map Range nodes, whose sum is what the Multiply reads)."""
     f = _field(family)
     grp = build_procedural_group(f)
     try:
-        amplitudes = {"Turbulence", "Grain", "Detail"}
+        amplitudes = {"Turbulence", "Grain", "Detail", "Tint"}
         noises = [n for n in grp.nodes if n.bl_idname == "ShaderNodeGroup" and "turbulence" in n.node_tree.name]
-        assert len(noises) == {"rings": 3}.get(family, 2)
+        assert len(noises) == {"rings": 3}.get(family, 2) + (family in TINTED)
+        read = []
         for n in noises:
             users = [link.to_node for link in n.outputs["Value"].links]
+            if users and users[0].bl_idname == "ShaderNodeMapRange":          # the tint's levels
+                assert all(u.bl_idname == "ShaderNodeMapRange" for u in users)
+                users, n = _summed(users[-1])
             assert users and all(u.bl_idname == "ShaderNodeMath" and u.operation == "MULTIPLY" for u in users)
             for u in users:
                 other = [link.from_socket for sock in u.inputs[:2] for link in sock.links if link.from_node != n]
                 assert len(other) == 1 and other[0].node.bl_idname == "NodeGroupInput"
-                assert other[0].name in amplitudes
+                read.append(other[0].name)
+        assert set(read) <= amplitudes and ("Tint" in read) == (family in TINTED)
     finally:
         bpy.data.node_groups.remove(grp)
 

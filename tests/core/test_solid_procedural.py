@@ -20,6 +20,7 @@ from omninoise.backend.solid.procedural.layers import Layers
 from omninoise.backend.solid.procedural.ramp import Ramp, fit_ramp, luminance, photo_colours
 from omninoise.backend.solid.procedural.rings import Rings
 from omninoise.backend.solid.procedural.search import minimise
+from omninoise.backend.solid.procedural.tint import FREQUENCIES, Tint, colour_axis, fit_tint
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CALM = dict(turbulence=0.0, turb_freq=1.0, detail=0.0)
@@ -281,6 +282,12 @@ def test_a_field_reads_back_from_json_and_refuses_bad_parameters():
         ProceduralField("layers", dict(spacing=0.2, tilt=0.0, azimuth=0.0, **CALM), ramp)
     with pytest.raises(Cancelled):
         f.evaluate(pts, chunk=100, cancel=lambda: True)
+    tint = Tint(2.0, (-0.3, 0.0, 0.3), (-0.1, 0.0, 0.2), (0.6, -0.8, 0.0))
+    t = ProceduralField("bonds", p, ramp, seed=3, tint=tint)
+    assert ProceduralField.from_dict(t.to_dict()).tint == tint and "tint" not in f.to_dict()
+    np.testing.assert_allclose(t.evaluate(pts), np.clip(a + tint(pts, 3), 0, 1), atol=1e-6)
+    with pytest.raises(SettingError, match="the tint's frequency must be a positive number"):
+        ProceduralField("bonds", p, ramp, tint=Tint(0.0, (0.0, 1.0), (0.0, 0.1), (1.0, 0.0, 0.0)))
 
 
 def test_oblique_planes_are_square_grids_of_photo_pixels():
@@ -320,7 +327,8 @@ def test_a_photo_drawn_by_a_family_is_fitted_by_that_family():
     fit = fit_procedural(photo, ProceduralConfig(budget=24, finalists=2, seed=1))
     assert fit.field.family == "cells", fit.scores
     assert fit.field.params["size"] == pytest.approx(0.2, rel=0.5)
-    assert fit.tried == 2 * sum(len(f.starts(estimate(photo, PX_PER_UNIT))) for f in FAMILIES.values()) + 2 * 24
+    starts = sum(len(f.starts(estimate(photo, PX_PER_UNIT))) for f in FAMILIES.values())
+    assert fit.tried == 2 * starts + 2 * 24 + 2 * (len(FREQUENCIES) + 1)
 
 
 @pytest.mark.parametrize("length, height, offset", [(0.5, 0.25, 0.5), (0.3, 0.3, 0.0), (0.4, 0.2, 0.25),
@@ -403,3 +411,36 @@ def test_auto_s_check_gives_the_evaluation_s_two_figures():
     assert f["axes"] == pytest.approx(np.mean([band_distance(groups[g], photo) for g in "xyz"]), abs=0.01)
     assert f["oblique"] == pytest.approx(band_distance(groups["oblique"], photo), abs=0.01)
     assert band_distance(groups["z"], photo) > 2 * band_distance(groups["x"], photo)      # the faint floor counts
+
+
+def _blur(x: np.ndarray, sigma: float) -> np.ndarray:
+    """A periodic Gaussian blur of a square image (H, H) by sigma px."""
+    f = np.fft.fftfreq(x.shape[0])
+    return np.real(np.fft.ifft2(np.fft.fft2(x) * np.exp(-2 * (np.pi * sigma) ** 2 * (f[:, None] ** 2 + f ** 2))))
+
+
+def test_the_tint_draws_the_hues_that_luminance_does_not_tell_apart():
+    """Green moss and red leaves of one luminance, in patches: a ramp by luminance gives both one olive.  The tint's
+    axis is the green-red one, the fit keeps a tint, and the solid's front is green and red in the photo's
+    proportions, spread along that axis almost as far as the photo."""
+    rng = np.random.default_rng(4)
+    moss = _blur(rng.standard_normal((192, 192)), 10) > 0
+    lum = 0.45 + 0.15 * np.tanh(20 * _blur(rng.standard_normal((192, 192)), 3))
+    green, red = np.array([0.1, 0.55, 0.1]), np.array([0.75, 0.35, 0.25])      # luminance 0.42 and 0.43
+    colour = np.where(moss[..., None], green, red)
+    photo = np.clip(colour * (lum / luminance(colour))[..., None], 0, 1)
+    axis = (green - red) / np.linalg.norm(green - red)
+    a, levels = colour_axis(photo)
+    assert abs(a @ axis) > 0.99 and np.all(np.diff(levels) > 0)
+    assert levels[0] < -0.3 and levels[-1] > 0.3                 # two hues, not a spread about one
+    along = (photo.reshape(-1, 3) - photo.reshape(-1, 3).mean(0)) @ axis
+    fitted = fit_procedural(photo, ProceduralConfig(budget=12, seed=1, side=48)).field
+    assert fitted.tint is not None and fitted.tint.frequency in FREQUENCIES
+    front = fitted.image(128).reshape(-1, 3)
+    drawn = (front - front.mean(0)) @ axis
+    assert abs((drawn > 0).mean() - moss.mean()) < 0.1 and drawn.std() > 0.7 * along.std()
+    plain = ProceduralField(fitted.family, fitted.params, fitted.ramp, fitted.seed).image(128).reshape(-1, 3)
+    assert ((plain - plain.mean(0)) @ axis).std() < 0.5 * along.std()        # the ramp alone: near one hue
+    t = fit_tint(photo, 4.0, 1)                                  # its stops hold at every frequency: u's quantiles
+    u = t.amount(_points(20000, extent=3.0), 1)
+    assert abs(np.median(u) - np.median(levels)) < 0.1 and abs((u > 0).mean() - (levels > 0).mean()) < 0.1

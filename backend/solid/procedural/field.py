@@ -1,6 +1,6 @@
-"""A fitted procedural solid as a colour field over texture space: a family, its parameters, the ramp and the
-seed, evaluated anywhere (it does not repeat), and written to and read from JSON (a bake's key, the node group's
-inputs).
+"""A fitted procedural solid as a colour field over texture space: a family, its parameters, the ramp, the tint
+(tint.py; none where the fit found the photo closer without) and the seed, evaluated anywhere (it does not
+repeat), and written to and read from JSON (a bake's key, the node group's inputs).
 
 Shapes: points float (P, 2 or 3) in texture units (2D points lie on z = 0) -> float32 (P, 3) sRGB in [0, 1].
 """
@@ -15,6 +15,7 @@ from .cells import Cells
 from .layers import PROFILES, Layers
 from .ramp import Ramp
 from .rings import Rings
+from .tint import Tint
 
 __all__ = ["FAMILIES", "ProceduralField", "PX_PER_UNIT", "KINDS", "DEFAULT_KINDS"]
 
@@ -32,11 +33,12 @@ DEFAULT_KINDS = tuple(FAMILIES)
 class ProceduralField:
     """``family`` (a name of :data:`FAMILIES`), ``params`` (its parameters, with ``flip``, for layers
     ``profile`` and for bonds ``pattern``, "courses" where it is absent), ``ramp`` (:class:`~.ramp.Ramp`) and
-    ``seed``; ``px_per_unit`` the photo's pixels per unit."""
+    ``seed``; ``px_per_unit`` the photo's pixels per unit; ``tint`` (:class:`~.tint.Tint`) or None."""
 
     dim = 3
 
-    def __init__(self, family: str, params: dict, ramp: Ramp, seed: int = 0, px_per_unit: float = PX_PER_UNIT):
+    def __init__(self, family: str, params: dict, ramp: Ramp, seed: int = 0, px_per_unit: float = PX_PER_UNIT,
+                 tint: Tint | None = None):
         if family not in FAMILIES:
             raise SettingError("family", f"unknown procedural family {family!r}; known: {', '.join(FAMILIES)}")
         fam = FAMILIES[family]
@@ -55,6 +57,9 @@ class ProceduralField:
             p["pattern"] = params.get("pattern", "courses")
         self.family, self.params, self.ramp, self.seed = family, p, ramp, int(seed)
         self.px_per_unit = float(px_per_unit)
+        if tint is not None and not (np.isfinite(tint.frequency) and tint.frequency > 0):
+            raise SettingError("tint", f"the tint's frequency must be a positive number, got {tint.frequency!r}")
+        self.tint = tint
 
     def values(self, points: np.ndarray) -> np.ndarray:
         """The family's value s at points float (P, 3) -> float64 (P,)."""
@@ -70,6 +75,11 @@ class ProceduralField:
                                          f"{', '.join(n for n, f in FAMILIES.items() if f.GAPPED)}")
         return fam.gaps(self.params, np.asarray(points, np.float64), self.seed)
 
+    def colours(self, points: np.ndarray) -> np.ndarray:
+        """The ramp's colours at points float (P, 3), plus the tint's offsets, before the clip -> float32 (P, 3)."""
+        c = self.ramp(self.values(points))
+        return c if self.tint is None else c + self.tint(points, self.seed)
+
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 16, progress=None, cancel=None) -> np.ndarray:
         """points float (P, 2 or 3) -> float32 (P, 3), in chunks: ``progress(fraction)`` after each, ``cancel()``
         returning True raises Cancelled."""
@@ -82,7 +92,7 @@ class ProceduralField:
         for a in range(0, len(pts), chunk):
             if cancel is not None and cancel():
                 raise Cancelled("cancelled")
-            out[a:a + chunk] = self.ramp(self.values(pts[a:a + chunk]))
+            out[a:a + chunk] = self.colours(pts[a:a + chunk])
             if progress is not None:
                 progress(min(1.0, (a + chunk) / len(pts)))
         return np.clip(out, 0.0, 1.0)
@@ -96,10 +106,12 @@ class ProceduralField:
         return self.evaluate(pts).reshape(size, size, 3)
 
     def to_dict(self) -> dict:
-        return dict(family=self.family, params=dict(self.params), ramp=self.ramp.to_dict(), seed=self.seed,
-                    px_per_unit=self.px_per_unit)
+        d = dict(family=self.family, params=dict(self.params), ramp=self.ramp.to_dict(), seed=self.seed,
+                 px_per_unit=self.px_per_unit)
+        return d if self.tint is None else dict(d, tint=self.tint.to_dict())
 
     @staticmethod
     def from_dict(d: dict) -> "ProceduralField":
+        tint = Tint.from_dict(d["tint"]) if d.get("tint") else None
         return ProceduralField(d["family"], d["params"], Ramp.from_dict(d["ramp"]), d.get("seed", 0),
-                               d.get("px_per_unit", PX_PER_UNIT))
+                               d.get("px_per_unit", PX_PER_UNIT), tint)

@@ -7,8 +7,10 @@
                  a higher frequency), drawn on the fit's planes and scored
     4. search    the best start of the ``finalists`` best kinds refined by Nelder-Mead (search.py) over its
                  parameters, ``budget`` calls each
-    5. ramp      the winner's colour ramp from its values over a block of space (ramp.py)
-    6. check     every finalist drawn on held-out planes (:data:`CHECK_PLANES`) and scored as in the search, with
+    5. ramp      each finalist's colour ramp from its values over a block of space (ramp.py)
+    6. tint      each finalist with no tint and with the photo's tint (tint.py) at each of tint.FREQUENCIES, drawn
+                 with its ramp on the fit's planes and scored as in the search; the closest kept
+    7. check     every finalist drawn on held-out planes (:data:`CHECK_PLANES`) and scored as in the search, with
                  other draws; the closest kept
 
 Every score draws the slices through :data:`FIT_PLANES` (two across each axis, two oblique) with the ramp fitted
@@ -33,6 +35,7 @@ from .field import DEFAULT_KINDS, FAMILIES, KINDS, PX_PER_UNIT, ProceduralField
 from .loss import SliceLoss
 from .ramp import fit_ramp, photo_colours
 from .search import minimise
+from .tint import FREQUENCIES, fit_tint
 
 __all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "FIT_PLANES", "CHECK_PLANES", "oblique_points",
            "plane_group", "kind_starts"]
@@ -168,14 +171,21 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     colours = photo_colours(img)
     starts = [(kind, name, t) for kind in config.families for name, s in kind_starts(kind, est)
               for t in ((s, _textured(s)) if config.textured else (s,))]
-    total = len(starts) + config.finalists * config.budget
+    total = len(starts) + config.finalists * (config.budget + len(FREQUENCIES) + 1)
     tried = [0]
 
-    def score(name, p):
+    def tick():
         tried[0] += 1
         if progress is not None:
             progress(min(1.0, tried[0] / total))
+
+    def score(name, p):
+        tick()
         return loss(_draw(name, p, planes, seed, colours, side)[0])
+
+    def score_field(field):
+        tick()
+        return loss(list(field.evaluate(planes).reshape(-1, side, side, 3)))
 
     scored = sorted(((score(n, s), k, n, s) for k, n, s in starts), key=lambda t: t[0])    # 3. start
     best = {}
@@ -189,11 +199,13 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
         x, d = minimise(lambda x: score(name, _unpack(fam, x, s0)), _pack(fam, s0), 0.08, config.budget, cancel)
         results[kind] = (name, _unpack(fam, x, s0) if d < d0 else s0)
     block = np.random.default_rng(seed).uniform(-2.0, 2.0, (1 << 15, 3))                  # 5. ramp
+    tints = [None] + [fit_tint(img, f, seed) for f in FREQUENCIES]
     fields = {}
     for kind, (name, p) in results.items():
         ramp = fit_ramp(FAMILIES[name].values(p, block, seed), colours, p["flip"])
-        fields[kind] = ProceduralField(name, p, ramp, seed, PX_PER_UNIT)
-    check = [oblique_points(side, ppu, n, o) for n, o in CHECK_PLANES]                    # 6. check
+        tinted = [ProceduralField(name, p, ramp, seed, PX_PER_UNIT, t) for t in tints]    # 6. tint
+        fields[kind] = min(tinted, key=score_field)
+    check = [oblique_points(side, ppu, n, o) for n, o in CHECK_PLANES]                    # 7. check
     held_out = SliceLoss(img, side, [plane_group(n) for n, _ in CHECK_PLANES], seed=1)
     scores = {name: round(held_out([f.evaluate(c).reshape(side, side, 3) for c in check]), 2)
               for name, f in fields.items()}

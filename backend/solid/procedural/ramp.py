@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Ramp", "fit_ramp", "STOPS", "luminance"]
+__all__ = ["Ramp", "fit_ramp", "photo_colours", "quantile_stops", "STOPS", "luminance"]
 
 STOPS = 16    #: stops per ramp (Blender's Color Ramp holds at most 32)
 
@@ -56,11 +56,14 @@ def photo_colours(photo: np.ndarray, stops: int = STOPS) -> np.ndarray:
 
 def fit_ramp(values: np.ndarray, colours: np.ndarray, flip: bool = False) -> Ramp:
     """A ramp whose stops sit at the quantiles of ``values`` (K group centres, K = len(colours)) and carry
-    ``colours`` (darkest first: :func:`photo_colours`), reversed where ``flip``.  Ties among the quantiles (a
-    value many points share, such as a joint's) are spread by a hair so that the positions increase."""
-    k = len(colours)
+    ``colours`` (darkest first: :func:`photo_colours`), reversed where ``flip`` (:func:`quantile_stops`)."""
+    c = np.asarray(colours, np.float64)[::-1] if flip else np.asarray(colours, np.float64)
+    return Ramp(quantile_stops(values, len(c)), tuple(tuple(float(v) for v in row) for row in np.clip(c, 0.0, 1.0)))
+
+
+def quantile_stops(values: np.ndarray, k: int) -> tuple:
+    """``k`` strictly increasing stops at the quantiles (i + 1/2) / k of ``values``: ties (a value many points
+    share, such as a joint's) spread by a hair."""
     q = np.quantile(np.asarray(values, np.float64), (np.arange(k) + 0.5) / k)
     span = max(float(q[-1] - q[0]), 1e-6)
-    q = q + np.arange(k) * span * 1e-6          # strictly increasing
-    c = np.asarray(colours, np.float64)[::-1] if flip else np.asarray(colours, np.float64)
-    return Ramp(tuple(float(v) for v in q), tuple(tuple(float(v) for v in row) for row in np.clip(c, 0.0, 1.0)))
+    return tuple(float(v) for v in q + np.arange(k) * span * 1e-6)
