@@ -139,9 +139,10 @@ def procedural(doc: dict) -> list:
 def procedural_node(doc: dict) -> list:
     blender = f"Blender {doc['blender']}, " if doc.get("blender") else ""
     out = [f"Cycles render time of the procedural solids' live node groups against Blender's Wave Texture: a plane "
-           f"filling a {doc.get('res')}² px frame, emission, {blender}CPU; nanoseconds per pixel-sample from "
-           f"{doc.get('samples')} and {2 * doc.get('samples', 0)} samples. Rows \"noises at 0\" set the group's "
-           f"Turbulence, Grain and Detail to 0: Cycles then leaves their Wave Noise groups out.", "",
+           f"filling a {doc.get('res')}² px frame, emission of the group's sRGB output, {blender}CPU; nanoseconds "
+           f"per pixel-sample from {doc.get('samples')} and {2 * doc.get('samples', 0)} samples. \"Tinted\": with a "
+           f"tint, one Wave Noise group more. Rows \"noises at 0\" set the group's Turbulence, Grain, Detail and "
+           f"Tint to 0: Cycles then leaves their Wave Noise groups out.", "",
            "| shader | ns per pixel-sample | vs Wave Texture | nodes |", "|---|---|---|---|"]
     for name, r in doc.get("results", {}).items():
         out.append(f"| {name} | {r['ns_per_pixel_sample']} | {r['vs_wave_texture']}x | {r['nodes']} |")
