@@ -340,9 +340,9 @@ def _to_linear(b, c):
 
 
 def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str | None = None):
-    """A node group drawing ``field`` (a backend ProceduralField): Vector, Scale and the family's parameters in;
-    Color (scene-linear, for a shader's Base Color), sRGB (the engine's values), Value (s) and for cells and bonds
-    Gap Mask (ProceduralField.gaps) out."""
+    """A node group drawing ``field`` (a backend ProceduralField): Vector, Scale and the family's parameters (and
+    Tint and Tint Frequency where the field has a tint) in; Color (scene-linear, for a shader's Base Color), sRGB
+    (the engine's values), Value (s) and for cells and bonds Gap Mask (ProceduralField.gaps) out."""
     tree = new_group(name or f"Procedural {field.family.title()}", tree_type, (), ())
     _interface(tree, field)
     tree[FIELD_KEY] = json.dumps(field.to_dict())
