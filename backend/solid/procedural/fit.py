@@ -22,7 +22,7 @@ Shapes: photo float (H, W, 3) sRGB in [0, 1], top row first.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -199,7 +199,8 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
         x, d = minimise(lambda x: score(name, _unpack(fam, x, s0)), _pack(fam, s0), 0.08, config.budget, cancel)
         results[kind] = (name, _unpack(fam, x, s0) if d < d0 else s0)
     block = np.random.default_rng(seed).uniform(-2.0, 2.0, (1 << 15, 3))                  # 5. ramp
-    tints = [None] + [fit_tint(img, f, seed) for f in FREQUENCIES]
+    tint = fit_tint(img, FREQUENCIES[0], seed)        # its axis, levels and stops hold at every frequency
+    tints = [None] + [replace(tint, frequency=f) for f in FREQUENCIES]
     fields = {}
     for kind, (name, p) in results.items():
         ramp = fit_ramp(FAMILIES[name].values(p, block, seed), colours, p["flip"])
