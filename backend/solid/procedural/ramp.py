@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Ramp", "fit_ramp", "photo_colours", "quantile_stops", "STOPS", "luminance"]
+__all__ = ["Ramp", "fit_ramp", "photo_colours", "luminance_groups", "quantile_stops", "STOPS", "luminance"]
 
 STOPS = 16    #: stops per ramp (Blender's Color Ramp holds at most 32)
 
@@ -46,12 +46,17 @@ class Ramp:
         return Ramp(tuple(float(p) for p in d["positions"]), tuple(tuple(float(v) for v in c) for c in d["colours"]))
 
 
-def photo_colours(photo: np.ndarray, stops: int = STOPS) -> np.ndarray:
-    """The photo's pixels split into ``stops`` groups of equal size by luminance rank, darkest first: each group's
-    mean colour, float64 (stops, 3)."""
+def luminance_groups(photo: np.ndarray, stops: int = STOPS) -> tuple:
+    """(the photo's pixels float64 (N, 3), ``stops`` arrays of their indices): groups of equal size by luminance
+    rank, darkest first."""
     px = np.asarray(photo, np.float64)[..., :3].reshape(-1, 3)
-    order = np.argsort(luminance(px), kind="stable")
-    return np.stack([g.mean(0) for g in np.array_split(px[order], stops)])
+    return px, np.array_split(np.argsort(luminance(px), kind="stable"), stops)
+
+
+def photo_colours(photo: np.ndarray, stops: int = STOPS) -> np.ndarray:
+    """The mean colour of each of the photo's :func:`luminance_groups`, darkest first: float64 (stops, 3)."""
+    px, groups = luminance_groups(photo, stops)
+    return np.stack([px[g].mean(0) for g in groups])
 
 
 def fit_ramp(values: np.ndarray, colours: np.ndarray, flip: bool = False) -> Ramp:

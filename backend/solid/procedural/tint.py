@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ramp import STOPS, luminance, quantile_stops
+from .ramp import STOPS, luminance_groups, quantile_stops
 from .turbulence import turbulence
 
 __all__ = ["Tint", "fit_tint", "colour_axis", "FREQUENCIES", "SEED_OFFSET"]
@@ -63,12 +63,11 @@ class Tint:
 
 def colour_axis(photo: np.ndarray, stops: int = STOPS) -> tuple:
     """(a float64 (3,), levels float64 (stops,) increasing): the first principal axis of the photo's colour less
-    its luminance group's mean (ramp.photo_colours' groups), and the scores along it split into ``stops`` groups of
-    equal size by rank, each group's mean."""
-    px = np.asarray(photo, np.float64)[..., :3].reshape(-1, 3)
-    order = np.argsort(luminance(px), kind="stable")
+    its luminance group's mean (ramp.luminance_groups, the groups of the ramp's colours), and the scores along it
+    split into ``stops`` groups of equal size by rank, each group's mean."""
+    px, groups = luminance_groups(photo, stops)
     rest = np.empty_like(px)
-    for g in np.array_split(order, stops):
+    for g in groups:
         rest[g] = px[g] - px[g].mean(0)
     a = np.linalg.eigh(np.cov(rest.T))[1][:, -1]
     z = np.sort(rest @ a)
