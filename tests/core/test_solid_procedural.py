@@ -129,8 +129,8 @@ def test_running_bond_courses_shift_by_half_a_unit_and_meet_at_the_corner():
     b = Bonds()
     x = np.linspace(0.0, 0.8, 801)
     for y in np.linspace(-1.0, 1.0, 9):                                          # at every depth
-        row0 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.0)], 1), 0)   # courses centred
-        row1 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.1)], 1), 0)   # on z = 0, 0.1
+        row0 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.0)], 1), 0)   # courses 0 and 1,
+        row1 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.1)], 1), 0)   # a quarter up
         assert (row0[np.min(np.abs(x[:, None] - [0.3, 0.7]), 1) < 0.0095] == -1.0).all()    # head joints, a
         assert (row1[np.min(np.abs(x[:, None] - [0.1, 0.5]), 1) < 0.0095] == -1.0).all()    # quarter unit on
     # the x wall and the y wall show their bed joints at the same heights (courses continue round a corner)
