@@ -260,11 +260,13 @@ def _face(b, t):
 def _courses(b, gi, p, w_seed):
     """(distance to the unit's nearest face, the unit's three integers) of the courses pattern, each row of units
     into the wall moved by its own random fraction (bonds.Bonds.units); ``w_seed`` the White Noise's W."""
+    from ..backend.solid.procedural.bonds import PHASE
+
     x, y, z = b.separate(p)
     length, height = gi.outputs["Length"], gi.outputs["Height"]
-    w = b.math("DIVIDE", z, height)
+    w = b.math("ADD", b.math("DIVIDE", z, height), PHASE)
     row = b.math("FLOOR", w)
-    u = b.math("ADD", b.math("DIVIDE", x, length), b.math("MULTIPLY", gi.outputs["Offset"], row))
+    u = b.math("ADD", b.math("DIVIDE", x, length), b.math("MULTIPLY_ADD", gi.outputs["Offset"], row, PHASE))
     i = b.math("FLOOR", u)
     sigma = b.channel(_white(b, b.combine(i, row, 0.5), w_seed), 0)
     v = b.math("ADD", b.math("DIVIDE", y, length), sigma)

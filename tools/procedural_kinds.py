@@ -37,6 +37,7 @@ def main() -> int:
     from bench.eval_procedural import photos
     from omninoise.backend.solid.model import slice_points
     from omninoise.backend.solid.procedural.field import ProceduralField
+    from omninoise.backend.solid.procedural.bonds import PHASE
     from omninoise.backend.solid.procedural.fit import ProceduralConfig, fit_procedural
     from omninoise.export import read_rgb
     from tools.procedural_sheet import write_sheet
@@ -51,7 +52,8 @@ def main() -> int:
         bonds = fit_procedural(img, ProceduralConfig(families=("bonds",))).field
         print(f"{name}: {default.family} by default; bonds {bonds.params}", flush=True)
         tiles = [crop(img, SIDE), default.image(SIDE, offset=POINT)]
-        mid = (np.floor(POINT[2] / bonds.params["height"]) + 0.5) * bonds.params["height"]
+        h = bonds.params["height"]
+        mid = (np.floor(POINT[2] / h + PHASE) + 0.5 - PHASE) * h
         tiles += [bonds.image(SIDE, axis="y", offset=POINT), bonds.image(SIDE, axis="x", offset=POINT),
                   bonds.image(SIDE, axis="z", offset=(POINT[0], POINT[1], mid))]
         front = slice_points(SIDE, bonds.px_per_unit, "y", POINT)

@@ -129,15 +129,31 @@ def test_running_bond_courses_shift_by_half_a_unit_and_meet_at_the_corner():
     b = Bonds()
     x = np.linspace(0.0, 0.8, 801)
     for y in np.linspace(-1.0, 1.0, 9):                                          # at every depth
-        row0 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.05)], 1), 0)
-        row1 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.15)], 1), 0)
-        assert (row0[np.min(np.abs(x[:, None] - [0.0, 0.4, 0.8]), 1) < 0.0095] == -1.0).all()  # head joints
-        assert (row1[np.min(np.abs(x[:, None] - [0.2, 0.6]), 1) < 0.0095] == -1.0).all()       # half a unit on
+        row0 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.0)], 1), 0)   # courses 0 and 1,
+        row1 = b.values(p, np.stack([x, np.full_like(x, y), np.full_like(x, 0.1)], 1), 0)   # a quarter up
+        assert (row0[np.min(np.abs(x[:, None] - [0.3, 0.7]), 1) < 0.0095] == -1.0).all()    # head joints, a
+        assert (row1[np.min(np.abs(x[:, None] - [0.1, 0.5]), 1) < 0.0095] == -1.0).all()    # quarter unit on
     # the x wall and the y wall show their bed joints at the same heights (courses continue round a corner)
     front = b.values(p, slice_points(64, 128.0, "y", (0, 0.013, 0)), 0).reshape(64, 64)
     side = b.values(p, slice_points(64, 128.0, "x", (0.013, 0, 0)), 0).reshape(64, 64)
     np.testing.assert_array_equal((front == -1).all(1), (side == -1).all(1))
     assert (front == -1).all(1).sum() >= 4
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.5])
+def test_a_cube_s_faces_at_round_coordinates_cut_units_not_a_bed_or_head_joint(offset):
+    """Units 1/2 long and courses 1/4 high: the planes x, z = -1, 0, 1 (the default cube's faces, and cuts through
+    the origin) lie on joints unless the courses' and units' phases move them off; each shows joint on a share
+    of its area near the share of a cut anywhere, not most of it."""
+    b = Bonds()
+    p = dict(length=0.5, height=0.25, offset=offset, joint=0.15, **CALM)
+    t = np.random.default_rng(2).uniform(-2.0, 2.0, (20000, 2))
+    anywhere = (b.values(p, np.random.default_rng(0).uniform(-2.0, 2.0, (40000, 3)), 3) == -1.0).mean()
+    for axis in (0, 2):
+        for c in (-1.0, 0.0, 1.0):
+            face = np.insert(t, axis, c, axis=1)
+            share = (b.values(p, face, 3) == -1.0).mean()
+            assert share < anywhere + 0.1, (axis, c, share, anywhere)
 
 
 def test_a_wall_cut_along_a_depth_joint_shows_scattered_units_not_a_face_of_mortar():

@@ -7,7 +7,13 @@ own random fraction of a unit, sigma = cell_random(i, row, 1/2): a wall cut alon
 of scattered units, as many as a cut anywhere, not every unit of a course (or of every course, in a stack bond)
 at once.
 
-    w = z / height,  row = floor(w),  u = x / length + offset row,  i = floor(u),  v = y / length + sigma
+    w = z / height + phi,  row = floor(w),  u = x / length + offset row + phi,  i = floor(u),  v = y / length + sigma
+
+The phase phi = 1/4 (:data:`PHASE`) keeps the joints off the planes through the origin and through round
+coordinates: z = 0 cuts every course a quarter of its height above a bed joint, and x = 0 every unit a quarter
+of its length from a head joint (in stack and running bonds alike), so the faces of a cube at x, z = +-1 cut
+units, not a sheet of mortar, where the units' sizes are 1/k (as photos' 32 and 64 px bricks are, at 128 px a
+unit) or 2/(2k + 1).
 
 Patterns "herringbone" and "herringbone45": in the wall (x, z), units ``height`` wide and n = max(1,
 round(length / height)) widths long, laid alternately along and across (the 90-degree herringbone, its zigzag on
@@ -34,9 +40,10 @@ import numpy as np
 
 from .family import Family, Param, cell_random, gapped, inside
 
-__all__ = ["Bonds", "PATTERNS", "herringbone", "units_long"]
+__all__ = ["Bonds", "PATTERNS", "herringbone", "units_long", "PHASE"]
 
 PATTERNS = ("courses", "herringbone", "herringbone45")
+PHASE = 0.25     #: added to z / height and to u (module doc): joints stand off round coordinates
 
 
 def _to_face(u: np.ndarray) -> np.ndarray:
@@ -86,9 +93,9 @@ class Bonds(Family):
         pts = np.asarray(points, np.float64)
         pattern = p.get("pattern", "courses")
         if pattern == "courses":
-            w = pts[:, 2] / p["height"]
+            w = pts[:, 2] / p["height"] + PHASE
             row = np.floor(w)
-            u = pts[:, 0] / p["length"] + p["offset"] * row
+            u = pts[:, 0] / p["length"] + p["offset"] * row + PHASE
             i = np.floor(u)
             v = pts[:, 1] / p["length"] + cell_random(i, row, 0.5, seed)
             d = np.minimum(_to_face(w) * p["height"], np.minimum(_to_face(u), _to_face(v)) * p["length"])
