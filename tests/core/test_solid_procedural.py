@@ -10,7 +10,7 @@ from omninoise.backend.grid import Cancelled
 from omninoise.backend.solid.model import slice_points
 from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
 from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_cubes, cell_w, voronoi
-from omninoise.backend.solid.procedural.estimate import estimate, repeat_length
+from omninoise.backend.solid.procedural.estimate import Estimates, estimate, repeat_length
 from omninoise.backend.solid.procedural.family import Param, axis_vector
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
 from omninoise.backend.solid.procedural.fit import (FIT_PLANES, ProceduralConfig, fit_procedural, oblique_points,
@@ -264,6 +264,17 @@ def test_gaps_take_the_ramp_s_end_that_the_photo_s_grout_shows():
             assert {s["flip"] for s in starts} == {not dark}
         assert {s["flip"] for s in Layers().starts(est)} == {False, True}
         assert {s["flip"] for s in Rings().starts(est)} == {False, True}
+
+
+@pytest.mark.parametrize("spacing_z, stretches", [(0.156, {0.4073, 1.0}), (0.36, {0.9399}), (0.9, {2.3499, 1.0})])
+def test_cells_start_round_as_well_where_the_photo_s_spacings_up_and_across_differ(spacing_z, stretches):
+    """Stones' repeats up and across a photo are weak autocorrelation peaks (a photo of round stones read 0.156
+    up, 0.383 across): cells start as tall as those say and round too, unless they nearly agree."""
+    est = Estimates(spacing=0.383, angle=0.0, spacing_x=0.383, spacing_z=spacing_z, diagonals=(0.5, 0.5),
+                    courses=(0.2, 0.0), dark_gaps=True)
+    starts = Cells().starts(est)
+    assert {round(s["stretch"], 4) for s in starts} == stretches
+    assert len(starts) == 2 * len(stretches) * len({s["size"] for s in starts})
 
 
 def test_nelder_mead_finds_a_bowl_s_bottom_within_its_budget():

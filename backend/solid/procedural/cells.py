@@ -105,12 +105,13 @@ class Cells(Family):
 
     def starts(self, est) -> list:
         """Cells the size of the photo's repeats (along its wave, across, up), thin and wide gaps, dark or pale as
-        the photo's are (``est.dark_gaps``); as tall as the photo's spacings up and across say, and round too
-        where those differ (a photo cannot tell a flattened cell from its own scale across and up; the search's
-        loss barely can, and one start's shape is where its search stays)."""
+        the photo's are (``est.dark_gaps``); as tall as the photo's spacings up over across, and round too where
+        those differ: stones' repeats are weak peaks of the autocorrelation (a photo of round stones read 0.41 as
+        high as wide), the fit's loss scores flat and round cells alike, and the search stays near its start."""
         flat = float(np.clip(est.spacing_z / max(est.spacing_x, 1e-6), 0.31, 2.9))
         out = []
-        for size in sorted({round(float(np.clip(s, 0.012, 1.4)), 4) for s in (est.spacing, est.spacing_x, est.spacing_z)}):
+        sizes = {round(float(np.clip(s, 0.012, 1.4)), 4) for s in (est.spacing, est.spacing_x, est.spacing_z)}
+        for size in sorted(sizes):
             for stretch in ((flat, 1.0) if abs(np.log(flat)) > 0.2 else (flat,)):
                 for gap in (0.04, 0.15):
                     out.append(dict(size=size, stretch=stretch, jitter=0.9, gap=gap, turbulence=0.2, detail=0.1,
