@@ -323,7 +323,8 @@ def test_oblique_planes_are_square_grids_of_photo_pixels():
     np.testing.assert_allclose((pts - [1.0, 2.0, 3.0]) @ n, 0.0, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(pts[0, 1] - pts[0, 0]), 1 / 128.0)
     np.testing.assert_allclose(np.linalg.norm(pts[1, 0] - pts[0, 0]), 1 / 128.0)
-    np.testing.assert_allclose(oblique_points(8, 128.0, (0, 1, 0), (0, 0.5, 0)), slice_points(8, 128.0, "y", (0, 0.5, 0)))
+    np.testing.assert_allclose(oblique_points(8, 128.0, (0, 1, 0), (0, 0.5, 0)),
+                               slice_points(8, 128.0, "y", (0, 0.5, 0)))
 
 
 def test_the_loss_weighs_each_group_of_cuts_alike():
