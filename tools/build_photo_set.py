@@ -35,7 +35,6 @@ import argparse
 import glob
 import hashlib
 import io
-import json
 import os
 import re
 import subprocess
@@ -134,10 +133,10 @@ def _version(deb_dir: str, pkg: str) -> str:
     return os.path.basename(debs[0]).split("_")[1] if debs else "unknown"
 
 
-def fetch(cache: str) -> str:
+def fetch(cache: str, packages: tuple = PACKAGES) -> str:
     """apt-get download + dpkg-deb -x the packages into ``cache``; returns the unpack folder."""
     os.makedirs(cache, exist_ok=True)
-    for pkg in PACKAGES:
+    for pkg in packages:
         if not glob.glob(os.path.join(cache, f"{pkg}_*.deb")):
             subprocess.run(["apt-get", "download", pkg], cwd=cache, check=True)
         x = os.path.join(cache, "x", pkg)
@@ -282,7 +281,7 @@ def write_attribution(out: str, what: str, intro: str, entries: list) -> None:
             fh.write("\n".join(lines) + "\n")
 
 
-def package_arguments(description: str, out: str, argv=None) -> tuple:
+def package_arguments(description: str, out: str, argv=None, packages: tuple = PACKAGES) -> tuple:
     """(arguments, the unpacked packages' folder, the .deb files' folder) of a tool that reads the packages:
     ``--cache`` (fetched there), ``--from`` (unpacked already) and ``-o``."""
     ap = argparse.ArgumentParser(description=description)
@@ -291,7 +290,7 @@ def package_arguments(description: str, out: str, argv=None) -> tuple:
     ap.add_argument("--from", dest="unpacked", help="a folder with the packages already unpacked (one folder each)")
     ap.add_argument("-o", "--out", default=out)
     a = ap.parse_args(argv)
-    unpacked = a.unpacked or fetch(a.cache)
+    unpacked = a.unpacked or fetch(a.cache, packages)
     return a, unpacked, os.path.dirname(os.path.abspath(unpacked)) if a.unpacked else a.cache
 
 

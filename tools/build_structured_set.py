@@ -1,10 +1,12 @@
 """Rebuild the held-out structured photos of the procedural solids: ``python tools/build_structured_set.py``.
 
-Photos whose structure runs through the material (planks, grain, tiles, cobbles), from the packages and under the
-licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0, public domain or
-Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold: neither model training
-nor any tuning read them.  Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the
-centre CROP px square) but without its stationarity filter, which would drop exactly these.  The evaluation of the
+Photos whose structure runs through the material (planks, grain, a board's figure, veins, tiles, cobbles), from the
+packages and under the licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0,
+public domain or Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold:
+neither model training nor any tuning read them.  Nexuiz's textures (GPL-2.0-or-later, the whole package) are taken
+here too, and only here: these photos are evaluated, never trained on, and the repository is GPL-3.0-or-later.
+Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the centre CROP px square) but
+without its stationarity filter, which would drop exactly these.  The evaluation of the
 procedural solids (``python -m bench solid-methods --method procedural --structured``) reads them beside the photo
 set's held-out brick, paving, tile and wood photos.
 
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import io
 import os
+import re
 import sys
 import zipfile
 
@@ -26,17 +29,39 @@ from tools.build_photo_set import (CROP, LICENCES, SOURCE_SIDE, _sha, _version, 
                                    parse_dep5, scaled_centre, stk_licence, write_attribution)
 
 OUT = os.path.join(ROOT, "data", "structured")
+PACKAGES = ("supertuxkart-data", "ufoai-textures", "nexuiz-textures")
+#: the licences taken: the photo set's, and Nexuiz's (module doc)
+STRUCTURED_LICENCES = LICENCES + ("GPL-2.0-or-later",)
+NEXUIZ_PK3 = "usr/share/games/nexuiz/data/textures.pk3"
 #: (package, path inside it, category): the structured photos the packages hold under the licences
 SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
            ("supertuxkart-data", "data/textures/japanRedWood.png", "wood"),
            ("supertuxkart-data", "data/textures/bow_tile.jpg", "paving"),
            ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile01.png", "tile"),
            ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile02.png", "tile"),
-           ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile03.png", "tile"))
+           ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile03.png", "tile"),
+           ("nexuiz-textures", "textures.pk3:textures/evil2_misc/blue_marble.jpg", "marble"),
+           ("nexuiz-textures", "textures.pk3:textures/egyptsoc_mat/wood17.tga", "wood"),
+           ("nexuiz-textures", "textures.pk3:textures/desertfactory_wood/wood04.tga", "wood"))
+
+
+def nexuiz_licence(text: str) -> tuple:
+    """(licence, authors) of nexuiz-textures from its copyright file (not DEP-5: one licence for the package)."""
+    if not re.search(r"either\s+version\s+2\s+of\s+the\s+License,\s+or\s+\(at\s+your\s+option\)\s+any\s+later"
+                     r"\s+version", text):
+        raise SystemExit("nexuiz-textures: its copyright file no longer grants GPL-2.0-or-later")
+    m = re.search(r"Nexuiz is \S+ (.*)", text)
+    return "GPL-2.0-or-later", re.sub(r"\s*<[^>]*>", "", m.group(1)).strip() if m else ""
 
 
 def _read(unpacked: str, pkg: str, path: str) -> tuple:
     """(bytes, licence, authors) of a package's file."""
+    if pkg == "nexuiz-textures":
+        root = os.path.join(unpacked, pkg)
+        with open(os.path.join(root, "usr/share/doc/nexuiz-textures/copyright"), encoding="utf-8") as fh:
+            lic = nexuiz_licence(fh.read())
+        with zipfile.ZipFile(os.path.join(root, NEXUIZ_PK3)) as z:
+            return (z.read(path.split(":", 1)[1]),) + lic
     if pkg == "ufoai-textures":
         root = os.path.join(unpacked, pkg)
         lic = parse_dep5(open(os.path.join(root, "usr/share/doc/ufoai-textures/copyright"), encoding="utf-8").read())
@@ -65,8 +90,8 @@ def build(unpacked: str, out: str, deb_dir: str) -> dict:
     entries = []
     for pkg, path, cat in SOURCES:
         data, licence, authors = _read(unpacked, pkg, path)
-        if licence not in LICENCES:
-            raise SystemExit(f"{pkg}: {path} is {licence}, not one of {', '.join(LICENCES)}")
+        if licence not in STRUCTURED_LICENCES:
+            raise SystemExit(f"{pkg}: {path} is {licence}, not one of {', '.join(STRUCTURED_LICENCES)}")
         a, box = centre_crop(data)
         stem = os.path.basename(path.split(":", 1)[-1]).rsplit(".", 1)[0].lower()
         fname = f"{cat}__{stem}.jpg"
@@ -89,7 +114,7 @@ def build(unpacked: str, out: str, deb_dir: str) -> dict:
 
 
 def main(argv=None) -> int:
-    a, unpacked, deb_dir = package_arguments(__doc__.split("\n")[0], OUT, argv)
+    a, unpacked, deb_dir = package_arguments(__doc__.split("\n")[0], OUT, argv, PACKAGES)
     os.makedirs(a.out, exist_ok=True)
     m = build(unpacked, a.out, deb_dir)
     print(f"{len(m['photos'])} structured photos in {os.path.relpath(a.out, ROOT)}")
