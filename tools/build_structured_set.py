@@ -6,9 +6,9 @@ public domain or Expat, per file from the packages' DEP-5 copyright files), that
 neither model training nor any tuning read them.  Nexuiz's textures (GPL-2.0-or-later, the whole package) are taken
 here too, and only here: these photos are evaluated, never trained on, and the repository is GPL-3.0-or-later.
 Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the centre CROP px square) but
-without its stationarity filter, which would drop exactly these.  The evaluation of the
-procedural solids (``python -m bench solid-methods --method procedural --structured``) reads them beside the photo
-set's held-out brick, paving, tile and wood photos.
+without its stationarity filter, which would drop exactly these.  The evaluation of the procedural solids
+(``python -m bench solid-procedural``) reads them beside the photo set's held-out brick, paving, tile and wood
+photos.
 
 ``data/structured/manifest.json`` lists per crop: package, version, path, licence, authors, the source's sha256,
 the crop box and the crop's sha256; ``data/structured/ATTRIBUTION.md`` is the attribution the licences ask for.
