@@ -3,8 +3,8 @@
 Photos whose structure runs through the material (planks, grain, a board's figure, veins, tiles, cobbles), from the
 packages and under the licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0,
 public domain or Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold:
-neither model training nor any tuning read them.  Nexuiz's textures (GPL-2.0-or-later, the whole package) are taken
-here too, and only here: these photos are evaluated, never trained on, and the repository is GPL-3.0-or-later.
+neither model training nor any tuning read them.  Nexuiz's and OpenArena's textures (GPL-2.0-or-later, the whole
+package) are taken here too, and only here: these photos are evaluated, never trained on, and the repository is GPL-3.0-or-later.
 Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the centre CROP px square) but
 without its stationarity filter, which would drop exactly these.  The evaluation of the procedural solids
 (``python -m bench solid-procedural``) reads them beside the photo set's held-out brick, paving, tile and wood
@@ -29,9 +29,11 @@ from tools.build_photo_set import (CROP, LICENCES, SOURCE_SIDE, _sha, _version, 
                                    parse_dep5, scaled_centre, stk_licence, write_attribution)
 
 OUT = os.path.join(ROOT, "data", "structured")
-PACKAGES = ("supertuxkart-data", "ufoai-textures", "nexuiz-textures")
-#: the licences taken: the photo set's, and Nexuiz's (module doc)
+PACKAGES = ("supertuxkart-data", "ufoai-textures", "nexuiz-textures", "openarena-081-textures")
+#: the licences taken: the photo set's, and Nexuiz's and OpenArena's (module doc)
 STRUCTURED_LICENCES = LICENCES + ("GPL-2.0-or-later",)
+#: DEP-5 licence names -> SPDX
+SPDX = {"GPL-2+": "GPL-2.0-or-later"}
 NEXUIZ_PK3 = "usr/share/games/nexuiz/data/textures.pk3"
 #: (package, path inside it, category): the structured photos the packages hold under the licences
 SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
@@ -42,7 +44,8 @@ SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
            ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile03.png", "tile"),
            ("nexuiz-textures", "textures.pk3:textures/evil2_misc/blue_marble.jpg", "marble"),
            ("nexuiz-textures", "textures.pk3:textures/egyptsoc_mat/wood17.tga", "wood"),
-           ("nexuiz-textures", "textures.pk3:textures/desertfactory_wood/wood04.tga", "wood"))
+           ("nexuiz-textures", "textures.pk3:textures/desertfactory_wood/wood04.tga", "wood"),
+           ("openarena-081-textures", "baseoa/pak4-textures.pk3:textures/proto2/marble02b.jpg", "marble"))
 
 
 def nexuiz_licence(text: str) -> tuple:
@@ -62,6 +65,13 @@ def _read(unpacked: str, pkg: str, path: str) -> tuple:
             lic = nexuiz_licence(fh.read())
         with zipfile.ZipFile(os.path.join(root, NEXUIZ_PK3)) as z:
             return (z.read(path.split(":", 1)[1]),) + lic
+    if pkg == "openarena-081-textures":
+        root = os.path.join(unpacked, pkg)
+        with open(os.path.join(root, "usr/share/doc", pkg, "copyright"), encoding="utf-8") as fh:
+            licence, authors = parse_dep5(fh.read())["*"]
+        pk3, name = path.split(":", 1)
+        with zipfile.ZipFile(os.path.join(root, "usr/share/games/openarena", pk3)) as z:
+            return z.read(name), SPDX.get(licence, licence), authors
     if pkg == "ufoai-textures":
         root = os.path.join(unpacked, pkg)
         lic = parse_dep5(open(os.path.join(root, "usr/share/doc/ufoai-textures/copyright"), encoding="utf-8").read())
