@@ -4,7 +4,8 @@ Photos whose structure runs through the material (planks, grain, a board's figur
 packages and under the licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0,
 public domain or Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold:
 neither model training nor any tuning read them.  Nexuiz's and OpenArena's textures (GPL-2.0-or-later, the whole
-package) are taken here too, and only here: these photos are evaluated, never trained on, and the repository is GPL-3.0-or-later.
+package) are taken here too, and only here: these photos are evaluated, never trained on, and the repository is
+GPL-3.0-or-later.
 Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the centre CROP px square) but
 without its stationarity filter, which would drop exactly these.  The evaluation of the procedural solids
 (``python -m bench solid-procedural``) reads them beside the photo set's held-out brick, paving, tile and wood
@@ -29,12 +30,14 @@ from tools.build_photo_set import (CROP, LICENCES, SOURCE_SIDE, _sha, _version, 
                                    parse_dep5, scaled_centre, stk_licence, write_attribution)
 
 OUT = os.path.join(ROOT, "data", "structured")
-PACKAGES = ("supertuxkart-data", "ufoai-textures", "nexuiz-textures", "openarena-081-textures")
 #: the licences taken: the photo set's, and Nexuiz's and OpenArena's (module doc)
 STRUCTURED_LICENCES = LICENCES + ("GPL-2.0-or-later",)
 #: DEP-5 licence names -> SPDX
 SPDX = {"GPL-2+": "GPL-2.0-or-later"}
-NEXUIZ_PK3 = "usr/share/games/nexuiz/data/textures.pk3"
+#: where each package keeps the files and archives that SOURCES names
+GAMES = {"supertuxkart-data": "usr/share/games/supertuxkart", "ufoai-textures": "usr/share/games/ufoai",
+         "nexuiz-textures": "usr/share/games/nexuiz/data", "openarena-081-textures": "usr/share/games/openarena"}
+PACKAGES = tuple(GAMES)
 #: (package, path inside it, category): the structured photos the packages hold under the licences
 SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
            ("supertuxkart-data", "data/textures/japanRedWood.png", "wood"),
@@ -57,33 +60,33 @@ def nexuiz_licence(text: str) -> tuple:
     return "GPL-2.0-or-later", re.sub(r"\s*<[^>]*>", "", m.group(1)).strip() if m else ""
 
 
-def _read(unpacked: str, pkg: str, path: str) -> tuple:
-    """(bytes, licence, authors) of a package's file."""
+def _licence(text: str, pkg: str, path: str) -> tuple:
+    """(licence, authors) of a package's file from the package's copyright file ``text``."""
     if pkg == "nexuiz-textures":
-        root = os.path.join(unpacked, pkg)
-        with open(os.path.join(root, "usr/share/doc/nexuiz-textures/copyright"), encoding="utf-8") as fh:
-            lic = nexuiz_licence(fh.read())
-        with zipfile.ZipFile(os.path.join(root, NEXUIZ_PK3)) as z:
-            return (z.read(path.split(":", 1)[1]),) + lic
-    if pkg == "openarena-081-textures":
-        root = os.path.join(unpacked, pkg)
-        with open(os.path.join(root, "usr/share/doc", pkg, "copyright"), encoding="utf-8") as fh:
-            licence, authors = parse_dep5(fh.read())["*"]
-        pk3, name = path.split(":", 1)
-        with zipfile.ZipFile(os.path.join(root, "usr/share/games/openarena", pk3)) as z:
-            return z.read(name), SPDX.get(licence, licence), authors
+        return nexuiz_licence(text)
+    lic = parse_dep5(text)
     if pkg == "ufoai-textures":
-        root = os.path.join(unpacked, pkg)
-        lic = parse_dep5(open(os.path.join(root, "usr/share/doc/ufoai-textures/copyright"), encoding="utf-8").read())
         pk3, name = path.split(":", 1)
-        with zipfile.ZipFile(os.path.join(root, "usr/share/games/ufoai", pk3)) as z:
-            data = z.read(name)
-        return (data,) + lic[pk3.replace("0textures.pk3", "") + name]
+        return lic[pk3.replace("0textures.pk3", "") + name]
+    if pkg == "openarena-081-textures":
+        licence, authors = lic["*"]
+        return SPDX.get(licence, licence), authors
+    return stk_licence(lic, path)
+
+
+def _read(unpacked: str, pkg: str, path: str) -> tuple:
+    """(bytes, licence, authors) of a package's file: under GAMES[pkg], inside an archive where ``path`` is
+    "archive:member"."""
     root = os.path.join(unpacked, pkg)
-    lic = parse_dep5(open(os.path.join(root, "usr/share/doc/supertuxkart-data/copyright"), encoding="utf-8").read())
-    L = stk_licence(lic, path)
-    with open(os.path.join(root, "usr/share/games/supertuxkart", path), "rb") as fh:
-        return (fh.read(),) + L
+    with open(os.path.join(root, "usr/share/doc", pkg, "copyright"), encoding="utf-8") as fh:
+        licence = _licence(fh.read(), pkg, path)
+    where = os.path.join(root, GAMES[pkg])
+    if ":" in path:
+        archive, member = path.split(":", 1)
+        with zipfile.ZipFile(os.path.join(where, archive)) as z:
+            return (z.read(member),) + licence
+    with open(os.path.join(where, path), "rb") as fh:
+        return (fh.read(),) + licence
 
 
 def centre_crop(data: bytes) -> tuple:

@@ -39,10 +39,10 @@ def test_structured_set_manifest_matches_the_files():
 
 
 def test_nexuiz_licence_is_read_off_its_copyright_file():
-    grant = ("Nexuiz is \u00a9 2002 - 2009 Alientrap, Lee Vermeulen <lv@example.org>\n\nThis program is free software; "
-             "you can redistribute it and/or\nmodify it under the terms of the GNU General Public License\nas published "
-             "by the Free Software Foundation; either version 2\nof the License, or (at your option) any later "
-             "version.\n")
+    grant = ("Nexuiz is \u00a9 2002 - 2009 Alientrap, Lee Vermeulen <lv@example.org>\n\nThis program is free "
+             "software; you can redistribute it and/or\nmodify it under the terms of the GNU General Public "
+             "License\nas published by the Free Software Foundation; either version 2\nof the License, or (at your "
+             "option) any later version.\n")
     assert bss.nexuiz_licence(grant) == ("GPL-2.0-or-later", "2002 - 2009 Alientrap, Lee Vermeulen")
     with pytest.raises(SystemExit, match="GPL-2.0-or-later"):
         bss.nexuiz_licence(grant.replace("either version 2", "version 2 only"))
