@@ -1,4 +1,4 @@
-"""The C row kernel (``rows.c``), loaded with ctypes when it has been built.
+"""The C kernels of wave noise (``rows.c``: grid rows, and points), loaded with ctypes when they have been built.
 
 ``tools/build_kernel.py`` (run by ``make setup``) compiles ``rows.c`` next to this file as
 ``_omni_rows.so`` (``.dylib`` on macOS, ``.dll`` on Windows); an installed extension has it from the
@@ -7,7 +7,9 @@ OMNINOISE_NO_CKERNEL=1, :mod:`.fast` runs its numba row kernel, which stays the 
 CPUs without AVX2 (the scalar loops), within 2e-6 with the AVX2 loops, which fuse the lerps and the ramp's weights
 and sums and take the weights' cosine from a shorter polynomial (see rows.c; tested).  The call releases the GIL, so rows are split across Python threads.
 
-Arrays are those of :class:`backend.wavenoise.fast.GridPlan`; see ``rows.c`` for shapes.
+Arrays are those of :class:`backend.wavenoise.fast.GridPlan`; see ``rows.c`` for shapes.  The point kernel
+(:func:`points`) evaluates noise at any points where numba is missing (Blender's Python): scalar C, numba's point
+kernel's bits (a procedural solid's fit reads its turbulence at its cuts' points through it).
 
 Table reads in the AVX2 loops come in two forms that read the same texels (so give the same bits): "window"
 (two vector loads and a permute where eight texels lie within 16, else a gather) and "gather" (always a
@@ -25,10 +27,11 @@ import time
 
 import numpy as np
 
-__all__ = ["local_path", "library_path", "available", "set_enabled", "vector", "fetch_mode", "padded", "rows"]
+__all__ = ["local_path", "library_path", "available", "set_enabled", "vector", "fetch_mode", "padded", "rows",
+           "points", "cells"]
 
 _F = np.float32
-ABI = 1
+ABI = 2
 #: texels after the padded table so the 16-texel window loads of rows.c stay inside the arrays
 PAD = 16
 _SUFFIX = {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
@@ -79,6 +82,12 @@ def _load():
         lib.omni_rows.argtypes = [f, i64, f, i64, i64, f, f, f, i64, i64, f, f, f, f, i64, f, f, f, f, i64,
                                   ctypes.c_float, ctypes.c_float, i32, i32, f, f]
         lib.omni_rows.restype = None
+        lib.omni_points.argtypes = [f, i64, i64, i64, f, f, f, i64, f, f, f, f, i64, f, i64, ctypes.c_float,
+                                    ctypes.c_float, f, f]
+        lib.omni_points.restype = None
+        lp = ctypes.POINTER(ctypes.c_int64)
+        lib.omni_cells.argtypes = [f, lp, i64, i64, f, f, i64, i64, i64, ctypes.c_float, f, f, lp]
+        lib.omni_cells.restype = None
         lib.omni_vector.restype = i32
         _lib = lib
     return _lib or None
@@ -167,12 +176,59 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
     first = 0
     if vec and fetch_mode() is None and R >= 16 and R * Nx >= CALIBRATE_SAMPLES:
         first = _calibrate(run, R)  # a quarter of the rows at most
-    n = max(1, min(_threads(), R - first))
+    _split(run, first, R)
+
+
+def points(x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, inv_period, shift, out_re, out_im) -> None:
+    """Fill out_re and out_im float32 (P,) with the noise at points x float32 (P, D), like fast_kernels._kernel
+    (the same bits). ``table``: the padded table float32 (N + 2, 2) of fast._padded_table.  Every array must be
+    C-contiguous float32 (checked)."""
+    lib = _load()
+    if lib is None:  # callers ask available() first (fast.evaluate)
+        raise RuntimeError("the C row kernel is not built (python tools/build_kernel.py)")
+    for a in (x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, out_re, out_im):
+        if a.dtype != _F or not a.flags.c_contiguous:
+            raise ValueError("the C point kernel needs C-contiguous float32 arrays")
+    P, D = x.shape
+    K = sdirs.shape[0]
+    if sdirs.shape != (K, D) or out_re.shape != (P,) or out_im.shape != (P,) or table.ndim != 2:
+        raise ValueError(f"point kernel shapes: x {x.shape}, sdirs {sdirs.shape}, out {out_re.shape}")
+    S = slpos.shape[1]
+    args = (D, _ptr(sdirs), _ptr(soffs), _ptr(amps), K, _ptr(nmin), _ptr(slpos), _ptr(omega), _ptr(zeta), S,
+            _ptr(table), len(table) - 2, _F(inv_period), _F(shift), _ptr(out_re), _ptr(out_im))
+    _split(lambda i0, i1: lib.omni_points(_ptr(x), i0, i1, *args), 0, P, grain=4096)
+
+
+def cells(local, back, near, hashes, first: int, jitter: float, f1, f2, which) -> None:
+    """One batch of :func:`backend.solid.procedural.cells.voronoi`'s loop (the same bits): points' ``local``
+    float32 (P, 3) positions in their cubes and ``back`` int64 (P,) rows of their cubes, against the neighbour
+    offsets ``near`` float32 (B, 3) whose cubes' feature point offsets are ``hashes`` float32 (B, C, 3); updates F1,
+    F2 float32 (P,) and ``which`` int64 (P,), the nearest feature point's neighbour (``first`` + its batch row)."""
+    lib = _load()
+    if lib is None:
+        raise RuntimeError("the C kernel is not built (python tools/build_kernel.py)")
+    for a, t in ((local, _F), (near, _F), (hashes, _F), (f1, _F), (f2, _F), (back, np.int64), (which, np.int64)):
+        if a.dtype != t or not a.flags.c_contiguous:
+            raise ValueError("the C cell kernel needs C-contiguous float32 and int64 arrays")
+    P, B = len(local), len(near)
+    if local.shape != (P, 3) or near.shape != (B, 3) or hashes.shape[::2] != (B, 3) or not (
+            back.shape == f1.shape == f2.shape == which.shape == (P,)):
+        raise ValueError(f"cell kernel shapes: local {local.shape}, near {near.shape}, hashes {hashes.shape}")
+    lp = ctypes.POINTER(ctypes.c_int64)
+    bp, wp = back.ctypes.data_as(lp), which.ctypes.data_as(lp)
+    args = (_ptr(near), _ptr(hashes), B, hashes.shape[1], int(first), _F(jitter), _ptr(f1), _ptr(f2), wp)
+    _split(lambda i0, i1: lib.omni_cells(_ptr(local), bp, i0, i1, *args), 0, P, grain=4096)
+
+
+def _split(run, first: int, R: int, grain: int = 1) -> None:
+    """run(r0, r1) over rows (or points) first .. R - 1 on up to _threads() threads: the calling thread and
+    helpers that live for this call only, taking pieces of at least ``grain`` rows in turn."""
+    n = max(1, min(_threads(), (R - first) // grain))
     if n == 1:
         return run(first, R)
     # more pieces than threads, so a thread that got cheap rows takes another.  The calling thread works too,
     # beside n - 1 helpers that live for this call only (none outlives a bake; starting one takes about 0.3 ms)
-    pieces = min(R - first, 4 * n)
+    pieces = min((R - first) // grain, 4 * n)
     bounds = [first + (R - first) * i // pieces for i in range(pieces + 1)]
     todo = iter([(a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a])
     lock, errors = threading.Lock(), []

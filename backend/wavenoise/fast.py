@@ -1,7 +1,8 @@
 """Optional compiled evaluation of wave noise (numba), identical maths to backend.wavenoise.wave.
 
 Used when numba is importable (the project's .venv installs it; Blender's
-bundled Python does not, and then the numpy path runs).  Covers single-table
+bundled Python does not, and then the C kernel of :mod:`.ckernel` runs where it is
+built, else the numpy path).  Covers single-table
 noises: isotropic, lobes, animated, custom waveforms.  Axis/sector tables and
 transitions use the numpy path.
 
@@ -12,7 +13,8 @@ weights cos/sin(pi/2 s) use polynomials accurate to 5e-7.
 Set OMNINOISE_NO_JIT=1 to disable.
 
 Grid rows (:class:`GridPlan`) run the C kernel of :mod:`.ckernel` instead where it is built (``make
-setup``), with or without numba: same maths, within 1e-6, faster; the numba row kernel is the reference.
+setup``), with or without numba: same maths, within 1e-6, faster; the numba row kernel is the reference.  Points
+(:func:`evaluate`) run the C point kernel where numba is missing (Blender): the numba point kernel's bits.
 """
 from __future__ import annotations
 
@@ -55,7 +57,9 @@ def engine_path() -> str:
 
 
 def supports(noise) -> bool:
-    return bool(numba) and _single(noise)
+    """Whether a compiled kernel evaluates this noise at points: numba's, else the C kernel (:func:`.ckernel.points`)
+    where it is built (Blender's Python has no numba)."""
+    return _single(noise) and (bool(numba) or ckernel.available())
 
 
 def _single(noise) -> bool:
@@ -99,8 +103,12 @@ def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
         return None
     re = np.empty(len(x), _F)
     im = np.empty(len(x), _F)
-    _kernels()._kernel(np.ascontiguousarray(x, _F), noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *rec,
-                       _padded_table(noise), _F(1.0 / noise.table.period), _F(noise.speed) * _F(time), re, im)
+    args = (np.ascontiguousarray(x, _F), noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *rec,
+            _padded_table(noise), _F(1.0 / noise.table.period), _F(noise.speed) * _F(time), re, im)
+    if numba:           # the reference, and a quarter faster than the C point kernel (AMD EPYC, 2 threads)
+        _kernels()._kernel(*args)
+    else:
+        ckernel.points(*args)
     return (re + 1j * im).astype(np.complex64)
 
 

@@ -37,6 +37,17 @@
  *   slice records (see fast._slice_records); tre, tim, dre, dim: (N + 2 + PAD) padded table values
  *   and differences, texel i + 1 holds T[i mod N]; out_re, out_im (R, Nx).
  *
+ * Points (omni_points): the same sum at any points, one point at a time, numba's point kernel
+ * (fast_kernels._kernel) operation for operation in scalar C: the same bits.  Arrays: x (P, D) points;
+ * strata and slice records as above; tab (N + 2, 2) the padded table as (re, im) pairs, texel i + 1 holding
+ * T[i mod N] (fast._padded_table); out_re, out_im (P).
+ *
+ * Cells (omni_cells): the distance loop of backend/solid/procedural/cells.voronoi, F1 and F2 of a jittered grid
+ * (Worley 1996) over a batch of neighbour cubes, numpy's float32 operations one for one: the same bits.  Arrays:
+ * local (P, 3) each point's position in its cube; back (P) int64 its cube's row in hashes; near (B, 3) the batch's
+ * neighbour offsets; hashes (B, C, 3) each neighbour cube's feature point offset (before the jitter); f1, f2 (P)
+ * and which (P) int64, the nearest feature point's neighbour index, updated in place.
+ *
  * Build: tools/build_kernel.py (cc -O3 -ffp-contract=off -shared -fPIC; the AVX2 loops carry a target
  * attribute and are chosen at run time, so the library runs on any x86-64 CPU, and elsewhere scalar).
  * Loaded by ctypes; the call releases the GIL, so Python threads split the rows.
@@ -52,7 +63,7 @@
 #define AVX2 __attribute__((target("avx2,fma")))
 #endif
 
-#define OMNI_ABI 1
+#define OMNI_ABI 2
 #ifdef _WIN32
 #define OMNI_API __declspec(dllexport)
 #else
@@ -504,4 +515,77 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
 #endif
   }
   free(A);
+}
+
+/* Points i0 .. i1 - 1 of x (P, D) (fast_kernels._kernel): out_re[i] + i out_im[i] the noise at x[i]. */
+OMNI_API void omni_points(const float *x, int64_t i0, int64_t i1, int64_t D, const float *sdirs, const float *soffs,
+                          const float *amps, int64_t K, const float *nmin, const float *slpos, const float *omega,
+                          const float *zeta, int64_t S, const float *tab, int64_t N, float inv_period, float shift,
+                          float *out_re, float *out_im) {
+  const float fN = (float)N, half = 0.5f;
+  for (int64_t i = i0; i < i1; i++) {
+    const float *xi = x + i * D;
+    float zr = 0.0f, zi = 0.0f;
+    for (int64_t k = 0; k < K; k++) {
+      float acc = 0.0f;
+      for (int64_t d = 0; d < D; d++) acc += xi[d] * sdirs[k * D + d];
+      float p = acc + soffs[k];
+      float n = floorf(p);
+      float f = p - n;
+      int64_t r = (int64_t)(n - nmin[k]);
+      float u = (f - slpos[k * S + r]) * (float)(0.5 / 0.3) + half;
+      if (u < 0.0f) u = 0.0f;
+      else if (u > 1.0f) u = 1.0f;
+      float s = u * u * (3.0f - 2.0f * u);
+      float w0 = cos_half_pi(s), w1 = cos_half_pi(1.0f - s);
+      float br = 0.0f, bi = 0.0f;
+      for (int side = 0; side < 2; side++) {
+        int64_t rr = r + side;
+        float dot = 0.0f;
+        for (int64_t d = 0; d < D; d++) dot += xi[d] * omega[(k * S + rr) * D + d];
+        float c = (dot - shift) * inv_period + zeta[k * S + rr];
+        c = c - floorf(c);
+        float j = c * fN - half;
+        float j0 = floorf(j);
+        float t = j - j0;
+        int64_t idx = (int64_t)j0 + 1;
+        float ar = tab[2 * idx] + (tab[2 * idx + 2] - tab[2 * idx]) * t;
+        float ai = tab[2 * idx + 1] + (tab[2 * idx + 3] - tab[2 * idx + 1]) * t;
+        float w = side == 0 ? w0 : w1;
+        br += w * ar;
+        bi += w * ai;
+      }
+      zr += amps[k] * br;
+      zi += amps[k] * bi;
+    }
+    out_re[i] = zr;
+    out_im[i] = zi;
+  }
+}
+
+/* Points i0 .. i1 - 1 against neighbours a0 .. a0 + B - 1 (cells.voronoi's loop): nearer feature points replace
+ * F1 (and push it to F2) in neighbour order, as np.where(d < f1, ...) does. */
+OMNI_API void omni_cells(const float *local, const int64_t *back, int64_t i0, int64_t i1, const float *near,
+                         const float *hashes, int64_t B, int64_t C, int64_t a0, float jitter, float *f1, float *f2,
+                         int64_t *which) {
+  for (int64_t i = i0; i < i1; i++) {
+    const float *l = local + 3 * i;
+    float g1 = f1[i], g2 = f2[i];
+    int64_t w = which[i];
+    for (int64_t b = 0; b < B; b++) {
+      const float *h = hashes + 3 * (b * C + back[i]), *n = near + 3 * b;
+      float v0 = n[0] + h[0] * jitter - l[0], v1 = n[1] + h[1] * jitter - l[1], v2 = n[2] + h[2] * jitter - l[2];
+      float d = sqrtf(v0 * v0 + v1 * v1 + v2 * v2);
+      if (d < g1) {
+        g2 = g1;
+        g1 = d;
+        w = a0 + b;
+      } else if (d < g2) {
+        g2 = d;
+      }
+    }
+    f1[i] = g1;
+    f2[i] = g2;
+    which[i] = w;
+  }
 }

@@ -1,4 +1,4 @@
-"""The C row kernel (backend/wavenoise/rows.c) against the numba row kernel, its reference."""
+"""The C row and point kernels (backend/wavenoise/rows.c) against the numba kernels, their reference."""
 import os
 import shutil
 import sys
@@ -133,6 +133,45 @@ def test_grid_without_numba_uses_the_c_kernel(monkeypatch):
     pts = np.stack([x.ravel(), y.ravel(), z.ravel()], 1)
     b = noise.evaluate(pts, 0.4, accelerate=False).real.reshape(a.shape)
     assert np.percentile(np.abs(a - b), 99) < 3e-4 and np.abs(a - b).max() < 1e-3
+
+
+@pytest.mark.parametrize("dim,speed,time", [(2, 0.0, 0.0), (3, 0.0, 0.0), (3, 1.5, 0.7), (4, 0.0, 0.0)])
+def test_point_kernel_gives_numba_bits(dim, speed, time, monkeypatch):
+    """fast.evaluate without numba (as in Blender) runs the C point kernel: numba's bits, on 2 threads and on 1."""
+    if not fast.numba:
+        pytest.skip("numba is the reference")
+    noise = _case(dim, 4.0, speed=speed, spectrum=("fractal", 1.0, 4.0))
+    x = np.random.default_rng(dim).uniform(-6.0, 6.0, (20011, dim)).astype(np.float32)
+    want = fast.evaluate(noise, x, time)
+    monkeypatch.setattr(fast, "numba", False)
+    assert fast.supports(noise)
+    got = fast.evaluate(noise, x, time)
+    monkeypatch.setattr(ckernel, "_threads", lambda: 1)
+    one = fast.evaluate(noise, x, time)
+    assert got.dtype == np.complex64 and np.array_equal(got.view(np.uint32), want.view(np.uint32))
+    assert np.array_equal(one.view(np.uint32), want.view(np.uint32))
+    numpy = noise.evaluate(x, time, accelerate=False)
+    assert np.abs(got - numpy).max() < 1e-5 and np.abs(got).max() > 0.1
+
+
+def test_point_and_cell_kernels_refuse_bad_arrays():
+    noise = _case(3, 2.0)
+    x = np.zeros((8, 3), np.float32)
+    rec = fast._slice_records(noise, x.min(0), x.max(0))
+    table = fast._padded_table(noise)
+    out = np.empty(8, np.float32)
+    with pytest.raises(ValueError, match="C-contiguous"):
+        ckernel.points(x.astype(np.float64), noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *rec, table,
+                       1.0, 0.0, out, out.copy())
+    with pytest.raises(ValueError, match="shapes"):
+        ckernel.points(x, noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *rec, table, 1.0, 0.0,
+                       np.empty(7, np.float32), out)
+    f, w = np.full(8, 8.0, np.float32), np.zeros(8, np.int64)
+    near, hashes = np.zeros((2, 3), np.float32), np.zeros((2, 1, 3), np.float32)
+    with pytest.raises(ValueError, match="int64"):
+        ckernel.cells(x, np.zeros(8, np.int32), near, hashes, 0, 0.9, f, f.copy(), w)
+    with pytest.raises(ValueError, match="shapes"):
+        ckernel.cells(x, np.zeros(8, np.int64), near, hashes[:1], 0, 0.9, f, f.copy(), w)
 
 
 def test_switch_off_and_bad_arrays():

@@ -113,6 +113,25 @@ def test_cells_find_each_point_s_nearest_and_second_nearest_feature_point(scale)
         np.testing.assert_array_equal(cell[i], cubes[order[0]])
 
 
+@pytest.mark.parametrize("spread,points", [(2.0, 20000), (40.0, 30000)])
+def test_the_c_kernel_s_cells_are_numpy_s_bit_for_bit(spread, points):
+    """voronoi's loop in the C kernel (where it is built, as for the extension) against numpy's: equal F1, F2 and
+    cubes, in one batch of neighbours (few cubes) and in many (a cube per point or so)."""
+    from omninoise.backend.wavenoise import ckernel
+
+    if not ckernel.available():
+        pytest.skip("the C kernel is not built here")
+    q = np.random.default_rng(int(spread)).uniform(-spread, spread, (points, 3))
+    got = voronoi(q, 0.85, 9)
+    before = ckernel.set_enabled(False)
+    try:
+        want = voronoi(q, 0.85, 9)
+    finally:
+        ckernel.set_enabled(before)
+    for g, w in zip(got, want):
+        assert g.dtype == w.dtype == np.float32 and np.array_equal(g, w)
+
+
 def test_cubes_are_found_once_each_as_numpy_finds_them():
     rng = np.random.default_rng(2)
     for base in (np.floor(rng.uniform(-40, 40, (5000, 3))), np.floor(rng.uniform(-2e6, 2e6, (5000, 3)))):

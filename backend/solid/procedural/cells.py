@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...wavenoise import ckernel
 from ...wavenoise.hashing import white_noise4
 from ...wavenoise.wave import white_color4
 from .family import Family, Param, gapped, inside
@@ -52,7 +53,8 @@ def _unique_cubes(base: np.ndarray) -> tuple:
 
 def voronoi(q: np.ndarray, jitter: float, seed: int) -> tuple:
     """F1 and F2 (float32 (P,)) at points q (P, 3) in cube units, and the nearest cell's cube (float32 (P, 3));
-    computed in float32, as the node group does."""
+    computed in float32, as the node group does: the loop over the 27 cubes in the C kernel where it is built
+    (:func:`~backend.wavenoise.ckernel.cells`, the same bits), else in numpy."""
     q = np.asarray(q, np.float32)
     base = np.floor(q)
     local = q - base
@@ -66,17 +68,24 @@ def voronoi(q: np.ndarray, jitter: float, seed: int) -> tuple:
     near = NEIGHBOURS.astype(np.float32)
     mine = cubes[back]
     step = max(1, HASH_BATCH // len(cubes))      # neighbours hashed per call: few calls, arrays that stay in cache
+    compiled = ckernel.available()
+    if compiled:            # the C kernel's loop (the same bits); it keeps which neighbour is nearest
+        which = np.zeros(len(q), np.int64)
+        local, back = np.ascontiguousarray(local), np.ascontiguousarray(back, np.int64)
     for a in range(0, len(near), step):
         c = (cubes[None, :, :] + near[a:a + step, None, :]).reshape(-1, 3)
         hashes = np.stack([white_color4(c[:, 0], c[:, 1], c[:, 2], cell_w(seed, 0), k) for k in range(3)],
                           -1).astype(np.float32).reshape(-1, len(cubes), 3)
+        if compiled:
+            ckernel.cells(local, back, np.ascontiguousarray(near[a:a + step]), hashes, a, rnd, f1, f2, which)
+            continue
         for n, h in zip(near[a:a + step], hashes):
             d = np.sqrt(np.sum(np.square(n + h[back] * rnd - local), axis=1, dtype=np.float32))
             nearer = d < f1
             f2 = np.where(nearer, f1, np.minimum(f2, d))
             best = np.where(nearer[:, None], mine + n, best)
             f1 = np.minimum(f1, d)
-    return f1, f2, best
+    return f1, f2, (mine + near[which] if compiled else best)
 
 
 class Cells(Family):
