@@ -20,8 +20,9 @@ photo (grass, rock, soil, sand, snow...), where "auto" is to keep the neural tex
 and the counts of the summary: photos where the procedural solid and "auto" are closer than random phase noise
 as a solid and than the neural texture, per figure; photos where "auto" is farther than the neural texture) and,
 with ``--sheet``, OUT.png: photo | neural front | procedural front, x and z cuts, per photo.  Also the seconds
-each fit took on this machine, and each fitted solid (``field``: ``ProceduralField.to_dict``), which the docs'
-sheet (``tools/procedural_sheet.py``) renders.
+each fit took on this machine, and again with numba off, as Blender's Python fits (``seconds_without_numba``;
+``same_fit_without_numba``: whether that fit came out the same), and each fitted solid (``field``:
+``ProceduralField.to_dict``), which the docs' sheet (``tools/procedural_sheet.py``) renders.
 """
 from __future__ import annotations
 
@@ -42,6 +43,7 @@ from omninoise.backend.solid.gaussian_rest import rest_field
 from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.request import SolidRequest
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
+from omninoise.backend.wavenoise import fast
 from omninoise.export import read_rgb
 from omninoise.export.atomic import write_json
 from omninoise.training.solid import photo_eval as pe
@@ -90,6 +92,20 @@ def gaussian_field(photo: np.ndarray, kind: str) -> _Field:
     return _Field(lambda pts: np.clip(m + rest_field(pts, r, 0), 0.0, 1.0).astype(np.float32), PX_PER_UNIT)
 
 
+def _fit_without_numba(req) -> tuple:
+    """(seconds, the fitted solid's dict) of the fit again with numba off, as Blender's Python runs it (the C
+    kernels where built, else numpy); (None, None) where numba is not installed (the fit just timed ran so)."""
+    if not fast.numba:
+        return None, None
+    fast.numba = False
+    try:
+        t = time.time()
+        field = dataclasses.replace(req, method="procedural").procedural_field()
+        return round(time.time() - t, 1), field.to_dict()
+    finally:
+        fast.numba = True
+
+
 def measure(path: str, fitted: dict | None = None) -> dict:
     """The figures of one photo; ``fitted``: its row of an earlier run, whose solid and fit seconds are taken."""
     photo = read_rgb(path)
@@ -98,13 +114,17 @@ def measure(path: str, fitted: dict | None = None) -> dict:
     if fitted is None:
         field = dataclasses.replace(req, method="procedural").procedural_field()
         seconds = time.time() - t
+        plain, again = _fit_without_numba(req)
+        same = None if again is None else again == field.to_dict()
     else:
         field, seconds = ProceduralField.from_dict(fitted["field"]), fitted["seconds"]
+        plain, same = fitted.get("seconds_without_numba"), fitted.get("same_fit_without_numba")
     choice = req.choose(field=field)
     model, code = choice.model, choice.code
     neural = _Field(lambda pts: model.evaluate(pts, code, 0), model.px_per_unit)
-    r = {"family": field.family, "seconds": round(seconds, 1), "chosen": choice.method,
-         "choice_distances": choice.distances, "field": field.to_dict()}
+    r = {"family": field.family, "seconds": round(seconds, 1), "seconds_without_numba": plain,
+         "same_fit_without_numba": same, "chosen": choice.method, "choice_distances": choice.distances,
+         "field": field.to_dict()}
     for name, f in (("procedural", field), ("neural", neural)):
         r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
     # random phase as a solid: the closer kind, figure by figure, as solid-methods
@@ -120,6 +140,10 @@ def measure(path: str, fitted: dict | None = None) -> dict:
 def summary(rows: dict) -> dict:
     s = {"photos": len(rows), "median_fit_seconds": round(float(np.median([r["seconds"] for r in rows.values()])), 1),
          "chosen_procedural": sum(r["chosen"] == "procedural" for r in rows.values())}
+    plain = [r for r in rows.values() if r.get("seconds_without_numba") is not None]
+    if plain:
+        s["median_fit_seconds_without_numba"] = round(float(np.median([r["seconds_without_numba"] for r in plain])), 1)
+        s["same_fit_without_numba"] = sum(bool(r["same_fit_without_numba"]) for r in plain)
     for who in ("procedural", "auto"):
         for k in ("axes", "oblique", "axes_band", "oblique_band"):
             s[f"{who}_beats_random_phase_solid_{k}"] = sum(r[f"{who}_{k}"] < r[f"random_phase_solid_{k}"]
