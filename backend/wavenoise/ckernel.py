@@ -1,4 +1,4 @@
-"""The C kernels of wave noise (``rows.c``: grid rows, and points), loaded with ctypes when they have been built.
+"""The C kernels (``rows.c``: wave noise on grid rows and at points, procedural cells), loaded with ctypes when built.
 
 ``tools/build_kernel.py`` (run by ``make setup``) compiles ``rows.c`` next to this file as
 ``_omni_rows.so`` (``.dylib`` on macOS, ``.dll`` on Windows); an installed extension has it from the
@@ -8,8 +8,9 @@ CPUs without AVX2 (the scalar loops), within 2e-6 with the AVX2 loops, which fus
 and sums and take the weights' cosine from a shorter polynomial (see rows.c; tested).  The call releases the GIL, so rows are split across Python threads.
 
 Arrays are those of :class:`backend.wavenoise.fast.GridPlan`; see ``rows.c`` for shapes.  The point kernel
-(:func:`points`) evaluates noise at any points where numba is missing (Blender's Python): scalar C, numba's point
-kernel's bits (a procedural solid's fit reads its turbulence at its cuts' points through it).
+(:func:`points`) evaluates noise at any points where numba is missing (Blender's Python), with numba's point
+kernel's bits (a procedural solid's fit reads its turbulence at its cuts' points through it); the cell kernel
+(:func:`cells`) runs the procedural cells' nearest feature point loop with numpy's bits.
 
 Table reads in the AVX2 loops come in two forms that read the same texels (so give the same bits): "window"
 (two vector loads and a permute where eight texels lie within 16, else a gather) and "gather" (always a
@@ -83,7 +84,7 @@ def _load():
                                   ctypes.c_float, ctypes.c_float, i32, i32, f, f]
         lib.omni_rows.restype = None
         lib.omni_points.argtypes = [f, i64, i64, i64, f, f, f, i64, f, f, f, f, i64, f, i64, ctypes.c_float,
-                                    ctypes.c_float, f, f]
+                                    ctypes.c_float, f, f, i32]
         lib.omni_points.restype = None
         lp = ctypes.POINTER(ctypes.c_int64)
         lib.omni_cells.argtypes = [f, lp, i64, i64, f, f, i64, i64, i64, ctypes.c_float, f, f, lp]
@@ -179,13 +180,14 @@ def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_p
     _split(run, first, R)
 
 
-def points(x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, inv_period, shift, out_re, out_im) -> None:
+def points(x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, inv_period, shift, out_re, out_im,
+           use_vector: bool = True) -> None:
     """Fill out_re and out_im float32 (P,) with the noise at points x float32 (P, D), like fast_kernels._kernel
-    (the same bits). ``table``: the padded table float32 (N + 2, 2) of fast._padded_table.  Every array must be
-    C-contiguous float32 (checked)."""
+    (the same bits). ``table``: the padded table float32 (N + 2, 2) of fast._padded_table; ``use_vector``: the
+    AVX2 build where the CPU runs it, else the scalar one.  Every array must be C-contiguous float32 (checked)."""
     lib = _load()
     if lib is None:  # callers ask available() first (fast.evaluate)
-        raise RuntimeError("the C row kernel is not built (python tools/build_kernel.py)")
+        raise RuntimeError("the C kernel is not built (python tools/build_kernel.py)")
     for a in (x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, out_re, out_im):
         if a.dtype != _F or not a.flags.c_contiguous:
             raise ValueError("the C point kernel needs C-contiguous float32 arrays")
@@ -195,7 +197,7 @@ def points(x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, inv_period, s
         raise ValueError(f"point kernel shapes: x {x.shape}, sdirs {sdirs.shape}, out {out_re.shape}")
     S = slpos.shape[1]
     args = (D, _ptr(sdirs), _ptr(soffs), _ptr(amps), K, _ptr(nmin), _ptr(slpos), _ptr(omega), _ptr(zeta), S,
-            _ptr(table), len(table) - 2, _F(inv_period), _F(shift), _ptr(out_re), _ptr(out_im))
+            _ptr(table), len(table) - 2, _F(inv_period), _F(shift), _ptr(out_re), _ptr(out_im), int(bool(use_vector)))
     _split(lambda i0, i1: lib.omni_points(_ptr(x), i0, i1, *args), 0, P, grain=4096)
 
 

@@ -105,7 +105,7 @@ def evaluate(noise, x: np.ndarray, time) -> np.ndarray | None:
     im = np.empty(len(x), _F)
     args = (np.ascontiguousarray(x, _F), noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *rec,
             _padded_table(noise), _F(1.0 / noise.table.period), _F(noise.speed) * _F(time), re, im)
-    if numba:           # the reference, and a quarter faster than the C point kernel (AMD EPYC, 2 threads)
+    if numba:           # the reference
         _kernels()._kernel(*args)
     else:
         ckernel.points(*args)

@@ -38,7 +38,8 @@
  *   and differences, texel i + 1 holds T[i mod N]; out_re, out_im (R, Nx).
  *
  * Points (omni_points): the same sum at any points, one point at a time, numba's point kernel
- * (fast_kernels._kernel) operation for operation in scalar C: the same bits.  Arrays: x (P, D) points;
+ * (fast_kernels._kernel) operation for operation, without fused multiply-adds: the same bits (compiled for AVX2
+ * too, where floor is one instruction, and chosen at run time).  Arrays: x (P, D) points;
  * strata and slice records as above; tab (N + 2, 2) the padded table as (re, im) pairs, texel i + 1 holding
  * T[i mod N] (fast._padded_table); out_re, out_im (P).
  *
@@ -518,10 +519,10 @@ OMNI_API void omni_rows(const float *xs, int64_t Nx, const float *others, int64_
 }
 
 /* Points i0 .. i1 - 1 of x (P, D) (fast_kernels._kernel): out_re[i] + i out_im[i] the noise at x[i]. */
-OMNI_API void omni_points(const float *x, int64_t i0, int64_t i1, int64_t D, const float *sdirs, const float *soffs,
-                          const float *amps, int64_t K, const float *nmin, const float *slpos, const float *omega,
-                          const float *zeta, int64_t S, const float *tab, int64_t N, float inv_period, float shift,
-                          float *out_re, float *out_im) {
+static inline __attribute__((always_inline)) void points_(const float *x, int64_t i0, int64_t i1, int64_t D,
+    const float *sdirs, const float *soffs, const float *amps, int64_t K, const float *nmin, const float *slpos,
+    const float *omega, const float *zeta, int64_t S, const float *tab, int64_t N, float inv_period, float shift,
+    float *out_re, float *out_im) {
   const float fN = (float)N, half = 0.5f;
   for (int64_t i = i0; i < i1; i++) {
     const float *xi = x + i * D;
@@ -561,6 +562,29 @@ OMNI_API void omni_points(const float *x, int64_t i0, int64_t i1, int64_t D, con
     out_re[i] = zr;
     out_im[i] = zi;
   }
+}
+
+#define POINTS_ARGS const float *x, int64_t i0, int64_t i1, int64_t D, const float *sdirs, const float *soffs, \
+    const float *amps, int64_t K, const float *nmin, const float *slpos, const float *omega, const float *zeta, \
+    int64_t S, const float *tab, int64_t N, float inv_period, float shift, float *out_re, float *out_im
+#define POINTS_CALL x, i0, i1, D, sdirs, soffs, amps, K, nmin, slpos, omega, zeta, S, tab, N, inv_period, shift, \
+    out_re, out_im
+
+#ifdef OMNI_X86
+/* the same operations compiled for AVX2 CPUs: floor becomes one instruction (no fused multiply-adds: the same
+ * bits) */
+AVX2 static void points_avx2(POINTS_ARGS) { points_(POINTS_CALL); }
+#endif
+
+/* vector: 1 for the AVX2 build where omni_vector(), 0 for the scalar one (the same bits) */
+OMNI_API void omni_points(POINTS_ARGS, int vector) {
+#ifdef OMNI_X86
+  if (vector && omni_vector()) {
+    points_avx2(POINTS_CALL);
+    return;
+  }
+#endif
+  points_(POINTS_CALL);
 }
 
 /* Points i0 .. i1 - 1 against neighbours a0 .. a0 + B - 1 (cells.voronoi's loop): nearer feature points replace

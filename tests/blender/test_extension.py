@@ -77,6 +77,9 @@ def test_install_enable_disable_in_temporary_user_folders(built_zip, tmp_path):
     # computes coordinates by matmul, not along rows, and stays within test_ckernel's 1e-3 bound
     assert out["kernel_vs_other"] < (1e-5 if out["other_path"] == "numba" else 1e-3), out["other_path"]
     assert out["kernel_signal"] > 0.1
+    # without numba (Blender's own Python) points run the wheel's point kernel, and the cells its cell kernel
+    assert out["points_compiled"] == KERNEL and out["points_vs_numpy"] < 1e-5
+    assert out["cells_same"]
     assert not out["disabled_props"] and out["reenabled_props"]
     if not out["openvdb"]:  # the bpy 4.2 wheel: a one-line message instead of a volume
         assert out["bake"] == ["ERROR"] and "OpenVDB Python module" in out["bake_error"]

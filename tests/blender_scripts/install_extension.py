@@ -9,6 +9,7 @@ import threading
 import time
 
 import bpy
+import numpy as np
 
 MOD = "bl_ext.user_default.omninoise"
 out = {}
@@ -64,7 +65,23 @@ without = be.evaluate_grid(noise, 12, 2.0)
 ck.set_enabled(True)
 out["kernel_vs_other"] = float(abs(with_kernel - without).max())
 out["kernel_signal"] = float(without.std())
-out["other_path"] = "numba" if importlib.import_module(MOD + ".backend.wavenoise.fast").available() else "numpy"
+fast = importlib.import_module(MOD + ".backend.wavenoise.fast")
+out["other_path"] = "numba" if fast.available() else "numpy"
+# points and the procedural cells as Blender's Python (no numba) reads them: the wheel's point and cell kernels
+pts = np.random.default_rng(0).uniform(-4.0, 4.0, (3000, 3)).astype(np.float32)
+saved, fast.numba = fast.numba, False
+try:
+    out["points_compiled"] = fast.supports(noise)
+    points = noise.evaluate(pts)
+finally:
+    fast.numba = saved
+out["points_vs_numpy"] = float(abs(points - noise.evaluate(pts, accelerate=False)).max())
+cells = importlib.import_module(MOD + ".backend.solid.procedural.cells")
+f1, f2, cube = cells.voronoi(pts, 0.9, 3)
+ck.set_enabled(False)
+g1, g2, gcube = cells.voronoi(pts, 0.9, 3)
+ck.set_enabled(True)
+out["cells_same"] = bool((f1 == g1).all() and (f2 == g2).all() and (cube == gcube).all())
 bake = bpy.context.scene.omninoise_bake
 bake.bounds_mode = "CUSTOM"
 bake.volume_resolution = (8, 8, 8)

@@ -150,6 +150,11 @@ def test_point_kernel_gives_numba_bits(dim, speed, time, monkeypatch):
     one = fast.evaluate(noise, x, time)
     assert got.dtype == np.complex64 and np.array_equal(got.view(np.uint32), want.view(np.uint32))
     assert np.array_equal(one.view(np.uint32), want.view(np.uint32))
+    re, im = np.empty(len(x), np.float32), np.empty(len(x), np.float32)     # the scalar build (CPUs without AVX2)
+    ckernel.points(x, noise.slice_dirs, noise.slice_offsets, noise.dirs.amp, *fast._slice_records(noise, x.min(0),
+                   x.max(0)), fast._padded_table(noise), np.float32(1.0 / noise.table.period),
+                   np.float32(noise.speed) * np.float32(time), re, im, use_vector=False)
+    assert np.array_equal(re, want.real) and np.array_equal(im, want.imag)
     numpy = noise.evaluate(x, time, accelerate=False)
     assert np.abs(got - numpy).max() < 1e-5 and np.abs(got).max() > 0.1
 
