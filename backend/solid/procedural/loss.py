@@ -18,6 +18,10 @@ __all__ = ["SliceLoss", "SAMPLES", "DIRECTIONS"]
 
 SAMPLES = 768      #: neighbourhoods per level and group
 DIRECTIONS = 32    #: projections per level
+#: neighbourhoods projected per matrix product.  OpenBLAS runs a product on one thread below m n k = 2^18 (48 x 147
+#: x 32 is under it): threaded, these small products took twice as long, and the BLAS threads they woke kept the
+#: cores from the wave-noise kernel's threads (a fit without numba took up to a quarter longer).  The same bits.
+ROWS = 48
 
 
 class SliceLoss:
@@ -61,6 +65,7 @@ class SliceLoss:
             for m in self.members:
                 o = np.concatenate([pyrs[i][lvl][where[i][0][:, None, None] + dy, where[i][1][:, None, None] + dx]
                                     .reshape(len(where[i][0]), -1, 3) for i in m])[:SAMPLES]
-                proj = np.sort(((o - mu) / sd).reshape(len(o), -1) @ v, axis=0)
+                a = ((o - mu) / sd).reshape(len(o), -1)
+                proj = np.sort(np.concatenate([a[i:i + ROWS] @ v for i in range(0, len(a), ROWS)]), axis=0)
                 total += float(np.abs(ref_sorted - proj).mean())
         return 1000.0 * total / (LEVELS * len(self.members))
