@@ -20,7 +20,7 @@ SAMPLES = 768      #: neighbourhoods per level and group
 DIRECTIONS = 32    #: projections per level
 #: neighbourhoods projected per matrix product.  OpenBLAS runs a product on one thread below m n k = 2^18 (48 x 147
 #: x 32 is under it): threaded, these small products took twice as long, and the BLAS threads they woke kept the
-#: cores from the wave-noise kernel's threads (a fit without numba took up to a quarter longer).  The same bits.
+#: cores from the wave-noise kernel's threads.  The same bits.
 ROWS = 48
 
 
