@@ -18,10 +18,11 @@ __all__ = ["SliceLoss", "SAMPLES", "DIRECTIONS"]
 
 SAMPLES = 768      #: neighbourhoods per level and group
 DIRECTIONS = 32    #: projections per level
-#: neighbourhoods projected per matrix product.  OpenBLAS runs a product on one thread below m n k = 2^18 (48 x 147
-#: x 32 is under it): threaded, these small products took twice as long, and the BLAS threads they woke kept the
-#: cores from the wave-noise kernel's threads.  The same bits.
-ROWS = 48
+#: the largest matrix product m n k that OpenBLAS runs on one thread (interface/gemm.c: 65536 x
+#: GEMM_MULTITHREAD_THRESHOLD 4).  The loss projects its neighbourhoods in pieces of rows that stay within it
+#: (768 x 75 x 32 would not): the BLAS threads a larger product wakes keep the cores from the wave-noise kernel's
+#: threads, and a fit without numba took longer.  The pieces give the same bits as one product.
+ONE_THREAD_MNK = 1 << 18
 
 
 class SliceLoss:
@@ -66,6 +67,7 @@ class SliceLoss:
                 o = np.concatenate([pyrs[i][lvl][where[i][0][:, None, None] + dy, where[i][1][:, None, None] + dx]
                                     .reshape(len(where[i][0]), -1, 3) for i in m])[:SAMPLES]
                 a = ((o - mu) / sd).reshape(len(o), -1)
-                proj = np.sort(np.concatenate([a[i:i + ROWS] @ v for i in range(0, len(a), ROWS)]), axis=0)
+                rows = max(1, ONE_THREAD_MNK // (a.shape[1] * v.shape[1]))
+                proj = np.sort(np.concatenate([a[i:i + rows] @ v for i in range(0, len(a), rows)]), axis=0)
                 total += float(np.abs(ref_sorted - proj).mean())
         return 1000.0 * total / (LEVELS * len(self.members))
