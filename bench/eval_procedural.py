@@ -115,16 +115,18 @@ def measure(path: str, fitted: dict | None = None) -> dict:
         field = dataclasses.replace(req, method="procedural").procedural_field()
         seconds = time.time() - t
         plain, again = _fit_without_numba(req)
-        same = None if again is None else again == field.to_dict()
+        fd = field.to_dict()
+        same = None if again is None else again == fd
     else:
         field, seconds = ProceduralField.from_dict(fitted["field"]), fitted["seconds"]
+        fd = field.to_dict()
         plain, same = fitted.get("seconds_without_numba"), fitted.get("same_fit_without_numba")
     choice = req.choose(field=field)
     model, code = choice.model, choice.code
     neural = _Field(lambda pts: model.evaluate(pts, code, 0), model.px_per_unit)
     r = {"family": field.family, "seconds": round(seconds, 1), "seconds_without_numba": plain,
          "same_fit_without_numba": same, "chosen": choice.method, "choice_distances": choice.distances,
-         "field": field.to_dict()}
+         "field": fd}
     for name, f in (("procedural", field), ("neural", neural)):
         r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
     # random phase as a solid: the closer kind, figure by figure, as solid-methods

@@ -129,10 +129,13 @@ def procedural(doc: dict) -> list:
                        f"{rp} | {nb} | {nf} |")
         out.append("")
     fams = ", ".join(f"{k} {v}" for k, v in s.get("families", {}).items())
-    timing = (f" Median fit time {s.get('median_fit_seconds')} s per photo on this machine"
-              + (f"; without numba, as Blender's Python fits, {s['median_fit_seconds_without_numba']} s (the same "
-                 f"solid on {s.get('same_fit_without_numba')} of {n})" if "median_fit_seconds_without_numba" in s
-                 else "") + "." if doc.get("set") == "structured" else "")
+    timing = ""
+    if doc.get("set") == "structured":
+        timing = f" Median fit time {s.get('median_fit_seconds')} s per photo on this machine"
+        if "median_fit_seconds_without_numba" in s:
+            timing += (f"; without numba, as Blender's Python fits, {s['median_fit_seconds_without_numba']} s (the "
+                       f"same solid on {s.get('same_fit_without_numba')} of {n})")
+        timing += "."
     out += [f"Families fitted: {fams}; auto kept the procedural solid on {s.get('chosen_procedural')} of "
             f"{n}.{timing}", ""]
     return out

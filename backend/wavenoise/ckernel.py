@@ -145,20 +145,26 @@ def _ptr(a: np.ndarray):
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
 
 
+def _checked(kernel: str, arrays: list):
+    """The loaded library, once every (array, dtype) of ``arrays`` is C-contiguous of that dtype (else ValueError);
+    RuntimeError where it is not built (callers ask :func:`available` first)."""
+    lib = _load()
+    if lib is None:
+        raise RuntimeError(f"the C {kernel} kernel is not built (python tools/build_kernel.py)")
+    for a, t in arrays:
+        if a.dtype != t or not a.flags.c_contiguous:
+            kinds = " and ".join(sorted({np.dtype(t).name for _, t in arrays}))
+            raise ValueError(f"the C {kernel} kernel needs C-contiguous {kinds} arrays")
+    return lib
+
+
 def rows(xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, tables, inv_period, shift,
          out_re, out_im=None, use_vector: bool = True) -> None:
     """Fill out_re (and out_im) float32 (R, Nx), C-contiguous, like fast._rows_kernel.
 
     tables: :func:`padded`'s four arrays.  Every array must be C-contiguous float32 (checked)."""
-    lib = _load()
-    if lib is None:  # callers ask available() first (GridPlan)
-        raise RuntimeError("the C row kernel is not built (python tools/build_kernel.py)")
     arrays = (xs, others, sdirs, soffs, amps, nmin, slpos, omega, zeta, *tables, out_re)
-    if out_im is not None:
-        arrays += (out_im,)
-    for a in arrays:
-        if a.dtype != _F or not a.flags.c_contiguous:
-            raise ValueError("the C row kernel needs C-contiguous float32 arrays")
+    lib = _checked("row", [(a, _F) for a in arrays + ((out_im,) if out_im is not None else ())])
     R, Nx = out_re.shape
     K, D = sdirs.shape
     if xs.shape != (Nx,) or others.shape != (R, D - 1) or (out_im is not None and out_im.shape != (R, Nx)):
@@ -185,12 +191,8 @@ def points(x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, inv_period, s
     """Fill out_re and out_im float32 (P,) with the noise at points x float32 (P, D), like fast_kernels._kernel
     (the same bits). ``table``: the padded table float32 (N + 2, 2) of fast._padded_table; ``use_vector``: the
     AVX2 build where the CPU runs it, else the scalar one.  Every array must be C-contiguous float32 (checked)."""
-    lib = _load()
-    if lib is None:  # callers ask available() first (fast.evaluate)
-        raise RuntimeError("the C kernel is not built (python tools/build_kernel.py)")
-    for a in (x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, out_re, out_im):
-        if a.dtype != _F or not a.flags.c_contiguous:
-            raise ValueError("the C point kernel needs C-contiguous float32 arrays")
+    lib = _checked("point", [(a, _F) for a in (x, sdirs, soffs, amps, nmin, slpos, omega, zeta, table, out_re,
+                                                out_im)])
     P, D = x.shape
     K = sdirs.shape[0]
     if sdirs.shape != (K, D) or out_re.shape != (P,) or out_im.shape != (P,) or table.ndim != 2:
@@ -206,12 +208,8 @@ def cells(local, back, near, hashes, first: int, jitter: float, f1, f2, which) -
     float32 (P, 3) positions in their cubes and ``back`` int64 (P,) rows of their cubes, against the neighbour
     offsets ``near`` float32 (B, 3) whose cubes' feature point offsets are ``hashes`` float32 (B, C, 3); updates F1,
     F2 float32 (P,) and ``which`` int64 (P,), the nearest feature point's neighbour (``first`` + its batch row)."""
-    lib = _load()
-    if lib is None:
-        raise RuntimeError("the C kernel is not built (python tools/build_kernel.py)")
-    for a, t in ((local, _F), (near, _F), (hashes, _F), (f1, _F), (f2, _F), (back, np.int64), (which, np.int64)):
-        if a.dtype != t or not a.flags.c_contiguous:
-            raise ValueError("the C cell kernel needs C-contiguous float32 and int64 arrays")
+    lib = _checked("cell", [(local, _F), (near, _F), (hashes, _F), (f1, _F), (f2, _F), (back, np.int64),
+                            (which, np.int64)])
     P, B = len(local), len(near)
     if local.shape != (P, 3) or near.shape != (B, 3) or hashes.shape[::2] != (B, 3) or not (
             back.shape == f1.shape == f2.shape == which.shape == (P,)):
