@@ -11,7 +11,7 @@ from omninoise.backend.solid.model import slice_points
 from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
 from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_cubes, cell_w, voronoi
 from omninoise.backend.solid.procedural.estimate import Estimates, estimate, repeat_length
-from omninoise.backend.solid.procedural.family import Param, axis_vector
+from omninoise.backend.solid.procedural.family import Param, axis_vector, dot3
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
 from omninoise.backend.solid.procedural.fit import (FIT_PLANES, ProceduralConfig, fit_procedural, oblique_points,
                                                    plane_group)
@@ -28,6 +28,12 @@ CALM = dict(turbulence=0.0, turb_freq=1.0, detail=0.0)
 
 def _points(n=4000, seed=0, extent=2.0):
     return np.random.default_rng(seed).uniform(-extent, extent, (n, 3))
+
+
+def test_dot3_is_the_matrix_product():
+    pts, v = _points(), axis_vector(0.7, 2.1)
+    np.testing.assert_allclose(dot3(pts, v), pts @ v, rtol=0, atol=1e-14)
+    assert dot3(pts.astype(np.float32), v).dtype == np.float64
 
 
 def test_a_parameter_maps_to_the_unit_interval_and_back():

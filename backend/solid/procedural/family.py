@@ -19,7 +19,7 @@ import numpy as np
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
-__all__ = ["Param", "Family", "cell_random", "axis_vector", "gapped", "inside", "SHARED", "DETAIL_FREQ"]
+__all__ = ["Param", "Family", "cell_random", "axis_vector", "dot3", "gapped", "inside", "SHARED", "DETAIL_FREQ"]
 
 DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
 
@@ -122,3 +122,11 @@ def cell_random(i, j, k, seed: int) -> np.ndarray:
 def axis_vector(tilt: float, azimuth: float) -> np.ndarray:
     """The unit vector ``tilt`` radians from +z, turned ``azimuth`` radians about z from +x: float64 (3,)."""
     return np.array([np.sin(tilt) * np.cos(azimuth), np.sin(tilt) * np.sin(azimuth), np.cos(tilt)])
+
+
+def dot3(points: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """points float (P, 3) . v (3,) -> float64 (P,), as three products and two sums in numpy rather than a matrix
+    product: OpenBLAS runs one of P rows on all its threads, which then wait, spinning, for the next, and keep a
+    core from the wave-noise kernel's threads (a fit without numba took 13.3 s against 10.8 s on one BLAS thread)."""
+    pts = np.asarray(points, np.float64)
+    return pts[:, 0] * v[0] + pts[:, 1] * v[1] + pts[:, 2] * v[2]

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .family import Family, Param, axis_vector
+from .family import Family, Param, axis_vector, dot3
 from .turbulence import turbulence
 
 __all__ = ["Layers", "PROFILES"]
@@ -28,7 +28,7 @@ class Layers(Family):
 
     def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         pts = np.asarray(points, np.float64)
-        h = pts @ axis_vector(p["tilt"], p["azimuth"]) / p["spacing"]
+        h = dot3(pts, axis_vector(p["tilt"], p["azimuth"])) / p["spacing"]
         if p["turbulence"] > 0:
             h += p["turbulence"] * turbulence(pts, p["turb_freq"], seed)
         f = h - np.floor(h)

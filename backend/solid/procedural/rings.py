@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .family import Family, Param, axis_vector
+from .family import Family, Param, axis_vector, dot3
 from .turbulence import turbulence
 
 __all__ = ["Rings", "GRAIN_STRETCH"]
@@ -49,13 +49,13 @@ class Rings(Family):
         pts = np.asarray(points, np.float64)
         d, c = self.geometry(p)
         rel = pts - c
-        along = rel @ d
+        along = dot3(rel, d)
         r = np.linalg.norm(rel - along[:, None] * d, axis=1)
         s = r / p["spacing"]
         if p["turbulence"] > 0:
             s += p["turbulence"] * turbulence(pts, p["turb_freq"], seed)
         if p["grain"] > 0:
-            squash = pts - (1.0 - 1.0 / GRAIN_STRETCH) * (pts @ d)[:, None] * d
+            squash = pts - (1.0 - 1.0 / GRAIN_STRETCH) * dot3(pts, d)[:, None] * d
             s += p["grain"] * turbulence(squash, 4.0 * p["turb_freq"], seed + 1)
         return s - np.floor(s)
 
