@@ -109,7 +109,7 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                                        "6 s to draw"),
         ("PROCEDURAL", "Procedural Solid", "Rings, layers, cells or bricks fitted to the photo: structure that runs "
                                            "on through the object (wood, veins, stones, courses); also a live node "
-                                           "group; about 15 s to fit"),
+                                           "group; about 12 s to fit"),
         ("AUTO", "Auto", "The procedural solid where it is closer to the photo than the neural texture, else the "
                          "neural texture")], default="NEURAL")
     families: EnumProperty(name="Kinds", options={"ENUM_FLAG"},
