@@ -135,7 +135,7 @@ def _version(deb_dir: str, pkg: str) -> str:
 
 def fetch(cache: str, packages: tuple = PACKAGES) -> str:
     """apt-get download + dpkg-deb -x the packages into ``cache``; returns the unpack folder."""
-    os.makedirs(cache, exist_ok=True)
+    os.makedirs(os.path.join(cache, "x"), exist_ok=True)     # dpkg-deb -x makes its folder, not the parents
     for pkg in packages:
         if not glob.glob(os.path.join(cache, f"{pkg}_*.deb")):
             subprocess.run(["apt-get", "download", pkg], cwd=cache, check=True)

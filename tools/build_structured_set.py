@@ -4,8 +4,9 @@ Photos whose structure runs through the material (planks, grain, a board's figur
 packages and under the licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0,
 public domain or Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold:
 neither model training nor any tuning read them.  Nexuiz's and OpenArena's textures (GPL-2.0-or-later, the whole
-package) are taken here too, and only here: these photos are evaluated, never trained on, and the repository is
-GPL-3.0-or-later.
+package) and UFO:AI's files under GPL-2.0-or-later are taken here too, and only here: these photos are evaluated,
+never trained on, and the repository is GPL-3.0-or-later (UFO:AI's GPL-2.0-only files, its veined marble and
+layered rock faces among them, are not).
 Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the centre CROP px square) but
 without its stationarity filter, which would drop exactly these.  The evaluation of the procedural solids
 (``python -m bench solid-procedural``) reads them beside the photo set's held-out brick, paving, tile and wood
@@ -45,6 +46,8 @@ SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
            ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile01.png", "tile"),
            ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile02.png", "tile"),
            ("ufoai-textures", "base/0textures.pk3:textures/tex_buildings/tile03.png", "tile"),
+           ("ufoai-textures", "base/0textures.pk3:textures/tex_nature/tree_chopped.jpg", "wood"),
+           ("ufoai-textures", "base/0textures.pk3:textures/tex_nature/tree_chopped2.jpg", "wood"),
            ("nexuiz-textures", "textures.pk3:textures/evil2_misc/blue_marble.jpg", "marble"),
            ("nexuiz-textures", "textures.pk3:textures/egyptsoc_mat/wood17.tga", "wood"),
            ("nexuiz-textures", "textures.pk3:textures/desertfactory_wood/wood04.tga", "wood"),
@@ -67,7 +70,8 @@ def _licence(text: str, pkg: str, path: str) -> tuple:
     lic = parse_dep5(text)
     if pkg == "ufoai-textures":
         pk3, name = path.split(":", 1)
-        return lic[pk3.replace("0textures.pk3", "") + name]
+        licence, authors = lic[pk3.replace("0textures.pk3", "") + name]
+        return SPDX.get(licence, licence), authors
     if pkg == "openarena-081-textures":
         licence, authors = lic["*"]
         return SPDX.get(licence, licence), authors
