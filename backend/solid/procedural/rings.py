@@ -60,8 +60,8 @@ class Rings(Family):
         return s - np.floor(s)
 
     def starts(self, est) -> list:
-        """The axis along the photo's stripes (in the wall x-z), far behind the wall (planks' stripes) or near
-        (arcs), and straight up through the wall (rings round a log seen from the side)."""
+        """The axis along the photo's stripes, in the wall x-z (a log seen from the side), 25 spacings behind the
+        wall (planks' stripes) or 6 (arcs), each with the ramp either way round."""
         out = []
         a = est.angle + np.pi / 2                       # the stripes' direction in the wall, from +x towards +z
         dx, dz = np.cos(a), np.sin(a)
