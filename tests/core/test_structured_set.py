@@ -46,3 +46,13 @@ def test_nexuiz_licence_is_read_off_its_copyright_file():
     assert bss.nexuiz_licence(grant) == ("GPL-2.0-or-later", "2002 - 2009 Alientrap, Lee Vermeulen")
     with pytest.raises(SystemExit, match="GPL-2.0-or-later"):
         bss.nexuiz_licence(grant.replace("either version 2", "version 2 only"))
+
+
+def test_ufoai_licences_are_read_per_file():
+    """UFO:AI's DEP-5 names a licence per file: GPL-2+ is taken as GPL-2.0-or-later, GPL-2 alone is not taken."""
+    dep5 = ("Files:\n base/textures/tex_nature/tree_chopped.jpg\nCopyright:\n Someone\nLicense: GPL-2+\n\n"
+            "Files:\n base/textures/tex_ctp1/marble_m_1.jpg\nCopyright:\n Another\nLicense: GPL-2\n")
+    member = "base/0textures.pk3:textures/tex_nature/tree_chopped.jpg"
+    assert bss._licence(dep5, "ufoai-textures", member) == ("GPL-2.0-or-later", "Someone")
+    licence, _ = bss._licence(dep5, "ufoai-textures", "base/0textures.pk3:textures/tex_ctp1/marble_m_1.jpg")
+    assert licence == "GPL-2" and licence not in bss.STRUCTURED_LICENCES
