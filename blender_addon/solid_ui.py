@@ -161,6 +161,9 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
                                   description="What the last preview found of the photo's regular pattern")
     gaussian_info: StringProperty(name="Fine Detail Found", default="", options={"SKIP_SAVE"},
                                   description="How much fine detail the last preview mixed in")
+    grid_info: StringProperty(name="Grid Found", default="", options={"SKIP_SAVE"},
+                              description="Whether the last procedural fit's photo repeats as a grid (bricks, tiles), "
+                                          "where Bonds alone lays it in courses")
     name: StringProperty(name="Name", default="Solid Texture",
                          description="Name of the baked image, color attribute, volume and material")
     folder: StringProperty(name="Folder", subtype="DIR_PATH", default="//omninoise_bakes",
@@ -238,6 +241,12 @@ def periodic_info(code) -> str:
     if h is None:
         return "Pattern: none found"
     return f"Pattern: {len(h)} waves, {100 * h.share:.0f} % of the variance"
+
+
+def grid_info(req) -> str:
+    """A line for the panel: a suggestion of Bonds alone where a procedural fit's photo repeats as a grid (bricks,
+    tiles) and other kinds are picked (backend SolidRequest.repeats_as_grid), else ""."""
+    return "Repeats as a grid: try Bonds alone" if req.repeats_as_grid("image: ") else ""
 
 
 def gaussian_info(code) -> str:
@@ -327,6 +336,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         p = context.scene.omninoise_solid
         m, code_fn = texture(p)
         seed, name = p.seed, f"{p.name} Preview"
+        grid = grid_info(panel_request(p)) if p.source == "IMAGE" and p.method in ("PROCEDURAL", "AUTO") else ""
 
         def work(progress, cancel):
             code = code_fn(lambda f: progress(0.2 * f), cancel)
@@ -337,7 +347,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         def done(result):
             img, info, rest = result
             store_srgb_image(name, np.flipud(img)).preview_ensure()
-            p.periodic_info, p.gaussian_info = info, rest
+            p.periodic_info, p.gaussian_info, p.grid_info = info, rest, grid
 
         return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
 
@@ -567,6 +577,7 @@ class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
         if req.exemplar is None or isinstance(req.exemplar, str):
             raise backend.SettingError("image", "a procedural solid is fitted to a photo: set Source to Image")
         scale, world, name = float(p.scale), p.coords == "WORLD", p.name
+        grid = grid_info(req)
 
         def work(progress, cancel):
             return req.procedural_field("", progress, cancel)
@@ -575,7 +586,7 @@ class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
             from .procedural_nodes import add_procedural_node, build_procedural_group
 
             group = build_procedural_group(field, name=f"{name} Procedural")
-            p.periodic_info = periodic_info(field)
+            p.periodic_info, p.grid_info = periodic_info(field), grid
 
             def node(nt):
                 n = add_procedural_node(nt, group, (-400.0, 0.0))
@@ -636,6 +647,8 @@ def _draw_photo(layout, p) -> None:
     if p.method in ("PROCEDURAL", "AUTO"):
         layout.label(text="Procedural Kinds:")
         layout.row(align=True).prop(p, "families", expand=True)
+        if p.grid_info:
+            layout.label(text=p.grid_info, icon="INFO")
     if p.method == "PROCEDURAL":
         if p.periodic_info:
             layout.label(text=p.periodic_info)

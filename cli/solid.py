@@ -106,6 +106,9 @@ def run(a: argparse.Namespace) -> int:
 
         require_vdb("-o")
     req = solid_request(a)
+    if not a.quiet and req.repeats_as_grid("--"):
+        print("note: the photo repeats across and up as a grid (bricks, tiles?); the kinds besides bonds often draw "
+              "stones or blotches there: --families bonds lays it in courses", file=sys.stderr)
     t0 = time.perf_counter()
     if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
         print(f"encoding {a.exemplar} ...", end="", file=sys.stderr, flush=True)

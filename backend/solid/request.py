@@ -222,6 +222,23 @@ class SolidRequest:
         except SettingError as exc:
             raise SettingError(f"{where}exemplar", exc.message) from None
 
+    def repeats_as_grid(self, where: str = "") -> bool:
+        """Whether methods "procedural" and "auto" would fit, besides bonds, kinds that draw stones or blotches on a
+        photo that repeats as a grid (bricks, tiles: :func:`~backend.solid.procedural.estimate.grid_repeat` at
+        least ``GRID``, read at the fit's resolution), so that the interfaces suggest bonds alone."""
+        from .pixels import at_most, rgb_pixels
+        from .procedural.estimate import GRID, grid_repeat
+        from .procedural.fit import PX_PER_UNIT, ProceduralConfig
+
+        if self.method not in ("procedural", "auto") or not set(self.families) - {"bonds", "herringbone"}:
+            return False
+        if self.exemplar is None or isinstance(self.exemplar, str) and not os.path.isfile(self.exemplar):
+            return False
+        img = rgb_pixels(np.asarray(self.exemplar_pixels(where), np.float32))
+        if min(img.shape[:2]) < 16:
+            return False
+        return grid_repeat(at_most(img, PX_PER_UNIT, ProceduralConfig().fit_side)[0]) >= GRID
+
     def solid_field(self, where: str = "", progress=None, cancel=None):
         """The field of a solid image method (spectral or procedural): :meth:`spectral_field` or
         :meth:`procedural_field`."""

@@ -222,6 +222,7 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         p.source, p.image, p.method, p.seed, p.scale = "IMAGE", bpy.data.images.load(path), "PROCEDURAL", 2, 1.5
         assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
         assert p.periodic_info.startswith("Fitted: ")
+        assert p.grid_info == "Repeats as a grid: try Bonds alone"       # a brick wall, the default kinds
         ima = bpy.data.images["Solid Texture Preview"]
         px = np.empty(ima.size[0] * ima.size[1] * 4, np.float32)
         ima.pixels.foreach_get(px)
@@ -264,6 +265,11 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         assert solid_ui.panel_request(p).key() == solid_request(flags).key()
         assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
         assert p.periodic_info in ("Fitted: bonds (herringbone)", "Fitted: bonds (herringbone45)")
+        assert p.grid_info == ""
+        p.families = {"BONDS", "CELLS"}
+        bpy.ops.mesh.primitive_cube_add()
+        assert bpy.ops.omninoise.solid_procedural_node() == {"FINISHED"}
+        assert p.grid_info == "Repeats as a grid: try Bonds alone"
         p.families = set()
         with pytest.raises(SettingError, match="pick at least one kind"):
             solid_ui.panel_request(p)

@@ -138,3 +138,15 @@ def test_auto_keeps_what_its_check_finds_closer(tmp_path):
     out = str(tmp_path / "auto.png")
     assert main(["solid", "--quiet", "--method", "auto", "--exemplar", PHOTO, "--size", "32", "-o", out]) == 0
     assert os.path.getsize(out) > 0
+
+
+@pytest.mark.parametrize("args, note", [(["--method", "procedural"], True), (["--method", "auto"], True),
+                                        (["--method", "procedural", "--families", "bonds"], False),
+                                        (["--method", "procedural", "--quiet"], False),
+                                        (["--method", "spectral"], False)])
+def test_a_brick_wall_s_fit_suggests_bonds(tmp_path, monkeypatch, capsys, args, note):
+    """The brick wall repeats as a grid: a procedural fit that tries other kinds says, before fitting, that bonds
+    lay it in courses (the result itself is not what is tested: the texture is stubbed)."""
+    monkeypatch.setattr(SolidRequest, "front_image", lambda self, size, *a, **k: np.full((size, size, 3), 0.5))
+    assert main(["solid", "--exemplar", PHOTO, "--size", "8", "-o", str(tmp_path / "a.png"), *args]) == 0
+    assert ("--families bonds lays it in courses" in capsys.readouterr().err) == note

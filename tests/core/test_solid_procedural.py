@@ -10,7 +10,7 @@ from omninoise.backend.grid import Cancelled
 from omninoise.backend.solid.model import slice_points
 from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
 from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_cubes, cell_w, voronoi
-from omninoise.backend.solid.procedural.estimate import Estimates, estimate, repeat_length
+from omninoise.backend.solid.procedural.estimate import GRID, Estimates, estimate, grid_repeat, repeat_length
 from omninoise.backend.solid.procedural.family import Param, axis_vector, dot3
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
 from omninoise.backend.solid.procedural.fit import (FIT_PLANES, ProceduralConfig, fit_procedural, oblique_points,
@@ -417,6 +417,32 @@ def test_held_out_walls_are_read_as_they_are_laid(photo, length, height, offset)
     assert est.spacing_x * PX_PER_UNIT == pytest.approx(length, abs=2)
     assert est.courses[0] * PX_PER_UNIT == pytest.approx(height, abs=2)
     assert min(abs(est.courses[1] - offset), 1 - abs(est.courses[1] - offset)) < 0.05, est.courses
+
+
+@pytest.mark.parametrize("photo, grid", [
+    ("photos/val/brick__tex_trak_trak4_brick2a.jpg", True), ("structured/tile__tile01.jpg", True),
+    ("structured/tile__tile03.jpg", True), ("photos/val/paving__forestfloor_pine.jpg", False),
+    ("structured/wood__wood17.jpg", False), ("structured/marble__marble02b.jpg", False)])
+def test_photos_that_repeat_as_a_grid_are_told_apart(photo, grid):
+    """Brick and tile walls repeat as grids, a forest floor, planks and marble do not; a drawn stack bond does, its
+    own noise alone does not; and the request asks it only of procedural fits that try kinds besides bonds."""
+    from omninoise.backend.solid.request import SolidRequest
+    from omninoise.export import read_rgb
+
+    path = os.path.join(ROOT, "data", photo)
+    assert (grid_repeat(read_rgb(path)) >= GRID) == grid
+    assert SolidRequest(exemplar=path, method="procedural").check().repeats_as_grid() == grid
+    assert not SolidRequest(exemplar=path, method="procedural", families=("bonds",)).check().repeats_as_grid()
+    assert not SolidRequest(exemplar=path, method="spectral").check().repeats_as_grid()
+
+
+def test_a_drawn_grid_repeats_as_one_and_its_noise_does_not():
+    ramp = Ramp((-1.0, 0.0, 2.0), ((0.9, 0.9, 0.85), (0.45, 0.2, 0.15), (0.6, 0.3, 0.2)))
+    wall = ProceduralField("bonds", dict(length=0.3, height=0.3, offset=0.0, joint=0.12, turbulence=0.05,
+                                         turb_freq=2.0, detail=0.05, flip=True), ramp, seed=3).image(256)
+    assert grid_repeat(wall) >= GRID
+    noise = np.random.default_rng(0).random((256, 256, 1)).repeat(3, 2)
+    assert grid_repeat(noise) < 0.2
 
 
 @pytest.mark.parametrize("pattern, n", [("herringbone", 2), ("herringbone", 3), ("herringbone45", 2),

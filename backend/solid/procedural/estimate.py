@@ -31,7 +31,7 @@ import numpy as np
 
 from .ramp import luminance
 
-__all__ = ["Estimates", "estimate", "repeat_length", "courses", "CORRELATION_SCALE"]
+__all__ = ["Estimates", "estimate", "repeat_length", "courses", "grid_repeat", "GRID", "CORRELATION_SCALE"]
 
 CORRELATION_SCALE = 4.0    #: a repeat where the autocorrelation has no peak: this many of its half-fall lengths
 BAND = (1.5, 24.0)         #: the band-pass's Gaussians, sigma in px
@@ -39,6 +39,7 @@ MIN_LAG = 6                #: shorter repeats are grain
 PEAK = 0.1                 #: a peak lower than this is chance
 FUNDAMENTAL = 0.8          #: the repeat is the first peak at least this share of the highest
 COURSES = (3, 2)           #: the courses a wall's repeat up may hold, most first (raking bonds, running bonds)
+GRID = 0.5                 #: a photo whose :func:`grid_repeat` is at least this repeats as a grid
 
 
 @dataclass(frozen=True)
@@ -102,6 +103,35 @@ def courses(ac: np.ndarray, across: float, up: float) -> tuple:
     return up, 0.0
 
 
+def _autocorrelation(lum: np.ndarray) -> np.ndarray:
+    """The autocorrelation of a luminance (H, W) less its mean, band-passed (module doc), 1 at lag (0, 0)."""
+    H, W = lum.shape
+    fy, fx = np.fft.fftfreq(H)[:, None], np.fft.fftfreq(W)[None, :]
+    f2 = (2 * np.pi) ** 2 * (fy ** 2 + fx ** 2)
+    band = np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)     # the DoG's transfer
+    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
+    return ac / max(ac[0, 0], 1e-12)
+
+
+def _repeats(ac: np.ndarray) -> tuple:
+    """(across, up): the repeats along x and along z of an autocorrelation, px."""
+    H, W = ac.shape
+    return repeat_length(ac[0, :W // 2]), repeat_length(ac[:H // 2, 0])
+
+
+def grid_repeat(photo: np.ndarray) -> float:
+    """How much the photo repeats as a grid, as brick courses and tile joints do: its band-passed autocorrelation one
+    repeat across and one repeat up, the lower of the two (1: the photo is itself shifted by either).  Of the photo
+    set's and the structured set's 582 photos (at most 256 px a side), the grids of bricks, tiles, paving and metal
+    plates read 0.53 to 0.93, the rows of ploughed fields 0.65 to 0.69, a patterned carpet 0.55 and every other
+    photo 0.48 at most: at least :data:`GRID`, the interfaces suggest bonds (the default kinds draw stones or
+    blotches on a wall)."""
+    lum = luminance(photo)
+    ac = _autocorrelation(lum - lum.mean())
+    across, up = _repeats(ac)
+    return float(min(_at(ac, across, 0.0), _at(ac, 0.0, up)))
+
+
 def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
     """The :class:`Estimates` of a photo at ``px_per_unit`` photo pixels per texture unit."""
     lum = luminance(photo)
@@ -112,13 +142,9 @@ def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
     tensor = np.array([[np.sum(gx * gx), np.sum(gx * gz)], [np.sum(gx * gz), np.sum(gz * gz)]])
     w, v = np.linalg.eigh(tensor)
     angle = float(np.arctan2(v[1, 1], v[0, 1]))
-    fy, fx = np.fft.fftfreq(H)[:, None], np.fft.fftfreq(W)[None, :]
-    f2 = (2 * np.pi) ** 2 * (fy ** 2 + fx ** 2)
-    band = np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)     # the DoG's transfer
-    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
-    ac /= max(ac[0, 0], 1e-12)
+    ac = _autocorrelation(lum)
     n = min(H, W) // 2
-    across, up = repeat_length(ac[0, :W // 2]), repeat_length(ac[:H // 2, 0])
+    across, up = _repeats(ac)
     height, shift = courses(ac, across, up)
     return Estimates(repeat_length(_ray(ac, angle, n)) / px_per_unit, angle, across / px_per_unit, up / px_per_unit,
                      tuple(repeat_length(_ray(ac, a, n)) / px_per_unit for a in (0.25 * np.pi, 0.75 * np.pi)),
