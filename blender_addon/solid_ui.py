@@ -246,7 +246,7 @@ def periodic_info(code) -> str:
 def grid_info(req) -> str:
     """A line for the panel: a suggestion of Bonds alone where a procedural fit's photo repeats as a grid (bricks,
     tiles) and other kinds are picked (backend SolidRequest.repeats_as_grid), else ""."""
-    return "Repeats as a grid: try Bonds alone" if req.repeats_as_grid("image: ") else ""
+    return "Repeats as a grid: try Bonds alone" if req.repeats_as_grid() else ""
 
 
 def gaussian_info(code) -> str:
