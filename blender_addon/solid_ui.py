@@ -211,10 +211,9 @@ def tile_request(p):
                                               method="synthesis", tile=int(p.tile)).check()
 
 
-def texture(p):
-    """(model, code_fn) for the panel's settings; code_fn(progress, cancel) runs on the worker (it may encode an
-    image, or draw a spectral solid, about 6 s, with progress and cancel)."""
-    req = panel_request(p)
+def texture(req):
+    """(model, code_fn) for the panel's request (:func:`panel_request`); code_fn(progress, cancel) runs on the worker
+    (it may encode an image, or draw a spectral solid, about 6 s, with progress and cancel)."""
     if req.method in ("spectral", "procedural"):     # no model: the "code" is the drawn or fitted solid
         return (_mod("solid.spectral_solid").SpectralTexture(req),
                 lambda progress=None, cancel=None: req.solid_field("", progress, cancel))
@@ -334,9 +333,9 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_solid
-        m, code_fn = texture(p)
-        seed, name = p.seed, f"{p.name} Preview"
-        grid = grid_info(panel_request(p)) if p.source == "IMAGE" and p.method in ("PROCEDURAL", "AUTO") else ""
+        req = panel_request(p)
+        m, code_fn = texture(req)
+        seed, name, grid = p.seed, f"{p.name} Preview", grid_info(req)
 
         def work(progress, cancel):
             code = code_fn(lambda f: progress(0.2 * f), cancel)
@@ -459,7 +458,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
             raise backend.SettingError("object", "select an object to bake onto")
         if p.target != "VOLUME" and obj.type != "MESH":
             raise backend.SettingError("object", f"{obj.name!r} is not a mesh; bake a mesh or choose Volume")
-        m, code_fn = texture(p)
+        m, code_fn = texture(panel_request(p))
         if m.dim != 3:
             raise backend.SettingError("model", f"model {m.name!r} is 2D; surfaces need a 3D solid texture")
         return self._start_target(context, p, obj, m, code_fn, blocking)
