@@ -1,12 +1,12 @@
 """Rebuild the held-out structured photos of the procedural solids: ``python tools/build_structured_set.py``.
 
-Photos whose structure runs through the material (planks, grain, a board's figure, veins, tiles, cobbles), from the
-packages and under the licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0, CC-BY-3.0, CC0,
-public domain or Expat, per file from the packages' DEP-5 copyright files), that the photo set does not hold:
-neither model training nor any tuning read them.  Nexuiz's and OpenArena's textures (GPL-2.0-or-later, the whole
-package) and UFO:AI's files under GPL-2.0-or-later are taken here too, and only here: these photos are evaluated,
-never trained on, and the repository is GPL-3.0-or-later (UFO:AI's GPL-2.0-only files, its veined marble and
-layered rock faces among them, are not).
+Photos whose structure runs through the material (planks, grain, a board's figure, veins, strata, tiles, cobbles),
+from the packages and under the licence rules of the photo set (``tools/build_photo_set.py``: CC-BY-SA-3.0,
+CC-BY-3.0, CC0, public domain or Expat, per file from the packages' DEP-5 copyright files), that the photo set does
+not hold: neither model training nor any tuning read them.  Nexuiz's and OpenArena's textures (GPL-2.0-or-later, the
+whole package) and the files of UFO:AI, Extreme Tux Racer and Scorched3D under GPL-2.0-or-later are taken here too,
+and only here: these photos are evaluated, never trained on, and the repository is GPL-3.0-or-later (UFO:AI's
+GPL-2.0-only files, its veined marble and layered rock faces among them, are not).
 Each is cut as the photo set cuts its crops (short side scaled to SOURCE_SIDE px, the centre CROP px square) but
 without its stationarity filter, which would drop exactly these.  The evaluation of the procedural solids
 (``python -m bench solid-procedural``) reads them beside the photo set's held-out brick, paving, tile and wood
@@ -31,13 +31,18 @@ from tools.build_photo_set import (CROP, LICENCES, SOURCE_SIDE, _sha, _version, 
                                    parse_dep5, scaled_centre, stk_licence, write_attribution)
 
 OUT = os.path.join(ROOT, "data", "structured")
-#: the licences taken: the photo set's, and Nexuiz's and OpenArena's (module doc)
+#: the licences taken: the photo set's, and GPL-2.0-or-later (module doc)
 STRUCTURED_LICENCES = LICENCES + ("GPL-2.0-or-later",)
 #: DEP-5 licence names -> SPDX
 SPDX = {"GPL-2+": "GPL-2.0-or-later"}
 #: where each package keeps the files and archives that SOURCES names
 GAMES = {"supertuxkart-data": "usr/share/games/supertuxkart", "ufoai-textures": "usr/share/games/ufoai",
-         "nexuiz-textures": "usr/share/games/nexuiz/data", "openarena-081-textures": "usr/share/games/openarena"}
+         "nexuiz-textures": "usr/share/games/nexuiz/data", "openarena-081-textures": "usr/share/games/openarena",
+         "extremetuxracer-data": "usr/share/games/etr", "scorched3d-data": "usr/share/games/scorched3d"}
+#: packages whose DEP-5 file names their files by the source tree's path: the folder that holds GAMES[pkg] there
+SOURCE_TREE = {"extremetuxracer-data": "data/", "scorched3d-data": ""}
+#: packages that name a texture by its folder (Scorched3D's landscapes each hold a rockside.jpg)
+NAMED_BY_FOLDER = ("scorched3d-data",)
 PACKAGES = tuple(GAMES)
 #: (package, path inside it, category): the structured photos the packages hold under the licences
 SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
@@ -51,7 +56,11 @@ SOURCES = (("supertuxkart-data", "data/textures/JapanwoodBridge.jpg", "wood"),
            ("nexuiz-textures", "textures.pk3:textures/evil2_misc/blue_marble.jpg", "marble"),
            ("nexuiz-textures", "textures.pk3:textures/egyptsoc_mat/wood17.tga", "wood"),
            ("nexuiz-textures", "textures.pk3:textures/desertfactory_wood/wood04.tga", "wood"),
-           ("openarena-081-textures", "baseoa/pak4-textures.pk3:textures/proto2/marble02b.jpg", "marble"))
+           ("openarena-081-textures", "baseoa/pak4-textures.pk3:textures/proto2/marble02b.jpg", "marble"),
+           ("extremetuxracer-data", "terrains/rock01.png", "marble"),
+           ("extremetuxracer-data", "terrains/rock06.png", "marble"),
+           ("scorched3d-data", "data/globalmods/none/data/textures/landscape/arizona/rockside.jpg", "stone"),
+           ("scorched3d-data", "data/globalmods/none/data/textures/landscape/denali/rockside.jpg", "stone"))
 
 
 def nexuiz_licence(text: str) -> tuple:
@@ -75,7 +84,28 @@ def _licence(text: str, pkg: str, path: str) -> tuple:
     if pkg == "openarena-081-textures":
         licence, authors = lic["*"]
         return SPDX.get(licence, licence), authors
+    if pkg in SOURCE_TREE:
+        licence, authors = dep5_last_match(lic, SOURCE_TREE[pkg] + path)
+        return SPDX.get(licence, licence), authors
     return stk_licence(lic, path)
+
+
+def dep5_last_match(lic: dict, path: str) -> tuple:
+    """(licence, authors) of the source tree's ``path`` under DEP-5 paragraphs ``lic``: the last Files pattern that
+    matches it, as the format reads them."""
+    import fnmatch
+
+    hits = [v for k, v in lic.items() if fnmatch.fnmatch(path, k)]
+    if not hits:
+        raise SystemExit(f"{path}: no Files paragraph of its package's copyright file names it")
+    return hits[-1]
+
+
+def stem(pkg: str, path: str) -> str:
+    """A source's name in the set: its file's name, lower case, after its folder's where NAMED_BY_FOLDER."""
+    parts = path.split(":", 1)[-1].split("/")
+    name = parts[-1].rsplit(".", 1)[0].lower()
+    return f"{parts[-2].lower()}_{name}" if pkg in NAMED_BY_FOLDER else name
 
 
 def _read(unpacked: str, pkg: str, path: str) -> tuple:
@@ -110,8 +140,7 @@ def build(unpacked: str, out: str, deb_dir: str) -> dict:
         if licence not in STRUCTURED_LICENCES:
             raise SystemExit(f"{pkg}: {path} is {licence}, not one of {', '.join(STRUCTURED_LICENCES)}")
         a, box = centre_crop(data)
-        stem = os.path.basename(path.split(":", 1)[-1]).rsplit(".", 1)[0].lower()
-        fname = f"{cat}__{stem}.jpg"
+        fname = f"{cat}__{stem(pkg, path)}.jpg"
         buf = io.BytesIO()
         Image.fromarray(a).save(buf, "JPEG", quality=90, subsampling=0)
         with atomic_path(os.path.join(out, fname)) as tmp:

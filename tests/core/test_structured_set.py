@@ -56,3 +56,28 @@ def test_ufoai_licences_are_read_per_file():
     assert bss._licence(dep5, "ufoai-textures", member) == ("GPL-2.0-or-later", "Someone")
     licence, _ = bss._licence(dep5, "ufoai-textures", "base/0textures.pk3:textures/tex_ctp1/marble_m_1.jpg")
     assert licence == "GPL-2" and licence not in bss.STRUCTURED_LICENCES
+
+
+def test_source_tree_licences_take_the_last_matching_paragraph():
+    """Extreme Tux Racer's and Scorched3D's DEP-5 files name source-tree paths; the last Files pattern that matches
+    a file gives its licence, so a mod's own paragraph is not read for the base game's textures."""
+    dep5 = ("Files: *\nCopyright: 2001-2014 Gavin Camp\nLicense: GPL-2+\n\n"
+            "Files: data/globalmods/apoc/*\nCopyright: Apocalypse mod team\nLicense: CC-BY-SA-3\n")
+    base = "data/globalmods/none/data/textures/landscape/arizona/rockside.jpg"
+    assert bss._licence(dep5, "scorched3d-data", base) == ("GPL-2.0-or-later", "2001-2014 Gavin Camp")
+    assert bss._licence(dep5, "scorched3d-data", "data/globalmods/apoc/data/rock.jpg")[0] == "CC-BY-SA-3"
+    etr = "Files: *\nCopyright: Extreme Tux Racer Team\nLicense: GPL-2+\n\nFiles: data/courses/extras/*\n" \
+          "Copyright: Milo Fungus\nLicense: GPL-2+\n\nFiles: src/quadtree.*\nCopyright: U. T.\nLicense: quadtree\n"
+    assert bss._licence(etr, "extremetuxracer-data", "terrains/rock01.png") == ("GPL-2.0-or-later",
+                                                                                 "Extreme Tux Racer Team")
+    assert bss._licence(etr, "extremetuxracer-data", "courses/extras/a/terrain.png")[1] == "Milo Fungus"
+    with pytest.raises(SystemExit, match="names it"):
+        bss.dep5_last_match({"src/*": ("GPL-2+", "")}, "data/terrains/rock01.png")
+
+
+def test_scorched3d_landscapes_are_named_by_their_folder():
+    names = [bss.stem(pkg, path) for pkg, path, _ in bss.SOURCES]
+    assert len(set(names)) == len(names)
+    assert bss.stem("scorched3d-data", "data/globalmods/none/data/textures/landscape/denali/rockside.jpg") \
+        == "denali_rockside"
+    assert bss.stem("nexuiz-textures", "textures.pk3:textures/egyptsoc_mat/wood17.tga") == "wood17"
