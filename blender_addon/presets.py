@@ -1,5 +1,5 @@
 """Presets through Blender's own preset system: the preset menu with + and − in the headers of the Transfer
-Function, Wave Noise and Neural Noise panels.
+Function, Wave Noise, Neural Noise and Solid Texture panels.
 
 Presets are Python files, as Blender's own are. The extension's folder holds the shipped ones
 (``presets/omninoise/<kind>/``, written by ``python -m tools.make_presets``), registered with
@@ -8,19 +8,20 @@ scripts folder. A wave preset sets ``bpy.context.omninoise_wave``, which each pa
 shows (a node tree's or the bake panel's), so one set of presets serves both.
 
 Each preset menu and its + operator live with the panel they serve (:mod:`.bake_ui`, :mod:`.wave_ui`,
-:mod:`.neural_ui`); this module holds what they share.
+:mod:`.neural_ui`, :mod:`.solid_ui`); this module holds what they share.
 """
 from __future__ import annotations
 
 import json
 import os
 
-__all__ = ["ROOT", "SUBDIRS", "WAVE_VALUES", "NEURAL_VALUES", "LOADING", "loading", "transfer_preset_text",
-           "classes", "attach", "detach"]
+__all__ = ["ROOT", "SUBDIRS", "WAVE_VALUES", "NEURAL_VALUES", "SOLID_VALUES", "LOADING", "loading",
+           "transfer_preset_text", "classes", "attach", "detach"]
 
 #: the folder that holds ``presets/omninoise/...`` (this package's own folder)
 ROOT = os.path.dirname(os.path.abspath(__file__))
-SUBDIRS = {"transfer": "omninoise/transfer", "wave": "omninoise/wave", "neural": "omninoise/neural"}
+SUBDIRS = {"transfer": "omninoise/transfer", "wave": "omninoise/wave", "neural": "omninoise/neural",
+           "solid": "omninoise/solid"}
 
 #: what a wave preset keeps: the look, not the seed
 WAVE_VALUES = ["props.dimensions", "props.directions", "props.spectrum", "props.fmin", "props.fmax",
@@ -28,6 +29,9 @@ WAVE_VALUES = ["props.dimensions", "props.directions", "props.spectrum", "props.
                "props.axis_scale", "props.speed"]
 #: what a neural preset keeps: the swatches and their layout and sampling, not the size, seed or output
 NEURAL_VALUES = ["p.swatches", "p.mode", "p.width", "p.sharpness", "p.sampler", "p.steps", "p.tileable"]
+#: what a solid texture preset keeps: how a photo becomes a solid (the method, the procedural kinds and the
+#: method's options), not the photo, scale, seed, bake target or output
+SOLID_VALUES = ["p.source", "p.method", "p.families", "p.refine", "p.periodic", "p.gaussian", "p.rest", "p.tile"]
 
 
 def transfer_preset_text(tf) -> str:

@@ -34,6 +34,8 @@ import os
 
 import bpy
 import numpy as np
+from bl_operators.presets import AddPresetBase
+from bl_ui.utils import PresetPanel
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from . import tasks
@@ -43,6 +45,7 @@ from .bake_ui import draw_progress
 from .common import Sidebar, backend_module as _mod, image_srgb, solid_models_folder, store_srgb_image
 from .tasks import TaskOperator
 from .preferences import threads
+from .presets import SOLID_VALUES, SUBDIRS
 
 __all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "tile_repeats", "attach",
            "detach"]
@@ -704,9 +707,30 @@ def draw_solid_all(layout, context) -> None:
             draw(_split(layout), p)
 
 
+class OMNINOISE_PT_solid_presets(PresetPanel, bpy.types.Panel):
+    bl_label = "Solid Texture Presets"
+    preset_subdir = SUBDIRS["solid"]
+    preset_operator = "script.execute_preset"
+    preset_add_operator = "omninoise.solid_preset_add"
+
+
+class OMNINOISE_OT_solid_preset_add(AddPresetBase, bpy.types.Operator):
+    """Add or remove a solid texture preset (the method, the procedural kinds and the method's options)"""
+
+    bl_idname = "omninoise.solid_preset_add"
+    bl_label = "Add Solid Texture Preset"
+    preset_menu = "OMNINOISE_PT_solid_presets"
+    preset_subdir = SUBDIRS["solid"]
+    preset_defines = ["p = bpy.context.scene.omninoise_solid"]
+    preset_values = SOLID_VALUES
+
+
 class OMNINOISE_PT_solid(Sidebar, bpy.types.Panel):
     bl_label = "Solid Texture"
     bl_space_type = "VIEW_3D"
+
+    def draw_header_preset(self, context):
+        OMNINOISE_PT_solid_presets.draw_panel_header(self.layout)
 
     def draw(self, context):
         draw_solid(self.layout, context)
@@ -730,7 +754,8 @@ PANELS = (OMNINOISE_PT_solid,) + tuple(_section_panel(*section) for section in S
 
 
 classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable,
-           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_OT_solid_procedural_node) + PANELS
+           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_OT_solid_procedural_node,
+           OMNINOISE_PT_solid_presets, OMNINOISE_OT_solid_preset_add) + PANELS
 
 
 def attach():

@@ -4,9 +4,10 @@
     python -m tools.make_presets --check    # exit 1 when a shipped preset differs from what this writes
 
 Transfer functions: backend.transfer.PRESETS. Wave noise: the looks in WAVE below. Neural noise: one swatch of each
-class the shipped model was trained on (its parameters at the middle of their ranges), and a few blends. The files
-are what Blender's own preset operators write (``bpy.utils.execfile`` runs them), so an artist's presets and these
-sit side by side in the same menus.
+class the shipped model was trained on (its parameters at the middle of their ranges), and a few blends. Solid
+textures: how a photo of each kind of material in SOLID below becomes a solid (the method and the procedural kinds).
+The files are what Blender's own preset operators write (``bpy.utils.execfile`` runs them), so an artist's presets
+and these sit side by side in the same menus.
 """
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import sys
 
 from omninoise.backend.paths import neural_model
 from omninoise.backend.transfer import PRESETS, preset
-from omninoise.blender_addon.presets import NEURAL_VALUES, WAVE_VALUES, transfer_preset_text
+from omninoise.blender_addon.presets import NEURAL_VALUES, SOLID_VALUES, WAVE_VALUES, transfer_preset_text
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FOLDER = os.path.join(ROOT, "blender_addon", "presets", "omninoise")
@@ -41,6 +42,33 @@ NEURAL_SETTINGS = dict(width=32.0, sharpness=1.0, sampler="dpmpp_2m", steps=10, 
 #: blends of the shipped classes: name -> (layout, classes)
 BLENDS = {"blend_cells_to_perlin": ("GRADIENT", ["cells_f1", "perlin"]),
           "blend_four_corners": ("CORNERS", ["cells_f1", "perlin", "spots", "damascus"])}
+
+#: solid texture presets: the values a solid preset sets (SOLID_VALUES), by file name. The procedural kinds where
+#: the fit, left to choose, often draws another material's look (stones on a brick wall, docs/guide/blender.md)
+SOLID_BASE = dict(source="IMAGE", method="PROCEDURAL", families={"RINGS", "LAYERS", "CELLS", "BONDS"}, refine=0,
+                  periodic=True, gaussian=True, rest="auto", tile=256)
+SOLID = {
+    "best_match": dict(method="AUTO"),
+    "neural_texture": dict(method="NEURAL"),
+    "rock_sand_soil": dict(method="SPECTRAL"),
+    "brick_wall_or_tiles": dict(families={"BONDS"}),
+    "herringbone_floor": dict(families={"HERRINGBONE"}),
+    "wood": dict(families={"RINGS", "LAYERS"}),
+    "veined_marble": dict(families={"LAYERS"}),
+    "stones_and_paving": dict(families={"CELLS"}),
+}
+
+
+def _literal(v) -> str:
+    """repr, with a set's items sorted (a preset file is compared as text)."""
+    return "{" + ", ".join(repr(x) for x in sorted(v)) + "}" if isinstance(v, (set, frozenset)) else repr(v)
+
+
+def solid_text(look: dict) -> str:
+    v = dict(SOLID_BASE, **look)
+    lines = ["import bpy", "p = bpy.context.scene.omninoise_solid", ""]
+    lines += [f"{path} = {_literal(v[path.split('.')[1]])}" for path in SOLID_VALUES]
+    return "\n".join(lines) + "\n"
 
 
 def wave_text(look: dict) -> str:
@@ -74,6 +102,7 @@ def presets() -> dict:
                 for name in config["trained_classes"]})
     out.update({f"neural/{name}.py": neural_text(layout, classes, config["class_params"])
                 for name, (layout, classes) in BLENDS.items()})
+    out.update({f"solid/{name}.py": solid_text(look) for name, look in SOLID.items()})
     return out
 
 

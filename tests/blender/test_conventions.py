@@ -233,6 +233,7 @@ def test_the_shipped_presets_are_those_the_tool_writes():
                        text=True)
     assert r.returncode == 0, r.stdout + r.stderr
     assert len(_shipped("transfer")) == len(PRESETS) and len(_shipped("wave")) >= 6 and len(_shipped("neural")) > 20
+    assert len(_shipped("solid")) >= 6
 
 
 def test_every_shipped_preset_loads_through_blenders_preset_menu(scene):
@@ -257,6 +258,14 @@ def test_every_shipped_preset_loads_through_blenders_preset_menu(scene):
     for path in _shipped("neural"):
         assert bpy.ops.script.execute_preset(filepath=path, menu_idname="OMNINOISE_PT_neural_presets") == {"FINISHED"}
         assert len(n.swatches) >= 1 and neural_ui.panel_request(n, 16) is not None, path
+    s = scene.omninoise_solid
+    for path in _shipped("solid"):
+        s.method, s.families = "NEURAL", {"RINGS"}
+        assert bpy.ops.script.execute_preset(filepath=path, menu_idname="OMNINOISE_PT_solid_presets") == {"FINISHED"}
+        assert s.source == "IMAGE" and s.families, path
+    bpy.ops.script.execute_preset(filepath=next(p for p in _shipped("solid") if "brick" in p),
+                                  menu_idname="OMNINOISE_PT_solid_presets")
+    assert (s.method, set(s.families)) == ("PROCEDURAL", {"BONDS"})
 
 
 def test_presets_save_and_load(scene):
@@ -287,3 +296,10 @@ def test_presets_save_and_load(scene):
     assert [s.noise for s in n.swatches][1] == "spots" and n.swatches[1].p0 == pytest.approx(7.5) and n.mode == "GRADIENT"
     assert bpy.ops.omninoise.neural_preset_add(name="Two", remove_name=True) == {"FINISHED"}
     assert not bpy.utils.preset_find("Two", "omninoise/neural")
+    s = scene.omninoise_solid
+    s.method, s.families, s.periodic, s.seed = "AUTO", {"CELLS", "HERRINGBONE"}, False, 5
+    assert bpy.ops.omninoise.solid_preset_add(name="Yard") == {"FINISHED"}
+    s.method, s.families, s.periodic, s.seed = "NEURAL", {"RINGS"}, True, 0
+    path = bpy.utils.preset_find("Yard", "omninoise/solid")
+    bpy.ops.script.execute_preset(filepath=path, menu_idname="OMNINOISE_PT_solid_presets")
+    assert (s.method, set(s.families), s.periodic, s.seed) == ("AUTO", {"CELLS", "HERRINGBONE"}, False, 0)

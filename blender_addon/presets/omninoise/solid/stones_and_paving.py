@@ -1,0 +1,11 @@
+import bpy
+p = bpy.context.scene.omninoise_solid
+
+p.source = 'IMAGE'
+p.method = 'PROCEDURAL'
+p.families = {'CELLS'}
+p.refine = 0
+p.periodic = True
+p.gaussian = True
+p.rest = 'auto'
+p.tile = 256
