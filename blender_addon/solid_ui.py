@@ -338,16 +338,16 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         p = context.scene.omninoise_solid
         req = panel_request(p)
         m, code_fn = texture(req)
-        seed, name, grid = p.seed, f"{p.name} Preview", grid_info(req)
+        seed, name = p.seed, f"{p.name} Preview"
 
         def work(progress, cancel):
             code = code_fn(lambda f: progress(0.2 * f), cancel)
             progress(0.2)
             img = m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
-            return img, periodic_info(code), gaussian_info(code)
+            return img, periodic_info(code), gaussian_info(code), grid_info(req)
 
         def done(result):
-            img, info, rest = result
+            img, info, rest, grid = result
             store_srgb_image(name, np.flipud(img)).preview_ensure()
             p.periodic_info, p.gaussian_info, p.grid_info = info, rest, grid
 
@@ -579,13 +579,14 @@ class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
         if req.exemplar is None or isinstance(req.exemplar, str):
             raise backend.SettingError("image", "a procedural solid is fitted to a photo: set Source to Image")
         scale, world, name = float(p.scale), p.coords == "WORLD", p.name
-        grid = grid_info(req)
 
         def work(progress, cancel):
-            return req.procedural_field("", progress, cancel)
+            return req.procedural_field("", progress, cancel), grid_info(req)
 
-        def done(field):
+        def done(result):
             from .procedural_nodes import add_procedural_node, build_procedural_group
+
+            field, grid = result
 
             group = build_procedural_group(field, name=f"{name} Procedural")
             p.periodic_info, p.grid_info = periodic_info(field), grid
