@@ -80,14 +80,13 @@ def _licence(text: str, pkg: str, path: str) -> tuple:
     if pkg == "ufoai-textures":
         pk3, name = path.split(":", 1)
         licence, authors = lic[pk3.replace("0textures.pk3", "") + name]
-        return SPDX.get(licence, licence), authors
-    if pkg == "openarena-081-textures":
+    elif pkg == "openarena-081-textures":
         licence, authors = lic["*"]
-        return SPDX.get(licence, licence), authors
-    if pkg in SOURCE_TREE:
+    elif pkg in SOURCE_TREE:
         licence, authors = dep5_last_match(lic, SOURCE_TREE[pkg] + path)
-        return SPDX.get(licence, licence), authors
-    return stk_licence(lic, path)
+    else:
+        return stk_licence(lic, path)
+    return SPDX.get(licence, licence), authors
 
 
 def dep5_last_match(lic: dict, path: str) -> tuple:
