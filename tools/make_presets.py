@@ -64,18 +64,18 @@ def _literal(v) -> str:
     return "{" + ", ".join(repr(x) for x in sorted(v)) + "}" if isinstance(v, (set, frozenset)) else repr(v)
 
 
-def solid_text(look: dict) -> str:
-    v = dict(SOLID_BASE, **look)
-    lines = ["import bpy", "p = bpy.context.scene.omninoise_solid", ""]
-    lines += [f"{path} = {_literal(v[path.split('.')[1]])}" for path in SOLID_VALUES]
+def values_text(define: str, paths: list, values: dict) -> str:
+    """A preset file that sets each of ``paths`` ("name.attribute") to ``values[attribute]``, after ``define``."""
+    lines = ["import bpy", define, ""] + [f"{path} = {_literal(values[path.split('.')[1]])}" for path in paths]
     return "\n".join(lines) + "\n"
+
+
+def solid_text(look: dict) -> str:
+    return values_text("p = bpy.context.scene.omninoise_solid", SOLID_VALUES, dict(SOLID_BASE, **look))
 
 
 def wave_text(look: dict) -> str:
-    v = dict(WAVE_BASE, **look)
-    lines = ["import bpy", "props = bpy.context.omninoise_wave", ""]
-    lines += [f"{path} = {v[path.split('.')[1]]!r}" for path in WAVE_VALUES]
-    return "\n".join(lines) + "\n"
+    return values_text("props = bpy.context.omninoise_wave", WAVE_VALUES, dict(WAVE_BASE, **look))
 
 
 def neural_text(layout: str, classes: list, class_params: dict) -> str:
