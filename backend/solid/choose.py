@@ -65,10 +65,10 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
     """The stages (module doc) for a checked request with method "auto" and an image exemplar; ``field``: its
     procedural solid when it is fitted already (the evaluation measures it on its own too)."""
     img = np.asarray(request.exemplar_pixels(where), np.float32)     # a file is read once: every stage takes these
-    proc = dataclasses.replace(request, method="procedural")
+    proc = request.replace(method="procedural")
     if field is None:                                                                   # 1. fit
         field = dataclasses.replace(proc, exemplar=img).procedural_field(where, progress)
-    neural = dataclasses.replace(request, method="neural")
+    neural = request.replace(method="neural")
     model = neural.load(where)
     named = None if report is None else (lambda _, history: report(request.exemplar, history))
     code, _ = dataclasses.replace(neural, exemplar=img).code(model, where, None, named, on_code)     # 2. encode

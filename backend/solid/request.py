@@ -24,6 +24,7 @@ Shapes: pixel exemplars float32 (H, W, 3) sRGB values in [0, 1], top row first.
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
 from dataclasses import dataclass, field
@@ -45,6 +46,15 @@ def _pixels_sha(x: np.ndarray) -> str:
     (v / 255) or by Blender (v * (1 / 255), which differs in the last float bit)."""
     q = np.round(np.clip(np.asarray(x, np.float64), 0.0, 1.0) * 65535.0).astype("<u2")
     return "pixels:" + hashlib.sha256(np.ascontiguousarray(q).tobytes() + repr(q.shape).encode()).hexdigest()
+
+
+def _file_stamp(path: str):
+    """(path, modification time in ns, size in bytes) of a file, or None where it cannot be read."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return path, st.st_mtime_ns, st.st_size
 
 
 def _digest(x) -> str | None:
@@ -167,16 +177,43 @@ class SolidRequest:
         return code, sha
 
     def exemplar_pixels(self, where: str = ""):
-        """An image method's exemplar (synthesis, spectral) as pixels: pixels as given, a path decoded to float
-        (H, W, 3) sRGB; SettingError naming the exemplar for a file it cannot read."""
+        """An image method's exemplar (synthesis, spectral, procedural) as pixels: pixels as given, a path decoded
+        to float (H, W, 3) sRGB; SettingError naming the exemplar for a file it cannot read.  A file is decoded once
+        per request, and again only where it changed on disk: the grid note and the fit read the same pixels, kept
+        read-only (the request keeps the path: a shipped model is looked up by the exemplar's name)."""
         if not isinstance(self.exemplar, str):
             return self.exemplar
         from ... import export
 
+        stamp = _file_stamp(self.exemplar)
+        kept = self.__dict__.get("_decoded")
+        if stamp is not None and kept is not None and kept[0] == stamp:
+            return kept[1]
         try:
-            return export.read_rgb(self.exemplar)
+            img = export.read_rgb(self.exemplar)
         except ValueError as exc:
             raise SettingError(f"{where}exemplar", str(exc)) from None
+        img.setflags(write=False)
+        if stamp is not None:
+            object.__setattr__(self, "_decoded", (stamp, img))     # frozen: the memo is no field (not in key or eq)
+        return img
+
+    def replace(self, **changes) -> "SolidRequest":
+        """``dataclasses.replace``, keeping this request's decoding of its file exemplar where the exemplar stays."""
+        new = dataclasses.replace(self, **changes)
+        if "exemplar" not in changes and "_decoded" in self.__dict__:
+            object.__setattr__(new, "_decoded", self.__dict__["_decoded"])
+        return new
+
+    def _exemplar_digest(self) -> str | None:
+        """The exemplar for the key (``_digest``), a file by the pixels of this request's one decoding."""
+        if isinstance(self.exemplar, str) and os.path.isfile(self.exemplar):
+            return _pixels_sha(self.exemplar_pixels())
+        return _digest(self.exemplar)
+
+    def __getstate__(self) -> dict:
+        """Pickled (a farm's workers) without the decoded pixels: a worker decodes the file where it runs."""
+        return {k: v for k, v in self.__dict__.items() if k != "_decoded"}
 
     def synthesis_field(self, where: str = "", progress=None, cancel=None):
         """Method "synthesis": the :class:`~backend.solid.synthesis.TileField` of a periodic 2D tile of ``tile`` px
@@ -283,22 +320,20 @@ class SolidRequest:
         methods "synthesis", "spectral" and "procedural" only what they read (exemplar, seed and tile, or periodic, the
         spectral solid's map onto the photo's marginals and its power's isotropic start; or the families tried)."""
         if self.method == "synthesis":
-            return dict(method="synthesis", exemplar=_digest(self.exemplar), seed=int(self.seed),
+            return dict(method="synthesis", exemplar=self._exemplar_digest(), seed=int(self.seed),
                         tile=int(self.tile))
         if self.method == "spectral":
             # marginals: the tile's values are mapped onto the photo's (spectral_solid.Marginals); start: its power
             # is found from an isotropic start (spectral_solid.solid_power); a bake keyed before either is redone
-            return dict(method="spectral", exemplar=_digest(self.exemplar), seed=int(self.seed),
+            return dict(method="spectral", exemplar=self._exemplar_digest(), seed=int(self.seed),
                         periodic=bool(self.periodic), marginals=True, start="isotropic")
         if self.method == "procedural":
-            return dict(method="procedural", exemplar=_digest(self.exemplar), seed=int(self.seed),
+            return dict(method="procedural", exemplar=self._exemplar_digest(), seed=int(self.seed),
                         families=list(self.families))
         if self.method == "auto":
-            import dataclasses
-
-            return dict(method="auto", procedural=dataclasses.replace(self, method="procedural").key(),
-                        neural=dataclasses.replace(self, method="neural").key())
-        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=_digest(self.exemplar),
+            return dict(method="auto", procedural=self.replace(method="procedural").key(),
+                        neural=self.replace(method="neural").key())
+        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=self._exemplar_digest(),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),
                     gaussian=bool(self.gaussian), rest=self.rest if self.gaussian else None)

@@ -50,6 +50,38 @@ def test_a_file_and_its_pixels_are_one_exemplar():
         SolidRequest(exemplar=PHOTO, gaussian=False).key()
 
 
+def test_a_file_is_decoded_once_per_request(tmp_path, monkeypatch):
+    """The grid note and the fit read one decoding of the photo: again only where the file changed on disk; the
+    pixels are read-only, the request keeps the path (its model and key), and a pickled request carries no pixels."""
+    import pickle
+
+    from PIL import Image
+
+    from omninoise import export
+
+    calls = []
+    real = export.read_rgb
+    monkeypatch.setattr(export, "read_rgb", lambda path: calls.append(path) or real(path))
+    photo = str(tmp_path / "photo.png")
+    Image.fromarray(np.full((24, 24, 3), 90, np.uint8)).save(photo)
+    req = SolidRequest(exemplar=photo, method="procedural").check()
+    first = req.exemplar_pixels()
+    assert req.exemplar_pixels() is first and len(calls) == 1
+    assert not req.repeats_as_grid() and len(calls) == 1
+    with pytest.raises(ValueError, match="read-only"):
+        first[0, 0, 0] = 1.0
+    assert req.exemplar == photo and req.key() == SolidRequest(exemplar=real(photo), method="procedural").key()
+    auto = req.replace(method="auto")            # method auto's stages and key share the decoding
+    assert auto.exemplar_pixels() is first and auto.key()["procedural"] == req.key() and len(calls) == 1
+    Image.fromarray(np.full((32, 32, 3), 200, np.uint8)).save(photo)    # changed on disk: read again
+    again = req.exemplar_pixels()
+    assert len(calls) == 2 and again.shape == (32, 32, 3) and np.allclose(again, 200 / 255)
+    copy = pickle.loads(pickle.dumps(req))
+    assert "_decoded" not in copy.__dict__ and copy.exemplar == photo
+    assert copy.exemplar_pixels().shape == (32, 32, 3) and len(calls) == 3
+    assert SolidRequest(exemplar=first).exemplar_pixels() is first       # pixels handed over are returned as they are
+
+
 def test_periodic_and_gaussian_must_be_a_yes_or_no():
     with pytest.raises(SettingError, match="source.periodic: expected true or false"):
         solid_request_from_dict(dict(exemplar=PHOTO, periodic="yes"))
