@@ -8,7 +8,9 @@ import numpy as np
 
 from ..errors import SettingError
 
-__all__ = ["rgb_pixels", "resize_rgb", "at_most"]
+__all__ = ["rgb_pixels", "resize_rgb", "at_most", "MIN_SIDE"]
+
+MIN_SIDE = 16    #: px a photo's shorter side keeps in :func:`at_most` (all of its own, where it has fewer)
 
 
 def rgb_pixels(image) -> np.ndarray:
@@ -31,8 +33,15 @@ def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:
 
 def at_most(image, px_per_unit: float, side: int) -> tuple:
     """(image float32 (H', W', 3), its px per unit): a photo over ``side`` px resized to that size, its frequencies
-    in texture units unchanged."""
+    in texture units unchanged.  A photo whose sides differ more than ``side`` / :data:`MIN_SIDE` times (a strip)
+    is first cut to a central window of its longer side, so that its shorter side keeps ``MIN_SIDE`` px (or all of
+    its own, where it has fewer): resized whole, it would be a line or nothing."""
     img = rgb_pixels(image)
+    short, axis = min(img.shape[:2]), int(img.shape[1] > img.shape[0])
+    window = max(side, short * side // max(1, min(short, MIN_SIDE)))
+    if img.shape[axis] > window:
+        start = (img.shape[axis] - window) // 2
+        img = img[start:start + window] if axis == 0 else img[:, start:start + window]
     ppu, W = float(px_per_unit), img.shape[1]
     f = side / max(img.shape[:2])
     if f < 1.0:

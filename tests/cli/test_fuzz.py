@@ -301,6 +301,22 @@ def test_the_broken_file_corpus_is_refused_by_every_image_input(tmp_path):
             assert not os.path.exists(out)
 
 
+def test_a_strip_photo_is_drawn_or_refused_in_one_line(tmp_path):
+    """A 20 x 20000 px strip: the neural texture reads its central window (its periodic part and Gaussian rest are
+    read at 256 px a side, where the whole strip would be no pixels wide); the spectral solid refuses it."""
+    import numpy as np
+    from PIL import Image
+
+    strip = str(tmp_path / "strip.png")
+    Image.fromarray((np.random.default_rng(0).random((20000, 20, 3)) * 255).astype(np.uint8)).save(strip)
+    out = str(tmp_path / "o.png")
+    assert main(["solid", "--exemplar", strip, "--size", "8", "--quiet", "-o", out]) == 0 and os.path.isfile(out)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        rc = main(["solid", "--exemplar", strip, "--method", "spectral", "--size", "8", "--quiet", "-o", str(tmp_path / "s.png")])
+    assert rc == 2 and err.getvalue().count("\n") == 1 and "20 x 20000 px" in err.getvalue()
+
+
 # -- every key of the settings schema, each with the values its type refuses ---------------------------------
 
 def wrong_values(t) -> list:

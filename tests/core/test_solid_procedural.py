@@ -474,6 +474,27 @@ def test_a_flat_or_tiny_photo():
         fit_procedural(np.zeros((40, 12, 3)))
 
 
+@pytest.mark.parametrize("shape", [(20, 4000), (4000, 20), (3000, 40)])
+def test_a_strip_is_read_as_a_central_window_that_keeps_its_shorter_side(shape):
+    """A photo whose sides differ more than 16 times: resized whole to the fit's 256 px it would be a line of pixels
+    (a 20 x 4000 strip: 1 x 256); its central window keeps 16 px across, its frequencies in texture units
+    unchanged."""
+    from omninoise.backend.solid.pixels import MIN_SIDE, at_most
+
+    strip = np.random.default_rng(1).random((*shape, 3)).astype(np.float32)
+    img, ppu = at_most(strip, PX_PER_UNIT, 256)
+    short, window = min(shape), min(shape) * 256 // MIN_SIDE
+    assert max(img.shape[:2]) == 256 and min(img.shape[:2]) == MIN_SIDE
+    assert ppu == pytest.approx(PX_PER_UNIT * MIN_SIDE / short)
+    start = (max(shape) - window) // 2
+    centre = strip[start:start + window] if shape[0] > shape[1] else strip[:, start:start + window]
+    np.testing.assert_array_equal(img, at_most(centre, PX_PER_UNIT, 256)[0])
+    photo, same = at_most(np.full((256, 200, 3), 0.5, np.float32), PX_PER_UNIT, 256)    # a photo is left whole
+    assert photo.shape == (256, 200, 3) and same == PX_PER_UNIT
+    field = fit_procedural(strip, ProceduralConfig(side=32, budget=4, finalists=1, textured=False)).field
+    assert np.isfinite(field.image(16)).all()
+
+
 def test_auto_s_check_gives_the_evaluation_s_two_figures():
     """choose.check_figures: ``axes``, the mean band distance of the groups of PLANES across x, y and z, and
     ``oblique``, that of the oblique cuts."""
