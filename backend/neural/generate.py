@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import SettingError
 from .sampler import (DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS, initial_noise, sample, sampler_eta,
                       step_noise_rng)
-from .schedule import SPACINGS, alphas_from_config
+from .schedule import SPACINGS
 
 __all__ = ["generate", "check_sampler", "image_eps", "auto_tile", "AUTO_WHOLE", "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES"]
 

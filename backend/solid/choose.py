@@ -8,7 +8,11 @@ texture otherwise.
                axis cuts group by group, and the oblique cuts (:func:`check_figures`); the procedural solid is kept
                only where it is closer on both figures by the margin the Gaussian rest's check asks
                (gaussian_rest.MARGIN: at most 0.92 times the neural texture's figure: one draw's distance is a noisy
-               figure), so a photo it does not suit, or suits only on a cube's faces, keeps the neural texture
+               figure), so a photo it does not suit, or suits only on a cube's faces, keeps the neural texture;
+               and only where its walls (the cuts across x and y) hold the photo's structure, which way it runs and
+               whether it repeats as a grid (structure.py), about as well as the neural texture's do: its structure
+               error at most STRUCTURE_TOLERANCE above theirs.  Patch statistics found a tile grid's irregular
+               stones and a red board's cracked cells closer than the neural texture's grid and planks
 
 Shapes: photos float32 (H, W, 3) sRGB in [0, 1].
 """
@@ -21,11 +25,19 @@ import numpy as np
 
 from .band_distance import band_distance
 from .gaussian_rest import MARGIN
+from .band_distance import central_crop
 from .procedural.fit import oblique_points, plane_group
+from .structure import photo_readings, structure_error
 
-__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures"]
+__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures", "wall_structure",
+           "STRUCTURE_TOLERANCE"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
+#: how much farther from the photo's structure than the neural texture's walls the procedural solid's may be
+#: (structure.structure_error: orientation vector distance + lattice difference)
+STRUCTURE_TOLERANCE = 0.15
+#: the photo's side the structure is read on: its central crop at its own scale, as the cuts are drawn
+STRUCTURE_SIDE = 256
 #: the check's planes (normal, a point on it), units: two across each axis and six at orientations drawn once (as a
 #: cube's faces and a mesh's faces cut a solid; a solid and a neural texture differ most from cut to cut on oblique
 #: ones), none of the fit's
@@ -48,11 +60,19 @@ def check_figures(images: list, photo: np.ndarray) -> dict:
     return {"axes": round(float(np.mean([d[g] for g in "xyz"])), 2), "oblique": round(d["oblique"], 2)}
 
 
+def wall_structure(images: list, photo: np.ndarray) -> float:
+    """The structure error (structure.py) of the walls among ``images`` (one per plane of :data:`PLANES`: the cuts
+    across x and across y) against the photo, drawn at the photo's own scale; rounded to 0.001."""
+    reading, lags = photo_readings(central_crop(np.asarray(photo, np.float64), STRUCTURE_SIDE))
+    walls = [img for img, (n, _) in zip(images, PLANES) if plane_group(n) in ("x", "y")]
+    return round(structure_error(walls, reading, lags), 3)
+
+
 @dataclass(frozen=True)
 class Choice:
     """``method``: "procedural" or "neural"; ``request``: the request as that method (what a bake's key reads);
     ``field`` the procedural solid (always fitted); ``model`` and ``code`` the neural texture; ``distances``
-    {method: {"axes": figure, "oblique": figure}} of the check."""
+    {method: {"axes": figure, "oblique": figure, "structure": its walls' structure error}} of the check."""
     method: str
     request: object
     field: object
@@ -76,8 +96,9 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
     planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
     drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
              "neural": [model.evaluate(p, code, int(request.seed)).reshape(SIDE, SIDE, 3) for p in planes]}
-    d = {k: check_figures(v, img) for k, v in drawn.items()}
-    closer = all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
+    d = {k: dict(check_figures(v, img), structure=wall_structure(v, img)) for k, v in drawn.items()}
+    closer = (all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
+              and d["procedural"]["structure"] <= d["neural"]["structure"] + STRUCTURE_TOLERANCE)
     keep = "procedural" if closer else "neural"
     return Choice(keep, proc if keep == "procedural" else neural, field, model, code, d)
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from omninoise.backend.wavenoise.hashing import hash_uint, hash_uint4, white_noise4, white_noise3, float_bits
+from omninoise.backend.wavenoise.hashing import float_bits, hash_uint, white_noise4
 
 # Stored reference samples (lookup3, Blender's constants): guard against
 # regressions even where bpy is unavailable.
@@ -28,7 +28,7 @@ def test_float_bits_roundtrip():
 
 
 def test_matches_blender_white_noise_node():
-    bpy = pytest.importorskip("bpy")
+    pytest.importorskip("bpy")
     from omninoise.blender_addon.field_eval import white_noise_node_values
 
     rng = np.random.default_rng(1)

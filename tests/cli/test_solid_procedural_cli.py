@@ -113,7 +113,8 @@ seed = 1
 
 def test_auto_keeps_what_its_check_finds_closer(tmp_path):
     """Auto keeps the procedural solid where its planes find it closer by the margin on both the axis and the oblique
-    cuts; its image is that texture's."""
+    cuts and its walls hold the photo's structure about as well; its image is that texture's."""
+    from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE
     from omninoise.backend.solid.gaussian_rest import MARGIN
 
     from omninoise import export
@@ -126,8 +127,9 @@ def test_auto_keeps_what_its_check_finds_closer(tmp_path):
     assert reads == [PHOTO]
     d = c.distances
     assert set(d) == {"procedural", "neural"}
-    assert all(set(d[m]) == {"axes", "oblique"} for m in d)
-    closer = all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
+    assert all(set(d[m]) == {"axes", "oblique", "structure"} for m in d)
+    closer = (all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
+              and d["procedural"]["structure"] <= d["neural"]["structure"] + STRUCTURE_TOLERANCE)
     assert c.method == ("procedural" if closer else "neural")
     assert c.request.method == c.method
     img = req.front_image(32)

@@ -31,7 +31,8 @@ import numpy as np
 
 from .ramp import luminance
 
-__all__ = ["Estimates", "estimate", "repeat_length", "courses", "grid_repeat", "GRID", "CORRELATION_SCALE"]
+__all__ = ["Estimates", "estimate", "repeat_length", "courses", "repeats", "grid_repeat", "GRID",
+           "CORRELATION_SCALE", "BAND"]
 
 CORRELATION_SCALE = 4.0    #: a repeat where the autocorrelation has no peak: this many of its half-fall lengths
 BAND = (1.5, 24.0)         #: the band-pass's Gaussians, sigma in px
@@ -117,6 +118,12 @@ def _repeats(ac: np.ndarray) -> tuple:
     """(across, up): the repeats along x and along z of an autocorrelation, px."""
     H, W = ac.shape
     return repeat_length(ac[0, :W // 2]), repeat_length(ac[:H // 2, 0])
+
+
+def repeats(photo: np.ndarray) -> tuple:
+    """(across, up): the photo's repeats along x and along z, px (module doc)."""
+    lum = luminance(photo)
+    return _repeats(_autocorrelation(lum - lum.mean()))
 
 
 def grid_repeat(photo: np.ndarray) -> float:

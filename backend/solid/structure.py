@@ -1,0 +1,87 @@
+"""What a photo's structure is, read as two numbers a solid's wall cuts can be held to: which way it runs and
+whether it repeats as a grid.
+
+Patch statistics (band_distance.py) compare neighbourhoods a few pixels wide; they do not see that a photo's planks
+all run one way or that its tiles repeat across and up, and a solid of stones or blotches can be closer by them
+than a texture that keeps the planks and the grid.  Auto (choose.py) reads these too:
+
+- **Orientation**: the structure tensor of the luminance's gradient summed over the image (Bigün & Granlund 1987),
+  J = [[Jxx, Jxz], [Jxz, Jzz]], as the vector ((Jxx - Jzz) / tr J, 2 Jxz / tr J): its length is the coherence
+  (0 for no preferred direction, 1 for straight parallel stripes) and its angle twice the direction across them,
+  so planks standing up and planks lying down read as opposite vectors.
+- **Lattice**: the band-passed autocorrelation one repeat across and one repeat up (the repeats the photo's own
+  autocorrelation reads, estimate.py), the lower of the two: near 1 where the image is itself shifted by a tile
+  either way, near 0 for stones, blotches and grain.  It is read with the mean over the overlap (the image padded
+  with zeros), so that a cut holding only two or three tiles reads its repeats as the photo does.
+
+A solid's walls are its cuts across x and across y (the photo stands upright on both).  The structure error of a
+set of cuts is |orientation - the photo's| + |lattice - the photo's|.
+
+Shapes: images float (H, W, 3) sRGB, top row first; lags in px.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .procedural.estimate import BAND, repeats
+from .procedural.ramp import luminance
+
+__all__ = ["orientation", "lattice", "readings", "structure_error", "photo_readings"]
+
+
+def orientation(image: np.ndarray) -> np.ndarray:
+    """The orientation vector of an image (module doc) -> float64 (2,), length in [0, 1]."""
+    lum = luminance(np.asarray(image, np.float64))
+    gz, gx = -np.gradient(lum, axis=0), np.gradient(lum, axis=1)          # z up
+    xx, zz, xz = np.sum(gx * gx), np.sum(gz * gz), np.sum(gx * gz)
+    tr = xx + zz
+    return np.zeros(2) if tr <= 1e-12 else np.array([(xx - zz) / tr, 2.0 * xz / tr])
+
+
+def lattice(image: np.ndarray, across: float, up: float) -> float:
+    """The lattice reading of an image (module doc) at repeats ``across`` and ``up`` px (at most 3/4 of its
+    sides)."""
+    lum = luminance(np.asarray(image, np.float64))
+    lum = lum - lum.mean()
+    H, W = lum.shape
+    fy, fx = np.fft.fftfreq(2 * H)[:, None], np.fft.fftfreq(2 * W)[None, :]
+    f2 = (2 * np.pi) ** 2 * (fy ** 2 + fx ** 2)
+    band = np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)   # estimate's difference of Gaussians
+    padded = np.zeros((2 * H, 2 * W))
+    padded[:H, :W] = lum
+    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(padded) * band) ** 2))
+    ones = np.zeros((2 * H, 2 * W))
+    ones[:H, :W] = 1.0
+    overlap = np.real(np.fft.ifft2(np.abs(np.fft.fft2(ones)) ** 2))
+    ac = ac / np.maximum(overlap, 1.0)
+    if ac[0, 0] <= 1e-12:
+        return 0.0
+    ac = ac / ac[0, 0]
+
+    def at(dx: float, dz: float) -> float:      # bilinear, z up = rows up
+        r, c = -dz, dx
+        r0, c0 = int(np.floor(r)), int(np.floor(c))
+        fr, fc = r - r0, c - c0
+        v = [[ac[(r0 + i) % (2 * H), (c0 + j) % (2 * W)] for j in (0, 1)] for i in (0, 1)]
+        return float((1 - fr) * ((1 - fc) * v[0][0] + fc * v[0][1]) + fr * ((1 - fc) * v[1][0] + fc * v[1][1]))
+
+    return min(at(min(across, 0.75 * W), 0.0), at(0.0, min(up, 0.75 * H)))
+
+
+def readings(images: list, across: float, up: float) -> np.ndarray:
+    """(orientation x, orientation z, lattice) of a set of images, each the mean over them -> float64 (3,)."""
+    o = np.mean([orientation(im) for im in images], axis=0)
+    return np.array([o[0], o[1], np.mean([lattice(im, across, up) for im in images])])
+
+
+def photo_readings(photo: np.ndarray) -> tuple:
+    """(the photo's :func:`readings`, (across, up)): its repeats in px, as estimate reads them."""
+    across, up = repeats(photo)
+    return readings([photo], across, up), (across, up)
+
+
+def structure_error(images: list, photo: np.ndarray, lags: tuple) -> float:
+    """How far a set of cuts' structure is from the photo's: the distance between their orientation vectors plus the
+    difference of their lattice readings (``photo``: the photo's :func:`readings`; ``lags``: its repeats, px)."""
+    r = readings(images, *lags)
+    return float(np.hypot(*(r[:2] - photo[:2])) + abs(r[2] - photo[2]))
