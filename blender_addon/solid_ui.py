@@ -113,8 +113,9 @@ class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
         ("PROCEDURAL", "Procedural Solid", "Rings, layers, cells or bricks fitted to the photo: structure that runs "
                                            "on through the object (wood, veins, stones, courses); also a live node "
                                            "group; about 12 s to fit"),
-        ("AUTO", "Auto", "The procedural solid where it is closer to the photo than the neural texture, else the "
-                         "neural texture")], default="NEURAL")
+        ("AUTO", "Auto", "The procedural solid where it is closer to the photo than the neural texture and keeps "
+                         "the photo's structure (its grain's direction, its grid) as well, else the neural texture")],
+        default="NEURAL")
     families: EnumProperty(name="Kinds", options={"ENUM_FLAG"},
                            description="The kinds of procedural solid the fit tries", items=[
         ("RINGS", "Rings", "Growth rings around an axis: ring-cut wood, knots"),
@@ -234,8 +235,8 @@ def periodic_info(code) -> str:
         d = code.distances
         kept = code.field.family if code.method == "procedural" else "neural texture"
         p, n = d["procedural"], d["neural"]
-        return (f"Auto: {kept} (procedural {p['axes']:.0f} / {p['oblique']:.0f}, neural {n['axes']:.0f} / "
-                f"{n['oblique']:.0f}: axis / oblique cuts)")
+        return (f"Auto: {kept} (procedural {p['axes']:.0f} / {p['oblique']:.0f} / {p['structure']:.2f}, neural "
+                f"{n['axes']:.0f} / {n['oblique']:.0f} / {n['structure']:.2f}: axis cuts / oblique cuts / structure)")
     if hasattr(code, "family"):         # a procedural solid (backend/solid/procedural)
         pattern = code.params.get("pattern", "courses")
         return f"Fitted: {code.family}" + ("" if pattern == "courses" else f" ({pattern})")

@@ -46,8 +46,8 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
     g.add_argument("--method", default="neural", choices=METHODS,
                    help="neural: the models' texture, 2D or 3D; spectral: the photo's spectrum and colours on every "
                         "cut, 2D or 3D, no network; procedural: rings, layers, cells or bricks fitted to the photo, "
-                        "2D or 3D, no network; auto: procedural where it is closer to the photo than neural, else "
-                        "neural; synthesis: a seamless 2D image copied from the photo")
+                        "2D or 3D, no network; auto: procedural where it is closer to the photo than neural and keeps "
+                        "its structure as well, else neural; synthesis: a seamless 2D image copied from the photo")
     g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
     g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
                                    "texture-space model)")

@@ -63,7 +63,7 @@ def check_figures(images: list, photo: np.ndarray) -> dict:
 def wall_structure(images: list, photo: np.ndarray) -> float:
     """The structure error (structure.py) of the walls among ``images`` (one per plane of :data:`PLANES`: the cuts
     across x and across y) against the photo, drawn at the photo's own scale; rounded to 0.001."""
-    reading, lags = photo_readings(central_crop(np.asarray(photo, np.float64), STRUCTURE_SIDE))
+    reading, lags = photo_readings(central_crop(np.asarray(photo, np.float64), STRUCTURE_SIDE), 0.75 * SIDE)
     walls = [img for img, (n, _) in zip(images, PLANES) if plane_group(n) in ("x", "y")]
     return round(structure_error(walls, reading, lags), 3)
 

@@ -39,8 +39,8 @@ def orientation(image: np.ndarray) -> np.ndarray:
 
 
 def lattice(image: np.ndarray, across: float, up: float) -> float:
-    """The lattice reading of an image (module doc) at repeats ``across`` and ``up`` px (at most 3/4 of its
-    sides)."""
+    """The lattice reading of an image (module doc) at repeats ``across`` and ``up`` px (read at most 3/4 of its
+    sides away: farther, the overlap is a strip)."""
     lum = luminance(np.asarray(image, np.float64))
     lum = lum - lum.mean()
     H, W = lum.shape
@@ -74,10 +74,11 @@ def readings(images: list, across: float, up: float) -> np.ndarray:
     return np.array([o[0], o[1], np.mean([lattice(im, across, up) for im in images])])
 
 
-def photo_readings(photo: np.ndarray) -> tuple:
-    """(the photo's :func:`readings`, (across, up)): its repeats in px, as estimate reads them."""
-    across, up = repeats(photo)
-    return readings([photo], across, up), (across, up)
+def photo_readings(photo: np.ndarray, longest: float) -> tuple:
+    """(the photo's :func:`readings`, (across, up)): its repeats in px as estimate reads them, at most ``longest``
+    (3/4 of the side of the cuts that will be read at them, so that the photo and the cuts are read at one lag)."""
+    lags = tuple(min(float(r), float(longest)) for r in repeats(photo))
+    return readings([photo], *lags), lags
 
 
 def structure_error(images: list, photo: np.ndarray, lags: tuple) -> float:

@@ -44,17 +44,18 @@ def test_orientation_reads_which_way_planks_run():
 
 
 def test_lattice_reads_a_grid_at_its_repeats_and_not_stones():
-    reading, lags = photo_readings(tiles(256, 40))
+    reading, lags = photo_readings(tiles(256, 40), 96)
     assert lags == (40.0, 40.0)
     assert reading[2] > 0.6 and np.linalg.norm(reading[:2]) < 0.1
     assert lattice(tiles(128, 40, (7, 19)), *lags) > 0.6           # a cut of two or three tiles reads the same
     assert lattice(stones(128, 24), *lags) < 0.2
     assert abs(lattice(tiles(128, 40), 200.0, 200.0)) <= 1.0        # lags past the cut are read at 3/4 of it
+    assert photo_readings(planks(256, 120, True), 96)[1][0] == 96.0   # a photo's repeat past the cuts' reach
 
 
 def test_a_grid_s_own_cuts_hold_its_structure_and_stones_or_stripes_do_not():
     photo = tiles(256, 40)
-    reading, lags = photo_readings(photo)
+    reading, lags = photo_readings(photo, 96)
     own = structure_error([tiles(128, 40, (k, 3 * k)) for k in range(4)], reading, lags)
     blotches = structure_error([stones(128, 30) for _ in range(4)], reading, lags)
     stripes = structure_error([planks(128, 40, False) for _ in range(4)], reading, lags)
