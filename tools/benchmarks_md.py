@@ -108,8 +108,9 @@ def procedural(doc: dict) -> list:
     out = [f"Procedural solids (`backend/solid/procedural`) on {n} held-out {doc.get('set')} photos: the patch "
            "distance (lower is better) of the x, y and z cuts (`axes`, two seeds) and of six cuts at random "
            "orientations (`oblique`), for the procedural solid, method auto (the procedural solid where its own check "
-           "finds it closer by a margin, else the neural texture), the neural texture (the default) and random phase noise drawn "
-           "as a solid. Counts are photos closer than the named texture.", ""]
+           "finds it closer by a margin and its walls keep the photo's structure as well, else the neural texture), "
+           "the neural texture (the default) and random phase noise drawn as a solid. Counts are photos closer than "
+           "the named texture.", ""]
     for sfx, title in (("", None), ("_band", "The same over the band-pass levels alone (`photo_eval.band_swd`: "
                                               "without the low-pass residue, where a photo's own crops score worst):")):
         if f"median_procedural_axes{sfx}" not in s:
