@@ -12,7 +12,10 @@ neighbourhoods, sliced Wasserstein, x 1000; lower is better):
   ``photo_eval.grouped_swd`` groups them), what each face of a cube shows;
 - ``oblique``: six cuts at random orientations (``photo_eval.OBLIQUE_NORMALS``), as a mesh's faces cut the solid;
 - ``axes_band`` and ``oblique_band``: the same over the band-pass levels alone (``photo_eval.band_swd``), without
-  the low-pass residue, where the photo's own crops score worst.
+  the low-pass residue, where the photo's own crops score worst;
+- ``structure``: the structure error of the x and y cuts (the walls, where the photo stands) against the photo
+  (``backend.solid.structure``: which way it runs, whether it repeats as a grid; lower is better), what patch
+  statistics do not see: a tile grid drawn as stones is near by the patch distance and far by this.
 
 Sets: ``structured``, the photo set's held-out brick, paving, tile and wood photos and the structured photos
 (``data/structured``, ``tools/build_structured_set.py``); ``stochastic``, every ``--every``-th other held-out
@@ -37,11 +40,14 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np
 
-from bench.solid_synthesis import SOLIDS, gaussian_solid, random_phase_solid, slices
+from bench.solid_synthesis import SIZE, SOLIDS, gaussian_solid, random_phase_solid, slices
 from bench.stamp import stamp
+from omninoise.backend.solid.band_distance import central_crop
+from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE
 from omninoise.backend.solid.gaussian_rest import rest_field
 from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.request import SolidRequest
+from omninoise.backend.solid.structure import photo_readings, structure_error
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
 from omninoise.backend.wavenoise import fast
 from omninoise.export import read_rgb
@@ -53,7 +59,7 @@ STRUCTURED = ("brick", "paving", "tile", "wood", "marble", "rust")   #: the phot
 SEEDS = 2
 #: the figures per texture: the patch distance of the axis cuts, of all of them pooled and of the oblique cuts, and
 #: the axis and oblique ones over the band-pass levels alone (``photo_eval.band_swd``)
-FIGURES = ("axes", "pooled", "oblique", "axes_band", "oblique_band")
+FIGURES = ("axes", "pooled", "oblique", "axes_band", "oblique_band", "structure")
 
 
 class _Field:
@@ -75,8 +81,10 @@ def _figures(axes: dict, oblique: list, photo: np.ndarray) -> dict:
     """:data:`FIGURES` of a texture's axis cuts ({axis: [images]}) and oblique cuts ([images])."""
     g = pe.grouped_swd(axes, photo)
     obl = pe.rounded_swds(pe.level_distances(oblique, photo))
+    walls = axes["x"] + axes["y"]
+    reading, lags = photo_readings(central_crop(np.asarray(photo, np.float64), 2 * SIZE), 0.75 * walls[0].shape[0])
     return {"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
-            "oblique_band": obl[1]}
+            "oblique_band": obl[1], "structure": round(structure_error(walls, reading, lags), 3)}
 
 
 def figures(field: _Field, photo: np.ndarray) -> dict:
@@ -157,6 +165,11 @@ def summary(rows: dict) -> dict:
                                                         for r in rows.values())
         for who in ("procedural", "neural", "random_phase_solid", "auto"):
             s[f"median_{who}_{k}"] = round(float(np.median([r[f"{who}_{k}"] for r in rows.values()])), 1)
+    for who in ("procedural", "neural", "random_phase_solid", "auto"):
+        s[f"median_{who}_structure"] = round(float(np.median([r[f"{who}_structure"] for r in rows.values()])), 3)
+    for who in ("procedural", "auto", "random_phase_solid"):     # loses the structure the neural texture keeps
+        s[f"{who}_structure_farther_than_neural"] = sum(
+            r[f"{who}_structure"] > r["neural_structure"] + STRUCTURE_TOLERANCE for r in rows.values())
     s["families"] = {f: sum(r["family"] == f for r in rows.values()) for f in sorted({r["family"] for r in rows.values()})}
     return s
 

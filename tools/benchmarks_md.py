@@ -129,6 +129,15 @@ def procedural(doc: dict) -> list:
             out.append(f"| {label} | {s.get(f'median_{who}_axes{sfx}')} | {s.get(f'median_{who}_oblique{sfx}')} | "
                        f"{rp} | {nb} | {nf} |")
         out.append("")
+    if "median_procedural_structure" in s:
+        out += [f"Structure: the walls' (x and y cuts') structure error against the photo (`backend/solid/structure.py`: "
+                f"which way it runs, whether it repeats as a grid; lower is better), median procedural "
+                f"{s['median_procedural_structure']}, auto {s['median_auto_structure']}, neural "
+                f"{s['median_neural_structure']}, random phase solid {s['median_random_phase_solid_structure']}. "
+                f"Photos where it is more than 0.15 above the neural texture's (the texture loses structure the "
+                f"neural texture keeps): procedural {s['procedural_structure_farther_than_neural']}, auto "
+                f"{s['auto_structure_farther_than_neural']}, random phase solid "
+                f"{s['random_phase_solid_structure_farther_than_neural']} of {n}.", ""]
     fams = ", ".join(f"{k} {v}" for k, v in s.get("families", {}).items())
     timing = ""
     if doc.get("set") == "structured":
