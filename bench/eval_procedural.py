@@ -41,14 +41,13 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np
 
-from bench.solid_synthesis import SIZE, SOLIDS, gaussian_solid, random_phase_solid, slices
+from bench.solid_synthesis import SOLIDS, gaussian_solid, random_phase_solid, slices
 from bench.stamp import stamp
-from omninoise.backend.solid.band_distance import central_crop
-from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE
+from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE, photo_structure
 from omninoise.backend.solid.gaussian_rest import rest_field
 from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.request import SolidRequest
-from omninoise.backend.solid.structure import photo_readings, structure_error
+from omninoise.backend.solid.structure import structure_error
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
 from omninoise.backend.wavenoise import fast
 from omninoise.export import read_rgb
@@ -82,10 +81,9 @@ def _figures(axes: dict, oblique: list, photo: np.ndarray) -> dict:
     """:data:`FIGURES` of a texture's axis cuts ({axis: [images]}) and oblique cuts ([images])."""
     g = pe.grouped_swd(axes, photo)
     obl = pe.rounded_swds(pe.level_distances(oblique, photo))
-    walls = axes["x"] + axes["y"]
-    reading, lags = photo_readings(central_crop(np.asarray(photo, np.float64), 2 * SIZE), 0.75 * walls[0].shape[0])
+    walls = axes["x"] + axes["y"]        # drawn at choose.SIDE px, as auto's check draws its walls
     return {"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
-            "oblique_band": obl[1], "structure": round(structure_error(walls, reading, lags), 3)}
+            "oblique_band": obl[1], "structure": round(structure_error(walls, *photo_structure(photo)), 3)}
 
 
 def figures(field: _Field, photo: np.ndarray) -> dict:

@@ -23,14 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .band_distance import band_distance
+from .band_distance import band_distance, central_crop
 from .gaussian_rest import MARGIN
-from .band_distance import central_crop
 from .procedural.fit import oblique_points, plane_group
 from .structure import photo_readings, structure_error
 
-__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures", "wall_structure",
-           "STRUCTURE_TOLERANCE"]
+__all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures", "photo_structure",
+           "wall_structure", "STRUCTURE_TOLERANCE"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
 #: how much farther from the photo's structure than the neural texture's walls the procedural solid's may be
@@ -60,12 +59,17 @@ def check_figures(images: list, photo: np.ndarray) -> dict:
     return {"axes": round(float(np.mean([d[g] for g in "xyz"])), 2), "oblique": round(d["oblique"], 2)}
 
 
-def wall_structure(images: list, photo: np.ndarray) -> float:
+def photo_structure(photo: np.ndarray) -> tuple:
+    """(readings, lags): structure.photo_readings of the photo's central crop at its own scale, as the check's
+    cuts of SIDE px are drawn, read at lags they can hold."""
+    return photo_readings(central_crop(np.asarray(photo, np.float64), STRUCTURE_SIDE), 0.75 * SIDE)
+
+
+def wall_structure(images: list, structure: tuple) -> float:
     """The structure error (structure.py) of the walls among ``images`` (one per plane of :data:`PLANES`: the cuts
-    across x and across y) against the photo, drawn at the photo's own scale; rounded to 0.001."""
-    reading, lags = photo_readings(central_crop(np.asarray(photo, np.float64), STRUCTURE_SIDE), 0.75 * SIDE)
+    across x and across y) against the photo's :func:`photo_structure`; rounded to 0.001."""
     walls = [img for img, (n, _) in zip(images, PLANES) if plane_group(n) in ("x", "y")]
-    return round(structure_error(walls, reading, lags), 3)
+    return round(structure_error(walls, *structure), 3)
 
 
 @dataclass(frozen=True)
@@ -96,7 +100,8 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
     planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
     drawn = {"procedural": [field.evaluate(p).reshape(SIDE, SIDE, 3) for p in planes],
              "neural": [model.evaluate(p, code, int(request.seed)).reshape(SIDE, SIDE, 3) for p in planes]}
-    d = {k: dict(check_figures(v, img), structure=wall_structure(v, img)) for k, v in drawn.items()}
+    structure = photo_structure(img)
+    d = {k: dict(check_figures(v, img), structure=wall_structure(v, structure)) for k, v in drawn.items()}
     closer = (all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
               and d["procedural"]["structure"] <= d["neural"]["structure"] + STRUCTURE_TOLERANCE)
     keep = "procedural" if closer else "neural"

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .procedural.estimate import BAND, repeats
+from .procedural.estimate import at_lag, band_transfer, repeats
 from .procedural.ramp import luminance
 
 __all__ = ["orientation", "lattice", "readings", "structure_error", "photo_readings"]
@@ -42,14 +42,10 @@ def lattice(image: np.ndarray, across: float, up: float) -> float:
     """The lattice reading of an image (module doc) at repeats ``across`` and ``up`` px (read at most 3/4 of its
     sides away: farther, the overlap is a strip)."""
     lum = luminance(np.asarray(image, np.float64))
-    lum = lum - lum.mean()
     H, W = lum.shape
-    fy, fx = np.fft.fftfreq(2 * H)[:, None], np.fft.fftfreq(2 * W)[None, :]
-    f2 = (2 * np.pi) ** 2 * (fy ** 2 + fx ** 2)
-    band = np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)   # estimate's difference of Gaussians
     padded = np.zeros((2 * H, 2 * W))
-    padded[:H, :W] = lum
-    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(padded) * band) ** 2))
+    padded[:H, :W] = lum - lum.mean()
+    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(padded) * band_transfer(2 * H, 2 * W)) ** 2))
     ones = np.zeros((2 * H, 2 * W))
     ones[:H, :W] = 1.0
     overlap = np.real(np.fft.ifft2(np.abs(np.fft.fft2(ones)) ** 2))
@@ -57,15 +53,7 @@ def lattice(image: np.ndarray, across: float, up: float) -> float:
     if ac[0, 0] <= 1e-12:
         return 0.0
     ac = ac / ac[0, 0]
-
-    def at(dx: float, dz: float) -> float:      # bilinear, z up = rows up
-        r, c = -dz, dx
-        r0, c0 = int(np.floor(r)), int(np.floor(c))
-        fr, fc = r - r0, c - c0
-        v = [[ac[(r0 + i) % (2 * H), (c0 + j) % (2 * W)] for j in (0, 1)] for i in (0, 1)]
-        return float((1 - fr) * ((1 - fc) * v[0][0] + fc * v[0][1]) + fr * ((1 - fc) * v[1][0] + fc * v[1][1]))
-
-    return min(at(min(across, 0.75 * W), 0.0), at(0.0, min(up, 0.75 * H)))
+    return float(min(at_lag(ac, min(across, 0.75 * W), 0.0), at_lag(ac, 0.0, min(up, 0.75 * H))))
 
 
 def readings(images: list, across: float, up: float) -> np.ndarray:

@@ -2,7 +2,7 @@
 structure error of a solid's walls, which auto (choose.py) holds the procedural solid to."""
 import numpy as np
 
-from omninoise.backend.solid.choose import PLANES, STRUCTURE_TOLERANCE, wall_structure
+from omninoise.backend.solid.choose import PLANES, STRUCTURE_TOLERANCE, photo_structure, wall_structure
 from omninoise.backend.solid.procedural.fit import plane_group
 from omninoise.backend.solid.structure import lattice, orientation, photo_readings, structure_error
 
@@ -66,7 +66,7 @@ def test_a_grid_s_own_cuts_hold_its_structure_and_stones_or_stripes_do_not():
 def test_auto_reads_the_structure_of_the_walls_alone():
     """choose.wall_structure reads the cuts across x and across y of PLANES: a floor or oblique cut of any kind
     leaves it as it is."""
-    photo = tiles(256, 40)
+    photo = photo_structure(tiles(256, 40))
     walls = [tiles(128, 40, (5 * i, 2 * i)) for i in range(len(PLANES))]
     others = [stones(128, 30) if plane_group(n) not in ("x", "y") else w for w, (n, _) in zip(walls, PLANES)]
     assert wall_structure(walls, photo) == wall_structure(others, photo) < 0.1

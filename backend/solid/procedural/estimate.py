@@ -31,8 +31,8 @@ import numpy as np
 
 from .ramp import luminance
 
-__all__ = ["Estimates", "estimate", "repeat_length", "courses", "repeats", "grid_repeat", "GRID",
-           "CORRELATION_SCALE", "BAND"]
+__all__ = ["Estimates", "estimate", "repeat_length", "courses", "repeats", "grid_repeat", "at_lag", "band_transfer",
+           "GRID", "CORRELATION_SCALE", "BAND"]
 
 CORRELATION_SCALE = 4.0    #: a repeat where the autocorrelation has no peak: this many of its half-fall lengths
 BAND = (1.5, 24.0)         #: the band-pass's Gaussians, sigma in px
@@ -70,7 +70,7 @@ def repeat_length(profile: np.ndarray) -> float:
     return float(CORRELATION_SCALE * (half[0] if len(half) else len(c)))
 
 
-def _at(ac: np.ndarray, dx, dz) -> np.ndarray:
+def at_lag(ac: np.ndarray, dx, dz) -> np.ndarray:
     """The autocorrelation (centred at [0, 0], wrapping) at lags (dx, dz) px, z up = rows up, read bilinearly
     (rounded positions would wobble the lags and raise false peaks)."""
     r, c = np.broadcast_arrays(-np.asarray(dz, np.float64), np.asarray(dx, np.float64))
@@ -88,29 +88,32 @@ def _at(ac: np.ndarray, dx, dz) -> np.ndarray:
 def _ray(ac: np.ndarray, angle: float, n: int) -> np.ndarray:
     """The autocorrelation along a ray at ``angle`` (radians from +x towards +z), n lags one px apart."""
     t = np.arange(n)
-    return _at(ac, t * np.cos(angle), t * np.sin(angle))
+    return at_lag(ac, t * np.cos(angle), t * np.sin(angle))
 
 
 def courses(ac: np.ndarray, across: float, up: float) -> tuple:
     """(a course's height, each course's shift along x in units of ``across``, in [0, 1)) from the
     autocorrelation ``ac`` and the repeats ``across`` and ``up``, px (module doc): the height in px."""
-    top = float(_at(ac, 0.0, up))
+    top = float(at_lag(ac, 0.0, up))
     lags = np.arange(max(int(round(across)), 1), dtype=np.float64)
     for k in COURSES:
-        row = _at(ac, lags, up / k)
+        row = at_lag(ac, lags, up / k)
         if up / k >= MIN_LAG and top > PEAK and row.max() >= FUNDAMENTAL * top:
             # a course up, the photo reads as itself shifted back by the courses' shift: the peak is at -shift
             return up / k, float(-lags[int(np.argmax(row))] / max(across, 1.0)) % 1.0
     return up, 0.0
 
 
-def _autocorrelation(lum: np.ndarray) -> np.ndarray:
-    """The autocorrelation of a luminance (H, W) less its mean, band-passed (module doc), 1 at lag (0, 0)."""
-    H, W = lum.shape
+def band_transfer(H: int, W: int) -> np.ndarray:
+    """The band-pass's transfer on an (H, W) FFT grid (module doc: the difference of Gaussians of BAND) -> (H, W)."""
     fy, fx = np.fft.fftfreq(H)[:, None], np.fft.fftfreq(W)[None, :]
     f2 = (2 * np.pi) ** 2 * (fy ** 2 + fx ** 2)
-    band = np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)     # the DoG's transfer
-    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band) ** 2))
+    return np.exp(-0.5 * f2 * BAND[0] ** 2) - np.exp(-0.5 * f2 * BAND[1] ** 2)
+
+
+def _autocorrelation(lum: np.ndarray) -> np.ndarray:
+    """The autocorrelation of a luminance (H, W) less its mean, band-passed (module doc), 1 at lag (0, 0)."""
+    ac = np.real(np.fft.ifft2(np.abs(np.fft.fft2(lum) * band_transfer(*lum.shape)) ** 2))
     return ac / max(ac[0, 0], 1e-12)
 
 
@@ -136,7 +139,7 @@ def grid_repeat(photo: np.ndarray) -> float:
     lum = luminance(photo)
     ac = _autocorrelation(lum - lum.mean())
     across, up = _repeats(ac)
-    return float(min(_at(ac, across, 0.0), _at(ac, 0.0, up)))
+    return float(min(at_lag(ac, across, 0.0), at_lag(ac, 0.0, up)))
 
 
 def estimate(photo: np.ndarray, px_per_unit: float) -> Estimates:
