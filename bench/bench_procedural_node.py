@@ -8,7 +8,9 @@ Color is read) with the settings of the parity tests
 pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
 Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone, layers also with
 a tint (backend/solid/procedural/tint.py: one more Wave Noise group), and each family also with its noises'
-amplitudes (Turbulence, Grain, Detail, Tint) at 0, which Cycles folds away.  Writes
+amplitudes (Turbulence, Grain, Detail, Tint) at 0, which Cycles folds away.  The "OSL:" rows render with Cycles'
+Open Shading Language, the groups' Wave Noise trees in their OSL form (one Script node each, as the groups take it
+there), each against the Wave Texture rendered by OSL too.  Writes
 docs/benchmarks/procedural_node.json, with Blender's version.
 
     python -m bench procedural-node [--res 128] [--samples 4] [--repeat 2]
@@ -40,9 +42,10 @@ PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centr
           "herringbone": dict(length=0.5, height=0.16, offset=0.3, joint=0.15, pattern="herringbone45")}
 
 
-def procedural(case: str, noise: bool = True, tint: bool = False):
+def procedural(case: str, noise: bool = True, tint: bool = False, form: str = "nodes"):
     """A group of the family ``case`` (a key of PARAMS); ``noise`` False: Turbulence, Grain, Detail and Tint at 0;
-    ``tint``: with a tint (a random photo's, at 2 cycles per unit, as the parity tests draw it)."""
+    ``tint``: with a tint (a random photo's, at 2 cycles per unit, as the parity tests draw it); ``form``: its Wave
+    Noise groups' ("osl": rendered with Open Shading Language)."""
     def make(nt):
         rng = np.random.default_rng(0)
         family = "bonds" if case == "herringbone" else case
@@ -53,7 +56,7 @@ def procedural(case: str, noise: bool = True, tint: bool = False):
                 p["grain"] = 0.0
         t = fit_tint(rng.uniform(0, 1, (32, 32, 3)), 2.0, 3) if tint else None
         f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3, tint=t)
-        grp = build_procedural_group(f)
+        grp = build_procedural_group(f, implementation=form)
         n = nt.nodes.new("ShaderNodeGroup")
         n.node_tree = grp
         if tint and not noise:
@@ -73,23 +76,28 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=2)
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "procedural_node.json"))
     a = ap.parse_args(argv)
-    cases = [("Blender Wave Texture", texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0))]
-    cases += [(f"Procedural {f}", procedural(f)) for f in PARAMS]
-    cases += [("Procedural layers, tinted", procedural("layers", tint=True))]
-    cases += [(f"Procedural {f}, noises at 0", procedural(f, noise=False)) for f in PARAMS if f != "herringbone"]
-    cases += [("Procedural layers, tinted, noises at 0", procedural("layers", noise=False, tint=True))]
+    wave = texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0)
+    cases = [("Blender Wave Texture", wave, False)]
+    cases += [(f"Procedural {f}", procedural(f), False) for f in PARAMS]
+    cases += [("Procedural layers, tinted", procedural("layers", tint=True), False)]
+    cases += [(f"Procedural {f}, noises at 0", procedural(f, noise=False), False) for f in PARAMS
+              if f != "herringbone"]
+    cases += [("Procedural layers, tinted, noises at 0", procedural("layers", noise=False, tint=True), False)]
+    cases += [("OSL: Blender Wave Texture", wave, True)]
+    cases += [(f"OSL: Procedural {f}", procedural(f, form="osl"), True) for f in PARAMS]
+    cases += [("OSL: Procedural layers, tinted", procedural("layers", tint=True, form="osl"), True)]
     res = {}
-    for name, make in cases:
+    for name, make, osl in cases:
         times = {}
         for spp in (a.samples, 2 * a.samples):
-            sc, mat = scene(a.res, spp)
+            sc, mat = scene(a.res, spp, osl=osl)
             nodes = shade(mat, make)
             bpy.ops.render.render()      # compile and warm up
             times[spp] = min(_timed() for _ in range(a.repeat))
         per = (times[2 * a.samples] - times[a.samples]) / (a.res * a.res * a.samples)
         res[name] = dict(ns_per_pixel_sample=round(per * 1e9, 1), nodes=nodes)
-    ref = res["Blender Wave Texture"]["ns_per_pixel_sample"]
-    for r in res.values():
+    for name, r in res.items():     # each against the Wave Texture rendered as it is, by SVM or by OSL
+        ref = res[("OSL: " if name.startswith("OSL: ") else "") + "Blender Wave Texture"]["ns_per_pixel_sample"]
         r["vs_wave_texture"] = round(r["ns_per_pixel_sample"] / ref, 1)
     print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
     for name, r in res.items():

@@ -12,6 +12,8 @@ parameters are the group's inputs for an artist to turn.
 * turbulence, grain and detail: Wave Noise groups (:func:`.wave_nodes.build_wave_group`) of the engine's
   turbulence settings for seeds seed, seed + 1 and seed + 2, each read at its frequency through its Scale input
   and weighed by its amplitude input (an amplitude of 0 leaves its group out of a Cycles render: :func:`_plus`);
+  built from Blender's nodes, or as one OSL script each where Cycles runs Open Shading Language (they follow the
+  scene as the Wave Noise node's Automatic form does: :func:`follow_form`);
 * the ramp as a sum of clamped Map Range nodes (one per stop interval: exact piecewise-linear colours; a Color Ramp
   node is sampled into a 256-entry table in Cycles);
 * where the field has a tint (backend/solid/procedural/tint.py), a Wave Noise group for seed + tint.SEED_OFFSET read
@@ -27,11 +29,18 @@ import json
 
 import numpy as np
 
-from .wave_nodes import NodeBuilder, build_wave_group, new_group
+import bpy
 
-__all__ = ["build_procedural_group", "add_procedural_node", "PARAMETERS", "FIELD_KEY"]
+from ..backend.errors import SettingError
+from .wave_nodes import IMPLEMENTATIONS, NodeBuilder, build_wave_group, new_group, tree_implementation
+
+__all__ = ["build_procedural_group", "add_procedural_node", "follow_form", "PARAMETERS", "FIELD_KEY",
+           "NOISE_SEED_KEY"]
 
 FIELD_KEY = "omninoise_procedural"
+#: the key on a procedural group's Wave Noise trees holding the seed of their turbulence settings
+#: (turbulence.turbulence_settings), from which :func:`follow_form` rebuilds them in another form
+NOISE_SEED_KEY = "omninoise_turbulence_seed"
 
 #: per family: (socket name, type, the engine's parameter or how it is read off the field)
 PARAMETERS = {
@@ -145,13 +154,22 @@ def _frac(b, x):
     return b.math("SUBTRACT", x, b.math("FLOOR", x))
 
 
-def _turbulence(b, groups: dict, seed: int, vector, frequency):
+class _Noises(dict):
+    """A group's Wave Noise trees by seed, built in ``form`` ("nodes" or "osl", wave_nodes.IMPLEMENTATIONS)."""
+
+    def __init__(self, form: str):
+        super().__init__()
+        self.form = form
+
+
+def _turbulence(b, groups: _Noises, seed: int, vector, frequency):
     """The Value of a Wave Noise group of the turbulence settings for ``seed`` at ``vector`` x ``frequency``."""
     from ..backend.solid.procedural.turbulence import turbulence_settings
 
     if seed not in groups:
         groups[seed] = build_wave_group(turbulence_settings(seed), b.tree.bl_idname,
-                                        name=f".{b.tree.name} turbulence {seed}")
+                                        name=f".{b.tree.name} turbulence {seed}", implementation=groups.form)
+        groups[seed][NOISE_SEED_KEY] = int(seed)
     node = b.new("GeometryNodeGroup" if b.geo else "ShaderNodeGroup")
     node.node_tree = groups[seed]
     b.put(node.inputs["Vector"], vector)
@@ -341,17 +359,24 @@ def _to_linear(b, c):
     return b.math("MULTIPLY_ADD", above, b.math("SUBTRACT", high, low), low)
 
 
-def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str | None = None):
+def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str | None = None,
+                           implementation: str = "nodes"):
     """A node group drawing ``field`` (a backend ProceduralField): Vector, Scale and the family's parameters (and
     Tint and Tint Frequency where the field has a tint) in; Color (scene-linear, for a shader's Base Color), sRGB
-    (the engine's values), Value (s) and for cells and bonds Gap Mask (ProceduralField.gaps) out."""
+    (the engine's values), Value (s) and for cells and bonds Gap Mask (ProceduralField.gaps) out.
+    ``implementation``: the form of its Wave Noise groups, "nodes" or "osl" (shader trees under Cycles with Open
+    Shading Language: :func:`follow_form` switches them as the scene's renderer changes)."""
+    if implementation not in IMPLEMENTATIONS:
+        raise SettingError("implementation", f"unknown {implementation!r}; choose {' or '.join(IMPLEMENTATIONS)}")
+    if implementation == "osl" and tree_type != "ShaderNodeTree":
+        raise SettingError("implementation", "the OSL form is for shader trees; Geometry Nodes use the node form")
     tree = new_group(name or f"Procedural {field.family.title()}", tree_type, (), ())
     _interface(tree, field)
     tree[FIELD_KEY] = json.dumps(field.to_dict())
     b = NodeBuilder(tree)
     gi, go = b.new("NodeGroupInput"), b.new("NodeGroupOutput")
     p = b.vmath("SCALE", gi.outputs["Vector"], scale=gi.outputs["Scale"])
-    seed, groups = field.seed, {}
+    seed, groups = field.seed, _Noises(implementation)
     fam, inside = field.family, None
     if fam == "rings":
         s = _rings(b, gi, p, seed, groups)
@@ -379,6 +404,24 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
     b.put(go.inputs["Color"], b.combine(*(_to_linear(b, c) for c in b.separate(srgb))))
     b.put(go.inputs["Value"], s)
     return tree
+
+
+def follow_form(form: str) -> int:
+    """Rebuild the Wave Noise trees of this file's procedural groups (shader trees, not linked from a library) that
+    are not in ``form`` ("nodes" or "osl") in it -> how many were rebuilt.  The Automatic form of the Wave Noise
+    node (wave_ui.follow_render_settings) calls this as the scene's renderer changes: OSL where Cycles runs Open
+    Shading Language, several times faster there, Blender's nodes everywhere else."""
+    from ..backend.solid.procedural.turbulence import turbulence_settings
+
+    done = 0
+    for tree in bpy.data.node_groups:
+        seed = tree.get(NOISE_SEED_KEY)
+        if (seed is None or tree.bl_idname != "ShaderNodeTree" or tree.library is not None
+                or tree_implementation(tree) == form):
+            continue
+        build_wave_group(turbulence_settings(int(seed)), tree=tree, implementation=form)
+        done += 1
+    return done
 
 
 def add_procedural_node(node_tree, group, location=(0.0, 0.0)):

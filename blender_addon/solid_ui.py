@@ -586,10 +586,12 @@ class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
 
         def done(result):
             from .procedural_nodes import add_procedural_node, build_procedural_group
+            from .wave_ui import scene_form
 
             field, grid = result
 
-            group = build_procedural_group(field, name=f"{name} Procedural")
+            group = build_procedural_group(field, name=f"{name} Procedural",
+                                           implementation=scene_form(bpy.context.scene))
             p.periodic_info, p.grid_info = periodic_info(field), grid
 
             def node(nt):

@@ -56,15 +56,21 @@ def scene_runs_osl(scene) -> bool:
             and bool(getattr(getattr(scene, "cycles", None), "shading_system", False)))
 
 
+def scene_form(scene) -> str:
+    """'osl' where ``scene`` renders with Cycles and Open Shading Language and this Blender compiles OSL, else
+    'nodes': the Automatic form of a Wave Noise shader tree."""
+    from .wave_osl import osl_available
+
+    return "osl" if scene_runs_osl(scene) and osl_available() else "nodes"
+
+
 def wanted_implementation(props, tree, scene) -> str:
     """'nodes' or 'osl': the form a Wave Noise tree should be built in for ``scene``."""
     if tree.bl_idname != "ShaderNodeTree" or props.implementation == "NODES":
         return "nodes"
     if props.implementation == "OSL":
         return "osl"
-    from .wave_osl import osl_available
-
-    return "osl" if scene_runs_osl(scene) and osl_available() else "nodes"
+    return scene_form(scene)
 
 
 def rebuild_tree(props, scene) -> None:
@@ -101,7 +107,8 @@ _last_scene_state = [None]
 
 @persistent
 def follow_render_settings(*_args) -> None:
-    """Automatic Wave Noise groups follow the scene: OSL form when Cycles runs OSL, nodes otherwise.
+    """Automatic Wave Noise groups follow the scene: OSL form when Cycles runs OSL, nodes otherwise; so do the
+    Wave Noise trees inside procedural solids' groups (procedural_nodes.follow_form).
 
     Runs before renders, after depsgraph updates and file loads, and when the render engine or
     Cycles' Open Shading Language switch is changed in the interface (message bus); it only
@@ -118,6 +125,9 @@ def follow_render_settings(*_args) -> None:
             continue
         if tree_implementation(tree) != wanted_implementation(props, tree, scene):
             rebuild_tree(props, scene)
+    from .procedural_nodes import follow_form
+
+    follow_form(scene_form(scene))
 
 
 class OMNINOISE_PG_wave(bpy.types.PropertyGroup):

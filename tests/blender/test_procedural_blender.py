@@ -11,13 +11,17 @@ bpy = pytest.importorskip("bpy")
 
 from omninoise import blender_addon  # noqa: E402
 from omninoise.backend.colour import srgb_to_linear  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
 from omninoise.backend.solid.procedural import fit  # noqa: E402
 from omninoise.backend.solid.procedural.field import ProceduralField  # noqa: E402
 from omninoise.backend.solid.procedural.ramp import fit_ramp  # noqa: E402
 from omninoise.backend.solid.procedural.tint import fit_tint  # noqa: E402
 from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
-from omninoise.blender_addon.procedural_nodes import FIELD_KEY, add_procedural_node, build_procedural_group  # noqa: E402,E501
+from omninoise.blender_addon.procedural_nodes import (FIELD_KEY, NOISE_SEED_KEY, add_procedural_node,  # noqa: E402
+                                                      build_procedural_group, follow_form)
+from omninoise.blender_addon.wave_nodes import tree_implementation  # noqa: E402
+from omninoise.blender_addon.wave_osl import osl_available  # noqa: E402
 from test_wave_node import _bake  # noqa: E402  (the Cycles EMIT bake of the Wave Noise tests)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -161,16 +165,36 @@ def test_each_noise_is_read_through_a_multiply_by_its_amplitude(family):
         bpy.data.node_groups.remove(grp)
 
 
+def _cycles_scene(osl: bool = False):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device, scene.cycles.samples = "CPU", 1
+    scene.cycles.shading_system = osl
+    return scene
+
+
 @pytest.mark.parametrize("family", ["rings", "layers", "bonds", "cells", "herringbone", "herringbone45"])
 def test_cycles_bake_equals_engine(family):
     """A plane baked in Cycles through the group's sRGB output (and for cells and bonds its Gap Mask), at the
     shading positions Cycles used (baked too): within 1e-3 of the engine on all but the pixels a float32 position
     puts across an edge."""
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    _cycles_scene()
+    _bake_equals_engine(_field(family), "nodes")
+
+
+@pytest.mark.skipif(not osl_available(), reason="this bpy has no OSL")
+@pytest.mark.parametrize("family", ["rings", "layers", "cells", "bonds"])
+def test_osl_bake_equals_engine(family):
+    """With Cycles on Open Shading Language, the group's Wave Noise trees in their OSL form (one Script node each,
+    several times faster there): the same bake within 1e-3 of the engine (layers and cells with a tint: all four
+    noises)."""
+    _cycles_scene(osl=True)
+    _bake_equals_engine(_field(family), "osl")
+
+
+def _bake_equals_engine(f, form: str):
     scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device, scene.cycles.samples = "CPU", 1
-    f = _field(family)
     mesh = bpy.data.meshes.new("plane")       # z = 0.05 cuts the bonds' courses 0.13 high through their units
     mesh.from_pydata([(-1, -1, 0.05), (1, -1, 0.05), (1, 1, 0.05), (-1, 1, 0.05)], [], [(0, 1, 2, 3)])
     uv = mesh.uv_layers.new(name="UV")
@@ -182,7 +206,10 @@ def test_cycles_bake_equals_engine(family):
     ob.data.materials.append(mat)
     nt = ensure_node_tree(mat)
     nt.nodes.clear()
-    g = add_procedural_node(nt, build_procedural_group(f))
+    grp = build_procedural_group(f, implementation=form)
+    noises = [n.node_tree for n in grp.nodes if n.bl_idname == "ShaderNodeGroup" and NOISE_SEED_KEY in n.node_tree]
+    assert noises and {tree_implementation(t) for t in noises} == {form}
+    g = add_procedural_node(nt, grp)
     em = nt.nodes.new("ShaderNodeEmission")
     nt.links.new(g.outputs["sRGB"], em.inputs["Color"])
     nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
@@ -254,7 +281,6 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         p.method = "AUTO"                     # auto says what it kept
         assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
         assert p.periodic_info.startswith("Auto: ") and "procedural" in p.periodic_info
-        from omninoise.backend.errors import SettingError
         from omninoise.blender_addon import solid_ui
         from omninoise.cli.main import build_parser
         from omninoise.cli.solid import solid_request
@@ -307,3 +333,35 @@ def test_eevee_render_equals_engine(tmp_path):
             got = np.asarray(channels["ViewLayer.Combined"].pixels, np.float32)[..., :3].reshape(-1, 3)
         err = np.abs(got - f.evaluate(centres)).max(1)
         assert np.percentile(err, 99) < 2e-3 and np.median(err) < 1e-3, (fam, float(np.percentile(err, 99)))
+
+
+def test_the_noises_follow_the_scene_s_renderer():
+    """A procedural group's Wave Noise trees take the form the scene renders fastest, as the Wave Noise node's
+    Automatic form does: OSL where Cycles runs Open Shading Language, Blender's nodes elsewhere; a Geometry Nodes
+    group keeps its nodes, and a group refuses the OSL form there."""
+    from omninoise.blender_addon import wave_ui
+
+    scene = _cycles_scene()
+    shader, geometry = build_procedural_group(_field("layers")), build_procedural_group(_field("cells"),
+                                                                                          "GeometryNodeTree")
+
+    def forms(grp):
+        return {tree_implementation(n.node_tree) for n in grp.nodes
+                if n.bl_idname.endswith("NodeGroup") and NOISE_SEED_KEY in n.node_tree}
+
+    def follow():
+        wave_ui._last_scene_state[0] = None
+        wave_ui.follow_render_settings()
+
+    assert forms(shader) == forms(geometry) == {"nodes"}
+    scene.cycles.shading_system = True
+    follow()
+    assert forms(shader) == {"osl" if osl_available() else "nodes"} and forms(geometry) == {"nodes"}
+    assert follow_form(wave_ui.scene_form(scene)) == 0
+    scene.cycles.shading_system = False
+    follow()
+    assert forms(shader) == forms(geometry) == {"nodes"}
+    with pytest.raises(SettingError, match="OSL form is for shader trees"):
+        build_procedural_group(_field("cells"), "GeometryNodeTree", implementation="osl")
+    with pytest.raises(SettingError, match="unknown 'svm'"):
+        build_procedural_group(_field("cells"), implementation="svm")
