@@ -32,15 +32,13 @@ import numpy as np
 import bpy
 
 from ..backend.errors import SettingError
-from .wave_nodes import IMPLEMENTATIONS, NodeBuilder, build_wave_group, new_group, tree_implementation
+from .wave_nodes import (IMPLEMENTATIONS, NodeBuilder, build_wave_group, new_group, settings_from_json,
+                         tree_implementation, tree_settings_json)
 
-__all__ = ["build_procedural_group", "add_procedural_node", "follow_form", "PARAMETERS", "FIELD_KEY",
-           "NOISE_SEED_KEY"]
+__all__ = ["build_procedural_group", "add_procedural_node", "follow_form", "noise_trees", "PARAMETERS",
+           "FIELD_KEY"]
 
 FIELD_KEY = "omninoise_procedural"
-#: the key on a procedural group's Wave Noise trees holding the seed of their turbulence settings
-#: (turbulence.turbulence_settings), from which :func:`follow_form` rebuilds them in another form
-NOISE_SEED_KEY = "omninoise_turbulence_seed"
 
 #: per family: (socket name, type, the engine's parameter or how it is read off the field)
 PARAMETERS = {
@@ -169,7 +167,6 @@ def _turbulence(b, groups: _Noises, seed: int, vector, frequency):
     if seed not in groups:
         groups[seed] = build_wave_group(turbulence_settings(seed), b.tree.bl_idname,
                                         name=f".{b.tree.name} turbulence {seed}", implementation=groups.form)
-        groups[seed][NOISE_SEED_KEY] = int(seed)
     node = b.new("GeometryNodeGroup" if b.geo else "ShaderNodeGroup")
     node.node_tree = groups[seed]
     b.put(node.inputs["Vector"], vector)
@@ -406,21 +403,29 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
     return tree
 
 
-def follow_form(form: str) -> int:
-    """Rebuild the Wave Noise trees of this file's procedural groups (shader trees, not linked from a library) that
-    are not in ``form`` ("nodes" or "osl") in it -> how many were rebuilt.  The Automatic form of the Wave Noise
-    node (wave_ui.follow_render_settings) calls this as the scene's renderer changes: OSL where Cycles runs Open
-    Shading Language, several times faster there, Blender's nodes everywhere else."""
-    from ..backend.solid.procedural.turbulence import turbulence_settings
+def noise_trees(group) -> list:
+    """The Wave Noise trees a procedural ``group`` reads (its group nodes' trees that carry wave settings)."""
+    out = []
+    for node in group.nodes:
+        tree = getattr(node, "node_tree", None)
+        if tree is not None and tree not in out and tree_settings_json(tree) is not None:
+            out.append(tree)
+    return out
 
+
+def follow_form(form: str) -> int:
+    """Rebuild, in ``form`` ("nodes" or "osl"), the Wave Noise trees of this file's procedural shader groups (not
+    linked from a library) that are in the other -> how many were rebuilt, each from the settings stored on it.  The
+    Automatic form of the Wave Noise node (wave_ui.follow_render_settings) calls this as the scene's renderer
+    changes: OSL where Cycles runs Open Shading Language, several times faster there, Blender's nodes elsewhere."""
     done = 0
-    for tree in bpy.data.node_groups:
-        seed = tree.get(NOISE_SEED_KEY)
-        if (seed is None or tree.bl_idname != "ShaderNodeTree" or tree.library is not None
-                or tree_implementation(tree) == form):
+    for group in list(bpy.data.node_groups):
+        if FIELD_KEY not in group or group.bl_idname != "ShaderNodeTree" or group.library is not None:
             continue
-        build_wave_group(turbulence_settings(int(seed)), tree=tree, implementation=form)
-        done += 1
+        for tree in noise_trees(group):
+            if tree.library is None and tree_implementation(tree) != form:
+                build_wave_group(settings_from_json(tree_settings_json(tree)), tree=tree, implementation=form)
+                done += 1
     return done
 
 

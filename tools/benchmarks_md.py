@@ -157,7 +157,9 @@ def procedural_node(doc: dict) -> list:
            f"filling a {doc.get('res')}² px frame, emission of the group's sRGB output, {blender}CPU; nanoseconds "
            f"per pixel-sample from {doc.get('samples')} and {2 * doc.get('samples', 0)} samples. \"Tinted\": with a "
            f"tint, one Wave Noise group more. Rows \"noises at 0\" set the group's Turbulence, Grain, Detail and "
-           f"Tint to 0: Cycles then leaves their Wave Noise groups out.", "",
+           f"Tint to 0: Cycles then leaves their Wave Noise groups out. Rows \"OSL:\" render with Cycles' Open "
+           f"Shading Language, where the groups' Wave Noise trees take their OSL form (one script each), against "
+           f"the Wave Texture rendered by OSL too.", "",
            "| shader | ns per pixel-sample | vs Wave Texture | nodes |", "|---|---|---|---|"]
     for name, r in doc.get("results", {}).items():
         out.append(f"| {name} | {r['ns_per_pixel_sample']} | {r['vs_wave_texture']}x | {r['nodes']} |")

@@ -18,8 +18,8 @@ from omninoise.backend.solid.procedural.ramp import fit_ramp  # noqa: E402
 from omninoise.backend.solid.procedural.tint import fit_tint  # noqa: E402
 from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
-from omninoise.blender_addon.procedural_nodes import (FIELD_KEY, NOISE_SEED_KEY, add_procedural_node,  # noqa: E402
-                                                      build_procedural_group, follow_form)
+from omninoise.blender_addon.procedural_nodes import (FIELD_KEY, add_procedural_node,  # noqa: E402
+                                                      build_procedural_group, follow_form, noise_trees)
 from omninoise.blender_addon.wave_nodes import tree_implementation  # noqa: E402
 from omninoise.blender_addon.wave_osl import osl_available  # noqa: E402
 from test_wave_node import _bake  # noqa: E402  (the Cycles EMIT bake of the Wave Noise tests)
@@ -184,16 +184,17 @@ def test_cycles_bake_equals_engine(family):
 
 
 @pytest.mark.skipif(not osl_available(), reason="this bpy has no OSL")
-@pytest.mark.parametrize("family", ["rings", "layers", "cells", "bonds"])
-def test_osl_bake_equals_engine(family):
+@pytest.mark.parametrize("family,built", [("rings", "osl"), ("layers", "osl"), ("cells", "nodes"), ("bonds", "nodes")])
+def test_osl_bake_equals_engine(family, built):
     """With Cycles on Open Shading Language, the group's Wave Noise trees in their OSL form (one Script node each,
-    several times faster there): the same bake within 1e-3 of the engine (layers and cells with a tint: all four
-    noises)."""
+    several times faster there), built so or switched to it from their node form by follow_form: the same bake
+    within 1e-3 of the engine (layers and cells with a tint: all four noises)."""
     _cycles_scene(osl=True)
-    _bake_equals_engine(_field(family), "osl")
+    _bake_equals_engine(_field(family), built, "osl")
 
 
-def _bake_equals_engine(f, form: str):
+def _bake_equals_engine(f, built: str, form: str | None = None):
+    """The bake of a group of ``f`` built with its noises in the form ``built``, then switched to ``form``."""
     scene = bpy.context.scene
     mesh = bpy.data.meshes.new("plane")       # z = 0.05 cuts the bonds' courses 0.13 high through their units
     mesh.from_pydata([(-1, -1, 0.05), (1, -1, 0.05), (1, 1, 0.05), (-1, 1, 0.05)], [], [(0, 1, 2, 3)])
@@ -206,9 +207,11 @@ def _bake_equals_engine(f, form: str):
     ob.data.materials.append(mat)
     nt = ensure_node_tree(mat)
     nt.nodes.clear()
-    grp = build_procedural_group(f, implementation=form)
-    noises = [n.node_tree for n in grp.nodes if n.bl_idname == "ShaderNodeGroup" and NOISE_SEED_KEY in n.node_tree]
-    assert noises and {tree_implementation(t) for t in noises} == {form}
+    grp = build_procedural_group(f, implementation=built)
+    assert {tree_implementation(t) for t in noise_trees(grp)} == {built}
+    if form is not None:
+        assert follow_form(form) == (0 if form == built else len(noise_trees(grp)))
+        assert {tree_implementation(t) for t in noise_trees(grp)} == {form}
     g = add_procedural_node(nt, grp)
     em = nt.nodes.new("ShaderNodeEmission")
     nt.links.new(g.outputs["sRGB"], em.inputs["Color"])
@@ -346,13 +349,13 @@ def test_the_noises_follow_the_scene_s_renderer():
                                                                                           "GeometryNodeTree")
 
     def forms(grp):
-        return {tree_implementation(n.node_tree) for n in grp.nodes
-                if n.bl_idname.endswith("NodeGroup") and NOISE_SEED_KEY in n.node_tree}
+        return {tree_implementation(t) for t in noise_trees(grp)}
 
     def follow():
         wave_ui._last_scene_state[0] = None
         wave_ui.follow_render_settings()
 
+    assert len(noise_trees(shader)) == 3 and len(noise_trees(geometry)) == 3     # turbulence, detail, tint
     assert forms(shader) == forms(geometry) == {"nodes"}
     scene.cycles.shading_system = True
     follow()
