@@ -404,11 +404,13 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
 
 
 def noise_trees(group) -> list:
-    """The Wave Noise trees a procedural ``group`` reads (its group nodes' trees that carry wave settings)."""
+    """The Wave Noise trees a procedural ``group`` builds and reads (its group nodes' trees that carry wave
+    settings; not a Wave Noise node an artist put in, whose form its own setting keeps)."""
     out = []
     for node in group.nodes:
         tree = getattr(node, "node_tree", None)
-        if tree is not None and tree not in out and tree_settings_json(tree) is not None:
+        if (tree is not None and tree not in out and tree_settings_json(tree) is not None
+                and not getattr(getattr(tree, "omninoise_wave", None), "is_wave", False)):
             out.append(tree)
     return out
 
@@ -424,7 +426,12 @@ def follow_form(form: str) -> int:
             continue
         for tree in noise_trees(group):
             if tree.library is None and tree_implementation(tree) != form:
-                build_wave_group(settings_from_json(tree_settings_json(tree)), tree=tree, implementation=form)
+                settings = settings_from_json(tree_settings_json(tree))
+                try:
+                    build_wave_group(settings, tree=tree, implementation=form)
+                except SettingError:     # a script that does not compile: the node form renders everywhere
+                    build_wave_group(settings, tree=tree, implementation="nodes")
+                    continue
                 done += 1
     return done
 

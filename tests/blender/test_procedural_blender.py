@@ -368,3 +368,20 @@ def test_the_noises_follow_the_scene_s_renderer():
         build_procedural_group(_field("cells"), "GeometryNodeTree", implementation="osl")
     with pytest.raises(SettingError, match="unknown 'svm'"):
         build_procedural_group(_field("cells"), implementation="svm")
+
+
+def test_a_noise_whose_script_does_not_compile_keeps_its_node_form(monkeypatch):
+    """Should Cycles' OSL compiler refuse a script, the group's noises stay (or are built again) in their node form,
+    which renders everywhere, rather than an empty tree."""
+    from omninoise.blender_addon import wave_osl
+
+    def refuse(*_args, **_kw):
+        raise SettingError("osl", "the script did not compile")
+
+    _cycles_scene()
+    grp = build_procedural_group(_field("rings"))
+    monkeypatch.setattr(wave_osl, "script_node", refuse)
+    assert follow_form("osl") == 0
+    trees = noise_trees(grp)
+    assert len(trees) == 3 and {tree_implementation(t) for t in trees} == {"nodes"}
+    assert all(len(t.nodes) > 20 for t in trees)
