@@ -26,11 +26,15 @@ pixel scale times Scale (a surface look, not a solid: a cut through the mesh sho
 Positions are object-local by default (the texture moves with the object) or
 world.  Everything heavy (encoding, rasterising, evaluating, writing) runs on
 a :mod:`.tasks` worker with progress and cancel; Blender data is read before
-and written after on the main thread.
+and written after on the main thread.  A preview, a bake and a node group of the
+same photo and settings share one fit or encoding (:func:`remembered`).
 """
 from __future__ import annotations
 
+import collections
+import json
 import os
+import threading
 
 import bpy
 import numpy as np
@@ -47,8 +51,8 @@ from .tasks import TaskOperator
 from .preferences import threads
 from .presets import SOLID_VALUES, SUBDIRS
 
-__all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "tile_repeats", "attach",
-           "detach"]
+__all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "remembered", "tile_repeats",
+           "attach", "detach"]
 
 #: another folder of solid texture models than the shipped one (tests point it elsewhere); None: the shipped models
 MODELS_DIR: str | None = None
@@ -215,17 +219,58 @@ def tile_request(p):
                                               method="synthesis", tile=int(p.tile)).check()
 
 
+#: the panel's last textures (fitted or drawn solids, auto's choices, codes) by their request's key, at most KEEP:
+#: a preview, a bake and a node group of one photo and the same settings fit or encode it once
+_DONE = collections.OrderedDict()
+_DONE_KEEP = 4
+_DONE_LOCK = threading.Lock()
+
+
+def _known(req):
+    """What :func:`remembered` holds for ``req``, or None."""
+    with _DONE_LOCK:
+        return _DONE.get(json.dumps(req.key(), sort_keys=True))
+
+
+def remembered(req, make):
+    """code_fn(progress, cancel) -> ``make(progress, cancel)``, made once per request key (``req.key()``: equal for
+    equal settings and pixels) while it is among the last :data:`_DONE_KEEP` made; an auto choice also stands for
+    its procedural solid (the same fit).  Runs on the worker; a cancelled or failed run leaves nothing."""
+    key = json.dumps(req.key(), sort_keys=True)
+
+    def code_fn(progress=None, cancel=None):
+        with _DONE_LOCK:
+            if key in _DONE:
+                _DONE.move_to_end(key)
+                return _DONE[key]
+        out = make(progress, cancel)
+        keys = [key]
+        if req.method == "auto":
+            keys.append(json.dumps(req.replace(method="procedural").key(), sort_keys=True))
+        with _DONE_LOCK:
+            for k, v in zip(keys, (out, getattr(out, "field", None))):
+                _DONE[k] = v
+                _DONE.move_to_end(k)
+            while len(_DONE) > _DONE_KEEP:
+                _DONE.popitem(last=False)
+        return out
+
+    return code_fn
+
+
 def texture(req):
     """(model, code_fn) for the panel's request (:func:`panel_request`); code_fn(progress, cancel) runs on the worker
-    (it may encode an image, or draw a spectral solid, about 6 s, with progress and cancel)."""
+    (it may encode an image, or draw a spectral solid, about 6 s, or fit a procedural one, about 12 s, with progress
+    and cancel; each made once for the same settings: :func:`remembered`)."""
     if req.method in ("spectral", "procedural"):     # no model: the "code" is the drawn or fitted solid
         return (_mod("solid.spectral_solid").SpectralTexture(req),
-                lambda progress=None, cancel=None: req.solid_field("", progress, cancel))
+                remembered(req, lambda progress=None, cancel=None: req.solid_field("", progress, cancel)))
     if req.method == "auto":         # the "code" is the choice (backend.solid.choose)
+        fitted = req.replace(method="procedural")    # a procedural preview's fit is auto's own
         return (_mod("solid.choose").AutoTexture(req),
-                lambda progress=None, cancel=None: req.choose("", progress))
+                remembered(req, lambda progress=None, cancel=None: req.choose("", progress, field=_known(fitted))))
     m = load_model(os.path.basename(req.model))
-    return m, lambda progress=None, cancel=None: req.code(m)[0]
+    return m, remembered(req, lambda progress=None, cancel=None: req.code(m)[0])
 
 
 def periodic_info(code) -> str:
@@ -581,8 +626,10 @@ class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
             raise backend.SettingError("image", "a procedural solid is fitted to a photo: set Source to Image")
         scale, world, name = float(p.scale), p.coords == "WORLD", p.name
 
+        fit = remembered(req, lambda progress=None, cancel=None: req.procedural_field("", progress, cancel))
+
         def work(progress, cancel):
-            return req.procedural_field("", progress, cancel), grid_info(req)
+            return fit(progress, cancel), grid_info(req)
 
         def done(result):
             from .procedural_nodes import add_procedural_node, build_procedural_group

@@ -233,11 +233,24 @@ def _bake_equals_engine(f, built: str, form: str | None = None):
 
 @pytest.fixture
 def small_fit(monkeypatch):
-    """A quick fit (small slices, a short search): the same stages, a tenth of the work."""
+    """A quick fit (small slices, a short search): the same stages, a tenth of the work; the fits it makes are
+    counted (``fits[0]``) and none is kept past the test (the panel's remembered ones are keyed by its settings)."""
     import functools
+
+    from omninoise.blender_addon import solid_ui
 
     monkeypatch.setattr(fit, "ProceduralConfig", functools.partial(fit.ProceduralConfig, side=32, budget=6,
                                                                    finalists=1, fit_side=64))
+    fits, real = [0], fit.fit_procedural
+
+    def counted(*args, **kw):
+        fits[0] += 1
+        return real(*args, **kw)
+
+    monkeypatch.setattr(fit, "fit_procedural", counted)
+    solid_ui._DONE.clear()
+    yield fits
+    solid_ui._DONE.clear()
 
 
 def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path):
@@ -253,6 +266,7 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
         assert p.periodic_info.startswith("Fitted: ")
         assert p.grid_info == "Repeats as a grid: try Bonds alone"       # a brick wall, the default kinds
+        assert small_fit[0] == 1
         ima = bpy.data.images["Solid Texture Preview"]
         px = np.empty(ima.size[0] * ima.size[1] * 4, np.float32)
         ima.pixels.foreach_get(px)
@@ -261,7 +275,9 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         field = SolidRequest(exemplar=pixels, method="procedural", seed=2).check().procedural_field()
         assert np.abs(got - field.image(128)).max() <= 0.5 / 255 + 1e-4     # the command line's solid
         bpy.ops.mesh.primitive_cube_add()
+        fitted = small_fit[0]
         assert bpy.ops.omninoise.solid_procedural_node() == {"FINISHED"}
+        assert small_fit[0] == fitted          # the preview's fit: the same photo and settings are fitted once
         mat = bpy.context.active_object.active_material
         node = next(n for n in mat.node_tree.nodes if n.type == "GROUP")
         assert node.inputs["Scale"].default_value == pytest.approx(1.5)
@@ -274,6 +290,7 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         # the bakes draw the same solid: a colour attribute at the cube's vertices (linear), object positions x Scale
         p.target, p.name = "COLOR_ATTRIBUTE", "Baked"
         assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        assert small_fit[0] == fitted
         me = bpy.context.active_object.data
         co = np.empty(len(me.vertices) * 3, np.float32)
         me.vertices.foreach_get("co", co)
@@ -284,6 +301,7 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         p.method = "AUTO"                     # auto says what it kept
         assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
         assert p.periodic_info.startswith("Auto: ") and "procedural" in p.periodic_info
+        assert small_fit[0] == fitted          # auto's procedural solid is the one fitted above
         from omninoise.blender_addon import solid_ui
         from omninoise.cli.main import build_parser
         from omninoise.cli.solid import solid_request
@@ -297,7 +315,9 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         assert p.grid_info == ""
         p.families = {"BONDS", "CELLS"}
         bpy.ops.mesh.primitive_cube_add()
+        fitted = small_fit[0]
         assert bpy.ops.omninoise.solid_procedural_node() == {"FINISHED"}
+        assert small_fit[0] == fitted + 1      # other kinds: another fit
         assert p.grid_info == "Repeats as a grid: try Bonds alone"
         p.families = set()
         with pytest.raises(SettingError, match="pick at least one kind"):
