@@ -112,9 +112,10 @@ def follow_render_settings(*_args) -> None:
 
     Runs before renders, after depsgraph updates and file loads, and when the render engine or
     Cycles' Open Shading Language switch is changed in the interface (message bus); it only
-    compares two settings unless they changed."""
+    compares those two settings and the number of node groups unless one of them changed."""
     scene = getattr(bpy.context, "scene", None)
-    state = (scene.name, scene_runs_osl(scene)) if scene is not None else None
+    # the node groups' count too: a group appended (an asset's material) or built is brought to the scene's form
+    state = (scene.name, scene_runs_osl(scene), len(bpy.data.node_groups)) if scene is not None else None
     if state == _last_scene_state[0]:
         return
     _last_scene_state[0] = state

@@ -381,9 +381,12 @@ def test_the_noises_follow_the_scene_s_renderer():
     follow()
     assert forms(shader) == {"osl" if osl_available() else "nodes"} and forms(geometry) == {"nodes"}
     assert follow_form(wave_ui.scene_form(scene)) == 0
+    added = build_procedural_group(_field("rings"))      # built (or appended) in the node form: the next update
+    wave_ui.follow_render_settings()                      # brings it to the scene's
+    assert forms(added) == {"osl" if osl_available() else "nodes"}
     scene.cycles.shading_system = False
     follow()
-    assert forms(shader) == forms(geometry) == {"nodes"}
+    assert forms(shader) == forms(geometry) == forms(added) == {"nodes"}
     with pytest.raises(SettingError, match="OSL form is for shader trees"):
         build_procedural_group(_field("cells"), "GeometryNodeTree", implementation="osl")
     with pytest.raises(SettingError, match="unknown 'svm'"):
