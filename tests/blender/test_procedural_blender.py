@@ -408,3 +408,47 @@ def test_a_noise_whose_script_does_not_compile_keeps_its_node_form(monkeypatch):
     trees = noise_trees(grp)
     assert len(trees) == 3 and {tree_implementation(t) for t in trees} == {"nodes"}
     assert all(len(t.nodes) > 20 for t in trees)
+
+
+def test_the_panel_remembers_its_last_textures_by_their_settings():
+    """remembered: one make per request key while among the last four; a failed or cancelled make leaves nothing; an
+    auto choice also stands for its procedural solid."""
+    from types import SimpleNamespace
+
+    from omninoise.blender_addon import solid_ui
+
+    class Req:
+        def __init__(self, name, method="procedural"):
+            self.name, self.method = name, method
+
+        def key(self):
+            return {"name": self.name, "method": self.method}
+
+        def replace(self, method):
+            return Req(self.name, method)
+
+    made = []
+
+    def make(progress=None, cancel=None):
+        made.append(1)
+        return object()
+
+    solid_ui._DONE.clear()
+    try:
+        first = solid_ui.remembered(Req("a"), make)()
+        assert solid_ui.remembered(Req("a"), make)() is first and len(made) == 1
+        for name in "bcde":                       # four more: "a" is the oldest and goes
+            solid_ui.remembered(Req(name), make)()
+        assert solid_ui.remembered(Req("a"), make)() is not first and len(made) == 6
+
+        def fails(progress=None, cancel=None):
+            raise RuntimeError("cancelled")
+
+        with pytest.raises(RuntimeError):
+            solid_ui.remembered(Req("f"), fails)()
+        assert solid_ui._known(Req("f")) is None
+        choice = SimpleNamespace(field=object())
+        assert solid_ui.remembered(Req("g", "auto"), lambda progress=None, cancel=None: choice)() is choice
+        assert solid_ui._known(Req("g")) is choice.field
+    finally:
+        solid_ui._DONE.clear()
