@@ -226,17 +226,24 @@ _DONE_KEEP = 4
 _DONE_LOCK = threading.Lock()
 
 
+def _memo_key(req) -> str:
+    """The request's key (equal settings and pixels) and, for the methods that read a model, its folder's path (the
+    key names the folder alone)."""
+    model = getattr(req, "model", None) if req.method in ("neural", "auto") else None
+    return json.dumps([req.key(), None if model is None else str(model)], sort_keys=True)
+
+
 def _known(req):
     """What :func:`remembered` holds for ``req``, or None."""
     with _DONE_LOCK:
-        return _DONE.get(json.dumps(req.key(), sort_keys=True))
+        return _DONE.get(_memo_key(req))
 
 
 def remembered(req, make):
     """code_fn(progress, cancel) -> ``make(progress, cancel)``, made once per request key (``req.key()``: equal for
     equal settings and pixels) while it is among the last :data:`_DONE_KEEP` made; an auto choice also stands for
     its procedural solid (the same fit).  Runs on the worker; a cancelled or failed run leaves nothing."""
-    key = json.dumps(req.key(), sort_keys=True)
+    key = _memo_key(req)
 
     def code_fn(progress=None, cancel=None):
         with _DONE_LOCK:
@@ -246,7 +253,7 @@ def remembered(req, make):
         out = make(progress, cancel)
         keys = [key]
         if req.method == "auto":
-            keys.append(json.dumps(req.replace(method="procedural").key(), sort_keys=True))
+            keys.append(_memo_key(req.replace(method="procedural")))
         with _DONE_LOCK:
             for k, v in zip(keys, (out, getattr(out, "field", None))):
                 _DONE[k] = v
