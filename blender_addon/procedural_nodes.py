@@ -32,7 +32,7 @@ import numpy as np
 import bpy
 
 from ..backend.errors import SettingError
-from .wave_nodes import (IMPLEMENTATIONS, NodeBuilder, build_wave_group, new_group, settings_from_json,
+from .wave_nodes import (NodeBuilder, build_wave_group, check_form, new_group, settings_from_json,
                          tree_implementation, tree_settings_json)
 
 __all__ = ["build_procedural_group", "add_procedural_node", "follow_form", "noise_trees", "PARAMETERS",
@@ -363,10 +363,7 @@ def build_procedural_group(field, tree_type: str = "ShaderNodeTree", name: str |
     (the engine's values), Value (s) and for cells and bonds Gap Mask (ProceduralField.gaps) out.
     ``implementation``: the form of its Wave Noise groups, "nodes" or "osl" (shader trees under Cycles with Open
     Shading Language: :func:`follow_form` switches them as the scene's renderer changes)."""
-    if implementation not in IMPLEMENTATIONS:
-        raise SettingError("implementation", f"unknown {implementation!r}; choose {' or '.join(IMPLEMENTATIONS)}")
-    if implementation == "osl" and tree_type != "ShaderNodeTree":
-        raise SettingError("implementation", "the OSL form is for shader trees; Geometry Nodes use the node form")
+    check_form(implementation, tree_type)       # before the group exists: a refused form leaves no half-built one
     tree = new_group(name or f"Procedural {field.family.title()}", tree_type, (), ())
     _interface(tree, field)
     tree[FIELD_KEY] = json.dumps(field.to_dict())

@@ -47,7 +47,7 @@ from .wave_constants import OUTPUTS, stratum_constants
 
 __all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json",
            "settings_from_json", "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group",
-           "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY", "tree_implementation"]
+           "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY", "tree_implementation", "check_form"]
 
 _F = np.float32
 SETTINGS_KEY = "omninoise_wave_settings"
@@ -421,6 +421,16 @@ def group_io(b: NodeBuilder) -> tuple:
     return gi, go, x, w
 
 
+def check_form(implementation: str, tree_type: str) -> None:
+    """SettingError unless ``implementation`` is one of :data:`IMPLEMENTATIONS` that a tree of ``tree_type`` can
+    hold (the OSL form: shader trees only)."""
+    if implementation not in IMPLEMENTATIONS:
+        raise backend.SettingError("implementation", f"unknown {implementation!r}; choose nodes or osl")
+    if implementation == "osl" and tree_type != "ShaderNodeTree":
+        raise backend.SettingError("implementation",
+                                   "the OSL form is for shader trees; Geometry Nodes use the node form")
+
+
 def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
                      name: str = "Wave Noise", implementation: str = "nodes") -> bpy.types.NodeTree:
     """Build (or rebuild in place) the Wave Noise group for ``settings`` (a backend WaveSettings).
@@ -430,8 +440,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     :mod:`.wave_osl`: Cycles with Open Shading Language only, shader trees only).
     Returns the group tree; its interface (INPUTS, OUTPUTS) is the same for every setting and form.
     """
-    if implementation not in IMPLEMENTATIONS:
-        raise backend.SettingError("implementation", f"unknown {implementation!r}; choose nodes or osl")
+    check_form(implementation, tree.bl_idname if tree is not None else tree_type)
     if settings.cellular != "none":
         raise backend.SettingError("cellular", "use the Wave Cellular node for cellular variants")
     if settings.example is not None or settings.transition_to is not None:
@@ -440,9 +449,6 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     table = noise.table
     if table.mode not in ("single", "axes"):
         raise backend.SettingError("anisotropy", f"table mode {table.mode!r} has no node form")
-    if implementation == "osl" and (tree.bl_idname if tree is not None else tree_type) != "ShaderNodeTree":
-        raise backend.SettingError("implementation",
-                                   "the OSL form is for shader trees; Geometry Nodes use the node form")
     if tree is None:
         tree = new_wave_tree(name, tree_type)
     else:
