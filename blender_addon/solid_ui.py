@@ -226,34 +226,36 @@ _DONE_KEEP = 4
 _DONE_LOCK = threading.Lock()
 
 
-def _memo_key(req) -> str:
-    """The request's key (equal settings and pixels) and, for the methods that read a model, its folder's path (the
-    key names the folder alone)."""
+def _memo_keys(req) -> list:
+    """The keys :func:`remembered` files ``req``'s texture under: its request's key (equal settings and pixels)
+    with, for the methods that read a model, its folder's path (the key names the folder alone); for method auto
+    also its procedural solid's (the auto key holds that key: the pixels are hashed once)."""
+    key = req.key()
     model = getattr(req, "model", None) if req.method in ("neural", "auto") else None
-    return json.dumps([req.key(), None if model is None else str(model)], sort_keys=True)
+    keys = [json.dumps([key, None if model is None else str(model)], sort_keys=True)]
+    if req.method == "auto":
+        keys.append(json.dumps([key["procedural"], None], sort_keys=True))
+    return keys
 
 
-def _known(req):
-    """What :func:`remembered` holds for ``req``, or None."""
+def _known(key: str):
+    """What :func:`remembered` holds under ``key``, or None."""
     with _DONE_LOCK:
-        return _DONE.get(_memo_key(req))
+        return _DONE.get(key)
 
 
-def remembered(req, make):
-    """code_fn(progress, cancel) -> ``make(progress, cancel)``, made once per request key (``req.key()``: equal for
-    equal settings and pixels) while it is among the last :data:`_DONE_KEEP` made; an auto choice also stands for
-    its procedural solid (the same fit).  Runs on the worker; a cancelled or failed run leaves nothing."""
-    key = _memo_key(req)
+def remembered(req, make, keys: list | None = None):
+    """code_fn(progress, cancel) -> ``make(progress, cancel)``, made once per request key (:func:`_memo_keys`,
+    or ``keys`` where the caller has them) while it is among the last :data:`_DONE_KEEP` made; an auto choice also
+    stands for its procedural solid (the same fit).  Runs on the worker; a cancelled or failed run leaves nothing."""
+    keys = keys or _memo_keys(req)
 
     def code_fn(progress=None, cancel=None):
         with _DONE_LOCK:
-            if key in _DONE:
-                _DONE.move_to_end(key)
-                return _DONE[key]
+            if keys[0] in _DONE:
+                _DONE.move_to_end(keys[0])
+                return _DONE[keys[0]]
         out = make(progress, cancel)
-        keys = [key]
-        if req.method == "auto":
-            keys.append(_memo_key(req.replace(method="procedural")))
         with _DONE_LOCK:
             for k, v in zip(keys, (out, getattr(out, "field", None))):
                 _DONE[k] = v
@@ -273,9 +275,10 @@ def texture(req):
         return (_mod("solid.spectral_solid").SpectralTexture(req),
                 remembered(req, lambda progress=None, cancel=None: req.solid_field("", progress, cancel)))
     if req.method == "auto":         # the "code" is the choice (backend.solid.choose)
-        fitted = req.replace(method="procedural")    # a procedural preview's fit is auto's own
+        keys = _memo_keys(req)                       # a procedural preview's fit (keys[1]) is auto's own
         return (_mod("solid.choose").AutoTexture(req),
-                remembered(req, lambda progress=None, cancel=None: req.choose("", progress, field=_known(fitted))))
+                remembered(req, lambda progress=None, cancel=None: req.choose("", progress, field=_known(keys[1])),
+                           keys))
     m = load_model(os.path.basename(req.model))
     return m, remembered(req, lambda progress=None, cancel=None: req.code(m)[0])
 
