@@ -98,15 +98,16 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _check_outputs(a: argparse.Namespace) -> None:
-    """The files a command will write (-o, --report), checked before any work: a name past the file system's
-    limit (a frame pattern's '#' counted as the widest frame number) or a folder in the file's place."""
+    """The files a command will write (-o, --report), checked before any work: a missing or read-only folder, a
+    name past the file system's limit (a frame pattern's '#' counted as the widest frame number) or a folder in the
+    file's place."""
     from omninoise.export.atomic import check_target
 
     for flag, attr in (("-o", "out"), ("--report", "report")):
         path = getattr(a, attr, None)
         if isinstance(path, str) and path:
             try:
-                check_target(re.sub(r"#+", lambda m: "0" * max(len(m.group()), 10), path), folder_made=True)
+                check_target(re.sub(r"#+", lambda m: "0" * max(len(m.group()), 10), path))
                 if os.path.isdir(path):
                     raise IsADirectoryError(f"output path is a folder, not a file: {path}")
             except OSError as exc:

@@ -226,9 +226,6 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
         raise SettingError("--frames", f"expected FIRST LAST with LAST >= FIRST, got {first} {last}")
     limits.frame_count("--frames", first, last, "run")
     limits.finite("--drift", a.drift)
-    folder = os.path.dirname(os.path.abspath(a.out))
-    if not os.path.isdir(folder):
-        raise SettingError("-o", f"output folder does not exist: {folder}")
     keys = read_keys(a.keys)
     n = last - first + 1
     bar = Bar(a.quiet, "frames ")
@@ -256,9 +253,6 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
         raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
     if not a.out:
         raise SettingError("-o", "--fit writes the fitted noise: give -o OUT (.png, .exr or .npy)")
-    for flag, path in (("-o", a.out), ("--report", a.report)):
-        if path and not os.path.isdir(os.path.dirname(os.path.abspath(path))):
-            raise SettingError(flag, f"output folder does not exist: {os.path.dirname(os.path.abspath(path))}")
     ext = os.path.splitext(a.out)[1].lower()
     if ext not in (".png", ".exr", ".npy"):
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")

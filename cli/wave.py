@@ -197,9 +197,6 @@ def run(a: argparse.Namespace) -> int:
         limits.positive("--example-extent", a.example_extent)
     limits.check_memory("--size", float(a.size) ** (min(a.dim, 3) if ext in (".npy", ".vdb") else 2)
                         * 4 * (5 if a.transfer else 2), f"a {a.size}-sample {a.dim}D grid")
-    folder = os.path.dirname(os.path.abspath(a.out))
-    if not os.path.isdir(folder):
-        raise SettingError("-o", f"output folder does not exist: {folder}")
     s = settings_from_args(a)
     tf = load_transfer(a.transfer) if a.transfer else None
     if tf is not None and a.range:

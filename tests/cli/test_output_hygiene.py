@@ -343,3 +343,38 @@ def test_outputs_that_cannot_be_written_are_refused_before_any_work(tmp_path, ca
             text = capsys.readouterr()
             assert "output path is a folder, not a file" in text.err + text.out, text
         assert sorted(os.listdir(tmp_path / "out")) == ["f_2.npy", "v.npy"]
+
+
+@pytest.mark.parametrize("args", [
+    ["wave", "--size", "8"],
+    ["neural", "--noise", "perlin", "--size", "16", "--steps", "1"],
+    ["solid", "--method", "procedural", "--exemplar", "{photo}", "--size", "8"],
+    ["solid", "--method", "auto", "--exemplar", "{photo}", "--dim", "3", "--size", "8"],
+    ["transfer", "fire"],
+])
+def test_an_output_folder_that_is_missing_or_read_only_is_refused_before_any_work(tmp_path, capsys, monkeypatch,
+                                                                                 args):
+    """The fit of a procedural solid takes seconds: the folder is checked first, not when the result is written."""
+    from omninoise.backend.solid.procedural import fit
+
+    def no_fit(*_a, **_k):
+        raise AssertionError("the fit ran")
+
+    monkeypatch.setattr(fit, "fit_procedural", no_fit)
+    photo = tmp_path / "photo.png"
+    write_unit_image(str(photo), np.random.default_rng(0).random((32, 32, 3)))
+    argv = [x.format(photo=photo) for x in args] + (["-o"] if args[0] == "transfer" else ["--quiet", "-o"])
+    ext = ".vdb" if "3" in args else ".json" if args[0] == "transfer" else ".png"
+    assert main(argv + [str(tmp_path / "nowhere" / ("out" + ext))]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "-o: output folder does not exist" in err[0], err
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        if not os.access(locked, os.W_OK):              # root writes anywhere
+            assert main(argv + [str(locked / ("out" + ext))]) == 2
+            assert "-o: output folder is not writable" in capsys.readouterr().err
+    finally:
+        locked.chmod(0o700)
+    assert sorted(os.listdir(tmp_path)) == ["locked", "photo.png"]
