@@ -77,18 +77,19 @@ def photos(which: str, every: int) -> list:
     return [f for f in val if os.path.basename(f).split("__")[0] not in STRUCTURED][::every]
 
 
-def _figures(axes: dict, oblique: list, photo: np.ndarray) -> dict:
-    """:data:`FIGURES` of a texture's axis cuts ({axis: [images]}) and oblique cuts ([images])."""
+def _figures(axes: dict, oblique: list, photo: np.ndarray, structure: tuple) -> dict:
+    """:data:`FIGURES` of a texture's axis cuts ({axis: [images]}) and oblique cuts ([images]); ``structure``:
+    the photo's :func:`~backend.solid.choose.photo_structure`."""
     g = pe.grouped_swd(axes, photo)
     obl = pe.rounded_swds(pe.level_distances(oblique, photo))
     walls = axes["x"] + axes["y"]        # drawn at choose.SIDE px, as auto's check draws its walls
     return {"axes": g["axes"], "pooled": g["pooled"], "oblique": obl[0], "axes_band": g["axes_band"],
-            "oblique_band": obl[1], "structure": round(structure_error(walls, *photo_structure(photo)), 3)}
+            "oblique_band": obl[1], "structure": round(structure_error(walls, *structure), 3)}
 
 
-def figures(field: _Field, photo: np.ndarray) -> dict:
+def figures(field: _Field, photo: np.ndarray, structure: tuple) -> dict:
     """:data:`FIGURES` of a texture drawn anywhere."""
-    return _figures(slices(field, SEEDS), pe.oblique_slices(field.evaluate, field.px_per_unit), photo)
+    return _figures(slices(field, SEEDS), pe.oblique_slices(field.evaluate, field.px_per_unit), photo, structure)
 
 
 def gaussian_field(photo: np.ndarray, kind: str) -> _Field:
@@ -131,14 +132,16 @@ def measure(path: str, fitted: dict | None = None) -> dict:
     choice = req.choose(field=field)
     model, code = choice.model, choice.code
     neural = _Field(lambda pts: model.evaluate(pts, code, 0), model.px_per_unit)
+    structure = photo_structure(photo)
     r = {"family": field.family, "seconds": round(seconds, 1), "seconds_without_numba": plain,
          "same_fit_without_numba": same, "chosen": choice.method, "choice_distances": choice.distances,
          "field": fd}
     for name, f in (("procedural", field), ("neural", neural)):
-        r.update({f"{name}_{k}": v for k, v in figures(f, photo).items()})
+        r.update({f"{name}_{k}": v for k, v in figures(f, photo, structure).items()})
     # random phase as a solid: the closer kind, figure by figure, as solid-methods
     rp = [_figures(random_phase_solid(photo, kind, SEEDS),
-                   pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT), photo) for kind in SOLIDS]
+                   pe.oblique_slices(gaussian_field(photo, kind).evaluate, PX_PER_UNIT), photo, structure)
+          for kind in SOLIDS]
     for k in FIGURES:
         r[f"random_phase_solid_{k}"] = min(f[k] for f in rp)
     for k in FIGURES:
