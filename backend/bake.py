@@ -281,8 +281,18 @@ def bake_frame(spec: BakeSpec, frame, progress=None, cancel=None) -> str:
     return path
 
 
+#: the share of a file's progress that making a source's texture takes where the bake makes it (a fit, a choice)
+PREPARE_SHARE = 0.5
+
+
 def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:
     from .. import export
+
+    if not getattr(spec.source, "ready", True):     # a texture made at its first use (sources._Prepared)
+        part = None if progress is None else (lambda x: progress(PREPARE_SHARE * x))
+        spec.source.prepare(part, cancel)
+        if progress is not None:
+            progress = (lambda x, p=progress: p(PREPARE_SHARE + (1.0 - PREPARE_SHARE) * x))
 
     ext = os.path.splitext(path)[1].lower()
     meta = {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import threading
 from dataclasses import dataclass
 from typing import Callable, Protocol
 
@@ -22,7 +23,8 @@ import numpy as np
 from . import limits
 from .errors import SettingError
 
-__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "solid_volume", "source_from_dict", "register_source", "source_kinds", "SOURCES"]
+__all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "SpectralSource", "AutoSource",
+           "solid_volume", "source_from_dict", "register_source", "source_kinds", "SOURCES"]
 
 _F = np.float32
 
@@ -113,6 +115,10 @@ class Source(Protocol):
 
     def to_dict(self) -> dict:
         """Everything that determines the values, as plain JSON types (for up-to-date checks)."""
+
+    # A source may also make its texture at its first use (a fit, a choice: :class:`_Prepared`): ``ready`` says
+    # whether it is made, ``prepare(progress, cancel)`` makes it; a bake makes it before drawing a file that is not
+    # up to date, and ``to_dict`` does not need it.
 
 
 class WaveSource:
@@ -391,67 +397,13 @@ class SolidSource:
         return d
 
 
-class SynthesisSource:
-    """A solid source with ``method = "synthesis"``: a periodic 2D image of ``tile`` px a side synthesised from an
-    image exemplar (:mod:`backend.solid.synthesis`, Kwatra et al. 2005 / Kopf et al. 2007) when the source is made,
-    then read at the grid's points, ``scale`` times the texture's own size (the photo's pixels at
-    PX_PER_UNIT per unit, as the neural texture).  2D grids only: :meth:`check_grid` names the setting for a
-    volume."""
-
-    kind = "solid"
-    animated = False
-    chunkable = True
-    rgb = True
-    dim = 2
-
-    def __init__(self, request, scale: float = 1.0, field=None, progress=None, cancel=None):
-        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "synthesis"; field: its
-        ready :class:`~backend.solid.synthesis.TileField` (else synthesised here, with progress and cancel)."""
-        import dataclasses
-
-        self.request, self.scale = request, limits.scale("source.scale", scale)
-        # a file is decoded once: its pixels serve the synthesis and the key's sha256 (equal to the key's of the
-        # same pixels handed over)
-        pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
-        self.field = field if field is not None else pixels.synthesis_field("source.", progress, cancel)
-        self.input_sha256 = pixels.key()["exemplar"]
-
-    def check_grid(self, shape) -> None:
-        if len(shape) != 2:
-            raise SettingError("source.method", "synthesis makes 2D images; a 3D grid needs the neural texture "
-                                                "(method = \"neural\"), method = \"spectral\" or \"procedural\"")
-
-    def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
-        from .colour import srgb_to_linear
-
-        if cancel is not None and cancel():
-            from .grid import Cancelled
-
-            raise Cancelled("cancelled")
-        rgb = self.field.evaluate(_grid_points(shape, first, step, start) * self.scale)
-        if progress is not None:
-            progress(1.0)
-        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
-
-    def to_dict(self) -> dict:
-        import dataclasses
-
-        r = self.request
-        # the settings drawn, so a bake is redone when they change, not only when the request does
-        settings = {k: list(v) if isinstance(v, tuple) else v
-                    for k, v in dataclasses.asdict(self.field.settings).items()}
-        return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
-                    input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale,
-                    settings=settings)
-
-
-class SpectralSource:
-    """A solid source with ``method = "spectral"``: a periodic Gaussian solid whose slices carry an image
-    exemplar's spectrum (:mod:`backend.solid.spectral_solid`: random phase noise lifted to 3D), or with ``method =
-    "procedural"``: a procedural solid fitted to the image (:mod:`backend.solid.procedural`), drawn when the
-    source is made, then read at the grid's points, ``scale`` times the texture's own size (the photo's pixels at
-    PX_PER_UNIT per unit, as the neural texture).  2D grids read a plane of constant z; 3D grids fill volumes
-    (with a constant ``density``, as :class:`SolidSource`)."""
+class _Prepared:
+    """A solid source of an image method whose texture is made once, at its first use rather than when the source
+    is made: a job file's bakes are checked when it is read (their exemplars' pixels too,
+    :meth:`~backend.solid.request.SolidRequest.check_pixels`), and a bake that is up to date, a dry run or another
+    bake of the job makes nothing.  :meth:`prepare` makes it (with progress and cancel; a bake calls it before
+    drawing), :meth:`evaluate` where it was not made yet; ``ready`` says whether it is made.  Subclasses give
+    ``_make(progress, cancel)`` and draw it in ``_draw``; the key (:meth:`to_dict`) is the request's."""
 
     kind = "solid"
     animated = False
@@ -459,31 +411,152 @@ class SpectralSource:
     rgb = True
     dim = 3
 
-    def __init__(self, request, scale: float = 1.0, density: float = 1.0, field=None, progress=None, cancel=None):
-        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "spectral" or "procedural";
-        field: its ready field (``request.solid_field()``; else drawn here, with progress and cancel)."""
-        import dataclasses
-
+    def __init__(self, request, scale: float = 1.0, density: float = 1.0, made=None):
         self.request, self.scale = request, limits.scale("source.scale", scale)
         self.density = float(limits.in_range("source.density", density, 0.0, float("inf")))
-        pixels = dataclasses.replace(request, exemplar=request.exemplar_pixels("source."))
-        self.field = field if field is not None else pixels.solid_field("source.", progress, cancel)
-        self.input_sha256 = pixels.key()["exemplar"]
+        # a file is decoded once: its pixels serve the texture and the key's sha256
+        self.pixels = request.replace(exemplar=request.exemplar_pixels("source.")).check_pixels("source.")
+        self._key = self.pixels.key()
+        self.input_sha256 = self.pixels.exemplar_digest()
+        self._made, self._lock = made, threading.Lock()
+
+    @property
+    def ready(self) -> bool:
+        return self._made is not None
+
+    def prepare(self, progress=None, cancel=None):
+        """The texture, made here the first time (``progress(fraction)``; ``cancel()`` returning True stops with
+        :class:`~backend.grid.Cancelled`)."""
+        with self._lock:
+            if self._made is None:
+                made = self._make(progress, cancel)
+                if cancel is not None and cancel():      # a search stopped early: its best so far is not kept
+                    from .grid import Cancelled
+
+                    raise Cancelled("cancelled")
+                self._made = made
+        if progress is not None:
+            progress(1.0)
+        return self._made
 
     def check_grid(self, shape) -> None:
         return None
 
     def evaluate(self, shape, first, step, time, progress=None, cancel=None, start=None) -> np.ndarray:
-        from .colour import srgb_to_linear
-
-        rgb = self.field.evaluate(_solid_points(shape, first, step, start) * self.scale, progress=progress,
-                                  cancel=cancel)
-        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
+        return self._draw(self.prepare(cancel=cancel), shape, first, step, time, progress, cancel, start)
 
     def to_dict(self) -> dict:
         r = self.request
-        return dict(kind=self.kind, method=r.method, exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
-                    input_sha256=self.input_sha256, seed=int(r.seed), scale=self.scale, density=self.density)
+        return dict(self._key, kind=self.kind, exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+                    input_sha256=self.input_sha256, scale=self.scale, density=self.density)
+
+    def __getstate__(self) -> dict:
+        """Pickled (a farm's workers) with what is made, without the lock."""
+        return {k: v for k, v in self.__dict__.items() if k != "_lock"}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._lock = threading.Lock()
+
+
+class SpectralSource(_Prepared):
+    """A solid source with ``method = "spectral"``: a periodic Gaussian solid whose slices carry an image
+    exemplar's spectrum (:mod:`backend.solid.spectral_solid`: random phase noise lifted to 3D), or with ``method =
+    "procedural"``: a procedural solid fitted to the image (:mod:`backend.solid.procedural`), made at its first
+    use (:class:`_Prepared`), then read at the grid's points, ``scale`` times the texture's own size (the photo's
+    pixels at PX_PER_UNIT per unit, as the neural texture).  2D grids read a plane of constant z; 3D grids fill
+    volumes (with a constant ``density``, as :class:`SolidSource`)."""
+
+    def __init__(self, request, scale: float = 1.0, density: float = 1.0, field=None):
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "spectral" or "procedural";
+        field: its ready field (``request.solid_field()``; else made at its first use)."""
+        super().__init__(request, scale, density, field)
+
+    def _make(self, progress, cancel):
+        return self.pixels.solid_field("source.", progress, cancel)
+
+    @property
+    def field(self):
+        return self.prepare()
+
+    def _draw(self, field, shape, first, step, time, progress, cancel, start) -> np.ndarray:
+        from .colour import srgb_to_linear
+
+        rgb = field.evaluate(_solid_points(shape, first, step, start) * self.scale, progress=progress, cancel=cancel)
+        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
+
+
+class SynthesisSource(_Prepared):
+    """A solid source with ``method = "synthesis"``: a periodic 2D image of ``tile`` px a side synthesised from an
+    image exemplar (:mod:`backend.solid.synthesis`, Kwatra et al. 2005 / Kopf et al. 2007) at its first use
+    (:class:`_Prepared`), then read at the grid's points, ``scale`` times the texture's own size (the photo's
+    pixels at PX_PER_UNIT per unit, as the neural texture).  2D grids only: :meth:`check_grid` names the setting
+    for a volume."""
+
+    dim = 2
+
+    def __init__(self, request, scale: float = 1.0, field=None):
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "synthesis"; field: its
+        ready :class:`~backend.solid.synthesis.TileField` (else synthesised at its first use)."""
+        super().__init__(request, scale, 1.0, field)
+
+    def _make(self, progress, cancel):
+        return self.pixels.synthesis_field("source.", progress, cancel)
+
+    @property
+    def field(self):
+        return self.prepare()
+
+    def check_grid(self, shape) -> None:
+        if len(shape) != 2:
+            raise SettingError("source.method", "synthesis makes 2D images; a 3D grid needs the neural texture "
+                                                "(method = \"neural\"), method = \"spectral\" or \"procedural\"")
+
+    def _draw(self, field, shape, first, step, time, progress, cancel, start) -> np.ndarray:
+        from .colour import srgb_to_linear
+
+        if cancel is not None and cancel():
+            from .grid import Cancelled
+
+            raise Cancelled("cancelled")
+        rgb = field.evaluate(_grid_points(shape, first, step, start) * self.scale)
+        if progress is not None:
+            progress(1.0)
+        return srgb_to_linear(rgb).reshape(tuple(shape) + (3,))
+
+    def to_dict(self) -> dict:
+        import dataclasses
+
+        from .solid.synthesis import image_settings
+
+        r = self.request
+        # the settings drawn (as the synthesis reads them off the request and the photo's size), so a bake is redone
+        # when they change, not only when the request does
+        drawn = image_settings(r.tile, np.shape(self.pixels.exemplar), r.seed)
+        settings = {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(drawn).items()}
+        return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+                    input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale,
+                    settings=settings)
+
+
+class AutoSource(_Prepared):
+    """A solid source with ``method = "auto"``: the procedural solid where it is closer to the photo than the
+    neural texture and keeps its structure as well, else the neural texture (:mod:`backend.solid.choose`), chosen
+    at its first use (:class:`_Prepared`) and drawn as :class:`SpectralSource` or :class:`SolidSource` draws it."""
+
+    def __init__(self, request, scale: float = 1.0, density: float = 1.0):
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "auto"."""
+        super().__init__(request, scale, density)
+        self.pixels.load("source.")         # the neural model is there and reads (before any work)
+
+    def _make(self, progress, cancel):
+        c = self.pixels.choose("source.", progress, cancel=cancel)
+        if c.method == "procedural":
+            return SpectralSource(c.request, self.scale, self.density, field=c.field)
+        return SolidSource(c.model, c.request, self.scale, self.density, code=c.code)
+
+    def _draw(self, chosen, shape, first, step, time, progress, cancel, start) -> np.ndarray:
+        return chosen.evaluate(shape, first, step, time, progress, cancel, start)
 
 
 _SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
@@ -647,10 +720,7 @@ def _solid_from_dict(d: dict, base_dir: str):
     if req.method in ("spectral", "procedural"):
         return SpectralSource(req, d.get("scale", 1.0), d.get("density", 1.0))
     if req.method == "auto":
-        c = req.choose("source.")
-        if c.method == "procedural":
-            return SpectralSource(c.request, d.get("scale", 1.0), d.get("density", 1.0), field=c.field)
-        return SolidSource(c.model, c.request, d.get("scale", 1.0), d.get("density", 1.0), code=c.code)
+        return AutoSource(req, d.get("scale", 1.0), d.get("density", 1.0))
     return SolidSource(req.folder(), req, d.get("scale", 1.0), d.get("density", 1.0))
 
 

@@ -85,13 +85,14 @@ class Choice:
     distances: dict
 
 
-def choose(request, where: str = "", progress=None, report=None, on_code=None, field=None) -> Choice:
+def choose(request, where: str = "", progress=None, report=None, on_code=None, field=None, cancel=None) -> Choice:
     """The stages (module doc) for a checked request with method "auto" and an image exemplar; ``field``: its
-    procedural solid when it is fitted already (the evaluation measures it on its own too)."""
+    procedural solid when it is fitted already (the evaluation measures it on its own too); ``progress`` and
+    ``cancel`` as the fit's (:func:`~backend.solid.procedural.fit.fit_procedural`)."""
     img = np.asarray(request.exemplar_pixels(where), np.float32)     # a file is read once: every stage takes these
     proc = request.replace(method="procedural")
     if field is None:                                                                   # 1. fit
-        field = dataclasses.replace(proc, exemplar=img).procedural_field(where, progress)
+        field = dataclasses.replace(proc, exemplar=img).procedural_field(where, progress, cancel)
     neural = request.replace(method="neural")
     model = neural.load(where)
     named = None if report is None else (lambda _, history: report(request.exemplar, history))

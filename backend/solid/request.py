@@ -198,6 +198,30 @@ class SolidRequest:
             object.__setattr__(self, "_decoded", (stamp, img))     # frozen: the memo is no field (not in key or eq)
         return img
 
+    def check_pixels(self, where: str = "") -> "SolidRequest":
+        """What the image methods (synthesis, spectral, procedural, auto) ask of the exemplar's pixels, checked
+        before any work (a job file's bakes when the job is read, their textures made when baked): SettingError
+        naming the exemplar for an image they cannot use; the request when they can."""
+        if self.method not in ("synthesis", "spectral", "procedural", "auto"):
+            return self
+        img = self.exemplar_pixels(where)
+        try:
+            if self.method == "synthesis":
+                from .synthesis import check_photo, image_settings
+
+                check_photo(img, image_settings(self.tile, np.shape(img), self.seed))
+            elif self.method == "spectral":
+                from .spectral_solid import check_photo
+
+                check_photo(img)
+            else:
+                from .procedural.fit import check_photo
+
+                check_photo(img)
+        except SettingError as exc:
+            raise SettingError(f"{where}exemplar", exc.message) from None
+        return self
+
     def replace(self, **changes) -> "SolidRequest":
         """``dataclasses.replace``, keeping this request's decoding of its file exemplar where the exemplar stays."""
         new = dataclasses.replace(self, **changes)
@@ -205,7 +229,7 @@ class SolidRequest:
             object.__setattr__(new, "_decoded", self.__dict__["_decoded"])
         return new
 
-    def _exemplar_digest(self) -> str | None:
+    def exemplar_digest(self) -> str | None:
         """The exemplar for the key (``_digest``), a file by the pixels of this request's one decoding."""
         if isinstance(self.exemplar, str) and os.path.isfile(self.exemplar):
             return _pixels_sha(self.exemplar_pixels())
@@ -283,12 +307,12 @@ class SolidRequest:
             return self.procedural_field(where, progress, cancel)
         return self.spectral_field(where, progress, cancel)
 
-    def choose(self, where: str = "", progress=None, report=None, on_code=None, field=None):
+    def choose(self, where: str = "", progress=None, report=None, on_code=None, field=None, cancel=None):
         """Method "auto": the :class:`~backend.solid.choose.Choice` between the procedural solid (``field`` where
         it is fitted already) and the neural texture (:func:`~backend.solid.choose.choose`)."""
         from .choose import choose
 
-        return choose(self, where, progress, report, on_code, field)
+        return choose(self, where, progress, report, on_code, field, cancel)
 
     def front_image(self, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
                     on_code=None, draw_progress=None) -> np.ndarray:
@@ -320,20 +344,20 @@ class SolidRequest:
         methods "synthesis", "spectral" and "procedural" only what they read (exemplar, seed and tile, or periodic, the
         spectral solid's map onto the photo's marginals and its power's isotropic start; or the families tried)."""
         if self.method == "synthesis":
-            return dict(method="synthesis", exemplar=self._exemplar_digest(), seed=int(self.seed),
+            return dict(method="synthesis", exemplar=self.exemplar_digest(), seed=int(self.seed),
                         tile=int(self.tile))
         if self.method == "spectral":
             # marginals: the tile's values are mapped onto the photo's (spectral_solid.Marginals); start: its power
             # is found from an isotropic start (spectral_solid.solid_power); a bake keyed before either is redone
-            return dict(method="spectral", exemplar=self._exemplar_digest(), seed=int(self.seed),
+            return dict(method="spectral", exemplar=self.exemplar_digest(), seed=int(self.seed),
                         periodic=bool(self.periodic), marginals=True, start="isotropic")
         if self.method == "procedural":
-            return dict(method="procedural", exemplar=self._exemplar_digest(), seed=int(self.seed),
+            return dict(method="procedural", exemplar=self.exemplar_digest(), seed=int(self.seed),
                         families=list(self.families))
         if self.method == "auto":
             return dict(method="auto", procedural=self.replace(method="procedural").key(),
                         neural=self.replace(method="neural").key())
-        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=self._exemplar_digest(),
+        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=self.exemplar_digest(),
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),
                     gaussian=bool(self.gaussian), rest=self.rest if self.gaussian else None)

@@ -86,8 +86,9 @@ from .model import plane_points
 from .synthesis import PX_PER_UNIT
 
 __all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "ISOTROPIC_ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES",
-           "slice_spectrum", "solid_power", "colour_factors", "photo_rest", "spectral_tile", "spectral_field",
-           "fit_marginals", "Marginals", "SplineField", "SpectralTexture", "bspline_weights", "bspline_prefilter"]
+           "check_photo", "slice_spectrum", "solid_power", "colour_factors", "photo_rest", "spectral_tile",
+           "spectral_field", "fit_marginals", "Marginals", "SplineField", "SpectralTexture", "bspline_weights",
+           "bspline_prefilter"]
 
 PERIOD = 128       #: photo px per repeat of the tile along each axis (the design's grid of PERIOD^3 frequencies)
 OVERSAMPLE = 2     #: voxels per photo px along each axis: PERIOD * OVERSAMPLE voxels a side
@@ -176,7 +177,7 @@ def colour_factors(P: np.ndarray, S: np.ndarray) -> np.ndarray:
     return L
 
 
-def _checked(photo) -> np.ndarray:
+def check_photo(photo) -> np.ndarray:
     """``photo`` as float32 (H, W, 3 or 4); SettingError naming what is wrong with it for a spectral solid."""
     img = np.asarray(photo, np.float32)
     if img.ndim != 3 or img.shape[2] not in (3, 4):
@@ -218,7 +219,7 @@ def spectral_tile(photo: np.ndarray, seed: int = 0, period: int | None = None, o
     taken out of the photo first, so the solid draws only the rest (:class:`SplineField` adds the part back).
     ``progress(fraction)`` as the work goes; ``cancel()`` returning True stops with Cancelled.
     ``iterations``, ``isotropic_iterations``: :func:`solid_power`'s."""
-    img = _checked(photo)
+    img = check_photo(photo)
     period = PERIOD if period is None else period
     if period < 8 or period % 2 or oversample < 1:
         raise SettingError("period", f"period must be an even number >= 8 and oversample >= 1, got {period}, "
@@ -322,7 +323,7 @@ def spectral_field(photo: np.ndarray, seed: int = 0, harmonics=None, progress=No
     :class:`SplineField` around the photo's mean colour, with the photo's harmonic part ``harmonics`` added back,
     and (``marginals``) its values mapped onto the marginals of the photo's rest (:func:`fit_marginals`).
     ``progress``, ``cancel`` and ``isotropic_iterations`` as :func:`spectral_tile`'s."""
-    img = _checked(photo)
+    img = check_photo(photo)
     rest = photo_rest(img, harmonics)       # once: the tile's spectrum and the marginals both read it
     coeffs = spectral_tile(rest, seed, progress=progress, cancel=cancel,     # the rest has no part left to take out
                            isotropic_iterations=isotropic_iterations)

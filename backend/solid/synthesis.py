@@ -293,6 +293,22 @@ def _inherit(sources: np.ndarray, photo: np.ndarray, fams: list) -> np.ndarray:
     return photo[np.clip(r, 0, photo.shape[0] - 1), np.clip(c, 0, photo.shape[1] - 1)].astype(_F)
 
 
+def check_photo(photo, settings: SynthesisSettings = SynthesisSettings()) -> np.ndarray:
+    """``photo`` as float32 (H, W, 3); SettingError naming what is wrong with it for a synthesis with ``settings``
+    (checked before any work)."""
+    img = np.asarray(photo, _F)
+    if img.ndim != 3 or img.shape[2] != 3:
+        raise SettingError("photo", f"the photo must be an RGB image (H, W, 3), got shape {img.shape}")
+    if not np.isfinite(img).all():
+        raise SettingError("photo", "the photo has non-finite values")
+    step = 2 ** (settings.levels - 1)
+    if min(img.shape[:2]) // step < settings.patch + 1:
+        raise SettingError("photo", f"the photo is {img.shape[1]} x {img.shape[0]} px; {settings.levels} levels of "
+                                    f"{settings.patch} px neighbourhoods need at least "
+                                    f"{(settings.patch + 1) * step} px a side")
+    return img
+
+
 def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSettings(), progress=None,
                cancel=None) -> np.ndarray:
     """A periodic tile whose slices look like ``photo`` float (H, W, 3) sRGB in [0, 1] (module doc): float32
@@ -302,15 +318,7 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
     ``cancel()`` returning True stops with :class:`~backend.grid.Cancelled`.  The photo must be at least ``settings.patch`` px on its short side at the
     coarsest level."""
     s = settings
-    img = np.asarray(photo, _F)
-    if img.ndim != 3 or img.shape[2] != 3:
-        raise SettingError("photo", f"the photo must be an RGB image (H, W, 3), got shape {img.shape}")
-    if not np.isfinite(img).all():
-        raise SettingError("photo", "the photo has non-finite values")
-    step = 2 ** (s.levels - 1)
-    if min(img.shape[:2]) // step < s.patch + 1:
-        raise SettingError("photo", f"the photo is {img.shape[1]} x {img.shape[0]} px; {s.levels} levels of "
-                                    f"{s.patch} px neighbourhoods need at least {(s.patch + 1) * step} px a side")
+    img = check_photo(photo, s)
     img = np.clip(img[::-1], 0.0, 1.0)      # row 0 at the bottom: rows run up the tile (module doc)
     rng = np.random.default_rng(s.seed)
     fams = _families(s.dim, s.planes)

@@ -152,3 +152,68 @@ def test_a_brick_wall_s_fit_suggests_bonds(tmp_path, monkeypatch, capsys, args, 
     monkeypatch.setattr(SolidRequest, "front_image", lambda self, size, *a, **k: np.full((size, size, 3), 0.5))
     assert main(["solid", "--exemplar", PHOTO, "--size", "8", "-o", str(tmp_path / "a.png"), *args]) == 0
     assert ("--families bonds lays it in courses" in capsys.readouterr().err) == note
+
+
+def test_a_job_fits_a_procedural_solid_when_it_bakes_its_file_only(tmp_path, monkeypatch, capsys):
+    """Reading a job, a dry run, another bake of the job and a bake that is up to date fit and choose nothing; the
+    fit runs once, when its file is baked, and again when the kinds tried change; auto's choice likewise; a photo
+    too small for the fit is refused when the job is read, before any bake."""
+    made = []
+    real_field = SolidRequest.solid_field
+
+    def counted_field(self, *a, **k):
+        made.append(self.method)
+        return real_field(self, *a, **k)
+
+    monkeypatch.setattr(SolidRequest, "solid_field", counted_field)
+    monkeypatch.setattr(SolidRequest, "choose", lambda *a, **k: made.append("auto") or pytest.fail("auto chose"))
+    shutil.copy(PHOTO, tmp_path / "bricks.jpg")
+    job = tmp_path / "job.toml"
+
+    def write(exemplar="bricks.jpg", kinds=""):
+        job.write_text("".join(f"""
+[[bake]]
+name = "{m}"
+output = "{m}.exr"
+resolution = [8, 8]
+[bake.source]
+kind = "solid"
+method = "{m}"
+exemplar = "{exemplar}"
+{kinds}
+""" for m in ("procedural", "auto")))
+
+    write()
+    assert main(["bake", str(job), "--dry-run"]) == 0 and made == []
+    assert main(["bake", str(job), "--quiet", "--only", "procedural"]) == 0 and made == ["procedural"]
+    img = read_rgb(str(tmp_path / "procedural.exr"))
+    assert img.shape == (8, 8, 3) and np.isfinite(img).all()
+    capsys.readouterr()
+    assert main(["bake", str(job), "--only", "procedural"]) == 0 and made == ["procedural"]
+    text = capsys.readouterr()
+    assert "procedural: up to date" in text.out + text.err
+    write(kinds='families = ["bonds"]')
+    assert main(["bake", str(job), "--dry-run"]) == 0 and made == ["procedural"]
+    assert capsys.readouterr().out.count("to bake") == 2        # the kinds are in both bakes' keys
+    assert main(["bake", str(job), "--quiet", "--only", "procedural"]) == 0 and made == ["procedural"] * 2
+    from omninoise.export.images import write_unit_image
+
+    write_unit_image(str(tmp_path / "small.png"), np.random.default_rng(0).random((12, 40, 3)))
+    write(exemplar="small.png")
+    assert main(["bake", str(job), "--dry-run"]) == 2 and made == ["procedural"] * 2
+    out = capsys.readouterr().out
+    assert out.count("a procedural solid is fitted to a photo of at least 16 x 16 px, got 40 x 12") == 2, out
+
+
+def test_a_fit_stopped_early_is_not_kept_by_its_source():
+    """A cancelled fit returns its best so far (the panel's preview draws it); a bake source does not keep it: it
+    stops with Cancelled and fits again at its next use."""
+    from omninoise.backend.grid import Cancelled
+    from omninoise.backend.sources import SpectralSource
+
+    src = SpectralSource(SolidRequest(exemplar=PHOTO, method="procedural").check())
+    assert not src.ready
+    with pytest.raises(Cancelled):
+        src.prepare(cancel=lambda: True)
+    assert not src.ready
+    assert src.evaluate((4, 4), np.zeros(3), np.full(2, 0.1), 0.0).shape == (4, 4, 3) and src.ready

@@ -37,9 +37,10 @@ from .ramp import fit_ramp, photo_colours
 from .search import minimise
 from .tint import FREQUENCIES, fit_tint
 
-__all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "FIT_PLANES", "CHECK_PLANES", "oblique_points",
-           "plane_group", "kind_starts"]
+__all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "check_photo", "MIN_SIDE", "FIT_PLANES",
+           "CHECK_PLANES", "oblique_points", "plane_group", "kind_starts"]
 
+MIN_SIDE = 16      #: the shortest photo side a fit reads, px
 #: a start's textured twin: turbulence and detail amplitudes, and the factor on its turbulence's frequency
 TEXTURED = (0.35, 0.35, 4.0)
 #: what the photo measures and the search keeps, by pattern: bonds in courses keep the units' length, the courses'
@@ -155,14 +156,21 @@ def kind_starts(kind: str, est) -> list:
     return [(kind, s) for s in FAMILIES[kind].starts(est)]
 
 
+def check_photo(photo: np.ndarray) -> np.ndarray:
+    """The photo's RGB pixels, float (H, W, 3); SettingError naming the exemplar for one under :data:`MIN_SIDE` px
+    a side (what a fit reads, checked before any work)."""
+    img = rgb_pixels(photo)
+    if min(img.shape[:2]) < MIN_SIDE:
+        raise SettingError("exemplar", f"a procedural solid is fitted to a photo of at least {MIN_SIDE} x {MIN_SIDE} "
+                                       f"px, got {img.shape[1]} x {img.shape[0]}")
+    return img
+
+
 def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfig(), progress=None,
                    cancel=None) -> ProceduralFit:
     """The stages (module doc) on a photo float (H, W, 3) sRGB; ``progress(fraction)`` after each solid drawn,
     ``cancel()`` returning True stops the search with the best so far."""
-    img = rgb_pixels(photo)                                                                 # 1. read
-    if img.shape[0] < 16 or img.shape[1] < 16:
-        raise SettingError("exemplar", f"a procedural solid is fitted to a photo of at least 16 x 16 px, got "
-                                       f"{img.shape[1]} x {img.shape[0]}")
+    img = check_photo(photo)                                                                # 1. read
     img, ppu = at_most(img, PX_PER_UNIT, config.fit_side)
     est = estimate(img, ppu)                                                                # 2. estimate
     side, seed = config.side, config.seed
@@ -171,7 +179,7 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     colours = photo_colours(img)
     starts = [(kind, name, t) for kind in config.families for name, s in kind_starts(kind, est)
               for t in ((s, _textured(s)) if config.textured else (s,))]
-    total = len(starts) + config.finalists * (config.budget + len(FREQUENCIES) + 1)
+    total = len(starts) + min(config.finalists, len(config.families)) * (config.budget + len(FREQUENCIES) + 1)
     tried = [0]
 
     def tick():
