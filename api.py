@@ -184,7 +184,10 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
 
         require_vdb("out")
     kinds = {} if families is None else dict(families=families)
+    given = [k for k, v in (("model", model is not None), ("refine", refine != 0), ("periodic", not periodic),
+                            ("families", families is not None)) if v]
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
+    req.check_reads(given)
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake
         from .backend.sources import BoxGrid, solid_volume

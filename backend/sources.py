@@ -710,7 +710,8 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
                         d.get("rest", "auto"), d.get("method", "neural"), d.get("tile", 256),
-                        d.get("families", DEFAULT_KINDS)).check("source.")
+                        d.get("families", DEFAULT_KINDS)).check("source.").check_reads(
+        [k for k in d if k not in ("method", "scale", "density")], "source.")
 
 
 def _solid_from_dict(d: dict, base_dir: str):

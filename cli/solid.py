@@ -19,6 +19,10 @@ from .common import Bar, add_command
 __all__ = ["add_parser", "run", "solid_request"]
 
 
+#: the flags of the request's settings whose names differ
+FLAGS = {"periodic": "--no-periodic", "gaussian": "--no-gaussian"}
+
+
 def _kinds(text: str) -> tuple:
     """``--families`` "cells,bonds" as a tuple of names (SolidRequest.check names one it does not know)."""
     return tuple(k.strip() for k in text.split(","))
@@ -77,8 +81,11 @@ def solid_request(a: argparse.Namespace):
     """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
     from omninoise.backend.solid.request import SolidRequest
 
+    given = [k for k, unset in (("model", None), ("to", None), ("mix", 0.5), ("refine", 0), ("periodic", True),
+                                ("gaussian", True), ("rest", "auto"), ("tile", 256), ("families", DEFAULT_KINDS))
+             if getattr(a, k) != unset]
     return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
-                        a.rest, a.method, a.tile, a.families).check("--")
+                        a.rest, a.method, a.tile, a.families).check("--").check_reads(given, "--", FLAGS)
 
 
 def run(a: argparse.Namespace) -> int:

@@ -38,6 +38,16 @@ def table_md(title: str, table: Table, note: str = "") -> str:
     return f"## {title}\n\n" + (note + "\n\n" if note else "") + "\n".join(rows) + "\n"
 
 
+def _reads() -> str:
+    """Which methods read which keys of a solid source (backend.solid.methods.READS), as a sentence."""
+    from omninoise.backend.solid.methods import READS
+
+    keys = dict.fromkeys(k for ks in READS.values() for k in ks)
+    said = "; ".join(f"`{k}` {', '.join(m for m, ks in READS.items() if k in ks)}" for k in keys)
+    return f"Each method reads its exemplar and seed and some of the other keys ({said}); one it does not read is " \
+           "refused."
+
+
 def page() -> str:
     parts = [INTRO,
              table_md("The file", JOB, "Top-level keys of the job file."),
@@ -50,7 +60,7 @@ def page() -> str:
                       "Neural noise: one class (`noise`), a mask blend (`blend`), four `corners` or a painted "
                       "`map` with `regions`; `keys` animates."),
              table_md('`[bake.source]` with `kind = "solid"`', SOURCE_TABLES["solid"],
-                      "A solid texture from a photo."),
+                      "A solid texture from a photo. " + _reads()),
              table_md("Ramp tables (`transfer = {...}` or a ramp .json file)", TRANSFER)]
     return "\n".join(parts)
 

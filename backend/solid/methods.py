@@ -1,7 +1,7 @@
 """The ways a solid texture request is drawn (its ``method``), named apart from the request so that the settings
 schema reads them without importing the request."""
 
-__all__ = ["METHODS", "IMAGE_METHODS", "SOLID_METHODS"]
+__all__ = ["METHODS", "IMAGE_METHODS", "SOLID_METHODS", "READS"]
 
 #: how the texture is made: "neural" (a model's texture, the default), "synthesis" (a periodic 2D image optimised
 #: from an image exemplar, :mod:`backend.solid.synthesis`), "spectral" (a periodic Gaussian solid with the image
@@ -13,3 +13,10 @@ METHODS = ("neural", "synthesis", "spectral", "procedural", "auto")
 IMAGE_METHODS = ("synthesis", "spectral", "procedural")
 #: the image methods that draw a solid (the others a 2D image)
 SOLID_METHODS = ("spectral", "procedural")
+#: the settings of a request each method reads besides its exemplar and seed (what its key holds,
+#: ``SolidRequest.key``); a front end refuses one set for a method that does not read it (``check_reads``)
+READS = {"neural": ("model", "to", "mix", "refine", "periodic", "gaussian", "rest"),
+         "synthesis": ("tile",),
+         "spectral": ("periodic",),
+         "procedural": ("families",),
+         "auto": ("model", "refine", "periodic", "gaussian", "rest", "families")}

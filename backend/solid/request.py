@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import SettingError
 from ..paths import solid_models
-from .methods import IMAGE_METHODS, METHODS
+from .methods import IMAGE_METHODS, METHODS, READS
 from .procedural.field import DEFAULT_KINDS
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
@@ -197,6 +197,19 @@ class SolidRequest:
         if stamp is not None:
             object.__setattr__(self, "_decoded", (stamp, img))     # frozen: the memo is no field (not in key or eq)
         return img
+
+    def check_reads(self, given, where: str = "", names: dict | None = None) -> "SolidRequest":
+        """SettingError naming the first of ``given`` (the settings a front end was given, by their names here) that
+        this request's method does not read (:data:`~backend.solid.methods.READS`): it would change nothing, and the
+        texture would not be the one asked for; ``names`` maps a setting to the name to report (a flag)."""
+        for key in given:
+            if key in ("exemplar", "seed") or key in READS[self.method]:
+                continue
+            readers = [m for m, keys in READS.items() if key in keys]
+            who = readers[0] if len(readers) == 1 else f"{', '.join(readers[:-1])} and {readers[-1]}"
+            raise SettingError((names or {}).get(key, f"{where}{key}"), f"method {self.method} does not read it; "
+                               f"{who} {'does' if len(readers) == 1 else 'do'}")
+        return self
 
     def check_pixels(self, where: str = "") -> "SolidRequest":
         """What the image methods (synthesis, spectral, procedural, auto) ask of the exemplar's pixels, checked

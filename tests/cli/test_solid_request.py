@@ -118,3 +118,51 @@ def test_job_refine_must_be_a_whole_number():
     with pytest.raises(SettingError, match="source.refine"):
         solid_request_from_dict({"exemplar": "gravel", "refine": 2.5})
     assert np.isclose(solid_request_from_dict({"exemplar": "gravel"}).mix, 0.5)
+
+
+CHANGES = dict(model="gravel_3d", to="gravel", mix=0.3, refine=3, periodic=False, gaussian=False, rest="upright",
+               tile=128, families=("bonds",))
+
+
+@pytest.mark.parametrize("method", ["neural", "synthesis", "spectral", "procedural", "auto"])
+def test_what_each_method_reads_is_what_its_key_holds(method):
+    """methods.READS, which the front ends check settings against, is what the request's key holds: a setting
+    changes a method's key where the method reads it (mix where there is a ``to``), and a setting it does not read
+    is refused by its check or leaves the key alone."""
+    from omninoise.backend.solid.methods import READS
+
+    base = SolidRequest(exemplar=PHOTO, method=method)
+    for key, value in CHANGES.items():
+        a = base.replace(to="grass") if key == "mix" and method == "neural" else base
+        b = a.replace(**{key: value})
+        try:
+            b.check()
+        except SettingError:
+            assert key not in READS[method], key
+            continue
+        assert (b.key() != a.key()) == (key in READS[method]), key
+
+
+@pytest.mark.parametrize("flags, table, api, name", [
+    (["--method", "procedural", "--tile", "128"], {"method": "procedural", "tile": 128}, None, "tile"),
+    (["--families", "bonds"], {"families": ["bonds"]}, dict(families=["bonds"]), "families"),
+    (["--method", "spectral", "--no-gaussian"], {"method": "spectral", "gaussian": False}, None, "gaussian"),
+    (["--method", "synthesis", "--no-periodic"], {"method": "synthesis", "periodic": False},
+     dict(method="synthesis", periodic=False), "periodic"),
+    (["--method", "procedural", "--model", "space"], {"method": "procedural", "model": "space"},
+     dict(method="procedural", model="space"), "model"),
+])
+def test_a_setting_the_method_does_not_read_is_refused_by_each_front_end(tmp_path, flags, table, api, name):
+    """A setting the method would ignore is named with the methods that read it, on the command line, in a job
+    file and in the Python API, before any work."""
+    import omninoise
+
+    flag = {"periodic": "--no-periodic", "gaussian": "--no-gaussian"}.get(name, f"--{name}")
+    with pytest.raises(SettingError, match=f"^{flag}: method .* does not read it; .* do(es)?$"):
+        cli("--exemplar", PHOTO, *flags)
+    with pytest.raises(SettingError, match=f"^source.{name}: method .* does not read it"):
+        solid_request_from_dict(dict(table, exemplar=PHOTO))
+    if api is not None:
+        with pytest.raises(SettingError, match=f"^{name}: method .* does not read it"):
+            omninoise.solid(PHOTO, 8, **api)
+    assert cli("--exemplar", PHOTO, "--method", "auto", "--families", "bonds", "--no-gaussian").method == "auto"
