@@ -412,13 +412,23 @@ class _Prepared:
     dim = 3
 
     def __init__(self, request, scale: float = 1.0, density: float = 1.0, made=None):
-        self.request, self.scale = request, limits.scale("source.scale", scale)
+        self.scale = limits.scale("source.scale", scale)
         self.density = float(limits.in_range("source.density", density, 0.0, float("inf")))
-        # a file is decoded once: its pixels serve the texture and the key's sha256
-        self.pixels = request.replace(exemplar=request.exemplar_pixels("source.")).check_pixels("source.")
-        self._key = self.pixels.key()
-        self.input_sha256 = self.pixels.exemplar_digest()
+        # the checks and the key read the pixels here; a file is read again when the texture is made, so that a job
+        # of many large photos holds none of them until then (a 4096 px photo is 200 MB as floats)
+        seen = request.replace(exemplar=request.exemplar_pixels("source.")).check_pixels("source.")
+        self._key, self.input_sha256 = seen.key(), seen.exemplar_digest()
+        self.photo_shape = np.shape(seen.exemplar)
+        self.request = self._unread(request)
         self._made, self._lock = made, threading.Lock()
+
+    @staticmethod
+    def _unread(request):
+        """The request without the pixels its file was decoded to (:meth:`SolidRequest.exemplar_pixels` keeps
+        them): what a texture is made from reads the file itself, and lets go of them with the request."""
+        import dataclasses
+
+        return dataclasses.replace(request)
 
     @property
     def ready(self) -> bool:
@@ -473,7 +483,7 @@ class SpectralSource(_Prepared):
         super().__init__(request, scale, density, field)
 
     def _make(self, progress, cancel):
-        return self.pixels.solid_field("source.", progress, cancel)
+        return self._unread(self.request).solid_field("source.", progress, cancel)
 
     @property
     def field(self):
@@ -501,7 +511,7 @@ class SynthesisSource(_Prepared):
         super().__init__(request, scale, 1.0, field)
 
     def _make(self, progress, cancel):
-        return self.pixels.synthesis_field("source.", progress, cancel)
+        return self._unread(self.request).synthesis_field("source.", progress, cancel)
 
     @property
     def field(self):
@@ -532,7 +542,7 @@ class SynthesisSource(_Prepared):
         r = self.request
         # the settings drawn (as the synthesis reads them off the request and the photo's size), so a bake is redone
         # when they change, not only when the request does
-        drawn = image_settings(r.tile, np.shape(self.pixels.exemplar), r.seed)
+        drawn = image_settings(r.tile, self.photo_shape, r.seed)
         settings = {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(drawn).items()}
         return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
                     input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale,
@@ -547,13 +557,13 @@ class AutoSource(_Prepared):
     def __init__(self, request, scale: float = 1.0, density: float = 1.0):
         """request: a checked :class:`~backend.solid.request.SolidRequest` with method "auto"."""
         super().__init__(request, scale, density)
-        self.pixels.load("source.")         # the neural model is there and reads (before any work)
+        self.request.load("source.")        # the neural model is there and reads (before any work)
 
     def _make(self, progress, cancel):
-        c = self.pixels.choose("source.", progress, cancel=cancel)
+        c = self._unread(self.request).choose("source.", progress, cancel=cancel)
         if c.method == "procedural":
             return SpectralSource(c.request, self.scale, self.density, field=c.field)
-        return SolidSource(c.model, c.request, self.scale, self.density, code=c.code)
+        return SolidSource(c.model, self._unread(c.request), self.scale, self.density, code=c.code)
 
     def _draw(self, chosen, shape, first, step, time, progress, cancel, start) -> np.ndarray:
         return chosen.evaluate(shape, first, step, time, progress, cancel, start)

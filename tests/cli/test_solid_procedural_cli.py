@@ -217,3 +217,44 @@ def test_a_fit_stopped_early_is_not_kept_by_its_source():
         src.prepare(cancel=lambda: True)
     assert not src.ready
     assert src.evaluate((4, 4), np.zeros(3), np.full(2, 0.1), 0.0).shape == (4, 4, 3) and src.ready
+
+
+def test_a_job_holds_no_photo_s_pixels_until_it_makes_the_texture(tmp_path):
+    """A job's sources read their photo when the job is read (checks, key) and again when a texture is made, and
+    keep neither: a job of many large photos holds none of them between its bakes."""
+    from omninoise.backend.jobs import load_job
+    from omninoise.backend.sources import AutoSource, SpectralSource
+
+    shutil.copy(PHOTO, tmp_path / "bricks.jpg")
+    job = tmp_path / "job.toml"
+    job.write_text("".join(f"""
+[[bake]]
+name = "{m}"
+output = "{m}.exr"
+resolution = [4, 4]
+[bake.source]
+kind = "solid"
+method = "{m}"
+exemplar = "bricks.jpg"
+""" for m in ("procedural", "spectral", "auto")))
+
+    def holds_pixels(obj, seen=None) -> bool:
+        seen = set() if seen is None else seen
+        if id(obj) in seen:
+            return False
+        seen.add(id(obj))
+        if isinstance(obj, np.ndarray):
+            return obj.size >= 64 * 64 * 3
+        if isinstance(obj, dict):
+            return any(holds_pixels(v, seen) for v in obj.values())
+        if isinstance(obj, (list, tuple)):
+            return any(holds_pixels(v, seen) for v in obj)
+        return hasattr(obj, "__dict__") and holds_pixels(vars(obj), seen)
+
+    specs = dict(load_job(str(job)))
+    assert isinstance(specs["auto"].source, AutoSource) and isinstance(specs["spectral"].source, SpectralSource)
+    for name, spec in specs.items():
+        assert not spec.source.ready and not holds_pixels(spec.source.request), name
+    src = specs["procedural"].source
+    assert src.evaluate((2, 2), np.zeros(3), np.full(2, 0.1), 0.0).shape == (2, 2, 3) and src.ready
+    assert not holds_pixels(src.request)
