@@ -417,7 +417,8 @@ class _Prepared:
         # the checks and the key read the pixels here; a file is read again when the texture is made, so that a job
         # of many large photos holds none of them until then (a 4096 px photo is 200 MB as floats)
         seen = request.replace(exemplar=request.exemplar_pixels("source.")).check_pixels("source.")
-        self._key, self.input_sha256 = seen.key(), seen.exemplar_digest()
+        self._key = seen.key()                                     # hashes the pixels: its digest is taken from it
+        self.input_sha256 = (self._key["procedural"] if request.method == "auto" else self._key)["exemplar"]
         self.photo_shape = np.shape(seen.exemplar)
         self.request = self._unread(request)
         self._made, self._lock = made, threading.Lock()

@@ -215,7 +215,7 @@ class SolidRequest:
         """What the image methods (synthesis, spectral, procedural, auto) ask of the exemplar's pixels, checked
         before any work (a job file's bakes when the job is read, their textures made when baked): SettingError
         naming the exemplar for an image they cannot use; the request when they can."""
-        if self.method not in ("synthesis", "spectral", "procedural", "auto"):
+        if self.method not in IMAGE_METHODS + ("auto",):
             return self
         img = self.exemplar_pixels(where)
         try:

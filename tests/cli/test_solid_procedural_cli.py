@@ -154,6 +154,24 @@ def test_a_brick_wall_s_fit_suggests_bonds(tmp_path, monkeypatch, capsys, args, 
     assert ("--families bonds lays it in courses" in capsys.readouterr().err) == note
 
 
+def solid_job(folder, methods, side: int, exemplar: str = "bricks.jpg", extra: str = ""):
+    """A job file in ``folder`` of one side x side EXR bake named after each method of ``methods``, each a solid of
+    that method from ``exemplar`` (``extra``: more lines of its source table) -> its path."""
+    job = folder / "job.toml"
+    job.write_text("".join(f"""
+[[bake]]
+name = "{m}"
+output = "{m}.exr"
+resolution = [{side}, {side}]
+[bake.source]
+kind = "solid"
+method = "{m}"
+exemplar = "{exemplar}"
+{extra}
+""" for m in methods))
+    return job
+
+
 def test_a_job_fits_a_procedural_solid_when_it_bakes_its_file_only(tmp_path, monkeypatch, capsys):
     """Reading a job, a dry run, another bake of the job and a bake that is up to date fit and choose nothing; the
     fit runs once, when its file is baked, and again when the kinds tried change; auto's choice likewise; a photo
@@ -168,22 +186,12 @@ def test_a_job_fits_a_procedural_solid_when_it_bakes_its_file_only(tmp_path, mon
     monkeypatch.setattr(SolidRequest, "solid_field", counted_field)
     monkeypatch.setattr(SolidRequest, "choose", lambda *a, **k: made.append("auto") or pytest.fail("auto chose"))
     shutil.copy(PHOTO, tmp_path / "bricks.jpg")
-    job = tmp_path / "job.toml"
 
     def write(exemplar="bricks.jpg", kinds=""):
-        job.write_text("".join(f"""
-[[bake]]
-name = "{m}"
-output = "{m}.exr"
-resolution = [8, 8]
-[bake.source]
-kind = "solid"
-method = "{m}"
-exemplar = "{exemplar}"
-{kinds}
-""" for m in ("procedural", "auto")))
+        return solid_job(tmp_path, ("procedural", "auto"), 8, exemplar, kinds)
 
-    write()
+    job = write()
+
     assert main(["bake", str(job), "--dry-run"]) == 0 and made == []
     assert main(["bake", str(job), "--quiet", "--only", "procedural"]) == 0 and made == ["procedural"]
     img = read_rgb(str(tmp_path / "procedural.exr"))
@@ -226,17 +234,7 @@ def test_a_job_holds_no_photo_s_pixels_until_it_makes_the_texture(tmp_path):
     from omninoise.backend.sources import AutoSource, SpectralSource
 
     shutil.copy(PHOTO, tmp_path / "bricks.jpg")
-    job = tmp_path / "job.toml"
-    job.write_text("".join(f"""
-[[bake]]
-name = "{m}"
-output = "{m}.exr"
-resolution = [4, 4]
-[bake.source]
-kind = "solid"
-method = "{m}"
-exemplar = "bricks.jpg"
-""" for m in ("procedural", "spectral", "auto")))
+    job = solid_job(tmp_path, ("procedural", "spectral", "auto"), 4)
 
     def holds_pixels(obj, seen=None) -> bool:
         seen = set() if seen is None else seen
