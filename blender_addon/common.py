@@ -41,11 +41,25 @@ def image_pixels(ima, setting: str) -> np.ndarray:
     return np.flipud(px.reshape(h, w, ima.channels))
 
 
-def image_srgb(ima, setting: str) -> np.ndarray:
-    """An image datablock as sRGB-encoded RGB, float32 (H, W, 3), top row first: float images hold scene-linear
-    values and are encoded; grey images are repeated into three channels."""
+def image_colours(ima, setting: str) -> np.ndarray:
+    """An input image datablock's colour channels, float32 (H, W, 1 or 3), top row first: its alpha must be opaque
+    everywhere (:func:`export.opaque`; a SettingError naming ``setting``) unless the image's Alpha is set to None."""
+    from .. import export
+
     px = image_pixels(ima, setting)
-    rgb = px[..., :3] if ima.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
+    if ima.alpha_mode == "NONE" and px.shape[2] in (2, 4):
+        return px[..., :-1]
+    try:
+        return export.opaque(px, f"image {ima.name!r}")
+    except export.ImageError as exc:
+        raise backend.SettingError(setting, str(exc)) from None
+
+
+def image_srgb(ima, setting: str) -> np.ndarray:
+    """An input image datablock as sRGB-encoded RGB, float32 (H, W, 3), top row first (:func:`image_colours`): float
+    images hold scene-linear values and are encoded; grey images are repeated into three channels."""
+    px = image_colours(ima, setting)
+    rgb = px if px.shape[2] == 3 else np.repeat(px[..., :1], 3, axis=2)
     if ima.is_float:
         from .. import export
 

@@ -25,7 +25,7 @@ from . import tasks
 from .. import backend
 from .bake_ui import draw_progress
 from .presets import NEURAL_VALUES, SUBDIRS
-from .common import Sidebar, backend_module as _mod, image_pixels, neural_model_folder
+from .common import Sidebar, backend_module as _mod, image_colours, neural_model_folder
 from .tasks import TaskOperator
 from .preferences import precision, threads
 
@@ -396,9 +396,7 @@ class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
         m = model()
         if p.fit_image is None:
             raise backend.SettingError("fit image", "pick an image to fit")
-        px = image_pixels(p.fit_image, "fit image")
-        if px.shape[2] == 4:
-            px = px[..., :3]
+        px = image_colours(p.fit_image, "fit image")
         img, notes = F.prepare_target(px if px.shape[2] > 1 else px[..., 0], m.multiple_of, p.fit_image.name)
         try:
             bank = F.load_bank(_mod("paths").fit_bank())

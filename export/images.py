@@ -13,7 +13,7 @@ import numpy as np
 
 from .atomic import atomic_path, require_finite
 
-__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "write_unit_image", "read_image", "read_rgb", "preview_8bit", "read_metadata",
+__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "write_unit_image", "read_image", "read_rgb", "opaque", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -214,21 +214,34 @@ def _decode_pillow(path: str) -> np.ndarray:
         raise ImageError(f"{path}: the image is more than the {MAX_PIXELS} px an input may have") from None
 
 
+OPAQUE = 254.5 / 255.0   #: the least alpha an input's pixel may have (an 8-bit 255; 254 is partly transparent)
+
+
+def opaque(a: np.ndarray, name: str) -> np.ndarray:
+    """The colour channels of an input image (H, W, C): with alpha (C 2 or 4) it must be opaque everywhere, since
+    what lies under a transparent pixel is no colour of the picture (a cutout's is often black, a pixel's edge
+    half its background's): ImageError naming ``name`` and the share of partly transparent pixels."""
+    if a.shape[2] not in (2, 4):
+        return a
+    clear = float(np.mean(a[..., -1] < OPAQUE))
+    if clear > 0.0:
+        raise ImageError(f"{name}: the image is partly transparent (alpha below 1 on {100 * clear:.3g} % of its "
+                         "pixels); inputs are read as opaque colours: flatten it onto a background or crop it to its "
+                         "opaque part")
+    return a[..., :-1]
+
+
 def read_image(path: str) -> np.ndarray:
     """Read an image as float32 grayscale (H, W) in the file's own range (.npy, .exr or any Pillow format):
-    the mean of its colour channels, alpha dropped."""
-    a = decode(path)
-    if a.shape[2] in (2, 4):
-        a = a[..., :-1]
+    the mean of its colour channels; an alpha channel must be opaque (:func:`opaque`)."""
+    a = opaque(decode(path), path)
     return a.mean(axis=2) if a.shape[2] > 1 else a[..., 0]
 
 
 def read_rgb(path: str) -> np.ndarray:
-    """Read an image file as float32 (H, W, 3) in [0, 1], its stored (sRGB) values; greyscale is repeated,
-    alpha dropped.  The exemplar format of the solid textures."""
-    a = decode(path)
-    if a.shape[2] in (2, 4):
-        a = a[..., :-1]
+    """Read an image file as float32 (H, W, 3) in [0, 1], its stored (sRGB) values; greyscale is repeated, an
+    alpha channel must be opaque (:func:`opaque`).  The exemplar format of the solid textures."""
+    a = opaque(decode(path), path)
     if a.shape[2] == 1:
         a = np.repeat(a, 3, axis=2)
     return np.clip(a, 0.0, 1.0)

@@ -357,6 +357,24 @@ def test_errors_are_reported(scene):
         bpy.ops.omninoise.solid_preview()
 
 
+def test_a_partly_transparent_exemplar_is_refused_unless_its_alpha_is_ignored(scene):
+    """What lies under a cutout's transparent pixels is no colour of the photo: refused, naming the image, unless
+    the image's Alpha is set to None (then its RGB is the photo)."""
+    p = scene.omninoise_solid
+    ima = _stripes_image("Cutout")
+    rgba = np.empty(128 * 128 * 4, np.float32)
+    ima.pixels.foreach_get(rgba)
+    rgba = rgba.reshape(128, 128, 4)
+    rgba[:32, :, 3] = 0.0
+    ima.pixels.foreach_set(rgba.ravel())
+    p.source, p.image = "IMAGE", ima
+    with pytest.raises(RuntimeError, match=r"image 'Cutout'.*partly transparent \(alpha below 1 on 25 %"):
+        bpy.ops.omninoise.solid_preview()
+    ima.alpha_mode = "NONE"
+    assert common.image_srgb(ima, "image").shape == (128, 128, 3)
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+
+
 def test_worker_bake_cancels_and_leaves_nothing(scene):
     bpy.ops.mesh.primitive_plane_add(size=2.0)
     p = scene.omninoise_solid

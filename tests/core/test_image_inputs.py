@@ -98,3 +98,29 @@ def test_exif_orientation_turns_a_photo_as_viewers_show_it(tmp_path, orientation
     got = read_rgb(path)
     assert got.shape == want.shape and np.array_equal(got, want)
     assert read_image(path).shape == want.shape[:2]
+
+
+def test_partly_transparent_inputs_are_refused_and_opaque_alpha_is_dropped(tmp_path, capsys):
+    """What lies under a transparent pixel is no colour of the picture (a cutout's is black here): an input with
+    alpha below 1 anywhere is refused in one line with its share; an alpha of 255 everywhere is read as RGB."""
+    rng = np.random.default_rng(3)
+    rgba = np.concatenate([rng.integers(0, 255, (40, 40, 3)), np.full((40, 40, 1), 255)], axis=2).astype(np.uint8)
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "opaque.png")
+    assert np.array_equal(read_rgb(str(tmp_path / "opaque.png")), rgba[..., :3] / np.float32(255.0))
+    assert read_image(str(tmp_path / "opaque.png")).shape == (40, 40)
+    rgba[:10, :, :3], rgba[:10, :, 3] = 0, 0                 # a cut-out top quarter
+    rgba[10, 0, 3] = 254                                     # and one pixel just short of opaque
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "cut.png")
+    grey = np.stack([rgba[..., 0], np.full((40, 40), 255, np.uint8)], axis=2)
+    grey[0, 0, 1] = 128
+    Image.fromarray(grey, "LA").save(tmp_path / "grey_cut.png")
+    for name, share in (("cut.png", "25.1 %"), ("grey_cut.png", "0.0625 %")):
+        for read in (read_rgb, read_image):
+            with pytest.raises(ImageError, match="partly transparent") as exc:
+                read(str(tmp_path / name))
+            assert share in str(exc.value) and name in str(exc.value) and "\n" not in str(exc.value)
+    rc = main(["solid", "--method", "spectral", "--dim", "2", "--size", "32", "--quiet",
+               "--exemplar", str(tmp_path / "cut.png"), "-o", str(tmp_path / "o.png")])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and "partly transparent" in err[0]
+    assert not (tmp_path / "o.png").exists()
