@@ -25,7 +25,7 @@ from . import tasks
 from .. import backend
 from .bake_ui import draw_progress
 from .presets import NEURAL_VALUES, SUBDIRS
-from .common import Sidebar, backend_module as _mod, image_colours, neural_model_folder
+from .common import Sidebar, backend_module as _mod, image_colours, image_pixels, neural_model_folder
 from .tasks import TaskOperator
 from .preferences import precision, threads
 
@@ -176,9 +176,8 @@ def panel_request(p: OMNINOISE_PG_neural, size: int, steps: int | None = None):
     iw, ih = img.size
     if iw != ih:
         raise backend.SettingError("blend map", f"the map is {iw}x{ih}; it must be square like the output")
-    px = np.empty(iw * ih * 4, np.float32)
-    img.pixels.foreach_get(px)
-    rgb = np.flipud(px.reshape(ih, iw, 4)[..., :3])  # Blender stores rows bottom-up
+    px = image_pixels(img, "blend map")     # a map's colours name its regions; what alpha a brush left is not read
+    rgb = px[..., :3] if px.shape[2] >= 3 else np.repeat(px[..., :1], 3, axis=2)
     if (iw, ih) != (size, size):  # nearest resampling of the painted regions
         rgb = rgb[(np.arange(size) * ih // size)[:, None], (np.arange(size) * iw // size)[None, :]]
     # brush strokes blend colours at their edges: each pixel takes its nearest swatch colour

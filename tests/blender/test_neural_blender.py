@@ -108,6 +108,12 @@ def test_clear_messages(scene):
     p.blend_map = img
     with pytest.raises(RuntimeError, match="the map is 16x8; it must be square"):
         bpy.ops.omninoise.neural_bake()
+    gone = bpy.data.images.new("gone", 16, 16)
+    gone.source, gone.filepath = "FILE", "//no_such_map.png"
+    gone.reload()
+    p.blend_map = gone
+    with pytest.raises(RuntimeError, match="blend map: image 'gone' has no pixels"):
+        bpy.ops.omninoise.neural_bake()
     sq = bpy.data.images.new("green", 16, 16)
     sq.colorspace_settings.name = "Non-Color"
     sq.pixels.foreach_set(np.tile([0.0, 1.0, 0.0, 1.0], 256).astype(np.float32))
