@@ -570,6 +570,32 @@ class AutoSource(_Prepared):
         return chosen.evaluate(shape, first, step, time, progress, cancel, start)
 
 
+class EncodedSource(_Prepared):
+    """A neural solid texture of an image file (method "neural" with the texture-space model): :class:`SolidSource`
+    once the photo is encoded (:mod:`backend.solid.pipeline`'s stages, seconds a photo), at its first use
+    (:class:`_Prepared`) rather than when a job is read.  The key is the request's (the photo's pixels, mix, refine,
+    seed, periodic, gaussian, rest) with the model's files."""
+
+    def __init__(self, request, model, scale: float = 1.0, density: float = 1.0):
+        """request: a checked :class:`~backend.solid.request.SolidRequest` with method "neural" whose exemplar is an
+        image file; model: its loaded :class:`~backend.solid.model.SolidTextureModel`, of mode "space"."""
+        self.model, self.dim = model, model.dim
+        super().__init__(request, scale, density)
+
+    def _make(self, progress, cancel):
+        code, _ = self.request.code(self.model, "source.", progress)
+        return SolidSource(self.model, self.request, self.scale, self.density, code=code)
+
+    def _draw(self, encoded, shape, first, step, time, progress, cancel, start) -> np.ndarray:
+        return encoded.evaluate(shape, first, step, time, progress, cancel, start)
+
+    def to_dict(self) -> dict:
+        d = dict(super().to_dict(), model=self.model.config["files"])
+        if self.model.spin:
+            d["spin"] = self.model.spin
+        return d
+
+
 _SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
                "rest", "method", "tile", "families")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
@@ -726,6 +752,8 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
 
 
 def _solid_from_dict(d: dict, base_dir: str):
+    import os
+
     req = solid_request_from_dict(d, base_dir)
     if req.method == "synthesis":
         return SynthesisSource(req, d.get("scale", 1.0))
@@ -733,7 +761,10 @@ def _solid_from_dict(d: dict, base_dir: str):
         return SpectralSource(req, d.get("scale", 1.0), d.get("density", 1.0))
     if req.method == "auto":
         return AutoSource(req, d.get("scale", 1.0), d.get("density", 1.0))
-    return SolidSource(req.folder(), req, d.get("scale", 1.0), d.get("density", 1.0))
+    model = req.load("source.")
+    if model.mode != "single" and isinstance(req.exemplar, str) and os.path.isfile(req.exemplar):
+        return EncodedSource(req, model, d.get("scale", 1.0), d.get("density", 1.0))
+    return SolidSource(model, req, d.get("scale", 1.0), d.get("density", 1.0))
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

@@ -220,3 +220,41 @@ def test_the_gaussian_rest_is_said_and_can_be_left_out(models, tmp_path, capsys)
     write_job(tmp_path / "job.toml", 8 / space.px_per_unit, models["space3"], f'exemplar = "{photo}"\ngaussian = false')
     assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
     np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(off))
+
+
+def test_a_job_encodes_its_photo_when_it_bakes_its_file_only(models, tmp_path, monkeypatch, capsys):
+    """A neural solid of a photo in a job file: reading the job, a dry run and an up-to-date bake encode nothing;
+    the bake encodes once and writes the volume the command line writes; a setting the encoding reads (periodic)
+    makes the bake due again."""
+    from PIL import Image
+
+    from omninoise.backend.jobs import load_job
+    from omninoise.backend.solid.model import SolidTextureModel
+    from omninoise.backend.solid.request import SolidRequest
+    from omninoise.backend.sources import EncodedSource
+
+    encoded = []
+    real_code = SolidRequest.code
+    monkeypatch.setattr(SolidRequest, "code", lambda self, *a, **k: encoded.append(1) or real_code(self, *a, **k))
+    Image.fromarray((np.random.default_rng(4).random((70, 90, 3)) * 255).astype(np.uint8)).save(tmp_path / "p.png")
+    space = SolidTextureModel(models["space3"])
+    write_job(tmp_path / "job.toml", 8 / space.px_per_unit, models["space3"], 'exemplar = "p.png"\nseed = 2')
+    src = dict(load_job(str(tmp_path / "job.toml")))["solid"].source
+    assert isinstance(src, EncodedSource) and not src.ready and encoded == []
+    assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 0 and encoded == []
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0 and encoded == [1]
+    cli = str(tmp_path / "cli.npy")
+    assert run(capsys, "--model", models["space3"], "--exemplar", str(tmp_path / "p.png"), "--dim", "3", "--size", "8",
+               "--seed", "2", "-o", cli)[0] == 0
+    np.testing.assert_array_equal(np.load(tmp_path / "job.npy"), np.load(cli))
+    job = tmp_path / "job.toml"
+    job.write_text(job.read_text().replace('"job.npy"', '"job.exr"').replace("[8, 8, 8]", "[8, 8]"))
+    encoded.clear()
+    assert main(["bake", str(job), "--quiet"]) == 0 and encoded == [1]      # .npy files carry no key; .exr do
+    encoded.clear()
+    capsys.readouterr()
+    assert main(["bake", str(job)]) == 0 and encoded == []
+    assert "up to date" in "".join(capsys.readouterr())
+    job.write_text(job.read_text() + "periodic = false\n")
+    assert main(["bake", str(job), "--dry-run"]) == 0 and encoded == []
+    assert "to bake" in capsys.readouterr().out

@@ -231,10 +231,10 @@ def test_a_job_holds_no_photo_s_pixels_until_it_makes_the_texture(tmp_path):
     """A job's sources read their photo when the job is read (checks, key) and again when a texture is made, and
     keep neither: a job of many large photos holds none of them between its bakes."""
     from omninoise.backend.jobs import load_job
-    from omninoise.backend.sources import AutoSource, SpectralSource
+    from omninoise.backend.sources import AutoSource, EncodedSource, SpectralSource
 
     shutil.copy(PHOTO, tmp_path / "bricks.jpg")
-    job = solid_job(tmp_path, ("procedural", "spectral", "auto"), 4)
+    job = solid_job(tmp_path, ("procedural", "spectral", "auto", "neural"), 4)
 
     def holds_pixels(obj, seen=None) -> bool:
         seen = set() if seen is None else seen
@@ -251,6 +251,7 @@ def test_a_job_holds_no_photo_s_pixels_until_it_makes_the_texture(tmp_path):
 
     specs = dict(load_job(str(job)))
     assert isinstance(specs["auto"].source, AutoSource) and isinstance(specs["spectral"].source, SpectralSource)
+    assert isinstance(specs["neural"].source, EncodedSource)
     for name, spec in specs.items():
         assert not spec.source.ready and not holds_pixels(spec.source.request), name
     src = specs["procedural"].source
