@@ -351,26 +351,26 @@ class SolidRequest:
         code, _ = self.code(model, where, progress, report, on_code)
         return model.image(size, code, int(self.seed), scale=scale, progress=draw_progress)
 
-    def key(self) -> dict:
+    def key(self, exemplar: str | None = None) -> dict:
         """A JSON summary: equal for equal settings from any front-end (images by their pixels' sha256); the rest's
         kind only where a Gaussian rest is asked for (without one it changes nothing, so a bake is not redone); for
         methods "synthesis", "spectral" and "procedural" only what they read (exemplar, seed and tile, or periodic, the
-        spectral solid's map onto the photo's marginals and its power's isotropic start; or the families tried)."""
+        spectral solid's map onto the photo's marginals and its power's isotropic start; or the families tried);
+        ``exemplar``: the exemplar's digest where it is known (:meth:`exemplar_digest`; auto's two keys share one)."""
+        ex = self.exemplar_digest() if exemplar is None else exemplar
         if self.method == "synthesis":
-            return dict(method="synthesis", exemplar=self.exemplar_digest(), seed=int(self.seed),
-                        tile=int(self.tile))
+            return dict(method="synthesis", exemplar=ex, seed=int(self.seed), tile=int(self.tile))
         if self.method == "spectral":
             # marginals: the tile's values are mapped onto the photo's (spectral_solid.Marginals); start: its power
             # is found from an isotropic start (spectral_solid.solid_power); a bake keyed before either is redone
-            return dict(method="spectral", exemplar=self.exemplar_digest(), seed=int(self.seed),
+            return dict(method="spectral", exemplar=ex, seed=int(self.seed),
                         periodic=bool(self.periodic), marginals=True, start="isotropic")
         if self.method == "procedural":
-            return dict(method="procedural", exemplar=self.exemplar_digest(), seed=int(self.seed),
-                        families=list(self.families))
+            return dict(method="procedural", exemplar=ex, seed=int(self.seed), families=list(self.families))
         if self.method == "auto":
-            return dict(method="auto", procedural=self.replace(method="procedural").key(),
-                        neural=self.replace(method="neural").key())
-        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=self.exemplar_digest(),
+            return dict(method="auto", procedural=self.replace(method="procedural").key(ex),
+                        neural=self.replace(method="neural").key(ex))
+        return dict(model=os.path.basename(os.path.normpath(self.folder())), exemplar=ex,
                     to=_digest(self.to), mix=float(self.mix) if self.to is not None else 0.0,
                     refine=int(self.refine), seed=int(self.seed), periodic=bool(self.periodic),
                     gaussian=bool(self.gaussian), rest=self.rest if self.gaussian else None)

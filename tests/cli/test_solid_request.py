@@ -71,8 +71,14 @@ def test_a_file_is_decoded_once_per_request(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match="read-only"):
         first[0, 0, 0] = 1.0
     assert req.exemplar == photo and req.key() == SolidRequest(exemplar=real(photo), method="procedural").key()
-    auto = req.replace(method="auto")            # method auto's stages and key share the decoding
+    auto = req.replace(method="auto")            # method auto's stages and key share the decoding, and one hash
+    from omninoise.backend.solid import request as request_module
+
+    hashed = []
+    real_sha = request_module._pixels_sha
+    monkeypatch.setattr(request_module, "_pixels_sha", lambda x: hashed.append(1) or real_sha(x))
     assert auto.exemplar_pixels() is first and auto.key()["procedural"] == req.key() and len(calls) == 1
+    assert len(hashed) == 2                      # auto's key, then the procedural request's own
     Image.fromarray(np.full((32, 32, 3), 200, np.uint8)).save(photo)    # changed on disk: read again
     again = req.exemplar_pixels()
     assert len(calls) == 2 and again.shape == (32, 32, 3) and np.allclose(again, 200 / 255)
