@@ -123,12 +123,10 @@ def _on_farm(a: argparse.Namespace) -> int:
         if not a.quiet and client.dashboard_link:
             print(f"omninoise bake: Dask dashboard {client.dashboard_link}", file=sys.stderr)
 
+        bar = Bar(a.quiet)
+
         def status(done, total, moved, eta):
-            if not a.quiet:
-                sys.stderr.write(f"\r  {done}/{total} tasks, {moved / 2 ** 20:.1f} MiB, ETA {eta:.0f} s   ")
-                if done == total:
-                    sys.stderr.write("\n")
-                sys.stderr.flush()
+            bar(done / max(total, 1), f"  {done}/{total} tasks, {moved / 2 ** 20:.1f} MiB, ETA {eta:.0f} s   ")
 
         outcomes = farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
                                  retries=a.retries, status=status, precision=a.precision)

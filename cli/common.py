@@ -43,20 +43,40 @@ def class_args(g) -> None:
 
 
 class Bar:
-    """A progress bar on standard error: ``bar(fraction)``; silent with ``quiet``."""
+    """A progress bar on standard error: ``bar(fraction)``; silent with ``quiet``.  On a terminal it is redrawn in
+    place at most every REDRAW_S seconds; written to a file or a pipe (a farm's or a CI's log) it is a line each time
+    the work passes another tenth, not a line of carriage returns."""
+
+    REDRAW_S = 0.1      #: the least time between two redraws on a terminal (and the first one is drawn at once)
+    STEPS = 10          #: lines written to a file or pipe over the work (and one at its end)
 
     def __init__(self, quiet: bool, label: str = ""):
         self.quiet, self.t0, self.label, self.done = quiet, time.perf_counter(), label, False
+        self.tty = sys.stderr.isatty()
+        self.drawn_at, self.step = -float("inf"), -1
 
-    def __call__(self, frac: float) -> None:
+    def __call__(self, frac: float, text: str | None = None) -> None:
+        """Show ``frac`` of the work done, as the bar or as ``text``."""
         if self.quiet or self.done:
             return
+        frac = min(max(float(frac), 0.0), 1.0) if frac == frac else 0.0
+        if frac >= 1.0 - 1e-6:      # shares of the work added up reach 1 within rounding (0.25 + 0.25 + 3 x 1/6)
+            frac = 1.0
         self.done = frac >= 1.0
+        now = time.perf_counter()
+        if self.tty:
+            if not self.done and now - self.drawn_at < self.REDRAW_S:
+                return
+        else:
+            step = int(frac * self.STEPS)
+            if step <= self.step:
+                return
+            self.step = step
+        self.drawn_at = now
         n = int(frac * 30)
-        sys.stderr.write(f"\r{self.label}[{'#' * n}{'.' * (30 - n)}] {frac * 100:5.1f}%  "
-                         f"{time.perf_counter() - self.t0:6.1f}s")
-        if frac >= 1.0:
-            sys.stderr.write("\n")
+        text = f"{self.label}[{'#' * n}{'.' * (30 - n)}] {frac * 100:5.1f}%  {now - self.t0:6.1f}s" \
+            if text is None else text
+        sys.stderr.write(f"\r{text}" + ("\n" if self.done else "") if self.tty else text.rstrip() + "\n")
         sys.stderr.flush()
 
 
