@@ -76,6 +76,7 @@ WINDOW = 3           #: ... within this many bins
 LINE_SAME = 0.9      #: a row is a line straight across the photo where this share of its pixels lie past ...
 LINE_STRENGTH = 0.5  #: ... the midpoint to its mean colour, which stands this many times the photo's RMS off ...
 LINE_WIDTH = 8       #: ... the median of the row means within this many rows (px) around it
+LINE_LENGTH = 16     #: a line runs at least this many px across (a column of a strip 3 px high is no line)
 
 
 def autocorrelation(u: np.ndarray, reach: float = REACH) -> tuple:
@@ -163,7 +164,10 @@ def period_lattice(u: np.ndarray, min_repeats: float = MIN_REPEATS) -> tuple:
     """(reciprocal basis float64 (2, 2) in cycles per photo, translations float64 (2, 2) px), or (None, None): the
     lattice of the photo u (C, H, W)'s periods (module doc, step 3)."""
     C, H0, W0 = u.shape
-    k = max(1, -(-max(H0, W0) // SIDE))          # a large photo's periods are sought on its k x k block means
+    if min(H0, W0) < 2 * MIN_REPEATS:           # too few rows or columns to hold two cells of a lattice
+        return None, None
+    k = max(1, -(-max(H0, W0) // SIDE))          # a large photo's periods are sought on its k x k block means ...
+    k = min(k, int(min(H0, W0) // (2 * MIN_REPEATS)))      # ... keeping a strip's short side able to hold them
     u = u[:, :H0 // k * k, :W0 // k * k].reshape(C, H0 // k, k, W0 // k, k).mean((2, 4))
     _, H, W = u.shape
     R, tx, ty = autocorrelation(u)
@@ -221,8 +225,10 @@ def _line_profile(rest: np.ndarray, same: float, strength: float, width: int) ->
     the median of the row means within ``width`` rows around it (the local level: shading and broad bands are not
     lines), where that stands ``strength`` times the rest's RMS off zero and ``same`` of the row's pixels lie past
     the midpoint from the local level towards it (a grout joint or a plank seam runs the whole width; a row of a
-    face's texture holds pixels on both sides); zero on every other row."""
+    face's texture holds pixels on both sides); zero on every other row, and on every row shorter than LINE_LENGTH."""
     m = rest.mean(2)                                                             # (C, H)
+    if rest.shape[2] < LINE_LENGTH:
+        return np.zeros_like(m)
     near = np.lib.stride_tricks.sliding_window_view(np.pad(m, ((0, 0), (width, width)), mode="wrap"),
                                                     2 * width + 1, axis=1)
     level = np.median(near, axis=2)                                              # (C, H)

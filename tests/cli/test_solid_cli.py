@@ -258,3 +258,16 @@ def test_a_job_encodes_its_photo_when_it_bakes_its_file_only(models, tmp_path, m
     job.write_text(job.read_text() + "periodic = false\n")
     assert main(["bake", str(job), "--dry-run"]) == 0 and encoded == []
     assert "to bake" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("shape", [(1, 600), (600, 2), (1, 1)])
+def test_a_photo_of_a_line_or_a_pixel_encodes(models, tmp_path, capsys, shape):
+    """The texture-space model reads photos of any size (its check's neighbourhoods shrink to fit): a strip one or
+    two px across has no lattice or line of the harmonic part to read, and gives a texture, not an internal error."""
+    from PIL import Image
+
+    Image.fromarray((np.random.default_rng(1).random(shape + (3,)) * 255).astype(np.uint8)).save(tmp_path / "p.png")
+    out = str(tmp_path / "o.npy")
+    rc, err = run(capsys, "--model", models["space3"], "--exemplar", str(tmp_path / "p.png"), "--size", "8", "-o", out)
+    assert rc == 0, err
+    assert np.isfinite(np.load(out)).all()

@@ -121,6 +121,20 @@ def test_a_large_tile_is_measured_on_its_block_means():
     assert on_grid(B, 0.05)
 
 
+def test_a_strip_of_a_few_rows_has_no_lattice():
+    """A photo one to three px high or wide cannot hold two cells of a lattice (it was an FFT of no points: a
+    1 x 5000 px strip made the neural texture's encoding fail); a long strip of 4 or 16 rows is searched on block
+    means that keep rows, and a photo of them encodes."""
+    rng = np.random.default_rng(0)
+    for h in (1, 2, 3):
+        assert period_lattice(mean_free(rng.random((h, 5000, 3)))) == (None, None)
+        assert period_lattice(mean_free(rng.random((5000, h, 3)))) == (None, None)
+    for h in (4, 16):
+        B, T = period_lattice(mean_free(rng.random((h, 5000, 3))))
+        assert (B is None) == (T is None)
+    assert len(photo_harmonics(rng.random((1, 5000, 3)), PPU)) == 0
+
+
 def floor_tile(H=192, W=224, grout=4, seed=0):
     """(photo (H, W, 3), its grout mask (H, W)): one floor tile of a library, framed by its grout along the top and
     left edges (so that it tiles), its face a smooth random texture with pixel noise."""
