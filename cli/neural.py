@@ -83,14 +83,17 @@ def _spec_arg(text: str, flag: str) -> tuple:
 
 def _painted_parts(a: argparse.Namespace) -> tuple:
     """--map and its --region flags -> (regions int (H, W) into specs, specs)."""
-    from omninoise.export.images import decode
+    from omninoise.export.images import ImageError, decode
     from omninoise.backend.neural.request import region_key, regions_from_map
 
     if not os.path.isfile(a.map):
         raise SettingError("--map", f"map not found: {a.map}")
     if not a.region:
         raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
-    px = decode(a.map)
+    try:
+        px = decode(a.map)
+    except ImageError as exc:
+        raise SettingError("--map", str(exc)) from None
     if px.shape[:2] != (a.size, a.size):
         raise SettingError("--map", f"map is {px.shape[1]}x{px.shape[0]} but --size is {a.size}")
     keys, specs = [], []
@@ -125,11 +128,14 @@ def neural_request(a: argparse.Namespace, model):
         regions, specs = _painted_parts(a)
         req = NeuralRequest("painted", specs, regions=regions, **kw)
     elif a.blend:
-        from omninoise.export.images import read_image
+        from omninoise.export.images import ImageError, read_image
 
         if not os.path.isfile(a.blend):
             raise SettingError("--blend", f"mask not found: {a.blend}")
-        mask = read_image(a.blend)
+        try:
+            mask = read_image(a.blend)
+        except ImageError as exc:
+            raise SettingError("--blend", str(exc)) from None
         if mask.shape != (a.size, a.size):
             raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
         spec2 = (a.noise2 or a.noise, param_items(a.param2, "--param2"))
@@ -243,7 +249,7 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     import json
 
     from omninoise.export.atomic import write_json
-    from omninoise.export.images import decode, write_unit_image
+    from omninoise.export.images import ImageError, decode, opaque, write_unit_image
     from omninoise.backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
     from omninoise.backend.neural.generate import generate
     from omninoise.backend.onnx_models import ModelError
@@ -261,16 +267,17 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     if not os.path.isfile(a.fit):
         raise SettingError("--fit", f"image not found: {a.fit}")
     try:
-        img = decode(a.fit)
-    except (OSError, ValueError) as exc:
-        raise SettingError("--fit", f"{a.fit}: not an image we can read ({exc})") from None
+        img = opaque(decode(a.fit), a.fit)
+    except ImageError as exc:
+        raise SettingError("--fit", str(exc)) from None
     try:
         bank = load_bank(fit_bank())
     except ModelError as exc:  # the fit still works, starting from every class at mid-range parameters
         print(f"note: no inverse-design bank ({exc}); trying every class", file=sys.stderr)
         bank = None
     img = img[..., 0] if img.shape[2] == 1 else img
-    for note in prepare_target(img, model.multiple_of, os.path.basename(a.fit))[1]:  # refuses too small images
+    # refuses too small and flat images, named by the flag and the file
+    for note in prepare_target(img, model.multiple_of, f"--fit {os.path.basename(a.fit)}")[1]:
         print("note: " + note, file=sys.stderr)
     bar = Bar(a.quiet, "fit    ")
     res = fit(model, img, size=a.fit_size, seed=a.seed, bank=bank, progress=lambda f: bar(0.8 * f))

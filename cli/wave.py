@@ -119,9 +119,12 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
     if a.example:
         if not os.path.isfile(a.example):
             raise SettingError("--example", f"image not found: {a.example}")
-        from omninoise.export.images import read_image
+        from omninoise.export.images import ImageError, read_image
 
-        example = read_image(a.example)
+        try:
+            example = read_image(a.example)
+        except ImageError as exc:
+            raise SettingError("--example", str(exc)) from None
     profile = ()
     if a.waveform == "custom":
         if not a.profile:

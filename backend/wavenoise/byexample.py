@@ -14,10 +14,22 @@ from ..errors import SettingError
 from .spectra import Spectrum
 from .tables import WaveTable, build_axis_table
 
-__all__ = ["sector_spectra", "example_table", "PLANES"]
+__all__ = ["check_example", "sector_spectra", "example_table", "PLANES"]
 
 #: plane name -> (a, b, normal) axis indices
 PLANES = {"xy": (0, 1, 2), "xz": (0, 2, 1), "yz": (1, 2, 0)}
+
+
+def check_example(image) -> np.ndarray:
+    """A by-example image as float64 (H, W), zero mean: SettingError naming ``example`` unless it is a grey image
+    of at least 16 x 16 px that is not one value (whose spectrum would be empty)."""
+    img = np.asarray(image, dtype=np.float64)
+    if img.ndim != 2 or min(img.shape) < 16:
+        raise SettingError("example", f"needs a 2D grayscale image of at least 16x16, got shape {img.shape}")
+    img = img - img.mean()
+    if not np.any(img):
+        raise SettingError("example", "the image is constant; its spectrum is empty")
+    return img
 
 
 def sector_spectra(image: np.ndarray, sectors: int, extent: float) -> tuple[list[Spectrum], float]:
@@ -26,15 +38,10 @@ def sector_spectra(image: np.ndarray, sectors: int, extent: float) -> tuple[list
     image: float (H, W) grayscale; extent: world units spanned by the image width.
     Returns one ``custom`` Spectrum per sector (amplitudes on [0, fmax]) and fmax.
     """
-    img = np.asarray(image, dtype=np.float64)
-    if img.ndim != 2 or min(img.shape) < 16:
-        raise SettingError("example", f"needs a 2D grayscale image of at least 16x16, got shape {img.shape}")
+    img = check_example(image)
     if not sectors >= 1:
         raise SettingError("sectors", f"must be >= 1, got {sectors}")
     h, w = img.shape
-    img = img - img.mean()
-    if not np.any(img):
-        raise SettingError("example", "the image is constant; its spectrum is empty")
     # Hann window against the spectral cross of non-periodic borders
     win = np.outer(np.hanning(h), np.hanning(w))
     power = np.abs(np.fft.fft2(img * win)) ** 2

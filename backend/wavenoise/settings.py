@@ -10,7 +10,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from .byexample import PLANES, example_table
+from .byexample import PLANES, check_example, example_table
 from .cellular import CellularNoise
 from .directions import DirectionSet, Domain
 from .. import limits
@@ -88,8 +88,12 @@ class WaveSettings:
         except (TypeError, ValueError) as exc:  # a tuple field holding something that is not a number
             raise SettingError("wave settings", f"expected numbers in the tuple settings ({exc})") from None
         WAVE_SETTINGS.check(d, "")
-        if self.example is not None and self.example_plane not in PLANES:
-            raise SettingError("example_plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")
+        if self.example is not None:
+            if self.example_plane not in PLANES:
+                raise SettingError("example_plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")
+            if self.dim not in (2, 3):
+                raise SettingError("example", "by-example noise is 2D or 3D")
+            check_example(self.example)
         self.spectrum.validate()
         return self
 

@@ -34,6 +34,7 @@ from omninoise.cli.main import main  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BROKEN = os.path.join(ROOT, "tests", "data", "broken")
+ODD = os.path.join(ROOT, "tests", "data", "odd")
 LIMIT_S = 30
 _seed = os.environ.get("OMNINOISE_FUZZ_SEED")
 FUZZ = settings(deadline=None, database=None, derandomize=_seed is None, print_blob=True,
@@ -299,6 +300,29 @@ def test_the_broken_file_corpus_is_refused_by_every_image_input(tmp_path):
             lines = err.getvalue().strip().splitlines()
             assert rc == 2 and len(lines) == 1 and os.path.basename(path) in lines[0], (argv, err.getvalue())
             assert not os.path.exists(out)
+
+
+ODD_INPUTS = {
+    "wave example": ["wave", "--size", "8", "--example"],
+    "neural blend": ["neural", "--noise", "perlin", "--noise2", "cells_f1", "--size", "8", "--steps", "1", "--blend"],
+    "neural map": ["neural", "--size", "8", "--steps", "1", "--region", "0=perlin", "--map"],
+    **{f"solid {m}": ["solid", "--method", m, "--size", "8", "--exemplar"]
+       for m in ("neural", "spectral", "synthesis", "procedural", "auto")},
+}
+
+
+@pytest.mark.parametrize("name", sorted(f for f in os.listdir(ODD) if f.endswith(".png")))
+def test_odd_images_are_drawn_or_refused_in_one_line_by_every_image_input(tmp_path, name):
+    """Each valid but unusual image of tests/data/odd (a line, a column two px wide, one pixel, a cut-out, one
+    grey) given to each image input: a finite result, or exit 2 with one line; never an internal error."""
+    for argv in ODD_INPUTS.values():
+        out = str(tmp_path / "o.npy")
+        run(argv + [os.path.join(ODD, name), "--quiet", "-o", out], out)
+        if os.path.exists(out):
+            import numpy as np
+
+            assert np.isfinite(np.load(out)).all(), argv
+            os.remove(out)
 
 
 def test_a_strip_photo_is_drawn_or_refused_in_one_line(tmp_path):

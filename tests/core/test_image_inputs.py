@@ -124,3 +124,24 @@ def test_partly_transparent_inputs_are_refused_and_opaque_alpha_is_dropped(tmp_p
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert rc == 2 and len(err) == 1 and "partly transparent" in err[0]
     assert not (tmp_path / "o.png").exists()
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["wave", "--size", "8", "--example"], "--example"),
+    (["neural", "--size", "16", "--steps", "1", "--noise", "perlin", "--noise2", "cells_f1", "--blend"], "--blend"),
+    (["neural", "--size", "16", "--steps", "1", "--fit"], "--fit"),
+])
+def test_an_unusable_image_is_named_by_its_flag(tmp_path, capsys, argv, flag):
+    """A cut-out and a flat grey image: refused in one line that names the flag they were given to, before any
+    work (by-example noise checks its image's size and contrast with its settings)."""
+    rgba = np.full((16, 16, 4), 255, np.uint8)
+    rgba[:4, :, 3] = 0
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "cut.png")
+    Image.fromarray(np.full((16, 16), 128, np.uint8)).save(tmp_path / "flat.png")
+    for name, why in (("cut.png", "partly transparent"), ("flat.png", "")):
+        rc = main(argv + [str(tmp_path / name), "--quiet", "-o", str(tmp_path / "o.png")])
+        err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+        if name == "flat.png" and flag == "--blend":
+            assert rc == 0                       # a flat mask is one noise everywhere
+            continue
+        assert rc == 2 and len(err) == 1 and f"error: {flag}" in err[0] and why in err[0], err
