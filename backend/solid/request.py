@@ -70,6 +70,26 @@ def _digest(x) -> str | None:
     return str(x)
 
 
+def check_pixels_given(x, setting: str) -> None:
+    """SettingError naming ``setting`` unless ``x`` is None, a name or file (a str), or pixels as every method
+    reads them: a float array (H, W, 3) of finite sRGB values in [0, 1] (8-bit pixels divided by 255), at least
+    one pixel."""
+    if x is None or isinstance(x, str):
+        return
+    if not isinstance(x, np.ndarray):
+        raise SettingError(setting, f"expected a name, an image file or sRGB pixels (H, W, 3), got {type(x).__name__}")
+    if x.dtype.kind != "f":
+        hint = " (divide 8-bit pixels by 255)" if x.dtype.kind in "ui" else ""
+        raise SettingError(setting, f"expected sRGB pixels as floats in [0, 1], got {x.dtype}{hint}")
+    if x.ndim != 3 or x.shape[2] != 3 or 0 in x.shape:
+        raise SettingError(setting, f"expected sRGB pixels (H, W, 3), got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise SettingError(setting, "the pixels hold NaN or infinite values")
+    lo, hi = float(x.min()), float(x.max())
+    if lo < 0.0 or hi > 1.0:
+        raise SettingError(setting, f"expected sRGB pixels in [0, 1], got values in [{lo:.4g}, {hi:.4g}]")
+
+
 @dataclass(frozen=True, eq=False)
 class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
@@ -108,6 +128,8 @@ class SolidRequest:
         twice = sorted({k for k in kinds if list(kinds).count(k) > 1})
         if twice:
             raise bad("families", f"names {', '.join(twice)} more than once")
+        for key in ("exemplar", "to"):
+            check_pixels_given(getattr(self, key), f"{where}{key}")
         if self.method in IMAGE_METHODS:
             m, ex = self.method, self.exemplar
             if isinstance(ex, str) and not os.path.isfile(ex):

@@ -22,10 +22,15 @@ PLANES = {"xy": (0, 1, 2), "xz": (0, 2, 1), "yz": (1, 2, 0)}
 
 def check_example(image) -> np.ndarray:
     """A by-example image as float64 (H, W), zero mean: SettingError naming ``example`` unless it is a grey image
-    of at least 16 x 16 px that is not one value (whose spectrum would be empty)."""
-    img = np.asarray(image, dtype=np.float64)
+    of finite numbers, at least 16 x 16 px, that is not one value (whose spectrum would be empty)."""
+    img = np.asarray(image)
+    if img.dtype.kind not in "fiu":
+        raise SettingError("example", f"needs a grayscale image of numbers, got {img.dtype}")
+    img = img.astype(np.float64)
     if img.ndim != 2 or min(img.shape) < 16:
         raise SettingError("example", f"needs a 2D grayscale image of at least 16x16, got shape {img.shape}")
+    if not np.all(np.isfinite(img)):
+        raise SettingError("example", "the image holds NaN or infinite values")
     img = img - img.mean()
     if not np.any(img):
         raise SettingError("example", "the image is constant; its spectrum is empty")

@@ -172,3 +172,30 @@ def test_a_setting_the_method_does_not_read_is_refused_by_each_front_end(tmp_pat
         with pytest.raises(SettingError, match=f"^{name}: method .* does not read it"):
             omninoise.solid(PHOTO, 8, **api)
     assert cli("--exemplar", PHOTO, "--method", "auto", "--families", "bonds", "--no-gaussian").method == "auto"
+
+
+@pytest.mark.parametrize("pixels, why", [
+    (np.full((8, 8, 3), 128, np.uint8), r"floats in \[0, 1\], got uint8 \(divide 8-bit pixels by 255\)"),
+    (np.full((8, 8, 3), 128.0), r"in \[0, 1\], got values in \[128, 128\]"),
+    (np.full((8, 8, 3), -0.5), r"in \[0, 1\], got values in \[-0.5, -0.5\]"),
+    (np.full((8, 8), 0.5), r"\(H, W, 3\), got shape \(8, 8\)"),
+    (np.full((8, 8, 4), 0.5), r"\(H, W, 3\), got shape \(8, 8, 4\)"),
+    (np.zeros((0, 8, 3)), r"got shape \(0, 8, 3\)"),
+    (np.full((8, 8, 3), np.nan), "NaN or infinite"),
+    (np.full((8, 8, 3), 0.5) + 0j, "got complex128"),
+    (np.full((8, 8, 3), True), "got bool"),
+    ([[[0.5] * 3] * 8] * 8, "got list"),
+])
+@pytest.mark.parametrize("method", ["neural", "spectral", "synthesis", "procedural", "auto"])
+def test_pixels_are_checked_alike_for_every_method(pixels, why, method):
+    """Pixels handed over (the Python API, Blender's images) are sRGB floats (H, W, 3) in [0, 1] for every method:
+    8-bit values, a grey or RGBA array, NaN, an empty array were read differently by each method (a white
+    procedural solid from 0..255 floats, an IndexError from an empty array) and are now one error naming them."""
+    with pytest.raises(SettingError, match=why) as exc:
+        SolidRequest(exemplar=pixels, method=method).check("source.")
+    assert exc.value.setting == "source.exemplar"
+    if method == "neural":
+        with pytest.raises(SettingError, match=why) as exc:
+            SolidRequest(exemplar="grass", to=pixels, mix=0.5).check()
+        assert exc.value.setting == "to"
+    SolidRequest(exemplar=np.full((8, 8, 3), 0.5, np.float32), method=method).check()

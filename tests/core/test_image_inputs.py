@@ -145,3 +145,22 @@ def test_an_unusable_image_is_named_by_its_flag(tmp_path, capsys, argv, flag):
             assert rc == 0                       # a flat mask is one noise everywhere
             continue
         assert rc == 2 and len(err) == 1 and f"error: {flag}" in err[0] and why in err[0], err
+
+
+@pytest.mark.parametrize("example, why", [
+    (np.full((32, 32), np.nan), "NaN or infinite"),
+    (np.full((32, 32), True), "image of numbers, got bool"),
+    (np.zeros((32, 32, 3)), r"2D grayscale image of at least 16x16, got shape \(32, 32, 3\)"),
+    (np.zeros((8, 64)), "at least 16x16"),
+    (np.full((32, 32), 0.5), "the image is constant"),
+])
+def test_a_by_example_array_is_checked_with_the_settings(example, why):
+    """omninoise.wave(example=...) takes a grey array: one that is not usable is refused, naming ``example``, as
+    the settings are checked (NaN was refused later, as the "samples" of a custom spectrum no one gave)."""
+    import omninoise
+    from omninoise.backend.errors import SettingError
+
+    with pytest.raises(SettingError, match=why) as exc:
+        omninoise.wave(16, example=example)
+    assert exc.value.setting == "example"
+    assert np.isfinite(omninoise.wave(16, example=np.random.default_rng(0).random((32, 32)))).all()
