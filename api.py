@@ -48,6 +48,9 @@ def _spectrum(value):
 
 
 def _check_out(out: str, allowed: tuple, what: str) -> str:
+    if not isinstance(out, (str, os.PathLike)):
+        raise SettingError("out", f"expected a file path, got {out!r}")
+    out = os.fspath(out)
     ext = os.path.splitext(out)[1].lower()
     if ext not in allowed:
         raise SettingError("out", f"{what} is written as {', '.join(allowed)}, not {ext or out!r}")
@@ -87,7 +90,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     from .backend.wavenoise.settings import WaveSettings
 
     size = _check_size(size)
-    limits.positive("extent", extent)
+    limits.in_range("extent", extent, limits.MIN_LENGTH, limits.MAX_COORD)
     limits.time("time", time)
     if "spectrum" in settings:
         settings["spectrum"] = _spectrum(settings["spectrum"])
@@ -136,7 +139,7 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
         net = NeuralNoiseModel(model or neural_model())
     except ModelError as exc:
         raise SettingError("model", str(exc)) from None
-    req = NeuralRequest("uniform", [(noise, dict(params or {}))], width=size, height=size, seed=seed,
+    req = NeuralRequest("uniform", [(noise, params)], width=size, height=size, seed=seed,
                         steps=DEFAULT_STEPS if steps is None else steps, sampler=sampler or DEFAULT_SAMPLER,
                         tileable=tileable).check(net)
     cb = None if progress is None else (lambda i, n, x0: progress((i + 1) / n))

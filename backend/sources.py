@@ -50,6 +50,8 @@ class BoxGrid:
         n = len(res)
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
             raise SettingError("bounds", f"must be finite numbers, got {self.bounds}")
+        if max(np.abs(lo).max(), np.abs(hi).max()) > limits.MAX_COORD:
+            raise SettingError("bounds", f"coordinates must lie within +-{limits.MAX_COORD:g} units, got {self.bounds}")
         if not np.all(hi[:n] > lo[:n]):
             raise SettingError("bounds", f"max must exceed min on x, y{', z' if n == 3 else ''}: {self.bounds}")
         if not np.all(hi[:n] - lo[:n] >= limits.MIN_LENGTH):

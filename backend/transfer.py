@@ -177,6 +177,9 @@ def transfer_from_dict(d: dict, where: str = "transfer") -> TransferFunction:
 
 def load_transfer(spec: str) -> TransferFunction:
     """A preset name or a JSON ramp file."""
+    if not isinstance(spec, (str, os.PathLike)):      # an int would be opened as a file descriptor
+        raise SettingError("transfer", f"expected a preset name or a ramp .json file, got {spec!r}")
+    spec = os.fspath(spec)
     if spec in PRESETS:
         return preset(spec)
     if not os.path.exists(spec):

@@ -30,8 +30,20 @@ LAYOUTS = {"uniform": 1, "blend": 2, "gradient": 2, "corners": 4, "painted": Non
 
 
 def _spec(s) -> tuple:
-    name, params = s
-    return str(name), {str(k): float(v) for k, v in dict(params or {}).items()}
+    """A (class, {parameter: value}) pair with its values as floats: SettingError naming ``param`` for parameters
+    that are no table of numbers (front ends check names and ranges against the model)."""
+    try:
+        name, params = s
+    except (TypeError, ValueError):
+        raise SettingError("noise", f"expected a (class, parameters) pair, got {s!r}") from None
+    if params is None:
+        params = {}
+    if not isinstance(params, dict):
+        raise SettingError("param", f"expected a table of parameter values, got {params!r}")
+    bad = [k for k, v in params.items() if isinstance(v, bool) or not isinstance(v, (int, float, np.number))]
+    if bad:
+        raise SettingError("param", f"{bad[0]}: expected a number, got {params[bad[0]]!r}")
+    return str(name), {str(k): float(v) for k, v in params.items()}
 
 
 @dataclass(frozen=True, eq=False)

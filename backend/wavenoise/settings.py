@@ -83,6 +83,9 @@ class WaveSettings:
     def validate(self) -> "WaveSettings":
         """The fields against :data:`backend.wavenoise.schema.WAVE_SETTINGS` (exact types, ranges, known
         names), then the rules that join fields; SettingError naming the first field that is wrong."""
+        for f in fields(self):        # None is "not given" only where it is the default (it would be left out)
+            if getattr(self, f.name) is None and f.default is not None:
+                raise SettingError(f.name, "expected a value, got None")
         try:
             d = {k: v for k, v in settings_to_dict(self).items() if v != []}  # () is a tuple setting left unset
         except (TypeError, ValueError) as exc:  # a tuple field holding something that is not a number

@@ -1,0 +1,41 @@
+"""The Python API (omninoise.wave, neural, solid) refuses a bad argument with a SettingError naming it, before any
+work: never a TypeError, ValueError or AttributeError from deep inside, never a file opened by a number."""
+import numpy as np
+import pytest
+
+import omninoise
+from omninoise.backend.errors import SettingError
+
+CASES = [
+    (lambda: omninoise.wave(8, seed=None), "seed", "expected a value, got None"),
+    (lambda: omninoise.wave(8, spectrum=None), "spectrum", "expected a value, got None"),
+    (lambda: omninoise.wave(8, directions=None), "directions", "expected a value, got None"),
+    (lambda: omninoise.wave(8, extent=1e300), "extent", r"must lie in \[1e-06, 1e\+07\]"),
+    (lambda: omninoise.wave(8, extent=0), "extent", "must lie in"),
+    (lambda: omninoise.wave(8, out=3), "out", "expected a file path, got 3"),
+    (lambda: omninoise.wave(8, transfer=3, out="x.png"), "transfer", "expected a preset name or a ramp .json file"),
+    (lambda: omninoise.neural("perlin", 16, steps=1, params={"scale": "x"}), "param", "scale: expected a number"),
+    (lambda: omninoise.neural("perlin", 16, steps=1, params=[1]), "param", "expected a table of parameter values"),
+    (lambda: omninoise.neural("perlin", 16, steps=1, params={"scale": True}), "param", "expected a number"),
+    (lambda: omninoise.solid("grass", 8, out=3), "out", "expected a file path"),
+    (lambda: omninoise.solid(np.full((8, 8, 3), 200, np.uint8), 8), "exemplar", "divide 8-bit pixels by 255"),
+]
+
+
+@pytest.mark.parametrize("call, setting, why", CASES)
+def test_a_bad_argument_is_a_setting_error_naming_it(call, setting, why, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SettingError, match=why) as exc:
+        call()
+    assert exc.value.setting == setting
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_transfer_path_may_be_a_path_object(tmp_path):
+    """A pathlib.Path is a path like a str (out and transfer)."""
+    import json
+
+    ramp = tmp_path / "ramp.json"
+    ramp.write_text(json.dumps({"range": [-1, 1], "stops": [[0, [0, 0, 0, 0]], [1, [1, 1, 1, 1]]]}))
+    assert str(omninoise.wave(8, out=tmp_path / "o.png", transfer=ramp)) == str(tmp_path / "o.png")
+    assert (tmp_path / "o.png").stat().st_size > 0
