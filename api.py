@@ -47,6 +47,11 @@ def _spectrum(value):
                                    f"got {value!r}")
 
 
+def _check_progress(progress) -> None:
+    if progress is not None and not callable(progress):
+        raise SettingError("progress", f"expected a function of the fraction done, or None, got {progress!r}")
+
+
 def _check_out(out: str, allowed: tuple, what: str) -> str:
     if not isinstance(out, (str, os.PathLike)):
         raise SettingError("out", f"expected a file path, got {out!r}")
@@ -89,6 +94,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     from .backend.transfer import load_transfer
     from .backend.wavenoise.settings import WaveSettings
 
+    _check_progress(progress)
     size = _check_size(size)
     limits.in_range("extent", extent, limits.MIN_LENGTH, limits.MAX_COORD)
     limits.time("time", time)
@@ -131,6 +137,7 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     from .backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
     from .backend.paths import neural_model
 
+    _check_progress(progress)
     size = _check_size(size, 8)
     if out is not None:
         _check_out(out, (".png", ".exr", ".npy"), "a neural noise image")
@@ -176,6 +183,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     from .backend.colour import srgb_to_linear
     from .backend.solid.request import SolidRequest
 
+    _check_progress(progress)
     size = _check_size(size)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
@@ -233,6 +241,7 @@ def bake(job: str, *, only: list | None = None, force: bool = False, keep_going:
     """
     from .backend.jobs import run_job
 
+    _check_progress(progress)
     if not isinstance(job, (str, os.PathLike)) or not os.path.isfile(job):
         raise SettingError("job", f"job file not found: {job!r}")
     return run_job(os.fspath(job), keep_going=keep_going, force=force, only=only, progress=progress)

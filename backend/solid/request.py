@@ -130,6 +130,8 @@ class SolidRequest:
             raise bad("families", f"names {', '.join(twice)} more than once")
         for key in ("exemplar", "to"):
             check_pixels_given(getattr(self, key), f"{where}{key}")
+        if self.model is not None and not isinstance(self.model, str):
+            raise bad("model", f"expected a model folder or a shipped model's name, got {self.model!r}")
         if self.method in IMAGE_METHODS:
             m, ex = self.method, self.exemplar
             if isinstance(ex, str) and not os.path.isfile(ex):

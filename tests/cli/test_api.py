@@ -19,6 +19,11 @@ CASES = [
     (lambda: omninoise.neural("perlin", 16, steps=1, params={"scale": True}), "param", "expected a number"),
     (lambda: omninoise.solid("grass", 8, out=3), "out", "expected a file path"),
     (lambda: omninoise.solid(np.full((8, 8, 3), 200, np.uint8), 8), "exemplar", "divide 8-bit pixels by 255"),
+    (lambda: omninoise.solid("grass", 8, model=3), "model", "expected a model folder or a shipped model's name"),
+    (lambda: omninoise.solid("grass", 8, progress=3), "progress", "expected a function of the fraction done"),
+    (lambda: omninoise.wave(8, progress="bar"), "progress", "expected a function"),
+    (lambda: omninoise.neural("perlin", 16, steps=1, progress=1), "progress", "expected a function"),
+    (lambda: omninoise.bake("job.toml", progress=1), "progress", "expected a function"),
 ]
 
 
