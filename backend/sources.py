@@ -786,7 +786,12 @@ def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
         except export.ImageError as exc:
             raise SettingError("source.example", str(exc)) from None
     w_offset = limits.finite("source.w_offset", d.pop("w_offset", 0.0))
-    return WaveSource(settings_from_dict(d, example), w_offset)
+    try:
+        settings = settings_from_dict(d, example)
+    except SettingError as exc:      # the settings' own rules name their keys; a job's are under [bake.source]
+        name = exc.setting if exc.setting.startswith("source") else f"source.{exc.setting}"
+        raise SettingError(name, exc.message) from None
+    return WaveSource(settings, w_offset)
 
 
 #: kind -> builder(table without "kind", base_dir) -> source.  A new kind of source is one module with a class

@@ -97,7 +97,11 @@ class WaveSettings:
             if self.dim not in (2, 3):
                 raise SettingError("example", "by-example noise is 2D or 3D")
             check_example(self.example)
-        self.spectrum.validate()
+        try:
+            self.spectrum.validate()
+        except SettingError as exc:
+            name = exc.setting if exc.setting.startswith("spectrum") else f"spectrum.{exc.setting}"
+            raise SettingError(name, exc.message) from None
         return self
 
     def max_frequency(self) -> float:

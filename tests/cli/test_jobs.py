@@ -85,6 +85,8 @@ def test_job_paths_are_relative_to_the_job_file(job, tmp_path, monkeypatch):
     (('seed = 4', 'seed = 4\nsped = 2'), r"bake 'marble': source.sped: unknown key \(did you mean speed\?\)"),
     (('name = "marble"', 'name = "clouds"'), "bake 'clouds': the name is used twice"),
     (('time_step = 0.5', 'time_step = 0.5\ncolour = 1'), "bake 'clouds': colour: unknown key"),
+    (("fmin = 1, fmax = 6}", "fmin = 7, fmax = 6}"), "bake 'clouds': source.spectrum.fmin: 7 is greater than fmax 6"),
+    (("fmin = 2\nfmax = 4", "fmin = 5\nfmax = 4"), "bake 'marble': source.spectrum.fmin: 5 is greater than fmax 4"),
 ])
 def test_bad_bakes_are_named_and_nothing_is_baked(job, edit, match):
     job.write_text(JOB.replace(*edit))
