@@ -383,7 +383,13 @@ def _material_with(obj, name: str, make_node):
     return mat
 
 
-class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
+class SolidTask(TaskOperator):
+    """The Solid Texture panel's operators: the request's exemplar is the panel's Image in their errors."""
+
+    setting_names = {"exemplar": "image"}
+
+
+class OMNINOISE_OT_solid_preview(SolidTask, bpy.types.Operator):
     """Preview the solid texture: a 128 px slice through the texture (the plane y = 0 seen from the front, z up) as an image"""
 
     bl_idname = "omninoise.solid_preview"
@@ -410,7 +416,7 @@ class OMNINOISE_OT_solid_preview(TaskOperator, bpy.types.Operator):
         return tasks.start(tasks.Task("Solid preview", work, done, None, threads()), blocking=blocking)
 
 
-class OMNINOISE_OT_solid_tileable(TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_solid_tileable(SolidTask, bpy.types.Operator):
     """Make a seamless tileable image from the photo by rearranging its pieces (courses, planks, stones), for Image
     Texture nodes on UV-mapped surfaces"""
 
@@ -503,7 +509,7 @@ class OMNINOISE_OT_solid_tile_material(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
     """Bake the solid texture onto the active object: a UV image, a color attribute or a volume"""
 
     bl_idname = "omninoise.solid_bake"
@@ -616,7 +622,7 @@ class OMNINOISE_OT_solid_bake(TaskOperator, bpy.types.Operator):
         return tasks.start(tasks.Task(f"Solid {name}", work, done, None, threads()), blocking=blocking)
 
 
-class OMNINOISE_OT_solid_procedural_node(TaskOperator, bpy.types.Operator):
+class OMNINOISE_OT_solid_procedural_node(SolidTask, bpy.types.Operator):
     """Fit a procedural solid to the photo and give the active object a material drawing it live from nodes: a node
     group whose inputs (spacing, sizes, turbulence...) can be edited afterwards"""
 

@@ -45,6 +45,7 @@ class Task:
         self.progress = 0.0
         self.status = "running"  # running | done | failed | cancelled
         self.message = ""
+        self.error: Exception | None = None     # what failed the work, for the operator to name in its terms
         self.result = None
         self.started = time.perf_counter()
         self._cancel = threading.Event()
@@ -79,7 +80,7 @@ class Task:
         except backend.Cancelled:
             self.status = "cancelled"
         except (backend.SettingError, OSError, ValueError, RuntimeError) as exc:
-            self.status, self.message = "failed", str(exc)
+            self.status, self.message, self.error = "failed", str(exc), exc
         except Exception as exc:  # an engine bug: keep the trace for the console, one line for the UI
             traceback.print_exc()
             self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"
@@ -196,6 +197,18 @@ class TaskOperator:
     blocking: BoolProperty(name="Blocking", description="Wait for the work to finish (scripts)", default=False,
                            options={"SKIP_SAVE", "HIDDEN"})
 
+    #: the backend's names of settings -> the panel's (a solid's "exemplar" is the panel's Image)
+    setting_names: dict = {}
+
+    def _said(self, exc: Exception) -> str:
+        """An error in one line, a setting named as the panel names it."""
+        if isinstance(exc, backend.SettingError) and exc.setting in self.setting_names:
+            return f"{self.setting_names[exc.setting]}: {exc.message}"
+        return str(exc)
+
+    def _failure(self, task) -> str:
+        return self._said(task.error) if task.error is not None else (task.message or task.status)
+
     @classmethod
     def poll(cls, context):
         return current() is None
@@ -213,7 +226,7 @@ class TaskOperator:
         try:
             return self._start(context, blocking)
         except refused as exc:
-            self.report({"ERROR"}, str(exc))
+            self.report({"ERROR"}, self._said(exc))
             return None
 
     def execute(self, context):
@@ -221,7 +234,7 @@ class TaskOperator:
         if task is None:
             return {"CANCELLED"}
         if task.status != "done":
-            self.report({"ERROR"} if task.status == "failed" else {"WARNING"}, task.message or task.status)
+            self.report({"ERROR"} if task.status == "failed" else {"WARNING"}, self._failure(task))
             return {"CANCELLED"}
         return {"FINISHED"}
 
@@ -238,7 +251,7 @@ class TaskOperator:
         task = self._task
         if not task.running:
             if task.status == "failed":
-                self.report({"ERROR"}, task.message)
+                self.report({"ERROR"}, self._failure(task))
             elif task.status == "cancelled":
                 self.report({"WARNING"}, f"{task.label}: cancelled")
             return {"FINISHED"} if task.status == "done" else {"CANCELLED"}
