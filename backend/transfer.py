@@ -65,6 +65,9 @@ class TransferFunction:
         for p, c in self.stops:
             if len(c) != 4:
                 raise SettingError("stops", f"colour at {p:g} needs 4 values (r, g, b, a), got {len(c)}")
+            if c[3] > 1.0:
+                raise SettingError("stops", f"the alpha of the stop at {p:g} must lie in [0, 1] (density_scale "
+                                            f"scales a volume's density), got {c[3]:g}")
         v0, v1 = self.range
         if v0 == v1:
             raise SettingError("range", f"needs two different values, got {tuple(self.range)}")
@@ -169,10 +172,14 @@ def transfer_from_dict(d: dict, where: str = "transfer") -> TransferFunction:
     base.update({k: v for k, v in d.items() if k != "preset"})
     if "stops" not in base:
         raise SettingError(where, "needs stops (or a preset)")
-    return TransferFunction(
+    tf = TransferFunction(
         stops=tuple(_stop(s, f"{where}.stops") for s in base["stops"]), range=tuple(base.get("range", (-1.5, 1.5))),
         interpolation=base.get("interpolation", "linear"), density_scale=float(base.get("density_scale", 1.0)),
-        temperature=tuple((float(p), float(k)) for p, k in base.get("temperature") or ())).validate()
+        temperature=tuple((float(p), float(k)) for p, k in base.get("temperature") or ()))
+    try:
+        return tf.validate()
+    except SettingError as exc:        # the ramp's own rules, named as the schema names its keys
+        raise SettingError(f"{where}.{exc.setting}" if where else exc.setting, exc.message) from None
 
 
 def load_transfer(spec: str) -> TransferFunction:
@@ -226,7 +233,7 @@ def preset(name: str) -> TransferFunction:
 
 
 #: the keys of a ramp table (a job file's ``transfer = {...}``, a ramp .json file)
-COLOR = ListOf(Float(-1e6, 1e6), 3, 4)
+COLOR = ListOf(Float(0.0, 1e6), 3, 4)     #: scene-linear r, g, b (above 1 for a glow) and alpha
 TRANSFER = Table({
     "preset": Field(Choice(tuple(PRESETS)), "start from a preset; other keys override it"),
     "range": Field(Items((Float(), Float()), "[v0, v1]"), "noise values mapped to ramp positions 0 and 1",

@@ -97,3 +97,21 @@ def test_presets_fill_part_of_a_wave_volume(name):
 def test_validates_as_a_dataclass():
     with pytest.raises(SettingError, match=r"stops: expected 1 to 4096 items, got 0"):
         TransferFunction(stops=()).validate()
+
+
+@pytest.mark.parametrize("stops, setting, why", [
+    ([[0, [-1, 0, 0, 0]], [1, [1, 1, 1, 1]]], r"ramp.json.stops\[0\]\[1\]\[0\]", r"must lie in \[0, 1000000\]"),
+    ([[0, [0, 0, 0, 0]], [1, [5, 1, 1, 2]]], "ramp.json.stops", "the alpha of the stop at 1 must lie in"),
+    ([[1, [0, 0, 0, 0]], [0, [1, 1, 1, 1]]], "ramp.json.stops", "positions must be sorted"),
+])
+def test_a_ramp_file_s_colours_and_rules_are_named_under_its_file(stops, setting, why):
+    """Scene-linear colours are not negative (a glow may pass 1); alpha lies in [0, 1] (a negative alpha made a
+    negative density); an error of the ramp's own rules is named under the file as the schema's are."""
+    from omninoise.backend.errors import SettingError
+    from omninoise.backend.transfer import transfer_from_dict
+
+    with pytest.raises(SettingError, match=why) as exc:
+        transfer_from_dict({"range": [0, 1], "stops": stops}, "ramp.json")
+    assert __import__("re").fullmatch(setting, exc.value.setting), exc.value.setting
+    glow = transfer_from_dict({"range": [0, 1], "stops": [[0, [0, 0, 0, 0]], [1, [5, 2, 1, 1]]]}, "ramp.json")
+    assert glow.rgba(np.array([1.0], np.float32))[0].tolist() == [5.0, 2.0, 1.0, 1.0]
