@@ -221,3 +221,41 @@ def test_settings_key_and_the_key_of_older_files():
     del grp[LEGACY_SETTINGS_KEY]
     assert tree_settings_json(grp) is None
     bpy.data.node_groups.remove(grp)
+
+
+def test_in_the_interface_a_setting_rebuilds_its_group_once_it_rests(monkeypatch):
+    """A dragged slider changes a setting many times a second and a rebuild takes 0.5 s or more: in the interface
+    the group is rebuilt once, REBUILD_DELAY_S after the last change, with the last values; a group removed
+    meanwhile is skipped.  Scripts (background Blender) rebuild at once."""
+    from omninoise import blender_addon
+    from omninoise.blender_addon import wave_ui
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    blender_addon.register()
+    registered = []                                             # the timer, as bpy.app.timers would hold it
+    try:
+        tree = wave_ui.new_wave_node_tree("Wave", "ShaderNodeTree")
+        props = tree.omninoise_wave
+        props.fmin = 1.5                                        # background: at once
+        assert settings_from_json(tree[SETTINGS_KEY]).spectrum.fmin == 1.5
+        built = []
+        real = wave_ui.build_wave_group
+        monkeypatch.setattr(wave_ui, "build_wave_group", lambda s, **k: built.append(s.spectrum.fmin) or real(s, **k))
+        monkeypatch.setattr(wave_ui, "deferred", lambda: True)
+        monkeypatch.setattr(bpy.app.timers, "register", lambda f, first_interval=0.0: registered.append(f))
+        monkeypatch.setattr(bpy.app.timers, "is_registered", lambda f: f in registered)
+        for v in (2.0, 2.5, 3.0):                               # a drag
+            props.fmin = v
+        assert built == [] and registered == [wave_ui.rebuild_due]
+        assert settings_from_json(tree[SETTINGS_KEY]).spectrum.fmin == 1.5
+        assert 0.0 < wave_ui.rebuild_due() <= wave_ui.REBUILD_DELAY_S      # not yet at rest: look again
+        monkeypatch.setattr(wave_ui, "_due_at", [0.0])
+        assert wave_ui.rebuild_due() is None and built == [3.0]
+        assert settings_from_json(tree[SETTINGS_KEY]).spectrum.fmin == 3.0 and not props.error
+        props.fmin = 4.0
+        bpy.data.node_groups.remove(tree)
+        monkeypatch.setattr(wave_ui, "_due_at", [0.0])
+        assert wave_ui.rebuild_due() is None and built == [3.0]
+    finally:
+        registered.clear()
+        blender_addon.unregister()
