@@ -47,7 +47,8 @@ from .wave_constants import OUTPUTS, stratum_constants
 
 __all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json",
            "settings_from_json", "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group",
-           "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY", "tree_implementation", "check_form"]
+           "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY", "tree_implementation", "check_form",
+           "SHAPE_KEY"]
 
 _F = np.float32
 SETTINGS_KEY = "omninoise_wave_settings"
@@ -62,6 +63,22 @@ def tree_settings_json(tree) -> str | None:
 IMPLEMENTATIONS = ("nodes", "osl")
 #: tree key holding the form a group was built in
 IMPLEMENTATION_KEY = "omninoise_wave_implementation"
+#: a node-form group's shape (everything but the constants a setting's change retunes) and, on it and on each
+#: stratum's sub-group, where those constants sit: a change of band, exponent, seed, speed or waveform that keeps
+#: the shape rewrites them and the table image in place instead of building every node again
+SHAPE_KEY = "omninoise_wave_shape"
+TUNED_KEY = "omninoise_wave_tuned"
+#: the stratum constants (wave_constants.stratum_constants) that are retuned in place
+TUNED = ("Slice Dir", "Slice Dir W", "Slice Offset", "Seed", "Inv Period", "Amplitude")
+
+
+class Tuned:
+    """A constant that :meth:`NodeBuilder.put` writes into a socket and records by name, to be retuned in place."""
+
+    __slots__ = ("name", "value")
+
+    def __init__(self, name: str, value):
+        self.name, self.value = name, value
 
 
 def tree_implementation(tree) -> str:
@@ -124,6 +141,7 @@ class NodeBuilder:
         self.geo = tree.bl_idname == "GeometryNodeTree"
         self.col = 0
         self.row = 0
+        self.tuned = []         # [socket path, Tuned name] of every Tuned constant put
 
     def new(self, kind: str, **props):
         n = self.tree.nodes.new(kind)
@@ -136,6 +154,9 @@ class NodeBuilder:
         return n
 
     def put(self, sock, v) -> None:
+        if isinstance(v, Tuned):
+            self.tuned.append([sock.path_from_id(), v.name])
+            v = v.value
         if isinstance(v, bpy.types.NodeSocket):
             self.tree.links.new(v, sock)
         elif isinstance(v, (tuple, list, np.ndarray)):
@@ -301,8 +322,10 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.typ
     b = NodeBuilder(tree)
     gi = b.new("NodeGroupInput")
     go = b.new("NodeGroupOutput")
+    tuned = {k: (Tuned(k, v) if k in TUNED and v is not None else v) for k, v in consts.items()}
     b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, img, rows,
-                                           mode, consts))
+                                           mode, tuned))
+    tree[TUNED_KEY] = json.dumps(b.tuned)
     return tree
 
 
@@ -449,31 +472,42 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     table = noise.table
     if table.mode not in ("single", "axes"):
         raise backend.SettingError("anisotropy", f"table mode {table.mode!r} has no node form")
+    amps = noise.dirs.amp
+    uniform = bool(np.all(amps == amps[0]))  # then one scale after the sum replaces 2 K multiplies
+    strata = [stratum_constants(noise, k) for k in range(noise.dirs.count)]
+    if uniform:
+        for consts in strata:
+            consts["Amplitude"] = None
+    # v t (Eq. 9) plus half a texel in world units: the lookup reads texel floor(c N - 1/2)
+    top = {"Speed": float(_F(noise.speed)), "Half Texel": float(_F(0.5 * noise.table.period / table.size)),
+           "Amplitude": float(amps[0])}
+    full = any(d.full for d in noise.dirs.domains)
+    shape = json.dumps([noise.dim, full, table.mode, table.values.shape[0], uniform,
+                        [{k: v for k, v in c.items() if k not in TUNED} for c in strata]])
+    img = ensure_table_image(table.values) if implementation == "nodes" else None
+    if tree is not None and implementation == "nodes" and _retune(tree, shape, strata, top, img):
+        tree[SETTINGS_KEY] = settings_to_json(settings)
+        return tree
     if tree is None:
         tree = new_wave_tree(name, tree_type)
     else:
         clear_tree(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
     tree[IMPLEMENTATION_KEY] = implementation
+    for key in (SHAPE_KEY, TUNED_KEY):
+        if key in tree:
+            del tree[key]
     if implementation == "osl":
         _build_osl(tree, noise)
         return tree
-    img = ensure_table_image(table.values)
     dim = noise.dim
-    full = any(d.full for d in noise.dirs.domains)
     b = NodeBuilder(tree)
     gi, go, x, w = group_io(b)
-    # v t (Eq. 9) plus half a texel in world units: the lookup reads texel floor(c N - 1/2)
-    shift = b.math("MULTIPLY_ADD", gi.outputs["Time"], float(_F(noise.speed)),
-                   float(_F(0.5 * noise.table.period / table.size)))
+    shift = b.math("MULTIPLY_ADD", gi.outputs["Time"], Tuned("Speed", top["Speed"]),
+                   Tuned("Half Texel", top["Half Texel"]))
     group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
     acc = (0.0, 0.0, 0.0)
-    amps = noise.dirs.amp
-    uniform = bool(np.all(amps == amps[0]))  # then one scale after the sum replaces 2 K multiplies
-    for k in range(noise.dirs.count):
-        consts = stratum_constants(noise, k)
-        if uniform:
-            consts["Amplitude"] = None
+    for k, consts in enumerate(strata):
         node = b.new(group_kind)
         node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
                                         table.values.shape[0], table.mode, consts)
@@ -484,13 +518,46 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
         b.put(node.inputs["Shift"], shift)
         acc = node.outputs["Sum"]
     if uniform:
-        acc = b.vmath("SCALE", acc, scale=float(amps[0]))
+        acc = b.vmath("SCALE", acc, scale=Tuned("Amplitude", top["Amplitude"]))
     re, im, _ = b.separate(acc)
     b.put(go.inputs["Value"], re)
     b.put(go.inputs["Imaginary"], im)
     b.put(go.inputs["Modulus"], b.vmath("LENGTH", acc))
     b.put(go.inputs["Phase"], b.math("ARCTAN2", im, re))
+    tree[TUNED_KEY] = json.dumps(b.tuned)
+    tree[SHAPE_KEY] = shape
     return tree
+
+
+def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: bpy.types.Image) -> bool:
+    """A node-form group of the same ``shape`` given its new constants (``strata``: each stratum's, ``top``: the
+    group's own) and table image in place; False where its shape differs, it was not built so or it was edited by
+    hand (the caller then builds it again, whole)."""
+    if tree.get(IMPLEMENTATION_KEY) != "nodes" or tree.get(SHAPE_KEY) != shape or TUNED_KEY not in tree:
+        return False
+    subs = [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
+    if len(subs) != len(strata) or any(t is None or TUNED_KEY not in t for t in subs):
+        return False
+
+    def put(t, path, value):
+        t.path_resolve(path).default_value = tuple(float(c) for c in value) if isinstance(value, tuple) \
+            else float(value)
+
+    try:                    # a group edited by hand (a node renamed or removed) is built again, whole
+        for path, name in json.loads(tree[TUNED_KEY]):
+            put(tree, path, top[name])
+        for sub, consts in zip(subs, strata):
+            for path, name in json.loads(sub[TUNED_KEY]):
+                put(sub, path, consts[name])
+    except (ValueError, KeyError, IndexError, TypeError, AttributeError):
+        return False
+    for sub in subs:
+        for n in sub.nodes:
+            if n.bl_idname == "ShaderNodeTexImage":
+                n.image = img
+            elif n.bl_idname == "GeometryNodeImageTexture":
+                n.inputs["Image"].default_value = img
+    return True
 
 
 def _build_osl(tree: bpy.types.NodeTree, noise) -> None:

@@ -259,3 +259,58 @@ def test_in_the_interface_a_setting_rebuilds_its_group_once_it_rests(monkeypatch
     finally:
         registered.clear()
         blender_addon.unregister()
+
+
+def _tree_dump(tree) -> list:
+    """Every node of a tree and its sub-groups, in order: kind, operation, inputs' values and links, image."""
+    out = []
+    for n in tree.nodes:
+        row = [n.bl_idname, getattr(n, "operation", None)]
+        for s in n.inputs:
+            v = getattr(s, "default_value", None)
+            if isinstance(v, float):
+                v = round(v, 7)
+            elif v is not None and hasattr(v, "__len__") and not isinstance(v, str):
+                v = tuple(round(float(c), 7) for c in v)
+            elif v is not None and not isinstance(v, (int, bool, str)):
+                v = v.name                                   # an image socket (Geometry Nodes)
+            row.append((s.name, v, s.is_linked))
+        row.append(getattr(getattr(n, "image", None), "name", None))
+        if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup"):
+            row.append(_tree_dump(n.node_tree))
+        out.append(row)
+    return out
+
+
+@pytest.mark.parametrize("tree_type", ["ShaderNodeTree", "GeometryNodeTree"])
+@pytest.mark.parametrize("dim", [2, 3, 4])
+def test_a_change_that_keeps_the_group_s_shape_retunes_it_in_place(tree_type, dim, monkeypatch):
+    """A change of band, spectrum, seed or waveform (a slider's) rewrites the constants it moves and the table
+    image in place: the group equals one built afresh, node for node, and no node is made; a change of the
+    directions' count builds it again."""
+    from omninoise.blender_addon import wave_nodes
+
+    base = WaveSettings(dim=dim, directions=6, spectrum=Spectrum("gaussian", 2, 8))
+    tree = build_wave_group(base, tree_type)
+    for change in (dict(spectrum=Spectrum("gaussian", 2.5, 7)), dict(spectrum=Spectrum("fractal", 1, 8, 1.3)),
+                   dict(seed=5), dict(waveform="crystal"), dict(speed=0.7), dict(speed=1.4)):
+        s = base.replace(**change)
+        made = []
+        real_new = wave_nodes.NodeBuilder.new
+        monkeypatch.setattr(wave_nodes.NodeBuilder, "new",
+                            lambda self, *a, **k: made.append(1) or real_new(self, *a, **k))
+        build_wave_group(s, tree=tree)
+        monkeypatch.undo()
+        assert settings_from_json(tree[SETTINGS_KEY]) == s
+        assert _tree_dump(tree) == _tree_dump(build_wave_group(s, tree_type)), change
+        if change != dict(speed=0.7):                     # a speed from 0 turns the directions over the whole sphere
+            assert made == [], change
+        base = s
+    build_wave_group(base.replace(directions=7), tree=tree)
+    assert sum(n.bl_idname.endswith("Group") for n in tree.nodes) == 7
+    sub = next(n.node_tree for n in tree.nodes if n.bl_idname.endswith("Group"))
+    for n in list(sub.nodes)[:40]:                        # edited by hand: built again, whole
+        n.name = n.name + " edited"
+    s = base.replace(directions=7, seed=9)
+    build_wave_group(s, tree=tree)
+    assert _tree_dump(tree) == _tree_dump(build_wave_group(s, tree_type))
