@@ -789,8 +789,7 @@ def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
     try:
         settings = settings_from_dict(d, example)
     except SettingError as exc:      # the settings' own rules name their keys; a job's are under [bake.source]
-        name = exc.setting if exc.setting.startswith("source") else f"source.{exc.setting}"
-        raise SettingError(name, exc.message) from None
+        raise exc.under("source") from None
     return WaveSource(settings, w_offset)
 
 

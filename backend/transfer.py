@@ -179,7 +179,7 @@ def transfer_from_dict(d: dict, where: str = "transfer") -> TransferFunction:
     try:
         return tf.validate()
     except SettingError as exc:        # the ramp's own rules, named as the schema names its keys
-        raise SettingError(f"{where}.{exc.setting}" if where else exc.setting, exc.message) from None
+        raise exc.under(where) from None
 
 
 def load_transfer(spec: str) -> TransferFunction:

@@ -15,6 +15,8 @@ engine or the OSL switch changes in the interface.
 """
 from __future__ import annotations
 
+import time
+
 import bpy
 from bl_operators.presets import AddPresetBase
 from bl_ui.utils import PresetPanel
@@ -111,8 +113,6 @@ def deferred() -> bool:
 def rebuild(props, context) -> None:
     """Rebuild the node group holding ``props`` (nothing for the bake panel's settings, which no tree holds): at
     once in scripts, in the interface once its settings rest for REBUILD_DELAY_S (:func:`rebuild_due`)."""
-    import time
-
     if not props.is_wave or getattr(props.id_data, "is_evaluated", False):
         return
     scene = getattr(context, "scene", None)
@@ -128,8 +128,6 @@ def rebuild(props, context) -> None:
 def rebuild_due():
     """The timer behind :func:`rebuild`: each group whose settings changed, rebuilt once they rest (a group or
     scene removed meanwhile is skipped); seconds until it looks again, or None when nothing is due."""
-    import time
-
     wait = _due_at[0] - time.monotonic()
     if wait > 0.0:
         return wait

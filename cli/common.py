@@ -80,6 +80,16 @@ class Bar:
         sys.stderr.flush()
 
 
+def flag_image(flag: str, read, path: str):
+    """``read(path)``, one of export's image readers, with an image it cannot use named by ``flag``."""
+    from omninoise.export.images import ImageError
+
+    try:
+        return read(path)
+    except ImageError as exc:
+        raise SettingError(flag, str(exc)) from None
+
+
 def set_threads(n: int, precision: str = "fp32") -> None:
     """The CLI's --threads and --precision as the defaults of every model the command loads."""
     from omninoise.backend.neural.precision import set_default_precision

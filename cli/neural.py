@@ -12,7 +12,7 @@ from omninoise.backend.neural.animate import LATENT_MODES
 from omninoise.backend.neural.precision import PRECISIONS
 from omninoise.backend.paths import neural_model
 
-from .common import Bar, add_command, class_args, param_items, set_threads
+from .common import Bar, add_command, class_args, flag_image, param_items, set_threads
 
 __all__ = ["add_parser", "run", "neural_request"]
 
@@ -83,17 +83,14 @@ def _spec_arg(text: str, flag: str) -> tuple:
 
 def _painted_parts(a: argparse.Namespace) -> tuple:
     """--map and its --region flags -> (regions int (H, W) into specs, specs)."""
-    from omninoise.export.images import ImageError, decode
+    from omninoise.export.images import decode
     from omninoise.backend.neural.request import region_key, regions_from_map
 
     if not os.path.isfile(a.map):
         raise SettingError("--map", f"map not found: {a.map}")
     if not a.region:
         raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
-    try:
-        px = decode(a.map)
-    except ImageError as exc:
-        raise SettingError("--map", str(exc)) from None
+    px = flag_image("--map", decode, a.map)
     if px.shape[:2] != (a.size, a.size):
         raise SettingError("--map", f"map is {px.shape[1]}x{px.shape[0]} but --size is {a.size}")
     keys, specs = [], []
@@ -128,14 +125,11 @@ def neural_request(a: argparse.Namespace, model):
         regions, specs = _painted_parts(a)
         req = NeuralRequest("painted", specs, regions=regions, **kw)
     elif a.blend:
-        from omninoise.export.images import ImageError, read_image
+        from omninoise.export.images import read_image
 
         if not os.path.isfile(a.blend):
             raise SettingError("--blend", f"mask not found: {a.blend}")
-        try:
-            mask = read_image(a.blend)
-        except ImageError as exc:
-            raise SettingError("--blend", str(exc)) from None
+        mask = flag_image("--blend", read_image, a.blend)
         if mask.shape != (a.size, a.size):
             raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
         spec2 = (a.noise2 or a.noise, param_items(a.param2, "--param2"))
@@ -249,7 +243,7 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     import json
 
     from omninoise.export.atomic import write_json
-    from omninoise.export.images import ImageError, decode, opaque, write_unit_image
+    from omninoise.export.images import decode, opaque, write_unit_image
     from omninoise.backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
     from omninoise.backend.neural.generate import generate
     from omninoise.backend.onnx_models import ModelError
@@ -266,10 +260,7 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
     if not os.path.isfile(a.fit):
         raise SettingError("--fit", f"image not found: {a.fit}")
-    try:
-        img = opaque(decode(a.fit), a.fit)
-    except ImageError as exc:
-        raise SettingError("--fit", str(exc)) from None
+    img = flag_image("--fit", lambda path: opaque(decode(path), path), a.fit)
     try:
         bank = load_bank(fit_bank())
     except ModelError as exc:  # the fit still works, starting from every class at mid-range parameters

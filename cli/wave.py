@@ -18,7 +18,7 @@ from omninoise.backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
 from omninoise.backend.wavenoise.tables import WAVEFORMS
 from omninoise.backend.wavenoise.wave import OUTPUTS
 
-from .common import Bar, add_command
+from .common import Bar, add_command, flag_image
 
 __all__ = ["add_parser", "run", "settings_from_args"]
 
@@ -119,12 +119,9 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
     if a.example:
         if not os.path.isfile(a.example):
             raise SettingError("--example", f"image not found: {a.example}")
-        from omninoise.export.images import ImageError, read_image
+        from omninoise.export.images import read_image
 
-        try:
-            example = read_image(a.example)
-        except ImageError as exc:
-            raise SettingError("--example", str(exc)) from None
+        example = flag_image("--example", read_image, a.example)
     profile = ()
     if a.waveform == "custom":
         if not a.profile:

@@ -100,8 +100,7 @@ class WaveSettings:
         try:
             self.spectrum.validate()
         except SettingError as exc:
-            name = exc.setting if exc.setting.startswith("spectrum") else f"spectrum.{exc.setting}"
-            raise SettingError(name, exc.message) from None
+            raise exc.under("spectrum") from None
         return self
 
     def max_frequency(self) -> float:
