@@ -11,9 +11,10 @@ It computes what :class:`backend.wavenoise.cellular.CellularNoise` computes with
     code  = h(slab, code, 26, seed)                                  (chained over families)
 
 Outputs: Cell = the final code (a grey id per polytope, Fig. 11c), Distance =
-min_f d_f in world units (polytope borders, Fig. 11a).  Constants (normals,
-offsets) are computed by the backend and written into socket defaults.  STIT
-recursion (depth > 0) stays bake-only.
+min_f d_f in world units (polytope borders, Fig. 11a).  Each family is one
+sub-group, chained through the running Distance and Code; its constants (normal,
+offset) are computed by the backend and written into its nodes' socket defaults.
+STIT recursion (depth > 0) stays bake-only.
 """
 from __future__ import annotations
 
@@ -37,15 +38,71 @@ def new_cellular_tree(name: str = "Wave Cellular", tree_type: str = "ShaderNodeT
 
 
 def _value(b: NodeBuilder, x, y, z, w):
+    """Blender's White Noise Texture (4D) at (x, y, z, w) -> its Value, read as Value + |Color - Color| (exactly the
+    Value): Cycles' SVM compiler keeps an output that nothing reads on its 255-float stack for the whole shader,
+    three floats for each unread Color, four Colors per plane family.  With the families' wait on the running
+    values (:func:`_family_group`) the largest direction counts the node offers compile; without either, a
+    shader reading Distance overflowed from 12 directions in 2D and bakes black."""
     node = b.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
     b.put(node.inputs["Vector"], b.combine(x, y, z))
     b.put(node.inputs["W"], w)
-    return node.outputs["Value"]
+    colour = node.outputs["Color"]
+    return b.math("ADD", node.outputs["Value"], b.vmath("DISTANCE", colour, colour))
+
+
+#: a family sub-group's inputs: the running Distance and Code, the scaled Position and W
+_FAMILY_INPUTS = (("Distance", "NodeSocketFloat", None), ("Code", "NodeSocketFloat", None),
+                  ("Position", "NodeSocketVector", None), ("W", "NodeSocketFloat", None))
+#: the first family's Distance in: min(FAR, d) is d exactly
+FAR = float(np.finfo(np.float32).max)
+
+
+def _family_group(name: str, tree_type: str, f: int, normal, inv: float, off: float, size: float, seed: float,
+                  dim: int) -> bpy.types.NodeTree:
+    """Sub-group for plane family ``f``: (Distance, Code) in -> (min(Distance, d_f), h(slab, Code, 26, seed)) out.
+
+    The family's constants are written into its nodes' sockets, as the Wave Noise node's strata are (a constant
+    group input would wait on Cycles' SVM stack).  One small tree per family: Blender adds a node, a link or a
+    value in time that grows with its tree's node count, so one tree of every family's nodes builds in time that
+    grows with the square of the directions (64 directions in 2D: 3971 nodes, 97 s in Blender 4.2).
+    """
+    tree = new_group(name, tree_type, _FAMILY_INPUTS, (("Distance", "NodeSocketFloat"), ("Code", "NodeSocketFloat")))
+    b = NodeBuilder(tree)
+    gi = b.new("NodeGroupInput")
+    go = b.new("NodeGroupOutput")
+    # Position + (r - r), r = (Distance, Code, 0), exactly the position: every node of the family waits on both
+    # running values, so Cycles' SVM compiler finishes family f before it starts family f + 1 (it emits any node
+    # whose inputs are ready, and held every family's hashes on its 255-float stack at once)
+    running = b.combine(gi.outputs["Distance"], gi.outputs["Code"])
+    x = b.vmath("ADD", gi.outputs["Position"], b.vmath("SUBTRACT", running, running))
+    w = gi.outputs["W"]
+    n3 = tuple(float(v) for v in (list(normal[:3]) + [0.0] * 3)[:3])
+    dot = b.vmath("DOT_PRODUCT", x, n3)
+    if dim == 4:
+        dot = b.math("MULTIPLY_ADD", w, float(normal[3]), dot)
+    p = b.math("MULTIPLY_ADD", dot, inv, off)
+    j = b.math("FLOOR", p)
+    o = b.math("SUBTRACT", p, j)
+
+    def plane(i):  # s(i) = 0.3 + 0.4 h(f, i, 25, seed)
+        return b.math("MULTIPLY_ADD", _value(b, float(f), i, float(_PLANE), seed), 0.4, 0.3)
+
+    here, nxt, prv = plane(j), plane(b.math("ADD", j, 1.0)), plane(b.math("SUBTRACT", j, 1.0))
+    below = b.math("LESS_THAN", o, here)  # 1 - above
+    up = b.math("SUBTRACT", b.math("ADD", nxt, 1.0), o)        # 1 + s(j+1) - φ
+    down = b.math("SUBTRACT", b.math("ADD", o, 1.0), prv)      # φ + 1 - s(j-1)
+    other = b.math("ADD", up, b.math("MULTIPLY", below, b.math("SUBTRACT", down, up)))
+    d = b.math("MULTIPLY", b.math("MINIMUM", b.math("ABSOLUTE", b.math("SUBTRACT", o, here)), other), size)
+    b.put(go.inputs["Distance"], b.math("MINIMUM", gi.outputs["Distance"], d))
+    slab = b.math("SUBTRACT", j, below)
+    b.put(go.inputs["Code"], _value(b, slab, gi.outputs["Code"], float(_CODE), seed))
+    return tree
 
 
 def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
                          name: str = "Wave Cellular") -> bpy.types.NodeTree:
-    """Build (or rebuild in place) the Wave Cellular group for ``settings`` (cellular polytope or code)."""
+    """Build (or rebuild in place) the Wave Cellular group for ``settings`` (cellular polytope or code): one
+    sub-group per plane family (:func:`_family_group`), chained through the running Distance and Code."""
     if settings.cellular not in ("polytope", "code"):
         raise backend.SettingError("cellular", "the node does polytope and code cells; STIT is bake-only")
     noise = backend.compile_noise(settings)
@@ -55,33 +112,21 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
         clear_tree(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
     seed = float(noise.seed)
-    C = noise.cell_size
-    inv = float(_F(1.0 / C))
+    inv = float(_F(1.0 / noise.cell_size))
     b = NodeBuilder(tree)
     _, go, x, w = group_io(b)
-    dim = noise.dim
-    dist, code = None, 0.0
+    group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
+    dist, code = FAR, 0.0
     for f, normal in enumerate(noise.normals):
-        n3 = tuple(float(v) for v in (list(normal[:3]) + [0.0] * 3)[:3])
-        off = float(np.asarray(backend.wavenoise.hashing.white_noise4(_F(f), _F(0), _F(_OFFSET), noise.seed)).reshape(-1)[0])
-        dot = b.vmath("DOT_PRODUCT", x, n3)
-        if dim == 4:
-            dot = b.math("MULTIPLY_ADD", w, float(normal[3]), dot)
-        p = b.math("MULTIPLY_ADD", dot, inv, off)
-        j = b.math("FLOOR", p)
-        o = b.math("SUBTRACT", p, j)
-        def plane(i, f=float(f)):  # s(i) = 0.3 + 0.4 h(f, i, 25, seed)
-            return b.math("MULTIPLY_ADD", _value(b, f, i, float(_PLANE), seed), 0.4, 0.3)
-
-        here, nxt, prv = plane(j), plane(b.math("ADD", j, 1.0)), plane(b.math("SUBTRACT", j, 1.0))
-        below = b.math("LESS_THAN", o, here)  # 1 - above
-        up = b.math("SUBTRACT", b.math("ADD", nxt, 1.0), o)        # 1 + s(j+1) - φ
-        down = b.math("SUBTRACT", b.math("ADD", o, 1.0), prv)      # φ + 1 - s(j-1)
-        other = b.math("ADD", up, b.math("MULTIPLY", below, b.math("SUBTRACT", down, up)))
-        d = b.math("MULTIPLY", b.math("MINIMUM", b.math("ABSOLUTE", b.math("SUBTRACT", o, here)), other), float(C))
-        dist = d if dist is None else b.math("MINIMUM", dist, d)
-        slab = b.math("SUBTRACT", j, below)
-        code = _value(b, slab, code, float(_CODE), seed)
+        off = float(np.asarray(backend.wavenoise.hashing.white_noise4(_F(f), _F(0), _F(_OFFSET), noise.seed)
+                               ).reshape(-1)[0])
+        node = b.new(group_kind)
+        node.node_tree = _family_group(f".{tree.name} family {f + 1}", tree.bl_idname, f, normal, inv, off,
+                                       float(noise.cell_size), seed, noise.dim)
+        node.label = f"Family {f + 1}"
+        for sock, v in (("Distance", dist), ("Code", code), ("Position", x), ("W", w)):
+            b.put(node.inputs[sock], v)
+        dist, code = node.outputs["Distance"], node.outputs["Code"]
     b.put(go.inputs["Cell"], code)
     b.put(go.inputs["Distance"], dist)
     return tree
