@@ -68,8 +68,25 @@ IMPLEMENTATION_KEY = "omninoise_wave_implementation"
 #: the shape rewrites them and the table image in place instead of building every node again
 SHAPE_KEY = "omninoise_wave_shape"
 TUNED_KEY = "omninoise_wave_tuned"
-#: the stratum constants (wave_constants.stratum_constants) that are retuned in place
-TUNED = ("Slice Dir", "Slice Dir W", "Slice Offset", "Seed", "Inv Period", "Amplitude")
+#: the stratum constants (wave_constants.stratum_constants, with :func:`_node_constants`' box corners) that are
+#: retuned in place
+TUNED = ("Slice Dir", "Slice Dir W", "Slice Offset", "Seed", "Inv Period", "Amplitude", "Box Lo 3", "Box Size 3",
+         "Box Lo W", "Box Size W")
+#: the stratum constants the nodes read only through others (the box, through its corners' sockets)
+_UNREAD = ("Box Lo", "Box Size")
+
+
+def _node_constants(consts: dict) -> dict:
+    """A stratum's constants (:func:`stratum_constants`) with its box as the nodes hold it: (0, lo0, lo1) and
+    (1, size0, size1), the offset and scale of the slice record (zeta, jitter 0, jitter 1), and lo2, size2 (4D)."""
+    lo, size = consts["Box Lo"], consts["Box Size"]
+    return dict(consts, **{"Box Lo 3": (0.0,) + tuple(lo[:2]), "Box Size 3": (1.0,) + tuple(size[:2]),
+                           "Box Lo W": lo[2], "Box Size W": size[2]})
+
+
+def _stratum_shape(consts: dict) -> str:
+    """What a stratum's sub-group is built from besides the constants it retunes (JSON)."""
+    return json.dumps({k: v for k, v in consts.items() if k not in TUNED and k not in _UNREAD})
 
 
 class Tuned:
@@ -326,6 +343,7 @@ def _stratum_group(name: str, tree_type: str, dim: int, full: bool, img: bpy.typ
     b.put(go.inputs["Sum"], _stratum_nodes(b, {s.name: s for s in gi.outputs if s.name}, dim, full, img, rows,
                                            mode, tuned))
     tree[TUNED_KEY] = json.dumps(b.tuned)
+    tree[SHAPE_KEY] = _stratum_shape(consts)
     return tree
 
 
@@ -350,9 +368,7 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, img: bpy.typ
     f = b.math("SUBTRACT", p, n0)
     n1 = b.math("ADD", n0, 1.0)
     k, seed = g["k"], g["Seed"]
-    box_lo, box_size = g["Box Lo"], g["Box Size"]
-    lo3 = (0.0,) + tuple(box_lo[:2])
-    size3 = (1.0,) + tuple(box_size[:2])
+    lo3, size3 = g["Box Lo 3"], g["Box Size 3"]
     waves = []
     for side, n in enumerate((n0, n1)):
         # (zeta, u0, u1) = (r, lo0 + size0 g, lo1 + size1 b) of node A
@@ -366,7 +382,7 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, img: bpy.typ
             u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wavenoise.wave.BLEND_HALF_WIDTH, 0.5)
         if dim == 4:
             jb = b.channel(b.white(k, n, STREAM["slice_b"], seed), 0)
-            uu.append(b.math("MULTIPLY_ADD", jb, box_size[2], box_lo[2]))
+            uu.append(b.math("MULTIPLY_ADD", jb, g["Box Size W"], g["Box Lo W"]))
         omega, om_w = _direction(b, uu, dim, full, g)
         dot = b.vmath("DOT_PRODUCT", x, omega)
         if om_w is not None:
@@ -399,12 +415,13 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, img: bpy.typ
 
 # -- the whole group ------------------------------------------------------------------
 
-def clear_tree(tree: bpy.types.NodeTree) -> None:
+def clear_tree(tree: bpy.types.NodeTree, keep=()) -> None:
+    """Remove every node of ``tree``, and the sub-groups left without a user but those in ``keep``."""
     for n in list(tree.nodes):
         if n.bl_idname == "ShaderNodeGroup" or n.bl_idname == "GeometryNodeGroup":
             sub = n.node_tree
             tree.nodes.remove(n)
-            if sub is not None and sub.users == 0:
+            if sub is not None and sub.users == 0 and sub not in keep:
                 bpy.data.node_groups.remove(sub)
         else:
             tree.nodes.remove(n)
@@ -474,7 +491,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
         raise backend.SettingError("anisotropy", f"table mode {table.mode!r} has no node form")
     amps = noise.dirs.amp
     uniform = bool(np.all(amps == amps[0]))  # then one scale after the sum replaces 2 K multiplies
-    strata = [stratum_constants(noise, k) for k in range(noise.dirs.count)]
+    strata = [_node_constants(stratum_constants(noise, k)) for k in range(noise.dirs.count)]
     if uniform:
         for consts in strata:
             consts["Amplitude"] = None
@@ -482,16 +499,18 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     top = {"Speed": float(_F(noise.speed)), "Half Texel": float(_F(0.5 * noise.table.period / table.size)),
            "Amplitude": float(amps[0])}
     full = any(d.full for d in noise.dirs.domains)
-    shape = json.dumps([noise.dim, full, table.mode, table.values.shape[0], uniform,
-                        [{k: v for k, v in c.items() if k not in TUNED} for c in strata]])
+    own = [noise.dim, full, table.mode, table.values.shape[0], uniform]
+    shape = json.dumps([own, [_stratum_shape(c) for c in strata]])
     img = ensure_table_image(table.values) if implementation == "nodes" else None
     if tree is not None and implementation == "nodes" and _retune(tree, shape, strata, top, img):
         tree[SETTINGS_KEY] = settings_to_json(settings)
         return tree
+    # a change of the directions' count keeps the strata it shares with the group, retuned (see _kept_strata)
+    kept = _kept_strata(tree, own) if tree is not None and implementation == "nodes" else []
     if tree is None:
         tree = new_wave_tree(name, tree_type)
     else:
-        clear_tree(tree)
+        clear_tree(tree, keep=kept)
     tree[SETTINGS_KEY] = settings_to_json(settings)
     tree[IMPLEMENTATION_KEY] = implementation
     for key in (SHAPE_KEY, TUNED_KEY):
@@ -509,8 +528,12 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     acc = (0.0, 0.0, 0.0)
     for k, consts in enumerate(strata):
         node = b.new(group_kind)
-        node.node_tree = _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
-                                        table.values.shape[0], table.mode, consts)
+        sub = kept[k] if k < len(kept) else None
+        if sub is not None and not _retune_stratum(sub, consts, img):
+            bpy.data.node_groups.remove(sub)
+            sub = None
+        node.node_tree = sub or _stratum_group(f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
+                                               table.values.shape[0], table.mode, consts)
         node.label = f"Direction {k + 1}"
         b.put(node.inputs["Sum"], acc)
         b.put(node.inputs["Position"], x)
@@ -526,38 +549,67 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     b.put(go.inputs["Phase"], b.math("ARCTAN2", im, re))
     tree[TUNED_KEY] = json.dumps(b.tuned)
     tree[SHAPE_KEY] = shape
+    for sub in kept[len(strata):]:
+        if sub.users == 0:
+            bpy.data.node_groups.remove(sub)
     return tree
+
+
+def _put(tree: bpy.types.NodeTree, path: str, value) -> None:
+    tree.path_resolve(path).default_value = tuple(float(c) for c in value) if isinstance(value, tuple) \
+        else float(value)
+
+
+def _retune_stratum(sub: bpy.types.NodeTree, consts: dict, img: bpy.types.Image) -> bool:
+    """A stratum's sub-group given ``consts`` and the table image in place; False where it was built from other
+    constants than those it retunes, not built so, or edited by hand (the caller then builds it again)."""
+    if sub.get(SHAPE_KEY) != _stratum_shape(consts) or TUNED_KEY not in sub:
+        return False
+    try:                    # a sub-group edited by hand (a node renamed or removed) is built again
+        for path, name in json.loads(sub[TUNED_KEY]):
+            _put(sub, path, consts[name])
+    except (ValueError, KeyError, IndexError, TypeError, AttributeError):
+        return False
+    for n in sub.nodes:
+        if n.bl_idname == "ShaderNodeTexImage":
+            n.image = img
+        elif n.bl_idname == "GeometryNodeImageTexture":
+            n.inputs["Image"].default_value = img
+    return True
+
+
+def _kept_strata(tree: bpy.types.NodeTree, own: list) -> list:
+    """The stratum sub-groups of a node-form group built with the group-level shape ``own`` (dimensions, table,
+    uniform amplitudes), in order; [] for another shape.  A change of the directions' count keeps them: the
+    strata it shares are retuned (a stratum's box and slice move with the count, its nodes do not), those it
+    adds are built, those it drops removed (Blender 4.2, 4D, 64 -> 48 directions: 0.7 s, 6.9 s built afresh;
+    3D, 16 -> 17: 0.05 s, 0.36 s)."""
+    if tree.get(IMPLEMENTATION_KEY) != "nodes" or SHAPE_KEY not in tree:
+        return []
+    try:
+        if json.loads(tree[SHAPE_KEY])[0] != own:
+            return []
+    except (ValueError, IndexError, TypeError, KeyError):
+        return []
+    subs = [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
+    return [t for t in subs if t is not None and TUNED_KEY in t]
 
 
 def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: bpy.types.Image) -> bool:
     """A node-form group of the same ``shape`` given its new constants (``strata``: each stratum's, ``top``: the
     group's own) and table image in place; False where its shape differs, it was not built so or it was edited by
-    hand (the caller then builds it again, whole)."""
+    hand (the caller then builds it again)."""
     if tree.get(IMPLEMENTATION_KEY) != "nodes" or tree.get(SHAPE_KEY) != shape or TUNED_KEY not in tree:
         return False
     subs = [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
-    if len(subs) != len(strata) or any(t is None or TUNED_KEY not in t for t in subs):
+    if len(subs) != len(strata) or any(t is None for t in subs):
         return False
-
-    def put(t, path, value):
-        t.path_resolve(path).default_value = tuple(float(c) for c in value) if isinstance(value, tuple) \
-            else float(value)
-
-    try:                    # a group edited by hand (a node renamed or removed) is built again, whole
+    try:                    # a group edited by hand (a node renamed or removed) is built again
         for path, name in json.loads(tree[TUNED_KEY]):
-            put(tree, path, top[name])
-        for sub, consts in zip(subs, strata):
-            for path, name in json.loads(sub[TUNED_KEY]):
-                put(sub, path, consts[name])
+            _put(tree, path, top[name])
     except (ValueError, KeyError, IndexError, TypeError, AttributeError):
         return False
-    for sub in subs:
-        for n in sub.nodes:
-            if n.bl_idname == "ShaderNodeTexImage":
-                n.image = img
-            elif n.bl_idname == "GeometryNodeImageTexture":
-                n.inputs["Image"].default_value = img
-    return True
+    return all(_retune_stratum(sub, consts, img) for sub, consts in zip(subs, strata))
 
 
 def _build_osl(tree: bpy.types.NodeTree, noise) -> None:

@@ -287,7 +287,7 @@ def _tree_dump(tree) -> list:
 def test_a_change_that_keeps_the_group_s_shape_retunes_it_in_place(tree_type, dim, monkeypatch):
     """A change of band, spectrum, seed or waveform (a slider's) rewrites the constants it moves and the table
     image in place: the group equals one built afresh, node for node, and no node is made; a change of the
-    directions' count builds it again."""
+    directions' count keeps the strata it shares, retuned, and builds only those it adds."""
     from omninoise.blender_addon import wave_nodes
 
     base = WaveSettings(dim=dim, directions=6, spectrum=Spectrum("gaussian", 2, 8))
@@ -306,8 +306,15 @@ def test_a_change_that_keeps_the_group_s_shape_retunes_it_in_place(tree_type, di
         if change != dict(speed=0.7):                     # a speed from 0 turns the directions over the whole sphere
             assert made == [], change
         base = s
-    build_wave_group(base.replace(directions=7), tree=tree)
-    assert sum(n.bl_idname.endswith("Group") for n in tree.nodes) == 7
+    for was, count in ((6, 7), (7, 4), (4, 7)):   # the strata both counts share are retuned, the rest built or removed
+        s = base.replace(directions=count)
+        before = {t.name for t in bpy.data.node_groups}
+        build_wave_group(s, tree=tree)
+        subs = [n.node_tree for n in tree.nodes if n.bl_idname.endswith("Group")]
+        assert len(subs) == count and len({t.name for t in subs} - before) == max(0, count - was)
+        assert _tree_dump(tree) == _tree_dump(build_wave_group(s, tree_type)), count
+        assert not [t for t in bpy.data.node_groups if t.name.startswith(f".{tree.name} ") and t.users == 0]
+    base = s
     sub = next(n.node_tree for n in tree.nodes if n.bl_idname.endswith("Group"))
     for n in list(sub.nodes)[:40]:                        # edited by hand: built again, whole
         n.name = n.name + " edited"
