@@ -392,7 +392,8 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, img: bpy.typ
         if mode == "single":  # a one-row image: a float Vector (c, c, c) reads T(c)
             waves.append(b.lerp(img, t, centre))
         else:  # per-axis tables, interpolated by omega_a^2 (Fig. 5 left)
-            comps = b.separate(omega)
+            # a Separate XYZ's unread z (2D) would hold a float of the SVM stack per wave: 2D, 64 directions overflowed
+            comps = b.separate(omega) if rows >= 3 else [b.channel(omega, a) for a in range(rows)]
             acc = None
             for a in range(rows):
                 wa = om_w if a == 3 else comps[a]

@@ -58,6 +58,8 @@ CASES = {
     "axes": (WaveSettings(dim=3, directions=8, seed=7, anisotropy="axes",
                           axis_spectra=(Spectrum("bandpass", 1, 3), Spectrum("bandpass", 4, 6),
                                         Spectrum("bandpass", 2, 3))), {}),
+    "axes2d": (WaveSettings(dim=2, directions=8, seed=7, anisotropy="axes",
+                            axis_spectra=(Spectrum("bandpass", 1, 3), Spectrum("bandpass", 4, 6))), {}),
     "crystal": (WaveSettings(dim=2, spectrum=Spectrum("gaussian", 2, 6), directions=8, seed=7, waveform="crystal"),
                 {}),
 }
@@ -149,14 +151,19 @@ def test_cycles_bake_equals_engine(case):
         assert np.percentile(d, 99) < 5e-5 and d.max() < 2e-4, (o, d.max())
 
 
+@pytest.mark.parametrize("anisotropy", ["none", "axes"])
 @pytest.mark.parametrize("dim,k", [(2, 64), (3, 32), (4, 32)])
-def test_cycles_compiles_many_directions(dim, k):
-    """Cycles' SVM stack (255 floats) holds the largest direction counts the node offers."""
+def test_cycles_compiles_many_directions(dim, k, anisotropy):
+    """Cycles' SVM stack (255 floats) holds the largest direction counts the node offers, with one table or one
+    per axis."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
     scene.cycles.samples = 1
-    grp = build_wave_group(WaveSettings(dim=dim, spectrum=Spectrum("bandpass", 2, 6), directions=k, seed=3),
+    kw = {}
+    if anisotropy == "axes":
+        kw = dict(anisotropy="axes", axis_spectra=tuple(Spectrum("bandpass", 2 * a, 6 * a) for a in (1, 2, 0.5, 1)[:dim]))
+    grp = build_wave_group(WaveSettings(dim=dim, spectrum=Spectrum("bandpass", 2, 6), directions=k, seed=3, **kw),
                            "ShaderNodeTree")
     ob, nt, *_ = _plane_material(grp, {})
     px = _bake(ob, nt, 8)
