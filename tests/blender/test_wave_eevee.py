@@ -1,4 +1,4 @@
-"""The Wave Noise node rendered by EEVEE equals the engine (Cycles *and* EEVEE).
+"""The Wave Noise and Wave Cellular nodes rendered by EEVEE equal the engine (Cycles *and* EEVEE).
 
 EEVEE needs an OpenGL 4.3 context; without a GPU, Mesa's llvmpipe gives one on
 the CPU (.ci/run installs it).  The renders run in a fresh Python
@@ -24,6 +24,7 @@ import pytest
 OpenEXR = pytest.importorskip("OpenEXR")
 pytest.importorskip("bpy")
 
+from omninoise.backend import WaveSettings, compile_noise  # noqa: E402
 from omninoise.backend.wavenoise.settings import settings_to_dict  # noqa: E402
 from omninoise.backend.wavenoise.wave import select_output  # noqa: E402
 from test_wave_node import CASES as NODE_CASES, SOCKETS, _engine  # noqa: E402
@@ -34,8 +35,9 @@ RES = 40
 ENC = 0.1  # as in the script
 REQUIRED = os.environ.get("OMNINOISE_REQUIRE_EEVEE") == "1"
 
-#: the cases of the Cycles bake test (tests/blender/test_wave_node.py)
+#: the cases of the Cycles bake test (tests/blender/test_wave_node.py), and the Wave Cellular node's default
 CASES = {name: NODE_CASES[name] for name in ("2d", "3d", "4d", "3d+t")}
+CELLS = WaveSettings(dim=3, cellular="polytope", directions=16, cell_size=0.4, seed=2)
 
 
 def _unavailable(reason: str):
@@ -51,11 +53,12 @@ def renders(tmp_path_factory):
     d = tmp_path_factory.mktemp("eevee")
     spec = {name: {"settings": settings_to_dict(s), "inputs": {SOCKETS[k]: v for k, v in kw.items()}}
             for name, (s, kw) in CASES.items()}
+    spec["cells"] = {"settings": settings_to_dict(CELLS), "inputs": {}}
     with open(d / "cases.json", "w", encoding="utf-8") as fh:
         json.dump(spec, fh)
     r = subprocess.run([sys.executable, SCRIPT, str(d / "cases.json"), str(d), str(RES)],
                        capture_output=True, text=True, cwd=ROOT, timeout=900)
-    if r.returncode != 0 or not all((d / f"{n}.exr").is_file() for n in CASES):
+    if r.returncode != 0 or not all((d / f"{n}.exr").is_file() for n in spec):
         tail = (r.stderr or r.stdout).strip().splitlines()[-3:]
         _unavailable(f"EEVEE did not render (exit {r.returncode}): {' | '.join(tail)}")
     return d
@@ -94,3 +97,15 @@ def test_eevee_render_equals_engine(renders, case):
         err = np.abs(got - enc)
         assert err.max() < 1e-3, (case, out, float(err.max()))
         assert np.corrcoef(got, ref)[0, 1] > 0.9999
+
+
+def test_eevee_renders_the_cellular_node(renders):
+    """The Wave Cellular node (3D, 16 directions: 32 plane families) in EEVEE: the engine's distance everywhere
+    and its cell at all but a few pixels (where float rounding puts a pixel centre on a plane's other side)."""
+    color, _ = _read(renders / "cells.exr")
+    ref = compile_noise(CELLS).evaluate(_centres(RES))
+    enc = lambda v: np.float32(0.5) + np.float32(ENC) * v  # noqa: E731
+    dist = np.abs(color[..., 0].ravel() - enc(ref.distance))
+    cell = np.abs(color[..., 1].ravel() - enc(ref.cell))
+    assert dist.max() < 1e-3, float(dist.max())
+    assert np.mean(cell < 1e-3) > 0.99 and len(np.unique(np.round(ref.cell, 4))) > 50

@@ -1,9 +1,11 @@
-"""Run by tests/blender/test_wave_eevee.py in a fresh Python: EEVEE renders of the Wave Noise node.
+"""Run by tests/blender/test_wave_eevee.py in a fresh Python: EEVEE renders of the Wave Noise and Wave Cellular
+nodes.
 
 argv: CASES.json OUT_DIR RES.  CASES.json maps a case name to {"settings": settings dict,
 "inputs": {"Scale"|"Time"|"W": value}}.  For each case an orthographic camera looks
 at a 2 x 2 plane ([-1, 1]^2 in object space, filling the frame) whose emission is
-0.5 + ENC * (Value, Imaginary, Modulus) (EEVEE clamps negative emission); a colour
+0.5 + ENC * (Value, Imaginary, Modulus) (EEVEE clamps negative emission), for cellular settings
+0.5 + ENC * (Distance, Cell, 0); a colour
 AOV "P" holds the shading position.  One sample, no pixel filter: each pixel is
 shaded at its centre.  Writes OUT_DIR/NAME.exr (multilayer, float) and prints one
 JSON line {name: seconds}.  EEVEE needs an OpenGL 4.3 context: a GPU, or Mesa's
@@ -22,6 +24,7 @@ sys.path.insert(0, ROOT)
 from bench.bench_node import scene  # noqa: E402  (the plane and orthographic camera of the render bench)
 from omninoise.backend.wavenoise.settings import settings_from_dict  # noqa: E402
 from omninoise.blender_addon.compat import eevee_engine, ensure_node_tree, set_multilayer_exr  # noqa: E402
+from omninoise.blender_addon.cellular_nodes import build_cellular_group  # noqa: E402
 from omninoise.blender_addon.wave_nodes import add_wave_node, build_wave_group  # noqa: E402
 
 ENC = 0.1
@@ -37,11 +40,13 @@ def render(name: str, spec: dict, out_dir: str, res: int) -> float:
     aov.name, aov.type = "P", "COLOR"
     nt = ensure_node_tree(mat)
     nt.nodes.clear()
-    g = add_wave_node(nt, build_wave_group(settings_from_dict(spec["settings"]), "ShaderNodeTree"))
+    settings = settings_from_dict(spec["settings"])
+    cellular = settings.cellular != "none"
+    g = add_wave_node(nt, (build_cellular_group if cellular else build_wave_group)(settings, "ShaderNodeTree"))
     for key, val in spec["inputs"].items():
         g.inputs[key].default_value = val
     comb = nt.nodes.new("ShaderNodeCombineXYZ")
-    for i, o in enumerate(("Value", "Imaginary", "Modulus")):
+    for i, o in enumerate(("Distance", "Cell") if cellular else ("Value", "Imaginary", "Modulus")):
         m = nt.nodes.new("ShaderNodeMath")
         m.operation = "MULTIPLY_ADD"
         m.inputs[1].default_value, m.inputs[2].default_value = ENC, 0.5
