@@ -551,7 +551,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     tree[TUNED_KEY] = json.dumps(b.tuned)
     tree[SHAPE_KEY] = shape
     for sub in kept[len(strata):]:
-        if sub.users == 0:
+        if sub is not None and sub.users == 0:
             bpy.data.node_groups.remove(sub)
     return tree
 
@@ -579,9 +579,15 @@ def _retune_stratum(sub: bpy.types.NodeTree, consts: dict, img: bpy.types.Image)
     return True
 
 
+def _own(sub) -> bool:
+    """Whether a stratum's sub-group was built so and belongs to its group alone: a group copied in Blender (a
+    node's group made single user) shares its sub-groups with the original, which retuning them would change."""
+    return sub is not None and TUNED_KEY in sub and sub.users == 1
+
+
 def _kept_strata(tree: bpy.types.NodeTree, own: list) -> list:
     """The stratum sub-groups of a node-form group built with the group-level shape ``own`` (dimensions, table,
-    uniform amplitudes), in order; [] for another shape.  A change of the directions' count keeps them: the
+    uniform amplitudes), in order (None for one it does not own); [] for another shape.  A change of the directions' count keeps them: the
     strata it shares are retuned (a stratum's box and slice move with the count, its nodes do not), those it
     adds are built, those it drops removed (Blender 4.2, 4D, 64 -> 48 directions: 0.7 s, 6.9 s built afresh;
     3D, 16 -> 17: 0.05 s, 0.36 s)."""
@@ -592,8 +598,8 @@ def _kept_strata(tree: bpy.types.NodeTree, own: list) -> list:
             return []
     except (ValueError, IndexError, TypeError, KeyError):
         return []
-    subs = [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
-    return [t for t in subs if t is not None and TUNED_KEY in t]
+    return [t if _own(t) else None
+            for t in (n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup"))]
 
 
 def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: bpy.types.Image) -> bool:
@@ -603,7 +609,7 @@ def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: 
     if tree.get(IMPLEMENTATION_KEY) != "nodes" or tree.get(SHAPE_KEY) != shape or TUNED_KEY not in tree:
         return False
     subs = [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
-    if len(subs) != len(strata) or any(t is None for t in subs):
+    if len(subs) != len(strata) or not all(_own(t) for t in subs):
         return False
     try:                    # a group edited by hand (a node renamed or removed) is built again
         for path, name in json.loads(tree[TUNED_KEY]):

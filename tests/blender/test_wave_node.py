@@ -289,6 +289,18 @@ def _tree_dump(tree) -> list:
     return out
 
 
+def test_a_copied_group_changes_alone():
+    """A group copied in Blender (a node's group made single user) shares its direction sub-groups with the
+    original: a change of the copy's seed or directions builds its own and leaves the original as it was."""
+    s, _ = CASES["3d"]
+    original = build_wave_group(s, "ShaderNodeTree")
+    copy = original.copy()
+    for change in (dict(seed=11), dict(directions=6), dict(directions=9, seed=2)):
+        build_wave_group(s.replace(**change), tree=copy)
+        assert _tree_dump(copy) == _tree_dump(build_wave_group(s.replace(**change), "ShaderNodeTree")), change
+        assert _tree_dump(original) == _tree_dump(build_wave_group(s, "ShaderNodeTree")), change
+
+
 @pytest.mark.parametrize("tree_type", ["ShaderNodeTree", "GeometryNodeTree"])
 @pytest.mark.parametrize("dim", [2, 3, 4])
 def test_a_change_that_keeps_the_group_s_shape_retunes_it_in_place(tree_type, dim, monkeypatch):
