@@ -8,6 +8,7 @@ from omninoise.backend import Spectrum, WaveSettings, compile_noise  # noqa: E40
 from omninoise.backend.errors import SettingError  # noqa: E402
 from omninoise.blender_addon.cellular_nodes import build_cellular_group  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
+from test_wave_node import _bake  # noqa: E402  (the Cycles EMIT bake of the Wave Noise tests)
 
 
 def _node(s, pts, output, w=None, scale=1.0):
@@ -51,21 +52,6 @@ def test_cellular_node_matches_engine(dim, mode, directions):
 def test_stit_stays_bake_only():
     with pytest.raises(SettingError, match="STIT is bake-only"):
         build_cellular_group(WaveSettings(dim=2, cellular="stit"), "GeometryNodeTree")
-
-
-def _bake(ob, nt, size):
-    img = bpy.data.images.new("bake", size, size, alpha=False, float_buffer=True)
-    img.colorspace_settings.name = "Non-Color"
-    it = nt.nodes.new("ShaderNodeTexImage")
-    it.image = img
-    nt.nodes.active = it
-    bpy.context.view_layer.objects.active = ob
-    ob.select_set(True)
-    bpy.ops.object.bake(type="EMIT", margin=0)
-    px = np.array(img.pixels[:], np.float32).reshape(size, size, 4)
-    nt.nodes.remove(it)
-    bpy.data.images.remove(img)
-    return px
 
 
 @pytest.mark.parametrize("dim, directions", [(2, 64), (3, 32), (4, 32)])
