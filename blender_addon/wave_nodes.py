@@ -63,8 +63,8 @@ def tree_settings_json(tree) -> str | None:
 IMPLEMENTATIONS = ("nodes", "osl")
 #: tree key holding the form a group was built in
 IMPLEMENTATION_KEY = "omninoise_wave_implementation"
-#: a node-form group's shape (everything but the constants a setting's change retunes) and, on it and on each
-#: stratum's sub-group, where those constants sit: a change of band, exponent, seed, speed or waveform that keeps
+#: a node-form group's and each stratum sub-group's shape (everything but the constants a setting's change
+#: retunes) and, on both, where those constants sit: a change of band, exponent, seed, speed or waveform that keeps
 #: the shape rewrites them and the table image in place instead of building every node again
 SHAPE_KEY = "omninoise_wave_shape"
 TUNED_KEY = "omninoise_wave_tuned"
@@ -587,10 +587,10 @@ def _own(sub) -> bool:
 
 def _kept_strata(tree: bpy.types.NodeTree, own: list) -> list:
     """The stratum sub-groups of a node-form group built with the group-level shape ``own`` (dimensions, table,
-    uniform amplitudes), in order (None for one it does not own); [] for another shape.  A change of the directions' count keeps them: the
-    strata it shares are retuned (a stratum's box and slice move with the count, its nodes do not), those it
-    adds are built, those it drops removed (Blender 4.2, 4D, 64 -> 48 directions: 0.7 s, 6.9 s built afresh;
-    3D, 16 -> 17: 0.05 s, 0.36 s)."""
+    uniform amplitudes), in order (None for one it does not own); [] for another shape.  A change of the
+    directions' count keeps them: the strata both counts share are retuned (a stratum's box and slice move with
+    the count, its nodes do not), those it adds are built, those it drops removed (Blender 4.2, 4D, 64 -> 48
+    directions: 0.7 s, 6.9 s built afresh; 3D, 16 -> 17: 0.05 s, 0.36 s)."""
     if tree.get(IMPLEMENTATION_KEY) != "nodes" or SHAPE_KEY not in tree:
         return []
     try:

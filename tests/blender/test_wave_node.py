@@ -162,7 +162,8 @@ def test_cycles_compiles_many_directions(dim, k, anisotropy):
     scene.cycles.samples = 1
     kw = {}
     if anisotropy == "axes":
-        kw = dict(anisotropy="axes", axis_spectra=tuple(Spectrum("bandpass", 2 * a, 6 * a) for a in (1, 2, 0.5, 1)[:dim]))
+        kw = dict(anisotropy="axes",
+                  axis_spectra=tuple(Spectrum("bandpass", 2 * a, 6 * a) for a in (1, 2, 0.5, 1)[:dim]))
     grp = build_wave_group(WaveSettings(dim=dim, spectrum=Spectrum("bandpass", 2, 6), directions=k, seed=3, **kw),
                            "ShaderNodeTree")
     ob, nt, *_ = _plane_material(grp, {})
