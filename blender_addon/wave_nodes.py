@@ -213,12 +213,16 @@ class NodeBuilder:
 
         Channel c of the Color is backend.wavenoise.wave.white_color4(k, n, stream, seed, c).
         The slice id n sits in the Combine XYZ, so the node depends on the stratum's chain
-        (a constant Combine could be scheduled early and crowd Cycles' SVM stack).
+        (a constant Combine could be scheduled early and crowd Cycles' SVM stack).  The Value is read
+        too, as the Color's scale Compare(Value, Value) = 1 (exactly the Color): Cycles' SVM compiler
+        keeps an unread output on its 255-float stack for the whole shader, and a Bump node compiles
+        its Height three times (a Bump of the Value at 2D and 64 directions overflowed it).
         """
         node = self.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
         self.put(node.inputs["Vector"], self.combine(k, n, float(stream)))
         self.put(node.inputs["W"], seed)
-        return node.outputs["Color"]
+        value = node.outputs["Value"]
+        return self.vmath("SCALE", node.outputs["Color"], scale=self.math("COMPARE", value, value, 0.0))
 
     def channel(self, color, c: int):
         """Channel c of a colour socket, read with an exact dot product (c . e_c).

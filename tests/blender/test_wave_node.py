@@ -151,22 +151,32 @@ def test_cycles_bake_equals_engine(case):
         assert np.percentile(d, 99) < 5e-5 and d.max() < 2e-4, (o, d.max())
 
 
-@pytest.mark.parametrize("anisotropy", ["none", "axes"])
+@pytest.mark.parametrize("use", ["none", "axes", "bump"])
 @pytest.mark.parametrize("dim,k", [(2, 64), (3, 32), (4, 32)])
-def test_cycles_compiles_many_directions(dim, k, anisotropy):
+def test_cycles_compiles_many_directions(dim, k, use):
     """Cycles' SVM stack (255 floats) holds the largest direction counts the node offers, with one table or one
-    per axis."""
+    per axis, and with the Value also bumping a BSDF's normal (Cycles compiles a Bump's height three times)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
     scene.cycles.samples = 1
     kw = {}
-    if anisotropy == "axes":
+    if use == "axes":
         kw = dict(anisotropy="axes",
                   axis_spectra=tuple(Spectrum("bandpass", 2 * a, 6 * a) for a in (1, 2, 0.5, 1)[:dim]))
     grp = build_wave_group(WaveSettings(dim=dim, spectrum=Spectrum("bandpass", 2, 6), directions=k, seed=3, **kw),
                            "ShaderNodeTree")
-    ob, nt, *_ = _plane_material(grp, {})
+    ob, nt, _, comb, em = _plane_material(grp, {})
+    if use == "bump":
+        bump = nt.nodes.new("ShaderNodeBump")
+        nt.links.new(comb.inputs[0].links[0].from_socket, bump.inputs["Height"])
+        bsdf = nt.nodes.new("ShaderNodeBsdfPrincipled")
+        nt.links.new(bump.outputs["Normal"], bsdf.inputs["Normal"])
+        both = nt.nodes.new("ShaderNodeAddShader")
+        out = em.outputs[0].links[0].to_socket
+        nt.links.new(em.outputs[0], both.inputs[0])
+        nt.links.new(bsdf.outputs[0], both.inputs[1])
+        nt.links.new(both.outputs[0], out)
     px = _bake(ob, nt, 8)
     assert px[..., 0].std() > 0.1  # an overflowing shader bakes to a constant
 
