@@ -208,21 +208,25 @@ class NodeBuilder:
         self.put(n.inputs[0], v)
         return tuple(n.outputs)
 
-    def white(self, k: float, n, stream: int, seed) -> bpy.types.NodeSocket:
-        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> its Color socket.
+    def white(self, k: float, n, stream: int, seed) -> tuple:
+        """Blender's White Noise Texture, 4D, at (k, n, stream, seed) -> its (Color, Value) sockets.
 
-        Channel c of the Color is backend.wavenoise.wave.white_color4(k, n, stream, seed, c).
+        Channel c of the Color is backend.wavenoise.wave.white_color4(k, n, stream, seed, c); the
+        Value is channel 0 (Blender's hash_float4_to_float3 starts with hash_float4_to_float).
         The slice id n sits in the Combine XYZ, so the node depends on the stratum's chain
-        (a constant Combine could be scheduled early and crowd Cycles' SVM stack).  The Value is read
-        too, as the Color's scale Compare(Value, Value) = 1 (exactly the Color): Cycles' SVM compiler
-        keeps an unread output on its 255-float stack for the whole shader, and a Bump node compiles
-        its Height three times (a Bump of the Value at 2D and 64 directions overflowed it).
+        (a constant Combine could be scheduled early and crowd Cycles' SVM stack).  Cycles' SVM
+        compiler keeps an output nothing reads on its 255-float stack for the whole shader, and a
+        Bump node compiles its Height three times: read both outputs where the stack needs it
+        (:meth:`both`).
         """
         node = self.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
         self.put(node.inputs["Vector"], self.combine(k, n, float(stream)))
         self.put(node.inputs["W"], seed)
-        value = node.outputs["Value"]
-        return self.vmath("SCALE", node.outputs["Color"], scale=self.math("COMPARE", value, value, 0.0))
+        return node.outputs["Color"], node.outputs["Value"]
+
+    def both(self, color, value):
+        """The Color, read with its Value as its scale Compare(Value, Value) = 1 (exactly the Color)."""
+        return self.vmath("SCALE", color, scale=self.math("COMPARE", value, value, 0.0))
 
     def channel(self, color, c: int):
         """Channel c of a colour socket, read with an exact dot product (c . e_c).
@@ -376,16 +380,21 @@ def _stratum_nodes(b: NodeBuilder, ins: dict, dim: int, full: bool, img: bpy.typ
     waves = []
     for side, n in enumerate((n0, n1)):
         # (zeta, u0, u1) = (r, lo0 + size0 g, lo1 + size1 b) of node A
-        zu = b.vmath("MULTIPLY_ADD", b.white(k, n, STREAM["slice_a"], seed), size3, c=lo3)
+        # Cycles' SVM stack, in a Bump of the noise at the most directions the node offers (2D 64, 4D 32), holds
+        # no unread output: in 2D zeta is the Value (r x 1 + 0), in 4D the Values are read by b.both; 3D fits
+        color, value = b.white(k, n, STREAM["slice_a"], seed)
+        zu = b.vmath("MULTIPLY_ADD", b.both(color, value) if dim == 4 else color, size3, c=lo3)
         # a Separate XYZ with an unlinked output would hold that float on the SVM stack for good
-        zu = b.separate(zu) if dim > 2 else [b.channel(zu, 0), b.channel(zu, 1)]
-        zeta, uu = zu[0], list(zu[1:min(dim, 3)])
+        if dim == 2:
+            zeta, uu = value, [b.channel(zu, 1)]
+        else:
+            zeta, *uu = b.separate(zu)
         if side == 0:  # border ramp of slice n0: slpos = SLPOS_MIN + SLPOS_RANGE fract(16 zeta_0)
             frac = b.math("FRACT", b.math("MULTIPLY", zeta, 16.0))
             slpos = b.math("MULTIPLY_ADD", frac, backend.wavenoise.wave.SLPOS_RANGE, backend.wavenoise.wave.SLPOS_MIN)
             u = b.math("MULTIPLY_ADD", b.math("SUBTRACT", f, slpos), 0.5 / backend.wavenoise.wave.BLEND_HALF_WIDTH, 0.5)
         if dim == 4:
-            jb = b.channel(b.white(k, n, STREAM["slice_b"], seed), 0)
+            jb = b.channel(b.both(*b.white(k, n, STREAM["slice_b"], seed)), 0)
             uu.append(b.math("MULTIPLY_ADD", jb, g["Box Size W"], g["Box Lo W"]))
         omega, om_w = _direction(b, uu, dim, full, g)
         dot = b.vmath("DOT_PRODUCT", x, omega)
