@@ -43,11 +43,8 @@ def _value(b: NodeBuilder, x, y, z, w):
     three floats for each unread Color, four Colors per plane family.  With the families' wait on the running
     values (:func:`_family_group`) the largest direction counts the node offers compile; without either, a
     shader reading Distance overflowed from 12 directions in 2D and bakes black."""
-    node = b.new("ShaderNodeTexWhiteNoise", noise_dimensions="4D")
-    b.put(node.inputs["Vector"], b.combine(x, y, z))
-    b.put(node.inputs["W"], w)
-    colour = node.outputs["Color"]
-    return b.math("ADD", node.outputs["Value"], b.vmath("DISTANCE", colour, colour))
+    colour, value = b.white(x, y, z, w)
+    return b.math("ADD", value, b.vmath("DISTANCE", colour, colour))
 
 
 #: a family sub-group's inputs: the running Distance and Code, the scaled Position and W

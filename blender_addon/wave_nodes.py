@@ -592,6 +592,11 @@ def _retune_stratum(sub: bpy.types.NodeTree, consts: dict, img: bpy.types.Image)
     return True
 
 
+def _sub_groups(tree: bpy.types.NodeTree) -> list:
+    """The trees of ``tree``'s group nodes (a node-form group's strata), in order; None for a node without one."""
+    return [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
+
+
 def _own(sub) -> bool:
     """Whether a stratum's sub-group was built so and belongs to its group alone: a group copied in Blender (a
     node's group made single user) shares its sub-groups with the original, which retuning them would change."""
@@ -611,8 +616,7 @@ def _kept_strata(tree: bpy.types.NodeTree, own: list) -> list:
             return []
     except (ValueError, IndexError, TypeError, KeyError):
         return []
-    return [t if _own(t) else None
-            for t in (n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup"))]
+    return [t if _own(t) else None for t in _sub_groups(tree)]
 
 
 def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: bpy.types.Image) -> bool:
@@ -621,7 +625,7 @@ def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: 
     hand (the caller then builds it again)."""
     if tree.get(IMPLEMENTATION_KEY) != "nodes" or tree.get(SHAPE_KEY) != shape or TUNED_KEY not in tree:
         return False
-    subs = [n.node_tree for n in tree.nodes if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup")]
+    subs = _sub_groups(tree)
     if len(subs) != len(strata) or not all(_own(t) for t in subs):
         return False
     try:                    # a group edited by hand (a node renamed or removed) is built again
