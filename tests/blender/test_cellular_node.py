@@ -8,7 +8,8 @@ from omninoise.backend import Spectrum, WaveSettings, compile_noise  # noqa: E40
 from omninoise.backend.errors import SettingError  # noqa: E402
 from omninoise.blender_addon.cellular_nodes import build_cellular_group  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
-from test_wave_node import _bake  # noqa: E402  (the Cycles EMIT bake of the Wave Noise tests)
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
+from test_wave_node import _bake, _uv_plane  # noqa: E402  (the Cycles EMIT bake and its plane, of the Wave Noise tests)
 
 
 def _node(s, pts, output, w=None, scale=1.0):
@@ -67,17 +68,8 @@ def test_cycles_bake_equals_engine_at_the_most_directions(dim, directions):
     sc.cycles.device = "CPU"
     s = WaveSettings(dim=dim, cellular="polytope", directions=directions, cell_size=0.4, seed=2)
     grp = build_cellular_group(s)
-    mesh = bpy.data.meshes.new("plane")
-    mesh.from_pydata([(-1, -1, 0.3), (1, -1, 0.3), (1, 1, 0.3), (-1, 1, 0.3)], [], [(0, 1, 2, 3)])
-    uv = mesh.uv_layers.new(name="UV")
-    for i, c in enumerate([(0, 0), (1, 0), (1, 1), (0, 1)]):
-        uv.data[i].uv = c
-    ob = bpy.data.objects.new("plane", mesh)
-    sc.collection.objects.link(ob)
-    mat = bpy.data.materials.new("cells")
-    mat.use_nodes = True
-    ob.data.materials.append(mat)
-    nt = mat.node_tree
+    ob, mat = _uv_plane("cells", 0.3)
+    nt = ensure_node_tree(mat)
     nt.nodes.clear()
     g = add_wave_node(nt, grp)
     comb = nt.nodes.new("ShaderNodeCombineXYZ")

@@ -22,7 +22,7 @@ from omninoise.blender_addon.procedural_nodes import (FIELD_KEY, add_procedural_
                                                       build_procedural_group, follow_form, noise_trees)
 from omninoise.blender_addon.wave_nodes import tree_implementation  # noqa: E402
 from omninoise.blender_addon.wave_osl import osl_available  # noqa: E402
-from test_wave_node import _bake  # noqa: E402  (the Cycles EMIT bake of the Wave Noise tests)
+from test_wave_node import _bake, _uv_plane  # noqa: E402  (the Cycles EMIT bake and its plane, of the Wave Noise tests)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FAMILY_PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centre_v=-0.5, grain=0.2),
@@ -195,16 +195,7 @@ def test_osl_bake_equals_engine(family, built):
 
 def _bake_equals_engine(f, built: str, form: str | None = None):
     """The bake of a group of ``f`` built with its noises in the form ``built``, then switched to ``form``."""
-    scene = bpy.context.scene
-    mesh = bpy.data.meshes.new("plane")       # z = 0.05 cuts the bonds' courses 0.13 high through their units
-    mesh.from_pydata([(-1, -1, 0.05), (1, -1, 0.05), (1, 1, 0.05), (-1, 1, 0.05)], [], [(0, 1, 2, 3)])
-    uv = mesh.uv_layers.new(name="UV")
-    for i, c in enumerate([(0, 0), (1, 0), (1, 1), (0, 1)]):
-        uv.data[i].uv = c
-    ob = bpy.data.objects.new("plane", mesh)
-    scene.collection.objects.link(ob)
-    mat = bpy.data.materials.new("procedural")
-    ob.data.materials.append(mat)
+    ob, mat = _uv_plane("procedural", 0.05)   # z = 0.05 cuts the bonds' courses 0.13 high through their units
     nt = ensure_node_tree(mat)
     nt.nodes.clear()
     grp = build_procedural_group(f, implementation=built)

@@ -90,16 +90,23 @@ def test_phase_output_where_defined():
     assert d[strong].max() < 2e-3 and np.median(d) < 1e-6
 
 
-def _plane_material(grp, kw):
+def _uv_plane(name: str, z: float = 0.0):
+    """A 2 x 2 plane at height ``z`` with a UV map over it and an empty material ``name``, in the scene, to bake
+    -> (object, material)."""
     mesh = bpy.data.meshes.new("plane")
-    mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    mesh.from_pydata([(-1, -1, z), (1, -1, z), (1, 1, z), (-1, 1, z)], [], [(0, 1, 2, 3)])
     uv = mesh.uv_layers.new(name="UV")
     for i, c in enumerate([(0, 0), (1, 0), (1, 1), (0, 1)]):
         uv.data[i].uv = c
     ob = bpy.data.objects.new("plane", mesh)
     bpy.context.scene.collection.objects.link(ob)
-    mat = bpy.data.materials.new("wave")
+    mat = bpy.data.materials.new(name)
     ob.data.materials.append(mat)
+    return ob, mat
+
+
+def _plane_material(grp, kw):
+    ob, mat = _uv_plane("wave")
     nt = ensure_node_tree(mat)
     nt.nodes.clear()
     g = add_wave_node(nt, grp)
