@@ -18,11 +18,14 @@ STIT recursion (depth > 0) stays bake-only.
 """
 from __future__ import annotations
 
+import json
+
 import bpy
 import numpy as np
 
 from .. import backend
-from .wave_nodes import INPUTS, SETTINGS_KEY, clear_tree, group_io, new_group, NodeBuilder, settings_to_json
+from .wave_nodes import (INPUTS, SETTINGS_KEY, TUNED_KEY, NodeBuilder, Tuned, clear_tree, copy_or_build, group_io,
+                         new_group, settings_to_json)
 
 __all__ = ["build_cellular_group", "new_cellular_tree", "CELL_OUTPUTS"]
 
@@ -54,17 +57,19 @@ _FAMILY_INPUTS = (("Distance", "NodeSocketFloat", None), ("Code", "NodeSocketFlo
 FAR = float(np.finfo(np.float32).max)
 
 
-def _family_group(name: str, tree_type: str, f: int, normal, inv: float, off: float, size: float, seed: float,
-                  dim: int) -> bpy.types.NodeTree:
-    """Sub-group for plane family ``f``: (Distance, Code) in -> (min(Distance, d_f), h(slab, Code, 26, seed)) out.
+def _family_group(name: str, tree_type: str, dim: int, consts: dict) -> bpy.types.NodeTree:
+    """Sub-group for one plane family: (Distance, Code) in -> (min(Distance, d_f), h(slab, Code, 26, seed)) out.
 
-    The family's constants are written into its nodes' sockets, as the Wave Noise node's strata are (a constant
-    group input would wait on Cycles' SVM stack).  One small tree per family: Blender adds a node, a link or a
-    value in time that grows with its tree's node count, so one tree of every family's nodes builds in time that
-    grows with the square of the directions (64 directions in 2D: 3971 nodes, 97 s in Blender 4.2).
+    The family's constants (``consts``: :func:`_family_constants`) are written into its nodes' sockets, as the Wave
+    Noise node's strata are (a constant group input would wait on Cycles' SVM stack), and recorded where they sit
+    (:class:`.wave_nodes.Tuned`): the next family is this one copied and retuned.  One small tree per family:
+    Blender adds a node, a link or a value in time that grows with its tree's node count, so one tree of every
+    family's nodes builds in time that grows with the square of the directions (64 directions in 2D: 3971 nodes,
+    97 s in Blender 4.2).
     """
     tree = new_group(name, tree_type, _FAMILY_INPUTS, (("Distance", "NodeSocketFloat"), ("Code", "NodeSocketFloat")))
     b = NodeBuilder(tree)
+    c = {k: Tuned(k, v) for k, v in consts.items()}
     gi = b.new("NodeGroupInput")
     go = b.new("NodeGroupOutput")
     # Position + (r - r), r = (Distance, Code, 0), exactly the position: every node of the family waits on both
@@ -72,28 +77,37 @@ def _family_group(name: str, tree_type: str, f: int, normal, inv: float, off: fl
     # whose inputs are ready, and held every family's hashes on its 255-float stack at once)
     running = b.combine(gi.outputs["Distance"], gi.outputs["Code"])
     x = b.vmath("ADD", gi.outputs["Position"], b.vmath("SUBTRACT", running, running))
-    w = gi.outputs["W"]
-    n3 = tuple(float(v) for v in (list(normal[:3]) + [0.0] * 3)[:3])
-    dot = b.vmath("DOT_PRODUCT", x, n3)
+    dot = b.vmath("DOT_PRODUCT", x, c["Normal"])
     if dim == 4:
-        dot = b.math("MULTIPLY_ADD", w, float(normal[3]), dot)
-    p = b.math("MULTIPLY_ADD", dot, inv, off)
+        dot = b.math("MULTIPLY_ADD", gi.outputs["W"], c["Normal W"], dot)
+    p = b.math("MULTIPLY_ADD", dot, c["Inverse Size"], c["Offset"])
     j = b.math("FLOOR", p)
     o = b.math("SUBTRACT", p, j)
 
     def plane(i):  # s(i) = 0.3 + 0.4 h(f, i, 25, seed)
-        return b.math("MULTIPLY_ADD", _value(b, float(f), i, float(_PLANE), seed), 0.4, 0.3)
+        return b.math("MULTIPLY_ADD", _value(b, c["Family"], i, float(_PLANE), c["Seed"]), 0.4, 0.3)
 
     here, nxt, prv = plane(j), plane(b.math("ADD", j, 1.0)), plane(b.math("SUBTRACT", j, 1.0))
     below = b.math("LESS_THAN", o, here)  # 1 - above
     up = b.math("SUBTRACT", b.math("ADD", nxt, 1.0), o)        # 1 + s(j+1) - φ
     down = b.math("SUBTRACT", b.math("ADD", o, 1.0), prv)      # φ + 1 - s(j-1)
     other = b.math("ADD", up, b.math("MULTIPLY", below, b.math("SUBTRACT", down, up)))
-    d = b.math("MULTIPLY", b.math("MINIMUM", b.math("ABSOLUTE", b.math("SUBTRACT", o, here)), other), size)
+    d = b.math("MULTIPLY", b.math("MINIMUM", b.math("ABSOLUTE", b.math("SUBTRACT", o, here)), other), c["Size"])
     b.put(go.inputs["Distance"], b.math("MINIMUM", gi.outputs["Distance"], d))
     slab = b.math("SUBTRACT", j, below)
-    b.put(go.inputs["Code"], _value(b, slab, gi.outputs["Code"], float(_CODE), seed))
+    b.put(go.inputs["Code"], _value(b, slab, gi.outputs["Code"], float(_CODE), c["Seed"]))
+    tree[TUNED_KEY] = json.dumps(b.tuned)
     return tree
+
+
+def _family_constants(noise, f: int) -> dict:
+    """Plane family f's constants: its index, normal (x, y, z and w), 1 / C, offset o_f, cell size C and seed."""
+    normal = np.asarray(noise.normals[f], dtype=np.float64)
+    off = float(np.asarray(backend.wavenoise.hashing.white_noise4(_F(f), _F(0), _F(_OFFSET), noise.seed)
+                           ).reshape(-1)[0])
+    return {"Family": float(f), "Normal": tuple(float(v) for v in (list(normal[:3]) + [0.0] * 3)[:3]),
+            "Normal W": float(normal[3]) if len(normal) > 3 else 0.0, "Inverse Size": float(_F(1.0 / noise.cell_size)),
+            "Offset": off, "Size": float(noise.cell_size), "Seed": float(noise.seed)}
 
 
 def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.types.NodeTree | None = None,
@@ -108,18 +122,16 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
     else:
         clear_tree(tree)
     tree[SETTINGS_KEY] = settings_to_json(settings)
-    seed = float(noise.seed)
-    inv = float(_F(1.0 / noise.cell_size))
     b = NodeBuilder(tree)
     _, go, x, w = group_io(b)
     group_kind = "GeometryNodeGroup" if b.geo else "ShaderNodeGroup"
     dist, code = FAR, 0.0
-    for f, normal in enumerate(noise.normals):
-        off = float(np.asarray(backend.wavenoise.hashing.white_noise4(_F(f), _F(0), _F(_OFFSET), noise.seed)
-                               ).reshape(-1)[0])
+    built = {}
+    for f in range(len(noise.normals)):
+        name, consts = f".{tree.name} family {f + 1}", _family_constants(noise, f)
         node = b.new(group_kind)
-        node.node_tree = _family_group(f".{tree.name} family {f + 1}", tree.bl_idname, f, normal, inv, off,
-                                       float(noise.cell_size), seed, noise.dim)
+        node.node_tree = copy_or_build(built, "family", name, consts,
+                                       lambda: _family_group(name, tree.bl_idname, noise.dim, consts))
         node.label = f"Family {f + 1}"
         for sock, v in (("Distance", dist), ("Code", code), ("Position", x), ("W", w)):
             b.put(node.inputs[sock], v)

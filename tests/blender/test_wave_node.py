@@ -320,11 +320,27 @@ def test_a_copied_group_changes_alone():
 
 
 @pytest.mark.parametrize("tree_type", ["ShaderNodeTree", "GeometryNodeTree"])
+@pytest.mark.parametrize("case", ["2d+t", "3d", "4d", "lobes", "axes", "axes2d"])
+def test_strata_copied_and_retuned_equal_strata_built_node_by_node(tree_type, case, monkeypatch):
+    """A group builds one sub-group per stratum shape and copies it for the other strata of that shape, retuned:
+    the group equals one whose every stratum is built node by node, and its strata are separate trees."""
+    from omninoise.blender_addon import wave_nodes
+
+    s, _ = CASES[case]
+    copied = build_wave_group(s, tree_type)
+    subs = [n.node_tree for n in copied.nodes if n.bl_idname.endswith("Group")]
+    assert len({t.name for t in subs}) == len(subs) == s.directions
+    assert all(t.users == 1 and t.name == f".{copied.name} direction {k + 1}" for k, t in enumerate(subs))
+    monkeypatch.setattr(wave_nodes, "_new_stratum", lambda built, *a: wave_nodes._stratum_group(*a))
+    assert _tree_dump(copied) == _tree_dump(build_wave_group(s, tree_type))
+
+
+@pytest.mark.parametrize("tree_type", ["ShaderNodeTree", "GeometryNodeTree"])
 @pytest.mark.parametrize("dim", [2, 3, 4])
 def test_a_change_that_keeps_the_group_s_shape_retunes_it_in_place(tree_type, dim, monkeypatch):
     """A change of band, spectrum, seed or waveform (a slider's) rewrites the constants it moves and the table
-    image in place: the group equals one built afresh, node for node, and no node is made; a change of the
-    directions' count keeps the strata it shares, retuned, and builds only those it adds."""
+    image in place: the group equals one built afresh, node for node, and no node is made; after a change of the
+    directions' count too, and no sub-group is left behind."""
     from omninoise.blender_addon import wave_nodes
 
     base = WaveSettings(dim=dim, directions=6, spectrum=Spectrum("gaussian", 2, 8))
@@ -343,12 +359,10 @@ def test_a_change_that_keeps_the_group_s_shape_retunes_it_in_place(tree_type, di
         if change != dict(speed=0.7):                     # a speed from 0 turns the directions over the whole sphere
             assert made == [], change
         base = s
-    for was, count in ((6, 7), (7, 4), (4, 7)):   # the strata both counts share are retuned, the rest built or removed
+    for count in (7, 4, 7):
         s = base.replace(directions=count)
-        before = {t.name for t in bpy.data.node_groups}
         build_wave_group(s, tree=tree)
-        subs = [n.node_tree for n in tree.nodes if n.bl_idname.endswith("Group")]
-        assert len(subs) == count and len({t.name for t in subs} - before) == max(0, count - was)
+        assert len([n for n in tree.nodes if n.bl_idname.endswith("Group")]) == count
         assert _tree_dump(tree) == _tree_dump(build_wave_group(s, tree_type)), count
         assert not [t for t in bpy.data.node_groups if t.name.startswith(f".{tree.name} ") and t.users == 0]
     base = s
