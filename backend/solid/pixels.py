@@ -14,13 +14,21 @@ MIN_SIDE = 16    #: px a photo's shorter side keeps in :func:`at_most` (all of i
 
 
 def rgb_pixels(image) -> np.ndarray:
-    """An exemplar image (H, W), (H, W, 3) or (H, W, 4) as float32 (H, W, 3); SettingError for other shapes."""
-    img = np.asarray(image, np.float32)
+    """An exemplar image (H, W), (H, W, 3) or (H, W, 4) as float32 (H, W, 3); SettingError for other shapes, no
+    pixel, or a NaN or infinite value."""
+    try:
+        img = np.asarray(image, np.float32)
+    except (TypeError, ValueError):
+        raise SettingError("exemplar", f"expected pixels (H, W), (H, W, 3) or (H, W, 4), got {type(image).__name__}"
+                           ) from None
     if img.ndim == 2:
         img = np.repeat(img[..., None], 3, axis=2)
-    if img.ndim != 3 or img.shape[2] not in (3, 4):
+    if img.ndim != 3 or img.shape[2] not in (3, 4) or 0 in img.shape:
         raise SettingError("exemplar", f"exemplar must be (H, W), (H, W, 3) or (H, W, 4), got {img.shape}")
-    return img[..., :3]
+    img = img[..., :3]
+    if not np.all(np.isfinite(img)):
+        raise SettingError("exemplar", "the pixels hold NaN or infinite values")
+    return img
 
 
 def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:

@@ -474,6 +474,19 @@ def test_a_flat_or_tiny_photo():
         fit_procedural(np.zeros((40, 12, 3)))
 
 
+@pytest.mark.parametrize("photo, message", [
+    (np.where(np.eye(64)[..., None] > 0, np.nan, 0.5) * np.ones(3), "NaN or infinite"),
+    (np.full((64, 64, 3), np.inf), "NaN or infinite"),
+    (np.zeros((0, 64, 3)), "got \\(0, 64, 3\\)"),
+    ("photo.jpg", "got str"),
+])
+def test_pixels_that_are_not_a_photo_are_refused_before_the_fit(photo, message):
+    """The fit's own entry refuses, naming the exemplar, what the request refuses (a NaN pixel stopped the fit in
+    its estimate with a bare ValueError)."""
+    with pytest.raises(SettingError, match=message):
+        fit_procedural(photo)
+
+
 @pytest.mark.parametrize("shape", [(20, 4000), (4000, 20), (3000, 40)])
 def test_a_strip_is_read_as_a_central_window_that_keeps_its_shorter_side(shape):
     """A photo whose sides differ more than 16 times: resized whole to the fit's 256 px it would be a line of pixels
