@@ -1,4 +1,5 @@
 """Errors with one-line messages that name the offending setting."""
+import numpy as np
 
 
 class SettingError(ValueError):
@@ -14,3 +15,14 @@ class SettingError(ValueError):
         if not prefix or self.setting == prefix or self.setting.startswith(prefix + "."):
             return self
         return SettingError(f"{prefix}.{self.setting}", self.message)
+
+
+def check_points(points, dims: tuple, dtype) -> np.ndarray:
+    """``points`` as a contiguous ``dtype`` array (P, D) with D in ``dims``; SettingError naming the points for
+    another shape or a NaN or infinite coordinate (P = 0 passes: no point, no value)."""
+    x = np.ascontiguousarray(points, dtype=dtype)
+    if x.ndim != 2 or x.shape[1] not in dims:
+        raise SettingError("points", f"expected shape (P, {' or '.join(map(str, dims))}), got {x.shape}")
+    if not np.isfinite(x).all():
+        raise SettingError("points", "the points hold NaN or infinite coordinates")
+    return x

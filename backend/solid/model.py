@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SettingError
+from ..errors import SettingError, check_points
 from ..grid import Cancelled
 from ..onnx_models import ModelError, SessionCache, load_model_json
 from ..paths import solid_models
@@ -333,9 +333,7 @@ class SolidTextureModel:
         read on the z = 0 plane.  A code with ``harmonics`` adds the photo's harmonic part (harmonic.py), one with
         a ``rest`` its Gaussian rest (gaussian_rest.py): rgb = mu + k sqrt(1 - t) L d + h(x) + sqrt(t) g(x).
         """
-        pts = np.asarray(points)
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
-            raise SettingError("points", f"points must have shape (N, 2) or (N, 3), got {pts.shape}")
+        pts = check_points(points, (2, 3), np.result_type(np.asarray(points).dtype, _F))
         if pts.shape[1] > self.dim:
             raise SettingError("points", f"model {self.name!r} is {self.dim}D and cannot be evaluated at 3D points")
         pts = self._padded(pts)

@@ -79,7 +79,7 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import SettingError
+from ..errors import SettingError, check_points
 from ..grid import Cancelled
 from ..periodic import periodic_component
 from .model import plane_points
@@ -382,9 +382,7 @@ class SplineField:
     @staticmethod
     def _points(points) -> np.ndarray:
         """points float (P, 2 or 3) -> float64 (P, 3) (2D points on z = 0); SettingError for another shape."""
-        pts = np.asarray(points, np.float64)
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
-            raise SettingError("points", f"points must have shape (P, 2) or (P, 3), got {pts.shape}")
+        pts = check_points(points, (2, 3), np.float64)
         if pts.shape[1] == 2:
             pts = np.concatenate([pts, np.zeros((pts.shape[0], 1))], axis=1)
         return pts

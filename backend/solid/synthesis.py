@@ -42,7 +42,7 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import SettingError
+from ..errors import SettingError, check_points
 from ..grid import Cancelled
 from .model import plane_points
 from .pixels import resize_rgb
@@ -368,9 +368,7 @@ class TileField:
 
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 18) -> np.ndarray:
         """points float (P, 2 or 3) in texture units (x, y[, z]) -> float32 (P, 3)."""
-        pts = np.asarray(points, np.float64)
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3) or pts.shape[1] > self.dim:
-            raise SettingError("points", f"points must have shape (P, 2) or (P, {self.dim}), got {pts.shape}")
+        pts = check_points(points, (2, 3) if self.dim == 3 else (2,), np.float64)
         if pts.shape[1] < self.dim:
             pts = np.concatenate([pts, np.zeros((pts.shape[0], 1))], axis=1)
         N = self.tile.shape[0]

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .directions import DirectionSet, map_directions
-from ..errors import SettingError
+from ..errors import SettingError, check_points
 from .hashing import MAX_EXACT_ID, white_noise4
 
 __all__ = ["CellularNoise", "CELLULAR_MODES"]
@@ -97,9 +97,7 @@ class CellularNoise:
 
     def evaluate(self, x: np.ndarray) -> CellularResult:
         """x: float32 (P, dim) -> CellularResult."""
-        x = np.ascontiguousarray(x, dtype=_F)
-        if x.ndim != 2 or x.shape[1] != self.dim:
-            raise SettingError("points", f"expected shape (P, {self.dim}), got {x.shape}")
+        x = check_points(x, (self.dim,), _F)
         dist = np.full(len(x), np.inf, _F)
         code = np.zeros(len(x), _F)
         for f, normal in enumerate(self.normals):

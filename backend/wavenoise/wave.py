@@ -28,7 +28,7 @@ import numpy as np
 
 from . import fast
 from .directions import DirectionSet, map_directions
-from ..errors import SettingError
+from ..errors import SettingError, check_points
 from .hashing import MAX_EXACT_ID, white_noise4
 from .tables import WaveTable, table_lookup
 
@@ -204,9 +204,11 @@ class WaveNoise:
         direction (Eq. 9).  For 4D noise the fourth coordinate is part of x.
         ``accelerate`` uses the compiled path of :mod:`backend.wavenoise.fast` when it applies.
         """
-        x = np.ascontiguousarray(x, dtype=_F)
-        if x.ndim != 2 or x.shape[1] != self.dim:
-            raise SettingError("points", f"expected shape (P, {self.dim}), got {x.shape}")
+        x = check_points(x, (self.dim,), _F)
+        if not np.isfinite(time).all():
+            raise SettingError("time", "the time holds NaN or infinite values")
+        if len(x) == 0:
+            return np.zeros(0, np.complex64)
         if accelerate:
             z = fast.evaluate(self, x, time)
             if z is not None:

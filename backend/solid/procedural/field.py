@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import SettingError
+from ...errors import SettingError, check_points
 from ...grid import Cancelled
 from .bonds import PATTERNS, Bonds
 from .cells import Cells
@@ -73,7 +73,7 @@ class ProceduralField:
         if not fam.GAPPED:
             raise SettingError("family", f"{self.family} have no gaps: a gap mask is drawn for "
                                          f"{', '.join(n for n, f in FAMILIES.items() if f.GAPPED)}")
-        return fam.gaps(self.params, np.asarray(points, np.float64), self.seed)
+        return fam.gaps(self.params, check_points(points, (3,), np.float64), self.seed)
 
     def colours(self, points: np.ndarray) -> np.ndarray:
         """The ramp's colours at points float (P, 3), plus the tint's offsets, before the clip -> float32 (P, 3)."""
@@ -83,9 +83,7 @@ class ProceduralField:
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 16, progress=None, cancel=None) -> np.ndarray:
         """points float (P, 2 or 3) -> float32 (P, 3), in chunks: ``progress(fraction)`` after each, ``cancel()``
         returning True raises Cancelled."""
-        pts = np.asarray(points, np.float64)
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
-            raise SettingError("points", f"points must have shape (P, 2) or (P, 3), got {pts.shape}")
+        pts = check_points(points, (2, 3), np.float64)
         if pts.shape[1] == 2:
             pts = np.concatenate([pts, np.zeros((len(pts), 1))], axis=1)
         out = np.empty((len(pts), 3), np.float32)
