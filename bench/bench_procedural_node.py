@@ -6,7 +6,7 @@ Cycles on the CPU), one group per family read through its sRGB output (the ramp'
 Color is read) with the settings of the parity tests
 (tests/blender/test_procedural_blender.py), each rendered once to compile and then timed; nanoseconds per
 pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
-Texture and the node count (sub-groups included).  Bonds are timed in courses and in a herringbone, layers also with
+Texture, the node count (sub-groups included) and the seconds the group took to build (the fastest of the builds).  Bonds are timed in courses and in a herringbone, layers also with
 a tint (backend/solid/procedural/tint.py: one more Wave Noise group), and each family also with its noises'
 amplitudes (Turbulence, Grain, Detail, Tint) at 0, which Cycles folds away.  The "OSL:" rows render with Cycles'
 Open Shading Language, the groups' Wave Noise trees in their OSL form (one Script node each, as the groups take it
@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -45,7 +46,7 @@ PARAMS = {"rings": dict(spacing=0.13, tilt=0.4, azimuth=1.0, centre_u=0.3, centr
 def procedural(case: str, noise: bool = True, tint: bool = False, form: str = "nodes"):
     """A group of the family ``case`` (a key of PARAMS); ``noise`` False: Turbulence, Grain, Detail and Tint at 0;
     ``tint``: with a tint (a random photo's, at 2 cycles per unit, as the parity tests draw it); ``form``: its Wave
-    Noise groups' ("osl": rendered with Open Shading Language)."""
+    Noise groups' ("osl": rendered with Open Shading Language).  ``make.builds`` holds each build's seconds."""
     def make(nt):
         rng = np.random.default_rng(0)
         family = "bonds" if case == "herringbone" else case
@@ -56,7 +57,9 @@ def procedural(case: str, noise: bool = True, tint: bool = False, form: str = "n
                 p["grain"] = 0.0
         t = fit_tint(rng.uniform(0, 1, (32, 32, 3)), 2.0, 3) if tint else None
         f = ProceduralField(family, p, fit_ramp(np.linspace(-1, 2, 64), rng.uniform(0, 1, (16, 3))), seed=3, tint=t)
+        t0 = time.perf_counter()
         grp = build_procedural_group(f, implementation=form)
+        make.builds.append(time.perf_counter() - t0)
         n = nt.nodes.new("ShaderNodeGroup")
         n.node_tree = grp
         if tint and not noise:
@@ -66,6 +69,7 @@ def procedural(case: str, noise: bool = True, tint: bool = False, form: str = "n
             return sum(1 + (count(x.node_tree) if x.bl_idname == "ShaderNodeGroup" else 0) for x in tree.nodes)
 
         return (n.inputs["Vector"], n.outputs["sRGB"]), count(grp)
+    make.builds = []
     return make
 
 
@@ -96,12 +100,15 @@ def main(argv=None) -> int:
             times[spp] = min(_timed() for _ in range(a.repeat))
         per = (times[2 * a.samples] - times[a.samples]) / (a.res * a.res * a.samples)
         res[name] = dict(ns_per_pixel_sample=round(per * 1e9, 1), nodes=nodes)
+        if getattr(make, "builds", None):
+            res[name]["build_seconds"] = round(min(make.builds), 3)
     for name, r in res.items():     # each against the Wave Texture rendered as it is, by SVM or by OSL
         ref = res[("OSL: " if name.startswith("OSL: ") else "") + "Blender Wave Texture"]["ns_per_pixel_sample"]
         r["vs_wave_texture"] = round(r["ns_per_pixel_sample"] / ref, 1)
     print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
     for name, r in res.items():
-        print(f"  {name:24s} {r['ns_per_pixel_sample']:10.1f} ns  {r['vs_wave_texture']:6.1f}x  {r['nodes']:5d} nodes")
+        print(f"  {name:24s} {r['ns_per_pixel_sample']:10.1f} ns  {r['vs_wave_texture']:6.1f}x  {r['nodes']:5d} nodes"
+              + (f"  built in {r['build_seconds']:.3f} s" if "build_seconds" in r else ""))
     write_json(a.out, dict(stamp=stamp(), blender=bpy.app.version_string, res=a.res, samples=a.samples, results=res))
     return 0
 
