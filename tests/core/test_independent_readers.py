@@ -97,3 +97,25 @@ def test_oiiotool_reads_our_images_pixel_for_pixel(tmp_path):
     info, got = read_exr_oiio(rgba)
     assert "4 channel" in info and "channel list: R, G, B, A" in info
     assert got.shape == (n, n, 4) and 0.0 <= got.min() and got[..., 3].max() <= 1.0 + 1e-6
+
+
+SOLID = ["solid", "--exemplar", "gravel_3d", "--seed", "2", "--quiet"]
+
+
+@needs_pyopenvdb
+@needs_oiio
+def test_independent_readers_read_our_solid_textures(tmp_path):
+    """A solid texture's volume (a colour grid and a constant density) and its RGB EXR, value for value."""
+    n = 8
+    npy, vdb, img, exr = (str(tmp_path / f) for f in ("s.npy", "s.vdb", "i.npy", "i.exr"))
+    for out, dim in ((npy, 3), (vdb, 3), (img, 2), (exr, 2)):
+        assert main(SOLID + ["--dim", str(dim), "--size", str(n), "-o", out]) == 0
+    ref = np.load(npy)                                         # [z, y, x, rgb], linear
+    v = read_vdb(vdb, n)
+    assert v["color"]["type"] == "Vec3SGrid" and v["color"]["active"] == n ** 3
+    assert v["density"]["cls"] == "fog volume" and np.ptp(np.array(v["density"]["values"])) == 0.0
+    np.testing.assert_allclose(np.array(v["color"]["values"]), ref, atol=1e-6)
+    assert ref.std() > 0.01                                    # a texture, not a constant
+    info, got = read_exr_oiio(exr)
+    assert "3 channel, float openexr" in info and "channel list: R, G, B" in info
+    np.testing.assert_allclose(got, np.load(img), atol=1e-6)
