@@ -17,9 +17,9 @@ class SettingError(ValueError):
         return SettingError(f"{prefix}.{self.setting}", self.message)
 
 
-def check_points(points, dims: tuple, dtype) -> np.ndarray:
-    """``points`` as a contiguous ``dtype`` array (P, D) with D in ``dims``; SettingError naming the points for
-    another shape or a NaN or infinite coordinate (P = 0 passes: no point, no value)."""
+def check_points(points, dims: tuple, dtype=None) -> np.ndarray:
+    """``points`` as a contiguous ``dtype`` array (P, D) with D in ``dims`` (None: their own dtype); SettingError
+    naming the points for another shape or a NaN or infinite coordinate (P = 0 passes: no point, no value)."""
     x = np.ascontiguousarray(points, dtype=dtype)
     if x.ndim != 2 or x.shape[1] not in dims:
         raise SettingError("points", f"expected shape (P, {' or '.join(map(str, dims))}), got {x.shape}")

@@ -1,17 +1,16 @@
 """Cycles render time of the procedural solids' node groups (blender_addon/procedural_nodes.py) against Blender's
 own Wave Texture, the node artists build wood and marble from by hand.
 
-The scene of ``python -m bench node`` (a plane filling an orthographic camera's R x R frame, emission shader,
-Cycles on the CPU), one group per family read through its sRGB output (the ramp's colours, as the Wave Texture's
-Color is read) with the settings of the parity tests
-(tests/blender/test_procedural_blender.py), each rendered once to compile and then timed; nanoseconds per
-pixel-sample from the difference between S and 2S samples (set-up and compilation cancel), the ratio to the Wave
-Texture, the node count (sub-groups included) and the seconds the group took to build (the fastest of the builds).  Bonds are timed in courses and in a herringbone, layers also with
-a tint (backend/solid/procedural/tint.py: one more Wave Noise group), and each family also with its noises'
-amplitudes (Turbulence, Grain, Detail, Tint) at 0, which Cycles folds away.  The "OSL:" rows render with Cycles'
-Open Shading Language, the groups' Wave Noise trees in their OSL form (one Script node each, as the groups take it
-there), each against the Wave Texture rendered by OSL too.  Writes
-docs/benchmarks/procedural_node.json, with Blender's version.
+The scene of ``python -m bench node`` (a plane filling an orthographic camera's R x R frame, emission shader, Cycles
+on the CPU), one group per family read through its sRGB output (the ramp's colours, as the Wave Texture's Color is
+read) with the settings of the parity tests (tests/blender/test_procedural_blender.py), each rendered once to
+compile and then timed; nanoseconds per pixel-sample from the difference between S and 2S samples (set-up and
+compilation cancel), the ratio to the Wave Texture, the node count (sub-groups included) and the seconds the group
+took to build (the fastest of its builds). Bonds are timed in courses and in a herringbone, layers also with a tint
+(backend/solid/procedural/tint.py: one more Wave Noise group), and each family also with its noises' amplitudes
+(Turbulence, Grain, Detail, Tint) at 0, which Cycles folds away. The "OSL:" rows render with Cycles' Open Shading
+Language, the groups' Wave Noise trees in their OSL form (one Script node each, as the groups take it there), each
+against the Wave Texture rendered by OSL too. Writes docs/benchmarks/procedural_node.json, with Blender's version.
 
     python -m bench procedural-node [--res 128] [--samples 4] [--repeat 2]
 """

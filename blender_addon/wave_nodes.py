@@ -381,10 +381,11 @@ def retune_tree(tree: bpy.types.NodeTree, values: dict) -> bool:
     return True
 
 
-def _new_stratum(built: dict, name: str, tree_type: str, dim: int, full: bool, img: bpy.types.Image, rows: int,
-                 mode: str, consts: dict) -> bpy.types.NodeTree:
-    """A stratum's sub-group, copied from one of its shape built here (:func:`copy_or_build`)."""
-    return copy_or_build(built, _stratum_shape(consts), name, consts,
+def _new_stratum(built: dict, shape: str, name: str, tree_type: str, dim: int, full: bool, img: bpy.types.Image,
+                 rows: int, mode: str, consts: dict) -> bpy.types.NodeTree:
+    """A stratum's sub-group, copied from one of its ``shape`` (:func:`_stratum_shape`) built here
+    (:func:`copy_or_build`)."""
+    return copy_or_build(built, shape, name, consts,
                          lambda: _stratum_group(name, tree_type, dim, full, img, rows, mode, consts))
 
 
@@ -547,7 +548,8 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
            "Amplitude": float(amps[0])}
     full = any(d.full for d in noise.dirs.domains)
     own = [noise.dim, full, table.mode, table.values.shape[0], uniform]
-    shape = json.dumps([own, [_stratum_shape(c) for c in strata]])
+    shapes = [_stratum_shape(c) for c in strata]
+    shape = json.dumps([own, shapes])
     img = ensure_table_image(table.values) if implementation == "nodes" else None
     if tree is not None and implementation == "nodes" and _retune(tree, shape, strata, top, img):
         tree[SETTINGS_KEY] = settings_to_json(settings)
@@ -574,8 +576,8 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     built = {}              # {stratum shape: a sub-group built here}, copied and retuned for the next of that shape
     for k, consts in enumerate(strata):
         node = b.new(group_kind)
-        node.node_tree = _new_stratum(built, f".{tree.name} direction {k + 1}", tree.bl_idname, dim, full, img,
-                                      table.values.shape[0], table.mode, consts)
+        node.node_tree = _new_stratum(built, shapes[k], f".{tree.name} direction {k + 1}", tree.bl_idname, dim,
+                                      full, img, table.values.shape[0], table.mode, consts)
         node.label = f"Direction {k + 1}"
         b.put(node.inputs["Sum"], acc)
         b.put(node.inputs["Position"], x)

@@ -333,7 +333,7 @@ class SolidTextureModel:
         read on the z = 0 plane.  A code with ``harmonics`` adds the photo's harmonic part (harmonic.py), one with
         a ``rest`` its Gaussian rest (gaussian_rest.py): rgb = mu + k sqrt(1 - t) L d + h(x) + sqrt(t) g(x).
         """
-        pts = check_points(points, (2, 3), np.result_type(np.asarray(points).dtype, _F))
+        pts = check_points(points, (2, 3))
         if pts.shape[1] > self.dim:
             raise SettingError("points", f"model {self.name!r} is {self.dim}D and cannot be evaluated at 3D points")
         pts = self._padded(pts)

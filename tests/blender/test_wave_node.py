@@ -331,7 +331,7 @@ def test_strata_copied_and_retuned_equal_strata_built_node_by_node(tree_type, ca
     subs = [n.node_tree for n in copied.nodes if n.bl_idname.endswith("Group")]
     assert len({t.name for t in subs}) == len(subs) == s.directions
     assert all(t.users == 1 and t.name == f".{copied.name} direction {k + 1}" for k, t in enumerate(subs))
-    monkeypatch.setattr(wave_nodes, "_new_stratum", lambda built, *a: wave_nodes._stratum_group(*a))
+    monkeypatch.setattr(wave_nodes, "_new_stratum", lambda built, shape, *a: wave_nodes._stratum_group(*a))
     assert _tree_dump(copied) == _tree_dump(build_wave_group(s, tree_type))
 
 
