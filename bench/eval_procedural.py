@@ -47,7 +47,7 @@ from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE, photo_structure
 from omninoise.backend.solid.gaussian_rest import rest_field
 from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.request import SolidRequest
-from omninoise.backend.solid.structure import structure_error
+from omninoise.backend.solid.procedural.structure import structure_error
 from omninoise.backend.solid.synthesis import PX_PER_UNIT
 from omninoise.backend.wavenoise import fast
 from omninoise.export import read_rgb

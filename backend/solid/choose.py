@@ -10,8 +10,8 @@ texture otherwise.
                (gaussian_rest.MARGIN: at most 0.92 times the neural texture's figure: one draw's distance is a noisy
                figure), so a photo it does not suit, or suits only on a cube's faces, keeps the neural texture;
                and only where its walls (the cuts across x and y) hold the photo's structure, which way it runs and
-               whether it repeats as a grid (structure.py), about as well as the neural texture's do: its structure
-               error at most STRUCTURE_TOLERANCE above theirs.  Patch statistics found a tile grid's irregular
+               whether it repeats as a grid (procedural/structure.py), about as well as the neural texture's do: its
+               structure error at most STRUCTURE_TOLERANCE above theirs.  Patch statistics found a tile grid's irregular
                stones and a red board's cracked cells closer than the neural texture's grid and planks
 
 Shapes: photos float32 (H, W, 3) sRGB in [0, 1].
@@ -23,20 +23,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .band_distance import band_distance, central_crop
+from .band_distance import band_distance
 from .gaussian_rest import MARGIN
 from .procedural.fit import oblique_points, plane_group
-from .structure import photo_readings, structure_error
+from .procedural.structure import TOLERANCE as STRUCTURE_TOLERANCE, photo_structure as _photo_structure, structure_error
 
 __all__ = ["Choice", "choose", "AutoTexture", "PLANES", "SIDE", "check_figures", "photo_structure",
            "wall_structure", "STRUCTURE_TOLERANCE"]
 
 SIDE = 128     #: px per side of each plane drawn for the check
-#: how much farther from the photo's structure than the neural texture's walls the procedural solid's may be
-#: (structure.structure_error: orientation vector distance + lattice difference)
-STRUCTURE_TOLERANCE = 0.15
-#: the photo's side the structure is read on: its central crop at its own scale, as the cuts are drawn
-STRUCTURE_SIDE = 256
 #: the check's planes (normal, a point on it), units: two across each axis and six at orientations drawn once (as a
 #: cube's faces and a mesh's faces cut a solid; a solid and a neural texture differ most from cut to cut on oblique
 #: ones), none of the fit's
@@ -60,14 +55,13 @@ def check_figures(images: list, photo: np.ndarray) -> dict:
 
 
 def photo_structure(photo: np.ndarray) -> tuple:
-    """(readings, lags): structure.photo_readings of the photo's central crop at its own scale, as the check's
-    cuts of SIDE px are drawn, read at lags they can hold."""
-    return photo_readings(central_crop(np.asarray(photo, np.float64), STRUCTURE_SIDE), 0.75 * SIDE)
+    """(readings, lags): structure.photo_structure of the photo for the check's cuts of SIDE px."""
+    return _photo_structure(photo, SIDE)
 
 
 def wall_structure(images: list, structure: tuple) -> float:
-    """The structure error (structure.py) of the walls among ``images`` (one per plane of :data:`PLANES`: the cuts
-    across x and across y) against the photo's :func:`photo_structure`; rounded to 0.001."""
+    """The structure error (procedural/structure.py) of the walls among ``images`` (one per plane of :data:`PLANES`:
+    the cuts across x and across y) against the photo's :func:`photo_structure`; rounded to 0.001."""
     walls = [img for img, (n, _) in zip(images, PLANES) if plane_group(n) in ("x", "y")]
     return round(structure_error(walls, *structure), 3)
 

@@ -13,8 +13,9 @@ from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_
 from omninoise.backend.solid.procedural.estimate import GRID, Estimates, estimate, grid_repeat, repeat_length
 from omninoise.backend.solid.procedural.family import Param, axis_vector, dot3
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
-from omninoise.backend.solid.procedural.fit import (FIT_PLANES, ProceduralConfig, fit_procedural, oblique_points,
-                                                   plane_group)
+from omninoise.backend.solid.procedural.fit import (FIT_PLANES, STRUCTURE_MARGIN, STRUCTURE_SIDE, ProceduralConfig,
+                                                   fit_procedural, oblique_points, pick, plane_group, walls_structure)
+from omninoise.backend.solid.procedural.structure import TOLERANCE, photo_structure
 from omninoise.backend.solid.procedural.loss import SliceLoss
 from omninoise.backend.solid.procedural.layers import Layers
 from omninoise.backend.solid.procedural.ramp import Ramp, fit_ramp, luminance, photo_colours
@@ -378,10 +379,41 @@ def test_a_photo_drawn_by_a_family_is_fitted_by_that_family():
                             Ramp((-1.0, 0.0, 2.0), ((0.1, 0.1, 0.1), (0.55, 0.25, 0.2), (0.75, 0.4, 0.3))), seed=5)
     photo = truth.image(192, offset=(0.0, 0.1, 0.0))
     fit = fit_procedural(photo, ProceduralConfig(budget=24, finalists=2, seed=1))
-    assert fit.field.family == "cells", fit.scores
+    assert fit.field.family == "cells", (fit.scores, fit.structure)
     assert fit.field.params["size"] == pytest.approx(0.2, rel=0.5)
+    assert set(fit.structure) == set(fit.scores) and fit.field.family == pick(fit.scores, fit.structure)
     starts = sum(len(f.starts(estimate(photo, PX_PER_UNIT))) for f in FAMILIES.values())
     assert fit.tried == 2 * starts + 2 * 24 + 2 * (len(FREQUENCIES) + 1)
+
+
+def test_the_check_keeps_the_closest_finalist_unless_a_near_one_holds_the_structure_better():
+    """Stage 7's pick: the closest by the check's distance, unless another within STRUCTURE_MARGIN of it has a
+    structure error lower by more than the tolerance."""
+    near, far = 1.0 + 0.5 * STRUCTURE_MARGIN, 1.0 + 2.0 * STRUCTURE_MARGIN
+    assert pick({"layers": 100.0, "bonds": 120.0}, {}) == "layers"
+    assert pick({"layers": 100.0, "bonds": 100.0 * near}, {"layers": 1.2, "bonds": 0.4}) == "bonds"
+    assert pick({"layers": 100.0, "bonds": 100.0 * far}, {"layers": 1.2, "bonds": 0.4}) == "layers"
+    assert pick({"layers": 100.0, "bonds": 100.0 * near}, {"layers": 0.5, "bonds": 0.5 - 0.5 * TOLERANCE}) == "layers"
+    assert pick({"layers": 100.0 * near, "bonds": 100.0}, {"layers": 0.3, "bonds": 1.2}) == "layers"
+    assert pick({"cells": 101.0, "rings": 100.0, "layers": 100.0 * near},
+                {"cells": 0.2, "rings": 0.9, "layers": 0.1}) == "layers"
+
+
+def test_a_wall_in_courses_holds_a_brick_photo_s_structure_and_blotches_do_not():
+    """What stage 7 reads: a running bond's walls hold the structure of a photo drawn by it (the cuts across x show
+    the units' depth, courses too); layers of blotches with the photo's colours (a brick wall's closest finalist by
+    patch statistics on one of the held-out photos) are farther by more than the tolerance."""
+    ramp = Ramp((-1.0, 0.0, 2.0), ((0.9, 0.9, 0.85), (0.45, 0.2, 0.15), (0.6, 0.3, 0.2)))
+    truth = ProceduralField("bonds", dict(length=0.5, height=0.25, offset=0.5, joint=0.12, turbulence=0.05,
+                                          turb_freq=2.0, detail=0.05, flip=True), ramp, seed=3)
+    blotches = ProceduralField("layers", dict(spacing=0.3, tilt=0.0, azimuth=0.0, profile="tri", turbulence=0.6,
+                                              turb_freq=3.0, detail=0.2, flip=False), ramp, seed=3)
+    photo = truth.image(256, offset=(0.0, 0.0, 0.0))
+    readings = photo_structure(photo, STRUCTURE_SIDE)
+    courses, blotched = (walls_structure(f, PX_PER_UNIT, readings) for f in (truth, blotches))
+    assert courses < 0.3 and blotched - courses > TOLERANCE, (courses, blotched)
+    assert pick({"layers": 150.0, "bonds": 150.0 * (1.0 + 0.5 * STRUCTURE_MARGIN)},
+                {"layers": blotched, "bonds": courses}) == "bonds"
 
 
 @pytest.mark.parametrize("length, height, offset", [(0.5, 0.25, 0.5), (0.3, 0.3, 0.0), (0.4, 0.2, 0.25),

@@ -1,10 +1,10 @@
-"""backend/solid/structure.py: a photo's structure as which way it runs and whether it repeats as a grid, and the
-structure error of a solid's walls, which auto (choose.py) holds the procedural solid to."""
+"""backend/solid/procedural/structure.py: a photo's structure as which way it runs and whether it repeats as a grid,
+and the structure error of a solid's walls, which the fit's check and auto (choose.py) hold the procedural solid to."""
 import numpy as np
 
 from omninoise.backend.solid.choose import PLANES, STRUCTURE_TOLERANCE, photo_structure, wall_structure
 from omninoise.backend.solid.procedural.fit import plane_group
-from omninoise.backend.solid.structure import lattice, orientation, photo_readings, structure_error
+from omninoise.backend.solid.procedural.structure import lattice, orientation, photo_readings, structure_error
 
 RNG = np.random.default_rng(11)
 

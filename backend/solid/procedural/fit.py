@@ -11,7 +11,10 @@
     6. tint      each finalist with no tint and with the photo's tint (tint.py) at each of tint.FREQUENCIES, drawn
                  with its ramp on the fit's planes and scored as in the search; the closest kept
     7. check     every finalist drawn on held-out planes (:data:`CHECK_PLANES`) and scored as in the search, with
-                 other draws; the closest kept
+                 other draws; the closest kept, unless another within :data:`STRUCTURE_MARGIN` of its distance holds
+                 the photo's structure better (structure.py: its walls' structure error lower by more than
+                 structure.TOLERANCE): patch statistics do not see which way a photo's courses and slabs run or
+                 that they repeat, and can find a brick wall's blotches a little closer than its courses
 
 Every score draws the slices through :data:`FIT_PLANES` (two across each axis, two oblique) with the ramp fitted
 to those slices' values, and measures them by :class:`~.loss.SliceLoss` (the photo's patch statistics over a
@@ -35,10 +38,12 @@ from .field import DEFAULT_KINDS, FAMILIES, KINDS, PX_PER_UNIT, ProceduralField
 from .loss import SliceLoss
 from .ramp import fit_ramp, photo_colours
 from .search import minimise
+from .structure import TOLERANCE, photo_structure, structure_error
 from .tint import FREQUENCIES, fit_tint
 
 __all__ = ["ProceduralConfig", "ProceduralFit", "fit_procedural", "check_photo", "MIN_SIDE", "FIT_PLANES",
-           "CHECK_PLANES", "oblique_points", "plane_group", "kind_starts"]
+           "CHECK_PLANES", "oblique_points", "plane_group", "kind_starts", "pick", "walls_structure",
+           "STRUCTURE_MARGIN", "STRUCTURE_SIDE"]
 
 MIN_SIDE = 16      #: the shortest photo side a fit reads, px
 #: a start's textured twin: turbulence and detail amplitudes, and the factor on its turbulence's frequency
@@ -61,6 +66,11 @@ CHECK_PLANES = (((1.0, 0.0, 0.0), (-1.7, 2.1, 0.9)), ((1.0, 0.0, 0.0), (2.45, -1
                 ((0.0, 0.0, 1.0), (-0.8, 1.4, -2.3)), ((0.0, 0.0, 1.0), (2.9, -2.2, 1.15)),
                 ((0.0, 0.0, 1.0), (-3.05, -0.35, -1.9)), ((-0.3, 0.8, 0.5), (2.2, 0.4, -1.6)),
                 ((0.7, -0.2, 0.7), (-2.4, -1.2, 1.9)), ((0.1, -0.6, -0.8), (-0.45, 3.4, 3.1)))
+
+#: how much farther than the closest finalist by the check's distance one that holds the photo's structure better
+#: may be and still be kept in its place (stage 7), a fraction
+STRUCTURE_MARGIN = 0.05
+STRUCTURE_SIDE = 128    #: px per side of the check's walls (its cuts across x and y) drawn for their structure
 
 
 def plane_group(normal) -> str:
@@ -92,10 +102,11 @@ class ProceduralConfig:
 @dataclass(frozen=True)
 class ProceduralFit:
     """The fitted ``field``; ``scores`` {kind: its check distance} of the finalists; ``tried`` the number of
-    solids drawn."""
+    solids drawn; ``structure`` {kind: its walls' structure error} of the finalists (empty for one finalist)."""
     field: ProceduralField
     scores: dict
     tried: int
+    structure: dict
 
 
 def oblique_points(size: int, px_per_unit: float, normal, origin) -> np.ndarray:
@@ -166,6 +177,25 @@ def check_photo(photo: np.ndarray) -> np.ndarray:
     return img
 
 
+def walls_structure(field: ProceduralField, ppu: float, photo: tuple) -> float:
+    """The structure error (structure.py) of ``field``'s walls among :data:`CHECK_PLANES`, drawn
+    :data:`STRUCTURE_SIDE` px a side at ``ppu`` px per unit, against ``photo``: the photo's
+    ``photo_structure(photo pixels, STRUCTURE_SIDE)`` at that px per unit."""
+    walls = [field.evaluate(oblique_points(STRUCTURE_SIDE, ppu, n, o)).reshape(STRUCTURE_SIDE, STRUCTURE_SIDE, 3)
+             for n, o in CHECK_PLANES if plane_group(n) in ("x", "y")]
+    return round(structure_error(walls, *photo), 3)
+
+
+def pick(scores: dict, structure: dict) -> str:
+    """The finalist stage 7 keeps: the closest by ``scores`` (its check distance), unless others within
+    :data:`STRUCTURE_MARGIN` of it have a ``structure`` error lower than its own by more than structure.TOLERANCE;
+    then the lowest of those."""
+    win = min(scores, key=scores.get)
+    better = [k for k in structure if scores[k] <= (1.0 + STRUCTURE_MARGIN) * scores[win]
+              and structure[k] < structure[win] - TOLERANCE]
+    return min(better, key=structure.get) if better else win
+
+
 def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfig(), progress=None,
                    cancel=None) -> ProceduralFit:
     """The stages (module doc) on a photo float (H, W, 3) sRGB; ``progress(fraction)`` after each solid drawn,
@@ -218,5 +248,8 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     held_out = SliceLoss(img, side, [plane_group(n) for n, _ in CHECK_PLANES], seed=1)
     scores = {name: round(held_out([f.evaluate(c).reshape(side, side, 3) for c in check]), 2)
               for name, f in fields.items()}
-    win = min(scores, key=scores.get)
-    return ProceduralFit(fields[win], scores, tried[0])
+    structure = {}
+    if len(fields) > 1:
+        photo_walls = photo_structure(img, STRUCTURE_SIDE)
+        structure = {name: walls_structure(f, ppu, photo_walls) for name, f in fields.items()}
+    return ProceduralFit(fields[pick(scores, structure)], scores, tried[0], structure)

@@ -3,7 +3,7 @@ whether it repeats as a grid.
 
 Patch statistics (band_distance.py) compare neighbourhoods a few pixels wide; they do not see that a photo's planks
 all run one way or that its tiles repeat across and up, and a solid of stones or blotches can be closer by them
-than a texture that keeps the planks and the grid.  Auto (choose.py) reads these too:
+than a texture that keeps the planks and the grid.  The fit's check (fit.py) and auto (choose.py) read these too:
 
 - **Orientation**: the structure tensor of the luminance's gradient summed over the image (Bigün & Granlund 1987),
   J = [[Jxx, Jxz], [Jxz, Jzz]], as the vector ((Jxx - Jzz) / tr J, 2 Jxz / tr J): its length is the coherence
@@ -15,7 +15,8 @@ than a texture that keeps the planks and the grid.  Auto (choose.py) reads these
   with zeros), so that a cut holding only two or three tiles reads its repeats as the photo does.
 
 A solid's walls are its cuts across x and across y (the photo stands upright on both).  The structure error of a
-set of cuts is |orientation - the photo's| + |lattice - the photo's|.
+set of cuts is |orientation - the photo's| + |lattice - the photo's|; one texture holds the photo's structure
+better than another where its error is lower by more than :data:`TOLERANCE`.
 
 Shapes: images float (H, W, 3) sRGB, top row first; lags in px.
 """
@@ -23,10 +24,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .procedural.estimate import at_lag, band_transfer, repeats
-from .procedural.ramp import luminance
+from ..band_distance import central_crop
+from .estimate import at_lag, band_transfer, repeats
+from .ramp import luminance
 
-__all__ = ["orientation", "lattice", "readings", "structure_error", "photo_readings"]
+__all__ = ["orientation", "lattice", "readings", "structure_error", "photo_readings", "photo_structure", "TOLERANCE"]
+
+#: a difference of structure errors that counts: the fit's check and auto keep a texture whose walls hold the photo's
+#: structure worse than another's only by less than this
+TOLERANCE = 0.15
 
 
 def orientation(image: np.ndarray) -> np.ndarray:
@@ -67,6 +73,12 @@ def photo_readings(photo: np.ndarray, longest: float) -> tuple:
     (3/4 of the side of the cuts that will be read at them, so that the photo and the cuts are read at one lag)."""
     lags = tuple(min(float(r), float(longest)) for r in repeats(photo))
     return readings([photo], *lags), lags
+
+
+def photo_structure(photo: np.ndarray, side: int) -> tuple:
+    """:func:`photo_readings` of the photo's central crop of twice ``side`` px at its own scale, at lags that cuts
+    of ``side`` px can hold (3/4 of it): what walls drawn ``side`` px a side at the photo's px per unit are held to."""
+    return photo_readings(central_crop(np.asarray(photo, np.float64), 2 * side), 0.75 * side)
 
 
 def structure_error(images: list, photo: np.ndarray, lags: tuple) -> float:
