@@ -21,6 +21,7 @@ at the cell centres ``(i + 1/2) * extent / N`` of ``[0, extent)``.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from typing import Callable
 
@@ -98,6 +99,11 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     size = _check_size(size)
     limits.in_range("extent", extent, limits.MIN_LENGTH, limits.MAX_COORD)
     limits.time("time", time)
+    known = [f.name for f in dataclasses.fields(WaveSettings)]
+    for name in settings:
+        if name not in known:
+            raise TypeError(f"wave() got an unexpected keyword argument {name!r}; its settings are "
+                            f"{', '.join(known)}")
     if "spectrum" in settings:
         settings["spectrum"] = _spectrum(settings["spectrum"])
     s = WaveSettings(**settings)

@@ -44,3 +44,12 @@ def test_a_transfer_path_may_be_a_path_object(tmp_path):
     ramp.write_text(json.dumps({"range": [-1, 1], "stops": [[0, [0, 0, 0, 0]], [1, [1, 1, 1, 1]]]}))
     assert str(omninoise.wave(8, out=tmp_path / "o.png", transfer=ramp)) == str(tmp_path / "o.png")
     assert (tmp_path / "o.png").stat().st_size > 0
+
+
+def test_an_unknown_wave_setting_is_a_type_error_naming_wave_and_its_settings():
+    """As for any Python function, an unknown keyword is a TypeError, from ``wave`` itself (not from the settings
+    class behind it), listing the settings it takes."""
+    with pytest.raises(TypeError, match=r"^wave\(\) got an unexpected keyword argument 'colour'; its settings are "
+                                        r"dim, .*spectrum") as exc:
+        omninoise.wave(8, colour=3)
+    assert "WaveSettings" not in str(exc.value)
