@@ -18,6 +18,7 @@ sys.path.insert(0, ROOT)
 import bpy  # noqa: E402
 
 from omninoise.blender_addon.bake_blender import load_image, load_volume  # noqa: E402
+from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
 
 
 def build_scene(bakes: str):
@@ -53,9 +54,7 @@ def build_scene(bakes: str):
     bpy.context.active_object.data.energy = 5.0
     world = bpy.data.worlds.new("Sky")
     world.color = (0.06, 0.11, 0.24)
-    if world.node_tree is None:  # Blender 4.x: new worlds start without nodes
-        world.use_nodes = True
-    bg = next(n for n in world.node_tree.nodes if n.type == "BACKGROUND")
+    bg = next(n for n in ensure_node_tree(world).nodes if n.type == "BACKGROUND")
     bg.inputs["Color"].default_value = (0.06, 0.11, 0.24, 1.0)
     sc.world = world
     sc.frame_set(6)

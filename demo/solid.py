@@ -173,9 +173,7 @@ def sun_and_sky(sc, rotation, energy: float) -> None:
     bpy.ops.object.light_add(type="SUN", rotation=rotation)
     bpy.context.active_object.data.energy = energy
     world = bpy.data.worlds.new("Sky")
-    if world.node_tree is None:
-        world.use_nodes = True
-    next(n for n in world.node_tree.nodes if n.type == "BACKGROUND").inputs["Color"].default_value = \
+    next(n for n in ensure_node_tree(world).nodes if n.type == "BACKGROUND").inputs["Color"].default_value = \
         (0.35, 0.38, 0.42, 1.0)
     sc.world = world
 

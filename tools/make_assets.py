@@ -264,8 +264,7 @@ def _preview_scene(shape: str):
     sc.render.film_transparent = False
     sc.view_settings.view_transform = "Standard"
     world = bpy.data.worlds.new(f"Preview {shape}")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.18, 0.18, 0.2, 1.0)
+    ensure_node_tree(world).nodes["Background"].inputs["Color"].default_value = (0.18, 0.18, 0.2, 1.0)
     sc.world = world
     if shape == "volume":       # the subject is the asset object itself, linked in by the caller
         obj = None

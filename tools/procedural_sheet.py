@@ -56,6 +56,8 @@ def _meshes() -> dict:
 
 
 def _scene():
+    from omninoise.blender_addon.compat import ensure_node_tree
+
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
     sc.cycles.device, sc.cycles.samples, sc.cycles.use_denoising = "CPU", SAMPLES, False
@@ -63,8 +65,7 @@ def _scene():
     sc.render.image_settings.file_format = "PNG"
     sc.view_settings.view_transform = "Standard"
     world = bpy.data.worlds.new("grey")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.35, 0.35, 0.35, 1.0)
+    ensure_node_tree(world).nodes["Background"].inputs["Color"].default_value = (0.35, 0.35, 0.35, 1.0)
     sc.world = world
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     cam.location, cam.rotation_euler = (2.9, -2.9, 2.5), (0.95, 0.0, 0.785)
