@@ -85,9 +85,10 @@ def test_the_wheel_holds_one_package_with_its_models_and_licence(installed):
             assert (pkg / rel).is_file(), f"{rel}: add its pattern to [tool.setuptools.package-data]"
     meta = next(n for n in zipfile.ZipFile(wheel).namelist() if n.endswith("METADATA"))
     text = zipfile.ZipFile(wheel).read(meta).decode()
-    for field in ("License: GPL-3.0-or-later", "Provides-Extra: fast", "Provides-Extra: farm",
-                  "Provides-Extra: train", "Classifier: License :: OSI Approved", "Project-URL:"):
+    for field in ("License-Expression: GPL-3.0-or-later", "License-File: LICENSE", "Provides-Extra: fast",
+                  "Provides-Extra: farm", "Provides-Extra: train", "Project-URL:"):
         assert field in text, field
+    assert any(n.endswith(".dist-info/licenses/LICENSE") for n in zipfile.ZipFile(wheel).namelist())
 
 
 def test_the_installed_package_runs_every_subcommand_and_the_api(installed, tmp_path):
