@@ -551,7 +551,7 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     shapes = [_stratum_shape(c) for c in strata]
     shape = json.dumps([own, shapes])
     img = ensure_table_image(table.values) if implementation == "nodes" else None
-    if tree is not None and implementation == "nodes" and _retune(tree, shape, strata, top, img):
+    if tree is not None and implementation == "nodes" and _retune(tree, shape, shapes, strata, top, img):
         tree[SETTINGS_KEY] = settings_to_json(settings)
         return tree
     if tree is None:
@@ -601,10 +601,11 @@ def _put(tree: bpy.types.NodeTree, path: str, value) -> None:
         else float(value)
 
 
-def _retune_stratum(sub: bpy.types.NodeTree, consts: dict, img: bpy.types.Image) -> bool:
-    """A stratum's sub-group given ``consts`` and the table image in place; False where it was built from other
-    constants than those it retunes, not built so, or edited by hand (the caller then builds it again)."""
-    if sub.get(SHAPE_KEY) != _stratum_shape(consts) or not retune_tree(sub, consts):
+def _retune_stratum(sub: bpy.types.NodeTree, shape: str, consts: dict, img: bpy.types.Image) -> bool:
+    """A stratum's sub-group given ``consts`` (of the stratum shape ``shape``, :func:`_stratum_shape`) and the
+    table image in place; False where it was built from other constants than those it retunes, not built so, or
+    edited by hand (the caller then builds it again)."""
+    if sub.get(SHAPE_KEY) != shape or not retune_tree(sub, consts):
         return False
     for n in sub.nodes:
         if n.bl_idname == "ShaderNodeTexImage":
@@ -625,10 +626,11 @@ def _own(sub) -> bool:
     return sub is not None and TUNED_KEY in sub and sub.users == 1
 
 
-def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: bpy.types.Image) -> bool:
-    """A node-form group of the same ``shape`` given its new constants (``strata``: each stratum's, ``top``: the
-    group's own) and table image in place; False where its shape differs, it was not built so or it was edited by
-    hand (the caller then builds it again)."""
+def _retune(tree: bpy.types.NodeTree, shape: str, shapes: list, strata: list, top: dict,
+            img: bpy.types.Image) -> bool:
+    """A node-form group of the same ``shape`` given its new constants (``strata``: each stratum's, of the stratum
+    shapes ``shapes``; ``top``: the group's own) and table image in place; False where its shape differs, it was
+    not built so or it was edited by hand (the caller then builds it again)."""
     if tree.get(IMPLEMENTATION_KEY) != "nodes" or tree.get(SHAPE_KEY) != shape:
         return False
     subs = _sub_groups(tree)
@@ -636,7 +638,7 @@ def _retune(tree: bpy.types.NodeTree, shape: str, strata: list, top: dict, img: 
         return False
     if not retune_tree(tree, top):          # a group edited by hand is built again
         return False
-    return all(_retune_stratum(sub, consts, img) for sub, consts in zip(subs, strata))
+    return all(_retune_stratum(*args, img) for args in zip(subs, shapes, strata))
 
 
 def _build_osl(tree: bpy.types.NodeTree, noise) -> None:

@@ -131,7 +131,8 @@ def procedural(doc: dict) -> list:
         out.append("")
     if "median_procedural_structure" in s:
         out += [f"Structure: the walls' (x and y cuts') structure error against the photo "
-                f"(`backend/solid/procedural/structure.py`: which way it runs, whether it repeats as a grid; lower is better), "
+                f"(`backend/solid/procedural/structure.py`: which way it runs, whether it repeats as a grid; lower is "
+                f"better), "
                 f"median procedural {s['median_procedural_structure']}, auto {s['median_auto_structure']}, neural "
                 f"{s['median_neural_structure']}, random phase solid {s['median_random_phase_solid_structure']}. "
                 f"Photos where it is more than 0.15 above the neural texture's (the texture loses structure the "
