@@ -142,6 +142,12 @@ def decode(path: str) -> np.ndarray:
     non-image, non-finite and oversized (> MAX_PIXELS, 2^27) files raise
     :class:`ImageError`; a missing one FileNotFoundError.
     """
+    return _decode(path)[0]
+
+
+def _decode(path: str) -> tuple:
+    """(:func:`decode`'s pixels, whether the file stores floats: scene-linear values by the convention of EXR,
+    float TIFF and float .npy, as Blender reads a float image, where 8- and 16-bit files store display values)."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"image not found: {path}")
     if os.path.getsize(path) == 0:
@@ -152,6 +158,7 @@ def decode(path: str) -> np.ndarray:
             a = np.load(path, allow_pickle=False)
             if a.dtype.kind not in "fiub":
                 raise ImageError(f"{path}: a .npy image must hold numbers, got {a.dtype}")
+            linear = a.dtype.kind == "f"
             a = a.astype(np.float32)
         elif ext == ".exr":
             import OpenEXR
@@ -161,8 +168,9 @@ def decode(path: str) -> np.ndarray:
                 key = "Y" if "Y" in chans else ("RGBA" if "RGBA" in chans else
                                                 ("RGB" if "RGB" in chans else next(iter(chans))))
                 a = np.asarray(chans[key].pixels, dtype=np.float32)
+            linear = True
         else:
-            a = _decode_pillow(path)
+            a, linear = _decode_pillow(path)
     except ImageError:
         raise
     except (OSError, ValueError, EOFError, SyntaxError, MemoryError, RuntimeError) as exc:  # OpenEXR: RuntimeError
@@ -176,13 +184,13 @@ def decode(path: str) -> np.ndarray:
         raise ImageError(f"{path}: {a.shape[1]}x{a.shape[0]} px is more than the {MAX_PIXELS} px an input may have")
     if not np.all(np.isfinite(a)):
         raise ImageError(f"{path}: the image holds NaN or infinite values")
-    return a
+    return a, linear
 
 
 _EXIF_ORIENTATION = 0x0112   #: EXIF tag: 1 upright, 2-8 mirrored and/or turned (cameras store the sensor's rows)
 
 
-def _decode_pillow(path: str) -> np.ndarray:
+def _decode_pillow(path: str) -> tuple:
     import warnings
 
     from PIL import Image, ImageOps, UnidentifiedImageError
@@ -199,15 +207,15 @@ def _decode_pillow(path: str) -> np.ndarray:
                     im = ImageOps.exif_transpose(im)     # a phone photo as every viewer shows it, not as stored
                 mode = im.mode
                 if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
-                    return np.asarray(im, dtype=np.float32) / 65535.0
+                    return np.asarray(im, dtype=np.float32) / 65535.0, False
                 if mode == "I":        # 16-bit PNGs open as 32-bit integers holding 0..65535
                     a = np.asarray(im, dtype=np.float32)
-                    return a / (65535.0 if a.max() <= 65535 else float(2 ** 31 - 1))
+                    return a / (65535.0 if a.max() <= 65535 else float(2 ** 31 - 1)), False
                 if mode == "F":
-                    return np.asarray(im, dtype=np.float32)
+                    return np.asarray(im, dtype=np.float32), True
                 if mode not in ("L", "LA", "RGB", "RGBA"):
                     im = im.convert("RGBA" if "A" in mode or "transparency" in im.info else "RGB")
-                return np.asarray(im, dtype=np.float32) / 255.0
+                return np.asarray(im, dtype=np.float32) / 255.0, False
     except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
         if isinstance(exc, UnidentifiedImageError):
             raise ImageError(f"{path}: not an image file this reader knows") from None
@@ -239,12 +247,15 @@ def read_image(path: str) -> np.ndarray:
 
 
 def read_rgb(path: str) -> np.ndarray:
-    """Read an image file as float32 (H, W, 3) in [0, 1], its stored (sRGB) values; greyscale is repeated, an
-    alpha channel must be opaque (:func:`opaque`).  The exemplar format of the solid textures."""
-    a = opaque(decode(path), path)
+    """Read an image file as sRGB-encoded float32 (H, W, 3) in [0, 1], the exemplar format of the solid textures:
+    an 8- or 16-bit file's stored values; a float file's (EXR, float TIFF, float .npy) scene-linear values encoded
+    (:func:`linear_to_srgb`, clipped to [0, 1] first), as Blender shows a float image.  Greyscale is repeated, an
+    alpha channel must be opaque (:func:`opaque`)."""
+    a, linear = _decode(path)
+    a = opaque(a, path)
     if a.shape[2] == 1:
         a = np.repeat(a, 3, axis=2)
-    return np.clip(a, 0.0, 1.0)
+    return linear_to_srgb(a) if linear else np.clip(a, 0.0, 1.0)
 
 
 def _png_text(path: str) -> dict:

@@ -38,6 +38,32 @@ def test_sixteen_bit_images_are_read_by_their_range(tmp_path):
     assert read_image(str(tmp_path / "rgb8.png"))[0, 0] == pytest.approx(0.2)
 
 
+
+def test_float_files_hold_scene_linear_colour_and_exemplars_read_them_as_blender_shows_them(tmp_path):
+    """A photo saved as EXR, float TIFF or float .npy (scene-linear, as the solid textures' own float outputs are)
+    reads as the same sRGB pixels as its 8-bit PNG: an exemplar is the same photo in any file; 8- and 16-bit files
+    keep their stored values."""
+    from omninoise.backend.colour import srgb_to_linear
+    from omninoise.export.images import write_exr
+
+    rng = np.random.default_rng(3)
+    srgb8 = rng.integers(0, 256, (24, 32, 3)).astype(np.uint8)
+    Image.fromarray(srgb8).save(tmp_path / "photo.png")
+    png = read_rgb(str(tmp_path / "photo.png"))
+    assert np.array_equal(png, srgb8 / np.float32(255))
+    linear = srgb_to_linear(png)
+    write_exr(str(tmp_path / "photo.exr"), linear)
+    np.save(tmp_path / "photo.npy", linear)
+    for name in ("photo.exr", "photo.npy"):
+        got = read_rgb(str(tmp_path / name))
+        assert got.dtype == np.float32 and np.abs(got - png).max() < 1e-5, name
+        assert abs(float(decode(str(tmp_path / name)).mean()) - float(linear.mean())) < 1e-6  # decode: as stored
+    Image.fromarray(linear[..., 1]).save(tmp_path / "green.tif")          # a float TIFF (one channel)
+    assert np.abs(read_rgb(str(tmp_path / "green.tif"))[..., 0] - png[..., 1]).max() < 1e-5
+    hdr = linear * 4.0                                                      # highlights above 1 clip, as in Blender
+    write_exr(str(tmp_path / "hdr.exr"), hdr)
+    assert read_rgb(str(tmp_path / "hdr.exr")).max() <= 1.0
+
 @pytest.mark.parametrize("make, match", [
     (lambda p: p.write_bytes(b""), "empty file"),
     (lambda p: p.write_text("hello, not an image"), "not an image file"),
