@@ -3,7 +3,7 @@
 For every photo of the set, the procedural solid the product fits (method "procedural",
 :mod:`backend.solid.procedural`), the neural texture the product draws by default (method "neural"), random phase
 noise drawn as a solid (``bench.solid_synthesis.random_phase_solid``: the closer of the isotropic and upright
-Gaussian solids, figure by figure) and what method "auto" delivers (:mod:`backend.solid.choose`: the procedural
+Gaussian solids, figure by figure; each one's figures are kept too) and what method "auto" delivers (:mod:`backend.solid.choose`: the procedural
 solid where its own check finds it closer than the neural texture by a margin and its walls keep the photo's
 structure about as well, else the neural texture) are cut by the same planes and measured by the held-out patch
 distance (``training.solid.photo_eval``: 7 x 7 Laplacian-pyramid neighbourhoods, sliced Wasserstein, x 1000; lower is
@@ -144,6 +144,7 @@ def measure(path: str, fitted: dict | None = None) -> dict:
           for kind in SOLIDS]
     for k in FIGURES:
         r[f"random_phase_solid_{k}"] = min(f[k] for f in rp)
+        r.update({f"random_phase_solid_{kind}_{k}": f[k] for kind, f in zip(SOLIDS, rp)})
     for k in FIGURES:
         r[f"auto_{k}"] = r[f"{choice.method}_{k}"]
     return r, field, neural, photo
@@ -160,6 +161,9 @@ def summary(rows: dict) -> dict:
         for k in ("axes", "oblique", "axes_band", "oblique_band"):
             s[f"{who}_beats_random_phase_solid_{k}"] = sum(r[f"{who}_{k}"] < r[f"random_phase_solid_{k}"]
                                                           for r in rows.values())
+            for kind in SOLIDS:     # each Gaussian solid alone
+                s[f"{who}_beats_random_phase_solid_{kind}_{k}"] = sum(
+                    r[f"{who}_{k}"] < r[f"random_phase_solid_{kind}_{k}"] for r in rows.values())
             s[f"{who}_beats_neural_{k}"] = sum(r[f"{who}_{k}"] < r[f"neural_{k}"] for r in rows.values())
             s[f"{who}_farther_than_neural_{k}"] = sum(r[f"{who}_{k}"] > r[f"neural_{k}"] for r in rows.values())
     for k in ("axes", "oblique", "axes_band", "oblique_band"):

@@ -109,8 +109,10 @@ def procedural(doc: dict) -> list:
            "distance (lower is better) of the x, y and z cuts (`axes`, two seeds) and of six cuts at random "
            "orientations (`oblique`), for the procedural solid, method auto (the procedural solid where its own check "
            "finds it closer by a margin and its walls keep the photo's structure as well, else the neural texture), "
-           "the neural texture (the default) and random phase noise drawn as a solid. Counts are photos closer than "
-           "the named texture.", ""]
+           "the neural texture (the default) and random phase noise drawn as a solid (the closer, figure by figure, of "
+           "two Gaussian solids with the photo's spectrum: isotropic, every cut with its radial spectrum, and upright, "
+           "the walls with its horizontal and vertical frequencies). Counts are photos closer than the named "
+           "texture.", ""]
     for sfx, title in (("", None), ("_band", "The same over the band-pass levels alone (`photo_eval.band_swd`: "
                                               "without the low-pass residue, where a photo's own crops score worst):")):
         if f"median_procedural_axes{sfx}" not in s:
@@ -129,6 +131,14 @@ def procedural(doc: dict) -> list:
             out.append(f"| {label} | {s.get(f'median_{who}_axes{sfx}')} | {s.get(f'median_{who}_oblique{sfx}')} | "
                        f"{rp} | {nb} | {nf} |")
         out.append("")
+
+        def against(who, kind):
+            key = f"{who}_beats_random_phase_solid_{kind}"
+            return f"{s.get(f'{key}_axes{sfx}')} / {s.get(f'{key}_oblique{sfx}')}"
+        alone = [f"{who}: isotropic {against(who, 'isotropic')}, upright {against(who, 'upright')}"
+                 for who in ("procedural", "auto") if f"{who}_beats_random_phase_solid_isotropic_axes{sfx}" in s]
+        if alone:
+            out += ["Closer than each Gaussian solid alone (axes / oblique): " + "; ".join(alone) + ".", ""]
     if "median_procedural_structure" in s:
         out += [f"Structure: the walls' (x and y cuts') structure error against the photo "
                 f"(`backend/solid/procedural/structure.py`: which way it runs, whether it repeats as a grid; lower is "
