@@ -209,6 +209,28 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
     np.testing.assert_allclose(col.reshape(-1, 3), want, atol=5e-5)     # the grid's points in its own arithmetic
 
 
+
+def test_a_photo_in_an_exr_is_the_same_photo_in_blender_and_on_the_command_line(scene, tmp_path):
+    """A float image holds scene-linear colour: the panel encodes it to sRGB, and the command line reads the same
+    file to the same pixels, so both make the same request."""
+    from omninoise.backend.colour import srgb_to_linear
+    from omninoise.cli.main import build_parser
+    from omninoise.cli.solid import solid_request
+    from omninoise.export.images import read_rgb, write_exr
+
+    rgb = np.random.default_rng(4).integers(0, 256, (64, 72, 3)).astype(np.float32) / 255
+    path = str(tmp_path / "ex.exr")
+    write_exr(path, srgb_to_linear(rgb))
+    ima = bpy.data.images.load(path)
+    assert ima.is_float
+    assert np.array_equal(common.image_srgb(ima, "image"), read_rgb(path))
+    assert np.abs(read_rgb(path) - rgb).max() < 1e-5
+    p = scene.omninoise_solid
+    p.source, p.image, p.method, p.seed = "IMAGE", ima, "SPECTRAL", 3
+    flags = build_parser().parse_args(["solid", "--method", "spectral", "--exemplar", path, "--seed", "3",
+                                       "-o", "x.png"])
+    assert solid_ui.panel_request(p).key() == solid_request(flags).key()
+
 def test_image_source_is_encoded_by_the_space_model(scene):
     p = scene.omninoise_solid
     ima = bpy.data.images.new("Exemplar", 160, 140, alpha=False)
