@@ -3,11 +3,11 @@
 For every photo of the set, the procedural solid the product fits (method "procedural",
 :mod:`backend.solid.procedural`), the neural texture the product draws by default (method "neural"), random phase
 noise drawn as a solid (``bench.solid_synthesis.random_phase_solid``: the closer of the isotropic and upright
-Gaussian solids, figure by figure; each one's figures are kept too) and what method "auto" delivers (:mod:`backend.solid.choose`: the procedural
-solid where its own check finds it closer than the neural texture by a margin and its walls keep the photo's
-structure about as well, else the neural texture) are cut by the same planes and measured by the held-out patch
-distance (``training.solid.photo_eval``: 7 x 7 Laplacian-pyramid neighbourhoods, sliced Wasserstein, x 1000; lower is
-better):
+Gaussian solids, figure by figure; each one's figures are kept too) and what method "auto" delivers
+(:mod:`backend.solid.choose`: the procedural solid where its own check finds it closer than the neural texture by a
+margin and its walls keep the photo's structure about as well, else the neural texture) are cut by the same planes
+and measured by the held-out patch distance (``training.solid.photo_eval``: 7 x 7 Laplacian-pyramid neighbourhoods,
+sliced Wasserstein, x 1000; lower is better):
 
 - ``axes``: the mean of the x, y and z cuts' distances (``photo_eval.SLICE_OFFSETS``, two seeds each, grouped as
   ``photo_eval.grouped_swd`` groups them), what each face of a cube shows;
