@@ -464,6 +464,9 @@ class OMNINOISE_OT_set_transfer(bpy.types.Operator):
                              "density_scale, stops and temperature (as in a job file)", options={"SKIP_SAVE"})
 
     def execute(self, context):
+        if not self.transfer.strip():
+            self.report({"ERROR"}, "transfer function preset: none given (a preset passes its ramp as JSON)")
+            return {"CANCELLED"}
         try:
             tf = backend.transfer.transfer_from_dict(json.loads(self.transfer), "preset")
         except (ValueError, backend.SettingError) as exc:

@@ -12,7 +12,8 @@ import os
 import bpy
 from bpy.props import EnumProperty, IntProperty, StringProperty
 
-#: the extension's package (``bl_ext.<repo>.omninoise``); empty when imported as a plain package
+#: the package above this one: the extension's (``bl_ext.<repo>.omninoise``) when Blender loaded it as an extension,
+#: ``omninoise`` when a script registered the installed Python package (``omninoise.register()``)
 ROOT_PACKAGE = (__package__ or "").rpartition(".")[0]
 
 
@@ -21,7 +22,7 @@ def cache_dir() -> str:
     prefs = get()
     path = prefs.cache_dir if prefs is not None and prefs.cache_dir else ""
     if not path:
-        if ROOT_PACKAGE:
+        if ROOT_PACKAGE.startswith("bl_ext."):     # Blender keeps an extension's user files for it
             path = bpy.utils.extension_path_user(ROOT_PACKAGE, path="cache", create=True)
         else:
             path = os.path.join(bpy.app.tempdir or os.path.expanduser("~"), "omninoise_cache")

@@ -183,6 +183,20 @@ def test_bake_image_operator(scene, tmp_path):
     assert img.source == "SEQUENCE" and tex.image_user.frame_duration == 3 and tex.image_user.frame_start == 2
 
 
+
+def test_an_unsaved_files_bake_goes_to_the_cache_folder_where_a_script_registered_the_package(scene):
+    """Registered by a script from the installed Python package (``omninoise.register()``, as these tests do),
+    not loaded by Blender as an extension, a bake of an unsaved file into the default folder ('//omninoise/')
+    goes to a cache folder under Blender's temporary folder, where an extension's would go to its user folder."""
+    from omninoise.blender_addon import preferences
+
+    assert not preferences.ROOT_PACKAGE.startswith("bl_ext.") and not bpy.data.filepath
+    p = scene.omninoise_bake
+    p.folder, p.name = "//omninoise/", "Cached"
+    assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
+    path = os.path.abspath(bpy.path.abspath(bpy.data.images["Cached"].filepath))
+    assert os.path.isfile(path) and path.startswith(os.path.join(preferences.cache_dir(), "omninoise"))
+
 def test_bad_settings_report_one_line(scene, tmp_path):
     p = scene.omninoise_bake
     p.wave.dimensions = "2"
@@ -193,6 +207,10 @@ def test_bad_settings_report_one_line(scene, tmp_path):
     with pytest.raises(RuntimeError, match="no active object"):
         bpy.ops.omninoise.bake_volume()
     assert os.listdir(tmp_path) == []
+    with pytest.raises(RuntimeError, match=r"transfer function preset: none given \(a preset passes"):
+        bpy.ops.omninoise.set_transfer()
+    with pytest.raises(RuntimeError, match="transfer function preset: .*needs stops"):
+        bpy.ops.omninoise.set_transfer(transfer='{"range": [1, 0]}')
 
 
 @needs_openvdb
