@@ -594,6 +594,9 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
                 from .bake_blender import world_bounds
 
                 lo, hi = (np.array(b) for b in world_bounds(obj))
+            if float((hi - lo).max()) <= 1e-6:     # a camera, light, empty or empty volume: nothing to fill
+                raise backend.SettingError("object", f"{obj.name!r} has no extent to fill with a volume (its bounding "
+                                                     "box is a point); bake an object with a size")
             ext = np.maximum(hi - lo, 1e-6)
             vs = float(ext.max()) / int(p.voxels)
             res = tuple(int(max(1, round(e / vs))) for e in ext)

@@ -377,6 +377,12 @@ def test_errors_are_reported(scene):
     p.source = "IMAGE"
     with pytest.raises(RuntimeError, match="pick an exemplar image"):
         bpy.ops.omninoise.solid_preview()
+    p.source, p.target = "SHIPPED", "VOLUME"
+    bpy.ops.object.empty_add()      # nothing to fill: refused before any work, nothing written
+    before = set(os.listdir(p.folder))
+    with pytest.raises(RuntimeError, match=r"'Empty' has no extent to fill with a volume"):
+        bpy.ops.omninoise.solid_bake()
+    assert set(os.listdir(p.folder)) == before
 
 
 def test_a_partly_transparent_exemplar_is_refused_unless_its_alpha_is_ignored(scene):
