@@ -150,6 +150,10 @@ def _bounds(p: OMNINOISE_PG_bake, context, rank: int) -> tuple:
         if obj is None:
             raise backend.SettingError("bounds", "no active object: select one, or use Custom bounds")
         lo, hi = world_bounds(obj)
+        flat = [a for a, l, h in zip("xyz"[:rank], lo, hi) if not h > l]
+        if flat:        # a camera, light or empty; a plane for a volume
+            raise backend.SettingError("bounds", f"the active object {obj.name!r} has no size along "
+                                                 f"{', '.join(flat)}: select one that does, or use Custom bounds")
     else:
         lo, hi = tuple(p.bounds_min), tuple(p.bounds_max)
     if rank == 2:  # an image covers x, y at the box's middle height

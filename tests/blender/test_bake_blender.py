@@ -206,7 +206,14 @@ def test_bad_settings_report_one_line(scene, tmp_path):
     p.bounds_mode = "OBJECT"
     with pytest.raises(RuntimeError, match="no active object"):
         bpy.ops.omninoise.bake_volume()
+    bpy.ops.object.empty_add()
+    with pytest.raises(RuntimeError, match="bounds: the active object 'Empty' has no size along x, y, z: select"):
+        bpy.ops.omninoise.bake_volume()
+    bpy.ops.mesh.primitive_plane_add()
+    with pytest.raises(RuntimeError, match="'Plane' has no size along z"):
+        bpy.ops.omninoise.bake_volume()
     assert os.listdir(tmp_path) == []
+    assert bpy.ops.omninoise.bake_image() == {"FINISHED"}       # a plane's image covers its x and y
     with pytest.raises(RuntimeError, match=r"transfer function preset: none given \(a preset passes"):
         bpy.ops.omninoise.set_transfer()
     with pytest.raises(RuntimeError, match="transfer function preset: .*needs stops"):
