@@ -134,9 +134,9 @@ class ImageError(ValueError):
 def decode(path: str) -> np.ndarray:
     """The one reader of every image input: float32 (H, W, C) with C in 1..4, values by the file's own range.
 
-    8-bit files are divided by 255, 16-bit ones by 65535 (a 16-bit mask is not
-    read as nearly white), float files (.exr, float TIFF, .npy) are kept as
-    they are.  A file with an EXIF orientation (a phone photo taken upright) is
+    8-bit files and uint8 arrays are divided by 255, 16-bit ones by 65535 (a
+    16-bit mask is not read as nearly white), float files (.exr, float TIFF,
+    .npy) and other arrays are kept as they are.  A file with an EXIF orientation (a phone photo taken upright) is
     turned as image viewers show it, so a brick photo's courses stay level
     (Blender's own images are read as Blender shows them).  Empty, truncated,
     non-image, non-finite and oversized (> MAX_PIXELS, 2^27) files raise
@@ -159,7 +159,8 @@ def _decode(path: str) -> tuple:
             if a.dtype.kind not in "fiub":
                 raise ImageError(f"{path}: a .npy image must hold numbers, got {a.dtype}")
             linear = a.dtype.kind == "f"
-            a = a.astype(np.float32)
+            scale = {np.dtype(np.uint8): 255.0, np.dtype(np.uint16): 65535.0}.get(a.dtype, 1.0)
+            a = a.astype(np.float32) / np.float32(scale)     # 8- and 16-bit arrays as 8- and 16-bit files
         elif ext == ".exr":
             import OpenEXR
 

@@ -58,6 +58,10 @@ def test_float_files_hold_scene_linear_colour_and_exemplars_read_them_as_blender
         got = read_rgb(str(tmp_path / name))
         assert got.dtype == np.float32 and np.abs(got - png).max() < 1e-5, name
         assert abs(float(decode(str(tmp_path / name)).mean()) - float(linear.mean())) < 1e-6  # decode: as stored
+    np.save(tmp_path / "photo8.npy", srgb8)                               # 8-bit arrays read as 8-bit files
+    assert np.array_equal(read_rgb(str(tmp_path / "photo8.npy")), png)
+    np.save(tmp_path / "photo16.npy", srgb8.astype(np.uint16) * 257)
+    assert np.abs(read_rgb(str(tmp_path / "photo16.npy")) - png).max() < 1e-6
     Image.fromarray(linear[..., 1]).save(tmp_path / "green.tif")          # a float TIFF (one channel)
     assert np.abs(read_rgb(str(tmp_path / "green.tif"))[..., 0] - png[..., 1]).max() < 1e-5
     hdr = linear * 4.0                                                      # highlights above 1 clip, as in Blender
