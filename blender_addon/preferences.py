@@ -3,11 +3,14 @@ shipped asset library (added to Blender's asset libraries with one click, as Ble
 preferences to the user).
 
 The cache defaults to Blender's per-extension user folder
-(``bpy.utils.extension_path_user``), never the extension's own folder.
+(``bpy.utils.extension_path_user``), never the extension's own folder; where a
+script registered the installed Python package instead, to the user's cache
+folder (:func:`user_cache`), which outlives the Blender session as that one does.
 """
 from __future__ import annotations
 
 import os
+import sys
 
 import bpy
 from bpy.props import EnumProperty, IntProperty, StringProperty
@@ -15,6 +18,19 @@ from bpy.props import EnumProperty, IntProperty, StringProperty
 #: the package above this one: the extension's (``bl_ext.<repo>.omninoise``) when Blender loaded it as an extension,
 #: ``omninoise`` when a script registered the installed Python package (``omninoise.register()``)
 ROOT_PACKAGE = (__package__ or "").rpartition(".")[0]
+
+
+def user_cache() -> str:
+    """The user's cache folder for OmniNoise outside Blender's extension folders: ``%LOCALAPPDATA%\\omninoise``
+    on Windows, ``~/Library/Caches/omninoise`` on macOS, ``$XDG_CACHE_HOME/omninoise`` (``~/.cache``) elsewhere."""
+    home = os.path.expanduser("~")
+    if sys.platform == "win32":
+        base = os.environ.get("LOCALAPPDATA") or os.path.join(home, "AppData", "Local")
+    elif sys.platform == "darwin":
+        base = os.path.join(home, "Library", "Caches")
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(home, ".cache")
+    return os.path.join(base, "omninoise")
 
 
 def cache_dir() -> str:
@@ -25,7 +41,7 @@ def cache_dir() -> str:
         if ROOT_PACKAGE.startswith("bl_ext."):     # Blender keeps an extension's user files for it
             path = bpy.utils.extension_path_user(ROOT_PACKAGE, path="cache", create=True)
         else:
-            path = os.path.join(bpy.app.tempdir or os.path.expanduser("~"), "omninoise_cache")
+            path = user_cache()
     os.makedirs(path, exist_ok=True)
     return path
 

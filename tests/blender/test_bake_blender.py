@@ -184,10 +184,11 @@ def test_bake_image_operator(scene, tmp_path):
 
 
 
-def test_an_unsaved_files_bake_goes_to_the_cache_folder_where_a_script_registered_the_package(scene):
+def test_an_unsaved_files_bake_goes_to_the_user_cache_where_a_script_registered_the_package(scene):
     """Registered by a script from the installed Python package (``omninoise.register()``, as these tests do),
     not loaded by Blender as an extension, a bake of an unsaved file into the default folder ('//omninoise/')
-    goes to a cache folder under Blender's temporary folder, where an extension's would go to its user folder."""
+    goes to the user's cache folder (``$XDG_CACHE_HOME/omninoise`` here), which outlives the Blender session as an
+    extension's user folder does; not to Blender's temporary folder, which goes with it."""
     from omninoise.blender_addon import preferences
 
     assert not preferences.ROOT_PACKAGE.startswith("bl_ext.") and not bpy.data.filepath
@@ -195,7 +196,9 @@ def test_an_unsaved_files_bake_goes_to_the_cache_folder_where_a_script_registere
     p.folder, p.name = "//omninoise/", "Cached"
     assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
     path = os.path.abspath(bpy.path.abspath(bpy.data.images["Cached"].filepath))
-    assert os.path.isfile(path) and path.startswith(os.path.join(preferences.cache_dir(), "omninoise"))
+    cache = os.path.join(os.environ["XDG_CACHE_HOME"], "omninoise")
+    assert preferences.cache_dir() == cache and os.path.isfile(path)
+    assert path.startswith(os.path.join(cache, "omninoise")) and not path.startswith(bpy.app.tempdir)
 
 def test_bad_settings_report_one_line(scene, tmp_path):
     p = scene.omninoise_bake
