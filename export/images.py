@@ -136,8 +136,9 @@ def decode(path: str) -> np.ndarray:
 
     8-bit files and uint8 arrays are divided by 255, 16-bit ones by 65535 (a
     16-bit mask is not read as nearly white), float files (.exr, float TIFF,
-    .npy) and other arrays are kept as they are.  A file with an EXIF orientation (a phone photo taken upright) is
-    turned as image viewers show it, so a brick photo's courses stay level
+    .npy) and other arrays are kept as they are.  A file with an EXIF
+    orientation (a phone photo taken upright) is turned as image viewers show
+    it, so a brick photo's courses stay level
     (Blender's own images are read as Blender shows them).  Empty, truncated,
     non-image, non-finite and oversized (> MAX_PIXELS, 2^27) files raise
     :class:`ImageError`; a missing one FileNotFoundError.

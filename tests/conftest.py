@@ -1,5 +1,6 @@
 import os
 import sys
+import tempfile
 
 import numpy as np
 import pytest
@@ -27,7 +28,7 @@ _package_from_checkout()
 
 #: the user's cache folder (what Blender bakes of unsaved files use where the package is registered by a script,
 #: as these tests do) lies in a folder of the test run, not in the home folder
-os.environ["XDG_CACHE_HOME"] = __import__("tempfile").mkdtemp(prefix="omninoise-tests-cache-")
+os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="omninoise-tests-cache-")
 
 #: folders whose every test is long (``make test-long``): Blender's (bpy start-up, renders) and training's (torch)
 LONG_FOLDERS = ("blender", "training")

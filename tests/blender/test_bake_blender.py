@@ -183,7 +183,6 @@ def test_bake_image_operator(scene, tmp_path):
     assert img.source == "SEQUENCE" and tex.image_user.frame_duration == 3 and tex.image_user.frame_start == 2
 
 
-
 def test_an_unsaved_files_bake_goes_to_the_user_cache_where_a_script_registered_the_package(scene):
     """Registered by a script from the installed Python package (``omninoise.register()``, as these tests do),
     not loaded by Blender as an extension, a bake of an unsaved file into the default folder ('//omninoise/')
@@ -199,6 +198,7 @@ def test_an_unsaved_files_bake_goes_to_the_user_cache_where_a_script_registered_
     cache = os.path.join(os.environ["XDG_CACHE_HOME"], "omninoise")
     assert preferences.cache_dir() == cache and os.path.isfile(path)
     assert path.startswith(os.path.join(cache, "omninoise")) and not path.startswith(bpy.app.tempdir)
+
 
 def test_bad_settings_report_one_line(scene, tmp_path):
     p = scene.omninoise_bake

@@ -209,7 +209,6 @@ def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scen
     np.testing.assert_allclose(col.reshape(-1, 3), want, atol=5e-5)     # the grid's points in its own arithmetic
 
 
-
 def test_a_photo_in_an_exr_is_the_same_photo_in_blender_and_on_the_command_line(scene, tmp_path):
     """A float image holds scene-linear colour: the panel encodes it to sRGB, and the command line reads the same
     file to the same pixels, so both make the same request."""
@@ -230,6 +229,7 @@ def test_a_photo_in_an_exr_is_the_same_photo_in_blender_and_on_the_command_line(
     flags = build_parser().parse_args(["solid", "--method", "spectral", "--exemplar", path, "--seed", "3",
                                        "-o", "x.png"])
     assert solid_ui.panel_request(p).key() == solid_request(flags).key()
+
 
 def test_image_source_is_encoded_by_the_space_model(scene):
     p = scene.omninoise_solid

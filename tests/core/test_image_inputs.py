@@ -38,7 +38,6 @@ def test_sixteen_bit_images_are_read_by_their_range(tmp_path):
     assert read_image(str(tmp_path / "rgb8.png"))[0, 0] == pytest.approx(0.2)
 
 
-
 def test_float_files_hold_scene_linear_colour_and_exemplars_read_them_as_blender_shows_them(tmp_path):
     """A photo saved as EXR, float TIFF or float .npy (scene-linear, as the solid textures' own float outputs are)
     reads as the same sRGB pixels as its 8-bit PNG: an exemplar is the same photo in any file; 8- and 16-bit files
@@ -67,6 +66,7 @@ def test_float_files_hold_scene_linear_colour_and_exemplars_read_them_as_blender
     hdr = linear * 4.0                                                      # highlights above 1 clip, as in Blender
     write_exr(str(tmp_path / "hdr.exr"), hdr)
     assert read_rgb(str(tmp_path / "hdr.exr")).max() <= 1.0
+
 
 @pytest.mark.parametrize("make, match", [
     (lambda p: p.write_bytes(b""), "empty file"),
