@@ -176,11 +176,14 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     ``"synthesis"`` (a seamless 2D image); ``scale`` is output pixels per exemplar
     pixel; ``refine`` search steps improve a photo's code; ``periodic`` keeps a photo's courses and planks;
     ``families`` are the kinds of solid a procedural fit tries (of ``"rings"``, ``"layers"``, ``"cells"``,
-    ``"bonds"`` and ``"herringbone"``; all but ``"herringbone"`` by default).
+    ``"bonds"`` and ``"herringbone"``; all but ``"herringbone"`` by default).  With ``method="procedural"`` the
+    fitted solid itself is saved by an ``out`` ending in ``.json``, and drawn again, without fitting, from that file
+    (or a ``ProceduralField``) given as the exemplar.
 
     Returns scene-linear RGB float32: ``(size, size, 3)`` for ``dim=2`` (the front view: x right, z up, top row
     first) or ``(size, size, size, 3)`` indexed ``[z, y, x]`` for ``dim=3``; or, with ``out``, writes it as
-    ``omninoise solid -o`` does (2D ``.png``/``.exr``/``.npy``, 3D ``.vdb``/``.npy``) and returns the path.
+    ``omninoise solid -o`` does (2D ``.png``/``.exr``/``.npy``, 3D ``.vdb``/``.npy``; the fitted procedural solid
+    ``.json``) and returns the path.
 
     >>> rgb = solid("grass", 16)
     >>> rgb.shape, rgb.dtype
@@ -195,8 +198,10 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
     limits.scale("scale", scale)
     limits.check_memory("size", float(size) ** dim * 4 * 4, f"a {size}-sample {dim}D texture")
-    if out is not None and _check_out(out, (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy"),
-                                      f"a {dim}D texture") == ".vdb":
+    allowed = (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy")
+    ext = None if out is None else _check_out(out, allowed + ((".json",) if method == "procedural" else ()),
+                                              f"a {dim}D texture")
+    if ext == ".vdb":
         from .backend.bake import require_vdb
 
         require_vdb("out")
@@ -205,6 +210,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
                             ("families", families is not None)) if v]
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
     req.check_reads(given)
+    if ext == ".json":          # the fitted procedural solid itself
+        from .backend.solid.procedural import saved
+
+        saved.save(os.fspath(out), req.procedural_field(progress=progress))
+        return os.fspath(out)
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake
         from .backend.sources import BoxGrid, solid_volume

@@ -418,10 +418,14 @@ class _Prepared:
         self.density = float(limits.in_range("source.density", density, 0.0, float("inf")))
         # the checks and the key read the pixels here; a file is read again when the texture is made, so that a job
         # of many large photos holds none of them until then (a 4096 px photo is 200 MB as floats)
-        seen = request.replace(exemplar=request.exemplar_pixels("source.")).check_pixels("source.")
+        from .solid.procedural.saved import is_saved
+
+        saved = is_saved(request.exemplar)          # a saved procedural solid: read and checked, no pixels
+        seen = request if saved else request.replace(exemplar=request.exemplar_pixels("source.")).check_pixels(
+            "source.")
         self._key = seen.key()                                     # hashes the pixels: its digest is taken from it
         self.input_sha256 = (self._key["procedural"] if request.method == "auto" else self._key)["exemplar"]
-        self.photo_shape = np.shape(seen.exemplar)
+        self.photo_shape = None if saved else np.shape(seen.exemplar)
         self.request = self._unread(request)
         self._made, self._lock = made, threading.Lock()
 

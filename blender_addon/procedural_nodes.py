@@ -90,23 +90,19 @@ def _socket_values(field) -> dict:
     return out
 
 
-#: the parameters whose range is a share (of a unit, a cube, a course): the group's sockets stop at its top; a cell's
-#: feature point beyond its cube (Jitter over 1) would lie outside the 27 cubes the group searches
-SHARES = ("offset", "jitter", "gap", "joint")
-
-
 def _bounds(family: str) -> dict:
-    """{socket name: (min, max or None)} of a family's float parameters: a length, size or frequency (the engine
-    searches it on a log axis) no smaller than the engine's smallest, so no slider reaches a division by 0; a share
-    within the engine's range; a noise's amplitude no smaller than 0."""
+    """{socket name: (min, max or None)} of a family's float parameters, where the engine draws them
+    (family.Param.check): a length, size or frequency no smaller than the engine's smallest, so no slider reaches a
+    division by 0; a noise's amplitude no smaller than 0; a share (of a unit, a cube, a course) within its range (a
+    cell's feature point beyond its cube, Jitter over 1, would lie outside the 27 cubes the group searches)."""
     from ..backend.solid.procedural.field import FAMILIES
 
     ranges = {q.name: q for q in FAMILIES[family].params()}
     out = {}
     for name, key in PARAMETERS[family] + SHARED:
         q = ranges.get(key)
-        if q is not None:
-            out[name] = (q.lo if q.log else 0.0, q.hi if key in SHARES else None)
+        if q is not None and q.floor:
+            out[name] = (q.lo, q.hi if q.cap else None)
     return out
 
 

@@ -39,10 +39,14 @@ omninoise solid --exemplar photo.jpg --size 512 -o like.png
 omninoise solid --exemplar gravel --to marble --mix 0.5 -o halfway.png
 omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 128 -o rock.vdb
 omninoise solid --method procedural --exemplar bricks.jpg --dim 3 --size 128 -o wall.vdb
+omninoise solid --method procedural --exemplar bricks.jpg -o wall.json
+omninoise solid --method procedural --exemplar wall.json --dim 3 --size 256 -o wall.vdb
 omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png""")
     g = s.add_argument_group("texture and output")
-    g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file")
-    g.add_argument("-o", "--out", help="2D: .png (sRGB), .exr or .npy (linear); 3D: .vdb or .npy (linear)")
+    g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file; --method procedural: "
+                                        "also a fitted solid saved as .json (-o)")
+    g.add_argument("-o", "--out", help="2D: .png (sRGB), .exr or .npy (linear); 3D: .vdb or .npy (linear); "
+                                       "--method procedural: .json, the fitted solid to draw again (--exemplar)")
     g.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2: an image; 3: a volume")
     g.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
     g.add_argument("--scale", type=float, default=1.0, help="zoom: output pixels per exemplar pixel")
@@ -106,7 +110,14 @@ def run(a: argparse.Namespace) -> int:
     limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     ext = os.path.splitext(a.out)[1].lower()
     allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
-    if ext not in allowed:
+    if ext == ".json":          # the fitted procedural solid itself, drawn later at any size
+        if a.method != "procedural":
+            raise SettingError("-o", "a .json output is a fitted procedural solid: give --method procedural")
+        for flag, value, unset in (("--dim", a.dim, 2), ("--size", a.size, 256), ("--scale", a.scale, 1.0)):
+            if value != unset:
+                raise SettingError(flag, "a .json output holds the fitted solid, not a drawing of it: leave "
+                                         f"{flag} out, and give it when the .json is drawn (--exemplar)")
+    elif ext not in allowed:
         raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
     if ext == ".vdb":
         from omninoise.backend.bake import require_vdb
@@ -144,6 +155,15 @@ def run(a: argparse.Namespace) -> int:
 
     stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid ",
              "procedural": "procedural fit ", "auto": "procedural fit "}[req.method]
+    if ext == ".json":
+        from omninoise.backend.solid.procedural import saved
+
+        field = req.procedural_field("--", Bar(a.quiet, stage))
+        saved.save(a.out, field)
+        if not a.quiet:
+            print(f"saved the fitted {field.family} to {a.out}: draw it with --method procedural --exemplar "
+                  f"{a.out}", file=sys.stderr)
+        return 0
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
         from omninoise.backend.bake import BakeSpec, run_bake
         from omninoise.backend.sources import BoxGrid, solid_volume

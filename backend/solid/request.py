@@ -35,6 +35,7 @@ from ..errors import SettingError
 from ..paths import solid_models
 from .methods import IMAGE_METHODS, METHODS, READS
 from .procedural.field import DEFAULT_KINDS
+from .procedural.saved import is_saved
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
 
@@ -93,7 +94,8 @@ def check_pixels_given(x, setting: str) -> None:
 @dataclass(frozen=True, eq=False)
 class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
-    model), ``exemplar`` and ``to`` (names, image files or pixels), ``mix`` in [0, 1], ``refine`` >= 0 search
+    model), ``exemplar`` and ``to`` (names, image files or pixels; for method "procedural" the exemplar may be a
+    saved procedural solid instead, a ProceduralField or its ``.json`` file, drawn as saved), ``mix`` in [0, 1], ``refine`` >= 0 search
     steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
     Gaussian rest, where the check keeps one), ``rest`` (which: one of gaussian_rest.REST_CHOICES), ``method`` (one of
     :data:`METHODS`), for "synthesis" ``tile`` (px per side of the periodic image) and for "procedural" and "auto"
@@ -128,6 +130,8 @@ class SolidRequest:
         twice = sorted({k for k in kinds if list(kinds).count(k) > 1})
         if twice:
             raise bad("families", f"names {', '.join(twice)} more than once")
+        if is_saved(self.exemplar):
+            return self._check_saved(where)
         for key in ("exemplar", "to"):
             check_pixels_given(getattr(self, key), f"{where}{key}")
         if self.model is not None and not isinstance(self.model, str):
@@ -156,6 +160,45 @@ class SolidRequest:
                     or t % TILE_STEP:
                 raise bad("tile", f"must be a multiple of {TILE_STEP} in [{MIN_TILE}, {MAX_TILE}], got {t!r}")
         return self
+
+    def _check_saved(self, where: str) -> "SolidRequest":
+        """:meth:`check` of a request whose exemplar is a saved procedural solid (a ProceduralField, or its JSON
+        file: procedural/saved.py): drawn by method procedural as saved, with nothing to fit or mix, and read here,
+        before any work."""
+        def bad(key, why):
+            return SettingError(f"{where}{key}", why)
+
+        if self.method != "procedural":
+            raise bad("exemplar", f"a saved procedural solid is drawn by method procedural, not {self.method}")
+        if int(self.seed) != 0:
+            raise bad("seed", "a saved procedural solid keeps the seed it was saved with; edit its \"seed\" to draw "
+                              "another")
+        for key, unset in (("to", None), ("refine", 0), ("families", DEFAULT_KINDS)):
+            value = getattr(self, key)
+            if (tuple(value) if key == "families" else value) != unset:
+                raise bad(key, "a saved procedural solid is drawn as it was saved; nothing is fitted or mixed")
+        if self.model is not None:
+            raise bad("model", "a saved procedural solid needs no model")
+        if isinstance(self.exemplar, str) and not os.path.isfile(self.exemplar):
+            raise bad("exemplar", f"there is no file {self.exemplar!r}")
+        self.saved_field(where)
+        return self
+
+    def saved_field(self, where: str = ""):
+        """The saved procedural solid the exemplar is (:func:`~backend.solid.procedural.saved.read`; a file is read
+        once per request, and again only where it changed on disk)."""
+        if not isinstance(self.exemplar, str):
+            return self.exemplar
+        from .procedural.saved import read
+
+        stamp = _file_stamp(self.exemplar)
+        kept = self.__dict__.get("_saved")
+        if stamp is not None and kept is not None and kept[0] == stamp:
+            return kept[1]
+        field = read(self.exemplar, f"{where}exemplar")
+        if stamp is not None:
+            object.__setattr__(self, "_saved", (stamp, field))
+        return field
 
     def folder(self, models: str | None = None) -> str:
         """The model folder: ``model`` itself, a shipped model by name, or (no model) the exemplar's own shipped
@@ -205,6 +248,9 @@ class SolidRequest:
         to float (H, W, 3) sRGB; SettingError naming the exemplar for a file it cannot read.  A file is decoded once
         per request, and again only where it changed on disk: the grid note and the fit read the same pixels, kept
         read-only (the request keeps the path: a shipped model is looked up by the exemplar's name)."""
+        if is_saved(self.exemplar):
+            raise SettingError(f"{where}exemplar", "a saved procedural solid is no photo: it is drawn by method "
+                                                   "procedural")
         if not isinstance(self.exemplar, str):
             return self.exemplar
         from ... import export
@@ -239,7 +285,7 @@ class SolidRequest:
         """What the image methods (synthesis, spectral, procedural, auto) ask of the exemplar's pixels, checked
         before any work (a job file's bakes when the job is read, their textures made when baked): SettingError
         naming the exemplar for an image they cannot use; the request when they can."""
-        if self.method not in IMAGE_METHODS + ("auto",):
+        if self.method not in IMAGE_METHODS + ("auto",) or is_saved(self.exemplar):
             return self
         img = self.exemplar_pixels(where)
         try:
@@ -262,12 +308,20 @@ class SolidRequest:
     def replace(self, **changes) -> "SolidRequest":
         """``dataclasses.replace``, keeping this request's decoding of its file exemplar where the exemplar stays."""
         new = dataclasses.replace(self, **changes)
-        if "exemplar" not in changes and "_decoded" in self.__dict__:
-            object.__setattr__(new, "_decoded", self.__dict__["_decoded"])
+        if "exemplar" not in changes:
+            for memo in ("_decoded", "_saved"):
+                if memo in self.__dict__:
+                    object.__setattr__(new, memo, self.__dict__[memo])
         return new
 
     def exemplar_digest(self) -> str | None:
-        """The exemplar for the key (``_digest``), a file by the pixels of this request's one decoding."""
+        """The exemplar for the key (``_digest``), a file by the pixels of this request's one decoding, a saved
+        procedural solid by its JSON."""
+        if is_saved(self.exemplar):
+            import json
+
+            text = json.dumps(self.saved_field().to_dict(), sort_keys=True)
+            return "procedural:" + hashlib.sha256(text.encode()).hexdigest()
         if isinstance(self.exemplar, str) and os.path.isfile(self.exemplar):
             return _pixels_sha(self.exemplar_pixels())
         return _digest(self.exemplar)
@@ -313,6 +367,8 @@ class SolidRequest:
         SettingError naming the exemplar for an image it cannot use."""
         from .procedural.fit import ProceduralConfig, fit_procedural
 
+        if is_saved(self.exemplar):
+            return self.saved_field(where)
         img = np.asarray(self.exemplar_pixels(where), np.float32)
         try:
             config = ProceduralConfig(seed=int(self.seed), families=tuple(self.families))
@@ -328,7 +384,8 @@ class SolidRequest:
         from .procedural.estimate import GRID, grid_repeat
         from .procedural.fit import PX_PER_UNIT, ProceduralConfig
 
-        if self.method not in ("procedural", "auto") or not set(self.families) - {"bonds", "herringbone"}:
+        if self.method not in ("procedural", "auto") or not set(self.families) - {"bonds", "herringbone"} \
+                or is_saved(self.exemplar):
             return False
         if self.exemplar is None or isinstance(self.exemplar, str) and not os.path.isfile(self.exemplar):
             return False

@@ -329,8 +329,14 @@ def test_a_field_reads_back_from_json_and_refuses_bad_parameters():
     np.testing.assert_array_equal(f.evaluate(pts[:, :2]), f.evaluate(np.c_[pts[:, :2], np.zeros(3000)]))
     with pytest.raises(SettingError, match="unknown procedural family 'tiles'"):
         ProceduralField("tiles", p, ramp)
-    with pytest.raises(SettingError, match=r"height must be in \[0.01, 1.0\]"):
+    with pytest.raises(SettingError, match="height must be a finite number, got nan"):
         ProceduralField("bonds", dict(p, height=float("nan")), ramp)
+    with pytest.raises(SettingError, match=r"height must be at least 0.01, got 0.0"):
+        ProceduralField("bonds", dict(p, height=0.0), ramp)
+    with pytest.raises(SettingError, match=r"joint must be in \[0.0, 0.5\], got 0.6"):
+        ProceduralField("bonds", dict(p, joint=0.6), ramp)
+    edited = ProceduralField("bonds", dict(p, length=3.0, turbulence=4.0), ramp)    # beyond the search, drawn
+    assert edited.params["length"] == 3.0 and np.isfinite(edited.evaluate(pts)).all()
     with pytest.raises(SettingError, match="profile must be one of saw, tri"):
         ProceduralField("layers", dict(spacing=0.2, tilt=0.0, azimuth=0.0, **CALM), ramp)
     with pytest.raises(Cancelled):

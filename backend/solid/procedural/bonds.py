@@ -82,8 +82,9 @@ class Bonds(Family):
     PARAMS = (Param("length", 0.02, 2.0, log=True, doc="a unit's length along x and y, units"),
               Param("height", 0.01, 1.0, log=True, doc="a course's height along z (herringbone: a unit's width), "
                                                         "units"),
-              Param("offset", 0.0, 1.0, doc="each course's (herringbone: each slab's) shift, in unit lengths"),
-              Param("joint", 0.0, 0.5, doc="the joints' width, in course heights"))
+              Param("offset", 0.0, 1.0, doc="each course's (herringbone: each slab's) shift, in unit lengths",
+                    cap=True),
+              Param("joint", 0.0, 0.5, doc="the joints' width, in course heights", cap=True))
 
     GAPPED = True
 

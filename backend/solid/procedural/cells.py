@@ -93,8 +93,9 @@ class Cells(Family):
     doc = "cells of a jittered grid with their own colours and gaps: stones, pebbles, flakes, spots"
     PARAMS = (Param("size", 0.01, 1.5, log=True, doc="a cell's side, units"),
               Param("stretch", 0.3, 3.0, log=True, doc="a cell's height over its width (along z)"),
-              Param("jitter", 0.0, 1.0, doc="how far feature points move within their cube, in sides"),
-              Param("gap", 0.0, 0.45, doc="the gap between cells, in cell sides"))
+              Param("jitter", 0.0, 1.0, doc="how far feature points move within their cube, in sides",
+                    cap=True),
+              Param("gap", 0.0, 0.45, doc="the gap between cells, in cell sides", cap=True))
 
     GAPPED = True
 

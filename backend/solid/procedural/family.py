@@ -26,12 +26,29 @@ DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8
 
 @dataclass(frozen=True)
 class Param:
-    """A parameter ``name`` in [lo, hi] (``log``: searched on a log axis); ``doc`` says what it is and its unit."""
+    """A parameter ``name`` searched in [lo, hi] (``log``: on a log axis); ``doc`` says what it is and its unit.
+    A solid drawn with edited parameters (the node group's inputs, a saved solid) keeps ``lo`` as its least value
+    where ``floor`` (a length, size or frequency above 0, an amplitude at least 0; not an angle or an offset) and
+    ``hi`` as its greatest where ``cap`` (a share of a unit, a cube or a course): :meth:`check`."""
     name: str
     lo: float
     hi: float
     log: bool = False
     doc: str = ""
+    floor: bool = True
+    cap: bool = False
+
+    def check(self, v) -> float:
+        """``v`` as a float where a drawn solid can take it (``floor``, ``cap``); ValueError naming it where not."""
+        ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+        v = float(v) if ok else v
+        if not ok or not np.isfinite(v):
+            raise ValueError(f"{self.name} must be a finite number, got {v!r}")
+        if self.cap and not self.lo <= v <= self.hi:
+            raise ValueError(f"{self.name} must be in [{self.lo}, {self.hi}], got {v!r}")
+        if self.floor and v < self.lo:
+            raise ValueError(f"{self.name} must be at least {self.lo}, got {v!r}")
+        return v
 
     def to_unit(self, v: float) -> float:
         """The value as a search coordinate in [0, 1]."""
@@ -81,15 +98,16 @@ class Family:
         return s
 
     def check(self, p: dict) -> dict:
-        """``p`` with every parameter present and within its range (ValueError naming one that is not)."""
+        """``p``'s parameters, each present and one a drawn solid can take (:meth:`Param.check`: a fit's are within
+        their search ranges, an artist's edits may leave them), as floats; ValueError naming one that is not."""
         out = {}
         for q in self.params():
             if q.name not in p:
                 raise ValueError(f"{self.name}: parameter {q.name!r} is missing")
-            v = float(p[q.name])
-            if not (np.isfinite(v) and q.lo <= v <= q.hi):
-                raise ValueError(f"{self.name}: {q.name} must be in [{q.lo}, {q.hi}], got {v!r}")
-            out[q.name] = v
+            try:
+                out[q.name] = q.check(p[q.name])
+            except ValueError as exc:
+                raise ValueError(f"{self.name}: {exc}") from None
         return out
 
 

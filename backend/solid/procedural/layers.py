@@ -23,8 +23,8 @@ class Layers(Family):
     name = "layers"
     doc = "a profile along a warped coordinate: veins, strata, straight grain"
     PARAMS = (Param("spacing", 0.005, 2.0, log=True, doc="distance between layers, units"),
-              Param("tilt", 0.0, np.pi, doc="the layers' normal's angle from +z, radians"),
-              Param("azimuth", 0.0, np.pi, doc="the normal's turn about z from +x, radians"))
+              Param("tilt", 0.0, np.pi, doc="the layers' normal's angle from +z, radians", floor=False),
+              Param("azimuth", 0.0, np.pi, doc="the normal's turn about z from +x, radians", floor=False))
 
     def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         pts = np.asarray(points, np.float64)

@@ -33,10 +33,12 @@ class Rings(Family):
     name = "rings"
     doc = "growth rings around an axis: wood's end grain, its planks' figure"
     PARAMS = (Param("spacing", 0.005, 1.0, log=True, doc="distance between rings, units"),
-              Param("tilt", 0.0, np.pi, doc="the axis's angle from +z, radians"),
-              Param("azimuth", 0.0, np.pi, doc="the axis's turn about z from +x, radians"),
-              Param("centre_u", -6.0, 6.0, doc="the axis's offset from the origin, across it, units"),
-              Param("centre_v", -6.0, 6.0, doc="the axis's offset from the origin, across it and u, units"),
+              Param("tilt", 0.0, np.pi, doc="the axis's angle from +z, radians", floor=False),
+              Param("azimuth", 0.0, np.pi, doc="the axis's turn about z from +x, radians", floor=False),
+              Param("centre_u", -6.0, 6.0, doc="the axis's offset from the origin, across it, units",
+                    floor=False),
+              Param("centre_v", -6.0, 6.0, doc="the axis's offset from the origin, across it and u, units",
+                    floor=False),
               Param("grain", 0.0, 1.0, doc="the streaks along the axis, in ring spacings"))
 
     def geometry(self, p: dict) -> tuple:
