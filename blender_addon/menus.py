@@ -56,6 +56,8 @@ class OMNINOISE_MT_object(bpy.types.Menu):
         layout.operator("omninoise.solid_preview", icon="HIDE_OFF")
         layout.operator("omninoise.solid_tile_material", icon="MOD_UVPROJECT")
         layout.operator("omninoise.solid_procedural_node", icon="NODETREE")
+        layout.operator("omninoise.solid_load_procedural", icon="IMPORT")
+        layout.operator("omninoise.solid_save_procedural", icon="EXPORT")
         layout.separator()
         layout.operator("omninoise.bake_volume", icon="VOLUME_DATA")
         layout.operator("omninoise.bake_image", icon="IMAGE_DATA")

@@ -36,7 +36,7 @@ from .wave_nodes import (NodeBuilder, build_wave_group, check_form, new_group, s
                          tree_implementation, tree_settings_json)
 
 __all__ = ["build_procedural_group", "add_procedural_node", "follow_form", "noise_trees", "PARAMETERS",
-           "FIELD_KEY"]
+           "FIELD_KEY", "procedural_node", "node_field", "node_space"]
 
 FIELD_KEY = "omninoise_procedural"
 
@@ -427,6 +427,78 @@ def follow_form(form: str) -> int:
                     continue
                 done += 1
     return done
+
+
+def procedural_node(obj):
+    """The group node of a procedural solid in ``obj``'s active material: the material's active node where it is
+    one, else its first; SettingError where there is none."""
+    mat = getattr(obj, "active_material", None)
+    nt = getattr(mat, "node_tree", None)
+    found = [] if nt is None else [n for n in nt.nodes if n.type == "GROUP" and n.node_tree is not None
+                                   and FIELD_KEY in n.node_tree]
+    if not found:
+        where = "nothing is selected" if obj is None else f"{obj.name!r}'s active material has none"
+        raise SettingError("object", f"no procedural node group: {where} (make one with Procedural Node Group or "
+                                     "load a saved solid)")
+    return nt.nodes.active if nt.nodes.active in found else found[0]
+
+
+def _value(node, name: str):
+    s = node.inputs[name]
+    if s.is_linked:
+        raise SettingError(name, f"{node.name!r}'s {name} is linked to another node; a bake reads the group's own "
+                                 "values: unlink it and set it")
+    v = s.default_value
+    return tuple(float(x) for x in v) if hasattr(v, "__len__") else float(v)
+
+
+def node_field(node):
+    """The ProceduralField a procedural group ``node`` draws as its inputs are set (an artist's edits included):
+    the field stored on its group (:data:`FIELD_KEY`) with the family's parameters read off the node's inputs
+    (the rings' Axis and Centre and the layers' Normal turned back into angles and offsets), Turbulence,
+    Turbulence Frequency and Detail, and the tint's amount (its levels times Tint; none at 0) and frequency.
+    SettingError naming an input that is linked, or one the engine does not draw."""
+    from ..backend.solid.procedural.family import axis_angles
+    from ..backend.solid.procedural.field import FAMILIES, ProceduralField
+    from ..backend.solid.procedural.tint import Tint
+
+    stored = ProceduralField.from_dict(json.loads(node.node_tree[FIELD_KEY]))
+    family, p, tint = stored.family, dict(stored.params), stored.tint
+    for name, key in PARAMETERS[family] + SHARED:
+        if key in p:
+            p[key] = _value(node, name)
+    direction = {"rings": "Axis", "layers": "Normal"}.get(family)
+    if direction is not None:
+        v = _value(node, direction)
+        try:
+            if family == "rings":
+                p.update(FAMILIES["rings"].placement(v, _value(node, "Centre")))
+            else:
+                p["tilt"], p["azimuth"] = axis_angles(v)
+        except SettingError:
+            raise
+        except ValueError as exc:
+            raise SettingError(direction, f"{node.name!r}: {exc}") from None
+    if tint is not None:
+        amount = _value(node, "Tint")
+        tint = None if amount == 0 else Tint(_value(node, "Tint Frequency"), tint.positions,
+                                             tuple(amount * v for v in tint.levels), tint.axis)
+    return ProceduralField(family, p, stored.ramp, stored.seed, stored.px_per_unit, tint)
+
+
+def node_space(node) -> tuple:
+    """(scale, world) of a procedural group ``node``: its Scale input (texture units per Blender unit) and whether
+    its Vector is the world Position (a Geometry node's) rather than the object's own space (a Texture Coordinate
+    node's Object output, as :func:`add_procedural_node` wires it); SettingError for another Vector."""
+    scale = _value(node, "Scale")
+    links = node.inputs["Vector"].links
+    src = links[0].from_socket if links else None
+    if src is not None and src.node.type == "TEX_COORD" and src.name == "Object" and src.node.object is None:
+        return scale, False
+    if src is not None and src.node.type == "NEW_GEOMETRY" and src.name == "Position":
+        return scale, True
+    raise SettingError("Vector", f"{node.name!r}'s Vector is not the object's own space (a Texture Coordinate "
+                                 "node's Object, with no object set) or the world Position: a bake draws one of those")
 
 
 def add_procedural_node(node_tree, group, location=(0.0, 0.0)):

@@ -40,6 +40,7 @@ import bpy
 import numpy as np
 from bl_operators.presets import AddPresetBase
 from bl_ui.utils import PresetPanel
+from bpy_extras.io_utils import ExportHelper, ImportHelper
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from . import tasks
@@ -104,9 +105,13 @@ def _space_model_name():
 
 
 class OMNINOISE_PG_solid(bpy.types.PropertyGroup):
-    source: EnumProperty(name="Source", description="Start from a ready texture or from a photo", items=[
+    source: EnumProperty(name="Source", description="Start from a ready texture, from a photo or from a procedural "
+                                                    "solid's node group", items=[
         ("SHIPPED", "Shipped", "A texture that ships with OmniNoise"),
-        ("IMAGE", "Image", "Any image: the texture-space model encodes it into a texture code")], default="SHIPPED")
+        ("IMAGE", "Image", "Any image: the texture-space model encodes it into a texture code"),
+        ("NODE_GROUP", "Node Group", "The active object's procedural node group as its inputs are set: preview and "
+                                     "bake what it renders, or save it for the command line and job files")],
+        default="SHIPPED")
     texture: EnumProperty(name="Texture", items=_texture_items, description="Which ready texture to use")
     method: EnumProperty(name="Method", description="How the photo becomes a solid texture", items=[
         ("NEURAL", "Neural Texture", "A network trained on many materials draws a solid that looks like the photo "
@@ -182,6 +187,11 @@ def panel_request(p):
     """The panel's :class:`backend.solid.request.SolidRequest`: the one request of the command line and job
     files, built from the properties (an image's pixels are read here, on the main thread: bpy data)."""
     SolidRequest = _mod("solid.request").SolidRequest
+    if p.source == "NODE_GROUP":
+        from .procedural_nodes import node_field, procedural_node
+
+        return SolidRequest(exemplar=node_field(procedural_node(bpy.context.active_object)),
+                            method="procedural").check()
     if p.source == "IMAGE":
         if p.image is None:
             raise backend.SettingError("image", "pick an exemplar image (or switch Source to Shipped)")
@@ -529,7 +539,8 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
         return self._start_target(context, p, obj, m, code_fn, blocking)
 
     def _start_target(self, context, p, obj, m, code_fn, blocking):
-        world, scale, seed, name = p.coords == "WORLD", float(p.scale), int(p.seed), p.name
+        scale, world = _space(p, obj)
+        seed, name = int(p.seed), p.name
         surface = _mod("solid.surface")
         if p.target == "UV_IMAGE":
             uv, pos = _mesh_arrays(context, obj, world, uv=True)
@@ -672,6 +683,90 @@ class OMNINOISE_OT_solid_procedural_node(SolidTask, bpy.types.Operator):
         return tasks.start(tasks.Task(f"Procedural {name}", work, done, None, threads()), blocking=blocking)
 
 
+def _space(p, obj) -> tuple:
+    """(scale, world) a bake reads the texture at: the panel's Scale and Coordinates, or with Source Node Group the
+    node's own Scale and Vector (procedural_nodes.node_space), so that the bake is what the node renders."""
+    if p.source == "NODE_GROUP":
+        from .procedural_nodes import node_space, procedural_node
+
+        return node_space(procedural_node(obj))
+    return float(p.scale), p.coords == "WORLD"
+
+
+class OMNINOISE_OT_solid_save_procedural(bpy.types.Operator, ExportHelper):
+    """Save the active object's procedural node group, as its inputs are set, as a JSON file that the command line
+    (--method procedural --exemplar FILE), job files and Python draw without fitting"""
+
+    bl_idname = "omninoise.solid_save_procedural"
+    bl_label = "Save Procedural Solid"
+    bl_options = {"REGISTER"}      # writes a file only: nothing in the .blend to undo
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def execute(self, context):
+        from .procedural_nodes import node_field, procedural_node
+
+        saved = _mod("solid.procedural.saved")
+        try:
+            field = node_field(procedural_node(context.active_object))
+            path = bpy.path.abspath(self.filepath)
+            if not path.lower().endswith(".json"):
+                raise backend.SettingError("file", f"a saved procedural solid is a .json file, not {path!r}")
+            saved.save(path, field)
+        except (backend.SettingError, OSError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Saved the {field.family} to {path}")
+        return {"FINISHED"}
+
+
+class OMNINOISE_OT_solid_load_procedural(bpy.types.Operator, ImportHelper):
+    """Give the active mesh a material drawing a saved procedural solid (a JSON file of the command line's -o or of
+    Save Procedural Solid) live from nodes, at the panel's Scale and Coordinates; no fit"""
+
+    bl_idname = "omninoise.solid_load_procedural"
+    bl_label = "Load Procedural Solid"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return tasks.current() is None
+
+    def execute(self, context):
+        from .procedural_nodes import add_procedural_node, build_procedural_group
+        from .wave_ui import scene_form
+
+        p = context.scene.omninoise_solid
+        obj = context.active_object
+        if obj is None or obj.type != "MESH":
+            self.report({"ERROR"}, "select a mesh to give the procedural material to")
+            return {"CANCELLED"}
+        path = bpy.path.abspath(self.filepath)
+        try:
+            field = _mod("solid.procedural.saved").read(path, "file")
+        except backend.SettingError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        name = os.path.splitext(os.path.basename(path))[0]
+        group = build_procedural_group(field, name=f"{name} Procedural", implementation=scene_form(context.scene))
+        scale, world = float(p.scale), p.coords == "WORLD"
+
+        def node(nt):
+            n = add_procedural_node(nt, group, (-400.0, 0.0))
+            n.inputs["Scale"].default_value = scale
+            if world:
+                nt.links.new(_world_position(nt), n.inputs["Vector"])
+            return n
+
+        _material_with(obj, f"{name} Procedural", node)
+        self.report({"INFO"}, f"Loaded the {field.family} of {os.path.basename(path)} (Source: Node Group bakes it)")
+        return {"FINISHED"}
+
+
 def _world_position(nt):
     """A Geometry node's Position output (world space) in ``nt``."""
     geo = next((n for n in nt.nodes if n.type == "NEW_GEOMETRY"), None) or nt.nodes.new("ShaderNodeNewGeometry")
@@ -699,18 +794,36 @@ def draw_solid(layout, context) -> None:
     _split(layout)
     if p.source == "SHIPPED":
         layout.prop(p, "texture")
-    else:
+    elif p.source == "IMAGE":
         layout.template_ID(p, "image", open="image.open")
         layout.prop(p, "method")
+    else:
+        _draw_node_group(layout, context)
     for suffix in ("Preview", "Tile"):
         prev = bpy.data.images.get(f"{p.name} {suffix}")
         if prev is not None and prev.preview is not None:
             layout.template_icon(icon_value=prev.preview.icon_id, scale=6.0)
-    layout.prop(p, "scale")
-    layout.prop(p, "seed")
+    if p.source != "NODE_GROUP":        # a node group's own Scale, and its seed is the fit's
+        layout.prop(p, "scale")
+        layout.prop(p, "seed")
     row = _idle_row(layout)
     row.operator(OMNINOISE_OT_solid_preview.bl_idname, text="Preview", icon="HIDE_OFF")
     row.operator(OMNINOISE_OT_solid_bake.bl_idname, text="Bake", icon="RENDER_STILL")
+
+
+def _draw_node_group(layout, context) -> None:
+    """Which node group Source Node Group reads (or why none), and saving and loading procedural solids."""
+    from .procedural_nodes import procedural_node
+
+    try:
+        node = procedural_node(context.active_object)
+        layout.label(text=f"{context.active_object.active_material.name} > {node.node_tree.name}", icon="NODETREE")
+        layout.label(text="Scale and coordinates: the node's")
+    except backend.SettingError as exc:
+        layout.label(text=exc.message, icon="ERROR")
+    row = _idle_row(layout)
+    row.operator(OMNINOISE_OT_solid_save_procedural.bl_idname, text="Save", icon="EXPORT")
+    row.operator(OMNINOISE_OT_solid_load_procedural.bl_idname, text="Load", icon="IMPORT")
 
 
 def _draw_photo(layout, p) -> None:
@@ -739,7 +852,8 @@ def _draw_photo(layout, p) -> None:
 
 def _draw_bake(layout, p) -> None:
     layout.prop(p, "target")
-    layout.prop(p, "coords")
+    if p.source != "NODE_GROUP":
+        layout.prop(p, "coords")
     if p.target == "UV_IMAGE":
         layout.prop(p, "size")
         layout.prop(p, "margin")
@@ -825,6 +939,7 @@ PANELS = (OMNINOISE_PT_solid,) + tuple(_section_panel(*section) for section in S
 
 classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable,
            OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_OT_solid_procedural_node,
+           OMNINOISE_OT_solid_save_procedural, OMNINOISE_OT_solid_load_procedural,
            OMNINOISE_PT_solid_presets, OMNINOISE_OT_solid_preset_add) + PANELS
 
 

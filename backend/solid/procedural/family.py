@@ -19,7 +19,7 @@ import numpy as np
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
-__all__ = ["Param", "Family", "cell_random", "axis_vector", "dot3", "gapped", "inside", "SHARED", "DETAIL_FREQ"]
+__all__ = ["Param", "Family", "cell_random", "axis_vector", "axis_angles", "dot3", "gapped", "inside", "SHARED", "DETAIL_FREQ"]
 
 DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
 
@@ -140,6 +140,17 @@ def cell_random(i, j, k, seed: int) -> np.ndarray:
 def axis_vector(tilt: float, azimuth: float) -> np.ndarray:
     """The unit vector ``tilt`` radians from +z, turned ``azimuth`` radians about z from +x: float64 (3,)."""
     return np.array([np.sin(tilt) * np.cos(azimuth), np.sin(tilt) * np.sin(azimuth), np.cos(tilt)])
+
+
+def axis_angles(v) -> tuple:
+    """(tilt, azimuth) of the direction of ``v`` (3,), not 0: :func:`axis_vector`'s inverse (azimuth in (-pi, pi];
+    0 along z); ValueError for a vector of no length or not finite."""
+    v = np.asarray(v, np.float64)
+    n = float(np.linalg.norm(v))
+    if not (np.isfinite(n) and n > 1e-12):
+        raise ValueError(f"a direction must have a length, got {tuple(float(x) for x in v)}")
+    d = v / n
+    return float(np.arccos(np.clip(d[2], -1.0, 1.0))), float(np.arctan2(d[1], d[0]))
 
 
 def dot3(points: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .family import Family, Param, axis_vector, dot3
+from .family import Family, Param, axis_angles, axis_vector, dot3
 from .turbulence import turbulence
 
 __all__ = ["Rings", "GRAIN_STRETCH"]
@@ -46,6 +46,14 @@ class Rings(Family):
         d = axis_vector(p["tilt"], p["azimuth"])
         e1, e2 = _basis(d)
         return d, p["centre_u"] * e1 + p["centre_v"] * e2
+
+    def placement(self, axis, centre) -> dict:
+        """:meth:`geometry`'s inverse: tilt, azimuth, centre_u and centre_v of the rings about the axis along
+        ``axis`` (3,) through ``centre`` (3,) (the node group's inputs); ValueError for an axis of no length."""
+        tilt, azimuth = axis_angles(axis)
+        e1, e2 = _basis(axis_vector(tilt, azimuth))
+        c = np.asarray(centre, np.float64)
+        return dict(tilt=tilt, azimuth=azimuth, centre_u=float(c @ e1), centre_v=float(c @ e2))
 
     def shape(self, p: dict, points: np.ndarray, seed: int) -> np.ndarray:
         pts = np.asarray(points, np.float64)

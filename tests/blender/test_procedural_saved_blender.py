@@ -1,0 +1,205 @@
+"""A procedural solid's node group as an artist has edited it, read back as the engine's field
+(blender_addon/procedural_nodes.node_field): the same solid the group renders, saved as JSON for the command line
+(Save Procedural Solid), loaded from JSON as a live material (Load Procedural Solid), and previewed and baked by the
+Solid Texture panel with Source Node Group at the node's own Scale and coordinates."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+from omninoise import blender_addon  # noqa: E402
+from omninoise.backend.colour import srgb_to_linear  # noqa: E402
+from omninoise.backend.errors import SettingError  # noqa: E402
+from omninoise.backend.solid.procedural import saved  # noqa: E402
+from omninoise.backend.solid.procedural.field import ProceduralField  # noqa: E402
+from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
+from omninoise.blender_addon.procedural_nodes import (add_procedural_node, build_procedural_group,  # noqa: E402
+                                                      node_field, node_space, procedural_node)
+from conftest import Recorder  # noqa: E402
+from test_procedural_blender import FAMILY_PARAMS, _field  # noqa: E402  (the group-against-engine tests' fields)
+
+#: an artist's edits per case: (input, value); sizes beyond the fit's search ranges, turned axes, less tint
+EDITS = {"rings": (("Spacing", 0.31), ("Axis", (0.2, -1.0, 0.4)), ("Centre", (0.5, 0.1, -2.0)), ("Grain", 0.6)),
+         "layers": (("Spacing", 2.7), ("Normal", (-0.3, 0.2, -1.0)), ("Tint", 0.4), ("Tint Frequency", 3.0)),
+         "cells": (("Size", 0.35), ("Stretch", 4.0), ("Jitter", 0.5), ("Gap", 0.2), ("Tint", 0.0)),
+         "bonds": (("Length", 2.5), ("Height", 0.2), ("Offset", 0.25), ("Joint", 0.3)),
+         "herringbone": (("Length", 0.44), ("Height", 0.11), ("Joint", 0.05))}
+SHARED = (("Turbulence", 0.7), ("Turbulence Frequency", 1.3), ("Detail", 0.05))
+
+
+def _edit(node, case):
+    for name, value in EDITS[case] + SHARED:
+        node.inputs[name].default_value = value
+
+
+@pytest.mark.parametrize("case", list(EDITS))
+def test_an_edited_group_s_field_is_what_the_group_draws(case):
+    """The group's nodes (in Geometry Nodes, the engine's equal: test_procedural_blender) with edited inputs and the
+    engine's field read back off those inputs draw the same values, and the edits are in the field."""
+    f = _field(case)
+    grp = build_procedural_group(f, "GeometryNodeTree")
+    pts = np.random.default_rng(2).uniform(-1.5, 1.5, (2000, 3)).astype(np.float32)
+    read = {}
+
+    def output(channel):
+        def build(tree, pos):
+            g = tree.nodes.new("GeometryNodeGroup")
+            g.node_tree = grp
+            _edit(g, case)
+            read["field"] = node_field(g)
+            tree.links.new(pos, g.inputs["Vector"])
+            sep = tree.nodes.new("ShaderNodeSeparateXYZ")
+            tree.links.new(g.outputs["sRGB"], sep.inputs[0])
+            return sep.outputs[channel]
+        return evaluate_field(pts, build)
+
+    try:
+        drawn = np.stack([output(c) for c in range(3)], 1)
+    finally:
+        bpy.data.node_groups.remove(grp)
+    field = read["field"]
+    ref = field.evaluate(pts.astype(np.float64))
+    assert np.abs(drawn - ref).max() < 1e-3 and np.median(np.abs(drawn - ref)) < 1e-5
+    assert np.abs(ref - f.evaluate(pts.astype(np.float64))).mean() > 0.02          # the edits changed the solid
+    p = field.params
+    assert p["turbulence"] == pytest.approx(0.7) and p["turb_freq"] == pytest.approx(1.3)
+    key = {"rings": "spacing", "layers": "spacing", "cells": "size"}.get(case, "length")
+    assert p[key] == pytest.approx(dict(EDITS[case])[key.title()])
+    assert {k: v for k, v in p.items() if isinstance(v, (str, bool))} == \
+        {k: v for k, v in f.params.items() if isinstance(v, (str, bool))}         # profile, pattern, flip kept
+    if case == "layers":
+        assert field.tint.frequency == pytest.approx(3.0)
+        np.testing.assert_allclose(field.tint.levels, 0.4 * np.array(f.tint.levels), rtol=1e-6)
+    if case == "cells":
+        assert f.tint is not None and field.tint is None                          # Tint 0: none drawn
+
+
+def _cube_with_group(f, scale=1.0):
+    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.3, -0.2, 0.1))
+    obj = bpy.context.active_object
+    mat = bpy.data.materials.new("Edited")
+    mat.use_nodes = True
+    obj.data.materials.append(mat)
+    node = add_procedural_node(mat.node_tree, build_procedural_group(f, name="Edited Procedural"))
+    node.inputs["Scale"].default_value = scale
+    return obj, node
+
+
+def test_save_load_and_bake_the_node_group_as_edited(tmp_path):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        from omninoise.blender_addon import solid_ui
+
+        f = _field("layers")
+        obj, node = _cube_with_group(f, scale=1.7)
+        _edit(node, "layers")
+        edited = node_field(node)
+        assert node_space(node) == (pytest.approx(1.7), False)
+
+        path = str(tmp_path / "edited.json")
+        assert bpy.ops.omninoise.solid_save_procedural(filepath=path) == {"FINISHED"}
+        assert json.load(open(path))["format"] == saved.FORMAT
+        assert saved.read(path).to_dict() == edited.to_dict()
+
+        # Source Node Group: the bake draws the node as edited, at its Scale, in the object's space
+        p = bpy.context.scene.omninoise_solid
+        p.source, p.target, p.name, p.scale = "NODE_GROUP", "COLOR_ATTRIBUTE", "Baked", 0.5
+        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        me = obj.data
+        co = np.empty(len(me.vertices) * 3, np.float32)
+        me.vertices.foreach_get("co", co)
+        rgba = np.empty(len(me.vertices) * 4, np.float32)
+        me.color_attributes["Baked"].data.foreach_get("color", rgba)
+        ref = srgb_to_linear(edited.evaluate(co.reshape(-1, 3).astype(np.float64) * np.float32(1.7)))
+        assert np.abs(rgba.reshape(-1, 4)[:, :3] - ref).max() < 1e-5
+        log = []                            # the panel names the node and draws neither Scale nor Seed
+        solid_ui.draw_solid_all(Recorder(log), bpy.context)
+        assert not {"scale", "seed", "coords", "texture", "image", "method"} & {a for n, a, t in log if n == "prop"}
+        labels = {t for n, a, t in log if n == "label"}
+        assert {"Edited > Edited Procedural", "Scale and coordinates: the node's"} <= labels
+        assert {"Save", "Load"} <= {t for n, a, t in log if n == "operator"}
+        assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+        ima = bpy.data.images["Baked Preview"]
+        px = np.empty(ima.size[0] * ima.size[1] * 4, np.float32)
+        ima.pixels.foreach_get(px)
+        assert np.abs(np.flipud(px.reshape(128, 128, 4)[..., :3]) - edited.image(128)).max() <= 0.5 / 255 + 1e-4
+
+        # Load: a new mesh draws the saved solid live; its node reads back as the file
+        bpy.ops.mesh.primitive_uv_sphere_add()
+        sphere = bpy.context.active_object
+        p.scale, p.coords = 2.0, "WORLD"
+        assert bpy.ops.omninoise.solid_load_procedural(filepath=path) == {"FINISHED"}
+        loaded = procedural_node(sphere)
+        assert loaded.node_tree.name.startswith("edited Procedural")
+        assert node_space(loaded) == (pytest.approx(2.0), True)
+        back = node_field(loaded)
+        pts = np.random.default_rng(3).uniform(-1, 1, (3000, 3))
+        assert np.abs(back.evaluate(pts) - edited.evaluate(pts)).max() < 1e-4     # float32 sockets
+        bsdf = next(n for n in sphere.active_material.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+        assert bsdf.inputs["Base Color"].links[0].from_node == loaded
+    finally:
+        blender_addon.unregister()
+
+
+def test_what_a_node_group_bake_cannot_read_is_named(tmp_path):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        from omninoise.blender_addon import solid_ui
+
+        p = bpy.context.scene.omninoise_solid
+        p.source = "NODE_GROUP"
+        bpy.ops.mesh.primitive_cube_add()
+        with pytest.raises(SettingError, match="no procedural node group: 'Cube''s active material has none"):
+            solid_ui.panel_request(p)
+        with pytest.raises(RuntimeError, match="no procedural node group"):
+            bpy.ops.omninoise.solid_save_procedural(filepath=str(tmp_path / "x.json"))
+        assert not os.path.exists(tmp_path / "x.json")
+        obj, node = _cube_with_group(_field("rings"))
+        nt = obj.active_material.node_tree
+        value = nt.nodes.new("ShaderNodeValue")
+        nt.links.new(value.outputs[0], node.inputs["Spacing"])
+        with pytest.raises(SettingError, match="Spacing is linked to another node"):
+            solid_ui.panel_request(p)
+        nt.links.remove(node.inputs["Spacing"].links[0])
+        node.inputs["Axis"].default_value = (0.0, 0.0, 0.0)
+        with pytest.raises(SettingError, match="Axis: .*a direction must have a length"):
+            solid_ui.panel_request(p)
+        node.inputs["Axis"].default_value = (0.0, 0.0, 1.0)
+        assert solid_ui.panel_request(p).method == "procedural"
+        uv = nt.nodes.new("ShaderNodeTexCoord")
+        nt.links.new(uv.outputs["UV"], node.inputs["Vector"])
+        p.target = "COLOR_ATTRIBUTE"
+        with pytest.raises(RuntimeError, match="Vector is not the object's own space"):
+            bpy.ops.omninoise.solid_bake()
+        bad = tmp_path / "bad.json"
+        bad.write_text('{"format": "omninoise procedural solid 1", "family": "rings"}')
+        with pytest.raises(RuntimeError, match="params: missing"):
+            bpy.ops.omninoise.solid_load_procedural(filepath=str(bad))
+        bpy.ops.object.camera_add()
+        with pytest.raises(RuntimeError, match="select a mesh"):
+            bpy.ops.omninoise.solid_load_procedural(filepath=str(bad))
+    finally:
+        blender_addon.unregister()
+
+
+def test_every_family_s_group_reads_back_as_its_field_unedited():
+    for case in FAMILY_PARAMS:
+        f = _field(case)
+        grp = build_procedural_group(f)
+        mat = bpy.data.materials.new("Unedited")
+        mat.use_nodes = True
+        try:
+            node = add_procedural_node(mat.node_tree, grp)
+            back = node_field(node)
+            pts = np.random.default_rng(4).uniform(-1.5, 1.5, (3000, 3))
+            diff = np.abs(back.evaluate(pts) - f.evaluate(pts))
+            assert back.family == f.family and np.median(diff) < 1e-6 and np.mean(diff > 1e-3) < 0.002, case
+            assert isinstance(back, ProceduralField)
+        finally:
+            bpy.data.materials.remove(mat)
+            bpy.data.node_groups.remove(grp)
