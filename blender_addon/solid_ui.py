@@ -662,25 +662,29 @@ class OMNINOISE_OT_solid_procedural_node(SolidTask, bpy.types.Operator):
             return fit(progress, cancel), grid_info(req)
 
         def done(result):
-            from .procedural_nodes import add_procedural_node, build_procedural_group
-            from .wave_ui import scene_form
-
             field, grid = result
-
-            group = build_procedural_group(field, name=f"{name} Procedural",
-                                           implementation=scene_form(bpy.context.scene))
+            _give_procedural(obj, field, name, scale, world)
             p.periodic_info, p.grid_info = periodic_info(field), grid
 
-            def node(nt):
-                n = add_procedural_node(nt, group, (-400.0, 0.0))
-                n.inputs["Scale"].default_value = scale
-                if world:
-                    nt.links.new(_world_position(nt), n.inputs["Vector"])
-                return n
-
-            _material_with(obj, f"{name} Procedural", node)
-
         return tasks.start(tasks.Task(f"Procedural {name}", work, done, None, threads()), blocking=blocking)
+
+
+def _give_procedural(obj, field, name: str, scale: float, world: bool):
+    """Give ``obj`` the material ``<name> Procedural`` (or its active one with a Principled BSDF) drawing ``field``
+    live: a new node group of it, in the scene's form, read at object positions (or world ones) times ``scale``."""
+    from .procedural_nodes import add_procedural_node, build_procedural_group
+    from .wave_ui import scene_form
+
+    group = build_procedural_group(field, name=f"{name} Procedural", implementation=scene_form(bpy.context.scene))
+
+    def node(nt):
+        n = add_procedural_node(nt, group, (-400.0, 0.0))
+        n.inputs["Scale"].default_value = scale
+        if world:
+            nt.links.new(_world_position(nt), n.inputs["Vector"])
+        return n
+
+    return _material_with(obj, f"{name} Procedural", node)
 
 
 def _space(p, obj) -> tuple:
@@ -737,9 +741,6 @@ class OMNINOISE_OT_solid_load_procedural(bpy.types.Operator, ImportHelper):
         return tasks.current() is None
 
     def execute(self, context):
-        from .procedural_nodes import add_procedural_node, build_procedural_group
-        from .wave_ui import scene_form
-
         p = context.scene.omninoise_solid
         obj = context.active_object
         if obj is None or obj.type != "MESH":
@@ -752,17 +753,7 @@ class OMNINOISE_OT_solid_load_procedural(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         name = os.path.splitext(os.path.basename(path))[0]
-        group = build_procedural_group(field, name=f"{name} Procedural", implementation=scene_form(context.scene))
-        scale, world = float(p.scale), p.coords == "WORLD"
-
-        def node(nt):
-            n = add_procedural_node(nt, group, (-400.0, 0.0))
-            n.inputs["Scale"].default_value = scale
-            if world:
-                nt.links.new(_world_position(nt), n.inputs["Vector"])
-            return n
-
-        _material_with(obj, f"{name} Procedural", node)
+        _give_procedural(obj, field, name, float(p.scale), p.coords == "WORLD")
         self.report({"INFO"}, f"Loaded the {field.family} of {os.path.basename(path)} (Source: Node Group bakes it)")
         return {"FINISHED"}
 
