@@ -203,3 +203,39 @@ def test_every_family_s_group_reads_back_as_its_field_unedited():
         finally:
             bpy.data.materials.remove(mat)
             bpy.data.node_groups.remove(grp)
+
+
+def test_an_asset_library_material_bakes_and_saves_as_its_node_group_draws(tmp_path):
+    """The shipped Procedural Brick Wall on a cube: Source Node Group reads its group (a running bond), and Save
+    writes it for the command line."""
+    from omninoise.blender_addon import preferences
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        with bpy.data.libraries.load(os.path.join(preferences.ASSETS, "omninoise_assets.blend"),
+                                     assets_only=True) as (src, dst):
+            dst.materials = ["Procedural Brick Wall"]
+        bpy.ops.mesh.primitive_cube_add()
+        obj = bpy.context.active_object
+        obj.data.materials.append(dst.materials[0])
+        node = procedural_node(obj)
+        field = node_field(node)
+        assert field.family == "bonds" and field.params["offset"] == pytest.approx(0.5, abs=1e-6)
+        p = bpy.context.scene.omninoise_solid
+        p.source, p.target, p.name = "NODE_GROUP", "COLOR_ATTRIBUTE", "Bricks"
+        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        me = obj.data
+        co = np.empty(len(me.vertices) * 3, np.float32)
+        me.vertices.foreach_get("co", co)
+        rgba = np.empty(len(me.vertices) * 4, np.float32)
+        me.color_attributes["Bricks"].data.foreach_get("color", rgba)
+        scale, world = node_space(node)
+        assert not world
+        ref = srgb_to_linear(field.evaluate(co.reshape(-1, 3).astype(np.float64) * np.float32(scale)))
+        assert np.abs(rgba.reshape(-1, 4)[:, :3] - ref).max() < 1e-5
+        path = str(tmp_path / "bricks.json")
+        assert bpy.ops.omninoise.solid_save_procedural(filepath=path) == {"FINISHED"}
+        assert saved.read(path).to_dict() == field.to_dict()
+    finally:
+        blender_addon.unregister()
