@@ -30,6 +30,7 @@ demo: $(STAMP) kernel
 	$(BIN)/python demo/neural.py out/demo
 	$(BIN)/python demo/solid.py out/demo
 	$(BIN)/python demo/solid_box.py out/demo
+	$(BIN)/python demo/procedural.py out/demo
 
 $(VENV)/.train: $(STAMP) requirements-train.txt
 	$(BIN)/python -m pip install -q -r requirements-train.txt -c requirements.txt
@@ -84,7 +85,8 @@ bench: $(VENV)/.bench kernel
 	$(BIN)/python -m bench speed
 
 # the README's pictures from make demo's output, and docs/benchmarks.md from the benchmarks' JSON
-README_PICTURES := gallery.png showcase_render.png volumes_render.png neural.png neural_panel.png solid_slices.png solid_render.png
+README_PICTURES := gallery.png showcase_render.png volumes_render.png neural.png neural_panel.png solid_slices.png solid_render.png \
+	procedural.png
 docs: $(STAMP)
 	@for f in $(README_PICTURES); do test -f out/demo/$$f || { echo "make docs: out/demo/$$f is missing: run make demo first"; exit 2; }; done
 	cp $(addprefix out/demo/,$(README_PICTURES)) docs/img/
