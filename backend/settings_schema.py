@@ -74,7 +74,8 @@ SOLID_SOURCE = Table({
     "kind": Field(Choice(("solid",)), "a solid texture from a photo (Henzler et al. 2020)", True),
     "method": Field(Choice(METHODS), "neural solid, 2D synthesis, spectral solid, procedural solid, or auto (procedural where closer and as structured, else neural)", default="neural"),
     "model": Field(FILE, "a shipped model's name or a model folder", default="chosen from the exemplar"),
-    "exemplar": Field(FILE, "the photo (an image file or a training exemplar's name)"),
+    "exemplar": Field(FILE, "the photo (an image file or a training exemplar's name); method procedural: also a "
+                            "solid saved as .json (omninoise solid -o)"),
     "to": Field(FILE, "a second exemplar to mix towards"),
     "mix": Field(Float(0.0, 1.0), "share of the second exemplar", default="0.5"),
     "refine": Field(Int(0, limits.MAX_REFINE), "search steps refining the encoded code", default="0"),
