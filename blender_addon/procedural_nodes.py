@@ -437,7 +437,7 @@ def procedural_node(obj):
     found = [] if nt is None else [n for n in nt.nodes if n.type == "GROUP" and n.node_tree is not None
                                    and FIELD_KEY in n.node_tree]
     if not found:
-        where = "nothing is selected" if obj is None else f"{obj.name!r}'s active material has none"
+        where = "nothing is selected" if obj is None else f"the active material of {obj.name!r} has none"
         raise SettingError("object", f"no procedural node group: {where} (make one with Procedural Node Group or "
                                      "load a saved solid)")
     return nt.nodes.active if nt.nodes.active in found else found[0]
@@ -446,8 +446,8 @@ def procedural_node(obj):
 def _value(node, name: str):
     s = node.inputs[name]
     if s.is_linked:
-        raise SettingError(name, f"{node.name!r}'s {name} is linked to another node; a bake reads the group's own "
-                                 "values: unlink it and set it")
+        raise SettingError(name, f"the {name} of node {node.name!r} is linked to another node; a bake reads the "
+                                 "group's own values: unlink it and set it")
     v = s.default_value
     return tuple(float(x) for x in v) if hasattr(v, "__len__") else float(v)
 
@@ -497,8 +497,9 @@ def node_space(node) -> tuple:
         return scale, False
     if src is not None and src.node.type == "NEW_GEOMETRY" and src.name == "Position":
         return scale, True
-    raise SettingError("Vector", f"{node.name!r}'s Vector is not the object's own space (a Texture Coordinate "
-                                 "node's Object, with no object set) or the world Position: a bake draws one of those")
+    raise SettingError("Vector", f"the Vector of node {node.name!r} is not the object's own space (a Texture "
+                                 "Coordinate node's Object, with no object set) or the world Position: a bake draws "
+                                 "one of those")
 
 
 def add_procedural_node(node_tree, group, location=(0.0, 0.0)):

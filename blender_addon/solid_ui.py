@@ -708,6 +708,21 @@ class OMNINOISE_OT_solid_save_procedural(bpy.types.Operator, ExportHelper):
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
 
+    def invoke(self, context, event):
+        """The file browser, at ``<node group name>.json`` beside the .blend (or in the last folder)."""
+        from .procedural_nodes import procedural_node
+
+        if not self.filepath:
+            try:
+                name = bpy.path.clean_name(procedural_node(context.active_object).node_tree.name)
+            except backend.SettingError as exc:
+                self.report({"ERROR"}, str(exc))
+                return {"CANCELLED"}
+            folder = os.path.dirname(bpy.data.filepath) if bpy.data.filepath else ""
+            self.filepath = os.path.join(folder, name + self.filename_ext)
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
     def execute(self, context):
         from .procedural_nodes import node_field, procedural_node
 
@@ -715,6 +730,9 @@ class OMNINOISE_OT_solid_save_procedural(bpy.types.Operator, ExportHelper):
         try:
             field = node_field(procedural_node(context.active_object))
             path = bpy.path.abspath(self.filepath)
+            if not self.filepath:
+                raise backend.SettingError("file", "no file to save to: pick one in the file browser (a script: "
+                                                   "filepath=...)")
             if not path.lower().endswith(".json"):
                 raise backend.SettingError("file", f"a saved procedural solid is a .json file, not {path!r}")
             saved.save(path, field)

@@ -154,16 +154,18 @@ def test_what_a_node_group_bake_cannot_read_is_named(tmp_path):
         p = bpy.context.scene.omninoise_solid
         p.source = "NODE_GROUP"
         bpy.ops.mesh.primitive_cube_add()
-        with pytest.raises(SettingError, match="no procedural node group: 'Cube''s active material has none"):
+        with pytest.raises(SettingError, match="no procedural node group: the active material of 'Cube' has none"):
             solid_ui.panel_request(p)
         with pytest.raises(RuntimeError, match="no procedural node group"):
             bpy.ops.omninoise.solid_save_procedural(filepath=str(tmp_path / "x.json"))
+        with pytest.raises(RuntimeError, match="no procedural node group"):
+            bpy.ops.omninoise.solid_save_procedural("INVOKE_DEFAULT")
         assert not os.path.exists(tmp_path / "x.json")
         obj, node = _cube_with_group(_field("rings"))
         nt = obj.active_material.node_tree
         value = nt.nodes.new("ShaderNodeValue")
         nt.links.new(value.outputs[0], node.inputs["Spacing"])
-        with pytest.raises(SettingError, match="Spacing is linked to another node"):
+        with pytest.raises(SettingError, match="the Spacing of node 'Group' is linked to another node"):
             solid_ui.panel_request(p)
         nt.links.remove(node.inputs["Spacing"].links[0])
         node.inputs["Axis"].default_value = (0.0, 0.0, 0.0)
@@ -174,7 +176,7 @@ def test_what_a_node_group_bake_cannot_read_is_named(tmp_path):
         uv = nt.nodes.new("ShaderNodeTexCoord")
         nt.links.new(uv.outputs["UV"], node.inputs["Vector"])
         p.target = "COLOR_ATTRIBUTE"
-        with pytest.raises(RuntimeError, match="Vector is not the object's own space"):
+        with pytest.raises(RuntimeError, match="the Vector of node 'Group' is not the object's own space"):
             bpy.ops.omninoise.solid_bake()
         bad = tmp_path / "bad.json"
         bad.write_text('{"format": "omninoise procedural solid 1", "family": "rings"}')
