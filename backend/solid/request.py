@@ -95,11 +95,12 @@ def check_pixels_given(x, setting: str) -> None:
 class SolidRequest:
     """A solid texture: ``model`` folder (or None: the exemplar's own shipped model, else the texture-space
     model), ``exemplar`` and ``to`` (names, image files or pixels; for method "procedural" the exemplar may be a
-    saved procedural solid instead, a ProceduralField or its ``.json`` file, drawn as saved), ``mix`` in [0, 1], ``refine`` >= 0 search
-    steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part), ``gaussian`` (its
-    Gaussian rest, where the check keeps one), ``rest`` (which: one of gaussian_rest.REST_CHOICES), ``method`` (one of
-    :data:`METHODS`), for "synthesis" ``tile`` (px per side of the periodic image) and for "procedural" and "auto"
-    ``families`` (the kinds of solid the fit tries, a list or tuple of procedural.field.KINDS)."""
+    saved procedural solid instead, a ProceduralField or its ``.json`` file, drawn as saved), ``mix`` in [0, 1],
+    ``refine`` >= 0 search steps, ``seed`` in [0, 2^32), ``periodic`` (an encoded image keeps its harmonic part),
+    ``gaussian`` (its Gaussian rest, where the check keeps one), ``rest`` (which: one of
+    gaussian_rest.REST_CHOICES), ``method`` (one of :data:`METHODS`), for "synthesis" ``tile`` (px per side of the
+    periodic image) and for "procedural" and "auto" ``families`` (the kinds of solid the fit tries, a list or tuple
+    of procedural.field.KINDS)."""
 
     model: str | None = None
     exemplar: str | np.ndarray | None = field(default=None, repr=False)

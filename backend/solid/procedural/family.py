@@ -19,7 +19,8 @@ import numpy as np
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
-__all__ = ["Param", "Family", "cell_random", "axis_vector", "axis_angles", "dot3", "gapped", "inside", "SHARED", "DETAIL_FREQ"]
+__all__ = ["Param", "Family", "cell_random", "axis_vector", "axis_angles", "dot3", "gapped", "inside", "SHARED",
+           "DETAIL_FREQ"]
 
 DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
 
