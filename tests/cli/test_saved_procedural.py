@@ -127,7 +127,8 @@ def test_an_edited_file_draws_its_edits(fitted, tmp_path, monkeypatch):
 def bad_docs():
     """(what is changed, the error's words)."""
     return [
-        (lambda d: d.update(format="omninoise procedural solid 2"), 'expected "format": "omninoise procedural solid 1"'),
+        (lambda d: d.update(format="omninoise procedural solid 2"),
+         'expected "format": "omninoise procedural solid 1"'),
         (lambda d: d.update(colour="red"), "colour: unknown key"),
         (lambda d: d.pop("ramp"), "ramp: missing"),
         (lambda d: d.update(family="tiles"), "unknown procedural family 'tiles'"),
@@ -176,12 +177,15 @@ def test_a_file_that_is_not_a_saved_solid_is_refused_in_one_line(fitted, tmp_pat
 
 @pytest.mark.parametrize("text, words", [("", "is not JSON"), ('{"format": NaN}', "NaN is no number"),
                                          ("[1, 2]", "expected a JSON object, got list"),
-                                         ("\xff\xfe", "is not JSON")])
+                                         ("\xff\xfe", "is not JSON"), ("[" * 200000, "nested too deep"),
+                                         ('{"format": "' + "x" * (1 << 20) + '"}', "over 1 MiB"),
+                                         ('{"format": "' + "x" * 5000 + '"}', "got 'xxxx")])
 def test_a_file_that_is_not_json_is_refused_in_one_line(tmp_path, text, words):
     bad = tmp_path / "bad.json"
     bad.write_bytes(text.encode("latin-1"))
-    with pytest.raises(SettingError, match=words):
+    with pytest.raises(SettingError, match=words) as e:
         SolidRequest(exemplar=str(bad), method="procedural").check()
+    assert len(str(e.value)) < 300 + len(str(bad))          # one short line, whatever the file holds
 
 
 @pytest.mark.parametrize("args, flag, words", [

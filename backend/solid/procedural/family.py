@@ -44,7 +44,8 @@ class Param:
         ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
         v = float(v) if ok else v
         if not ok or not np.isfinite(v):
-            raise ValueError(f"{self.name} must be a finite number, got {v!r}")
+            shown = repr(v) if len(repr(v)) <= 60 else repr(v)[:57] + "..."
+            raise ValueError(f"{self.name} must be a finite number, got {shown}")
         if self.cap and not self.lo <= v <= self.hi:
             raise ValueError(f"{self.name} must be in [{self.lo}, {self.hi}], got {v!r}")
         if self.floor and v < self.lo:
