@@ -444,7 +444,10 @@ def procedural_node(obj):
 
 
 def _value(node, name: str):
-    s = node.inputs[name]
+    s = node.inputs.get(name)
+    if s is None:
+        raise SettingError(name, f"node {node.name!r} has no input {name!r}: its group {node.node_tree.name!r} was "
+                                 "changed; make the group again (Procedural Node Group, or Load a saved solid)")
     if s.is_linked:
         raise SettingError(name, f"the {name} of node {node.name!r} is linked to another node; a bake reads the "
                                  "group's own values: unlink it and set it")
@@ -458,11 +461,17 @@ def node_field(node):
     (the rings' Axis and Centre and the layers' Normal turned back into angles and offsets), Turbulence,
     Turbulence Frequency and Detail, and the tint's amount (its levels times Tint; none at 0) and frequency.
     SettingError naming an input that is linked, or one the engine does not draw."""
+    from ..backend.solid.procedural import saved
     from ..backend.solid.procedural.family import axis_angles
     from ..backend.solid.procedural.field import FAMILIES, ProceduralField
     from ..backend.solid.procedural.tint import Tint
 
-    stored = ProceduralField.from_dict(json.loads(node.node_tree[FIELD_KEY]))
+    try:
+        stored = saved.from_document(dict(json.loads(node.node_tree[FIELD_KEY]), format=saved.FORMAT))
+    except (TypeError, ValueError, RecursionError) as exc:
+        why = f"{exc.setting}: {exc.message}" if isinstance(exc, SettingError) else str(exc)
+        raise SettingError("node group", f"{node.node_tree.name!r} holds no procedural solid that can be read "
+                                         f"(its {FIELD_KEY!r} property: {why})") from None
     family, p, tint = stored.family, dict(stored.params), stored.tint
     for name, key in PARAMETERS[family] + SHARED:
         if key in p:

@@ -16,8 +16,9 @@ from omninoise.backend.errors import SettingError  # noqa: E402
 from omninoise.backend.solid.procedural import saved  # noqa: E402
 from omninoise.backend.solid.procedural.field import ProceduralField  # noqa: E402
 from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
-from omninoise.blender_addon.procedural_nodes import (add_procedural_node, build_procedural_group,  # noqa: E402
-                                                      node_field, node_space, procedural_node)
+from omninoise.blender_addon.procedural_nodes import (FIELD_KEY, add_procedural_node,  # noqa: E402
+                                                      build_procedural_group, node_field, node_space,
+                                                      procedural_node)
 from conftest import Recorder  # noqa: E402
 from test_procedural_blender import FAMILY_PARAMS, _field  # noqa: E402  (the group-against-engine tests' fields)
 
@@ -178,6 +179,13 @@ def test_what_a_node_group_bake_cannot_read_is_named(tmp_path):
         p.target = "COLOR_ATTRIBUTE"
         with pytest.raises(RuntimeError, match="the Vector of node 'Group' is not the object's own space"):
             bpy.ops.omninoise.solid_bake()
+        node.node_tree.interface.remove(node.node_tree.interface.items_tree["Detail"])    # an artist's change
+        with pytest.raises(SettingError, match="node 'Group' has no input 'Detail': its group 'Edited Procedural' "
+                                               "was changed"):
+            solid_ui.panel_request(p)
+        node.node_tree[FIELD_KEY] = '{"family": "rings"}'
+        with pytest.raises(SettingError, match="holds no procedural solid that can be read .*params: missing"):
+            solid_ui.panel_request(p)
         bad = tmp_path / "bad.json"
         bad.write_text('{"format": "omninoise procedural solid 1", "family": "rings"}')
         with pytest.raises(RuntimeError, match="params: missing"):
