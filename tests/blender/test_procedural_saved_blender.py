@@ -19,7 +19,7 @@ from omninoise.blender_addon.field_eval import evaluate_field  # noqa: E402
 from omninoise.blender_addon.procedural_nodes import (FIELD_KEY, add_procedural_node,  # noqa: E402
                                                       build_procedural_group, node_field, node_space,
                                                       procedural_node)
-from conftest import Recorder  # noqa: E402
+from conftest import Recorder, needs_openvdb  # noqa: E402
 from test_procedural_blender import FAMILY_PARAMS, _field  # noqa: E402  (the group-against-engine tests' fields)
 
 #: an artist's edits per case: (input, value); sizes beyond the fit's search ranges, turned axes, less tint
@@ -247,5 +247,27 @@ def test_an_asset_library_material_bakes_and_saves_as_its_node_group_draws(tmp_p
         path = str(tmp_path / "bricks.json")
         assert bpy.ops.omninoise.solid_save_procedural(filepath=path) == {"FINISHED"}
         assert saved.read(path).to_dict() == field.to_dict()
+    finally:
+        blender_addon.unregister()
+
+
+@needs_openvdb
+def test_a_volume_bake_of_the_node_group_fills_the_object_s_bounds_with_the_edited_solid(tmp_path):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        obj, node = _cube_with_group(_field("bonds"), scale=1.3)
+        _edit(node, "bonds")
+        edited = node_field(node)
+        p = bpy.context.scene.omninoise_solid
+        p.source, p.target, p.voxels, p.folder, p.name = "NODE_GROUP", "VOLUME", 8, str(tmp_path), "Wall"
+        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        from omninoise.export.vdb import read_volume
+
+        col = read_volume(str(tmp_path / "Wall.vdb"), "color", (8, 8, 8))
+        c = -1 + (np.arange(8) + 0.5) * 0.25            # voxel centres of the cube's own bounds [-1, 1]^3
+        z, y, x = np.meshgrid(c, c, c, indexing="ij")
+        ref = srgb_to_linear(edited.evaluate(np.stack([x, y, z], -1).reshape(-1, 3) * np.float32(1.3)))
+        np.testing.assert_allclose(col.reshape(-1, 3), ref, atol=1e-5)
     finally:
         blender_addon.unregister()
