@@ -53,7 +53,7 @@ def save(path: str, field: ProceduralField) -> None:
     from ....export.atomic import write_text
 
     text = json.dumps(document(field), indent=1, allow_nan=False)
-    text = re.sub(r"\[\s*([-+0-9.eE,\s]+?)\s*\]", lambda m: "[" + ", ".join(m.group(1).split()).replace(",,", ",")
+    text = re.sub(r"\[\s*([-+0-9.eE,\s]+?)\s*\]", lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(","))
                   + "]", text)
     write_text(path, text + "\n")
 
