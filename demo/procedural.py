@@ -26,7 +26,7 @@ from omninoise.export.atomic import write_json  # noqa: E402
 from omninoise.export.images import linear_to_srgb, write_png  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from solid import cycles_scene, save_and_render, sun_and_sky  # noqa: E402  (demo/solid.py: the same scene)
+from solid import cycles_scene, floor_camera_and_sun, save_and_render  # noqa: E402  (demo/solid.py: the same scene)
 
 #: (photo, the kinds fitted, the node group's inputs edited afterwards)
 PHOTOS = ((os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg"), {"BONDS"}, {}),
@@ -57,12 +57,7 @@ def build_scene(out: str) -> dict:
                           edits=edits)
     p.source = "NODE_GROUP"           # the board as edited, saved for the command line and job files
     assert bpy.ops.omninoise.solid_save_procedural(filepath=os.path.join(out, "wood_grain.json")) == {"FINISHED"}
-    bpy.ops.mesh.primitive_plane_add(size=40.0)
-    bpy.ops.object.camera_add(location=(0.0, -6.6, 4.6), rotation=(1.08, 0.0, 0.0))
-    cam = bpy.context.active_object
-    cam.data.lens = 36
-    sc.camera = cam
-    sun_and_sky(sc, (0.8, 0.3, -0.6), 3.5)
+    floor_camera_and_sun(sc, (0.0, -6.6, 4.6), (1.08, 0.0, 0.0))
     return used
 
 

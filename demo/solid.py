@@ -178,6 +178,17 @@ def sun_and_sky(sc, rotation, energy: float) -> None:
     sc.world = world
 
 
+def floor_camera_and_sun(sc, location, rotation) -> None:
+    """A floor 40 units wide, a 36 mm camera at ``location`` turned by ``rotation``, and :func:`sun_and_sky`: the
+    stage of the demos' rows of cubes."""
+    bpy.ops.mesh.primitive_plane_add(size=40.0)
+    bpy.ops.object.camera_add(location=location, rotation=rotation)
+    cam = bpy.context.active_object
+    cam.data.lens = 36
+    sc.camera = cam
+    sun_and_sky(sc, (0.8, 0.3, -0.6), 3.5)
+
+
 def save_and_render(out: str, blend: str, png: str) -> float:
     """Save the scene as out/blend and render its camera (PNG) to out/png, each written whole (a temporary file
     renamed): the render's seconds."""

@@ -25,7 +25,7 @@ from omninoise.backend.paths import solid_models  # noqa: E402
 from omninoise.export.atomic import write_json  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from solid import cycles_scene, save_and_render, sun_and_sky  # noqa: E402  (demo/solid.py: the same scene)
+from solid import cycles_scene, floor_camera_and_sun, save_and_render  # noqa: E402  (demo/solid.py: the same scene)
 
 VAL = os.path.join(ROOT, "data", "photos", "val")
 PHOTOS = [os.path.join(VAL, n) for n in ("brick__beige_bricks.jpg", "paving__sahara_paving_stones_01.jpg",
@@ -64,12 +64,7 @@ def build_scene(out: str) -> dict:
         bpy.context.view_layer.objects.active = cube
         assert bpy.ops.omninoise.solid_tile_material() == {"FINISHED"}
         used[name] = row
-    bpy.ops.mesh.primitive_plane_add(size=40.0)
-    bpy.ops.object.camera_add(location=(0.0, -7.4, 7.6), rotation=(0.82, 0.0, 0.0))
-    cam = bpy.context.active_object
-    cam.data.lens = 36
-    sc.camera = cam
-    sun_and_sky(sc, (0.8, 0.3, -0.6), 3.5)
+    floor_camera_and_sun(sc, (0.0, -7.4, 7.6), (0.82, 0.0, 0.0))
     return used
 
 
