@@ -373,11 +373,12 @@ _BESIDE_BSDF = 320
 
 def _material_with(obj, name: str, make_node):
     """Wire ``make_node(node_tree)``'s Color output into Base Color: the active material's Principled
-    BSDF when it has one, else a new material ``OmniNoise <name>`` given to the object."""
+    BSDF when it has one and is the file's own, else a new material ``OmniNoise <name>`` given to the object (in
+    place of the active one: a material linked from a library cannot keep an edit)."""
     mat = obj.active_material
-    if mat is None or mat.node_tree is None or \
+    if mat is None or mat.library is not None or mat.node_tree is None or \
             not any(n.type == "BSDF_PRINCIPLED" for n in mat.node_tree.nodes):
-        mat = bpy.data.materials.get(f"OmniNoise {name}") or bpy.data.materials.new(f"OmniNoise {name}")
+        mat = bpy.data.materials.get((f"OmniNoise {name}", None)) or bpy.data.materials.new(f"OmniNoise {name}")
         ensure_node_tree(mat)
         if obj.active_material is None:
             obj.data.materials.append(mat)

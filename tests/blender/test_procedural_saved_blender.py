@@ -271,3 +271,31 @@ def test_a_volume_bake_of_the_node_group_fills_the_object_s_bounds_with_the_edit
         np.testing.assert_allclose(col.reshape(-1, 3), ref, atol=1e-5)
     finally:
         blender_addon.unregister()
+
+
+def test_a_material_linked_from_a_library_is_left_as_it_is(tmp_path):
+    """A linked material cannot keep an edit (it is read from its library each time): Load Procedural Solid and a
+    bake give the object a material of the file's own in its place; the linked one reads back unchanged."""
+    from omninoise.blender_addon import preferences
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        with bpy.data.libraries.load(os.path.join(preferences.ASSETS, "omninoise_assets.blend"), link=True,
+                                     assets_only=True) as (src, dst):
+            dst.materials = ["Procedural Brick Wall"]
+        linked = dst.materials[0]
+        nodes = len(linked.node_tree.nodes)
+        bpy.ops.mesh.primitive_cube_add()
+        obj = bpy.context.active_object
+        obj.data.materials.append(linked)
+        field = node_field(procedural_node(obj))          # read from the library's group: a bake can use it
+        path = str(tmp_path / "bricks.json")
+        assert bpy.ops.omninoise.solid_save_procedural(filepath=path) == {"FINISHED"}
+        assert bpy.ops.omninoise.solid_load_procedural(filepath=path) == {"FINISHED"}
+        mat = obj.active_material
+        assert mat.library is None and mat.name == "OmniNoise bricks Procedural"
+        assert node_field(procedural_node(obj)).to_dict() == field.to_dict()
+        assert len(linked.node_tree.nodes) == nodes
+    finally:
+        blender_addon.unregister()
