@@ -479,13 +479,12 @@ def node_field(node):
     direction = {"rings": "Axis", "layers": "Normal"}.get(family)
     if direction is not None:
         v = _value(node, direction)
+        centre = _value(node, "Centre") if family == "rings" else None
         try:
             if family == "rings":
-                p.update(FAMILIES["rings"].placement(v, _value(node, "Centre")))
+                p.update(FAMILIES["rings"].placement(v, centre))
             else:
                 p["tilt"], p["azimuth"] = axis_angles(v)
-        except SettingError:
-            raise
         except ValueError as exc:
             raise SettingError(direction, f"{node.name!r}: {exc}") from None
     if tint is not None:

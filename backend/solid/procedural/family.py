@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...schema import shown_value
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
@@ -44,8 +45,7 @@ class Param:
         ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
         v = float(v) if ok else v
         if not ok or not np.isfinite(v):
-            shown = repr(v) if len(repr(v)) <= 60 else repr(v)[:57] + "..."
-            raise ValueError(f"{self.name} must be a finite number, got {shown}")
+            raise ValueError(f"{self.name} must be a finite number, got {shown_value(v)}")
         if self.cap and not self.lo <= v <= self.hi:
             raise ValueError(f"{self.name} must be in [{self.lo}, {self.hi}], got {v!r}")
         if self.floor and v < self.lo:

@@ -24,6 +24,7 @@ import re
 import numpy as np
 
 from ...errors import SettingError
+from ...schema import shown_value
 from .field import ProceduralField
 from .ramp import Ramp
 from .tint import Tint
@@ -79,12 +80,6 @@ def read(path: str, setting: str = "exemplar") -> ProceduralField:
         raise SettingError(setting, f"{path}: {exc.setting}: {exc.message}") from None
 
 
-def _shown(v) -> str:
-    """``v`` as the error line shows it: its repr, cut to 60 characters."""
-    text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _no_constant(name: str):
     raise ValueError(f"{name} is no number a saved solid holds")
 
@@ -94,23 +89,23 @@ def from_document(doc) -> ProceduralField:
     if not isinstance(doc, dict):
         raise SettingError("format", f"expected a JSON object, got {type(doc).__name__}")
     if doc.get("format") != FORMAT:
-        raise SettingError("format", f"expected \"format\": \"{FORMAT}\", got {_shown(doc.get('format'))}")
+        raise SettingError("format", f"expected \"format\": \"{FORMAT}\", got {shown_value(doc.get('format'))}")
     unknown = sorted(set(doc) - set(_KEYS))
     if unknown:
-        raise SettingError(_shown(unknown[0]).strip("'"), f"unknown key; a saved procedural solid has "
+        raise SettingError(shown_value(unknown[0]).strip("'"), f"unknown key; a saved procedural solid has "
                                                           f"{', '.join(_KEYS)}")
     for key in ("family", "params", "ramp"):
         if key not in doc:
             raise SettingError(key, "missing")
     if not isinstance(doc["family"], str):
-        raise SettingError("family", f"expected a name, got {_shown(doc['family'])}")
+        raise SettingError("family", f"expected a name, got {shown_value(doc['family'])}")
     params = doc["params"]
     if not isinstance(params, dict):
-        raise SettingError("params", f"expected an object of the family's parameters, got {_shown(params)}")
+        raise SettingError("params", f"expected an object of the family's parameters, got {shown_value(params)}")
     _known_params(doc["family"], params)
     seed = doc.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= _MAX_SEED:
-        raise SettingError("seed", f"expected a whole number in [0, {_MAX_SEED}], got {_shown(seed)}")
+        raise SettingError("seed", f"expected a whole number in [0, {_MAX_SEED}], got {shown_value(seed)}")
     ppu = _number(doc.get("px_per_unit", 128.0), "px_per_unit")
     if not ppu > 0:
         raise SettingError("px_per_unit", f"must be above 0, got {ppu!r}")
@@ -130,21 +125,21 @@ def _known_params(family: str, params: dict) -> None:
     known |= {"layers": {"profile"}, "bonds": {"pattern"}}.get(family, set())
     unknown = sorted(set(params) - known)
     if unknown:
-        raise SettingError("params", f"{family} have no parameter {_shown(unknown[0])}; theirs: "
+        raise SettingError("params", f"{family} have no parameter {shown_value(unknown[0])}; theirs: "
                                      f"{', '.join(sorted(known))}")
     if not isinstance(params.get("flip", False), bool):
-        raise SettingError("params", f"flip must be true or false, got {_shown(params['flip'])}")
+        raise SettingError("params", f"flip must be true or false, got {shown_value(params['flip'])}")
 
 
 def _number(v, where: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
-        raise SettingError(where, f"expected a finite number, got {_shown(v)}")
+        raise SettingError(where, f"expected a finite number, got {shown_value(v)}")
     return float(v)
 
 
 def _numbers(v, where: str, low: float = -np.inf, high: float = np.inf) -> list:
     if not isinstance(v, list):
-        raise SettingError(where, f"expected a list of numbers, got {_shown(v)}")
+        raise SettingError(where, f"expected a list of numbers, got {shown_value(v)}")
     out = [_number(x, where) for x in v]
     if any(not low <= x <= high for x in out):
         raise SettingError(where, f"values must lie in [{low}, {high}]")
@@ -162,7 +157,8 @@ def _stops(v, where: str) -> tuple:
 
 def _ramp(d) -> Ramp:
     if not isinstance(d, dict) or set(d) != {"positions", "colours"}:
-        raise SettingError("ramp", f"expected {{\"positions\": [...], \"colours\": [[r, g, b], ...]}}, got {_shown(d)}")
+        raise SettingError("ramp", f"expected {{\"positions\": [...], \"colours\": [[r, g, b], ...]}}, "
+                                   f"got {shown_value(d)}")
     x = _stops(d["positions"], "ramp.positions")
     c = d["colours"]
     if not isinstance(c, list) or len(c) != len(x):
@@ -171,7 +167,7 @@ def _ramp(d) -> Ramp:
     for rgb in c:
         v = _numbers(rgb, "ramp.colours", 0.0, 1.0)
         if len(v) != 3:
-            raise SettingError("ramp.colours", f"expected [r, g, b] in [0, 1], got {_shown(rgb)}")
+            raise SettingError("ramp.colours", f"expected [r, g, b] in [0, 1], got {shown_value(rgb)}")
         cols.append(tuple(v))
     return Ramp(x, tuple(cols))
 
@@ -179,7 +175,7 @@ def _ramp(d) -> Ramp:
 def _tint(d) -> Tint:
     keys = {"frequency", "positions", "levels", "axis"}
     if not isinstance(d, dict) or set(d) != keys:
-        raise SettingError("tint", f"expected an object of {', '.join(sorted(keys))}, or null, got {_shown(d)}")
+        raise SettingError("tint", f"expected an object of {', '.join(sorted(keys))}, or null, got {shown_value(d)}")
     f = _number(d["frequency"], "tint.frequency")
     if not f > 0:
         raise SettingError("tint.frequency", f"must be above 0, got {f!r}")
@@ -189,5 +185,5 @@ def _tint(d) -> Tint:
         raise SettingError("tint.levels", f"expected {len(x)} levels, one per position")
     axis = _numbers(d["axis"], "tint.axis", -1.0, 1.0)
     if len(axis) != 3 or not np.linalg.norm(axis) > 0:
-        raise SettingError("tint.axis", f"expected a colour direction [r, g, b], got {_shown(d['axis'])}")
+        raise SettingError("tint.axis", f"expected a colour direction [r, g, b], got {shown_value(d['axis'])}")
     return Tint(f, x, tuple(levels), tuple(axis))
