@@ -89,6 +89,18 @@ def _cube_with_group(f, scale=1.0):
     return obj, node
 
 
+def _assert_baked(obj, name: str, field, scale: float) -> None:
+    """The colour attribute ``name`` of ``obj``'s mesh holds ``field`` (linear) at its vertices' object positions
+    times ``scale`` (a float32 socket value), within 1e-5."""
+    me = obj.data
+    co = np.empty(len(me.vertices) * 3, np.float32)
+    me.vertices.foreach_get("co", co)
+    rgba = np.empty(len(me.vertices) * 4, np.float32)
+    me.color_attributes[name].data.foreach_get("color", rgba)
+    ref = srgb_to_linear(field.evaluate(co.reshape(-1, 3).astype(np.float64) * np.float32(scale)))
+    assert np.abs(rgba.reshape(-1, 4)[:, :3] - ref).max() < 1e-5
+
+
 def test_save_load_and_bake_the_node_group_as_edited(tmp_path):
     bpy.ops.wm.read_homefile(use_empty=True)
     blender_addon.register()
@@ -110,13 +122,7 @@ def test_save_load_and_bake_the_node_group_as_edited(tmp_path):
         p = bpy.context.scene.omninoise_solid
         p.source, p.target, p.name, p.scale = "NODE_GROUP", "COLOR_ATTRIBUTE", "Baked", 0.5
         assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
-        me = obj.data
-        co = np.empty(len(me.vertices) * 3, np.float32)
-        me.vertices.foreach_get("co", co)
-        rgba = np.empty(len(me.vertices) * 4, np.float32)
-        me.color_attributes["Baked"].data.foreach_get("color", rgba)
-        ref = srgb_to_linear(edited.evaluate(co.reshape(-1, 3).astype(np.float64) * np.float32(1.7)))
-        assert np.abs(rgba.reshape(-1, 4)[:, :3] - ref).max() < 1e-5
+        _assert_baked(obj, "Baked", edited, 1.7)
         log = []                            # the panel names the node and draws neither Scale nor Seed
         solid_ui.draw_solid_all(Recorder(log), bpy.context)
         assert not {"scale", "seed", "coords", "texture", "image", "method"} & {a for n, a, t in log if n == "prop"}
@@ -235,15 +241,9 @@ def test_an_asset_library_material_bakes_and_saves_as_its_node_group_draws(tmp_p
         p = bpy.context.scene.omninoise_solid
         p.source, p.target, p.name = "NODE_GROUP", "COLOR_ATTRIBUTE", "Bricks"
         assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
-        me = obj.data
-        co = np.empty(len(me.vertices) * 3, np.float32)
-        me.vertices.foreach_get("co", co)
-        rgba = np.empty(len(me.vertices) * 4, np.float32)
-        me.color_attributes["Bricks"].data.foreach_get("color", rgba)
         scale, world = node_space(node)
         assert not world
-        ref = srgb_to_linear(field.evaluate(co.reshape(-1, 3).astype(np.float64) * np.float32(scale)))
-        assert np.abs(rgba.reshape(-1, 4)[:, :3] - ref).max() < 1e-5
+        _assert_baked(obj, "Bricks", field, scale)
         path = str(tmp_path / "bricks.json")
         assert bpy.ops.omninoise.solid_save_procedural(filepath=path) == {"FINISHED"}
         assert saved.read(path).to_dict() == field.to_dict()
