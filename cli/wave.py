@@ -132,7 +132,10 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
             with warnings.catch_warnings():     # an empty file is reported below, in one line, not as a warning too
                 warnings.simplefilter("ignore", UserWarning)
                 prof = np.load(a.profile, allow_pickle=False) if a.profile.endswith(".npy") else np.loadtxt(a.profile)
-            profile = tuple(np.asarray(prof, np.float64).ravel())
+            prof = np.asarray(prof, np.float64)
+            if sum(n > 1 for n in prof.shape) > 1:
+                raise ValueError(f"one row or column of samples expected, got shape {prof.shape}")
+            profile = tuple(prof.ravel())
         except (ValueError, OSError, EOFError, TypeError) as exc:
             raise SettingError("--profile", f"{a.profile}: not a list of numbers "
                                             f"({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})") from None

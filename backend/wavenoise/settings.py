@@ -91,6 +91,12 @@ class WaveSettings:
         except (TypeError, ValueError) as exc:  # a tuple field holding something that is not a number
             raise SettingError("wave settings", f"expected numbers in the tuple settings ({exc})") from None
         WAVE_SETTINGS.check(d, "")
+        if self.waveform == "custom":
+            if not self.profile:
+                raise SettingError("profile", "waveform custom needs a profile: one period's samples")
+            if max(self.profile) == min(self.profile):
+                raise SettingError("profile", f"all {len(self.profile)} samples are {self.profile[0]:g}; "
+                                              "a waveform needs samples that vary")
         if self.example is not None:
             if self.example_plane not in PLANES:
                 raise SettingError("example_plane", f"must be one of {', '.join(PLANES)}, got {self.example_plane!r}")

@@ -131,13 +131,15 @@ def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
 
 
 @pytest.mark.parametrize("content, name", [("0 1 banana 2\n", "p.txt"), ("", "p.txt"), ("0 nan 1\n", "p.txt"),
-                                           ("\x93NUMPY broken", "p.npy")])
+                                           ("\x93NUMPY broken", "p.npy"), ("1 1 1 1\n", "p.txt"),
+                                           ("0 1\n2 3\n", "p.txt")])
 def test_bad_custom_profiles(tmp_path, capsys, content, name):
     (tmp_path / name).write_text(content)
     rc = main(["wave", "--size", "8", "--quiet", "--waveform", "custom", "--profile", str(tmp_path / name),
                "-o", str(tmp_path / "o.npy")])
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert rc == 2 and len(err) == 1 and "--profile" in err[0], err
+    assert not (tmp_path / "o.npy").exists()
 
 
 def test_an_internal_error_is_one_line_without_debug_and_a_traceback_with_it(tmp_path, capsys, monkeypatch):
