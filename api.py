@@ -106,12 +106,20 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
                             f"{', '.join(known)}")
     if "spectrum" in settings:
         settings["spectrum"] = _spectrum(settings["spectrum"])
+    tuples = {f.name for f in dataclasses.fields(WaveSettings) if isinstance(f.default, tuple)}
+    for name in tuples & set(settings):     # a list or an array where the settings hold a tuple
+        if isinstance(settings[name], (list, np.ndarray)):
+            settings[name] = tuple(np.asarray(settings[name]).tolist() if isinstance(settings[name], np.ndarray)
+                                   else settings[name])
     s = WaveSettings(**settings)
     rank = 2 if s.dim == 2 else 3          # 3D and 4D noise fill a volume (4D: at w = time)
     if out is not None:
-        _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid")
-    elif transfer is not None:
-        raise SettingError("transfer", "maps values onto a ramp for a file; give out= too")
+        ext = _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid")
+        if half and ext not in (".exr", ".vdb"):
+            raise SettingError("half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
+    elif transfer is not None or half:
+        raise SettingError("transfer" if transfer is not None else "half",
+                           "applies to a written file; give out= too")
     limits.check_memory("size", float(size) ** rank * 4 * 2, f"a {size}-sample {s.dim}D grid")
     grid = BoxGrid((size,) * rank, ((0.0, 0.0, 0.0), (float(extent),) * 3))
     source = WaveSource(s)
@@ -258,6 +266,8 @@ def bake(job: str, *, only: list | None = None, force: bool = False, keep_going:
     from .backend.jobs import run_job
 
     _check_progress(progress)
+    if only is not None and (isinstance(only, (str, bytes)) or not all(isinstance(n, str) for n in only)):
+        raise SettingError("only", f"expected a list of bake names, got {only!r}")
     if not isinstance(job, (str, os.PathLike)) or not os.path.isfile(job):
         raise SettingError("job", f"job file not found: {job!r}")
     return run_job(os.fspath(job), keep_going=keep_going, force=force, only=only, progress=progress)

@@ -88,11 +88,13 @@ class WaveSettings:
                 raise SettingError(f.name, "expected a value, got None")
         try:
             d = {k: v for k, v in settings_to_dict(self).items() if v != []}  # () is a tuple setting left unset
+        except SettingError:
+            raise
         except (TypeError, ValueError) as exc:  # a tuple field holding something that is not a number
             raise SettingError("wave settings", f"expected numbers in the tuple settings ({exc})") from None
         WAVE_SETTINGS.check(d, "")
         if self.waveform == "custom":
-            if not self.profile:
+            if len(self.profile) == 0:
                 raise SettingError("profile", "waveform custom needs a profile: one period's samples")
             if max(self.profile) == min(self.profile):
                 raise SettingError("profile", f"all {len(self.profile)} samples are {self.profile[0]:g}; "
@@ -162,22 +164,28 @@ def settings_to_dict(s: WaveSettings) -> dict:
     """WaveSettings -> plain dict of JSON/TOML types (by-example images are left out)."""
     out = {}
     for f in fields(s):
-        v = getattr(s, f.name)
         if f.name == "example":
             continue
-        if f.name == "spectrum":
-            v = _spectrum_to_dict(v)
-        elif f.name == "transition_to":
-            v = None if v is None else _spectrum_to_dict(v)
-        elif f.name == "axis_spectra":
-            v = [_spectrum_to_dict(a) for a in v]
-        elif f.name == "lobes":
-            v = [[[float(c) for c in a], float(w)] for a, w in v]
-        elif isinstance(v, tuple):
-            v = [float(c) for c in v]
+        try:
+            v = _plain(f.name, getattr(s, f.name))
+        except (TypeError, ValueError) as exc:    # a tuple field holding something that is not a number
+            raise SettingError(f.name, f"expected numbers ({exc})") from None
         if v is not None:
             out[f.name] = v
     return out
+
+
+def _plain(name: str, v):
+    """One WaveSettings field as JSON/TOML types."""
+    if name in ("spectrum", "transition_to"):
+        return None if v is None else _spectrum_to_dict(v)
+    if name == "axis_spectra":
+        return [_spectrum_to_dict(a) for a in v]
+    if name == "lobes":
+        return [[[float(c) for c in a], float(w)] for a, w in v]
+    if isinstance(v, (tuple, np.ndarray)):
+        return [float(c) for c in v]
+    return v
 
 
 def settings_from_dict(d: dict, example: np.ndarray | None = None) -> WaveSettings:

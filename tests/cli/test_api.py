@@ -24,7 +24,23 @@ CASES = [
     (lambda: omninoise.wave(8, progress="bar"), "progress", "expected a function"),
     (lambda: omninoise.neural("perlin", 16, steps=1, progress=1), "progress", "expected a function"),
     (lambda: omninoise.bake("job.toml", progress=1), "progress", "expected a function"),
+    (lambda: omninoise.bake("job.toml", only="clouds"), "only", "expected a list of bake names"),
+    (lambda: omninoise.wave(8, half=True), "half", "give out= too"),
+    (lambda: omninoise.wave(8, half=True, out="x.npy"), "half", "into .exr and .vdb only"),
+    (lambda: omninoise.wave(8, waveform="custom", profile=np.zeros((2, 2))), "profile", "expected numbers"),
+    (lambda: omninoise.wave(8, waveform="custom", profile=[1.0, 1.0]), "profile", "samples that vary"),
 ]
+
+
+def test_a_tuple_setting_may_be_a_list_or_an_array():
+    """Python users hand over lists and numpy arrays where the settings hold tuples: the noise is the same."""
+    profile = np.sin(np.linspace(0.0, 2.0 * np.pi, 32, endpoint=False)) ** 3
+    ref = omninoise.wave(8, waveform="custom", profile=tuple(profile.tolist()), seed=3)
+    np.testing.assert_array_equal(omninoise.wave(8, waveform="custom", profile=profile, seed=3), ref)
+    np.testing.assert_array_equal(omninoise.wave(8, waveform="custom", profile=list(profile), seed=3), ref)
+    lobes = omninoise.wave(8, dim=3, anisotropy="lobes", lobes=[[[0, 0, 1], 1.0]], seed=3)
+    np.testing.assert_array_equal(lobes, omninoise.wave(8, dim=3, anisotropy="lobes", lobes=(((0, 0, 1), 1.0),),
+                                                        seed=3))
 
 
 @pytest.mark.parametrize("call, setting, why", CASES)
