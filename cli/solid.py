@@ -123,7 +123,7 @@ def run(a: argparse.Namespace) -> int:
         from omninoise.backend.bake import require_vdb
 
         require_vdb("-o")
-    req = solid_request(a)
+    req = solid_request(a).check_pixels("--")      # a photo it cannot use is named before any note or work
     if not a.quiet and req.repeats_as_grid("--"):
         print("note: the photo repeats across and up as a grid (bricks, tiles?); the kinds besides bonds often draw "
               "stones or blotches there: --families bonds lays it in courses", file=sys.stderr)

@@ -220,7 +220,9 @@ def _decode_pillow(path: str) -> tuple:
                 return np.asarray(im, dtype=np.float32) / 255.0, False
     except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
         if isinstance(exc, UnidentifiedImageError):
-            raise ImageError(f"{path}: not an image file this reader knows") from None
+            tiff = os.path.splitext(path)[1].lower() in (".tif", ".tiff")   # Pillow reads one float channel only
+            raise ImageError(f"{path}: not an image file this reader knows"
+                             + ("; a TIFF of float colours is read as .exr: save it as one" if tiff else "")) from None
         raise ImageError(f"{path}: the image is more than the {MAX_PIXELS} px an input may have") from None
 
 

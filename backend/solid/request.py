@@ -71,6 +71,16 @@ def _digest(x) -> str | None:
     return str(x)
 
 
+def _read_file(path: str, setting: str) -> np.ndarray:
+    """An image file decoded to sRGB (H, W, 3) float32; SettingError naming ``setting`` where it cannot be read."""
+    from ... import export
+
+    try:
+        return export.read_rgb(path)
+    except ValueError as exc:
+        raise SettingError(setting, str(exc)) from None
+
+
 def check_pixels_given(x, setting: str) -> None:
     """SettingError naming ``setting`` unless ``x`` is None, a name or file (a str), or pixels as every method
     reads them: a float array (H, W, 3) of finite sRGB values in [0, 1] (8-bit pixels divided by 255), at least
@@ -254,16 +264,11 @@ class SolidRequest:
                                                    "procedural")
         if not isinstance(self.exemplar, str):
             return self.exemplar
-        from ... import export
-
         stamp = _file_stamp(self.exemplar)
         kept = self.__dict__.get("_decoded")
         if stamp is not None and kept is not None and kept[0] == stamp:
             return kept[1]
-        try:
-            img = export.read_rgb(self.exemplar)
-        except ValueError as exc:
-            raise SettingError(f"{where}exemplar", str(exc)) from None
+        img = _read_file(self.exemplar, f"{where}exemplar")
         img.setflags(write=False)
         if stamp is not None:
             object.__setattr__(self, "_decoded", (stamp, img))     # frozen: the memo is no field (not in key or eq)
@@ -285,8 +290,15 @@ class SolidRequest:
     def check_pixels(self, where: str = "") -> "SolidRequest":
         """What the image methods (synthesis, spectral, procedural, auto) ask of the exemplar's pixels, checked
         before any work (a job file's bakes when the job is read, their textures made when baked): SettingError
-        naming the exemplar for an image they cannot use; the request when they can."""
-        if self.method not in IMAGE_METHODS + ("auto",) or is_saved(self.exemplar):
+        naming the exemplar for an image they cannot use; the request when they can.  The neural method's image
+        files (``exemplar``, ``to``) must decode: a file it cannot read is named before the encoding starts."""
+        if is_saved(self.exemplar):
+            return self
+        if self.method not in IMAGE_METHODS + ("auto",):
+            if isinstance(self.to, str) and os.path.isfile(self.to):
+                _read_file(self.to, f"{where}to")
+            if isinstance(self.exemplar, str) and os.path.isfile(self.exemplar):
+                self.exemplar_pixels(where)
             return self
         img = self.exemplar_pixels(where)
         try:

@@ -271,3 +271,31 @@ def test_a_photo_of_a_line_or_a_pixel_encodes(models, tmp_path, capsys, shape):
     rc, err = run(capsys, "--model", models["space3"], "--exemplar", str(tmp_path / "p.png"), "--size", "8", "-o", out)
     assert rc == 0, err
     assert np.isfinite(np.load(out)).all()
+
+
+@pytest.mark.parametrize("flag", ["--exemplar", "--to"])
+def test_a_photo_the_encoder_cannot_read_is_named_before_its_note(models, tmp_path, capsys, flag):
+    """Without --quiet the neural method says "encoding PHOTO ..." before it encodes: a photo it cannot read (here
+    one holding NaN, and one with transparent pixels) is refused in one line naming the flag, not glued to the note;
+    a job file names the same setting when it is read."""
+    import OpenEXR
+    from PIL import Image
+
+    good = tmp_path / "good.png"
+    Image.fromarray((np.random.default_rng(0).random((40, 40, 3)) * 255).astype(np.uint8)).save(good)
+    nan = np.full((40, 40, 3), 0.5, np.float32)
+    nan[3, 4] = np.nan
+    with OpenEXR.File({"type": OpenEXR.scanlineimage}, {"RGB": nan}) as f:
+        f.write(str(tmp_path / "nan.exr"))
+    Image.fromarray(np.zeros((40, 40, 4), np.uint8)).save(tmp_path / "clear.png")
+    for bad, why in (("nan.exr", "holds NaN"), ("clear.png", "partly transparent")):
+        args = ["--exemplar", str(tmp_path / bad)] if flag == "--exemplar" else \
+            ["--exemplar", str(good), "--to", str(tmp_path / bad)]
+        rc = main(["solid", "--model", models["space3"], *args, "--size", "8", "-o", str(tmp_path / "o.png")])
+        err = capsys.readouterr().err
+        assert rc == 2 and err.startswith(f"omninoise solid: error: {flag}: ") and why in err, err
+        assert err.count("\n") == 1 and not (tmp_path / "o.png").exists()
+    source = f'exemplar = "{good.name}"\nto = "nan.exr"' if flag == "--to" else 'exemplar = "nan.exr"'
+    write_job(tmp_path / "job.toml", 1.0, models["space3"], source)
+    assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
+    assert f"bake 'solid': source.{flag[2:]}: " in capsys.readouterr().out

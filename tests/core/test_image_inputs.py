@@ -194,3 +194,29 @@ def test_a_by_example_array_is_checked_with_the_settings(example, why):
         omninoise.wave(16, example=example)
     assert exc.value.setting == "example"
     assert np.isfinite(omninoise.wave(16, example=np.random.default_rng(0).random((32, 32)))).all()
+
+
+def _float_rgb_tiff(path, h: int = 4, w: int = 4) -> None:
+    """An uncompressed little-endian TIFF of three 32-bit float channels (SampleFormat 3), as a renderer saves
+    one; Pillow reads one float channel only."""
+    import struct
+
+    pixels = np.full((h, w, 3), 0.5, "<f4").tobytes()
+    tags = [(256, 3, 1, w), (257, 3, 1, h), (258, 3, 3, 8 + len(pixels)), (259, 3, 1, 1), (262, 3, 1, 2),
+            (273, 4, 1, 8), (277, 3, 1, 3), (278, 3, 1, h), (279, 4, 1, len(pixels)), (284, 3, 1, 1),
+            (339, 3, 3, 8 + len(pixels) + 6)]
+    ifd = 8 + len(pixels) + 12
+    body = struct.pack("<2sHI", b"II", 42, ifd) + pixels + struct.pack("<3H", 32, 32, 32) + struct.pack("<3H", 3, 3, 3)
+    body += struct.pack("<H", len(tags)) + b"".join(
+        struct.pack("<HHI", t, k, n) + (struct.pack("<HH", v, 0) if k == 3 and n == 1 else struct.pack("<I", v))
+        for t, k, n, v in tags) + struct.pack("<I", 0)
+    path.write_bytes(body)
+
+
+def test_a_float_colour_tiff_is_refused_saying_to_save_it_as_exr(tmp_path):
+    p = tmp_path / "render.tif"
+    _float_rgb_tiff(p)
+    with pytest.raises(ImageError, match="not an image file this reader knows; a TIFF of float colours is read as "
+                                         r"\.exr: save it as one") as exc:
+        decode(str(p))
+    assert "\n" not in str(exc.value)
