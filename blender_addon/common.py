@@ -32,12 +32,15 @@ class Sidebar:
 
 def image_pixels(ima, setting: str) -> np.ndarray:
     """An image datablock's pixels as stored, float32 (H, W, C), top row first (Blender keeps rows bottom-up);
-    an image without pixels (a missing file) is a SettingError naming ``setting``."""
+    an image without pixels (a missing file) or with a NaN or infinite one (a float render's) is a SettingError
+    naming ``setting``."""
     w, h = ima.size
     if w * h == 0:
         raise backend.SettingError(setting, f"image {ima.name!r} has no pixels (is its file missing?)")
     px = np.empty(w * h * ima.channels, np.float32)
     ima.pixels.foreach_get(px)
+    if not np.isfinite(px).all():
+        raise backend.SettingError(setting, f"image {ima.name!r} holds NaN or infinite values")
     return np.flipud(px.reshape(h, w, ima.channels))
 
 

@@ -114,6 +114,13 @@ def test_clear_messages(scene):
     p.blend_map = gone
     with pytest.raises(RuntimeError, match="blend map: image 'gone' has no pixels"):
         bpy.ops.omninoise.neural_bake()
+    hot = bpy.data.images.new("hot", 16, 16, float_buffer=True)     # a float render with a NaN pixel
+    px = np.ones(16 * 16 * 4, np.float32)
+    px[40] = np.nan
+    hot.pixels.foreach_set(px)
+    p.blend_map = hot
+    with pytest.raises(RuntimeError, match="blend map: image 'hot' holds NaN or infinite values"):
+        bpy.ops.omninoise.neural_bake()
     sq = bpy.data.images.new("green", 16, 16)
     sq.colorspace_settings.name = "Non-Color"
     sq.pixels.foreach_set(np.tile([0.0, 1.0, 0.0, 1.0], 256).astype(np.float32))

@@ -416,7 +416,7 @@ def test_an_image_a_method_cannot_use_is_named_as_the_panel_names_it(scene):
     bad = bpy.data.images.new("Bad", 32, 32, float_buffer=True)
     bad.pixels.foreach_set(np.full(32 * 32 * 4, np.nan, np.float32))
     p.image = bad
-    with pytest.raises(RuntimeError, match="image: the pixels hold NaN or infinite values"):
+    with pytest.raises(RuntimeError, match="image: image 'Bad' holds NaN or infinite values"):
         bpy.ops.omninoise.solid_preview()
 
 
