@@ -46,8 +46,16 @@ class _Version(argparse.Action):
         parser.exit()
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with a bad flag reported as every other bad input is: one line naming it, exit 2 (not the usage
+    first); the subcommands' parsers are of this class too."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}; see '{self.prog} --help'\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
+    ap = Parser(
         prog="omninoise", formatter_class=Help,
         description="OmniNoise: wave noise, neural noise and solid textures from photos, as images, arrays and "
                     "volumes.",

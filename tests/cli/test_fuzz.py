@@ -74,7 +74,7 @@ def run(argv: list, out: str | None) -> None:
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             try:
                 rc = main(argv)
-            except SystemExit as exc:  # argparse: usage + one error line, exit 2
+            except SystemExit as exc:  # argparse: one error line, exit 2
                 rc = exc.code
     finally:
         signal.alarm(0)

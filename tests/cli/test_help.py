@@ -47,3 +47,20 @@ def test_version(capsys):
         build_parser().parse_args(["--version"])
     assert e.value.code == 0
     assert re.match(r"omninoise \d+\.\d+\.\d+ \(wave noise: (C row kernel|numba kernel|numpy)", capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("argv, first", [
+    (["wave", "--dim", "5", "-o", "x.npy"], "omninoise wave: error: argument --dim: invalid choice: 5"),
+    (["wave", "--size", "abc", "-o", "x.npy"], "omninoise wave: error: argument --size: invalid int value: 'abc'"),
+    (["solid", "--families"], "omninoise solid: error: argument --families: expected one argument"),
+    (["neural", "--corners", "perlin", "gabor"], "omninoise neural: error: argument --corners: expected 4"),
+    (["wave"], "omninoise wave: error: the following arguments are required: -o/--out"),
+    (["bogus"], "omninoise: error: argument SUBCOMMAND: invalid choice: 'bogus'"),
+])
+def test_a_flag_argparse_cannot_read_is_one_line_and_exit_2(argv, first, capsys):
+    """As every other bad input: one line naming the flag (not the usage first), pointing at the help."""
+    with pytest.raises(SystemExit) as e:
+        build_parser().parse_args(argv)
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and err.count("\n") == 1 and err.startswith(first), err
+    assert err.rstrip().endswith("--help'")
