@@ -57,6 +57,9 @@ def _check_out(out: str, allowed: tuple, what: str) -> str:
     if not isinstance(out, (str, os.PathLike)):
         raise SettingError("out", f"expected a file path, got {out!r}")
     out = os.fspath(out)
+    from .backend.bake import check_one_file
+
+    check_one_file(out, "out")
     ext = os.path.splitext(out)[1].lower()
     if ext not in allowed:
         raise SettingError("out", f"{what} is written as {', '.join(allowed)}, not {ext or out!r}")

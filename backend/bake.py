@@ -43,7 +43,8 @@ from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
-__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "FORMATS", "KEY_NAME", "Cancelled"]
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "check_one_file",
+           "FORMATS", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
@@ -119,6 +120,8 @@ class BakeSpec:
                                    "(e.g. clouds_####.vdb)")
             if not self.source.animated:
                 raise SettingError("frames", "this source does not change over time (set speed, or dim = 4)")
+        else:
+            check_one_file(self.output, "output", " (or give a frame range)")
         folder = os.path.dirname(os.path.abspath(self.output))
         if not self.make_folders and not os.path.isdir(folder):
             raise SettingError("output", f"folder does not exist: {folder}")
@@ -174,6 +177,14 @@ class BakeResult:
 def has_frame_field(pattern: str) -> bool:
     """Whether a file name has a '#' run for the frame number (``clouds_####.vdb``)."""
     return bool(_FRAME.search(os.path.basename(pattern)))
+
+
+def check_one_file(path: str, setting: str, or_else: str = "") -> None:
+    """SettingError naming ``setting`` where ``path``, written as one file, has a '#' in its name: '#' stands for a
+    sequence's frame number everywhere (job files, Blender), and a file named ``clouds_####.exr`` is a mistake."""
+    if has_frame_field(path):
+        raise SettingError(setting, f"{os.path.basename(path)}: '#' stands for the frame number of a sequence, and "
+                                    f"this writes one file: take it out of the name{or_else}")
 
 
 def frame_path(pattern: str, frame) -> str:

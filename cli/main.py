@@ -109,11 +109,14 @@ def _check_outputs(a: argparse.Namespace) -> None:
     """The files a command will write (-o, --report), checked before any work: a missing or read-only folder, a
     name past the file system's limit (a frame pattern's '#' counted as the widest frame number) or a folder in the
     file's place."""
+    from omninoise.backend.bake import check_one_file
     from omninoise.export.atomic import check_target
 
     for flag, attr in (("-o", "out"), ("--report", "report")):
         path = getattr(a, attr, None)
         if isinstance(path, str) and path:
+            if not (flag == "-o" and getattr(a, "frames", None)):       # neural --frames writes a sequence
+                check_one_file(path, flag)
             try:
                 check_target(re.sub(r"#+", lambda m: "0" * max(len(m.group()), 10), path))
                 if os.path.isdir(path):

@@ -6,6 +6,8 @@ import sys
 import numpy as np
 import pytest
 
+import omninoise
+from omninoise.backend.errors import SettingError
 from omninoise.cli.main import main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -88,3 +90,22 @@ def test_vdb_without_openvdb_is_bad_input_before_any_work(argv, tmp_path, monkey
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "-o: writing .vdb needs the OpenVDB Python module" in err[0], err
     assert not out.exists() and not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("argv", [
+    ["wave", "--size", "8", "-o", "{d}/w_##.npy"],
+    ["solid", "--exemplar", "grass", "--size", "8", "-o", "{d}/s_##.png"],
+    ["neural", "--noise", "perlin", "--size", "16", "-o", "{d}/n_####.png"],
+    ["bake", "{d}/job.toml"],
+])
+def test_a_frame_number_in_the_name_of_one_file_is_refused(tmp_path, capsys, argv):
+    """'#' is the frame number of a sequence (job files, neural --frames, Blender): in the name of one file it is a
+    mistake, refused in one line before any work, not written as a file named 'w_##.npy'."""
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "a"\noutput = "j_##.exr"\nresolution = [8, 8]\n'
+                                       '[bake.source]\nkind = "wave"\n')
+    rc = main([x.format(d=tmp_path) for x in argv] + ["--quiet"])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and "'#' stands for the frame number of a sequence" in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["job.toml"]
+    with pytest.raises(SettingError, match="'#' stands for the frame number"):
+        omninoise.wave(8, out=str(tmp_path / "w#.npy"))
