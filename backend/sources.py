@@ -232,10 +232,10 @@ class NeuralSource:
             self.layout, self.specs = "uniform", [self.spec]
         self.width, self.sharpness = float(width), float(sharpness)
         self.steps, self.seed, self.tileable = int(steps), int(seed), bool(tileable)
-        for spec in self.specs:
+        for spec in self.specs if not keys else ():     # keyframes are checked below, each named by its frame
             self.model.param_vector(*spec)  # unknown classes / parameters fail now, with their names
         # animation: keyframes whose `frame` is the bake's time (a job sets time = frame number)
-        from .neural.animate import LATENT_MODES
+        from .neural.animate import LATENT_MODES, check_keys
 
         self.keys = list(keys) if keys else None
         self.animated = self.keys is not None
@@ -247,8 +247,7 @@ class NeuralSource:
             if self.latent not in LATENT_MODES:
                 raise SettingError("source.latent", f"unknown latent motion {self.latent!r}; choose one of "
                                                     f"{', '.join(LATENT_MODES)}")
-            for k in self.keys:
-                self.model.param_vector(*k.spec)
+            check_keys(self.model, self.keys, "source.keys")
 
     def check_grid(self, shape) -> None:
         """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask or
@@ -649,7 +648,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         from .neural.animate import parse_keys, read_keys
 
         if isinstance(d["keys"], str):
-            keys = read_keys(os.path.join(base_dir, d["keys"]))
+            keys = read_keys(os.path.join(base_dir, d["keys"]), "source.keys")
         elif isinstance(d["keys"], list):
             keys = parse_keys({"key": d["keys"]}, "source.keys")
         else:

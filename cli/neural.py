@@ -206,7 +206,7 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     """``neural --keys KEYS.toml --frames FIRST LAST -o name_####.png``: one file per frame, each written
     atomically (an interrupted run keeps the frames it finished)."""
     from omninoise.backend.bake import frame_path, has_frame_field
-    from omninoise.backend.neural.animate import animate, read_keys
+    from omninoise.backend.neural.animate import animate, check_keys, read_keys
     from omninoise.export.images import write_unit_image
 
     if not (a.keys and a.frames):
@@ -227,6 +227,7 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     limits.frame_count("--frames", first, last, "run")
     limits.finite("--drift", a.drift)
     keys = read_keys(a.keys)
+    check_keys(model, keys)
     n = last - first + 1
     bar = Bar(a.quiet, "frames ")
     frames = animate(model, keys, (first, last), a.size, a.size, latent=a.latent, speed=a.drift, steps=steps,

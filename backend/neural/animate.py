@@ -109,11 +109,21 @@ def even_keys(specs: list, first: int, last: int, seed: int = 0) -> list:
             for i, (f, (name, params)) in enumerate(zip(frames, specs))]
 
 
-def read_keys(path: str) -> list:
-    """Keyframes of a TOML file (see the module doc)."""
+def read_keys(path: str, where: str = "--keys") -> list:
+    """Keyframes of a TOML file (see the module doc); ``where`` names the file in errors (a flag, a job's key)."""
     from ..documents import read_document
 
-    return parse_keys(read_document(path, "--keys", "toml"), "--keys")
+    return parse_keys(read_document(path, where, "toml"), where)
+
+
+def check_keys(model, keys: list, where: str = "--keys") -> None:
+    """Each keyframe's class and parameters against ``model``, before any frame is drawn: SettingError naming the
+    keyframe by its frame."""
+    for k in keys:
+        try:
+            model.param_vector(*k.spec)
+        except SettingError as exc:
+            raise SettingError(f"{where}: key at frame {k.frame}", exc.message) from None
 
 
 def frame_weight(keys: list, frame: float) -> tuple:

@@ -227,3 +227,21 @@ def test_a_new_source_kind_is_one_class_and_one_registration(tmp_path, monkeypat
     job.write_text(job.read_text().replace('kind = "ramp"', 'kind = "nope"'))
     (entry,) = load_job(str(job))
     assert "unknown source 'nope'; choose one of wave, neural, solid, ramp" in str(entry[1])
+
+
+@pytest.mark.parametrize("key, why", [('params = {scale = 100}', "key at frame 3: scale=100 is outside [2, 16]"),
+                                      ('params = {zz = 1}', "key at frame 3: perlin has no parameter 'zz'")])
+def test_a_bad_keyframe_is_named_by_its_frame_and_its_file(tmp_path, capsys, key, why):
+    """A keyframe's class or parameter the model refuses names the keyframe file's setting and the key's frame,
+    on the command line and in a job file, before any frame is drawn (it was reported as a bare 'param')."""
+    (tmp_path / "k.toml").write_text(f'[[key]]\nframe = 1\nnoise = "spots"\n[[key]]\nframe = 3\nnoise = "perlin"\n'
+                                     f'{key}\n')
+    rc = main(["neural", "--keys", str(tmp_path / "k.toml"), "--frames", "1", "3", "--size", "16", "--quiet",
+               "-o", str(tmp_path / "f_##.png")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and err.startswith(f"omninoise neural: error: --keys: {why}"), err
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "a"\noutput = "n_##.png"\nresolution = [16, 16]\n'
+                                       'frames = [1, 3]\n[bake.source]\nkind = "neural"\nkeys = "k.toml"\n')
+    assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
+    assert f"bake 'a': source.keys: {why}" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["job.toml", "k.toml"]
