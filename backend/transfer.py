@@ -182,19 +182,19 @@ def transfer_from_dict(d: dict, where: str = "transfer") -> TransferFunction:
         raise exc.under(where) from None
 
 
-def load_transfer(spec: str) -> TransferFunction:
-    """A preset name or a JSON ramp file."""
+def load_transfer(spec: str, where: str = "transfer") -> TransferFunction:
+    """A preset name or a JSON ramp file; ``where`` names the setting in errors (a flag, a job's key)."""
     if not isinstance(spec, (str, os.PathLike)):      # an int would be opened as a file descriptor
-        raise SettingError("transfer", f"expected a preset name or a ramp .json file, got {spec!r}")
+        raise SettingError(where, f"expected a preset name or a ramp .json file, got {spec!r}")
     spec = os.fspath(spec)
     if spec in PRESETS:
         return preset(spec)
     if not os.path.exists(spec):
-        raise SettingError("transfer", f"{spec!r} is neither a preset ({', '.join(PRESETS)}) nor a file")
+        raise SettingError(where, f"{spec!r} is neither a preset ({', '.join(PRESETS)}) nor a file")
     from .documents import read_document
 
-    d = read_document(spec, "transfer", "json")
-    return transfer_from_dict(d, os.path.basename(spec))
+    d = read_document(spec, where, "json")
+    return transfer_from_dict(d, f"{where}: {os.path.basename(spec)}")
 
 
 #: presets for the wave noise's real output (mean 0, std ~0.7); ``range`` adapts them to others

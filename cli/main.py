@@ -88,9 +88,20 @@ def _terminate(signum, frame):
 STOP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n))
 
 
+def _reader_left() -> int:
+    """The exit status of a command whose standard output's reader left (a pipe into ``head``): 128 + SIGPIPE, as
+    a command that signal ended, without a traceback; the interpreter's flush at exit goes to /dev/null."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    return 141
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
-    a = ap.parse_args(argv)
+    try:
+        a = ap.parse_args(argv)
+    except BrokenPipeError:             # --help or --version into a pipe whose reader left
+        return _reader_left()
     if argv is None and hugepages.wanted(a.command, getattr(a, "size", 0) or 0, os.environ):
         try:   # a large neural image: the same command again, with huge pages (cli/hugepages.py)
             hugepages.reexec()
@@ -138,6 +149,8 @@ def _run(a: argparse.Namespace) -> int:
     except (SettingError, FileNotFoundError, PermissionError, IsADirectoryError, OutputNameError, ImageError) as exc:
         say(f"error: {exc}")
         return 2
+    except BrokenPipeError:             # the reader of standard output left (`omninoise neural --list | head`)
+        return _reader_left()
     except KeyboardInterrupt as exc:
         signum = getattr(exc, "signum", signal.SIGINT)
         print("", file=sys.stderr)

@@ -201,7 +201,7 @@ def run(a: argparse.Namespace) -> int:
     limits.check_memory("--size", float(a.size) ** (min(a.dim, 3) if ext in (".npy", ".vdb") else 2)
                         * 4 * (5 if a.transfer else 2), f"a {a.size}-sample {a.dim}D grid")
     s = settings_from_args(a)
-    tf = load_transfer(a.transfer) if a.transfer else None
+    tf = load_transfer(a.transfer, "--transfer") if a.transfer else None
     if tf is not None and a.range:
         tf = tf.with_range(*a.range)
     from omninoise.backend.sources import WaveSource

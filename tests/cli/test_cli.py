@@ -48,6 +48,7 @@ def test_png_and_exr(tmp_path, capsys):
     (["--period", "100"], "Nyquist"),
     (["--example", "/no/such/image.png"], "--example"),
     (["--waveform", "custom"], "--profile"),
+    (["--transfer", "nope"], "--transfer: 'nope' is neither a preset"),
 ])
 def test_bad_settings_fail_with_one_line(tmp_path, capsys, args, setting):
     out = tmp_path / "x.png"
@@ -109,3 +110,17 @@ def test_a_frame_number_in_the_name_of_one_file_is_refused(tmp_path, capsys, arg
     assert sorted(p.name for p in tmp_path.iterdir()) == ["job.toml"]
     with pytest.raises(SettingError, match="'#' stands for the frame number"):
         omninoise.wave(8, out=str(tmp_path / "w#.npy"))
+
+
+@pytest.mark.parametrize("argv", [["transfer", "fire"], ["neural", "--list"], ["--version"]])
+def test_a_reader_that_leaves_the_pipe_ends_the_command_quietly(argv):
+    """`omninoise neural --list | head -1`: when the reader of standard output has left, the command ends with
+    128 + SIGPIPE and no traceback or 'internal error' (it reported a BrokenPipeError as a bug)."""
+    read, write = os.pipe()
+    os.close(read)                      # the reader is gone before the first write
+    try:
+        r = subprocess.run([sys.executable, "-m", "omninoise", *argv], cwd=ROOT, stdout=write,
+                           stderr=subprocess.PIPE, text=True)
+    finally:
+        os.close(write)
+    assert r.returncode == 141 and r.stderr == "", r.stderr
