@@ -105,8 +105,11 @@ def param_items(items: list, flag: str) -> dict:
     out = {}
     for item in items:
         key, sep, val = item.partition("=")
-        if not sep:
+        key = key.strip()
+        if not sep or not key:
             raise SettingError(flag, f"expected NAME=VALUE, got {item!r}")
+        if key in out:
+            raise SettingError(flag, f"{key} is given twice")
         try:
             out[key] = float(val)
         except ValueError:

@@ -142,7 +142,9 @@ def neural_request(a: argparse.Namespace, model):
         return req.check(model)
     except SettingError as exc:  # name the flag where the request's field has one
         flag = {"noise": "--noise", "map": "--map", "blend": "--blend", "size": "--size", "seed": "--seed",
-                "width": "--width"}.get(exc.setting, exc.setting)
+                "width": "--width", "transition": "--width", "sharpness": "--sharpness",
+                "param": "--corners" if a.corners else ("--region" if a.map else "--param")}.get(exc.setting,
+                                                                                                 exc.setting)
         raise SettingError(flag, exc.message) from None
 
 
@@ -180,6 +182,10 @@ def run(a: argparse.Namespace) -> int:
         return 0
     if a.keys or a.frames:
         return _animate(a, model, sampler, steps, tile)
+    for flag, given in (("--latent", a.latent != "fixed"), ("--drift", a.drift != 0.05)):
+        if given:
+            raise SettingError(flag, "moves the starting noise from frame to frame of an animation: give --keys "
+                                     "and --frames too")
     if a.fit:
         return _fit(a, model, sampler, steps, tile)
     if a.report:
@@ -245,7 +251,7 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
 
     from omninoise.export.atomic import write_json
     from omninoise.export.images import decode, opaque, write_unit_image
-    from omninoise.backend.neural.fit import fit, fitted_conditioning, load_bank, prepare_target
+    from omninoise.backend.neural.fit import check_fit_size, fit, fitted_conditioning, load_bank, prepare_target
     from omninoise.backend.neural.generate import generate
     from omninoise.backend.onnx_models import ModelError
     from omninoise.backend.paths import fit_bank
@@ -259,6 +265,7 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
         raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
+    check_fit_size(a.fit_size, model.multiple_of, "--fit-size")
     if not os.path.isfile(a.fit):
         raise SettingError("--fit", f"image not found: {a.fit}")
     img = flag_image("--fit", lambda path: opaque(decode(path), path), a.fit)

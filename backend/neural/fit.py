@@ -208,6 +208,13 @@ def render(model, cands: list, S: int, steps: int = 6, sampler: str = "dpmpp_2m"
     return np.clip((x0[:, 0] + 1.0) * 0.5, 0.0, 1.0).astype(_F)
 
 
+def check_fit_size(size: int, multiple: int, where: str = "fit size") -> None:
+    """SettingError naming ``where`` unless ``size`` (the side of the windows compared, px) is a multiple of the
+    model's ``multiple`` of at least 16 (a larger one than the image is cut to the image)."""
+    if size % multiple or size < 16:
+        raise SettingError(where, f"must be a multiple of {multiple} of at least 16, got {size}")
+
+
 def fit(model, image: np.ndarray, size: int = 64, steps: int = 6, sampler: str = "dpmpp_2m", keep: int = 3,
         rounds: int = 3, population: int = 4, seeds: int = 3, seed: int = 0, batch: int = 8,
         bank: dict | None = None, rng: np.random.Generator | None = None, progress: Callable[[float], None] | None = None,
@@ -217,8 +224,7 @@ def fit(model, image: np.ndarray, size: int = 64, steps: int = 6, sampler: str =
     (default: ``np.random.default_rng(seed)``).  ``bank`` (:func:`load_bank`) is used when it was built at the
     fit size, else stage 1 tries every class at mid-range parameters."""
     k = model.multiple_of
-    if size % k or size < 16:
-        raise SettingError("fit size", f"must be a multiple of {k} of at least 16, got {size}")
+    check_fit_size(size, k)
     img, notes = prepare_target(image, k)
     S = min(size, (min(img.shape) // k) * k)
     target = target_statistic(img, S)

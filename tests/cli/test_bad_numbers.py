@@ -3,6 +3,7 @@ directions, table sizes and grid sizes each give a one-line error naming the set
 import os
 import re
 
+import numpy as np
 import pytest
 
 from omninoise.backend import limits
@@ -122,6 +123,15 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["solid", "--exemplar", "gravel", "--scale", "inf", "-o", "{d}/s.png"], "--scale"),
     (["solid", "--exemplar", "gravel", "--size", "100000000", "-o", "{d}/s.png"], "--size"),
     (["zoo", "--noise", "perlin", "-o", "{d}/o.txt"], "-o"),
+    (["neural", "--noise", "perlin", "--param", "=3", "-o", "{d}/n.png"], "--param: expected NAME=VALUE"),
+    (["neural", "--noise", "perlin", "--param", "scale=3", "--param", "scale=4", "-o", "{d}/n.png"],
+     "--param: scale is given twice"),
+    (["neural", "--noise", "perlin", "--param", "scale=300", "-o", "{d}/n.png"], "--param: scale=300 is outside"),
+    (["neural", "--corners", "perlin", "gabor", "spots", "noise:Scale=99", "-o", "{d}/n.png"],
+     "--corners: Scale=99 is outside"),
+    (["neural", "--noise", "perlin", "--latent", "slerp", "-o", "{d}/n.png"], "--latent: moves the starting noise"),
+    (["neural", "--noise", "perlin", "--drift", "1", "-o", "{d}/n.png"], "--drift: moves the starting noise"),
+    (["neural", "--fit", "{d}/none.png", "--fit-size", "4", "-o", "{d}/n.png"], "--fit-size: must be a multiple"),
 ])
 def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
     rc = main([x.format(d=tmp_path) for x in args])
@@ -177,3 +187,15 @@ def test_bad_solid_source_numbers_are_named(tmp_path, source, match):
     res = run_job(str(job))
     assert res[0].status == "invalid" and re.search(match, res[0].message), [r.message for r in res]
     assert not (tmp_path / "s.png").exists()
+
+
+@pytest.mark.parametrize("flag, value", [("--sharpness", "inf"), ("--width", "-1")])
+def test_a_blend_setting_is_named_by_its_flag(tmp_path, capsys, flag, value):
+    from PIL import Image
+
+    Image.fromarray(np.tile(np.arange(16, dtype=np.uint8) * 16, (16, 1))).save(tmp_path / "m.png")
+    rc = main(["neural", "--noise", "perlin", "--size", "16", "--blend", str(tmp_path / "m.png"), flag, value,
+               "-o", str(tmp_path / "n.png")])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(err) == 1 and f"error: {flag}: " in err[0], err
+    assert os.listdir(tmp_path) == ["m.png"]
