@@ -743,6 +743,8 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     from .solid.request import SolidRequest
 
     _check_keys(d, _SOLID_KEYS, "solid")
+    if "mix" in d and "to" not in d:
+        raise SettingError("source.mix", "weighs the texture of to: give to = EXEMPLAR too")
 
     def path(v):
         return os.path.join(base_dir, v) if isinstance(v, str) and os.path.exists(os.path.join(base_dir, v)) else v

@@ -85,6 +85,8 @@ def solid_request(a: argparse.Namespace):
     """The :class:`backend.solid.request.SolidRequest` of ``omninoise solid``'s flags, checked."""
     from omninoise.backend.solid.request import SolidRequest
 
+    if a.to is None and a.mix != 0.5:
+        raise SettingError("--mix", "weighs the texture of --to: give --to EXEMPLAR too")
     given = [k for k, unset in (("model", None), ("to", None), ("mix", 0.5), ("refine", 0), ("periodic", True),
                                 ("gaussian", True), ("rest", "auto"), ("tile", 256), ("families", DEFAULT_KINDS))
              if getattr(a, k) != unset]

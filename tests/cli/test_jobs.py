@@ -245,3 +245,13 @@ def test_a_bad_keyframe_is_named_by_its_frame_and_its_file(tmp_path, capsys, key
     assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
     assert f"bake 'a': source.keys: {why}" in capsys.readouterr().out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["job.toml", "k.toml"]
+
+
+def test_a_solid_mix_without_to_is_refused(tmp_path, capsys):
+    """``mix`` weighs the texture of ``to``: alone it would change nothing, and the texture would not be the one
+    asked for."""
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "s"\noutput = "s.png"\nresolution = [8, 8]\n'
+                                       'bounds = [[0, 0, 0], [1, 0, 1]]\n[bake.source]\nkind = "solid"\n'
+                                       'exemplar = "grass"\nmix = 0.2\n')
+    assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
+    assert "bake 's': source.mix: weighs the texture of to" in capsys.readouterr().out
