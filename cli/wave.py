@@ -107,7 +107,28 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
     return w
 
 
+#: flags that change the noise only beside another setting: (flag, attribute, its default, whether it is read,
+#: what it needs); given where it is not read, it would change nothing and the noise would not be the one asked for
+READ_WITH = (
+    ("--exponent", "exponent", 1.0, lambda a: a.spectrum == "fractal", "--spectrum fractal"),
+    ("--profile", "profile", None, lambda a: a.waveform == "custom", "--waveform custom"),
+    ("--cell-size", "cell_size", None, lambda a: a.cellular != "none", "--cellular"),
+    ("--stit-probability", "stit_probability", 0.5, lambda a: a.cellular == "stit", "--cellular stit"),
+    ("--stit-depth", "stit_depth", 3, lambda a: a.cellular == "stit", "--cellular stit"),
+    ("--axis-spectrum", "axis_spectrum", [], lambda a: a.anisotropy == "axes", "--anisotropy axes"),
+    ("--lobe", "lobe", [], lambda a: a.anisotropy == "lobes", "--anisotropy lobes"),
+    ("--spread", "spread", 20.0, lambda a: a.anisotropy == "lobes" or a.example, "--anisotropy lobes or --example"),
+    ("--example-plane", "example_plane", "xy", lambda a: a.example, "--example"),
+    ("--example-extent", "example_extent", None, lambda a: a.example, "--example"),
+    ("--sectors", "sectors", 8, lambda a: a.example, "--example"),
+    ("--transition-length", "transition_length", None, lambda a: a.transition is not None, "--transition"),
+)
+
+
 def settings_from_args(a: argparse.Namespace) -> WaveSettings:
+    for flag, attr, unset, read, needs in READ_WITH:
+        if getattr(a, attr) != unset and not read(a):
+            raise SettingError(flag, f"is read only with {needs}; without it, it would change nothing")
     if not 1 <= a.directions <= limits.MAX_DIRECTIONS:
         raise SettingError("--directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {a.directions}")
     if a.period is not None:

@@ -124,3 +124,26 @@ def test_a_reader_that_leaves_the_pipe_ends_the_command_quietly(argv):
     finally:
         os.close(write)
     assert r.returncode == 141 and r.stderr == "", r.stderr
+
+
+@pytest.mark.parametrize("flag, value, needs", [
+    ("--exponent", "2", ["--spectrum", "fractal"]), ("--profile", "{d}/p.txt", ["--waveform", "custom"]),
+    ("--cell-size", "0.5", ["--cellular", "polytope"]), ("--stit-probability", "0.3", ["--cellular", "stit"]),
+    ("--stit-depth", "2", ["--cellular", "stit"]), ("--axis-spectrum", "bandpass:1:2", None),
+    ("--lobe", "1,0:1", ["--anisotropy", "lobes"]), ("--spread", "10", ["--anisotropy", "lobes", "--lobe", "1,0:1"]),
+    ("--example-plane", "xz", None), ("--example-extent", "2", None), ("--sectors", "4", None),
+    ("--transition-length", "2", ["--transition", "bandpass:1:2"]),
+])
+def test_a_flag_read_only_beside_another_is_refused_alone(tmp_path, capsys, flag, value, needs):
+    """A wave flag that changes the noise only beside another setting (the fractal exponent, a cell size, a lobe)
+    is refused without it, naming both, as the solid command refuses a flag its method does not read: the noise
+    would not be the one asked for. With the setting it needs, the command runs."""
+    (tmp_path / "p.txt").write_text("0 1 0.5 0.2\n")
+    out, value = str(tmp_path / "o.npy"), value.format(d=tmp_path)
+    rc, err = run(capsys, "--size", "8", "--quiet", flag, value, "-o", out)
+    assert rc == 2 and err.startswith(f"omninoise wave: error: {flag}: is read only with ") and \
+        err.count("\n") == 1, err
+    assert not os.path.exists(out)
+    if needs is not None:
+        rc, err = run(capsys, "--size", "8", "--quiet", flag, value, *needs, "-o", out)
+        assert rc == 0, err

@@ -90,7 +90,8 @@ def test_space_model_encode_and_interpolate(models, tmp_path, capsys):
 @pytest.mark.parametrize("args, msg", [
     (["--exemplar", "gravel"], "give --exemplar"),
     (["--exemplar", "gravel", "--size", "0", "-o", "x.png"], "--size: must be >= 1"),
-    (["--exemplar", "gravel", "--mix", "2", "-o", "x.png"], "--mix: must lie in [0, 1]"),
+    (["--exemplar", "gravel", "--to", "grass", "--mix", "2", "-o", "x.png"], "--mix: must lie in [0, 1]"),
+    (["--exemplar", "gravel", "--mix", "0.2", "-o", "x.png"], "--mix: weighs the texture of --to"),
     (["--exemplar", "gravel", "--dim", "3", "-o", "x.png"], "a 3D result is written as .vdb, .npy"),
     (["--exemplar", "gravel", "--to", "grass", "-o", "x.png"], "interpolation needs the space model"),
 ])
