@@ -115,6 +115,10 @@ def neural_request(a: argparse.Namespace, model):
         raise SettingError("--size", f"must be >= 8, got {a.size}")
     if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
         raise SettingError("--blend", "choose one of --blend, --corners and --map")
+    for flag, given in (("--width", a.width != 32.0), ("--sharpness", a.sharpness != 1.0)):
+        if given and not (a.blend or a.map):
+            raise SettingError(flag, "shapes the transitions of --blend and --map; without them it would change "
+                                     "nothing")
     kw = dict(width=a.size, height=a.size, transition=a.width, sharpness=a.sharpness, seed=a.seed,
               steps=DEFAULT_STEPS if a.steps is None else a.steps, sampler=a.sampler or DEFAULT_SAMPLER,
               spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=a.tile)

@@ -133,6 +133,9 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["neural", "--noise", "perlin", "--drift", "1", "-o", "{d}/n.png"], "--drift: moves the starting noise"),
     (["neural", "--fit", "{d}/none.png", "--fit-size", "4", "-o", "{d}/n.png"], "--fit-size: must be a multiple"),
     (["solid", "--exemplar", "grass", "--mix", "0.3", "-o", "{d}/s.png"], "--mix: weighs the texture of --to"),
+    (["neural", "--noise", "perlin", "--width", "8", "-o", "{d}/n.png"], "--width: shapes the transitions"),
+    (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--sharpness", "2", "-o", "{d}/n.png"],
+     "--sharpness: shapes the transitions"),
 ])
 def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
     rc = main([x.format(d=tmp_path) for x in args])
