@@ -134,6 +134,9 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["neural", "--fit", "{d}/none.png", "--fit-size", "4", "-o", "{d}/n.png"], "--fit-size: must be a multiple"),
     (["solid", "--exemplar", "grass", "--mix", "0.3", "-o", "{d}/s.png"], "--mix: weighs the texture of --to"),
     (["neural", "--noise", "perlin", "--width", "8", "-o", "{d}/n.png"], "--width: shapes the transitions"),
+    (["transfer", "fire", "-o", "{d}/ramp.txt"], "-o: a ramp is written as .json"),
+    (["transfer", "-o", "{d}/ramp.json"], "-o: saves a preset: give its name"),
+    (["transfer", "--list", "fire"], "--list: lists the presets"),
     (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--sharpness", "2", "-o", "{d}/n.png"],
      "--sharpness: shapes the transitions"),
 ])
