@@ -47,6 +47,13 @@ omninoise bake job.toml --workers 4""")
 def run(a: argparse.Namespace) -> int:
     from omninoise.backend.jobs import JobError, load_job, run_job
 
+    farm = a.workers is not None or a.cluster
+    for flag, given in (("--retries", a.retries != 2), ("--brick-voxels", a.brick_voxels is not None),
+                        ("--tls-ca-file", a.tls_ca_file), ("--tls-cert", a.tls_cert), ("--tls-key", a.tls_key)):
+        if given and not farm:
+            raise SettingError(flag, "applies to a farm bake: give --workers N or --cluster ADDRESS too")
+    if a.cluster and "://" in a.cluster and not a.cluster.startswith(("tcp://", "tls://")):   # host:port is tcp
+        raise SettingError("--cluster", f"expected a Dask scheduler's tcp:// or tls:// address, got {a.cluster!r}")
     if a.dry_run:
         entries = load_job(a.job)
         bad = [s for _, s in entries if isinstance(s, JobError)]
@@ -65,7 +72,7 @@ def run(a: argparse.Namespace) -> int:
             return 2
         return 0
     set_threads(a.threads, a.precision)
-    if a.workers is not None or a.cluster:
+    if farm:
         return _on_farm(a)
     now = {}      # the bake in progress: one bar per bake
 

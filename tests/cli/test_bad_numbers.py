@@ -137,6 +137,10 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["transfer", "fire", "-o", "{d}/ramp.txt"], "-o: a ramp is written as .json"),
     (["transfer", "-o", "{d}/ramp.json"], "-o: saves a preset: give its name"),
     (["transfer", "--list", "fire"], "--list: lists the presets"),
+    (["bake", "{d}/job.toml", "--retries", "5"], "--retries: applies to a farm bake"),
+    (["bake", "{d}/job.toml", "--brick-voxels", "64"], "--brick-voxels: applies to a farm bake"),
+    (["bake", "{d}/job.toml", "--tls-cert", "c.pem"], "--tls-cert: applies to a farm bake"),
+    (["bake", "{d}/job.toml", "--cluster", "http://host:8786"], "--cluster: expected a Dask scheduler's tcp://"),
     (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--sharpness", "2", "-o", "{d}/n.png"],
      "--sharpness: shapes the transitions"),
 ])
