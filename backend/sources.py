@@ -777,7 +777,7 @@ def _solid_from_dict(d: dict, base_dir: str):
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
     import os
 
-    from .wavenoise.settings import settings_from_dict
+    from .wavenoise.settings import check_read, settings_from_dict
 
     example = None
     if "example" in d:
@@ -791,8 +791,11 @@ def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
         except export.ImageError as exc:
             raise SettingError("source.example", str(exc)) from None
     w_offset = limits.finite("source.w_offset", d.pop("w_offset", 0.0))
+    spectrum = d.get("spectrum")
+    given = list(d) + (["exponent"] if isinstance(spectrum, dict) and "exponent" in spectrum else [])
     try:
         settings = settings_from_dict(d, example)
+        check_read(settings, given)     # a key that changes nothing here: the noise would not be the one asked for
     except SettingError as exc:      # the settings' own rules name their keys; a job's are under [bake.source]
         raise exc.under("source") from None
     return WaveSource(settings, w_offset)

@@ -13,7 +13,7 @@ from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.transfer import PRESETS, load_transfer
 from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
-from omninoise.backend.wavenoise.settings import ANISOTROPY, PLANES, WaveSettings
+from omninoise.backend.wavenoise.settings import ANISOTROPY, PLANES, WaveSettings, check_read
 from omninoise.backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
 from omninoise.backend.wavenoise.tables import WAVEFORMS
 from omninoise.backend.wavenoise.wave import OUTPUTS
@@ -107,28 +107,22 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
     return w
 
 
-#: flags that change the noise only beside another setting: (flag, attribute, its default, whether it is read,
-#: what it needs); given where it is not read, it would change nothing and the noise would not be the one asked for
-READ_WITH = (
-    ("--exponent", "exponent", 1.0, lambda a: a.spectrum == "fractal", "--spectrum fractal"),
-    ("--profile", "profile", None, lambda a: a.waveform == "custom", "--waveform custom"),
-    ("--cell-size", "cell_size", None, lambda a: a.cellular != "none", "--cellular"),
-    ("--stit-probability", "stit_probability", 0.5, lambda a: a.cellular == "stit", "--cellular stit"),
-    ("--stit-depth", "stit_depth", 3, lambda a: a.cellular == "stit", "--cellular stit"),
-    ("--axis-spectrum", "axis_spectrum", [], lambda a: a.anisotropy == "axes", "--anisotropy axes"),
-    ("--lobe", "lobe", [], lambda a: a.anisotropy == "lobes", "--anisotropy lobes"),
-    ("--spread", "spread", 20.0, lambda a: a.anisotropy == "lobes" or a.example, "--anisotropy lobes or --example"),
-    ("--example-plane", "example_plane", "xy", lambda a: a.example, "--example"),
-    ("--example-extent", "example_extent", None, lambda a: a.example, "--example"),
-    ("--sectors", "sectors", 8, lambda a: a.example, "--example"),
-    ("--transition-length", "transition_length", None, lambda a: a.transition is not None, "--transition"),
-)
+#: the flag of each wave setting :data:`~backend.wavenoise.settings.READ_WITH` names
+FLAGS = {"exponent": "--exponent", "profile": "--profile", "cell_size": "--cell-size",
+         "stit_probability": "--stit-probability", "stit_depth": "--stit-depth", "axis_spectra": "--axis-spectrum",
+         "lobes": "--lobe", "spread": "--spread", "example_plane": "--example-plane",
+         "example_extent": "--example-extent", "sectors": "--sectors", "transition_length": "--transition-length",
+         "spectrum": "--spectrum", "waveform": "--waveform", "cellular": "--cellular", "anisotropy": "--anisotropy",
+         "example": "--example", "transition_to": "--transition"}
+#: each flag's attribute and its default: a flag is given where its value is not the default
+GIVEN = {"exponent": ("exponent", 1.0), "profile": ("profile", None), "cell_size": ("cell_size", None),
+         "stit_probability": ("stit_probability", 0.5), "stit_depth": ("stit_depth", 3),
+         "axis_spectra": ("axis_spectrum", []), "lobes": ("lobe", []), "spread": ("spread", 20.0),
+         "example_plane": ("example_plane", "xy"), "example_extent": ("example_extent", None),
+         "sectors": ("sectors", 8), "transition_length": ("transition_length", None)}
 
 
 def settings_from_args(a: argparse.Namespace) -> WaveSettings:
-    for flag, attr, unset, read, needs in READ_WITH:
-        if getattr(a, attr) != unset and not read(a):
-            raise SettingError(flag, f"is read only with {needs}; without it, it would change nothing")
     if not 1 <= a.directions <= limits.MAX_DIRECTIONS:
         raise SettingError("--directions", f"must lie in [1, {limits.MAX_DIRECTIONS}], got {a.directions}")
     if a.period is not None:
@@ -177,9 +171,12 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
         lobes=tuple(a.lobe), spread=a.spread, example=example, example_plane=a.example_plane, sectors=a.sectors,
         transition_to=a.transition, table_size=a.table_size, table_period=a.period, **used)
     try:
-        return s.validate()
+        s = s.validate()
     except SettingError as exc:     # named as the flag the user typed, where the setting has one
         raise SettingError(_flag(a, exc.setting), exc.message) from None
+    check_read(s, [k for k, (attr, unset) in GIVEN.items() if getattr(a, attr) != unset],
+               lambda k, v=None: FLAGS[k] if v is None else f"{FLAGS[k]} {v}")
+    return s
 
 
 #: settings whose flag has another name

@@ -20,7 +20,8 @@ from .tables import DEFAULT_SIZE, build_axis_table, build_table, build_waveform_
 from .schema import ANISOTROPY, WAVE_SETTINGS
 from .wave import Transition, WaveNoise
 
-__all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict"]
+__all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict",
+           "READ_WITH", "check_read"]
 
 
 
@@ -186,6 +187,37 @@ def _plain(name: str, v):
     if isinstance(v, (tuple, np.ndarray)):
         return [float(c) for c in v]
     return v
+
+
+#: settings that change the noise only beside another: name -> (whether ``s`` reads it, what it needs as
+#: (setting, value) pairs, one of which must hold; value None: any but the default). ``exponent`` is the spectrum's.
+READ_WITH = {
+    "exponent": (lambda s: s.spectrum.kind == "fractal", (("spectrum", "fractal"),)),
+    "profile": (lambda s: s.waveform == "custom", (("waveform", "custom"),)),
+    "cell_size": (lambda s: s.cellular != "none", (("cellular", None),)),
+    "stit_probability": (lambda s: s.cellular == "stit", (("cellular", "stit"),)),
+    "stit_depth": (lambda s: s.cellular == "stit", (("cellular", "stit"),)),
+    "axis_spectra": (lambda s: s.anisotropy == "axes", (("anisotropy", "axes"),)),
+    "lobes": (lambda s: s.anisotropy == "lobes", (("anisotropy", "lobes"),)),
+    "spread": (lambda s: s.anisotropy == "lobes" or s.example is not None,
+               (("anisotropy", "lobes"), ("example", None))),
+    "example_plane": (lambda s: s.example is not None, (("example", None),)),
+    "example_extent": (lambda s: s.example is not None, (("example", None),)),
+    "sectors": (lambda s: s.example is not None, (("example", None),)),
+    "transition_length": (lambda s: s.transition_to is not None, (("transition_to", None),)),
+}
+
+
+def check_read(s: WaveSettings, given, shown=None) -> None:
+    """SettingError naming the first of ``given`` (setting names, as :data:`READ_WITH`) that ``s`` does not read: it
+    would change nothing, and the noise would not be the one asked for. ``shown(name, value=None)`` writes a setting,
+    or a setting holding a value, as the front end does (default: a job file's ``cellular = "stit"``)."""
+    shown = shown or (lambda k, v=None: k if v is None else f'{k} = "{v}"')
+    for key in given:
+        read, needs = READ_WITH.get(key, (None, None))
+        if read is not None and not read(s):
+            what = " or ".join(shown(k, v) for k, v in needs)
+            raise SettingError(shown(key), f"is read only with {what}; without it, it would change nothing")
 
 
 def settings_from_dict(d: dict, example: np.ndarray | None = None) -> WaveSettings:

@@ -255,3 +255,18 @@ def test_a_solid_mix_without_to_is_refused(tmp_path, capsys):
                                        'exemplar = "grass"\nmix = 0.2\n')
     assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
     assert "bake 's': source.mix: weighs the texture of to" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("source, key, needs", [
+    ('cell_size = 2', "cell_size", "cellular"),
+    ('spectrum = {kind = "bandpass", fmin = 1, fmax = 4, exponent = 2}', "exponent", 'spectrum = "fractal"'),
+    ('stit_depth = 2\ncellular = "polytope"', "stit_depth", 'cellular = "stit"'),
+    ('spread = 10', "spread", 'anisotropy = "lobes" or example'),
+    ('sectors = 4', "sectors", "example"),
+])
+def test_a_wave_key_that_changes_nothing_is_refused(tmp_path, capsys, source, key, needs):
+    """As on the command line: a wave key read only beside another setting is refused without it, naming both."""
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "a"\noutput = "w.npy"\nresolution = [8, 8]\n'
+                                       f'[bake.source]\nkind = "wave"\n{source}\n')
+    assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
+    assert f"bake 'a': source.{key}: is read only with {needs};" in capsys.readouterr().out
