@@ -643,6 +643,10 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     _check_keys(d, _NEURAL_KEYS, "neural")
     if "regions" in d and "map" not in d:
         raise SettingError("source.regions", "regions name the colours of a painted map: give map = FILE too")
+    for key in ("width", "sharpness"):
+        if key in d and "blend" not in d and "map" not in d:
+            raise SettingError(f"source.{key}", "shapes the transitions of blend and map; without them it would "
+                                                "change nothing")
     keys = None
     if "keys" in d:  # animation: a keyframe file (relative to the job) or an inline list of [[key]] tables
         from .neural.animate import parse_keys, read_keys

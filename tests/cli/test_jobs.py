@@ -270,3 +270,11 @@ def test_a_wave_key_that_changes_nothing_is_refused(tmp_path, capsys, source, ke
                                        f'[bake.source]\nkind = "wave"\n{source}\n')
     assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
     assert f"bake 'a': source.{key}: is read only with {needs};" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("key", ["width = 8", "sharpness = 2"])
+def test_a_neural_transition_without_a_blend_or_map_is_refused(tmp_path, capsys, key):
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "a"\noutput = "n.png"\nresolution = [16, 16]\n'
+                                       f'[bake.source]\nkind = "neural"\nnoise = "perlin"\n{key}\n')
+    assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
+    assert f"source.{key.split()[0]}: shapes the transitions of blend and map" in capsys.readouterr().out
