@@ -335,7 +335,7 @@ def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
         bpy.ops.omninoise.swatch_add()
     specs = [s.spec() for s in p.swatches]
     flag = lambda spec: spec[0] + ":" + ",".join(f"{k}={v!r}" for k, v in spec[1].items())  # noqa: E731
-    args = ["--size", "32", "--seed", "5", "--steps", "3", "--sampler", p.sampler, "--width", "6"]
+    args = ["--size", "32", "--seed", "5", "--steps", "3", "--sampler", p.sampler]
     if mode == "SINGLE":
         p.active = 1
         args += ["--noise", specs[1][0]] + [a for k, v in specs[1][1].items() for a in ("--param", f"{k}={v!r}")]
@@ -348,7 +348,7 @@ def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
         px = np.empty(n * n * 4, np.float32)
         ima.pixels.foreach_get(px)
         write_png(str(tmp_path / "map.png"), np.rint(np.flipud(px.reshape(n, n, 4)[..., :3]) * 255).astype(np.uint8))
-        args += ["--map", str(tmp_path / "map.png")]
+        args += ["--map", str(tmp_path / "map.png"), "--width", "6"]    # the panel's width shapes maps only
         for s in p.swatches[:2]:
             args += ["--region", "#%02x%02x%02x=" % tuple(round(c * 255) for c in s.color) + flag(s.spec())]
         args[1] = str(n)
