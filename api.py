@@ -216,6 +216,10 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         from .backend.bake import require_vdb
 
         require_vdb("out")
+    for name, value, unset in (("dim", dim, 2), ("size", size, 256), ("scale", scale, 1.0)):
+        if ext == ".json" and value != unset:
+            raise SettingError(name, "a .json output holds the fitted solid, not a drawing of it: leave "
+                                     f"{name} out, and give it when the .json is drawn")
     kinds = {} if families is None else dict(families=families)
     given = [k for k, v in (("model", model is not None), ("refine", refine != 0), ("periodic", not periodic),
                             ("families", families is not None)) if v]

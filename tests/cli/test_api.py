@@ -29,6 +29,10 @@ CASES = [
     (lambda: omninoise.wave(8, half=True, out="x.npy"), "half", "into .exr and .vdb only"),
     (lambda: omninoise.wave(8, waveform="custom", profile=np.zeros((2, 2))), "profile", "expected numbers"),
     (lambda: omninoise.wave(8, waveform="custom", profile=[1.0, 1.0]), "profile", "samples that vary"),
+    (lambda: omninoise.solid("photo.png", 64, method="procedural", out="wall.json"), "size",
+     "a .json output holds the fitted solid"),
+    (lambda: omninoise.solid("photo.png", dim=3, method="procedural", out="wall.json"), "dim",
+     "a .json output holds the fitted solid"),
 ]
 
 
