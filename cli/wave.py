@@ -113,7 +113,7 @@ FLAGS = {"exponent": "--exponent", "profile": "--profile", "cell_size": "--cell-
          "lobes": "--lobe", "spread": "--spread", "example_plane": "--example-plane",
          "example_extent": "--example-extent", "sectors": "--sectors", "transition_length": "--transition-length",
          "spectrum": "--spectrum", "waveform": "--waveform", "cellular": "--cellular", "anisotropy": "--anisotropy",
-         "example": "--example", "transition_to": "--transition"}
+         "example": "--example", "transition_to": "--transition", "dim": "--dim"}
 #: each flag's attribute and its default: a flag is given where its value is not the default
 GIVEN = {"exponent": ("exponent", 1.0), "profile": ("profile", None), "cell_size": ("cell_size", None),
          "stit_probability": ("stit_probability", 0.5), "stit_depth": ("stit_depth", 3),

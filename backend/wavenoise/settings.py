@@ -189,22 +189,23 @@ def _plain(name: str, v):
     return v
 
 
-#: settings that change the noise only beside another: name -> (whether ``s`` reads it, what it needs as
-#: (setting, value) pairs, one of which must hold; value None: any but the default). ``exponent`` is the spectrum's.
+#: settings that change the noise only beside another: name -> (whether ``s`` reads it, what it needs: one or more
+#: alternatives, each (setting, value) pairs that must all hold; value None: any but the default). ``exponent`` is
+#: the spectrum's; a 2D by-example noise reads neither its plane nor a band's spread.
 READ_WITH = {
-    "exponent": (lambda s: s.spectrum.kind == "fractal", (("spectrum", "fractal"),)),
-    "profile": (lambda s: s.waveform == "custom", (("waveform", "custom"),)),
-    "cell_size": (lambda s: s.cellular != "none", (("cellular", None),)),
-    "stit_probability": (lambda s: s.cellular == "stit", (("cellular", "stit"),)),
-    "stit_depth": (lambda s: s.cellular == "stit", (("cellular", "stit"),)),
-    "axis_spectra": (lambda s: s.anisotropy == "axes", (("anisotropy", "axes"),)),
-    "lobes": (lambda s: s.anisotropy == "lobes", (("anisotropy", "lobes"),)),
-    "spread": (lambda s: s.anisotropy == "lobes" or s.example is not None,
-               (("anisotropy", "lobes"), ("example", None))),
-    "example_plane": (lambda s: s.example is not None, (("example", None),)),
-    "example_extent": (lambda s: s.example is not None, (("example", None),)),
-    "sectors": (lambda s: s.example is not None, (("example", None),)),
-    "transition_length": (lambda s: s.transition_to is not None, (("transition_to", None),)),
+    "exponent": (lambda s: s.spectrum.kind == "fractal", ((("spectrum", "fractal"),),)),
+    "profile": (lambda s: s.waveform == "custom", ((("waveform", "custom"),),)),
+    "cell_size": (lambda s: s.cellular != "none", ((("cellular", None),),)),
+    "stit_probability": (lambda s: s.cellular == "stit", ((("cellular", "stit"),),)),
+    "stit_depth": (lambda s: s.cellular == "stit", ((("cellular", "stit"),),)),
+    "axis_spectra": (lambda s: s.anisotropy == "axes", ((("anisotropy", "axes"),),)),
+    "lobes": (lambda s: s.anisotropy == "lobes", ((("anisotropy", "lobes"),),)),
+    "spread": (lambda s: s.anisotropy == "lobes" or (s.example is not None and s.dim == 3),
+               ((("anisotropy", "lobes"),), (("example", None), ("dim", 3)))),
+    "example_plane": (lambda s: s.example is not None and s.dim == 3, ((("example", None), ("dim", 3)),)),
+    "example_extent": (lambda s: s.example is not None, ((("example", None),),)),
+    "sectors": (lambda s: s.example is not None, ((("example", None),),)),
+    "transition_length": (lambda s: s.transition_to is not None, ((("transition_to", None),),)),
 }
 
 
@@ -212,11 +213,11 @@ def check_read(s: WaveSettings, given, shown=None) -> None:
     """SettingError naming the first of ``given`` (setting names, as :data:`READ_WITH`) that ``s`` does not read: it
     would change nothing, and the noise would not be the one asked for. ``shown(name, value=None)`` writes a setting,
     or a setting holding a value, as the front end does (default: a job file's ``cellular = "stit"``)."""
-    shown = shown or (lambda k, v=None: k if v is None else f'{k} = "{v}"')
+    shown = shown or (lambda k, v=None: k if v is None else f"{k} = {v!r}".replace("'", '"'))
     for key in given:
         read, needs = READ_WITH.get(key, (None, None))
         if read is not None and not read(s):
-            what = " or ".join(shown(k, v) for k, v in needs)
+            what = " or ".join(" with ".join(shown(k, v) for k, v in alt) for alt in needs)
             raise SettingError(shown(key), f"is read only with {what}; without it, it would change nothing")
 
 

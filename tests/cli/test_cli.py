@@ -147,3 +147,17 @@ def test_a_flag_read_only_beside_another_is_refused_alone(tmp_path, capsys, flag
     if needs is not None:
         rc, err = run(capsys, "--size", "8", "--quiet", flag, value, *needs, "-o", out)
         assert rc == 0, err
+
+
+def test_a_by_example_plane_is_read_in_3d_only(tmp_path, capsys):
+    """A 2D by-example noise lies in its image's plane: --example-plane and --spread (the band's half-angle around
+    that plane) are read by 3D by-example noise only."""
+    from omninoise.export.images import write_png
+
+    write_png(str(tmp_path / "e.png"), (np.random.default_rng(0).random((32, 32)) * 255).astype(np.uint8))
+    out, ex = str(tmp_path / "o.npy"), str(tmp_path / "e.png")
+    for flag, value in (("--example-plane", "xz"), ("--spread", "10")):
+        rc, err = run(capsys, "--size", "8", "--quiet", "--example", ex, flag, value, "-o", out)
+        assert rc == 2 and f"{flag}: is read only with " in err and "--example with --dim 3" in err, err
+        rc, err = run(capsys, "--size", "8", "--quiet", "--dim", "3", "--example", ex, flag, value, "-o", out)
+        assert rc == 0, err

@@ -261,7 +261,7 @@ def test_a_solid_mix_without_to_is_refused(tmp_path, capsys):
     ('cell_size = 2', "cell_size", "cellular"),
     ('spectrum = {kind = "bandpass", fmin = 1, fmax = 4, exponent = 2}', "exponent", 'spectrum = "fractal"'),
     ('stit_depth = 2\ncellular = "polytope"', "stit_depth", 'cellular = "stit"'),
-    ('spread = 10', "spread", 'anisotropy = "lobes" or example'),
+    ('spread = 10', "spread", 'anisotropy = "lobes" or example with dim = 3'),
     ('sectors = 4', "sectors", "example"),
 ])
 def test_a_wave_key_that_changes_nothing_is_refused(tmp_path, capsys, source, key, needs):
