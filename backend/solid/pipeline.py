@@ -121,9 +121,10 @@ def photo_code(model: SolidTextureModel, image: np.ndarray, config: PhotoConfig 
     return PhotoCode(code if r is None else dataclasses.replace(code, rest=r), z, h, r, history, img)
 
 
-def _exemplar_code(model: SolidTextureModel, exemplar, config: PhotoConfig, setting: str, progress) -> PhotoCode:
+def _exemplar_code(model: SolidTextureModel, exemplar, config: PhotoConfig, setting: str, progress,
+                   read=None) -> PhotoCode:
     """Stage 1, then :func:`photo_code` for pixels: a training exemplar's name gives its stored code, part and rest;
-    an image file is read; pixels are taken as they are."""
+    an image file is read (by ``read``, default ``export.read_rgb``); pixels are taken as they are."""
     if isinstance(exemplar, np.ndarray):
         return photo_code(model, exemplar, config, progress, setting)
     if exemplar in model.codes:
@@ -135,20 +136,21 @@ def _exemplar_code(model: SolidTextureModel, exemplar, config: PhotoConfig, sett
         raise SettingError(setting, f"{exemplar!r} is neither an image file nor an exemplar the model knows "
                                     f"({', '.join(model.codes) or 'none'})")
     try:
-        img = export.read_rgb(exemplar)
+        img = (read or export.read_rgb)(exemplar)
     except ValueError as exc:
         raise SettingError(setting, str(exc)) from None
     return photo_code(model, img, config, progress, setting)
 
 
 def texture_code(model: SolidTextureModel, exemplar=None, to=None, mix: float = 0.0,
-                 config: PhotoConfig = PhotoConfig(), where: str = "", progress=None, report=None):
+                 config: PhotoConfig = PhotoConfig(), where: str = "", progress=None, report=None, read=None):
     """A texture request's code, every stage: (TextureCode, the input images' sha256 or None).
 
     A single-exemplar model gives its own texture (``to``, ``refine`` and an ``exemplar`` other than its own are
     errors); a space model gives ``exemplar`` (a training exemplar's name, an image file or pixels), mixed with
     ``to`` by ``mix`` in [0, 1] (stage 7).  ``where`` prefixes the setting names in errors ("source." for job
-    files, "--" for flags); ``report(name, history)`` hears each refinement's distances."""
+    files, "--" for flags); ``report(name, history)`` hears each refinement's distances; ``read(path)`` decodes
+    an image file (default ``export.read_rgb``; a request passes the decoding its checks made)."""
     def name(key):
         return f"{where}{key}"
 
@@ -173,7 +175,7 @@ def texture_code(model: SolidTextureModel, exemplar=None, to=None, mix: float = 
     for ex, key in ((exemplar, "exemplar"), (to, "to")):
         if ex is None:
             continue
-        c = _exemplar_code(model, ex, config, name(key), progress)
+        c = _exemplar_code(model, ex, config, name(key), progress, read)
         if c.history and report is not None:
             report(ex, c.history)
         codes.append(c)

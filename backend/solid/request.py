@@ -249,10 +249,26 @@ class SolidRequest:
         from .pipeline import texture_code
 
         code, sha = texture_code(model, self.exemplar, self.to, float(self.mix), self.photo_config(), where,
-                                 progress, report)
+                                 progress, report, self._read)
         if on_code is not None:
             on_code(code)
         return code, sha
+
+    def _read(self, path: str) -> np.ndarray:
+        """``export.read_rgb(path)``, or this request's own decoding of ``path`` (:meth:`exemplar_pixels`, made by
+        the checks) where the file has not changed since: a photo is decoded once per request."""
+        img = self._kept(path)
+        if img is not None:
+            return img
+        from ... import export
+
+        return export.read_rgb(path)
+
+    def _kept(self, path: str):
+        """This request's decoding of the file at ``path`` (:meth:`exemplar_pixels`), or None where it has none or
+        the file changed since (its modification time or size)."""
+        kept = self.__dict__.get("_decoded")
+        return kept[1] if kept is not None and kept[0] == _file_stamp(path) else None
 
     def exemplar_pixels(self, where: str = ""):
         """An image method's exemplar (synthesis, spectral, procedural) as pixels: pixels as given, a path decoded
@@ -264,10 +280,10 @@ class SolidRequest:
                                                    "procedural")
         if not isinstance(self.exemplar, str):
             return self.exemplar
+        kept = self._kept(self.exemplar)
+        if kept is not None:
+            return kept
         stamp = _file_stamp(self.exemplar)
-        kept = self.__dict__.get("_decoded")
-        if stamp is not None and kept is not None and kept[0] == stamp:
-            return kept[1]
         img = _read_file(self.exemplar, f"{where}exemplar")
         img.setflags(write=False)
         if stamp is not None:
