@@ -107,19 +107,11 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
     return w
 
 
-#: the flag of each wave setting :data:`~backend.wavenoise.settings.READ_WITH` names
-FLAGS = {"exponent": "--exponent", "profile": "--profile", "cell_size": "--cell-size",
-         "stit_probability": "--stit-probability", "stit_depth": "--stit-depth", "axis_spectra": "--axis-spectrum",
-         "lobes": "--lobe", "spread": "--spread", "example_plane": "--example-plane",
-         "example_extent": "--example-extent", "sectors": "--sectors", "transition_length": "--transition-length",
-         "spectrum": "--spectrum", "waveform": "--waveform", "cellular": "--cellular", "anisotropy": "--anisotropy",
-         "example": "--example", "transition_to": "--transition", "dim": "--dim"}
-#: each flag's attribute and its default: a flag is given where its value is not the default
-GIVEN = {"exponent": ("exponent", 1.0), "profile": ("profile", None), "cell_size": ("cell_size", None),
-         "stit_probability": ("stit_probability", 0.5), "stit_depth": ("stit_depth", 3),
-         "axis_spectra": ("axis_spectrum", []), "lobes": ("lobe", []), "spread": ("spread", 20.0),
-         "example_plane": ("example_plane", "xy"), "example_extent": ("example_extent", None),
-         "sectors": ("sectors", 8), "transition_length": ("transition_length", None)}
+#: the defaults of the flags of the settings :data:`~backend.wavenoise.settings.READ_WITH` names: a flag is given
+#: where its value is not its default
+READ_WITH_DEFAULTS = {"exponent": 1.0, "profile": None, "cell_size": None, "stit_probability": 0.5, "stit_depth": 3,
+                      "axis_spectra": [], "lobes": [], "spread": 20.0, "example_plane": "xy", "example_extent": None,
+                      "sectors": 8, "transition_length": None}
 
 
 def settings_from_args(a: argparse.Namespace) -> WaveSettings:
@@ -174,8 +166,8 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
         s = s.validate()
     except SettingError as exc:     # named as the flag the user typed, where the setting has one
         raise SettingError(_flag(a, exc.setting), exc.message) from None
-    check_read(s, [k for k, (attr, unset) in GIVEN.items() if getattr(a, attr) != unset],
-               lambda k, v=None: FLAGS[k] if v is None else f"{FLAGS[k]} {v}")
+    check_read(s, [k for k, unset in READ_WITH_DEFAULTS.items() if getattr(a, _FLAGS.get(k, k)) != unset],
+               lambda k, v=None: _flag(a, k) if v is None else f"{_flag(a, k)} {v}")
     return s
 
 
