@@ -111,9 +111,9 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
         settings["spectrum"] = _spectrum(settings["spectrum"])
     tuples = {f.name for f in dataclasses.fields(WaveSettings) if isinstance(f.default, tuple)}
     for name in tuples & set(settings):     # a list or an array where the settings hold a tuple
-        if isinstance(settings[name], (list, np.ndarray)):
-            settings[name] = tuple(np.asarray(settings[name]).tolist() if isinstance(settings[name], np.ndarray)
-                                   else settings[name])
+        v = settings[name]
+        v = v.tolist() if isinstance(v, np.ndarray) else v
+        settings[name] = tuple(v) if isinstance(v, list) else v
     s = WaveSettings(**settings)
     rank = 2 if s.dim == 2 else 3          # 3D and 4D noise fill a volume (4D: at w = time)
     if out is not None:
