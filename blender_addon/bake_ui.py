@@ -297,8 +297,11 @@ class OMNINOISE_OT_run_job(TaskOperator, bpy.types.Operator):
     def _start(self, context, blocking):
         p = context.scene.omninoise_bake
         path = bpy.path.abspath(self.filepath or p.job_file)
-        if not path or not os.path.isfile(path):
-            self.report({"ERROR"}, f"job file not found: {path or '(none)'}")
+        if not path:
+            self.report({"ERROR"}, "job file: pick a TOML job file to run")
+            return None
+        if not os.path.isfile(path):
+            self.report({"ERROR"}, f"job file: no file at {path}")
             return None
         keep_going, force = self.keep_going or p.keep_going, self.force or p.force
 

@@ -32,8 +32,11 @@ class Sidebar:
 
 def image_pixels(ima, setting: str) -> np.ndarray:
     """An image datablock's pixels as stored, float32 (H, W, C), top row first (Blender keeps rows bottom-up);
-    an image without pixels (a missing file) or with a NaN or infinite one (a float render's) is a SettingError
-    naming ``setting``."""
+    an image without pixels (a missing file, the Render Result) or with a NaN or infinite one (a float render's) is
+    a SettingError naming ``setting``."""
+    if ima.type in ("RENDER_RESULT", "COMPOSITING"):      # Blender shows these; their pixels are not readable
+        raise backend.SettingError(setting, f"image {ima.name!r} is Blender's render view, whose pixels scripts "
+                                            "cannot read: save it (Image > Save As) and open the saved file")
     w, h = ima.size
     if w * h == 0:
         raise backend.SettingError(setting, f"image {ima.name!r} has no pixels (is its file missing?)")

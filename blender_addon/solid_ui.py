@@ -36,6 +36,7 @@ import json
 import os
 import threading
 
+import bmesh
 import bpy
 import numpy as np
 from bl_operators.presets import AddPresetBase
@@ -338,6 +339,35 @@ def _vertex_positions(me, obj, world: bool) -> np.ndarray:
     return co
 
 
+def _store_vertex_colors(obj, name: str, rgb: np.ndarray) -> None:
+    """Write linear ``rgb`` (V, 3) into the point color attribute ``name`` of mesh ``obj`` and make it the active
+    color. In Edit Mode through the edit mesh: Blender writes the edit mesh back over the mesh when Edit Mode ends."""
+    me = obj.data
+    editing = obj.mode == "EDIT"
+    bm = bmesh.from_edit_mesh(me) if editing else None
+    count = len(bm.verts) if editing else len(me.vertices)
+    if count != len(rgb):
+        raise backend.SettingError("object", f"{obj.name!r} has {count} vertices, the bake was of {len(rgb)}: the "
+                                             "mesh changed while it ran; bake again")
+    attr = me.color_attributes.get(name)
+    if attr is not None and (attr.domain != "POINT" or attr.data_type != "FLOAT_COLOR"):
+        me.color_attributes.remove(attr)
+        attr = None
+    attr = attr or me.color_attributes.new(name, "FLOAT_COLOR", "POINT")
+    me.color_attributes.active_color = attr
+    rgba = np.ones((count, 4), np.float32)
+    rgba[:, :3] = rgb
+    if editing:
+        bm = bmesh.from_edit_mesh(me)          # the attribute's new layer is a new edit mesh layout
+        layer = bm.verts.layers.float_color[name]
+        for v, c in zip(bm.verts, rgba.tolist()):
+            v[layer] = c
+        bmesh.update_edit_mesh(me)
+    else:
+        attr.data.foreach_set("color", rgba.ravel())
+        me.update()
+
+
 def _mesh_arrays(context, obj, world: bool, uv: bool):
     """Triangles of the evaluated mesh: (uv (T, 3, 2) or None, positions (T, 3, 3)) float64."""
     dg = context.evaluated_depsgraph_get()
@@ -569,6 +599,8 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
 
         elif p.target == "COLOR_ATTRIBUTE":
             me = obj.data
+            if obj.mode == "EDIT":      # the mesh holds the shape it had when Edit Mode began
+                obj.update_from_editmode()
             co = _vertex_positions(me, obj, world)
             linear = _mod("solid.bake").srgb_to_linear
 
@@ -578,16 +610,7 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
                 return linear(rgb)
 
             def done(rgb):
-                attr = me.color_attributes.get(name)
-                if attr is not None and (attr.domain != "POINT" or attr.data_type != "FLOAT_COLOR"):
-                    me.color_attributes.remove(attr)
-                    attr = None
-                attr = attr or me.color_attributes.new(name, "FLOAT_COLOR", "POINT")
-                rgba = np.ones((len(me.vertices), 4), np.float32)
-                rgba[:, :3] = rgb
-                attr.data.foreach_set("color", rgba.ravel())
-                me.color_attributes.active_color = attr
-                me.update()
+                _store_vertex_colors(obj, name, rgb)
 
                 def node(nt):
                     n = next((x for x in nt.nodes if x.type == "VERTEX_COLOR" and x.layer_name == name), None)
@@ -764,6 +787,9 @@ class OMNINOISE_OT_solid_load_procedural(bpy.types.Operator, ImportHelper):
         obj = context.active_object
         if obj is None or obj.type != "MESH":
             self.report({"ERROR"}, "select a mesh to give the procedural material to")
+            return {"CANCELLED"}
+        if not self.filepath:
+            self.report({"ERROR"}, "file: pick a saved procedural solid (.json) to load")
             return {"CANCELLED"}
         path = bpy.path.abspath(self.filepath)
         try:

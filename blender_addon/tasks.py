@@ -104,6 +104,8 @@ class Task:
         if self.status == "done" and self.on_done is not None:
             try:
                 self.on_done(self.result)
+            except backend.SettingError as exc:      # the data changed while the work ran (a mesh edited)
+                self.status, self.message, self.error = "failed", str(exc), exc
             except Exception as exc:  # turning files into Blender data failed
                 traceback.print_exc()
                 self.status, self.message = "failed", f"{type(exc).__name__}: {exc}"

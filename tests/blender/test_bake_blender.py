@@ -221,6 +221,10 @@ def test_bad_settings_report_one_line(scene, tmp_path):
         bpy.ops.omninoise.set_transfer()
     with pytest.raises(RuntimeError, match="transfer function preset: .*needs stops"):
         bpy.ops.omninoise.set_transfer(transfer='{"range": [1, 0]}')
+    with pytest.raises(RuntimeError, match="job file: pick a TOML job file to run"):
+        bpy.ops.omninoise.run_job()
+    with pytest.raises(RuntimeError, match="job file: no file at .*missing.toml"):
+        bpy.ops.omninoise.run_job(filepath=str(tmp_path / "missing.toml"))
 
 
 @needs_openvdb

@@ -196,6 +196,8 @@ def test_what_a_node_group_bake_cannot_read_is_named(tmp_path):
         bad.write_text('{"format": "omninoise procedural solid 1", "family": "rings"}')
         with pytest.raises(RuntimeError, match="params: missing"):
             bpy.ops.omninoise.solid_load_procedural(filepath=str(bad))
+        with pytest.raises(RuntimeError, match=r"file: pick a saved procedural solid \(.json\) to load"):
+            bpy.ops.omninoise.solid_load_procedural()
         bpy.ops.object.camera_add()
         with pytest.raises(RuntimeError, match="select a mesh"):
             bpy.ops.omninoise.solid_load_procedural(filepath=str(bad))

@@ -7,7 +7,7 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from omninoise import blender_addon  # noqa: E402
+from omninoise import backend, blender_addon  # noqa: E402
 from conftest import Recorder, needs_openvdb  # noqa: E402
 from omninoise.blender_addon import common, solid_ui, tasks  # noqa: E402
 from omninoise.backend.solid.bake import srgb_to_linear  # noqa: E402
@@ -132,6 +132,50 @@ def test_color_attribute_bake(scene):
     node = next(n for n in obj.active_material.node_tree.nodes if n.type == "VERTEX_COLOR")
     assert node.layer_name == "Solid Texture"
 
+
+
+def test_color_attribute_bake_in_edit_mode_is_of_the_edited_mesh_and_survives_leaving_it(scene):
+    """In Edit Mode the mesh data holds the shape Edit Mode began with and Blender writes the edit mesh back over
+    it on leaving: the bake reads the edited vertices and its colors are still there in Object Mode."""
+    import bmesh
+
+    bpy.ops.mesh.primitive_cube_add()
+    obj = bpy.context.active_object
+    scene.omninoise_solid.target = "COLOR_ATTRIBUTE"
+    bpy.ops.object.mode_set(mode="EDIT")
+    bm = bmesh.from_edit_mesh(obj.data)
+    bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=2, use_grid_fill=True)
+    for v in bm.verts:
+        v.co *= 1.5
+    bmesh.update_edit_mesh(obj.data)
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    bpy.ops.object.mode_set(mode="OBJECT")
+    me = obj.data
+    assert len(me.vertices) == 56
+    got = np.empty(len(me.vertices) * 4, np.float32)
+    me.color_attributes["Solid Texture"].data.foreach_get("color", got)
+    co = np.empty(len(me.vertices) * 3, np.float32)
+    me.vertices.foreach_get("co", co)
+    assert np.abs(co).max() == pytest.approx(1.5)
+    m = _model()
+    ref = srgb_to_linear(m.evaluate(co.reshape(-1, 3).astype(np.float64) * 2.0, m.default_code(), seed=3))
+    np.testing.assert_allclose(got.reshape(-1, 4)[:, :3], ref, atol=1e-5)
+    assert me.color_attributes.active_color.name == "Solid Texture"
+
+
+def test_a_mesh_changed_while_its_color_bake_ran_is_named_not_an_internal_error(scene):
+    bpy.ops.mesh.primitive_cube_add()
+    obj = bpy.context.active_object
+    with pytest.raises(backend.SettingError, match="'Cube' has 8 vertices, the bake was of 9: the mesh changed"):
+        solid_ui._store_vertex_colors(obj, "Solid Texture", np.zeros((9, 3), np.float32))
+    assert "Solid Texture" not in obj.data.color_attributes
+
+    def done(rgb):
+        solid_ui._store_vertex_colors(obj, "Solid Texture", rgb)
+
+    task = tasks.start(tasks.Task("t", lambda progress, cancel: np.zeros((9, 3), np.float32), done), blocking=True)
+    assert task.status == "failed" and task.message.startswith("object: 'Cube' has 8 vertices")
+    assert isinstance(task.error, backend.SettingError)     # the operator names it as the panel does
 
 @needs_openvdb
 def test_volume_bake(scene, tmp_path):
@@ -417,6 +461,14 @@ def test_an_image_a_method_cannot_use_is_named_as_the_panel_names_it(scene):
     bad.pixels.foreach_set(np.full(32 * 32 * 4, np.nan, np.float32))
     p.image = bad
     with pytest.raises(RuntimeError, match="image: image 'Bad' holds NaN or infinite values"):
+        bpy.ops.omninoise.solid_preview()
+    scene.render.engine, scene.render.resolution_x, scene.render.resolution_y = "BLENDER_WORKBENCH", 16, 16
+    bpy.ops.object.camera_add()
+    scene.camera = bpy.context.active_object
+    bpy.ops.render.render()                 # the Render Result: an image an artist can pick, whose pixels are hidden
+    p.image = bpy.data.images["Render Result"]
+    with pytest.raises(RuntimeError, match=r"image: image 'Render Result' is Blender's render view, whose pixels "
+                                           r"scripts cannot read: save it \(Image > Save As\)"):
         bpy.ops.omninoise.solid_preview()
 
 
