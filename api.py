@@ -149,6 +149,7 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     >>> img.shape, bool(0.0 <= img.min() and img.max() <= 1.0)
     ((32, 32), True)
     """
+    from .backend.neural.generate import check_memory as neural_memory
     from .backend.neural.model import ModelError, NeuralNoiseModel
     from .backend.neural.request import NeuralRequest, generate_request
     from .backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
@@ -158,7 +159,7 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     size = _check_size(size, 8)
     if out is not None:
         _check_out(out, (".png", ".exr", ".npy"), "a neural noise image")
-    limits.check_memory("size", float(size) ** 2 * 4 * 160, f"a {size}² neural image (activations)")
+    neural_memory("size", size, size)
     try:
         net = NeuralNoiseModel(model or neural_model())
     except ModelError as exc:

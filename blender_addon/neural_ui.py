@@ -228,12 +228,9 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
         if p.tileable and size % 8:
             size += 8 - size % 8
         steps = min(p.steps, 10) if self.preview else p.steps
+        _mod("neural.generate").check_memory("size", size, size)
         m = model()
         req = panel_request(p, size, steps)
-        gib = (m.embedding.shape[1] + len(m.params)) * size * size * 4 * 12 / 2**30  # U-Net activations: ~12x cond
-        if gib > 16:
-            self.report({"ERROR"}, f"{size}² needs about {gib:.0f} GiB; bake a smaller size")
-            return None
         depth = p.depth
         name = p.name + (" Preview" if self.preview else "")
         save_path = None
@@ -324,6 +321,7 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
 
         p = context.scene.omninoise_neural
         size = p.size + (-p.size) % 8 if p.tileable else p.size
+        _mod("neural.generate").check_memory("size", size, size)
         try:
             m = model()
             keys = sequence_keys(p)

@@ -339,6 +339,11 @@ def _vertex_positions(me, obj, world: bool) -> np.ndarray:
     return co
 
 
+#: bytes a UV image bake holds per texel at its peak: each texel's surface point (float64), its color, the image's
+#: pixels (123 measured on a plane filling a 2048² image)
+UV_BAKE_BYTES = 128
+
+
 def _store_vertex_colors(obj, name: str, rgb: np.ndarray) -> None:
     """Write linear ``rgb`` (V, 3) into the point color attribute ``name`` of mesh ``obj`` and make it the active
     color. In Edit Mode through the edit mesh: Blender writes the edit mesh back over the mesh when Edit Mode ends."""
@@ -574,8 +579,9 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
         seed, name = int(p.seed), p.name
         surface = _mod("solid.surface")
         if p.target == "UV_IMAGE":
-            uv, pos = _mesh_arrays(context, obj, world, uv=True)
             size, margin = int(p.size), int(p.margin)
+            _mod("limits").check_memory("image size", size * size * UV_BAKE_BYTES, f"a {size}² UV image bake")
+            uv, pos = _mesh_arrays(context, obj, world, uv=True)
 
             def work(progress, cancel):
                 code = code_fn(None, cancel)

@@ -9,6 +9,7 @@ import sys
 from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.neural.animate import LATENT_MODES
+from omninoise.backend.neural.generate import check_memory as neural_memory
 from omninoise.backend.neural.precision import PRECISIONS
 from omninoise.backend.paths import neural_model
 
@@ -170,10 +171,10 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError(f"--{exc.setting}", exc.message) from None
     if not 0 <= a.seed < 2 ** 32:
         raise SettingError("--seed", f"must lie in [0, 2^32), got {a.seed}")
-    limits.check_memory("--size", float(a.size) ** 2 * 4 * 160, f"a {a.size}² neural image (activations)")
     tile = a.tile
     if tile is not None and tile < 0:
         raise SettingError("--tile", f"must be >= 0 (0: never tile), got {tile}")
+    neural_memory("--size", a.size, a.size, tile)
     folder = a.model or neural_model()
     try:
         model = NeuralNoiseModel(folder)

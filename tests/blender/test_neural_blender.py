@@ -127,6 +127,10 @@ def test_clear_messages(scene):
     p.blend_map = sq
     with pytest.raises(RuntimeError, match="matches no swatch colour"):
         bpy.ops.omninoise.neural_bake()
+    p.mode, p.size = "SINGLE", 16384
+    for op in (bpy.ops.omninoise.neural_bake, bpy.ops.omninoise.neural_bake_sequence):
+        with pytest.raises(RuntimeError, match=r"size: a 16384 x 16384 neural image needs 64\.8 GiB, above the "):
+            op()
 
 
 def test_settings_survive_save_and_reload(scene, tmp_path):

@@ -134,6 +134,13 @@ def test_color_attribute_bake(scene):
 
 
 
+def test_a_uv_image_too_large_for_memory_is_refused_before_any_work(scene):
+    bpy.ops.mesh.primitive_plane_add()
+    scene.omninoise_solid.size = 200000
+    with pytest.raises(RuntimeError, match=r"image size: a 200000² UV image bake needs 4768\.4 GiB, above the limit"):
+        bpy.ops.omninoise.solid_bake()
+    assert "Solid Texture" not in bpy.data.images
+
 def test_color_attribute_bake_in_edit_mode_is_of_the_edited_mesh_and_survives_leaving_it(scene):
     """In Edit Mode the mesh data holds the shape Edit Mode began with and Blender writes the edit mesh back over
     it on leaving: the bake reads the edited vertices and its colors are still there in Object Mode."""

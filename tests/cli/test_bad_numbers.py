@@ -59,6 +59,30 @@ def test_memory_error_says_how_much(monkeypatch):
         limits.memory_limit()
 
 
+def test_a_neural_image_is_refused_by_what_it_takes_drawn_whole_or_in_tiles(monkeypatch, capsys, tmp_path):
+    """Up to 1024 px an image is drawn whole (the U-Net's activations over every pixel), larger ones in 512 px
+    tiles: what a size takes grows by the piece drawn at once plus a little per pixel."""
+    from omninoise.backend.neural import generate as G
+
+    assert G.peak_bytes(1024, 1024) == 1024 ** 2 * (G.PIECE_BYTES + G.IMAGE_BYTES)
+    assert G.peak_bytes(4096, 4096) == 512 ** 2 * G.PIECE_BYTES + 4096 ** 2 * G.IMAGE_BYTES
+    assert G.peak_bytes(2048, 2048, tile=0) == 2048 ** 2 * (G.PIECE_BYTES + G.IMAGE_BYTES)
+    G.check_memory("size", 4096, 4096)                      # about 5 GiB: drawn in tiles under the default limit
+    with pytest.raises(SettingError, match=r"size: a 9000 x 9000 neural image needs 20\.1 GiB, above the limit"):
+        G.check_memory("size", 9000, 9000)
+    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "2G")
+    with pytest.raises(SettingError, match=r"a 1024 x 1024 neural image needs 3\.6 GiB"):
+        G.check_memory("size", 1024, 1024)                  # drawn whole
+    G.check_memory("size", 1024, 1024, tile=512)            # in tiles it fits
+    out = tmp_path / "n.png"
+    assert main(["neural", "--noise", "perlin", "--size", "1024", "-o", str(out)]) == 2
+    assert main(["neural", "--noise", "perlin", "--size", "1024", "--tile", "0", "-o", str(out)]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert len(err) == 2 and all(ln.startswith("omninoise neural: error: --size: a 1024 x 1024 neural image needs")
+                                 for ln in err), err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("edit, match", [
     (("time_step = 0.5", "time_step = nan"), "time_step: must be a finite number"),   # was a segfault
     (("time_step = 0.5", 'time_step = "x"'), "time_step: expected a number"),
