@@ -265,10 +265,23 @@ class SolidRequest:
         return export.read_rgb(path)
 
     def _kept(self, path: str):
-        """This request's decoding of the file at ``path`` (:meth:`exemplar_pixels`), or None where it has none or
-        the file changed since (its modification time or size)."""
-        kept = self.__dict__.get("_decoded")
+        """This request's decoding of the file at ``path`` (:meth:`_decode`), or None where it has none or the file
+        changed since (its modification time or size)."""
+        kept = self.__dict__.get("_decoded", {}).get(path)
         return kept[1] if kept is not None and kept[0] == _file_stamp(path) else None
+
+    def _decode(self, path: str, setting: str) -> np.ndarray:
+        """The file at ``path`` decoded (read-only float (H, W, 3) sRGB) once per request and again only where it
+        changed on disk; SettingError naming ``setting`` for a file it cannot read."""
+        kept = self._kept(path)
+        if kept is not None:
+            return kept
+        stamp = _file_stamp(path)
+        img = _read_file(path, setting)
+        img.setflags(write=False)
+        if stamp is not None:       # frozen: the memo is no field (not in key or eq)
+            object.__setattr__(self, "_decoded", {**self.__dict__.get("_decoded", {}), path: (stamp, img)})
+        return img
 
     def exemplar_pixels(self, where: str = ""):
         """An image method's exemplar (synthesis, spectral, procedural) as pixels: pixels as given, a path decoded
@@ -280,15 +293,7 @@ class SolidRequest:
                                                    "procedural")
         if not isinstance(self.exemplar, str):
             return self.exemplar
-        kept = self._kept(self.exemplar)
-        if kept is not None:
-            return kept
-        stamp = _file_stamp(self.exemplar)
-        img = _read_file(self.exemplar, f"{where}exemplar")
-        img.setflags(write=False)
-        if stamp is not None:
-            object.__setattr__(self, "_decoded", (stamp, img))     # frozen: the memo is no field (not in key or eq)
-        return img
+        return self._decode(self.exemplar, f"{where}exemplar")
 
     def check_reads(self, given, where: str = "", names: dict | None = None) -> "SolidRequest":
         """SettingError naming the first of ``given`` (the settings a front end was given, by their names here) that
@@ -312,7 +317,7 @@ class SolidRequest:
             return self
         if self.method not in IMAGE_METHODS + ("auto",):
             if isinstance(self.to, str) and os.path.isfile(self.to):
-                _read_file(self.to, f"{where}to")
+                self._decode(self.to, f"{where}to")
             if isinstance(self.exemplar, str) and os.path.isfile(self.exemplar):
                 self.exemplar_pixels(where)
             return self
@@ -337,10 +342,10 @@ class SolidRequest:
     def replace(self, **changes) -> "SolidRequest":
         """``dataclasses.replace``, keeping this request's decoding of its file exemplar where the exemplar stays."""
         new = dataclasses.replace(self, **changes)
-        if "exemplar" not in changes:
-            for memo in ("_decoded", "_saved"):
-                if memo in self.__dict__:
-                    object.__setattr__(new, memo, self.__dict__[memo])
+        if "_decoded" in self.__dict__:         # the files' decodings hold while the files stay
+            object.__setattr__(new, "_decoded", dict(self.__dict__["_decoded"]))
+        if "exemplar" not in changes and "_saved" in self.__dict__:
+            object.__setattr__(new, "_saved", self.__dict__["_saved"])
         return new
 
     def exemplar_digest(self) -> str | None:

@@ -303,8 +303,8 @@ def test_a_photo_the_encoder_cannot_read_is_named_before_its_note(models, tmp_pa
 
 
 def test_the_neural_method_decodes_a_photo_once(models, tmp_path, capsys, monkeypatch):
-    """The command line's check of the photo and the encoding share one decoding of the file (a 12 MP photo takes
-    0.7 s to decode)."""
+    """The command line's check of the photos (``--exemplar``, ``--to``) and the encoding share one decoding of each
+    file (a 12 MP photo takes 0.7 s to decode)."""
     from PIL import Image
 
     from omninoise import export
@@ -317,3 +317,10 @@ def test_the_neural_method_decodes_a_photo_once(models, tmp_path, capsys, monkey
                   "-o", str(tmp_path / "o.png"))
     assert rc == 0, err
     assert reads == [photo]
+    other = str(tmp_path / "q.png")                     # with --to, each file once
+    Image.fromarray((np.random.default_rng(4).random((48, 48, 3)) * 255).astype(np.uint8)).save(other)
+    reads.clear()
+    rc, err = run(capsys, "--model", models["space3"], "--exemplar", photo, "--to", other, "--mix", "0.5",
+                  "--size", "8", "-o", str(tmp_path / "o.png"))
+    assert rc == 0, err
+    assert sorted(reads) == [photo, other]
