@@ -339,6 +339,14 @@ def _vertex_positions(me, obj, world: bool) -> np.ndarray:
     return co
 
 
+def active_mesh(context, purpose: str):
+    """The active object where it is a mesh; a SettingError naming the object, that asks to select a mesh to
+    ``purpose``, where it is not."""
+    obj = context.active_object
+    if obj is None or obj.type != "MESH":
+        raise backend.SettingError("object", f"select a mesh to {purpose}")
+    return obj
+
 #: bytes a UV image bake holds per texel at its peak: each texel's surface point (float64), its color, the image's
 #: pixels (123 measured on a plane filling a 2048² image)
 UV_BAKE_BYTES = 128
@@ -541,14 +549,15 @@ class OMNINOISE_OT_solid_tile_material(bpy.types.Operator):
 
     def execute(self, context):
         p = context.scene.omninoise_solid
-        obj = context.active_object
         name = f"{p.name} Tile"
         ima = bpy.data.images.get(name)
-        if obj is None or obj.type != "MESH":
-            self.report({"ERROR"}, "select a mesh to project the tile onto")
-            return {"CANCELLED"}
-        if ima is None:
-            self.report({"ERROR"}, f"no tileable image {name!r} yet: make one with Make Tileable Image first")
+        try:
+            obj = active_mesh(context, "project the tile onto")
+            if ima is None:
+                raise backend.SettingError("tile", f"no tileable image {name!r} yet: make one with Make Tileable "
+                                                   "Image first")
+        except backend.SettingError as exc:
+            self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         repeats = tile_repeats(p.scale, ima.size[0])
         _material_with(obj, name, lambda nt: _project_tile(nt, ima, repeats, p.coords == "WORLD"))
@@ -678,9 +687,7 @@ class OMNINOISE_OT_solid_procedural_node(SolidTask, bpy.types.Operator):
         import dataclasses
 
         p = context.scene.omninoise_solid
-        obj = context.active_object
-        if obj is None or obj.type != "MESH":
-            raise backend.SettingError("object", "select a mesh to give the procedural material to")
+        obj = active_mesh(context, "give the procedural material to")
         req = dataclasses.replace(panel_request(p), method="procedural")
         if req.exemplar is None or isinstance(req.exemplar, str):
             raise backend.SettingError("image", "a procedural solid is fitted to a photo: set Source to Image")
@@ -790,15 +797,11 @@ class OMNINOISE_OT_solid_load_procedural(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         p = context.scene.omninoise_solid
-        obj = context.active_object
-        if obj is None or obj.type != "MESH":
-            self.report({"ERROR"}, "select a mesh to give the procedural material to")
-            return {"CANCELLED"}
-        if not self.filepath:
-            self.report({"ERROR"}, "file: pick a saved procedural solid (.json) to load")
-            return {"CANCELLED"}
         path = bpy.path.abspath(self.filepath)
         try:
+            obj = active_mesh(context, "give the procedural material to")
+            if not self.filepath:
+                raise backend.SettingError("file", "pick a saved procedural solid (.json) to load")
             field = _mod("solid.procedural.saved").read(path, "file")
         except backend.SettingError as exc:
             self.report({"ERROR"}, str(exc))

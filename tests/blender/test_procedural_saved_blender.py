@@ -199,7 +199,7 @@ def test_what_a_node_group_bake_cannot_read_is_named(tmp_path):
         with pytest.raises(RuntimeError, match=r"file: pick a saved procedural solid \(.json\) to load"):
             bpy.ops.omninoise.solid_load_procedural()
         bpy.ops.object.camera_add()
-        with pytest.raises(RuntimeError, match="select a mesh"):
+        with pytest.raises(RuntimeError, match="object: select a mesh to give the procedural material to"):
             bpy.ops.omninoise.solid_load_procedural(filepath=str(bad))
     finally:
         blender_addon.unregister()

@@ -362,13 +362,14 @@ def test_the_tile_is_box_projected_onto_a_mesh_without_uvs_at_the_photos_scale(s
     the photo's pixel scale times Scale (4 repeats of a 64 px tile per Blender unit at Scale 2: 32 stripe periods
     across a 2 unit face); the nodes are reused when it runs again; errors say what is missing."""
     p = scene.omninoise_solid
-    with pytest.raises(RuntimeError, match="select a mesh"):
+    with pytest.raises(RuntimeError, match="object: select a mesh to project the tile onto"):
         bpy.ops.omninoise.solid_tile_material()
     bpy.ops.mesh.primitive_cube_add(size=2.0)
     cube = bpy.context.active_object
     while cube.data.uv_layers:
         cube.data.uv_layers.remove(cube.data.uv_layers[0])
-    with pytest.raises(RuntimeError, match="make one with Make Tileable Image first"):
+    with pytest.raises(RuntimeError, match="tile: no tileable image 'Solid Texture Tile' yet: make one with Make "
+                                           "Tileable Image first"):
         bpy.ops.omninoise.solid_tile_material()
     p.source, p.image, p.tile, p.seed, p.scale = "IMAGE", _stripes_image(), 64, 5, 2.0
     assert bpy.ops.omninoise.solid_tileable() == {"FINISHED"}
