@@ -190,7 +190,8 @@ def load_image(name: str, paths: list, frames, raw: bool, target_material=None):
 
 
 def output_folder(path: str) -> str:
-    """An absolute, existing output folder for a panel path ('//' = beside the .blend)."""
+    """An absolute, existing output folder for a panel path ('//' = beside the .blend); a SettingError naming
+    the folder where it is a file or cannot be made."""
     from .preferences import cache_dir
 
     if path.startswith("//") and not bpy.data.filepath:
@@ -198,5 +199,10 @@ def output_folder(path: str) -> str:
         path = os.path.join(base, path[2:])
     folder = bpy.path.abspath(path) if path else cache_dir()
     folder = os.path.abspath(folder)
-    os.makedirs(folder, exist_ok=True)
+    if os.path.exists(folder) and not os.path.isdir(folder):
+        raise backend.SettingError("folder", f"{folder} is a file, not a folder")
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as exc:
+        raise backend.SettingError("folder", f"cannot make {folder}: {exc.strerror or exc}") from None
     return folder

@@ -29,7 +29,7 @@ from .common import Sidebar
 from .presets import SUBDIRS, transfer_preset_text
 from .preferences import precision, threads
 from .wave_nodes import settings_from_json, tree_settings_json
-from .wave_ui import OMNINOISE_PG_wave, draw_wave_presets, draw_wave_settings
+from .wave_ui import OMNINOISE_PG_wave, draw_wave_presets, draw_wave_settings, setting_label
 
 __all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "apply_transfer", "draw_progress", "classes", "attach", "detach"]
 
@@ -197,9 +197,22 @@ def _message(text: str) -> None:
     print(f"OmniNoise: {text}")
 
 
+#: the bake's own settings behind the backend's names (the wave settings' labels are read off their panel)
+BAKE_LABELS = {"range": "From and To", "range[0]": "From", "range[1]": "To", "density_scale": "Density",
+               "time": "Time", "time_step": "Time per Frame", "frames": "Start and End",
+               "temperature[0][0]": "Temperature Start", "temperature[1][1]": "Temperature Max"}
+
+
 class _BakeOperator(TaskOperator):
     bl_options = {"REGISTER", "UNDO"}
     target = "VOLUME"
+
+    def _said(self, exc: Exception) -> str:
+        """A setting error named as the panel names the setting (Min Frequency, Time per Frame, From and To)."""
+        if not isinstance(exc, backend.SettingError):
+            return str(exc)
+        label = BAKE_LABELS.get(exc.setting) or setting_label(bpy.context.scene.omninoise_bake.wave, exc.setting)
+        return f"{label}: {exc.message}"
 
     def _start(self, context, blocking: bool):
         spec = build_spec(context, self.target)

@@ -221,6 +221,20 @@ def test_bad_settings_report_one_line(scene, tmp_path):
         bpy.ops.omninoise.set_transfer()
     with pytest.raises(RuntimeError, match="transfer function preset: .*needs stops"):
         bpy.ops.omninoise.set_transfer(transfer='{"range": [1, 0]}')
+    p.wave.fmin = 9.0                       # the panel's names, not the settings' (spectrum.fmin, range)
+    with pytest.raises(RuntimeError, match=r"Min Frequency: 9 is greater than fmax \d"):
+        bpy.ops.omninoise.bake_image()
+    p.wave.fmin, p.range_min, p.range_max = 2.0, 0.5, 0.5
+    with pytest.raises(RuntimeError, match=r"From and To: needs two different values, got \(0.5, 0.5\)"):
+        bpy.ops.omninoise.bake_image()
+    p.range_max, p.animated, p.time_per_frame = 1.0, True, float("nan")
+    with pytest.raises(RuntimeError, match="Time per Frame: must be a finite number, got nan"):
+        bpy.ops.omninoise.bake_image()
+    p.animated = False
+    (tmp_path / "a_file").write_text("")
+    p.folder = str(tmp_path / "a_file")
+    with pytest.raises(RuntimeError, match="folder: .*a_file is a file, not a folder"):
+        bpy.ops.omninoise.bake_image()
     with pytest.raises(RuntimeError, match="job file: pick a TOML job file to run"):
         bpy.ops.omninoise.run_job()
     with pytest.raises(RuntimeError, match="job file: no file at .*missing.toml"):

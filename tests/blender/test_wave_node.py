@@ -286,6 +286,27 @@ def test_in_the_interface_a_setting_rebuilds_its_group_once_it_rests(monkeypatch
         blender_addon.unregister()
 
 
+def test_a_settings_error_in_the_panel_names_the_setting_as_the_panel_does():
+    """The Wave Noise panel shows why a group could not be built under the setting's label, not the settings'
+    dotted name (spectrum.fmin); it clears once the settings are good again."""
+    from omninoise import blender_addon
+    from omninoise.blender_addon import wave_ui
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    blender_addon.register()
+    try:
+        props = wave_ui.new_wave_node_tree("Wave", "ShaderNodeTree").omninoise_wave
+        props.fmin = 9.0
+        assert props.error == f"Min Frequency: 9 is greater than fmax {props.fmax:g}"
+        props.fmin = 1.0
+        assert not props.error
+        props.dimensions, props.anisotropy, props.axis = "3", "lobes", (0.0, 0.0, 0.0)
+        assert props.error == "Axis: lobe axis (0.0, 0.0, 0.0) must be a non-zero 3-vector"
+        assert wave_ui.setting_label(props, "axis_spectra[1].fmax") == "Axis Frequency"
+        assert wave_ui.setting_label(props, "table size") == "table size"       # no such property: as it is
+    finally:
+        blender_addon.unregister()
+
 def _tree_dump(tree) -> list:
     """Every node of a tree and its sub-groups, in order: kind, operation, inputs' values and links, image."""
     out = []
