@@ -78,6 +78,13 @@ class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
                          description="Which value of the noise is baked")
     cellular: EnumProperty(name="Cellular", items=_CELLULAR, default="none",
                            description="Bake cells cut by the waves' planes instead of the noise itself")
+    cell_size: FloatProperty(name="Cell Size", default=0.0, min=0.0, soft_max=10.0,
+                             description="Distance between the planes of one family, in scene units (0: from the "
+                                         "frequency band, as the command line's default)")
+    stit_probability: FloatProperty(name="Split Probability", default=0.5, min=0.0, max=1.0,
+                                    description="STIT: how likely a cell is split again at each depth")
+    stit_depth: IntProperty(name="Split Depth", default=3, min=0, max=8,
+                            description="STIT: how many times cells may be split")
     # grid
     bounds_mode: EnumProperty(name="Bounds", description="The box in the scene that the bake fills", items=[
         ("OBJECT", "Active Object", "The active object's world bounding box"),
@@ -141,7 +148,12 @@ def _settings(p: OMNINOISE_PG_bake):
         s = settings_from_json(text)
     else:
         s = p.wave.to_settings(node=False)
-    return s.replace(output=p.output, cellular=p.cellular)
+    cells = {}
+    if p.cellular != "none" and p.cell_size > 0.0:        # else the node's own, or the band's
+        cells["cell_size"] = p.cell_size
+    if p.cellular == "stit":
+        cells.update(stit_probability=p.stit_probability, stit_depth=p.stit_depth)
+    return s.replace(output=p.output, cellular=p.cellular, **cells)
 
 
 def _bounds(p: OMNINOISE_PG_bake, context, rank: int) -> tuple:
@@ -198,7 +210,8 @@ def _message(text: str) -> None:
 
 
 #: the bake's own settings behind the backend's names (the wave settings' labels are read off their panel)
-BAKE_LABELS = {"range": "From and To", "range[0]": "From", "range[1]": "To", "density_scale": "Density",
+BAKE_LABELS = {"cell size": "Cell Size", "stit probability": "Split Probability", "stit depth": "Split Depth",
+               "range": "From and To", "range[0]": "From", "range[1]": "To", "density_scale": "Density",
                "time": "Time", "time_step": "Time per Frame", "frames": "Start and End",
                "temperature[0][0]": "Temperature Start", "temperature[1][1]": "Temperature Max"}
 
@@ -372,6 +385,11 @@ class OMNINOISE_PT_bake(_Panel, bpy.types.Panel):
             draw_wave_settings(layout, p.wave)
         layout.prop(p, "output")
         layout.prop(p, "cellular")
+        if p.cellular != "none":
+            layout.prop(p, "cell_size")
+        if p.cellular == "stit":
+            layout.prop(p, "stit_probability")
+            layout.prop(p, "stit_depth")
 
 
 class OMNINOISE_PT_bake_ramp(_Panel, bpy.types.Panel):

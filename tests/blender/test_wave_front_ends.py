@@ -44,3 +44,23 @@ def test_flags_job_tables_and_the_panel_give_equal_settings(flags, table, props)
     panel = p.to_settings()
     assert cli == job, (cli, job)
     assert panel == cli, (panel, cli)
+
+
+@pytest.mark.parametrize("flags, props", [
+    (["--cellular", "stit", "--cell-size", "0.375", "--stit-probability", "0.75", "--stit-depth", "2"],
+     dict(cellular="stit", cell_size=0.375, stit_probability=0.75, stit_depth=2)),
+    (["--cellular", "polytope"], dict(cellular="polytope")),        # Cell Size 0: from the band, as the flag's default
+    (["--cellular", "code", "--cell-size", "1.5"], dict(cellular="code", cell_size=1.5, stit_depth=5)),
+])
+def test_the_bake_panels_cells_are_the_command_lines(flags, props):
+    """The Bake Noise panel's Cellular, Cell Size and STIT split settings give the command line's settings (the
+    split settings only where STIT reads them)."""
+    from omninoise.blender_addon import bake_ui
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    p = bpy.context.scene.omninoise_bake
+    p.wave.dimensions, p.wave.fmin, p.wave.fmax = "2", 2.0, 6.0
+    for k, v in props.items():
+        setattr(p, k, v)
+    cli = settings_from_args(build_parser().parse_args(["wave", "--fmin", "2", "--fmax", "6", *flags, "-o", "x.npy"]))
+    assert bake_ui._settings(p) == cli
