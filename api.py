@@ -53,13 +53,15 @@ def _check_progress(progress) -> None:
         raise SettingError("progress", f"expected a function of the fraction done, or None, got {progress!r}")
 
 
-def _check_out(out: str, allowed: tuple, what: str) -> str:
+def _check_out(out: str, allowed: tuple, what: str, read: tuple = ()) -> str:
+    """The extension of ``out``, a file of ``allowed`` kinds that is not one of the files ``read`` (name, value)."""
     if not isinstance(out, (str, os.PathLike)):
         raise SettingError("out", f"expected a file path, got {out!r}")
     out = os.fspath(out)
-    from .backend.bake import check_one_file
+    from .backend.bake import check_not_read, check_one_file
 
     check_one_file(out, "out")
+    check_not_read(out, "out", read)
     ext = os.path.splitext(out)[1].lower()
     if ext not in allowed:
         raise SettingError("out", f"{what} is written as {', '.join(allowed)}, not {ext or out!r}")
@@ -117,7 +119,8 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     s = WaveSettings(**settings)
     rank = 2 if s.dim == 2 else 3          # 3D and 4D noise fill a volume (4D: at w = time)
     if out is not None:
-        ext = _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid")
+        ext = _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid",
+                         (("transfer", transfer),))
         if half and ext not in (".exr", ".vdb"):
             raise SettingError("half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
     elif transfer is not None or half:
@@ -212,7 +215,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     limits.check_memory("size", float(size) ** dim * 4 * 4, f"a {size}-sample {dim}D texture")
     allowed = (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy")
     ext = None if out is None else _check_out(out, allowed + ((".json",) if method == "procedural" else ()),
-                                              f"a {dim}D texture")
+                                              f"a {dim}D texture", (("exemplar", exemplar),))
     if ext == ".vdb":
         from .backend.bake import require_vdb
 

@@ -43,7 +43,7 @@ from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
-__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "check_one_file",
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "check_one_file", "check_not_read",
            "FORMATS", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
@@ -185,6 +185,18 @@ def check_one_file(path: str, setting: str, or_else: str = "") -> None:
     if has_frame_field(path):
         raise SettingError(setting, f"{os.path.basename(path)}: '#' stands for the frame number of a sequence, and "
                                     f"this writes one file: take it out of the name{or_else}")
+
+
+def check_not_read(path: str, setting: str, inputs) -> None:
+    """SettingError naming ``setting`` where writing the file ``path`` would replace a file the work reads:
+    ``inputs`` holds (name, path) pairs of what it reads (a photo, a mask, a ramp, the job file), and a photo
+    written over would be lost. Paths are compared as files (links and '..' resolved); anything that is no file is
+    passed over."""
+    if not os.path.isfile(path):
+        return
+    for name, src in inputs:
+        if isinstance(src, (str, os.PathLike)) and os.path.isfile(src) and os.path.samefile(path, src):
+            raise SettingError(setting, f"{os.path.basename(path)} is the file {name} reads: write to another file")
 
 
 def frame_path(pattern: str, frame) -> str:

@@ -124,7 +124,7 @@ import os
 from dataclasses import dataclass
 from typing import Callable
 
-from .bake import BakeResult, BakeSpec, Cancelled, frame_path, run_bake
+from .bake import BakeResult, BakeSpec, Cancelled, check_not_read, frame_path, run_bake
 from .documents import read_document
 from .errors import SettingError
 from .schema import did_you_mean, shown_value
@@ -189,8 +189,9 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
                     make_folders=True).validate()
 
 
-def parse_job(doc: dict, base_dir: str) -> list:
-    """Job document -> list of (name, BakeSpec or JobError)."""
+def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
+    """Job document -> list of (name, BakeSpec or JobError); ``job_path`` is the job file, which no bake may
+    write over."""
     from .settings_schema import BAKE, JOB
 
     try:
@@ -239,9 +240,28 @@ def parse_job(doc: dict, base_dir: str) -> list:
             out.append((name, JobError(f"bake {name!r}: output {os.path.basename(clash)} is also written by bake "
                                        f"{outputs[clash]!r}")))
             continue
+        try:        # a bake written over a file it reads (its photo, mask, ramp) or the job file would lose it
+            read = [(key, os.path.join(base_dir, v)) for key, v in _strings(d) if key != "output"]
+            for f in files:
+                check_not_read(f, "output", read + [("the job", job_path)])
+        except SettingError as exc:
+            out.append((name, JobError(f"bake {name!r}: {exc}")))
+            continue
         outputs.update(dict.fromkeys(files, name))
         out.append((name, spec))
     return out
+
+
+def _strings(value, key: str = ""):
+    """(dotted key, string) of every string a bake table holds, nested tables and lists included."""
+    if isinstance(value, str):
+        yield key, value
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield from _strings(v, f"{key}.{k}" if key else str(k))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            yield from _strings(v, f"{key}[{i}]")
 
 
 def load_job(path: str) -> list:
@@ -251,7 +271,7 @@ def load_job(path: str) -> list:
         doc = read_document(path, "job file", "toml")
     except SettingError as exc:
         raise JobError(exc.message) from None
-    return parse_job(doc, os.path.dirname(os.path.abspath(path)))
+    return parse_job(doc, os.path.dirname(os.path.abspath(path)), path)
 
 
 def select_bakes(entries: list, only: list | None) -> list:

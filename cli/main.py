@@ -118,22 +118,29 @@ def main(argv: list[str] | None = None) -> int:
 
 def _check_outputs(a: argparse.Namespace) -> None:
     """The files a command will write (-o, --report), checked before any work: a missing or read-only folder, a
-    name past the file system's limit (a frame pattern's '#' counted as the widest frame number) or a folder in the
-    file's place."""
-    from omninoise.backend.bake import check_one_file
+    name past the file system's limit (a frame pattern's '#' counted as the widest frame number), a folder in the
+    file's place, or a file the command reads (a photo written over would be lost)."""
+    from omninoise.backend.bake import check_not_read, check_one_file
     from omninoise.export.atomic import check_target
 
-    for flag, attr in (("-o", "out"), ("--report", "report")):
+    outputs = (("-o", "out"), ("--report", "report"))
+    read = [(f"--{k.replace('_', '-')}" if k != "job" else "the job", v) for k, v in vars(a).items()
+            if isinstance(v, str) and k not in ("command", "out", "report")]     # the files given, by their flags
+    for flag, attr in outputs:
         path = getattr(a, attr, None)
         if isinstance(path, str) and path:
             if not (flag == "-o" and getattr(a, "frames", None)):       # neural --frames writes a sequence
                 check_one_file(path, flag)
+            check_not_read(path, flag, read)
             try:
                 check_target(re.sub(r"#+", lambda m: "0" * max(len(m.group()), 10), path))
                 if os.path.isdir(path):
                     raise IsADirectoryError(f"output path is a folder, not a file: {path}")
             except OSError as exc:
                 raise SettingError(flag, str(exc)) from None
+    named = [os.path.realpath(getattr(a, k)) for _, k in outputs if isinstance(getattr(a, k, None), str)]
+    if len(named) == 2 and named[0] == named[1]:
+        raise SettingError("--report", f"{os.path.basename(a.report)} is also -o: write the report to another file")
 
 
 def _run(a: argparse.Namespace) -> int:

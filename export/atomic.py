@@ -88,6 +88,8 @@ def check_target(path: str, folder_made: bool = False) -> None:
     if not folder_made:
         if not os.path.isdir(folder):
             raise FileNotFoundError(f"output folder does not exist: {folder}")
+        if not os.path.isdir(os.path.dirname(path) or "."):      # 'sub/..' is a folder only where sub is one
+            raise FileNotFoundError(f"output folder does not exist: {os.path.dirname(path)}")
         if not os.access(folder, os.W_OK):
             raise PermissionError(f"output folder is not writable: {folder}")
 

@@ -378,3 +378,52 @@ def test_an_output_folder_that_is_missing_or_read_only_is_refused_before_any_wor
     finally:
         locked.chmod(0o700)
     assert sorted(os.listdir(tmp_path)) == ["locked", "photo.png"]
+
+
+def test_an_output_written_over_a_file_the_command_reads_is_refused_and_the_file_kept(tmp_path, capsys):
+    """`-o photo.png` beside `--exemplar photo.png` (or through a link to it), a job bake whose output is its own
+    photo, the API's ``out`` equal to its exemplar, and a report written over the image: exit 2 in one line naming
+    the flag, before any work; the photo is the same bytes after."""
+    import omninoise
+    from omninoise.backend.errors import SettingError
+
+    photo, ramp = tmp_path / "photo.png", tmp_path / "ramp.json"
+    write_unit_image(str(photo), np.random.default_rng(0).random((32, 32, 3)))
+    assert main(["transfer", "fire", "-o", str(ramp)]) == 0
+    os.symlink(photo, tmp_path / "link.png")
+    before = photo.read_bytes(), ramp.read_bytes()
+    for argv, said in (
+            (["solid", "--exemplar", str(photo), "-o", str(photo)], "-o: photo.png is the file --exemplar reads"),
+            (["solid", "--exemplar", str(tmp_path / "link.png"), "-o", str(photo)], "--exemplar reads"),
+            (["solid", "--exemplar", str(photo), "-o", str(tmp_path / "link.png")], "--exemplar reads"),
+            (["wave", "--example", str(photo), "-o", str(photo)], "-o: photo.png is the file --example reads"),
+            (["wave", "--transfer", str(ramp), "-o", str(ramp)], "-o: ramp.json is the file --transfer reads"),
+            (["neural", "--fit", str(photo), "-o", str(photo)], "-o: photo.png is the file --fit reads"),
+            (["neural", "--fit", str(photo), "-o", str(tmp_path / "f.png"), "--report", str(tmp_path / "f.png")],
+             "--report: f.png is also -o: write the report to another file")):
+        assert main(argv + ["--quiet"]) == 2, argv
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and said in err[0], (argv, err)
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "s"\noutput = "photo.png"\nresolution = [8, 8]\n[bake.source]\n'
+                   'kind = "solid"\nexemplar = "photo.png"\n')
+    assert main(["bake", str(job), "--quiet"]) == 2
+    assert "bake 's': output: photo.png is the file source.exemplar reads: write to another file" in \
+        capsys.readouterr().err
+    with pytest.raises(SettingError, match="out: photo.png is the file exemplar reads"):
+        omninoise.solid(str(photo), 8, out=str(photo))
+    with pytest.raises(SettingError, match="out: ramp.json is the file transfer reads"):
+        omninoise.wave(8, transfer=str(ramp), out=str(ramp))
+    assert (photo.read_bytes(), ramp.read_bytes()) == before
+    assert sorted(os.listdir(tmp_path)) == ["job.toml", "link.png", "photo.png", "ramp.json"]
+
+
+def test_an_output_through_a_missing_folder_and_back_is_refused_before_any_work(tmp_path, capsys):
+    """`sub/../x.png` names a folder only where sub is one (the system resolves it so): refused in one line, not
+    an error of the final rename after the work."""
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "sub" / ".." / "x.png")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "-o: output folder does not exist: " in err[0] and err[0].endswith("sub/.."), err
+    (tmp_path / "sub").mkdir()
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "sub" / ".." / "x.png")]) == 0
+    assert (tmp_path / "x.png").is_file()
