@@ -237,11 +237,10 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
         if p.save != "NONE" and not self.preview:
             from .bake_blender import output_folder
 
-            try:
-                save_path = os.path.join(output_folder(p.folder), bpy.path.clean_name(name) + "." + p.save.lower())
-            except OSError as exc:
-                self.report({"ERROR"}, f"output folder: {exc}")
-                return None
+            save_path = os.path.join(output_folder(p.folder), bpy.path.clean_name(name) + "." + p.save.lower())
+            maps = [(f"the image {ima.name!r}", bpy.path.abspath(ima.filepath)) for ima in (p.blend_map, p.fit_image)
+                    if ima is not None and ima.filepath]
+            _mod("bake").check_not_read(save_path, "name", maps)    # a painted map saved under the bake's name
         obj, add_node = context.active_object, p.add_node and not self.preview
 
         def work(progress, cancel):

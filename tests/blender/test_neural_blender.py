@@ -133,6 +133,22 @@ def test_clear_messages(scene):
             op()
 
 
+def test_a_bake_saved_over_its_own_blend_map_file_is_refused_and_the_map_kept(scene, tmp_path):
+    """A blend map painted and saved in the output folder under the bake's name would be written over."""
+    p = scene.omninoise_neural
+    p.folder, p.save, p.mode, p.size = str(tmp_path) + os.sep, "PNG", "MAP", 16
+    painted = bpy.data.images.new("painted", 16, 16)
+    painted.pixels.foreach_set(np.tile(list(p.swatches[0].color) + [1.0], 256).astype(np.float32))
+    painted.filepath_raw, painted.file_format = str(tmp_path / (bpy.path.clean_name(p.name) + ".png")), "PNG"
+    painted.save()
+    p.blend_map = painted
+    kept = (tmp_path / (bpy.path.clean_name(p.name) + ".png")).read_bytes()
+    with pytest.raises(RuntimeError, match=r"name: .*\.png is the file the image 'painted' reads: write to another"):
+        bpy.ops.omninoise.neural_bake()
+    assert (tmp_path / (bpy.path.clean_name(p.name) + ".png")).read_bytes() == kept
+    p.name = "Other"
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"} and (tmp_path / "Other.png").is_file()
+
 def test_settings_survive_save_and_reload(scene, tmp_path):
     p = scene.omninoise_neural
     p.swatches[1].p0 = 7.5
