@@ -7,15 +7,23 @@ from __future__ import annotations
 
 import os
 
+from .errors import SettingError
+
 __all__ = ["models_root", "neural_model", "solid_models", "fit_bank"]
 
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the package folder, holding backend/
 
 
 def models_root() -> str:
-    """The folder of models: ``OMNINOISE_MODELS`` when set (even if missing: its error then names it), else the
-    package's own ``models`` folder."""
-    return os.environ.get("OMNINOISE_MODELS") or os.path.join(_HERE, "models")
+    """The folder of models: ``OMNINOISE_MODELS`` when set, else the package's own ``models`` folder; a
+    SettingError naming ``OMNINOISE_MODELS`` where it names no folder."""
+    root = os.environ.get("OMNINOISE_MODELS")
+    if not root:
+        return os.path.join(_HERE, "models")
+    if not os.path.isdir(root):
+        raise SettingError("OMNINOISE_MODELS", f"{root} is not a folder (it names the folder of models, which holds "
+                                               "neural_noise and solid)")
+    return root
 
 
 def neural_model() -> str:

@@ -97,7 +97,10 @@ _ITEMS_CACHE = []
 
 
 def _texture_items(self, context):
-    _ITEMS_CACHE[:] = _catalogue() or [("NONE", "No models", f"No solid texture models in {models_dir()}")]
+    try:
+        _ITEMS_CACHE[:] = _catalogue() or [("NONE", "No models", f"No solid texture models in {models_dir()}")]
+    except backend.SettingError as exc:         # OMNINOISE_MODELS names no folder: the menu says so
+        _ITEMS_CACHE[:] = [("NONE", "No models", str(exc))]
     return _ITEMS_CACHE   # Blender needs the strings kept alive
 
 

@@ -129,9 +129,16 @@ def test_omninoise_models_points_every_front_end_at_another_model_folder(tmp_pat
     from omninoise.cli.main import main
 
     monkeypatch.setenv("OMNINOISE_MODELS", str(tmp_path / "farm-models"))
+    for argv in (["neural", "--noise", "perlin"], ["solid", "--exemplar", "gravel_2d"]):    # no such folder
+        assert main(argv + ["-o", str(tmp_path / "n.png")]) == 2
+        assert capsys.readouterr().err.strip() == (f"omninoise {argv[0]}: error: OMNINOISE_MODELS: {tmp_path}/farm-"
+                                                   "models is not a folder (it names the folder of models, which "
+                                                   "holds neural_noise and solid)")
+    (tmp_path / "farm-models").mkdir()
     assert paths.neural_model() == str(tmp_path / "farm-models" / "neural_noise")
     assert main(["neural", "--noise", "perlin", "-o", str(tmp_path / "n.png")]) == 2
     assert str(tmp_path / "farm-models") in capsys.readouterr().err  # the error names the folder it looked in
+    assert not (tmp_path / "n.png").exists()
 
 
 def test_the_api_examples_run():

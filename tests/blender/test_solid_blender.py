@@ -556,3 +556,17 @@ def test_the_panel_builds_the_command_lines_request(scene, tmp_path):
     assert req.key() == flags("--method", "synthesis", "--exemplar", str(tmp_path / "ex.png"), "--tile", "64").key()
     assert req.key() == solid_request_from_dict({"method": "synthesis", "exemplar": str(tmp_path / "ex.png"),
                                                  "tile": 64, "seed": 3}).key()
+
+
+def test_a_models_folder_that_is_no_folder_is_said_in_the_texture_menu_and_by_the_operators(scene, monkeypatch,
+                                                                                           tmp_path):
+    """OMNINOISE_MODELS naming no folder: the Texture menu's one item says so (the menu's callback must not
+    raise while Blender draws it), and the operators refuse in one line naming the variable."""
+    monkeypatch.setattr(solid_ui, "MODELS_DIR", None)
+    monkeypatch.setenv("OMNINOISE_MODELS", str(tmp_path / "gone"))
+    said = f"OMNINOISE_MODELS: {tmp_path / 'gone'} is not a folder"
+    items = solid_ui._texture_items(None, bpy.context)
+    assert len(items) == 1 and items[0][0] == "NONE" and items[0][2].startswith(said)
+    bpy.ops.mesh.primitive_cube_add()
+    with pytest.raises(RuntimeError, match=said):
+        bpy.ops.omninoise.solid_preview()
