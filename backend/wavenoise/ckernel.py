@@ -28,6 +28,8 @@ import time
 
 import numpy as np
 
+from ..errors import SettingError
+
 __all__ = ["local_path", "library_path", "available", "set_enabled", "vector", "fetch_mode", "padded", "rows",
            "points", "cells"]
 
@@ -117,7 +119,7 @@ def fetch_mode() -> str | None:
     """The table-read form the AVX2 loops use in this process ("window" or "gather"), or None while no call has
     been large enough to time them.  OMNINOISE_FETCH with another value is an error, named here."""
     if _fetch is not None and _fetch not in FETCH_MODES:
-        raise ValueError(f"OMNINOISE_FETCH must be one of {', '.join(FETCH_MODES)}, got {_fetch!r}")
+        raise SettingError("OMNINOISE_FETCH", f"must be one of {', '.join(FETCH_MODES)}, got {_fetch!r}")
     return _fetch
 
 

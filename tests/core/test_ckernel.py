@@ -266,7 +266,16 @@ def test_first_large_call_picks_a_fetch_mode(monkeypatch):
     assert ckernel.fetch_mode() is None and np.isfinite(small[0]).all()
 
 
-def test_bad_fetch_mode_is_named(monkeypatch):
+def test_bad_fetch_mode_is_named(monkeypatch, capsys, tmp_path):
+    """A setting error (exit 2, one line naming the variable), not an internal error."""
+    from omninoise.backend.errors import SettingError
+    from omninoise.cli.main import main
+
     monkeypatch.setattr(ckernel, "_fetch", "fast")
-    with pytest.raises(ValueError, match="OMNINOISE_FETCH must be one of window, gather, got 'fast'"):
+    with pytest.raises(SettingError, match="OMNINOISE_FETCH: must be one of window, gather, got 'fast'"):
         ckernel.fetch_mode()
+    if ckernel.available():
+        assert main(["wave", "--size", "256", "--quiet", "-o", str(tmp_path / "w.npy")]) == 2
+        assert capsys.readouterr().err.strip() == ("omninoise wave: error: OMNINOISE_FETCH: must be one of window, "
+                                                   "gather, got 'fast'")
+        assert not (tmp_path / "w.npy").exists()
