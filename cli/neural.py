@@ -34,7 +34,7 @@ omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
     class_args(g)
     g.add_argument("--tileable", action="store_true", help="a seamless tile (size a multiple of 8)")
     g.add_argument("--model", help="another model folder (default: the shipped model)")
-    g.add_argument("--quiet", action="store_true", help="no progress bar")
+    g.add_argument("--quiet", action="store_true", help="no progress bar or notes")
     g = n.add_argument_group("blends")
     g.add_argument("--blend", metavar="MASK", help="a grayscale mask image: white areas take --noise2 / --param2")
     g.add_argument("--noise2", help="class of the masked area (default: --noise)")
@@ -277,12 +277,14 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     try:
         bank = load_bank(fit_bank())
     except ModelError as exc:  # the fit still works, starting from every class at mid-range parameters
-        print(f"note: no inverse-design bank ({exc}); trying every class", file=sys.stderr)
+        if not a.quiet:
+            print(f"note: no inverse-design bank ({exc}); trying every class", file=sys.stderr)
         bank = None
     img = img[..., 0] if img.shape[2] == 1 else img
     # refuses too small and flat images, named by the flag and the file
     for note in prepare_target(img, model.multiple_of, f"--fit {os.path.basename(a.fit)}")[1]:
-        print("note: " + note, file=sys.stderr)
+        if not a.quiet:
+            print("note: " + note, file=sys.stderr)
     bar = Bar(a.quiet, "fit    ")
     res = fit(model, img, size=a.fit_size, seed=a.seed, bank=bank, progress=lambda f: bar(0.8 * f))
     cond = fitted_conditioning(model, res, a.size, a.size)

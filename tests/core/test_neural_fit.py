@@ -89,6 +89,11 @@ def test_the_fit_improves_on_its_start_and_the_cli_gives_the_same(model, tmp_pat
     rep = json.load(open(tmp_path / "f.json"))
     assert rep["classes"] == res.classes and rep["seed"] == res.seed and rep["params"] == res.params
     assert rep["command"].startswith("omninoise neural --noise ") and os.path.isfile(tmp_path / "f.png")
+    np.save(tmp_path / "c.npy", np.repeat(target[..., None], 3, axis=2) * 0.5 + 0.25)   # colour, low contrast
+    capsys.readouterr()
+    assert main(["neural", "--fit", str(tmp_path / "c.npy"), "--fit-size", "32", "--size", "32", "-o",
+                 str(tmp_path / "c.png"), "--quiet"]) == 0
+    assert capsys.readouterr() == ("", "")                  # --quiet: no bar, no notes (grey, stretched), no summary
     with pytest.raises(Cancelled):
         fit(model, target, cancel=lambda: True)
 
