@@ -350,6 +350,7 @@ def active_mesh(context, purpose: str):
         raise backend.SettingError("object", f"select a mesh to {purpose}")
     return obj
 
+
 #: bytes a UV image bake holds per texel at its peak: each texel's surface point (float64), its color, the image's
 #: pixels (123 measured on a plane filling a 2048² image)
 UV_BAKE_BYTES = 128

@@ -24,8 +24,8 @@ from .sampler import (DEFAULT_SAMPLER, DEFAULT_SPACING, DEFAULT_STEPS, SAMPLERS,
                       step_noise_rng)
 from .schedule import SPACINGS
 
-__all__ = ["generate", "check_sampler", "image_eps", "auto_tile", "peak_bytes", "check_memory", "AUTO_WHOLE", "AUTO_TILE",
-           "DEFAULT_OVERLAP", "MAP_CACHE_BYTES", "PIECE_BYTES", "IMAGE_BYTES"]
+__all__ = ["generate", "check_sampler", "image_eps", "auto_tile", "peak_bytes", "check_memory", "AUTO_WHOLE",
+           "AUTO_TILE", "DEFAULT_OVERLAP", "MAP_CACHE_BYTES", "PIECE_BYTES", "IMAGE_BYTES"]
 
 _F = np.float32
 AUTO_WHOLE = 1024          #: with tile=None, sides up to this are generated in one piece ...
