@@ -38,8 +38,10 @@ def read_document(path: str, setting: str, kind: str):
         raise SettingError(setting, f"{path}: cannot be read ({exc.strerror or exc})") from None
     if len(data) > MAX_DOCUMENT_BYTES:
         raise SettingError(setting, f"{path} is more than {MAX_DOCUMENT_BYTES >> 20} MiB")
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise SettingError(setting, f"{path}: UTF-16 text; save it as UTF-8")
     try:
-        text = data.decode("utf-8")
+        text = data.decode("utf-8-sig")         # a byte-order mark, as some Windows editors write, is left out
     except UnicodeDecodeError as exc:
         raise SettingError(setting, f"{path}: not UTF-8 text (byte {exc.start})") from None
     try:

@@ -312,15 +312,29 @@ def test_documents_are_read_within_bounds(tmp_path, capsys, argv):
     os.mkfifo(fifo)
     toml = argv[0] != "wave"
     cases = {str(fifo): "is not a regular file", "/dev/zero": "is not a regular file",
-             "bad": "not UTF-8 text", "deep": "nested too deeply to read"}
+             "bad": "not UTF-8 text", "u16": "UTF-16 text; save it as UTF-8", "deep": "nested too deeply to read"}
     (tmp_path / "bad").write_bytes(b'a = "\xff"\n' if toml else b'{"stops": "\xff"}')
+    (tmp_path / "u16").write_text('a = 1\n' if toml else '{"stops": 1}', encoding="utf-16")
     (tmp_path / "deep").write_text("a = " + "[" * 100_000 if toml else '{"a":' * 100_000)
     for name, said in cases.items():
         path = name if name.startswith("/") else str(tmp_path / name)
         assert main([x.format(f=path, d=tmp_path) for x in argv] + ["--quiet"]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and said in err[0], (name, err)
-    assert sorted(os.listdir(tmp_path)) == ["bad", "deep", "fifo"]
+    assert sorted(os.listdir(tmp_path)) == ["bad", "deep", "fifo", "u16"]
+
+
+def test_a_document_saved_with_a_byte_order_mark_is_read(tmp_path):
+    """Windows editors may begin UTF-8 text with a byte-order mark (and end lines with CR LF): a job file and a
+    ramp so saved are read as without it."""
+    job = tmp_path / "job.toml"
+    job.write_bytes(b"\xef\xbb\xbf" + b'[[bake]]\r\nname = "w"\r\noutput = "w.png"\r\nresolution = [8, 8]\r\n'
+                    b'transfer = "r.json"\r\n[bake.source]\r\nkind = "wave"\r\n')
+    assert main(["transfer", "fire", "-o", str(tmp_path / "r.json")]) == 0
+    (tmp_path / "r.json").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "r.json").read_bytes())
+    assert main(["bake", str(job), "--quiet"]) == 0 and (tmp_path / "w.png").is_file()
+    assert main(["wave", "--size", "8", "--quiet", "--transfer", str(tmp_path / "r.json"), "-o",
+                 str(tmp_path / "c.png")]) == 0
 
 
 def test_outputs_that_cannot_be_written_are_refused_before_any_work(tmp_path, capsys):

@@ -188,6 +188,14 @@ def test_a_file_that_is_not_json_is_refused_in_one_line(tmp_path, text, words):
     assert len(str(e.value)) < 300 + len(str(bad))          # one short line, whatever the file holds
 
 
+
+def test_a_file_saved_with_a_byte_order_mark_is_the_same_solid(fitted, tmp_path):
+    """An edit in a Windows editor may begin the file with a UTF-8 byte-order mark."""
+    path, field = fitted
+    marked = tmp_path / "marked.json"
+    marked.write_bytes(b"\xef\xbb\xbf" + open(path, "rb").read())
+    assert saved.read(str(marked)).to_dict() == field.to_dict()
+
 @pytest.mark.parametrize("args, flag, words", [
     (["--method", "neural"], "--exemplar", "drawn by method procedural, not neural"),
     (["--method", "auto"], "--exemplar", "drawn by method procedural, not auto"),

@@ -64,7 +64,7 @@ def read(path: str, setting: str = "exemplar") -> ProceduralField:
     try:
         size = os.path.getsize(path)
         if size <= MAX_BYTES:
-            with open(path, encoding="utf-8") as fh:
+            with open(path, encoding="utf-8-sig") as fh:      # a byte-order mark (Windows editors) left out
                 doc = json.load(fh, parse_constant=_no_constant)
     except OSError as exc:
         raise SettingError(setting, f"cannot read {path}: {exc.strerror or exc}") from None
