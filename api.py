@@ -183,8 +183,8 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
 def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: str = "neural", seed: int = 0,
           scale: float = 1.0, refine: int = 0, periodic: bool = True, model: str | None = None,
           families: tuple | None = None, out: str | None = None, progress: Progress = None):
-    """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, or sRGB
-    float pixels ``(H, W, 3)`` in [0, 1]).
+    """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, as a string or
+    a path, or sRGB float pixels ``(H, W, 3)`` in [0, 1]).
 
     ``method`` is ``"neural"`` (the models' texture, 2D or 3D), ``"spectral"`` (the photo's spectrum and colours
     on every cut, 2D or 3D), ``"procedural"`` (rings, layers, cells or bricks fitted to the photo, 2D or 3D) or
@@ -208,6 +208,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     from .backend.solid.request import SolidRequest
 
     _check_progress(progress)
+    exemplar = os.fspath(exemplar) if isinstance(exemplar, os.PathLike) else exemplar    # a pathlib.Path too
     size = _check_size(size)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
