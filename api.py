@@ -208,7 +208,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     from .backend.solid.request import SolidRequest
 
     _check_progress(progress)
-    exemplar = os.fspath(exemplar) if isinstance(exemplar, os.PathLike) else exemplar    # a pathlib.Path too
+    exemplar, model = (os.fspath(x) if isinstance(x, os.PathLike) else x for x in (exemplar, model))  # Paths too
     size = _check_size(size)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")

@@ -68,14 +68,19 @@ def test_a_transfer_path_may_be_a_path_object(tmp_path):
 
 
 def test_a_photo_may_be_a_path_object(tmp_path):
-    """solid's exemplar, a file, as a pathlib.Path: the same texture as its str; out as a Path beside it."""
+    """solid's exemplar, a file, as a pathlib.Path: the same texture as its str; out and a model folder as Paths."""
     from omninoise.export.images import write_unit_image
 
     photo = tmp_path / "photo.png"
     write_unit_image(str(photo), np.random.default_rng(1).random((40, 40, 3)))
-    by_path = omninoise.solid(photo, 16, method="spectral", seed=2)
-    np.testing.assert_array_equal(by_path, omninoise.solid(str(photo), 16, method="spectral", seed=2))
-    assert str(omninoise.solid(photo, 16, method="spectral", out=tmp_path / "s.png")) == str(tmp_path / "s.png")
+    by_path = omninoise.solid(photo, 8, seed=2)
+    np.testing.assert_array_equal(by_path, omninoise.solid(str(photo), 8, seed=2))
+    assert str(omninoise.solid(photo, 8, out=tmp_path / "s.png")) == str(tmp_path / "s.png")
+    from omninoise.backend.paths import solid_models
+    from pathlib import Path
+
+    folder = Path(solid_models()) / "gravel_3d"                 # a model folder as a Path
+    np.testing.assert_array_equal(omninoise.solid("gravel_3d", 8, model=folder), omninoise.solid("gravel_3d", 8))
 
 def test_an_unknown_wave_setting_is_a_type_error_naming_wave_and_its_settings():
     """As for any Python function, an unknown keyword is a TypeError, from ``wave`` itself (not from the settings
