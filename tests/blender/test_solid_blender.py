@@ -141,6 +141,21 @@ def test_a_uv_image_too_large_for_memory_is_refused_before_any_work(scene):
         bpy.ops.omninoise.solid_bake()
     assert "Solid Texture" not in bpy.data.images
 
+def test_a_uv_map_that_covers_no_pixel_is_refused_not_baked_black(scene):
+    """Every face's UVs at one point (before work), or faces too small to hold a pixel's centre (found by the
+    work): one line naming the UV map, and no black image."""
+    bpy.ops.mesh.primitive_cube_add()
+    uv = bpy.context.active_object.data.uv_layers.active
+    a = np.empty(len(uv.data) * 2, np.float32)
+    uv.data.foreach_get("uv", a)
+    for squeezed in (np.zeros_like(a), a * 0.001 + 0.3):
+        uv.data.foreach_set("uv", squeezed.astype(np.float32))
+        with pytest.raises(RuntimeError, match=r"uv: the UV map of 'Cube' covers no pixel of the image: unwrap it"):
+            bpy.ops.omninoise.solid_bake()
+        assert "Solid Texture" not in bpy.data.images
+    uv.data.foreach_set("uv", a)
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+
 def test_color_attribute_bake_in_edit_mode_is_of_the_edited_mesh_and_survives_leaving_it(scene):
     """In Edit Mode the mesh data holds the shape Edit Mode began with and Blender writes the edit mesh back over
     it on leaving: the bake reads the edited vertices and its colors are still there in Object Mode."""
