@@ -221,7 +221,7 @@ def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
         try:
             spec = _spec(d, base_dir, i)
         except (SettingError, FileNotFoundError) as exc:
-            out.append((name, JobError(f"bake {name!r}: {exc}")))
+            out.append((name, JobError(f"bake {name!r}: {exc}{_written_before(d, base_dir, outputs)}")))
             continue
         real = os.path.realpath(spec.output)
         try:
@@ -250,6 +250,17 @@ def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
         outputs.update(dict.fromkeys(files, name))
         out.append((name, spec))
     return out
+
+
+def _written_before(d: dict, base_dir: str, outputs: dict) -> str:
+    """Where a bake reads a file that is not there yet but an earlier bake of the job writes: a hint that a job's
+    bakes are checked before any runs (and a farm runs them at once), so the file must exist first."""
+    for _, v in _strings(d):
+        f = os.path.normcase(os.path.realpath(os.path.join(base_dir, v)))
+        if f in outputs and not os.path.exists(f):
+            return (f" (bake {outputs[f]!r} writes it: a job is checked before any bake runs; bake that one first, "
+                    "on its own or with --only)")
+    return ""
 
 
 def _strings(value, key: str = ""):

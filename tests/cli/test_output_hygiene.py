@@ -441,3 +441,18 @@ def test_an_output_through_a_missing_folder_and_back_is_refused_before_any_work(
     (tmp_path / "sub").mkdir()
     assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "sub" / ".." / "x.png")]) == 0
     assert (tmp_path / "x.png").is_file()
+
+
+def test_a_bake_reading_what_an_earlier_bake_writes_says_so(tmp_path, capsys):
+    """A job is checked before any bake runs: a bake whose photo an earlier bake writes is invalid until that file
+    exists, and its message says which bake writes it; baked first with --only, the job then runs whole."""
+    job = tmp_path / "job.toml"
+    job.write_text('[[bake]]\nname = "mask"\noutput = "m.png"\nresolution = [64, 64]\n[bake.source]\nkind = "wave"\n'
+                   '[[bake]]\nname = "like"\noutput = "l.png"\nresolution = [8, 8]\n[bake.source]\nkind = "wave"\n'
+                   'example = "m.png"\n')
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    out = capsys.readouterr().out
+    assert "bake 'like': " in out and "(bake 'mask' writes it: a job is checked before any bake runs; bake that one " \
+           "first, on its own or with --only)" in out, out
+    assert main(["bake", str(job), "--only", "mask", "--quiet"]) == 0
+    assert main(["bake", str(job), "--quiet"]) == 0 and (tmp_path / "l.png").is_file()
