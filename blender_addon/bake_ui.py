@@ -220,12 +220,9 @@ class _BakeOperator(TaskOperator):
     bl_options = {"REGISTER", "UNDO"}
     target = "VOLUME"
 
-    def _said(self, exc: Exception) -> str:
-        """A setting error named as the panel names the setting (Min Frequency, Time per Frame, From and To)."""
-        if not isinstance(exc, backend.SettingError):
-            return str(exc)
-        label = BAKE_LABELS.get(exc.setting) or setting_label(bpy.context.scene.omninoise_bake.wave, exc.setting)
-        return f"{label}: {exc.message}"
+    def _label(self, setting: str) -> str:
+        """The bake panel's label of a setting (Min Frequency, Time per Frame, From and To)."""
+        return BAKE_LABELS.get(setting) or setting_label(bpy.context.scene.omninoise_bake.wave, setting)
 
     def _start(self, context, blocking: bool):
         spec = build_spec(context, self.target)

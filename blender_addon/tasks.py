@@ -202,11 +202,14 @@ class TaskOperator:
     #: the backend's names of settings -> the panel's (a solid's "exemplar" is the panel's Image)
     setting_names: dict = {}
 
+    def _label(self, setting: str) -> str | None:
+        """The panel's name of a backend setting, or None where the panel calls it as the backend does."""
+        return self.setting_names.get(setting)
+
     def _said(self, exc: Exception) -> str:
         """An error in one line, a setting named as the panel names it."""
-        if isinstance(exc, backend.SettingError) and exc.setting in self.setting_names:
-            return f"{self.setting_names[exc.setting]}: {exc.message}"
-        return str(exc)
+        label = self._label(exc.setting) if isinstance(exc, backend.SettingError) else None
+        return f"{label}: {exc.message}" if label is not None else str(exc)
 
     def _failure(self, task) -> str:
         return self._said(task.error) if task.error is not None else (task.message or task.status)
