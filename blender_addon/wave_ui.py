@@ -15,7 +15,6 @@ engine or the OSL switch changes in the interface.
 """
 from __future__ import annotations
 
-import re
 import time
 
 import bpy
@@ -99,8 +98,7 @@ _PROPERTIES = {"dim": "dimensions", "lobes": "axis", "axis_spectra": "axis_scale
 def setting_label(props, setting: str) -> str:
     """The panel's label of the property of ``props`` (an :class:`OMNINOISE_PG_wave`) behind a wave setting's dotted
     name ("spectrum.fmax" -> "Max Frequency", "axis_spectra[0].fmin" -> "Axis Frequency"), or the name itself."""
-    parts = re.split(r"[.\[]", setting.replace(" ", "_"))
-    ident = parts[-1] if parts[0] == "spectrum" else parts[0]
+    ident = backend.wavenoise.settings.field_of(setting)
     prop = props.bl_rna.properties.get(_PROPERTIES.get(ident, ident))
     return prop.name if prop is not None else setting
 

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 import warnings
 
@@ -13,7 +12,7 @@ from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.transfer import PRESETS, load_transfer
 from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
-from omninoise.backend.wavenoise.settings import ANISOTROPY, PLANES, WaveSettings, check_read
+from omninoise.backend.wavenoise.settings import ANISOTROPY, PLANES, WaveSettings, check_read, field_of
 from omninoise.backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
 from omninoise.backend.wavenoise.tables import WAVEFORMS
 from omninoise.backend.wavenoise.wave import OUTPUTS
@@ -178,8 +177,7 @@ _FLAGS = {"lobes": "lobe", "axis_spectra": "axis_spectrum", "table_period": "per
 def _flag(a: argparse.Namespace, setting: str) -> str:
     """The flag behind a setting's dotted name ("spectrum.fmax" -> --fmax, "lobes[0][1]" -> --lobe), or the
     name itself."""
-    parts = re.split(r"[.\[]", setting.replace(" ", "_"))
-    dest = parts[-1] if parts[0] == "spectrum" else parts[0]
+    dest = field_of(setting)
     dest = _FLAGS.get(dest, dest)
     return "--" + dest.replace("_", "-") if hasattr(a, dest) else setting
 

@@ -6,6 +6,7 @@ into a :class:`~backend.wavenoise.wave.WaveNoise` or :class:`~backend.wavenoise.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
@@ -21,7 +22,7 @@ from .schema import ANISOTROPY, WAVE_SETTINGS
 from .wave import Transition, WaveNoise
 
 __all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict",
-           "READ_WITH", "check_read"]
+           "READ_WITH", "check_read", "field_of"]
 
 
 
@@ -188,6 +189,13 @@ def _plain(name: str, v):
         return [float(c) for c in v]
     return v
 
+
+def field_of(setting: str) -> str:
+    """The field behind a setting's name in an error: "spectrum.fmax" -> "fmax" (a spectrum's own), "lobes[0][1]"
+    -> "lobes", "axis_spectra[0].fmin" -> "axis_spectra", "cell size" -> "cell_size"; a front end names that field
+    as its user knows it (a flag, a panel's label)."""
+    parts = re.split(r"[.\[]", setting.replace(" ", "_"))
+    return parts[-1] if parts[0] == "spectrum" else parts[0]
 
 #: settings that change the noise only beside another: name -> (whether ``s`` reads it, what it needs: one or more
 #: alternatives, each (setting, value) pairs that must all hold; value None: any but the default). ``exponent`` is
