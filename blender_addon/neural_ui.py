@@ -321,16 +321,9 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
         p = context.scene.omninoise_neural
         size = p.size + (-p.size) % 8 if p.tileable else p.size
         _mod("neural.generate").check_memory("size", size, size)
-        try:
-            m = model()
-            keys = sequence_keys(p)
-            folder = output_folder(p.folder)
-        except (backend.SettingError, _mod("neural.model").ModelError) as exc:
-            self.report({"ERROR"}, str(exc))
-            return None
-        except OSError as exc:
-            self.report({"ERROR"}, f"output folder: {exc}")
-            return None
+        m = model()                 # its errors, the keys' and the folder's are reported by _begin, in one line
+        keys = sequence_keys(p)
+        folder = output_folder(p.folder)
         ext = "png" if p.save == "PNG" else "exr"  # a sequence lives on disk: EXR unless PNG was picked
         pattern = os.path.join(folder, bpy.path.clean_name(p.name) + "_####." + ext)
         first, last = p.frame_start, p.frame_end
