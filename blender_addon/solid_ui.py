@@ -597,14 +597,12 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             uv, pos = _mesh_arrays(context, obj, world, uv=True)
 
             unwrap = f"the UV map of {obj.name!r} covers no pixel of the image: unwrap it (UV > Smart UV Project)"
-            if not np.abs(np.cross(uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0])).any():    # every face at a point
-                raise backend.SettingError("uv", unwrap)
 
             def work(progress, cancel):
-                code = code_fn(None, cancel)
                 mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.3 * f), cancel)
-                if not mask.any():          # faces too small to hold a pixel's centre: a black image
-                    raise backend.SettingError("uv", unwrap)
+                if not mask.any():          # UVs at a point, or faces too small to hold a pixel's centre: refused
+                    raise backend.SettingError("uv", unwrap)        # before the texture is made (a fit: seconds)
+                code = code_fn(None, cancel)
                 mask, pts = surface.dilate(mask, pts, margin)
                 rgb = np.zeros((size, size, 3), np.float32)
                 rgb[mask] = m.evaluate(pts[mask] * scale, code, seed,

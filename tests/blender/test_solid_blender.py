@@ -142,8 +142,8 @@ def test_a_uv_image_too_large_for_memory_is_refused_before_any_work(scene):
     assert "Solid Texture" not in bpy.data.images
 
 def test_a_uv_map_that_covers_no_pixel_is_refused_not_baked_black(scene):
-    """Every face's UVs at one point (before work), or faces too small to hold a pixel's centre (found by the
-    work): one line naming the UV map, and no black image."""
+    """Every face's UVs at one point, or faces too small to hold a pixel's centre: one line naming the UV map,
+    found before the texture is made, and no black image."""
     bpy.ops.mesh.primitive_cube_add()
     uv = bpy.context.active_object.data.uv_layers.active
     a = np.empty(len(uv.data) * 2, np.float32)
