@@ -253,10 +253,15 @@ def read_image(path: str) -> np.ndarray:
 def read_rgb(path: str) -> np.ndarray:
     """Read an image file as sRGB-encoded float32 (H, W, 3) in [0, 1], the exemplar format of the solid textures:
     an 8- or 16-bit file's stored values; a float file's (EXR, float TIFF, float .npy) scene-linear values encoded
-    (:func:`linear_to_srgb`, clipped to [0, 1] first), as Blender shows a float image.  Greyscale is repeated, an
-    alpha channel must be opaque (:func:`opaque`)."""
+    (:func:`linear_to_srgb`, clipped to [0, 1] first), as Blender shows a float image; a float file of whole numbers
+    above 1 (8- or 16-bit values stored as floats, which would read as white) is refused.  Greyscale is repeated,
+    an alpha channel must be opaque (:func:`opaque`)."""
     a, linear = _decode(path)
     a = opaque(a, path)
+    if linear and a.max() > 1.0 and np.array_equal(a, np.round(a)):
+        raise ImageError(f"{path}: a float image holds scene-linear colour (0 to 1, more only in highlights), but "
+                         f"this one holds whole numbers up to {a.max():g}, as 8- or 16-bit pixels do: store them as "
+                         "uint8 or uint16, or divided by 255 or 65535")
     if a.shape[2] == 1:
         a = np.repeat(a, 3, axis=2)
     return linear_to_srgb(a) if linear else np.clip(a, 0.0, 1.0)

@@ -68,6 +68,29 @@ def test_float_files_hold_scene_linear_colour_and_exemplars_read_them_as_blender
     assert read_rgb(str(tmp_path / "hdr.exr")).max() <= 1.0
 
 
+def test_a_float_photo_of_whole_numbers_above_1_is_refused_naming_the_fix(tmp_path, capsys):
+    """An 8-bit photo saved by numpy as floats (0 to 255) read as scene-linear colour came out white; it is refused
+    in one line saying how to store it, as a file and through the command line (exit 2, nothing written). Whole
+    numbers up to 1 (a mask of 0 and 1) and an HDR image's fractional highlights are colour as before."""
+    from omninoise.export.images import write_exr
+
+    srgb8 = np.random.default_rng(3).integers(0, 256, (32, 32, 3)).astype(np.float32)
+    np.save(tmp_path / "f255.npy", srgb8)
+    write_exr(str(tmp_path / "f255.exr"), srgb8)
+    for name in ("f255.npy", "f255.exr"):
+        with pytest.raises(ImageError, match=r"f255\.\w+: a float image holds scene-linear colour \(0 to 1, more only in "
+                                             r"highlights\), but this one holds whole numbers up to 255, as 8- or "
+                                             r"16-bit pixels do: store them as uint8 or uint16, or divided by 255"):
+            read_rgb(str(tmp_path / name))
+    out = tmp_path / "o.png"
+    assert main(["solid", "--exemplar", str(tmp_path / "f255.npy"), "--method", "spectral", "-o", str(out)]) == 2
+    assert "--exemplar: " in capsys.readouterr().err and not out.exists()
+    np.save(tmp_path / "mask.npy", (srgb8 > 127).astype(np.float32))
+    assert np.allclose(np.unique(read_rgb(str(tmp_path / "mask.npy"))), [0.0, 1.0])
+    np.save(tmp_path / "hdr.npy", srgb8 / 100.0)
+    assert abs(read_rgb(str(tmp_path / "hdr.npy")).max() - 1.0) < 1e-6
+
+
 @pytest.mark.parametrize("make, match", [
     (lambda p: p.write_bytes(b""), "empty file"),
     (lambda p: p.write_text("hello, not an image"), "not an image file"),
