@@ -229,7 +229,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     given = [k for k, v in (("model", model is not None), ("refine", refine != 0), ("periodic", not periodic),
                             ("families", families is not None)) if v]
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
-    req.check_reads(given)
+    req.check_reads(given).check_pixels()      # a photo no method can use is named before any work
     if ext == ".json":          # the fitted procedural solid itself
         from .backend.solid.procedural import saved
 

@@ -35,6 +35,7 @@ from ..errors import SettingError
 from ..paths import solid_models
 from .methods import IMAGE_METHODS, METHODS, READS
 from .procedural.field import DEFAULT_KINDS
+from .pixels import MIN_SIDE
 from .procedural.saved import is_saved
 
 __all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
@@ -84,7 +85,7 @@ def _read_file(path: str, setting: str) -> np.ndarray:
 def check_pixels_given(x, setting: str) -> None:
     """SettingError naming ``setting`` unless ``x`` is None, a name or file (a str), or pixels as every method
     reads them: a float array (H, W, 3) of finite sRGB values in [0, 1] (8-bit pixels divided by 255), at least
-    one pixel."""
+    :data:`~backend.solid.pixels.MIN_SIDE` px a side (:func:`check_side`)."""
     if x is None or isinstance(x, str):
         return
     if not isinstance(x, np.ndarray):
@@ -99,6 +100,16 @@ def check_pixels_given(x, setting: str) -> None:
     lo, hi = float(x.min()), float(x.max())
     if lo < 0.0 or hi > 1.0:
         raise SettingError(setting, f"expected sRGB pixels in [0, 1], got values in [{lo:.4g}, {hi:.4g}]")
+    check_side(x, setting)
+
+
+def check_side(photo: np.ndarray, setting: str) -> None:
+    """SettingError naming ``setting`` for a photo (H, W, ...) under :data:`~backend.solid.pixels.MIN_SIDE` px a
+    side: every method reads a texture from a photo at least that large (the procedural fit's least; spectral
+    solids and synthesis need more, and say so)."""
+    if min(photo.shape[:2]) < MIN_SIDE:
+        raise SettingError(setting, f"the photo is {photo.shape[1]} x {photo.shape[0]} px; a texture is read from a "
+                                    f"photo of at least {MIN_SIDE} px a side")
 
 
 @dataclass(frozen=True, eq=False)
@@ -312,14 +323,15 @@ class SolidRequest:
         """What the image methods (synthesis, spectral, procedural, auto) ask of the exemplar's pixels, checked
         before any work (a job file's bakes when the job is read, their textures made when baked): SettingError
         naming the exemplar for an image they cannot use; the request when they can.  The neural method's image
-        files (``exemplar``, ``to``) must decode: a file it cannot read is named before the encoding starts."""
+        files (``exemplar``, ``to``) must decode, and its photos (files or pixels) hold at least
+        :data:`~backend.solid.pixels.MIN_SIDE` px a side, as the procedural fit's: a photo it cannot use is named
+        before the encoding starts."""
         if is_saved(self.exemplar):
             return self
         if self.method not in IMAGE_METHODS + ("auto",):
-            if isinstance(self.to, str) and os.path.isfile(self.to):
-                self._decode(self.to, f"{where}to")
-            if isinstance(self.exemplar, str) and os.path.isfile(self.exemplar):
-                self.exemplar_pixels(where)
+            for key, x in (("exemplar", self.exemplar), ("to", self.to)):
+                if isinstance(x, str) and os.path.isfile(x):
+                    check_side(self._decode(x, f"{where}{key}"), f"{where}{key}")
             return self
         img = self.exemplar_pixels(where)
         try:

@@ -473,15 +473,20 @@ def test_a_partly_transparent_exemplar_is_refused_unless_its_alpha_is_ignored(sc
 
 
 def test_an_image_a_method_cannot_use_is_named_as_the_panel_names_it(scene):
-    """The request's exemplar is the panel's Image: a photo too small for the method, and a float image holding
-    NaN, are reported as the image's errors, before and while the work runs."""
+    """The request's exemplar is the panel's Image: a photo too small for any method or for the method, and a
+    float image holding NaN, are reported as the image's errors, before and while the work runs."""
     p = scene.omninoise_solid
-    line = bpy.data.images.new("Line", 64, 1)
-    p.source, p.image, p.method = "IMAGE", line, "SPECTRAL"
-    with pytest.raises(RuntimeError, match=r"image: the photo is 64 x 1 px; a spectral solid needs at least 32"):
+    p.source, p.image = "IMAGE", bpy.data.images.new("Line", 64, 1)
+    for method in ("NEURAL", "SPECTRAL"):
+        p.method = method
+        with pytest.raises(RuntimeError, match=r"image: the photo is 64 x 1 px; a texture is read from a photo of "
+                                               r"at least 16 px a side"):
+            bpy.ops.omninoise.solid_preview()
+    p.image = bpy.data.images.new("Small", 24, 24)
+    with pytest.raises(RuntimeError, match=r"image: the photo is 24 x 24 px; a spectral solid needs at least 32"):
         bpy.ops.omninoise.solid_preview()
     p.method = "NEURAL"
-    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}        # the neural texture reads any photo
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}        # the neural texture reads it
     bad = bpy.data.images.new("Bad", 32, 32, float_buffer=True)
     bad.pixels.foreach_set(np.full(32 * 32 * 4, np.nan, np.float32))
     p.image = bad

@@ -261,15 +261,21 @@ def test_a_job_encodes_its_photo_when_it_bakes_its_file_only(models, tmp_path, m
     assert "to bake" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("shape", [(1, 600), (600, 2), (1, 1)])
-def test_a_photo_of_a_line_or_a_pixel_encodes(models, tmp_path, capsys, shape):
-    """The texture-space model reads photos of any size (its check's neighbourhoods shrink to fit): a strip one or
-    two px across has no lattice or line of the harmonic part to read, and gives a texture, not an internal error."""
+@pytest.mark.parametrize("shape", [(1, 600), (600, 2), (1, 1), (16, 600)])
+def test_a_photo_under_16_px_a_side_is_refused_and_a_strip_of_16_encodes(models, tmp_path, capsys, shape):
+    """Every method reads its texture from a photo at least 16 px a side: a line or a pixel is refused in one line
+    naming the flag, before any work, as the image methods refuse it; a strip 16 px across (too thin for a lattice
+    or line of the harmonic part to read) gives a texture."""
     from PIL import Image
 
     Image.fromarray((np.random.default_rng(1).random(shape + (3,)) * 255).astype(np.uint8)).save(tmp_path / "p.png")
     out = str(tmp_path / "o.npy")
     rc, err = run(capsys, "--model", models["space3"], "--exemplar", str(tmp_path / "p.png"), "--size", "8", "-o", out)
+    if min(shape) < 16:
+        assert rc == 2 and err.strip().endswith(f"--exemplar: the photo is {shape[1]} x {shape[0]} px; a texture is "
+                                                "read from a photo of at least 16 px a side"), err
+        assert not os.path.exists(out)
+        return
     assert rc == 0, err
     assert np.isfinite(np.load(out)).all()
 

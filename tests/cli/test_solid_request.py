@@ -185,6 +185,8 @@ def test_a_setting_the_method_does_not_read_is_refused_by_each_front_end(tmp_pat
     (np.full((8, 8, 3), 0.5) + 0j, "got complex128"),
     (np.full((8, 8, 3), True), "got bool"),
     ([[[0.5] * 3] * 8] * 8, "got list"),
+    (np.full((8, 8, 3), 0.5), r"the photo is 8 x 8 px; a texture is read from a photo of at least 16 px a side"),
+    (np.full((40, 15, 3), 0.5), r"the photo is 15 x 40 px"),
 ])
 @pytest.mark.parametrize("method", ["neural", "spectral", "synthesis", "procedural", "auto"])
 def test_pixels_are_checked_alike_for_every_method(pixels, why, method):
@@ -198,4 +200,17 @@ def test_pixels_are_checked_alike_for_every_method(pixels, why, method):
         with pytest.raises(SettingError, match=why) as exc:
             SolidRequest(exemplar="grass", to=pixels, mix=0.5).check()
         assert exc.value.setting == "to"
-    SolidRequest(exemplar=np.full((8, 8, 3), 0.5, np.float32), method=method).check()
+    SolidRequest(exemplar=np.full((16, 16, 3), 0.5, np.float32), method=method).check()
+
+
+@pytest.mark.parametrize("method", ["neural", "spectral", "procedural"])
+def test_python_refuses_a_photo_file_under_16_px_a_side_before_any_work(tmp_path, method):
+    """``omninoise.solid`` checks a photo file's pixels as the command line does, before the model is loaded or
+    the output written: the neural texture encoded a 12 px photo where the other methods refuse it."""
+    import omninoise
+    from PIL import Image
+
+    Image.fromarray(np.full((12, 40, 3), 90, np.uint8)).save(tmp_path / "small.png")
+    with pytest.raises(SettingError, match=r"^exemplar: .*12"):
+        omninoise.solid(str(tmp_path / "small.png"), 8, method=method, out=str(tmp_path / "o.png"))
+    assert not (tmp_path / "o.png").exists()
