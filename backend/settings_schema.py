@@ -58,7 +58,7 @@ NEURAL_SOURCE = Table({
     "corners": Field(ListOf(CLASS_SPEC, 4, 4), "four class specs: top-left, top-right, bottom-left, bottom-right"),
     "map": Field(FILE, "a painted map whose colours name classes"),
     "regions": Field(MapOf(CLASS_SPEC, '"#rrggbb" or grey level "0".."255"'), "map: each colour's class spec"),
-    "width": Field(Float(0.0, 1e4, above=True), "transition width of masks and maps, px", default="32"),
+    "width": Field(Float(0.0, 1e4, above=True), "transition width of masks and maps, in their px", default="32"),
     "sharpness": Field(Float(0.0, 1e3, above=True), "how sharp transitions are", default="1"),
     "sampler": Field(Choice(tuple(SAMPLERS)), "the diffusion sampler", default="the model's"),
     "steps": Field(Int(1, 1000), "denoising steps; more is finer and slower", default="the sampler's"),

@@ -178,11 +178,9 @@ def panel_request(p: OMNINOISE_PG_neural, size: int, steps: int | None = None):
         raise backend.SettingError("blend map", f"the map is {iw}x{ih}; it must be square like the output")
     px = image_pixels(img, "blend map")     # a map's colours name its regions; what alpha a brush left is not read
     rgb = px[..., :3] if px.shape[2] >= 3 else np.repeat(px[..., :1], 3, axis=2)
-    if (iw, ih) != (size, size):  # nearest resampling of the painted regions
-        rgb = rgb[(np.arange(size) * ih // size)[:, None], (np.arange(size) * iw // size)[None, :]]
-    # brush strokes blend colours at their edges: each pixel takes its nearest swatch colour
+    # brush strokes blend colours at their edges: each pixel takes its nearest swatch colour; the request draws the
+    # regions at the output's size, the transitions in the map's pixels
     regions = R.regions_from_colours(rgb, [tuple(s.color) for s in sw], tolerance=0.2, where="blend map")
-    kw["transition"] = p.width * size / max(iw, 1)
     return R.NeuralRequest("painted", [s.spec() for s in sw], regions=regions, **kw).check(m)
 
 

@@ -39,7 +39,9 @@ omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
     g.add_argument("--blend", metavar="MASK", help="a grayscale mask image: white areas take --noise2 / --param2")
     g.add_argument("--noise2", help="class of the masked area (default: --noise)")
     g.add_argument("--param2", action="append", default=[], metavar="NAME=VALUE", help="its parameters (repeat)")
-    g.add_argument("--width", type=float, default=32.0, help="blend transition width, px")
+    g.add_argument("--width", type=float, default=32.0,
+                   help="blend transition width, px of the mask or map (one of another size, with the image's "
+                        "proportions, is drawn at --size)")
     g.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1: linear)")
     g.add_argument("--corners", nargs=4, metavar="SPEC",
                    help="four-corner blend: top-left top-right bottom-left bottom-right, each CLASS[:NAME=V,...]")
@@ -92,8 +94,6 @@ def _painted_parts(a: argparse.Namespace) -> tuple:
     if not a.region:
         raise SettingError("--region", "a --map needs --region KEY=SPEC for each of its colours")
     px = flag_image("--map", decode, a.map)
-    if px.shape[:2] != (a.size, a.size):
-        raise SettingError("--map", f"map is {px.shape[1]}x{px.shape[0]} but --size is {a.size}")
     keys, specs = [], []
     for r in a.region:
         key, sep, spec = r.partition("=")
@@ -135,8 +135,6 @@ def neural_request(a: argparse.Namespace, model):
         if not os.path.isfile(a.blend):
             raise SettingError("--blend", f"mask not found: {a.blend}")
         mask = flag_image("--blend", read_image, a.blend)
-        if mask.shape != (a.size, a.size):
-            raise SettingError("--blend", f"mask is {mask.shape[1]}x{mask.shape[0]} but --size is {a.size}")
         spec2 = (a.noise2 or a.noise, param_items(a.param2, "--param2"))
         req = NeuralRequest("blend", [spec, spec2], mask=mask > 0.5, **kw)
     else:

@@ -8,8 +8,10 @@ share (classes, parameters, map sizes, sampler), :meth:`NeuralRequest.conditioni
 :func:`generate_request` the image. :meth:`NeuralRequest.key` is a JSON summary (maps by sha256): equal settings
 from any front-end give equal keys (tests/cli/test_neural_request.py), and bakes store it to skip up-to-date files.
 
-Shapes: ``mask`` bool (H, W), True where the second spec is; ``regions`` int (H, W), each pixel's index into
-``specs``; images float32 (H, W) in [0, 1], rows top to bottom.
+Shapes: ``mask`` bool (h, w), True where the second spec is; ``regions`` int (h, w), each pixel's index into
+``specs``: at the image's size (H, W) or any other of its proportions, drawn at the image's size by nearest pixel
+(:func:`map_at`), with transitions measured in the map's pixels (a map painted at 512 px and drawn at 2048 keeps
+its transitions' look); images float32 (H, W) in [0, 1], rows top to bottom.
 """
 from __future__ import annotations
 
@@ -23,10 +25,27 @@ from ..errors import SettingError
 from . import conditioning as C
 from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 
-__all__ = ["LAYOUTS", "NeuralRequest", "generate_request", "regions_from_colours", "region_key", "regions_from_map"]
+__all__ = ["LAYOUTS", "NeuralRequest", "generate_request", "regions_from_colours", "region_key", "regions_from_map",
+           "map_fits", "map_at"]
 
 #: layout -> how many specs it takes (None: any number, one per painted region)
 LAYOUTS = {"uniform": 1, "blend": 2, "gradient": 2, "corners": 4, "painted": None}
+
+
+def map_fits(shape, height: int, width: int) -> bool:
+    """Whether a mask or map of ``shape`` (h, w, ...) draws a ``width`` x ``height`` image: its own size, or
+    another of the image's proportions (within one pixel of the image's height at its width)."""
+    h, w = shape[:2]
+    return (h, w) == (height, width) or (h > 0 and w > 0 and abs(h * width / w - height) < 1.0)
+
+
+def map_at(arr: np.ndarray, height: int, width: int) -> tuple:
+    """(``arr`` (h, w) drawn at (height, width) by nearest pixel, the factor its pixels grow by): a painted region
+    keeps its index and a mask its two values, with no value between (blurring is the transitions' work)."""
+    h, w = arr.shape[:2]
+    if (h, w) == (height, width):
+        return arr, 1.0
+    return arr[(np.arange(height) * h // height)[:, None], (np.arange(width) * w // width)[None, :]], width / w
 
 
 def _spec(s) -> tuple:
@@ -49,8 +68,8 @@ def _spec(s) -> tuple:
 @dataclass(frozen=True, eq=False)
 class NeuralRequest:
     """A neural-noise image: ``layout`` of ``specs`` ((class, {parameter: value}) pairs), ``width`` x ``height``
-    pixels, transitions of ``transition`` px with exponent ``sharpness`` (blend and painted layouts), and the
-    sampler settings of :func:`backend.neural.generate.generate`."""
+    pixels, transitions of ``transition`` px of the mask or map with exponent ``sharpness`` (blend and painted
+    layouts), and the sampler settings of :func:`backend.neural.generate.generate`."""
 
     layout: str
     specs: tuple
@@ -92,15 +111,13 @@ class NeuralRequest:
             raise SettingError("size", f"must be >= 8, got {self.width}x{self.height}")
         for s in self.specs:
             model.param_vector(*s)  # unknown classes or parameters, with their names
-        shape = (self.height, self.width)
-        if self.layout == "blend":
-            if self.mask is None or self.mask.shape != shape:
-                got = "none" if self.mask is None else f"{self.mask.shape[1]}x{self.mask.shape[0]}"
-                raise SettingError("blend", f"mask is {got} but the image is {self.width}x{self.height}")
+        for layout, key, arr in (("blend", "blend", self.mask), ("painted", "map", self.regions)):
+            if self.layout == layout and (arr is None or not map_fits(arr.shape, self.height, self.width)):
+                what = "mask" if key == "blend" else "map"
+                got = "none" if arr is None else f"{arr.shape[1]}x{arr.shape[0]}"
+                raise SettingError(key, f"{what} is {got} but the image is {self.width}x{self.height}: a {what} "
+                                        "is drawn at the image's size and must have its proportions")
         if self.layout == "painted":
-            if self.regions is None or self.regions.shape != shape:
-                got = "none" if self.regions is None else f"{self.regions.shape[1]}x{self.regions.shape[0]}"
-                raise SettingError("map", f"map is {got} but the image is {self.width}x{self.height}")
             if self.regions.min() < 0 or self.regions.max() >= len(self.specs):
                 raise SettingError("map", f"region indices must lie in [0, {len(self.specs)}), "
                                           f"got {self.regions.min()}..{self.regions.max()}")
@@ -124,15 +141,17 @@ class NeuralRequest:
         if self.layout == "uniform":
             return C.uniform(model, self.specs[0], H, W)
         if self.layout == "blend":
-            return C.blend(model, self.specs[0], self.specs[1], C.mask_weight(self.mask, self.transition,
+            mask, grow = map_at(self.mask, H, W)
+            return C.blend(model, self.specs[0], self.specs[1], C.mask_weight(mask, self.transition * grow,
                                                                              self.sharpness))
         if self.layout == "gradient":  # the first spec on the left blending linearly into the second on the right
             w = np.broadcast_to(np.linspace(0.0, 1.0, W, dtype=np.float32)[None, :], (H, W))
             return C.blend(model, self.specs[0], self.specs[1], w)
         if self.layout == "corners":
             return C.four_corner(model, list(self.specs), H, W)
-        present = sorted(int(i) for i in np.unique(self.regions))
-        return C.painted(model, self.regions, {i: self.specs[i] for i in present}, self.transition, self.sharpness)
+        regions, grow = map_at(self.regions, H, W)
+        present = sorted(int(i) for i in np.unique(regions))
+        return C.painted(model, regions, {i: self.specs[i] for i in present}, self.transition * grow, self.sharpness)
 
     def key(self) -> dict:
         """A JSON summary: every setting, maps by sha256 (equal keys: equal images)."""
@@ -143,6 +162,8 @@ class NeuralRequest:
             d.update(transition=self.transition, sharpness=self.sharpness)
             arr = self.mask if self.layout == "blend" else self.regions
             d["map_sha256"] = hashlib.sha256(np.ascontiguousarray(arr).tobytes()).hexdigest()
+            if arr.shape != (self.height, self.width):      # the bytes alone do not tell a 64x32 map from 32x64
+                d["map_size"] = [arr.shape[1], arr.shape[0]]
         return d
 
 

@@ -371,7 +371,7 @@ def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
         args += ["--map", str(tmp_path / "map.png"), "--width", "6"]    # the panel's width shapes maps only
         for s in p.swatches[:2]:
             args += ["--region", "#%02x%02x%02x=" % tuple(round(c * 255) for c in s.color) + flag(s.spec())]
-        args[1] = str(n)
+        args[1] = str(n // 2)  # both draw the map at the image's size, its transitions in the map's pixels
     panel = neural_ui.panel_request(p, int(args[1]))
     cli = neural_request(build_parser().parse_args(["neural", *args, "-o", "x.png"]), neural_ui.model())
     if mode == "MAP":  # the panel lists every swatch; the map uses the first two

@@ -121,3 +121,38 @@ def test_requests_check_what_every_front_end_shares(model):
         with pytest.raises(SettingError, match=None) as e:
             req.check(model)
         assert msg in str(e.value), (msg, str(e.value))
+
+
+@pytest.mark.parametrize("layout", ["blend", "painted"])
+def test_a_mask_or_map_of_another_size_is_drawn_at_the_images_size(layout, model, maps, monkeypatch, capsys):
+    """A 32 px mask or painted map drawn as a 64 px image (command line and job file alike) is the image of that
+    map grown to 64 px by nearest pixel with its transition width doubled (transitions are in the map's pixels, as
+    the Blender panel reads its blend map); a map of other proportions is refused naming it, before any work."""
+    flags, table = CASES[layout]
+    monkeypatch.chdir(maps)
+    sampling = [a if a != "32" else "64" for a in SAMPLING]
+    cli = neural_request(build_parser().parse_args(["neural", "--model", TINY, *flags, *sampling, "-o", "x.png"]),
+                         model)
+    job = source_from_dict(dict(kind="neural", model=TINY, seed=3, steps=3, sampler="ddim", **table),
+                           str(maps)).request((64, 64))
+    assert cli.key() == job.key() and job.key()["map_size"] == [32, 32]
+    small = cli.mask if layout == "blend" else cli.regions
+    grown = np.repeat(np.repeat(small, 2, axis=0), 2, axis=1)
+    big = NeuralRequest(layout, cli.specs, 64, 64, **{"mask" if layout == "blend" else "regions": grown},
+                        transition=2 * cli.transition, sharpness=cli.sharpness, seed=3, steps=3, sampler="ddim")
+    np.testing.assert_array_equal(cli.conditioning(model), big.conditioning(model))
+    np.testing.assert_allclose(generate_request(model, job), generate_request(model, big), atol=1e-6)
+    with pytest.raises(SettingError, match=r"is 32x32 but the image is 64x48: a (mask|map) is drawn at the image's "
+                                           r"size and must have its proportions"):
+        NeuralRequest(layout, cli.specs, 64, 48, mask=cli.mask, regions=cli.regions).check(model)
+    flag = "--blend" if layout == "blend" else "--map"
+    assert main(["neural", "--model", TINY, *flags, "--size", "48", "-o", "x.png"]) == 0
+    wide = np.zeros((16, 32), np.uint8)
+    write_png(str(maps / "wide.png"), wide)
+    args = [a if a not in ("mask.png", "paint.png") else "wide.png" for a in flags]
+    assert main(["neural", "--model", TINY, *args, "--size", "32", "-o", "y.png", "--quiet"]) == 2
+    assert f"{flag}: " in capsys.readouterr().err and not (maps / "y.png").exists()
+    with pytest.raises(SettingError, match=f"^source.{'blend' if layout == 'blend' else 'map'}: (mask|map) is 32x16 "
+                                           "but the resolution is 32x32"):
+        source_from_dict(dict(kind="neural", model=TINY, **dict(table, **{"blend" if layout == "blend" else "map":
+                                                                          "wide.png"})), str(maps)).check_grid((32, 32))

@@ -149,6 +149,7 @@ def test_neural_cli(tiny, tmp_path, capsys):
     from omninoise.export.images import write_png
 
     write_png(str(tmp_path / "m.png"), mask)
+    write_png(str(tmp_path / "wide.png"), mask[:16])
     assert main(base + ["--noise", "spots", "--noise2", "perlin", "--param2", "scale=10", "--blend",
                         str(tmp_path / "m.png"), "--size", "32", "-o", png]) == 0
     assert main(base + ["--corners", "spots:coverage=0.3", "perlin", "cells_f1:scale=10,jitter=0.5", "spots",
@@ -166,8 +167,8 @@ def test_neural_cli(tiny, tmp_path, capsys):
     assert "spots" in json.loads(capsys.readouterr().out)["classes"]
     for args, msg in [(["--noise", "lava", "-o", png], "unknown class 'lava'"),
                       (["--noise", "spots", "--param", "coverage=9", "-o", png], "outside [0.2, 0.8]"),
-                      (["--noise", "spots", "--blend", str(tmp_path / "m.png"), "--size", "16", "-o", png],
-                       "mask is 32x32 but --size is 16"),
+                      (["--noise", "spots", "--blend", str(tmp_path / "wide.png"), "--size", "16", "-o", png],
+                       "--blend: mask is 32x16 but the image is 16x16"),
                       (["--noise", "spots", "--noise2", "perlin", "-o", png], "needs --blend")]:
         assert main(base + args) == 2
         assert msg in capsys.readouterr().err
