@@ -58,13 +58,11 @@ def _check_out(out: str, allowed: tuple, what: str, read: tuple = ()) -> str:
     if not isinstance(out, (str, os.PathLike)):
         raise SettingError("out", f"expected a file path, got {out!r}")
     out = os.fspath(out)
-    from .backend.bake import check_not_read, check_one_file
+    from .backend.bake import check_not_read, check_one_file, output_type
 
     check_one_file(out, "out")
     check_not_read(out, "out", read)
-    ext = os.path.splitext(out)[1].lower()
-    if ext not in allowed:
-        raise SettingError("out", f"{what} is written as {', '.join(allowed)}, not {ext or out!r}")
+    ext = output_type(out, allowed, what, "out")
     folder = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(folder):
         raise SettingError("out", f"output folder does not exist: {folder}")

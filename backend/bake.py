@@ -44,7 +44,7 @@ from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
 __all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "check_one_file",
-           "check_not_read", "FORMATS", "KEY_NAME", "Cancelled"]
+           "check_not_read", "output_type", "FORMATS", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
@@ -185,6 +185,15 @@ def check_one_file(path: str, setting: str, or_else: str = "") -> None:
     if has_frame_field(path):
         raise SettingError(setting, f"{os.path.basename(path)}: '#' stands for the frame number of a sequence, and "
                                     f"this writes one file: take it out of the name{or_else}")
+
+
+def output_type(path: str, allowed: tuple, what: str, setting: str) -> str:
+    """The extension of the output file ``path``, lower case; SettingError naming ``setting`` where it is none of
+    ``allowed`` (what ``what``, "a neural noise image", is written as)."""
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if ext not in allowed:
+        raise SettingError(setting, f"{what} is written as {', '.join(allowed)}, not {ext or os.fspath(path)!r}")
+    return ext
 
 
 def check_not_read(path: str, setting: str, inputs) -> None:

@@ -7,6 +7,7 @@ import os
 import sys
 
 from omninoise.backend import limits
+from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.neural.animate import LATENT_MODES
 from omninoise.backend.neural.generate import check_memory as neural_memory
@@ -14,6 +15,8 @@ from omninoise.backend.neural.precision import PRECISIONS
 from omninoise.backend.paths import neural_model
 
 from .common import Bar, add_command, class_args, flag_image, param_items, set_threads
+
+IMAGE_TYPES = (".png", ".exr", ".npy")   #: what a neural noise image is written as
 
 __all__ = ["add_parser", "run", "neural_request"]
 
@@ -195,9 +198,7 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("--report", "a fit report needs --fit IMAGE")
     if not (a.noise or a.corners or a.map) or not a.out:
         raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
-    ext = os.path.splitext(a.out)[1].lower()
-    if ext not in (".png", ".exr", ".npy"):
-        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")
     req = neural_request(a, model)
     bar = Bar(a.quiet)
     try:
@@ -225,9 +226,7 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     if not a.out or not has_frame_field(a.out):
         raise SettingError("-o", "an animation writes one file per frame: put '#' for the frame number in the "
                                  "name, e.g. -o noise_####.png")
-    ext = os.path.splitext(a.out)[1].lower()
-    if ext not in (".png", ".exr", ".npy"):
-        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
     first, last = a.frames
@@ -263,9 +262,7 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
         raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
     if not a.out:
         raise SettingError("-o", "--fit writes the fitted noise: give -o OUT (.png, .exr or .npy)")
-    ext = os.path.splitext(a.out)[1].lower()
-    if ext not in (".png", ".exr", ".npy"):
-        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .png, .exr or .npy")
+    output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
     check_fit_size(a.fit_size, model.multiple_of, "--fit-size")

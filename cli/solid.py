@@ -9,6 +9,7 @@ import time
 import numpy as np
 
 from omninoise.backend import limits
+from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import METHODS
 from omninoise.backend.solid.gaussian_rest import REST_CHOICES
@@ -111,7 +112,6 @@ def run(a: argparse.Namespace) -> int:
     limits.scale("--scale", a.scale)
     limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     ext = os.path.splitext(a.out)[1].lower()
-    allowed = (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy")
     if ext == ".json":          # the fitted procedural solid itself, drawn later at any size
         if a.method != "procedural":
             raise SettingError("-o", "a .json output is a fitted procedural solid: give --method procedural")
@@ -119,8 +119,8 @@ def run(a: argparse.Namespace) -> int:
             if value != unset:
                 raise SettingError(flag, "a .json output holds the fitted solid, not a drawing of it: leave "
                                          f"{flag} out, and give it when the .json is drawn (--exemplar)")
-    elif ext not in allowed:
-        raise SettingError("-o", f"a {a.dim}D result is written as {', '.join(allowed)}, not {ext or a.out!r}")
+    else:
+        output_type(a.out, (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy"), f"a {a.dim}D result", "-o")
     if ext == ".vdb":
         from omninoise.backend.bake import require_vdb
 

@@ -26,8 +26,7 @@ omninoise transfer fire -o my_ramp.json""")
 def run(a: argparse.Namespace) -> int:
     import json
 
-    import os
-
+    from omninoise.backend.bake import output_type
     from omninoise.backend.errors import SettingError
     from omninoise.backend.transfer import preset
 
@@ -35,8 +34,8 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("--list", "lists the presets; leave out the preset name, or --list to print the preset")
     if a.out and not a.preset:
         raise SettingError("-o", f"saves a preset: give its name ({', '.join(PRESETS)})")
-    if a.out and os.path.splitext(a.out)[1].lower() != ".json":
-        raise SettingError("-o", f"a ramp is written as .json, not {os.path.splitext(a.out)[1] or a.out!r}")
+    if a.out:
+        output_type(a.out, (".json",), "a ramp", "-o")
     if a.list or not a.preset:
         print("\n".join(PRESETS))
         return 0

@@ -9,6 +9,7 @@ import warnings
 import numpy as np
 
 from omninoise.backend import limits
+from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.transfer import PRESETS, load_transfer
 from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
@@ -183,9 +184,7 @@ def _flag(a: argparse.Namespace, setting: str) -> str:
 
 
 def run(a: argparse.Namespace) -> int:
-    ext = os.path.splitext(a.out)[1].lower()
-    if ext not in (".npy", ".exr", ".png", ".vdb"):
-        raise SettingError("-o", f"unsupported output type {ext or a.out!r}; use .npy, .exr, .png or .vdb")
+    ext = output_type(a.out, (".npy", ".exr", ".png", ".vdb"), "wave noise", "-o")
     if a.dim > 2 and ext not in (".npy", ".vdb"):
         raise SettingError("-o", f"a {a.dim}D grid is a volume; write it as .vdb or .npy")
     if a.dim == 2 and ext == ".vdb":

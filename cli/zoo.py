@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 import argparse
-import os
 
 from omninoise.backend import limits
+from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
 
 from .common import add_command, class_args
@@ -39,8 +39,7 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
     if not 0 <= a.seed < 2 ** 32:
         raise SettingError("--seed", f"must lie in [0, 2^32), got {a.seed}")
-    if os.path.splitext(a.out)[1].lower() not in (".png", ".exr", ".npy"):
-        raise SettingError("-o", f"unsupported output type {os.path.splitext(a.out)[1] or a.out!r}; use .png, .exr or .npy")
+    output_type(a.out, (".png", ".exr", ".npy"), "a noise image", "-o")
     limits.check_memory("--size", float(a.size) ** 2 * 4 * 8, f"a {a.size}² zoo image")
     try:
         params = zoo.parse_params(a.noise, a.param)

@@ -456,3 +456,22 @@ def test_a_bake_reading_what_an_earlier_bake_writes_says_so(tmp_path, capsys):
            "first, on its own or with --only)" in out, out
     assert main(["bake", str(job), "--only", "mask", "--quiet"]) == 0
     assert main(["bake", str(job), "--quiet"]) == 0 and (tmp_path / "l.png").is_file()
+
+
+@pytest.mark.parametrize("args, said", [
+    (["wave", "--size", "4"], "wave noise is written as .npy, .exr, .png, .vdb"),
+    (["neural", "--noise", "perlin"], "a neural noise image is written as .png, .exr, .npy"),
+    (["neural", "--keys", "k.toml", "--frames", "1", "2"], "a neural noise image is written as .png, .exr, .npy"),
+    (["neural", "--fit", "photo.png"], "a neural noise image is written as .png, .exr, .npy"),
+    (["solid", "--exemplar", "grass"], "a 2D result is written as .png, .exr, .npy"),
+    (["solid", "--exemplar", "grass", "--dim", "3"], "a 3D result is written as .vdb, .npy"),
+    (["transfer", "fire"], "a ramp is written as .json"),
+])
+def test_every_command_names_the_types_its_output_is_written_as(tmp_path, capsys, monkeypatch, args, said):
+    """An output of a type the command does not write is refused in one line of one form on every command, saying
+    what it writes; the keyframed and fitted neural noise's too (they each checked it in their own words)."""
+    monkeypatch.chdir(tmp_path)
+    out = "x_#.jpg" if "--keys" in args else "x.jpg"
+    assert main(args + ["-o", out]) == 2
+    assert capsys.readouterr().err.strip().endswith(f"-o: {said}, not '.jpg'")
+    assert os.listdir(tmp_path) == []

@@ -103,7 +103,7 @@ def test_the_fit_improves_on_its_start_and_the_cli_gives_the_same(model, tmp_pat
     (["--fit", "missing.png", "-o", "o.png"], "image not found"),
     (["--fit", "small.png", "-o", "o.png"], "small.png: 10x10 px"),
     (["--fit", "small.png", "--noise", "perlin", "-o", "o.png"], "leave out --noise"),
-    (["--fit", "small.png", "-o", "o.vdb"], "unsupported output type"),
+    (["--fit", "small.png", "-o", "o.vdb"], "-o: a neural noise image is written as .png, .exr, .npy, not '.vdb'"),
 ])
 def test_fit_errors_name_what_is_wrong(args, msg, tmp_path, capsys, monkeypatch):
     from PIL import Image
