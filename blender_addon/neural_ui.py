@@ -178,8 +178,11 @@ def panel_request(p: OMNINOISE_PG_neural, size: int, steps: int | None = None):
         raise backend.SettingError("blend map", f"the map is {iw}x{ih}; it must be square like the output")
     px = image_pixels(img, "blend map")     # a map's colours name its regions; what alpha a brush left is not read
     rgb = px[..., :3] if px.shape[2] >= 3 else np.repeat(px[..., :1], 3, axis=2)
-    # brush strokes blend colours at their edges: each pixel takes its nearest swatch colour; the request draws the
-    # regions at the output's size, the transitions in the map's pixels
+    # a map larger than the output is read at the output's size (a 4096 px map classified whole takes 7 s, here on
+    # the main thread); a smaller one the request draws at that size; the transitions stay in the map's pixels
+    rgb, grow = R.map_at(rgb, min(size, ih), min(size, iw))
+    kw["transition"] = p.width * grow
+    # brush strokes blend colours at their edges: each pixel takes its nearest swatch colour
     regions = R.regions_from_colours(rgb, [tuple(s.color) for s in sw], tolerance=0.2, where="blend map")
     return R.NeuralRequest("painted", [s.spec() for s in sw], regions=regions, **kw).check(m)
 
