@@ -46,4 +46,5 @@ def test_the_python_examples_run(path, folder, capsys):
         assert [(o.name, o.status) for o in env["outcomes"]] == [("clouds", "baked")]
     else:
         assert env["values"].shape == (64,) and np.isfinite(env["values"]).all()
+        assert env["blend"].shape == (128, 128) and np.isfinite(env["blend"]).all()
         assert env["vol"].shape == (64, 64, 64, 3)
