@@ -78,9 +78,10 @@ def test_a_float_photo_of_whole_numbers_above_1_is_refused_naming_the_fix(tmp_pa
     np.save(tmp_path / "f255.npy", srgb8)
     write_exr(str(tmp_path / "f255.exr"), srgb8)
     for name in ("f255.npy", "f255.exr"):
-        with pytest.raises(ImageError, match=r"f255\.\w+: a float image holds scene-linear colour \(0 to 1, more only in "
-                                             r"highlights\), but this one holds whole numbers up to 255, as 8- or "
-                                             r"16-bit pixels do: store them as uint8 or uint16, or divided by 255"):
+        with pytest.raises(ImageError, match=r"f255\.\w+: a float image holds scene-linear colour \(0 to 1, more "
+                                             r"only in highlights\), but this one holds whole numbers up to 255, "
+                                             r"as 8- or 16-bit pixels do: store them as uint8 or uint16, or divided "
+                                             r"by 255"):
             read_rgb(str(tmp_path / name))
     out = tmp_path / "o.png"
     assert main(["solid", "--exemplar", str(tmp_path / "f255.npy"), "--method", "spectral", "-o", str(out)]) == 2
