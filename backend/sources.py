@@ -252,16 +252,14 @@ class NeuralSource:
     def check_grid(self, shape) -> None:
         """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask or
         painted map of other proportions (one of another size with the same is drawn at the resolution)."""
-        from .neural.request import map_fits
+        from .neural.request import map_error
 
         if len(shape) != 2:
             raise SettingError("grid", "neural noise bakes images (resolution [width, height])")
-        for key, arr in (("blend", self.mask), ("map", self.regions)):
-            if arr is not None and not map_fits(arr.shape, *shape):
-                what = "mask" if key == "blend" else "map"
-                raise SettingError(f"source.{key}", f"{what} is {arr.shape[1]}x{arr.shape[0]} but the resolution "
-                                   f"is {shape[1]}x{shape[0]}: a {what} is drawn at the resolution and must have "
-                                   "its proportions")
+        for key, what, arr in (("blend", "mask", self.mask), ("map", "map", self.regions)):
+            why = None if arr is None else map_error(arr, *shape, what, "the resolution", "the resolution")
+            if why is not None:
+                raise SettingError(f"source.{key}", why)
 
     def request(self, shape):
         """The :class:`backend.neural.request.NeuralRequest` of this source on an (H, W) grid (not animated)."""

@@ -26,17 +26,23 @@ from . import conditioning as C
 from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 
 __all__ = ["LAYOUTS", "NeuralRequest", "generate_request", "regions_from_colours", "region_key", "regions_from_map",
-           "map_fits", "map_at"]
+           "map_error", "map_at"]
 
 #: layout -> how many specs it takes (None: any number, one per painted region)
 LAYOUTS = {"uniform": 1, "blend": 2, "gradient": 2, "corners": 4, "painted": None}
 
 
-def map_fits(shape, height: int, width: int) -> bool:
-    """Whether a mask or map of ``shape`` (h, w, ...) draws a ``width`` x ``height`` image: its own size, or
-    another of the image's proportions (within one pixel of the image's height at its width)."""
-    h, w = shape[:2]
-    return (h, w) == (height, width) or (h > 0 and w > 0 and abs(h * width / w - height) < 1.0)
+def map_error(arr, height: int, width: int, what: str, image: str = "the image",
+              at: str = "the image's size") -> str | None:
+    """Why the ``what`` ("mask" or "map") ``arr`` (h, w, ...; None: not given) cannot draw a ``width`` x ``height``
+    image, in the words of its caller (``image`` and where it is drawn, ``at``), or None where it can: its own size,
+    or another of the image's proportions (within one pixel of the image's height at its width)."""
+    if arr is not None:
+        h, w = arr.shape[:2]
+        if (h, w) == (height, width) or (h > 0 and w > 0 and abs(h * width / w - height) < 1.0):
+            return None
+    got = "none" if arr is None else f"{arr.shape[1]}x{arr.shape[0]}"
+    return f"{what} is {got} but {image} is {width}x{height}: a {what} is drawn at {at} and must have its proportions"
 
 
 def map_at(arr: np.ndarray, height: int, width: int) -> tuple:
@@ -111,12 +117,10 @@ class NeuralRequest:
             raise SettingError("size", f"must be >= 8, got {self.width}x{self.height}")
         for s in self.specs:
             model.param_vector(*s)  # unknown classes or parameters, with their names
-        for layout, key, arr in (("blend", "blend", self.mask), ("painted", "map", self.regions)):
-            if self.layout == layout and (arr is None or not map_fits(arr.shape, self.height, self.width)):
-                what = "mask" if key == "blend" else "map"
-                got = "none" if arr is None else f"{arr.shape[1]}x{arr.shape[0]}"
-                raise SettingError(key, f"{what} is {got} but the image is {self.width}x{self.height}: a {what} "
-                                        "is drawn at the image's size and must have its proportions")
+        for layout, key, what, arr in (("blend", "blend", "mask", self.mask), ("painted", "map", "map", self.regions)):
+            why = map_error(arr, self.height, self.width, what) if self.layout == layout else None
+            if why is not None:
+                raise SettingError(key, why)
         if self.layout == "painted":
             if self.regions.min() < 0 or self.regions.max() >= len(self.specs):
                 raise SettingError("map", f"region indices must lie in [0, {len(self.specs)}), "
