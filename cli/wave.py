@@ -152,9 +152,9 @@ def settings_from_args(a: argparse.Namespace) -> WaveSettings:
     # equal settings from flags, job files and the panel are equal requests (tests/blender/test_wave_front_ends.py)
     used = {}
     if example is not None:
-        used["example_extent"] = a.example_extent or a.extent
+        used["example_extent"] = a.example_extent if a.example_extent is not None else a.extent
     if a.transition is not None:
-        used["transition_length"] = a.transition_length or a.extent
+        used["transition_length"] = a.transition_length if a.transition_length is not None else a.extent
     s = WaveSettings(
         dim=a.dim, spectrum=Spectrum(a.spectrum, a.fmin, a.fmax, a.exponent), directions=a.directions,
         seed=a.seed, output=a.output, speed=a.speed, slice_width=a.slice_width, waveform=a.waveform,
@@ -210,7 +210,10 @@ def run(a: argparse.Namespace) -> int:
     s = settings_from_args(a)
     tf = load_transfer(a.transfer, "--transfer") if a.transfer else None
     if tf is not None and a.range:
-        tf = tf.with_range(*a.range)
+        try:
+            tf = tf.with_range(*a.range)
+        except SettingError as exc:     # "range", "range[0]": the flag's two values
+            raise SettingError("--range", exc.message) from None
     from omninoise.backend.sources import WaveSource
 
     WaveSource(s).check_extent(a.extent, abs(a.time), ("--extent", "--time"))

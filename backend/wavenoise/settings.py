@@ -107,10 +107,27 @@ class WaveSettings:
             if self.dim not in (2, 3):
                 raise SettingError("example", "by-example noise is 2D or 3D")
             check_example(self.example)
-        try:
-            self.spectrum.validate()
-        except SettingError as exc:
-            raise exc.under("spectrum") from None
+        spectra = [("spectrum", self.spectrum)] + [(f"axis_spectra[{i}]", sp) for i, sp in enumerate(self.axis_spectra)]
+        if self.transition_to is not None:
+            spectra.append(("transition_to", self.transition_to))
+        for name, sp in spectra:
+            try:
+                sp.validate()
+            except SettingError as exc:
+                raise exc.under(name) from None
+        if self.anisotropy == "axes" and len(self.axis_spectra) != self.dim:
+            raise SettingError("axis_spectra", f"per-axis anisotropy needs {self.dim} spectra, one per axis, "
+                                               f"got {len(self.axis_spectra)}")
+        if self.anisotropy == "lobes" and not self.lobes:
+            raise SettingError("lobes", "lobe anisotropy needs at least one (axis, weight) lobe")
+        vectors = [(f"lobes[{i}]", "lobe axis", axis) for i, (axis, _) in enumerate(self.lobes)]
+        vectors += [(name, name.replace("_", " "), v) for name, v in (("transition_axis", self.transition_axis),
+                                                                       ("transition_origin", self.transition_origin))
+                    if len(v)]
+        for name, what, v in vectors:
+            if len(v) != self.dim or (what != "transition origin" and not np.linalg.norm(v) > 0):
+                zero = "" if what == "transition origin" else "non-zero "
+                raise SettingError(name, f"{what} {tuple(v)} must be a {zero}{self.dim}-vector")
         return self
 
     def max_frequency(self) -> float:
@@ -280,13 +297,9 @@ def _domains(s: WaveSettings) -> tuple[list[Domain], tuple]:
             return [Domain("band", 3, np.radians(s.spread), (a, b, c))], (a, b)
         raise SettingError("example", "by-example noise is 2D or 3D")
     if s.anisotropy == "lobes":
-        if not s.lobes:
-            raise SettingError("lobes", "lobe anisotropy needs at least one (axis, weight) lobe")
         doms = []
-        for axis, weight in s.lobes:
+        for axis, weight in s.lobes:       # validated: non-zero d-vectors
             v = np.asarray(axis, dtype=np.float64)
-            if v.shape != (d,) or not np.linalg.norm(v) > 0:
-                raise SettingError("lobes", f"lobe axis {tuple(axis)} must be a non-zero {d}-vector")
             doms.append(Domain("cap", d, np.radians(s.spread), tuple(v / np.linalg.norm(v)), weight=float(weight)))
         return doms, (0, 1)
     return [Domain("cap", d, np.pi / 2, last, full=s.animated)], (0, 1)
@@ -319,8 +332,6 @@ def compile_noise(s: WaveSettings) -> WaveNoise | CellularNoise:
         table = type(table)(pair.values[:1], pair.period, "single", s.dim, table.meta)
         axis = np.asarray(s.transition_axis or np.eye(s.dim)[0], np.float32)
         origin = np.asarray(s.transition_origin or np.zeros(s.dim), np.float32)
-        if axis.shape != (s.dim,) or origin.shape != (s.dim,):
-            raise SettingError("transition", f"origin and axis must be {s.dim}-vectors")
         transition = Transition(pair.values[1:2], origin, axis / np.linalg.norm(axis), float(s.transition_length))
     width = s.slice_width if s.slice_width is not None else 6.0 / table.mean_frequency()
     return WaveNoise(table, dirs, s.seed, width, s.speed, transition, plane)

@@ -34,6 +34,27 @@ def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("args, message", [
+    (["--anisotropy", "axes"], "--axis-spectrum: per-axis anisotropy needs 2 spectra, one per axis, got 0"),
+    (["--anisotropy", "axes", "--axis-spectrum", "gaussian:1:2", "--axis-spectrum", "gaussian:3:1"],
+     "--axis-spectrum: 3 is greater than fmax 1"),
+    (["--anisotropy", "lobes", "--lobe", "1,0,0:1"], "--lobe: lobe axis (1.0, 0.0, 0.0) must be a non-zero 2-vector"),
+    (["--transition", "gaussian:2:1"], "--transition: 2 is greater than fmax 1"),
+    (["--transition", "gaussian:1:2", "--transition-length", "0"], "--transition-length: must lie in [1e-06"),
+    (["--transfer", "fire", "--range", "nan", "1"], "--range: must be a finite number, got nan"),
+    (["--transfer", "fire", "--range", "1", "1"], "--range: needs two different values"),
+])
+def test_settings_that_join_flags_are_named_by_the_flag(tmp_path, capsys, args, message):
+    """A rule over several wave settings (a spectrum per axis, a lobe's axis, the transition's band, a ramp's
+    range) is checked before any work and named by the flag the user typed; a transition length of 0 is refused,
+    not read as "not given" (the extent)."""
+    out = tmp_path / "x.png"
+    rc = main(["wave", "--size", "16", "--quiet", *args, "-o", str(out)])
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert rc == 2 and len(lines) == 1 and lines[0].startswith(f"omninoise wave: error: {message}"), lines
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("args,setting", [
     (["--steps", "0"], "--steps: must be a whole number"),
     (["--sampler", "bogus"], "--sampler: unknown sampler"),
@@ -88,6 +109,10 @@ def test_a_neural_image_is_refused_by_what_it_takes_drawn_whole_or_in_tiles(monk
     (("time_step = 0.5", 'time_step = "x"'), "time_step: expected a number"),
     (("time_step = 0.5", 'time_step = 0.5\ntime = "x"'), "time: expected a number"),       # was a ValueError
     (("frames = [1, 2]", 'frames = ["a", "b"]'), r"frames\[0\]: expected a whole number, got 'a'"),
+    (("seed = 4", 'seed = 4\ntransition_to = {kind = "gaussian", fmin = 1, fmax = 3}\ntransition_axis = [0, 0, 0]'),
+     r"source.transition_axis: transition axis \(0.0, 0.0, 0.0\) must be a non-zero 3-vector"),  # was all NaN
+    (("seed = 4", 'seed = 4\nanisotropy = "lobes"\nlobes = [[[1, 0], 1]]'),
+     r"source.lobes\[0\]: lobe axis \(1.0, 0.0\) must be a non-zero 3-vector"),
     (("half = true", 'half = "no"'), "half: expected true or false"),                 # "no" was taken as true
     (("resolution = [32, 16]", "resolution = [100000000, 100000]"), "resolution"),
     (("bounds = [[-1, -1, 0], [1, 1, 1]]", "bounds = [[-1, -1, 0], [inf, 1, 1]]"), r"bounds\[1\]\[0\]: must be a finite number, got inf"),
