@@ -35,17 +35,32 @@ __all__ = ["wave", "neural", "solid", "bake"]
 Progress = Callable[[float], None] | None
 
 
-def _spectrum(value):
+def _spectrum(value, name: str = "spectrum"):
+    """A spectrum setting given as a Spectrum, a dict of its fields or a (kind, fmin, fmax[, exponent]) tuple."""
     from .backend.wavenoise.spectra import Spectrum
 
-    if value is None or isinstance(value, Spectrum):
-        return value
-    if isinstance(value, dict):
-        return Spectrum(**value)
+    if value is None or isinstance(value, (Spectrum, dict)) or (name == "spectrum" and isinstance(value, str)):
+        return value            # a dict's keys and a kind's name are checked with the settings, naming the setting
     if isinstance(value, (tuple, list)) and value and isinstance(value[0], str):
         return Spectrum(*value)
-    raise SettingError("spectrum", f"expected a Spectrum, a dict or a (kind, fmin, fmax[, exponent]) tuple, "
-                                   f"got {value!r}")
+    raise SettingError(name, f"expected a Spectrum, a dict or a (kind, fmin, fmax[, exponent]) tuple, got {value!r}")
+
+
+def _plain(value):
+    """A Python setting as a job file would hold it: spectra as tables, arrays and tuples as lists, numpy numbers
+    as Python's."""
+    from .backend.wavenoise.settings import spectrum_to_dict
+    from .backend.wavenoise.spectra import Spectrum
+
+    if isinstance(value, Spectrum):
+        return spectrum_to_dict(value)
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    return value
 
 
 def _check_progress(progress) -> None:
@@ -80,10 +95,11 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     """Wave noise (Guehl et al. 2025) on a ``size``-sample grid over ``[0, extent)`` per axis.
 
     ``settings`` are :class:`~omninoise.backend.wavenoise.settings.WaveSettings` fields (``dim`` 2, 3 or 4,
-    ``spectrum``, ``directions``, ``seed``, ``output``, ``waveform``, ``cellular``, ...); ``spectrum`` may be a
-    :class:`~omninoise.backend.wavenoise.spectra.Spectrum`, a dict of its fields or a tuple
-    ``(kind, fmin, fmax[, exponent])`` with frequencies in cycles per unit.  ``time`` is the animation time (or
-    the fourth coordinate w for ``dim=4``).
+    ``spectrum``, ``directions``, ``seed``, ``output``, ``waveform``, ``cellular``, ...), checked as a job file's
+    ``[bake.source]`` keys are (``docs/guide/job-reference.md``); a spectrum (``spectrum``, ``transition_to``, each
+    of ``axis_spectra``) may be a :class:`~omninoise.backend.wavenoise.spectra.Spectrum`, a dict of its fields or a
+    tuple ``(kind, fmin, fmax[, exponent])`` with frequencies in cycles per unit, and ``spectrum`` its kind's name
+    alone.  ``time`` is the animation time (or the fourth coordinate w for ``dim=4``).
 
     Returns float32 ``(size, size)`` for ``dim=2`` and ``(size, size, size)`` (``[z, y, x]``) for 3D and 4D, or,
     with ``out``, writes ``.npy``, ``.exr``, ``.png`` (2D) or ``.vdb`` (3D) as ``omninoise wave -o`` does, through
@@ -96,7 +112,8 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     from .backend.bake import BakeSpec, evaluate_values, run_bake
     from .backend.sources import BoxGrid, WaveSource
     from .backend.transfer import load_transfer
-    from .backend.wavenoise.settings import WaveSettings
+    from .backend.wavenoise.schema import WAVE_SETTINGS
+    from .backend.wavenoise.settings import WaveSettings, check_read, settings_from_dict
 
     _check_progress(progress)
     size = _check_size(size)
@@ -107,14 +124,21 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
         if name not in known:
             raise TypeError(f"wave() got an unexpected keyword argument {name!r}; its settings are "
                             f"{', '.join(known)}")
-    if "spectrum" in settings:
-        settings["spectrum"] = _spectrum(settings["spectrum"])
-    tuples = {f.name for f in dataclasses.fields(WaveSettings) if isinstance(f.default, tuple)}
-    for name in tuples & set(settings):     # a list or an array where the settings hold a tuple
-        v = settings[name]
-        v = v.tolist() if isinstance(v, np.ndarray) else v
-        settings[name] = tuple(v) if isinstance(v, list) else v
-    s = WaveSettings(**settings)
+    for name in ("spectrum", "transition_to"):
+        if name in settings:
+            settings[name] = _spectrum(settings[name], name)
+    if isinstance(settings.get("axis_spectra"), (tuple, list)):
+        settings["axis_spectra"] = [_spectrum(v, f"axis_spectra[{i}]") for i, v in enumerate(settings["axis_spectra"])]
+    example = settings.pop("example", None)
+    # read as a job file's settings are: checked against their table (types, ranges, lengths), then joined; a
+    # setting that changes nothing beside the others (a profile without waveform="custom") is refused
+    for f in dataclasses.fields(WaveSettings):     # None is "not given" only where it is the default
+        if f.name in settings and settings[f.name] is None and f.default is not None:
+            raise SettingError(f.name, "expected a value, got None")
+    plain = {k: _plain(v) for k, v in settings.items() if v is not None}
+    WAVE_SETTINGS.check(plain, "")
+    s = settings_from_dict(plain, example)
+    check_read(s, list(settings), lambda k, v=None: k if v is None else f"{k}={v!r}")
     rank = 2 if s.dim == 2 else 3          # 3D and 4D noise fill a volume (4D: at w = time)
     if out is not None:
         ext = _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid",

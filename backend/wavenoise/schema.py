@@ -9,6 +9,7 @@ from .. import limits
 from ..schema import AnyOf, Choice, Field, Float, Int, Items, ListOf, Table
 from .byexample import PLANES
 from .cellular import CELLULAR_MODES
+from .hashing import MAX_EXACT_ID
 from .spectra import SPECTRUM_KINDS
 from .tables import WAVEFORMS
 from .wave import OUTPUTS
@@ -17,6 +18,7 @@ __all__ = ["ANISOTROPY", "SEED", "COORD", "LENGTH", "FREQUENCY", "SPECTRUM", "WA
 
 ANISOTROPY = ("none", "axes", "lobes")
 SEED = Int(0, 2 ** 32 - 1)
+WAVE_SEED = Int(0, MAX_EXACT_ID - 1)    #: the wave hashes read a seed as a float32 id, exact below 2^24
 COORD = Float(-limits.MAX_COORD, limits.MAX_COORD)
 LENGTH = Float(limits.MIN_LENGTH, limits.MAX_COORD)
 FREQUENCY = Float(0.0, limits.MAX_FREQUENCY)
@@ -39,7 +41,7 @@ WAVE_SETTINGS = Table({
                       "a spectrum table, or its kind with fmin, fmax, exponent beside it", default="gaussian"),
     "directions": Field(Int(1, limits.MAX_DIRECTIONS), "number of wave directions; more is smoother and slower",
                         default="16"),
-    "seed": Field(SEED, "random seed of the tables and directions", default="0"),
+    "seed": Field(WAVE_SEED, "random seed of the tables and directions", default="0"),
     "output": Field(Choice(OUTPUTS), "which part of the complex noise is written", default="real"),
     "speed": Field(Float(-limits.MAX_SPEED, limits.MAX_SPEED), "wave speed in units per unit time; non-zero "
                    "animates", default="0"),

@@ -22,7 +22,7 @@ from .schema import ANISOTROPY, WAVE_SETTINGS
 from .wave import Transition, WaveNoise
 
 __all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict",
-           "READ_WITH", "check_read", "field_of"]
+           "READ_WITH", "check_read", "field_of", "spectrum_to_dict"]
 
 
 
@@ -156,7 +156,7 @@ class WaveSettings:
 _SPECTRUM_KEYS = ("kind", "fmin", "fmax", "exponent", "split", "ratio", "samples")
 
 
-def _spectrum_to_dict(sp: Spectrum) -> dict:
+def spectrum_to_dict(sp: Spectrum) -> dict:
     d = dict(kind=sp.kind, fmin=float(sp.fmin), fmax=float(sp.fmax), exponent=float(sp.exponent))
     if sp.kind == "twolevel":
         d.update(split=float(sp.split), ratio=float(sp.ratio))
@@ -197,9 +197,9 @@ def settings_to_dict(s: WaveSettings) -> dict:
 def _plain(name: str, v):
     """One WaveSettings field as JSON/TOML types."""
     if name in ("spectrum", "transition_to"):
-        return None if v is None else _spectrum_to_dict(v)
+        return None if v is None else spectrum_to_dict(v)
     if name == "axis_spectra":
-        return [_spectrum_to_dict(a) for a in v]
+        return [spectrum_to_dict(a) for a in v]
     if name == "lobes":
         return [[[float(c) for c in a], float(w)] for a, w in v]
     if isinstance(v, (tuple, np.ndarray)):

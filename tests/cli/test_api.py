@@ -27,7 +27,15 @@ CASES = [
     (lambda: omninoise.bake("job.toml", only="clouds"), "only", "expected a list of bake names"),
     (lambda: omninoise.wave(8, half=True), "half", "give out= too"),
     (lambda: omninoise.wave(8, half=True, out="x.npy"), "half", "into .exr and .vdb only"),
-    (lambda: omninoise.wave(8, waveform="custom", profile=np.zeros((2, 2))), "profile", "expected numbers"),
+    (lambda: omninoise.wave(8, waveform="custom", profile=np.zeros((2, 2))), "profile[0]",
+     r"expected a number, got \[0.0, 0.0\]"),
+    (lambda: omninoise.wave(8, profile=[0.0, 1.0, 0.0]), "profile", "is read only with waveform='custom'"),
+    (lambda: omninoise.wave(8, anisotropy="lobes", lobes=5), "lobes", "expected a list of 1 to 64 items"),
+    (lambda: omninoise.wave(8, seed=1 << 24), "seed", r"must lie in \[0, 16777215\]"),
+    (lambda: omninoise.wave(8, transition_to=("gaussian", 1, 2), transition_axis=(0, 0)), "transition_axis",
+     "must be a non-zero 2-vector"),
+    (lambda: omninoise.wave(8, anisotropy="axes", axis_spectra=[("gaussian", 1, 2)]), "axis_spectra",
+     "needs 2 spectra, one per axis, got 1"),
     (lambda: omninoise.wave(8, waveform="custom", profile=[1.0, 1.0]), "profile", "samples that vary"),
     (lambda: omninoise.solid("photo.png", 64, method="procedural", out="wall.json"), "size",
      "a .json output holds the fitted solid"),
@@ -45,6 +53,23 @@ def test_a_tuple_setting_may_be_a_list_or_an_array():
     lobes = omninoise.wave(8, dim=3, anisotropy="lobes", lobes=[[[0, 0, 1], 1.0]], seed=3)
     np.testing.assert_array_equal(lobes, omninoise.wave(8, dim=3, anisotropy="lobes", lobes=(((0, 0, 1), 1.0),),
                                                         seed=3))
+
+
+def test_every_spectrum_setting_takes_the_spectrum_forms():
+    """The transition's and the axes' spectra take the forms ``spectrum`` takes (a Spectrum, a dict, a tuple), as
+    their job-file tables are read; they crashed with an AttributeError as dicts or tuples."""
+    from omninoise.backend.wavenoise.spectra import Spectrum
+
+    a, b = Spectrum("gaussian", 1.0, 2.0), Spectrum("bandpass", 2.0, 4.0)
+    ref = omninoise.wave(8, transition_to=a, seed=2)
+    assert np.isfinite(ref).all() and ref.std() > 0.1
+    for form in (("gaussian", 1, 2), {"kind": "gaussian", "fmin": 1, "fmax": 2}):
+        np.testing.assert_array_equal(omninoise.wave(8, transition_to=form, seed=2), ref)
+    ref = omninoise.wave(8, anisotropy="axes", axis_spectra=(a, b), seed=2)
+    np.testing.assert_array_equal(omninoise.wave(8, anisotropy="axes", axis_spectra=[
+        ("gaussian", 1, 2), {"kind": "bandpass", "fmin": 2, "fmax": 4}], seed=2), ref)
+    np.testing.assert_array_equal(omninoise.wave(8, spectrum="bandpass", seed=2),
+                                  omninoise.wave(8, spectrum=Spectrum("bandpass"), seed=2))
 
 
 @pytest.mark.parametrize("call, setting, why", CASES)
