@@ -642,13 +642,20 @@ def _check_keys(d: dict, known: tuple, kind: str) -> None:
 def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     import os
 
+    from .neural.request import check_layout_reads
+
     _check_keys(d, _NEURAL_KEYS, "neural")
-    if "regions" in d and "map" not in d:
-        raise SettingError("source.regions", "regions name the colours of a painted map: give map = FILE too")
-    for key in ("width", "sharpness"):
-        if key in d and "blend" not in d and "map" not in d:
-            raise SettingError(f"source.{key}", "shapes the transitions of blend and map; without them it would "
-                                                "change nothing")
+    layouts = [k for k in ("blend", "corners", "map") if k in d]
+    if len(layouts) > 1:
+        raise SettingError(f"source.{layouts[1]}", f"choose one of blend, corners and map (got {' and '.join(layouts)})")
+    if "keys" in d and layouts:
+        raise SettingError("source.keys", "keyframes set the classes of the whole image; leave out blend, corners "
+                                          "and map")
+    layout = "animated" if "keys" in d else {"map": "painted"}.get(layouts[0], layouts[0]) if layouts else "uniform"
+    try:
+        check_layout_reads(layout, list(d))     # a key this layout does not read: the image would not be the one asked
+    except SettingError as exc:
+        raise exc.under("source") from None
     keys = None
     if "keys" in d:  # animation: a keyframe file (relative to the job) or an inline list of [[key]] tables
         from .neural.animate import parse_keys, read_keys
@@ -661,16 +668,11 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
             raise SettingError("source.keys", f"expected a keyframe file or a list of tables, got {d['keys']!r}")
         d.setdefault("noise", keys[0].noise)
         d.setdefault("params", keys[0].params)
-    elif "latent" in d or "drift" in d:
-        raise SettingError("source.latent", "latent motion animates keyframes: give keys too")
     if "noise" not in d and "corners" not in d and "map" not in d:
         raise SettingError("source.noise", "a neural source needs noise = CLASS (or corners, or map and regions)")
     from .paths import neural_model
 
     model = os.path.join(base_dir, d["model"]) if "model" in d else neural_model()
-    layouts = [k for k in ("blend", "corners", "map") if k in d]
-    if len(layouts) > 1:
-        raise SettingError(f"source.{layouts[1]}", f"choose one of blend, corners and map (got {' and '.join(layouts)})")
     corners = regions = region_specs = None
     if "corners" in d:
         c = d["corners"]
@@ -709,8 +711,6 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
             mask = export.read_image(path)
         except export.ImageError as exc:
             raise SettingError("source.blend", str(exc)) from None
-    elif "noise2" in d or "params2" in d:
-        raise SettingError("source.noise2", "a second noise needs blend = MASK")
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
                         d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps"), d.get("seed", 0),
                         d.get("tileable", False), d.get("sampler"), keys, d.get("latent", "fixed"), d.get("drift", 0.05),

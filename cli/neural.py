@@ -110,6 +110,29 @@ def _painted_parts(a: argparse.Namespace) -> tuple:
     return regions_from_map(px, keys, "--map"), specs
 
 
+#: the flag of each setting :data:`~backend.neural.request.READ_BY` names, and of each layout's chooser
+FLAG_OF = {"params": "--param", "params2": "--param2", "regions": "--region"}
+
+
+def check_reads(a: argparse.Namespace) -> None:
+    """Refuse, before any work, a flag that the image asked for does not read (a --region without --map, a --param
+    beside --corners, a --width in an animation): it would change nothing, and the image would not be the one
+    asked for; and two ways of laying out the classes at once."""
+    from omninoise.backend.neural.request import check_layout_reads
+
+    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
+        raise SettingError("--blend", "choose one of --blend, --corners and --map")
+    for flag, given in (("--report", a.report), ("--fit-size", a.fit_size != 64)):
+        if given and not a.fit:
+            raise SettingError(flag, f"a fit {'report' if flag == '--report' else 'window size'} needs --fit IMAGE")
+    layout = ("animated" if a.keys or a.frames else "fit" if a.fit else "corners" if a.corners
+              else "painted" if a.map else "blend" if a.blend else "uniform")
+    given = [k for k, v in (("noise", a.noise), ("params", a.param), ("noise2", a.noise2), ("params2", a.param2),
+                            ("width", a.width != 32.0), ("sharpness", a.sharpness != 1.0), ("regions", a.region),
+                            ("latent", a.latent != "fixed"), ("drift", a.drift != 0.05)) if v]
+    check_layout_reads(layout, given, lambda k: FLAG_OF.get(k, "--" + k))
+
+
 def neural_request(a: argparse.Namespace, model):
     """The :class:`backend.neural.request.NeuralRequest` of ``omninoise neural`` flags (checked)."""
     from omninoise.backend.neural.request import NeuralRequest
@@ -117,12 +140,6 @@ def neural_request(a: argparse.Namespace, model):
 
     if a.size < 8:
         raise SettingError("--size", f"must be >= 8, got {a.size}")
-    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
-        raise SettingError("--blend", "choose one of --blend, --corners and --map")
-    for flag, given in (("--width", a.width != 32.0), ("--sharpness", a.sharpness != 1.0)):
-        if given and not (a.blend or a.map):
-            raise SettingError(flag, "shapes the transitions of --blend and --map; without them it would change "
-                                     "nothing")
     kw = dict(width=a.size, height=a.size, transition=a.width, sharpness=a.sharpness, seed=a.seed,
               steps=DEFAULT_STEPS if a.steps is None else a.steps, sampler=a.sampler or DEFAULT_SAMPLER,
               spacing=a.spacing, eta=a.eta, tileable=a.tileable, tile=a.tile)
@@ -141,8 +158,6 @@ def neural_request(a: argparse.Namespace, model):
         spec2 = (a.noise2 or a.noise, param_items(a.param2, "--param2"))
         req = NeuralRequest("blend", [spec, spec2], mask=mask > 0.5, **kw)
     else:
-        if a.noise2 or a.param2:
-            raise SettingError("--noise2", "a second noise needs --blend MASK")
         req = NeuralRequest("uniform", [spec], **kw)
     try:
         return req.check(model)
@@ -186,16 +201,11 @@ def run(a: argparse.Namespace) -> int:
     if a.list:
         print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))
         return 0
+    check_reads(a)
     if a.keys or a.frames:
         return _animate(a, model, sampler, steps, tile)
-    for flag, given in (("--latent", a.latent != "fixed"), ("--drift", a.drift != 0.05)):
-        if given:
-            raise SettingError(flag, "moves the starting noise from frame to frame of an animation: give --keys "
-                                     "and --frames too")
     if a.fit:
         return _fit(a, model, sampler, steps, tile)
-    if a.report:
-        raise SettingError("--report", "a fit report needs --fit IMAGE")
     if not (a.noise or a.corners or a.map) or not a.out:
         raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
     output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")

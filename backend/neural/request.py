@@ -26,10 +26,43 @@ from . import conditioning as C
 from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 
 __all__ = ["LAYOUTS", "NeuralRequest", "generate_request", "regions_from_colours", "region_key", "regions_from_map",
-           "map_error", "map_at"]
+           "map_error", "map_at", "READ_BY", "check_layout_reads"]
 
 #: layout -> how many specs it takes (None: any number, one per painted region)
 LAYOUTS = {"uniform": 1, "blend": 2, "gradient": 2, "corners": 4, "painted": None}
+
+
+#: the settings (a job's keys) that only some ways of laying out an image's classes read -> (those layouts, what
+#: the setting does; ``{name}`` a setting's name as the front end shows it). ``animated`` is an animation's: its
+#: keyframes set the classes
+READ_BY = {
+    "noise": (("uniform", "blend"), "is the class of the whole image, or of a blend's unmasked part"),
+    "params": (("uniform", "blend"), "sets the parameters of {noise}"),
+    "noise2": (("blend",), "is the class of a blend's masked part"),
+    "params2": (("blend",), "sets the parameters of {noise2}"),
+    "width": (("blend", "painted"), "shapes the transitions of {blend} and {map}"),
+    "sharpness": (("blend", "painted"), "shapes the transitions of {blend} and {map}"),
+    "regions": (("painted",), "names the colours of {map}"),
+    "latent": (("animated",), "moves the starting noise from frame to frame of {keys}"),
+    "drift": (("animated",), "moves the starting noise from frame to frame of {keys}"),
+}
+#: the setting that lays the classes out in each layout but the uniform one
+CHOSEN_BY = {"blend": "blend", "corners": "corners", "painted": "map", "animated": "keys"}
+
+
+def check_layout_reads(layout: str, given, shown: Callable[[str], str] = str) -> None:
+    """SettingError naming the first of ``given`` (:data:`READ_BY` names) that an image laid out as ``layout`` (a
+    :data:`LAYOUTS` name, ``animated``, or a front end's own whose chooser ``shown`` names) does not read: it would
+    change nothing, and the image would not be the one asked for. ``shown(name)`` writes a setting's name as the
+    front end does (a job's key, a flag)."""
+    for key in given:
+        if key not in READ_BY or layout in READ_BY[key][0]:
+            continue
+        layouts, does = READ_BY[key]
+        choosers = [shown(CHOSEN_BY[name]) for name in layouts if name in CHOSEN_BY]
+        here = f"with {shown(CHOSEN_BY.get(layout, layout))}" if layout != "uniform" else f"without {' or '.join(choosers)}"
+        does = does.format(**{name: shown(name) for name in ("noise", "noise2", "blend", "map", "keys")})
+        raise SettingError(shown(key), f"{does}; {here}, it would change nothing")
 
 
 def map_error(arr, height: int, width: int, what: str, image: str = "the image",

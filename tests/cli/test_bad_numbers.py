@@ -192,6 +192,14 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["bake", "{d}/job.toml", "--cluster", "http://host:8786"], "--cluster: expected a Dask scheduler's tcp://"),
     (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--sharpness", "2", "-o", "{d}/n.png"],
      "--sharpness: shapes the transitions"),
+    # flags the image's layout does not read (each was ignored): a map's regions, a class beside the corners
+    (["neural", "--noise", "perlin", "--region", "0=spots", "-o", "{d}/n.png"],
+     "--region: names the colours of --map; without --map, it would change nothing"),
+    (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--param", "scale=4", "-o", "{d}/n.png"],
+     "--param: sets the parameters of --noise; with --corners, it would change nothing"),
+    (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--noise", "perlin", "-o", "{d}/n.png"],
+     "--noise: is the class of the whole image, or of a blend's unmasked part; with --corners"),
+    (["neural", "--noise", "perlin", "--fit-size", "32", "-o", "{d}/n.png"], "--fit-size: a fit window size needs --fit"),
 ])
 def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
     rc = main([x.format(d=tmp_path) for x in args])

@@ -90,7 +90,16 @@ sampler = "ddim"
 
 @pytest.mark.parametrize("table, msg", [
     (dict(corners=["spots", "perlin", "spots"]), "source.corners: expected 4 items, got 3"),
-    (dict(regions={"#ff0000": "spots"}), "source.regions: regions name the colours of a painted map"),
+    (dict(regions={"#ff0000": "spots"}), "source.regions: names the colours of map; without map, it would change"),
+    (dict(corners=["spots"] * 4, params={"coverage": 0.5}),
+     "source.params: sets the parameters of noise; with corners, it would change nothing"),
+    (dict(corners=["spots"] * 4, noise="perlin"), "source.noise: is the class of the whole image, or of a blend's"),
+    (dict(map="paint.png", regions={"#000000": "spots"}, noise2="perlin"),
+     "source.noise2: is the class of a blend's masked part; with map, it would change nothing"),
+    (dict(keys=[{"frame": 1, "noise": "spots"}], width=4.0),
+     "source.width: shapes the transitions of blend and map; with keys, it would change nothing"),
+    (dict(keys=[{"frame": 1, "noise": "spots"}], noise="perlin"), "source.noise: is the class of the whole image"),
+    (dict(noise="spots", drift=0.1), "source.drift: moves the starting noise from frame to frame of keys; without"),
     (dict(map="paint.png", corners=["spots"] * 4), "choose one of blend, corners and map"),
     (dict(map="paint.png", regions={"#ff00": "spots"}), "bad colour '#ff00'"),
     (dict(map="paint.png", regions={"#000000": "spots", "#ff0000": "perlin"}),
