@@ -113,7 +113,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     from .backend.sources import BoxGrid, WaveSource
     from .backend.transfer import load_transfer
     from .backend.wavenoise.schema import WAVE_SETTINGS
-    from .backend.wavenoise.settings import WaveSettings, check_read, settings_from_dict
+    from .backend.wavenoise.settings import WaveSettings, check_read, check_time, settings_from_dict
 
     _check_progress(progress)
     size = _check_size(size)
@@ -139,6 +139,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     WAVE_SETTINGS.check(plain, "")
     s = settings_from_dict(plain, example)
     check_read(s, list(settings), lambda k, v=None: k if v is None else f"{k}={v!r}")
+    check_time("time", time, s, "speed", "dim=4")
     rank = 2 if s.dim == 2 else 3          # 3D and 4D noise fill a volume (4D: at w = time)
     if out is not None:
         ext = _check_out(out, (".npy", ".exr", ".png") if rank == 2 else (".npy", ".vdb"), f"a {s.dim}D grid",

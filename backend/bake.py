@@ -54,6 +54,10 @@ SLAB_VOXELS = 1 << 19
 _FRAME = re.compile(r"#+")
 
 
+#: what makes a kind of source change over time, for a frame range of one that does not
+ANIMATED_BY = {"wave": "set speed, or dim = 4", "neural": "give keys: keyframes of its classes"}
+
+
 @dataclass(frozen=True)
 class BakeSpec:
     """One bake.
@@ -110,6 +114,9 @@ class BakeSpec:
             raise SettingError("grid", "a 2D noise cannot fill a 3D grid; use dim = 3 or 4")
         if getattr(self.source, "rgb", False) and self.transfer is not None:
             raise SettingError("transfer", "a solid texture has its own colours; remove the transfer function")
+        if ext == ".npy" and self.transfer is not None:
+            raise SettingError("transfer", ".npy holds the raw values, which a ramp does not colour: write .vdb, .exr "
+                                           "or .png, or remove the transfer function")
         if self.frames is not None:
             a, b = self.frames
             if int(a) != a or int(b) != b or b < a:
@@ -119,7 +126,8 @@ class BakeSpec:
                 raise SettingError("output", f"{os.path.basename(self.output)}: a frame range needs '#' in the file name "
                                    "(e.g. clouds_####.vdb)")
             if not self.source.animated:
-                raise SettingError("frames", "this source does not change over time (set speed, or dim = 4)")
+                how = ANIMATED_BY.get(self.source.kind)
+                raise SettingError("frames", "this source does not change over time" + (f" ({how})" if how else ""))
         else:
             check_one_file(self.output, "output", " (or give a frame range)")
         folder = os.path.dirname(os.path.abspath(self.output))

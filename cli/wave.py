@@ -13,7 +13,7 @@ from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.transfer import PRESETS, load_transfer
 from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
-from omninoise.backend.wavenoise.settings import ANISOTROPY, PLANES, WaveSettings, check_read, field_of
+from omninoise.backend.wavenoise.settings import ANISOTROPY, PLANES, WaveSettings, check_read, check_time, field_of
 from omninoise.backend.wavenoise.spectra import SPECTRUM_KINDS, Spectrum
 from omninoise.backend.wavenoise.tables import WAVEFORMS
 from omninoise.backend.wavenoise.wave import OUTPUTS
@@ -208,6 +208,7 @@ def run(a: argparse.Namespace) -> int:
     limits.check_memory("--size", float(a.size) ** (min(a.dim, 3) if ext in (".npy", ".vdb") else 2)
                         * 4 * (5 if a.transfer else 2), f"a {a.size}-sample {a.dim}D grid")
     s = settings_from_args(a)
+    check_time("--time", a.time, s, "--speed", "--dim 4")
     tf = load_transfer(a.transfer, "--transfer") if a.transfer else None
     if tf is not None and a.range:
         try:

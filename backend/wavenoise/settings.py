@@ -22,7 +22,7 @@ from .schema import ANISOTROPY, WAVE_SETTINGS
 from .wave import Transition, WaveNoise
 
 __all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict",
-           "READ_WITH", "check_read", "field_of", "spectrum_to_dict"]
+           "READ_WITH", "check_read", "check_time", "field_of", "spectrum_to_dict"]
 
 
 
@@ -244,6 +244,14 @@ def check_read(s: WaveSettings, given, shown=None) -> None:
         if read is not None and not read(s):
             what = " or ".join(" with ".join(shown(k, v) for k, v in alt) for alt in needs)
             raise SettingError(shown(key), f"is read only with {what}; without it, it would change nothing")
+
+
+def check_time(name: str, time: float, s: WaveSettings, speed: str = "speed", dim4: str = "dim = 4") -> None:
+    """Refuse a time ``name`` other than 0 for noise that does not change with it (still, 2D or 3D): it would
+    change nothing. ``speed`` and ``dim4`` name the settings that make it read, as the front end does."""
+    if time != 0.0 and not (s.dim == 4 or s.animated):
+        raise SettingError(name, f"is read only with {speed} (animated noise) or {dim4} (its fourth coordinate); "
+                                 "without them, it would change nothing")
 
 
 def settings_from_dict(d: dict, example: np.ndarray | None = None) -> WaveSettings:

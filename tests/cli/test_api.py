@@ -27,6 +27,8 @@ CASES = [
     (lambda: omninoise.bake("job.toml", only="clouds"), "only", "expected a list of bake names"),
     (lambda: omninoise.wave(8, half=True), "half", "give out= too"),
     (lambda: omninoise.wave(8, half=True, out="x.npy"), "half", "into .exr and .vdb only"),
+    (lambda: omninoise.wave(8, transfer="fire", out="x.npy"), "transfer", ".npy holds the raw values"),
+    (lambda: omninoise.wave(8, time=1.0), "time", "is read only with speed"),
     (lambda: omninoise.wave(8, waveform="custom", profile=np.zeros((2, 2))), "profile[0]",
      r"expected a number, got \[0.0, 0.0\]"),
     (lambda: omninoise.wave(8, profile=[0.0, 1.0, 0.0]), "profile", "is read only with waveform='custom'"),

@@ -43,6 +43,7 @@ def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
     (["--transition", "gaussian:1:2", "--transition-length", "0"], "--transition-length: must lie in [1e-06"),
     (["--transfer", "fire", "--range", "nan", "1"], "--range: must be a finite number, got nan"),
     (["--transfer", "fire", "--range", "1", "1"], "--range: needs two different values"),
+    (["--time", "2"], "--time: is read only with --speed (animated noise) or --dim 4 (its fourth coordinate)"),
 ])
 def test_settings_that_join_flags_are_named_by_the_flag(tmp_path, capsys, args, message):
     """A rule over several wave settings (a spectrum per axis, a lobe's axis, the transition's band, a ramp's
@@ -109,6 +110,8 @@ def test_a_neural_image_is_refused_by_what_it_takes_drawn_whole_or_in_tiles(monk
     (("time_step = 0.5", 'time_step = "x"'), "time_step: expected a number"),
     (("time_step = 0.5", 'time_step = 0.5\ntime = "x"'), "time: expected a number"),       # was a ValueError
     (("frames = [1, 2]", 'frames = ["a", "b"]'), r"frames\[0\]: expected a whole number, got 'a'"),
+    (('output = "out/clouds_##.vdb"', 'output = "out/clouds_##.npy"'),
+     r"bake 'clouds': transfer: .npy holds the raw values, which a ramp does not colour"),   # was left out unsaid
     (("seed = 4", 'seed = 4\ntransition_to = {kind = "gaussian", fmin = 1, fmax = 3}\ntransition_axis = [0, 0, 0]'),
      r"source.transition_axis: transition axis \(0.0, 0.0, 0.0\) must be a non-zero 3-vector"),  # was all NaN
     (("seed = 4", 'seed = 4\nanisotropy = "lobes"\nlobes = [[[1, 0], 1]]'),
@@ -267,3 +270,20 @@ def test_a_blend_setting_is_named_by_its_flag(tmp_path, capsys, flag, value):
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
     assert rc == 2 and len(err) == 1 and f"error: {flag}: " in err[0], err
     assert os.listdir(tmp_path) == ["m.png"]
+
+
+@pytest.mark.parametrize("source, why", [
+    ('kind = "neural"\nnoise = "perlin"', "frames: this source does not change over time (give keys: keyframes "
+                                          "of its classes)"),
+    ('kind = "wave"', "frames: this source does not change over time (set speed, or dim = 4)"),
+    ('kind = "solid"\nexemplar = "grass"', "frames: this source does not change over time"),
+])
+def test_a_frame_range_of_a_still_source_says_what_would_animate_it(tmp_path, source, why):
+    """A still source's frame range is refused with the setting that animates its kind (a neural source's is its
+    keyframes, not a wave's speed)."""
+    job = tmp_path / "job.toml"
+    job.write_text(f'[[bake]]\nname = "still"\noutput = "s_##.png"\nresolution = [16, 16]\nframes = [1, 2]\n'
+                   f'[bake.source]\n{source}\n')
+    res = run_job(str(job))
+    assert [r.status for r in res] == ["invalid"] and res[0].message.endswith(why), res[0].message
+    assert os.listdir(tmp_path) == ["job.toml"]
