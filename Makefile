@@ -44,31 +44,32 @@ test: $(STAMP) $(VENV)/.train kernel
 test-long: $(STAMP) $(VENV)/.train kernel
 	$(BIN)/python -m pytest -q -m long
 
-# The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS and 4.5 LTS
+# The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS, 4.3, 4.4 and 4.5 LTS
 # (Python 3.11), 5.1 and 5.2 (Python 3.13; Blender 5.1+ runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
 PY313 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.13*/bin/python3.13) $(shell command -v python3.13))
-BPY_VENVS := .venv-bpy42 .venv-bpy45 .venv-bpy51 .venv-bpy52
-.venv-bpy42/.installed: requirements-blender.txt pyproject.toml
-	$(PY) -m venv .venv-bpy42
-	.venv-bpy42/bin/python -m pip install -q bpy==4.2.23 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
-	.venv-bpy42/bin/python -m pip install -q --no-deps -e .
-	@touch $@
-.venv-bpy45/.installed: requirements-blender.txt pyproject.toml
-	$(PY) -m venv .venv-bpy45
-	.venv-bpy45/bin/python -m pip install -q bpy==4.5.15 -r requirements-blender.txt numba==0.68.1 llvmlite==0.50.0
-	.venv-bpy45/bin/python -m pip install -q --no-deps -e .
-	@touch $@
-.venv-bpy51/.installed: requirements-blender.txt pyproject.toml
-	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.1 (set PY313=...)"; exit 2; }
-	$(PY313) -m venv .venv-bpy51
-	.venv-bpy51/bin/python -m pip install -q bpy==5.1.2 -r requirements-blender.txt
-	.venv-bpy51/bin/python -m pip install -q --no-deps -e .
-	@touch $@
-.venv-bpy52/.installed: requirements-blender.txt pyproject.toml
-	@test -n "$(PY313)" || { echo "make test-blender: Python 3.13 is needed for bpy 5.2 (set PY313=...)"; exit 2; }
-	$(PY313) -m venv .venv-bpy52
-	.venv-bpy52/bin/python -m pip install -q bpy==5.2.3 -r requirements-blender.txt
-	.venv-bpy52/bin/python -m pip install -q --no-deps -e .
+BPY_VENVS := .venv-bpy42 .venv-bpy43 .venv-bpy44 .venv-bpy45 .venv-bpy51 .venv-bpy52
+NUMBA_311 := numba==0.68.1 llvmlite==0.50.0
+BPY_42 := 4.2.23
+BPY_43 := 4.3.0
+BPY_44 := 4.4.0
+BPY_45 := 4.5.15
+BPY_51 := 5.1.2
+BPY_52 := 5.2.3
+PY_42 := $(PY)
+PY_43 := $(PY)
+PY_44 := $(PY)
+PY_45 := $(PY)
+PY_51 := $(PY313)
+PY_52 := $(PY313)
+EXTRA_42 := $(NUMBA_311)
+EXTRA_43 := $(NUMBA_311)
+EXTRA_44 := $(NUMBA_311)
+EXTRA_45 := $(NUMBA_311)
+.venv-bpy%/.installed: requirements-blender.txt pyproject.toml
+	@test -n "$(PY_$*)" || { echo "make test-blender: Python 3.13 is needed for bpy $(BPY_$*) (set PY313=...)"; exit 2; }
+	$(PY_$*) -m venv .venv-bpy$*
+	.venv-bpy$*/bin/python -m pip install -q bpy==$(BPY_$*) -r requirements-blender.txt $(EXTRA_$*)
+	.venv-bpy$*/bin/python -m pip install -q --no-deps -e .
 	@touch $@
 
 test-blender: $(STAMP) kernel $(addsuffix /.installed,$(BPY_VENVS))

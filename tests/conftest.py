@@ -109,6 +109,6 @@ def _has_openvdb() -> bool:
         return False
 
 
-#: .vdb steps need Blender's OpenVDB module, which the bpy 4.2 wheel lacks (Blender 4.2 itself ships pyopenvdb)
+#: .vdb steps need Blender's OpenVDB module, which the bpy 4.2 and 4.3 wheels lack (Blender itself ships pyopenvdb)
 needs_openvdb = pytest.mark.skipif(not _has_openvdb(), reason="this bpy build has no OpenVDB Python module "
-                                                             "(the bpy 4.2 wheel; Blender 4.2 ships pyopenvdb)")
+                                                             "(the bpy 4.2 and 4.3 wheels; Blender ships pyopenvdb)")
