@@ -59,6 +59,16 @@ def _file_stamp(path: str):
     return path, st.st_mtime_ns, st.st_size
 
 
+#: the neural method's settings that read a photo (the exemplar's or --to's), and what they do
+PHOTO_READS = {"refine": "refinement fits the code to a photo", "periodic": "the periodic part is read off a photo",
+               "rest": "the rest's orientation is read off a photo"}
+
+
+def _is_photo(x) -> bool:
+    """Whether an exemplar (or ``to``) is a photo: pixels, or an image file (not a shipped texture's name)."""
+    return isinstance(x, np.ndarray) or (isinstance(x, str) and os.path.isfile(x))
+
+
 def _digest(x) -> str | None:
     """What an exemplar is, for the key: a name as itself, a file or pixels by the sha256 of the pixels."""
     if x is None:
@@ -309,14 +319,29 @@ class SolidRequest:
     def check_reads(self, given, where: str = "", names: dict | None = None) -> "SolidRequest":
         """SettingError naming the first of ``given`` (the settings a front end was given, by their names here) that
         this request's method does not read (:data:`~backend.solid.methods.READS`): it would change nothing, and the
-        texture would not be the one asked for; ``names`` maps a setting to the name to report (a flag)."""
+        texture would not be the one asked for: a rest's orientation without the Gaussian rest, and the photo's
+        settings (:data:`PHOTO_READS`) of a shipped texture, too; ``names`` maps a setting to the name to report (a
+        flag)."""
+        def name(key):
+            return (names or {}).get(key, f"{where}{key}")
+
         for key in given:
             if key in ("exemplar", "seed") or key in READS[self.method]:
                 continue
             readers = [m for m, keys in READS.items() if key in keys]
             who = readers[0] if len(readers) == 1 else f"{', '.join(readers[:-1])} and {readers[-1]}"
-            raise SettingError((names or {}).get(key, f"{where}{key}"), f"method {self.method} does not read it; "
-                               f"{who} {'does' if len(readers) == 1 else 'do'}")
+            raise SettingError(name(key), f"method {self.method} does not read it; "
+                                          f"{who} {'does' if len(readers) == 1 else 'do'}")
+        if "rest" in given and not self.gaussian:
+            raise SettingError(name("rest"), f"orients the Gaussian rest, which {name('gaussian')} leaves out: it "
+                                             "would change nothing")
+        if self.method == "neural" and not any(_is_photo(x) for x in (self.exemplar, self.to)):
+            for key in PHOTO_READS:
+                if key in given:        # a shipped texture is drawn from the model's own code, with no photo read
+                    what = (f"{self.exemplar!r} is a shipped texture, drawn" if isinstance(self.exemplar, str)
+                            else "the model's one texture is drawn")
+                    raise SettingError(name(key), f"{PHOTO_READS[key]}; {what} from the model's own code: it would "
+                                                  "change nothing")
         return self
 
     def check_pixels(self, where: str = "") -> "SolidRequest":

@@ -203,6 +203,13 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--noise", "perlin", "-o", "{d}/n.png"],
      "--noise: is the class of the whole image, or of a blend's unmasked part; with --corners"),
     (["neural", "--noise", "perlin", "--fit-size", "32", "-o", "{d}/n.png"], "--fit-size: a fit window size needs --fit"),
+    # a photo's settings for a shipped texture, a rest's orientation without the rest (each was ignored)
+    (["solid", "--exemplar", "grass", "--refine", "2", "-o", "{d}/s.png"],
+     "--refine: refinement fits the code to a photo; 'grass' is a shipped texture, drawn from the model's own code"),
+    (["solid", "--exemplar", "grass", "--no-periodic", "-o", "{d}/s.png"],
+     "--no-periodic: the periodic part is read off a photo; 'grass' is a shipped texture"),
+    (["solid", "--exemplar", "grass", "--rest", "upright", "--no-gaussian", "-o", "{d}/s.png"],
+     "--rest: orients the Gaussian rest, which --no-gaussian leaves out: it would change nothing"),
 ])
 def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
     rc = main([x.format(d=tmp_path) for x in args])

@@ -7,6 +7,8 @@ import pytest
 
 from omninoise.cli.main import main
 from omninoise.backend.paths import solid_models
+from omninoise.backend.errors import SettingError
+from omninoise.backend.solid.request import SolidRequest
 
 TINY = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "tiny_solid")
 
@@ -123,7 +125,10 @@ def test_refine_option(models, tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 0 and "neighbourhood distance" in err and np.load(p).shape == (8, 8, 3)
     rc, err = run(capsys, "--model", models["single3"], "--exemplar", "gravel", "--refine", "3", "-o", p)
-    assert rc == 2 and "refining needs the space model" in err
+    assert rc == 2 and "--refine: refinement fits the code to a photo; 'gravel' is a shipped texture" in err
+    with pytest.raises(SettingError, match="refine: refinement fits the code to a photo; the model's one texture is "
+                                           "drawn from the model's own code: it would change nothing"):
+        SolidRequest(models["single3"], None, refine=3).check().check_reads(["refine"])
 
 
 def test_a_job_file_interpolates_as_the_command_line(models, tmp_path, capsys):
