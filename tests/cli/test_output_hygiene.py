@@ -262,7 +262,7 @@ def test_two_bakes_writing_one_file_are_refused_through_links_and_overlapping_fr
 
 
 @pytest.mark.parametrize("args, flag", [
-    (["wave", "--seed", "-1", "--size", "8", "-o", "{d}/a.npy"], "--seed: must lie in [0, 4294967295], got -1"),
+    (["wave", "--seed", "-1", "--size", "8", "-o", "{d}/a.npy"], "--seed: must lie in [0, 16777215], got -1"),
     (["wave", "--spectrum", "fractal", "--exponent", "nan", "--size", "8", "-o", "{d}/a.npy"],
      "--exponent: must be a finite number"),
     (["zoo", "--noise", "perlin", "--seed", "-1", "--size", "8", "-o", "{d}/z.png"], "--seed: must lie in [0, 2^32)"),
