@@ -60,7 +60,8 @@ def check_layout_reads(layout: str, given, shown: Callable[[str], str] = str) ->
             continue
         layouts, does = READ_BY[key]
         choosers = [shown(CHOSEN_BY[name]) for name in layouts if name in CHOSEN_BY]
-        here = f"with {shown(CHOSEN_BY.get(layout, layout))}" if layout != "uniform" else f"without {' or '.join(choosers)}"
+        here = (f"with {shown(CHOSEN_BY.get(layout, layout))}" if layout != "uniform"
+                else f"without {' or '.join(choosers)}")
         does = does.format(**{name: shown(name) for name in ("noise", "noise2", "blend", "map", "keys")})
         raise SettingError(shown(key), f"{does}; {here}, it would change nothing")
 

@@ -120,14 +120,13 @@ class WaveSettings:
                                                f"got {len(self.axis_spectra)}")
         if self.anisotropy == "lobes" and not self.lobes:
             raise SettingError("lobes", "lobe anisotropy needs at least one (axis, weight) lobe")
-        vectors = [(f"lobes[{i}]", "lobe axis", axis) for i, (axis, _) in enumerate(self.lobes)]
-        vectors += [(name, name.replace("_", " "), v) for name, v in (("transition_axis", self.transition_axis),
-                                                                       ("transition_origin", self.transition_origin))
-                    if len(v)]
-        for name, what, v in vectors:
-            if len(v) != self.dim or (what != "transition origin" and not np.linalg.norm(v) > 0):
-                zero = "" if what == "transition origin" else "non-zero "
-                raise SettingError(name, f"{what} {tuple(v)} must be a {zero}{self.dim}-vector")
+        directions = [(f"lobes[{i}]", "lobe axis", axis) for i, (axis, _) in enumerate(self.lobes)]
+        for name, what, v in directions + [("transition_axis", "transition axis", self.transition_axis)]:
+            if len(v) and (len(v) != self.dim or not np.linalg.norm(v) > 0):   # a direction: non-zero
+                raise SettingError(name, f"{what} {tuple(v)} must be a non-zero {self.dim}-vector")
+        if len(self.transition_origin) not in (0, self.dim):
+            raise SettingError("transition_origin", f"transition origin {tuple(self.transition_origin)} must be a "
+                                                    f"{self.dim}-vector")
         return self
 
     def max_frequency(self) -> float:

@@ -202,7 +202,8 @@ def test_model_without_hashes_is_refused(tmp_path):
      "--param: sets the parameters of --noise; with --corners, it would change nothing"),
     (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--noise", "perlin", "-o", "{d}/n.png"],
      "--noise: is the class of the whole image, or of a blend's unmasked part; with --corners"),
-    (["neural", "--noise", "perlin", "--fit-size", "32", "-o", "{d}/n.png"], "--fit-size: a fit window size needs --fit"),
+    (["neural", "--noise", "perlin", "--fit-size", "32", "-o", "{d}/n.png"],
+     "--fit-size: a fit window size needs --fit"),
     # a photo's settings for a shipped texture, a rest's orientation without the rest (each was ignored)
     (["solid", "--exemplar", "grass", "--refine", "2", "-o", "{d}/s.png"],
      "--refine: refinement fits the code to a photo; 'grass' is a shipped texture, drawn from the model's own code"),

@@ -169,7 +169,8 @@ def test_neural_cli(tiny, tmp_path, capsys):
                       (["--noise", "spots", "--param", "coverage=9", "-o", png], "outside [0.2, 0.8]"),
                       (["--noise", "spots", "--blend", str(tmp_path / "wide.png"), "--size", "16", "-o", png],
                        "--blend: mask is 32x16 but the image is 16x16"),
-                      (["--noise", "spots", "--noise2", "perlin", "-o", png], "needs --blend")]:
+                      (["--noise", "spots", "--noise2", "perlin", "-o", png],
+                       "--noise2: is the class of a blend's masked part; without --blend")]:
         assert main(base + args) == 2
         assert msg in capsys.readouterr().err
     assert main(["neural", "--model", str(tmp_path / "none"), "--noise", "spots", "-o", png]) == 2
