@@ -113,7 +113,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     from .backend.sources import BoxGrid, WaveSource
     from .backend.transfer import load_transfer
     from .backend.wavenoise.schema import WAVE_SETTINGS
-    from .backend.wavenoise.settings import WaveSettings, check_read, check_time, settings_from_dict
+    from .backend.wavenoise.settings import WaveSettings, check_none, check_read, check_time, settings_from_dict
 
     _check_progress(progress)
     size = _check_size(size)
@@ -132,9 +132,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     example = settings.pop("example", None)
     # read as a job file's settings are: checked against their table (types, ranges, lengths), then joined; a
     # setting that changes nothing beside the others (a profile without waveform="custom") is refused
-    for f in dataclasses.fields(WaveSettings):     # None is "not given" only where it is the default
-        if f.name in settings and settings[f.name] is None and f.default is not None:
-            raise SettingError(f.name, "expected a value, got None")
+    check_none(settings)
     plain = {k: _plain(v) for k, v in settings.items() if v is not None}
     WAVE_SETTINGS.check(plain, "")
     s = settings_from_dict(plain, example)

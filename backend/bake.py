@@ -54,10 +54,6 @@ SLAB_VOXELS = 1 << 19
 _FRAME = re.compile(r"#+")
 
 
-#: what makes a kind of source change over time, for a frame range of one that does not
-ANIMATED_BY = {"wave": "set speed, or dim = 4", "neural": "give keys: keyframes of its classes"}
-
-
 @dataclass(frozen=True)
 class BakeSpec:
     """One bake.
@@ -126,7 +122,7 @@ class BakeSpec:
                 raise SettingError("output", f"{os.path.basename(self.output)}: a frame range needs '#' in the file name "
                                    "(e.g. clouds_####.vdb)")
             if not self.source.animated:
-                how = ANIMATED_BY.get(self.source.kind)
+                how = getattr(self.source, "animated_by", None)
                 raise SettingError("frames", "this source does not change over time" + (f" ({how})" if how else ""))
         else:
             check_one_file(self.output, "output", " (or give a frame range)")

@@ -96,7 +96,8 @@ class Source(Protocol):
 
     kind      short name ("wave")
     dim       coordinates the noise takes: 2, 3 or 4 (4D: W is the bake's time)
-    animated  True when the output changes with time
+    animated  True when the output changes with time (``animated_by``, where a kind has it: the settings that
+              make it change, for a frame range of one that does not)
     chunkable True when any sub-box may be evaluated alone (else the whole grid at once)
     """
 
@@ -132,6 +133,7 @@ class WaveSource:
 
     kind = "wave"
     chunkable = True
+    animated_by = "set speed, or dim = 4"
 
     def __init__(self, settings, w_offset: float = 0.0):
         from .wavenoise.settings import compile_noise
@@ -197,6 +199,7 @@ class NeuralSource:
     dim = 2
     animated = False
     chunkable = False
+    animated_by = "give keys: keyframes of its classes"
 
     def __init__(self, model_folder: str, noise: str, params: dict | None = None, noise2: str | None = None,
                  params2: dict | None = None, mask: np.ndarray | None = None, width: float = 32.0,
@@ -648,9 +651,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     layouts = [k for k in ("blend", "corners", "map") if k in d]
     if len(layouts) > 1:
         raise SettingError(f"source.{layouts[1]}", f"choose one of blend, corners and map (got {' and '.join(layouts)})")
-    if "keys" in d and layouts:
-        raise SettingError("source.keys", "keyframes set the classes of the whole image; leave out blend, corners "
-                                          "and map")
+    # keys beside blend, corners or map: NeuralSource refuses the pair
     layout = "animated" if "keys" in d else {"map": "painted"}.get(layouts[0], layouts[0]) if layouts else "uniform"
     try:
         check_layout_reads(layout, list(d))     # a key this layout does not read: the image would not be the one asked

@@ -180,7 +180,7 @@ class SolidRequest:
                 raise bad("refine", f"refinement searches a neural texture's code; {m} has none")
         if self.method == "auto":
             ex = self.exemplar
-            if not isinstance(ex, np.ndarray) and not (isinstance(ex, str) and os.path.isfile(ex)):
+            if not _is_photo(ex):
                 raise bad("exemplar", f"auto chooses for a photo: an image file or pixels, got {ex!r}")
             if self.to is not None:
                 raise bad("to", "interpolation needs the neural texture (method neural); auto draws one texture")
@@ -458,7 +458,7 @@ class SolidRequest:
         if self.method not in ("procedural", "auto") or not set(self.families) - {"bonds", "herringbone"} \
                 or is_saved(self.exemplar):
             return False
-        if self.exemplar is None or isinstance(self.exemplar, str) and not os.path.isfile(self.exemplar):
+        if not _is_photo(self.exemplar):
             return False
         img = rgb_pixels(np.asarray(self.exemplar_pixels(where), np.float32))
         if min(img.shape[:2]) < 16:

@@ -22,7 +22,8 @@ from .schema import ANISOTROPY, WAVE_SETTINGS
 from .wave import Transition, WaveNoise
 
 __all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict",
-           "READ_WITH", "check_read", "check_time", "field_of", "spectrum_to_dict"]
+           "READ_WITH", "check_none", "check_read", "check_time", "field_of",
+           "spectrum_to_dict"]
 
 
 
@@ -85,9 +86,7 @@ class WaveSettings:
     def validate(self) -> "WaveSettings":
         """The fields against :data:`backend.wavenoise.schema.WAVE_SETTINGS` (exact types, ranges, known
         names), then the rules that join fields; SettingError naming the first field that is wrong."""
-        for f in fields(self):        # None is "not given" only where it is the default (it would be left out)
-            if getattr(self, f.name) is None and f.default is not None:
-                raise SettingError(f.name, "expected a value, got None")
+        check_none({f.name: getattr(self, f.name) for f in fields(self)})
         try:
             d = {k: v for k, v in settings_to_dict(self).items() if v != []}  # () is a tuple setting left unset
         except SettingError:
@@ -243,6 +242,14 @@ def check_read(s: WaveSettings, given, shown=None) -> None:
         if read is not None and not read(s):
             what = " or ".join(" with ".join(shown(k, v) for k, v in alt) for alt in needs)
             raise SettingError(shown(key), f"is read only with {what}; without it, it would change nothing")
+
+
+def check_none(values: dict) -> None:
+    """SettingError naming the first of ``values`` (WaveSettings fields) that is None where None is not its default:
+    None is "not given" only where it is the default (it would be left out)."""
+    for f in fields(WaveSettings):
+        if f.name in values and values[f.name] is None and f.default is not None:
+            raise SettingError(f.name, "expected a value, got None")
 
 
 def check_time(name: str, time: float, s: WaveSettings, speed: str = "speed", dim4: str = "dim = 4") -> None:
