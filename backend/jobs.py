@@ -157,9 +157,11 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
-def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
+def _spec(d: dict, base_dir: str, index: int, own: frozenset = frozenset()) -> BakeSpec:
     """One merged ``[[bake]]`` table -> its checked BakeSpec (:data:`~backend.settings_schema.BAKE` first, then
-    its source's table, then the rules that join keys)."""
+    its source's table, then the rules that join keys).  ``own`` names the keys the bake's own table gives (not
+    ``[defaults]``, which may set ``time`` for still and animated bakes alike): there, a ``time`` of a still
+    source and a ``time_step`` without ``frames`` change nothing and are refused."""
     from .settings_schema import BAKE
 
     d = BAKE.check(d, "")
@@ -181,6 +183,13 @@ def _spec(d: dict, base_dir: str, index: int) -> BakeSpec:
     keys = getattr(source, "keys", None)
     if keys:  # animated neural noise: the bake's time is the frame number its keyframes name
         time0, dt = float(frames[0] if frames else keys[0].frame), 1.0
+    if "time" in own and not source.animated:
+        how = getattr(source, "animated_by", None)
+        raise SettingError("time", "this source does not change over time" + (f" ({how})" if how else "")
+                           + "; its time changes nothing")
+    if "time_step" in own and frames is None:
+        raise SettingError("time_step", "sets the time between the frames of a sequence; without frames it changes "
+                                        "nothing")
     half = d.get("half", False)
     if half and os.path.splitext(output)[1].lower() not in (".exr", ".vdb"):
         raise SettingError("half", f"writes 16-bit floats into .exr and .vdb only, not {os.path.basename(output)}")
@@ -219,7 +228,7 @@ def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
             continue
         seen.add(name)
         try:
-            spec = _spec(d, base_dir, i)
+            spec = _spec(d, base_dir, i, frozenset(b))
         except (SettingError, FileNotFoundError) as exc:
             out.append((name, JobError(f"bake {name!r}: {exc}{_written_before(d, base_dir, outputs)}")))
             continue

@@ -108,8 +108,10 @@ BAKE = Table({
     "frames": Field(Items((Int(-10 ** 9, 10 ** 9), Int(-10 ** 9, 10 ** 9)),
                           "[first, last], whole numbers in [-1000000000, 1000000000]"),
                     "a numbered sequence of frames, inclusive"),
-    "time": Field(Float(-limits.MAX_TIME, limits.MAX_TIME), "time (4D: W) of the first frame", default="0"),
-    "time_step": Field(Float(0.0, limits.MAX_TIME, above=True), "time between frames", default="1/24"),
+    "time": Field(Float(-limits.MAX_TIME, limits.MAX_TIME), "time (4D: W) of the first frame, for an animated source",
+                  default="0"),
+    "time_step": Field(Float(0.0, limits.MAX_TIME, above=True), "time between frames, for a bake with frames",
+                       default="1/24"),
     "half": Field(Bool(), ".exr and .vdb: 16-bit half floats", default="false"),
     "source": Field(Table(what="a [bake.source] table"), "what is baked; see the source tables below", True),
 }, "a [[bake]] table")

@@ -87,6 +87,11 @@ def test_job_paths_are_relative_to_the_job_file(job, tmp_path, monkeypatch):
     (('time_step = 0.5', 'time_step = 0.5\ncolour = 1'), "bake 'clouds': colour: unknown key"),
     (("fmin = 1, fmax = 6}", "fmin = 7, fmax = 6}"), "bake 'clouds': source.spectrum.fmin: 7 is greater than fmax 6"),
     (("fmin = 2\nfmax = 4", "fmin = 5\nfmax = 4"), "bake 'marble': source.spectrum.fmin: 5 is greater than fmax 4"),
+    # settings that change nothing: a still source's time, a time step without frames
+    (("half = true", "half = true\ntime = 2.0"), r"bake 'marble': time: this source does not change over time \(set "
+                                                 r"speed, or dim = 4\); its time changes nothing"),
+    (("frames = [1, 2]\n", ""), "bake 'clouds': time_step: sets the time between the frames of a sequence; without "
+                                "frames it changes nothing"),
 ])
 def test_bad_bakes_are_named_and_nothing_is_baked(job, edit, match):
     job.write_text(JOB.replace(*edit))
@@ -94,6 +99,12 @@ def test_bad_bakes_are_named_and_nothing_is_baked(job, edit, match):
     assert out[-1].status == "invalid"
     assert __import__("re").search(match, out[-1].message), out[-1].message
     assert os.listdir(job.parent / "out") == []  # invalid bakes fail before any work
+
+
+def test_defaults_may_time_still_and_animated_bakes_alike(job):
+    job.write_text(JOB.replace("[defaults]", "[defaults]\ntime = 2.0\ntime_step = 0.25"))
+    specs = dict(load_job(str(job)))
+    assert (specs["clouds"].time, specs["clouds"].time_step, specs["marble"].time) == (2.0, 0.5, 2.0)
 
 
 def test_keep_going_bakes_the_others(job):
