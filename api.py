@@ -205,7 +205,7 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
           scale: float = 1.0, refine: int = 0, periodic: bool = True, model: str | None = None,
           families: tuple | None = None, out: str | None = None, progress: Progress = None):
     """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, as a string or
-    a path, or sRGB float pixels ``(H, W, 3)`` in [0, 1]).
+    a path, or sRGB float pixels in [0, 1]: ``(H, W, 3)``, grey ``(H, W)`` or with an opaque alpha ``(H, W, 4)``).
 
     ``method`` is ``"neural"`` (the models' texture, 2D or 3D), ``"spectral"`` (the photo's spectrum and colours
     on every cut, 2D or 3D), ``"procedural"`` (rings, layers, cells or bricks fitted to the photo, 2D or 3D) or
@@ -226,10 +226,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     ((16, 16, 3), dtype('float32'))
     """
     from .backend.colour import srgb_to_linear
-    from .backend.solid.request import SolidRequest
+    from .backend.solid.request import SolidRequest, pixels_as_rgb
 
     _check_progress(progress)
     exemplar, model = (os.fspath(x) if isinstance(x, os.PathLike) else x for x in (exemplar, model))  # Paths too
+    exemplar = pixels_as_rgb(exemplar, "exemplar")      # grey or RGBA pixels, as an image file's are read
     size = _check_size(size)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")

@@ -92,6 +92,25 @@ def _read_file(path: str, setting: str) -> np.ndarray:
         raise SettingError(setting, str(exc)) from None
 
 
+def pixels_as_rgb(x, setting: str):
+    """``x`` with float pixels of other layouts laid out as sRGB (H, W, 3), as an image file's are read
+    (``export.read_rgb``): grey (H, W) or (H, W, 1) repeated to three channels, an alpha channel ((H, W, 2) or
+    (H, W, 4)) dropped where it is opaque (SettingError naming ``setting`` where it is not); anything else as
+    given, for :func:`check_pixels_given` to name."""
+    if not isinstance(x, np.ndarray) or x.dtype.kind != "f" or x.ndim not in (2, 3) or 0 in x.shape:
+        return x
+    if x.ndim == 2:
+        x = x[..., None]
+    if x.shape[2] in (2, 4):
+        from ...export.images import ImageError, opaque
+
+        try:
+            x = opaque(x, setting)
+        except ImageError as exc:
+            raise SettingError(setting, str(exc).split(": ", 1)[1]) from None
+    return np.repeat(x, 3, axis=2) if x.shape[2] == 1 else x
+
+
 def check_pixels_given(x, setting: str) -> None:
     """SettingError naming ``setting`` unless ``x`` is None, a name or file (a str), or pixels as every method
     reads them: a float array (H, W, 3) of finite sRGB values in [0, 1] (8-bit pixels divided by 255), at least

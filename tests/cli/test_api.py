@@ -109,6 +109,21 @@ def test_a_photo_may_be_a_path_object(tmp_path):
     folder = Path(solid_models()) / "gravel_3d"                 # a model folder as a Path
     np.testing.assert_array_equal(omninoise.solid("gravel_3d", 8, model=folder), omninoise.solid("gravel_3d", 8))
 
+
+def test_grey_and_rgba_pixels_are_read_as_their_files_are():
+    """A photo's pixels as grey (H, W) or (H, W, 1), or with an opaque alpha (H, W, 4): the texture of their RGB
+    (H, W, 3), as a grey or RGBA image file is read; a transparent pixel is refused as in a file."""
+    grey = np.random.default_rng(2).random((40, 40)).astype(np.float32)
+    rgb = np.repeat(grey[..., None], 3, axis=2)
+    ref = omninoise.solid(rgb, 8, method="spectral", seed=1)
+    rgba = np.concatenate([rgb, np.ones((40, 40, 1), np.float32)], axis=2)
+    for pixels in (grey, grey[..., None], rgba, grey.astype(np.float64)):
+        np.testing.assert_array_equal(omninoise.solid(pixels, 8, method="spectral", seed=1), ref)
+    rgba[3, 4, 3] = 0.5
+    with pytest.raises(SettingError, match=r"^exemplar: the image is partly transparent \(alpha below 1 on 0.0625 %"):
+        omninoise.solid(rgba, 8, method="spectral")
+
+
 def test_an_unknown_wave_setting_is_a_type_error_naming_wave_and_its_settings():
     """As for any Python function, an unknown keyword is a TypeError, from ``wave`` itself (not from the settings
     class behind it), listing the settings it takes."""
