@@ -48,6 +48,8 @@ __all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
+#: why a ramp and a .npy output are refused together, in every front end (named by its own setting there)
+NPY_RAMP = ".npy holds the raw values, which a ramp does not colour: write .vdb, .exr or .png, or remove the ramp"
 KEY_NAME = "omninoise_key"
 #: voxels per slab: ~2 MiB of values plus ~8 MiB of colour at a time
 SLAB_VOXELS = 1 << 19
@@ -111,8 +113,7 @@ class BakeSpec:
         if getattr(self.source, "rgb", False) and self.transfer is not None:
             raise SettingError("transfer", "a solid texture has its own colours; remove the transfer function")
         if ext == ".npy" and self.transfer is not None:
-            raise SettingError("transfer", ".npy holds the raw values, which a ramp does not colour: write .vdb, .exr "
-                                           "or .png, or remove the transfer function")
+            raise SettingError("transfer", NPY_RAMP)
         if self.frames is not None:
             a, b = self.frames
             if int(a) != a or int(b) != b or b < a:

@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 
 from omninoise.backend import limits
-from omninoise.backend.bake import output_type
+from omninoise.backend.bake import NPY_RAMP, output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.transfer import PRESETS, load_transfer
 from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
@@ -194,7 +194,7 @@ def run(a: argparse.Namespace) -> int:
 
         require_vdb("-o")
     if a.transfer and ext == ".npy":
-        raise SettingError("--transfer", ".npy holds raw values; use .vdb, .exr or .png for a ramp")
+        raise SettingError("--transfer", NPY_RAMP)
     if a.range and not a.transfer:
         raise SettingError("--range", "maps values onto a ramp; give --transfer too")
     if a.half and ext not in (".exr", ".vdb"):

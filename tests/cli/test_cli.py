@@ -58,6 +58,15 @@ def test_bad_settings_fail_with_one_line(tmp_path, capsys, args, setting):
     assert not out.exists()
 
 
+def test_a_ramp_on_raw_values_is_refused_in_the_words_of_a_job(tmp_path, capsys):
+    from omninoise.backend.bake import NPY_RAMP
+
+    out = tmp_path / "x.npy"
+    rc, err = run(capsys, "--size", "16", "--quiet", "--transfer", "fire", "-o", str(out))
+    assert (rc, err.strip()) == (2, f"omninoise wave: error: --transfer: {NPY_RAMP}") and not out.exists()
+    assert "remove the ramp" in NPY_RAMP
+
+
 def test_existing_output_survives_failure(tmp_path, capsys):
     out = tmp_path / "keep.npy"
     np.save(out, np.arange(3, dtype=np.float32))
