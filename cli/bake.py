@@ -44,16 +44,41 @@ omninoise bake job.toml --workers 4""")
     return b
 
 
+TLS_FLAGS = (("--tls-ca-file", "tls_ca_file"), ("--tls-cert", "tls_cert"), ("--tls-key", "tls_key"))
+
+
+def check_cluster(a: argparse.Namespace) -> None:
+    """Refuse, before any work, a ``--cluster`` that is not a scheduler's address (``tcp://HOST:PORT``,
+    ``tls://HOST:PORT`` or ``HOST:PORT``, which is tcp), a tls:// address without its three certificate files (each
+    an existing file), and those files beside an address that is not tls://."""
+    scheme, sep, rest = a.cluster.partition("://")
+    if not sep:
+        scheme, rest = "tcp", a.cluster
+    host, colon, port = rest.rpartition(":")
+    if scheme not in ("tcp", "tls") or not colon or not host.strip("[]") or not port.isdigit() \
+            or not 1 <= int(port) <= 65535:
+        raise SettingError("--cluster", "expected a Dask scheduler's address, tcp://HOST:PORT or tls://HOST:PORT, "
+                                        f"got {a.cluster!r}")
+    for flag, key in TLS_FLAGS:
+        path = getattr(a, key)
+        if scheme != "tls" and path:
+            raise SettingError(flag, f"applies to a tls:// scheduler; {a.cluster} is not encrypted")
+        if scheme == "tls" and not path:
+            raise SettingError(flag, "a tls:// scheduler needs --tls-ca-file, --tls-cert and --tls-key")
+        if path and not os.path.isfile(path):
+            raise SettingError(flag, f"no such file: {path}")
+
+
 def run(a: argparse.Namespace) -> int:
     from omninoise.backend.jobs import JobError, load_job, run_job
 
-    farm = a.workers is not None or a.cluster
+    farm = a.workers is not None or a.cluster is not None
     for flag, given in (("--retries", a.retries != 2), ("--brick-voxels", a.brick_voxels is not None),
                         ("--tls-ca-file", a.tls_ca_file), ("--tls-cert", a.tls_cert), ("--tls-key", a.tls_key)):
         if given and not farm:
             raise SettingError(flag, "applies to a farm bake: give --workers N or --cluster ADDRESS too")
-    if a.cluster and "://" in a.cluster and not a.cluster.startswith(("tcp://", "tls://")):   # host:port is tcp
-        raise SettingError("--cluster", f"expected a Dask scheduler's tcp:// or tls:// address, got {a.cluster!r}")
+    if a.cluster is not None:
+        check_cluster(a)
     if a.dry_run:
         entries = load_job(a.job)
         bad = [s for _, s in entries if isinstance(s, JobError)]
@@ -99,25 +124,8 @@ def run(a: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-def _on_farm(a: argparse.Namespace) -> int:
-    """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (cli/farm.py); exit codes as locally."""
-    from omninoise.backend.jobs import JobError
-
-    if a.workers is not None and a.cluster:
-        raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
-    if a.workers is not None and not 1 <= a.workers <= 512:
-        raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
-    if a.retries < 0:
-        raise SettingError("--retries", f"must be >= 0, got {a.retries}")
-    if a.brick_voxels is not None and a.brick_voxels < 1:
-        raise SettingError("--brick-voxels", f"must be >= 1, got {a.brick_voxels}")
-    if not os.path.isfile(a.job):
-        raise JobError(f"job file not found: {a.job}")
-    try:
-        from . import farm
-    except ImportError as exc:
-        raise SettingError("--workers" if a.workers else "--cluster",
-                           f"needs Dask ({exc}); pip install 'dask[distributed]' or the farm extra") from None
+def _farm_outcomes(a: argparse.Namespace, farm) -> list:
+    """The job's outcomes from a run on the cluster ``a`` names (``farm`` is cli/farm.py)."""
     try:
         client = farm.local_client(a.workers) if a.workers else farm.remote_client(a.cluster, a.tls_ca_file,
                                                                                    a.tls_cert, a.tls_key)
@@ -135,13 +143,36 @@ def _on_farm(a: argparse.Namespace) -> int:
         def status(done, total, moved, eta):
             bar(done / max(total, 1), f"  {done}/{total} tasks, {moved / 2 ** 20:.1f} MiB, ETA {eta:.0f} s   ")
 
-        outcomes = farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
-                                 retries=a.retries, status=status, precision=a.precision)
+        return farm.run_farm(a.job, client, force=a.force, only=a.only, brick_voxels=a.brick_voxels,
+                             retries=a.retries, status=status, precision=a.precision)
     finally:
         cluster = getattr(client, "cluster", None)
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _on_farm(a: argparse.Namespace) -> int:
+    """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (cli/farm.py); exit codes as locally."""
+    from omninoise.backend.jobs import JobError, load_job, select_bakes
+
+    if a.workers is not None and a.cluster:
+        raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
+    if a.workers is not None and not 1 <= a.workers <= 512:
+        raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
+    if a.retries < 0:
+        raise SettingError("--retries", f"must be >= 0, got {a.retries}")
+    if a.brick_voxels is not None and a.brick_voxels < 1:
+        raise SettingError("--brick-voxels", f"must be >= 1, got {a.brick_voxels}")
+    if not os.path.isfile(a.job):
+        raise JobError(f"job file not found: {a.job}")
+    try:
+        from . import farm
+    except ImportError as exc:
+        raise SettingError("--workers" if a.workers else "--cluster",
+                           f"needs Dask ({exc}); pip install 'dask[distributed]' or the farm extra") from None
+    # the job's bakes are checked before a cluster is started or a scheduler reached (which may take 30 s)
+    outcomes = farm.invalid_bakes(select_bakes(load_job(a.job), a.only)) or _farm_outcomes(a, farm)
     for o in outcomes:
         if o.status in ("baked", "up to date") and not a.quiet:
             print(f"omninoise bake: {shown(o.name)}: {o.status} ({shown(o.message)})", file=sys.stderr)

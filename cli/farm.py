@@ -212,6 +212,12 @@ def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None 
     return Client(address, security=security, timeout="30s")
 
 
+def invalid_bakes(entries: list) -> list:
+    """The invalid bakes of a job's (name, spec or JobError) entries, as outcomes: a farm run checks them before
+    it reaches a machine, as a one-machine run does before any work."""
+    return [JobOutcome(n, "invalid", str(s)) for n, s in entries if isinstance(s, JobError)]
+
+
 def run_farm(job: str, client, force: bool = False, only: list | None = None, brick_voxels: int | None = None,
              retries: int = 2, progress=None, log=None, status=None, precision: str = "fp32") -> list:
     """Run a job file's bakes on ``client``'s cluster -> list of :class:`backend.jobs.JobOutcome` (one per bake).
@@ -228,9 +234,9 @@ def run_farm(job: str, client, force: bool = False, only: list | None = None, br
 
     job = os.path.abspath(job)
     entries = select_bakes(load_job(job), only)
-    bad = [(n, s) for n, s in entries if isinstance(s, JobError)]
+    bad = invalid_bakes(entries)
     if bad:
-        return [JobOutcome(n, "invalid", str(s)) for n, s in bad]
+        return bad
     manifest = read_manifest(job)
     tag = f"farm-{uuid.uuid4().hex[:12]}"     # this run's temporaries: the only ones it removes
     tasks, skipped, volumes = plan(entries, force, brick_voxels or brick_voxels_for(client), manifest)

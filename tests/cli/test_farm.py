@@ -196,6 +196,36 @@ def test_the_cli_runs_a_job_on_a_local_cluster(tmp_path, capsys):
     assert main(["bake", job, "--workers", "1", "--cluster", "tcp://127.0.0.1:1"]) == 2
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["--cluster", "farmhead"], "--cluster: expected a Dask scheduler's address, tcp://HOST:PORT or tls://HOST:PORT, "
+                                "got 'farmhead'"),
+    (["--cluster", "tcp://farmhead"], "--cluster: expected a Dask scheduler's address"),
+    (["--cluster", "farmhead:99999"], "--cluster: expected a Dask scheduler's address"),
+    (["--cluster", ""], "--cluster: expected a Dask scheduler's address, tcp://HOST:PORT or tls://HOST:PORT, got ''"),
+    (["--cluster", "http://farmhead:8786"], "--cluster: expected a Dask scheduler's address"),
+    (["--cluster", "tls://farmhead:8786", "--tls-ca-file", "{job}", "--tls-cert", "{job}"],
+     "--tls-key: a tls:// scheduler needs --tls-ca-file, --tls-cert and --tls-key"),
+    (["--cluster", "tls://farmhead:8786", "--tls-ca-file", "{job}", "--tls-cert", "/no/cert.pem", "--tls-key", "{job}"],
+     "--tls-cert: no such file: /no/cert.pem"),
+    (["--cluster", "tcp://farmhead:8786", "--tls-key", "{job}"],
+     "--tls-key: applies to a tls:// scheduler; tcp://farmhead:8786 is not encrypted"),
+])
+def test_a_cluster_that_is_no_scheduler_address_is_refused_before_any_work(tmp_path, capsys, flags, message):
+    job = job_in(tmp_path, JOB.split("[[bake]]\nname = \"seq\"")[0])
+    assert main(["bake", job, "--quiet", *(f.format(job=job) for f in flags)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"omninoise bake: error: {message}") and "\n" not in err, err
+    assert not (tmp_path / "out" / "img.exr").exists()
+
+
+def test_a_farm_job_s_bad_bake_is_named_before_the_scheduler_is_reached(tmp_path, capsys):
+    """No scheduler listens on port 1: the bad bake is what the error names, not the connection."""
+    job = job_in(tmp_path, JOB.split("[[bake]]\nname = \"seq\"")[0].replace("resolution = [", "resolution = [0, "))
+    assert main(["bake", job, "--quiet", "--cluster", "tcp://127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err
+    assert "resolution" in err and "scheduler" not in err, err
+
+
 def _certs(folder) -> tuple:
     """A throwaway CA and one certificate for 127.0.0.1 signed by it (openssl), as a farm's admin would make."""
     ca_key, ca, key, csr, cert = (str(folder / n) for n in ("ca.key", "ca.pem", "node.key", "node.csr", "node.pem"))
