@@ -93,6 +93,8 @@ class BakeSpec:
                 raise SettingError("time_step", f"the last frame's time, {last:g}, passes {limits.MAX_TIME:g}; use a "
                                                 "smaller time_step or fewer frames")
         ext = os.path.splitext(self.output)[1].lower()
+        if os.path.isdir(self.output):
+            raise SettingError("output", f"output path is a folder, not a file: {self.output}")
         if ext not in FORMATS:
             raise SettingError("output", f"{self.output!r}: unsupported type {ext or '(none)'}; use {', '.join(FORMATS)}")
         rank = self.grid.rank

@@ -147,6 +147,7 @@ def test_sequences_number_frames_and_move(tmp_path):
     (dict(output="v.vdb", grid=BoxGrid((8, 8))), "needs a 3D grid"),
     (dict(output="v.png", grid=BoxGrid((8, 8, 8))), "needs a 2D grid"),
     (dict(output="v.tif"), "unsupported type"),
+    (dict(output=""), "output path is a folder, not a file"),      # not "unsupported type (none)"
     (dict(output="v_##.vdb", frames=(1, 2)), "does not change over time"),
     (dict(output="v.vdb", frames=(1, 2), source=WaveSource(S3.replace(speed=1.0))), "needs '#'"),
     (dict(output="v.vdb", frames=(3, 1), source=WaveSource(S3.replace(speed=1.0))), "end >= start"),
