@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 
 __all__ = ["ROOT", "SUBDIRS", "WAVE_VALUES", "NEURAL_VALUES", "SOLID_VALUES", "LOADING", "loading",
-           "transfer_preset_text", "classes", "attach", "detach"]
+           "transfer_preset_text", "copy_presets", "classes", "attach", "detach"]
 
 #: the folder that holds ``presets/omninoise/...`` (this package's own folder)
 ROOT = os.path.dirname(os.path.abspath(__file__))
@@ -53,13 +54,40 @@ classes = ()
 
 
 def attach():
-    """The shipped presets' folder on Blender's preset path."""
+    """The shipped presets' folder on Blender's preset path; in a Blender without ``register_preset_path`` (4.2.0)
+    the shipped presets are copied into the user's presets folder instead (:func:`copy_presets`)."""
     import bpy      # here, not at the top: tools/make_presets.py reads this module's tables without Blender
 
-    bpy.utils.register_preset_path(ROOT)
+    register = getattr(bpy.utils, "register_preset_path", None)
+    if register is not None:
+        register(ROOT)
+    else:
+        copy_presets(lambda sub: bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", sub), create=True))
+
+
+def copy_presets(folder_of) -> list:
+    """Copy each shipped preset into ``folder_of(subdir)`` (the user's presets folder of a kind, made if need be)
+    where that folder has no file of its name, as add-ons did before Blender read presets from an extension's
+    folder: an artist's own edit of a preset stays, and a preset the artist removed comes back on the next start.
+    Returns the files copied; a folder that cannot be written leaves that kind without its shipped presets, with a
+    line on the console, and the extension starts."""
+    copied = []
+    for sub in SUBDIRS.values():
+        src = os.path.join(ROOT, "presets", sub)
+        try:
+            dst = folder_of(sub)
+            for name in sorted(os.listdir(src)):
+                if name.endswith(".py") and not os.path.exists(os.path.join(dst, name)):
+                    shutil.copyfile(os.path.join(src, name), os.path.join(dst, name))
+                    copied.append(os.path.join(dst, name))
+        except OSError as exc:
+            print(f"OmniNoise: the shipped {sub.split('/')[-1]} presets are not available: {exc}")
+    return copied
 
 
 def detach():
     import bpy
 
-    bpy.utils.unregister_preset_path(ROOT)
+    unregister = getattr(bpy.utils, "unregister_preset_path", None)
+    if unregister is not None:
+        unregister(ROOT)

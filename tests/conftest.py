@@ -29,6 +29,8 @@ _package_from_checkout()
 #: the user's cache folder (what Blender bakes of unsaved files use where the package is registered by a script,
 #: as these tests do) lies in a folder of the test run, not in the home folder
 os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="omninoise-tests-cache-")
+#: and the user's scripts folder (user presets, the shipped presets where a Blender copies them there) too
+os.environ["BLENDER_USER_SCRIPTS"] = tempfile.mkdtemp(prefix="omninoise-tests-scripts-")
 
 #: folders whose every test is long (``make test-long``): Blender's (bpy start-up, renders) and training's (torch)
 LONG_FOLDERS = ("blender", "training")
