@@ -4,8 +4,9 @@ Function, Wave Noise, Neural Noise and Solid Texture panels.
 Presets are Python files, as Blender's own are. The extension's folder holds the shipped ones
 (``presets/omninoise/<kind>/``, written by ``python -m tools.make_presets``), registered with
 ``bpy.utils.register_preset_path``; Blender keeps them read-only and writes an artist's own presets into the user
-scripts folder. A wave preset sets ``bpy.context.omninoise_wave``, which each panel points at the settings it
-shows (a node tree's or the bake panel's), so one set of presets serves both.
+scripts folder (Blender 4.2.0 has no ``register_preset_path``: there they are copied into that folder). A wave
+preset sets ``bpy.context.omninoise_wave``, which each panel points at the settings it shows (a node tree's or the
+bake panel's), so one set of presets serves both.
 
 Each preset menu and its + operator live with the panel they serve (:mod:`.bake_ui`, :mod:`.wave_ui`,
 :mod:`.neural_ui`, :mod:`.solid_ui`); this module holds what they share.
@@ -76,6 +77,8 @@ def copy_presets(folder_of) -> list:
         src = os.path.join(ROOT, "presets", sub)
         try:
             dst = folder_of(sub)
+            if not dst or not os.path.isdir(dst):       # Blender gives "" for a folder it could not make
+                raise NotADirectoryError(f"no folder {dst!r}")
             for name in sorted(os.listdir(src)):
                 if name.endswith(".py") and not os.path.exists(os.path.join(dst, name)):
                     shutil.copyfile(os.path.join(src, name), os.path.join(dst, name))

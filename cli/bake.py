@@ -74,7 +74,7 @@ def run(a: argparse.Namespace) -> int:
 
     farm = a.workers is not None or a.cluster is not None
     for flag, given in (("--retries", a.retries != 2), ("--brick-voxels", a.brick_voxels is not None),
-                        ("--tls-ca-file", a.tls_ca_file), ("--tls-cert", a.tls_cert), ("--tls-key", a.tls_key)):
+                        *((f, getattr(a, key)) for f, key in TLS_FLAGS)):
         if given and not farm:
             raise SettingError(flag, "applies to a farm bake: give --workers N or --cluster ADDRESS too")
     if a.cluster is not None:
