@@ -3,6 +3,7 @@
 Every version check of the Blender layer lives here, so the rest of the code
 asks a question ("which EEVEE engine id?") instead of comparing versions.
 
+    4.2.0    ``bpy.utils.register_preset_path`` is missing (later 4.2 releases have it).
     4.2-4.5  EEVEE is ``BLENDER_EEVEE_NEXT``; add-on properties and ID custom
              properties share one storage (a custom key must not equal the name
              of a registered property); materials and worlds get a node tree
@@ -17,9 +18,14 @@ from __future__ import annotations
 
 import bpy
 
-__all__ = ["VERSION", "eevee_engine", "has_gabor_node", "ensure_node_tree", "set_multilayer_exr", "id_property"]
+__all__ = ["VERSION", "reads_extension_presets", "eevee_engine", "has_gabor_node", "ensure_node_tree", "set_multilayer_exr", "id_property"]
 
 VERSION: tuple = tuple(bpy.app.version[:2])
+
+
+def reads_extension_presets() -> bool:
+    """Whether Blender reads presets from an extension's own folder (``bpy.utils.register_preset_path``; not 4.2.0)."""
+    return hasattr(bpy.utils, "register_preset_path")
 
 
 def eevee_engine() -> str:

@@ -59,9 +59,10 @@ def attach():
     the shipped presets are copied into the user's presets folder instead (:func:`copy_presets`)."""
     import bpy      # here, not at the top: tools/make_presets.py reads this module's tables without Blender
 
-    register = getattr(bpy.utils, "register_preset_path", None)
-    if register is not None:
-        register(ROOT)
+    from .compat import reads_extension_presets
+
+    if reads_extension_presets():
+        bpy.utils.register_preset_path(ROOT)
     else:
         copy_presets(lambda sub: bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", sub), create=True))
 
@@ -91,6 +92,7 @@ def copy_presets(folder_of) -> list:
 def detach():
     import bpy
 
-    unregister = getattr(bpy.utils, "unregister_preset_path", None)
-    if unregister is not None:
-        unregister(ROOT)
+    from .compat import reads_extension_presets
+
+    if reads_extension_presets():
+        bpy.utils.unregister_preset_path(ROOT)

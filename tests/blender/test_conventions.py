@@ -10,7 +10,7 @@ bpy = pytest.importorskip("bpy")
 
 from omninoise import blender_addon  # noqa: E402
 from conftest import Recorder, _has_openvdb  # noqa: E402
-from omninoise.blender_addon import menus, neural_ui, presets, solid_ui, wave_ui  # noqa: E402
+from omninoise.blender_addon import compat, menus, neural_ui, presets, solid_ui, wave_ui  # noqa: E402
 from omninoise.backend.transfer import PRESETS, preset  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -239,7 +239,7 @@ def test_the_shipped_presets_are_those_the_tool_writes():
 def test_every_shipped_preset_loads_through_blenders_preset_menu(scene):
     b, n = scene.omninoise_bake, scene.omninoise_neural
     found = bpy.utils.preset_paths("omninoise/wave")
-    if hasattr(bpy.utils, "register_preset_path"):     # the shipped folder itself, read-only
+    if compat.reads_extension_presets():              # the shipped folder itself, read-only
         assert presets.ROOT in [os.path.dirname(os.path.dirname(os.path.dirname(p))) for p in found]
     else:                                              # Blender 4.2.0: copies in the user's presets folder
         user = bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", "omninoise"))
