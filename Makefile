@@ -45,10 +45,10 @@ test-long: $(STAMP) $(VENV)/.train kernel
 	$(BIN)/python -m pytest -q -m long
 
 # The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS (4.2.0, the extension's
-# least version, and the latest 4.2), 4.3, 4.4 and 4.5 LTS (Python 3.11), 5.1 and 5.2 (Python 3.13; Blender 5.1+ runs
-# 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
+# least version, and the latest 4.2), 4.3, 4.4 and 4.5 LTS (Python 3.11), 5.1, 5.2 and 5.3 (Python 3.13; Blender 5.1+
+# runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
 PY313 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.13*/bin/python3.13) $(shell command -v python3.13))
-BPY_VENVS := .venv-bpy420 .venv-bpy42 .venv-bpy43 .venv-bpy44 .venv-bpy45 .venv-bpy51 .venv-bpy52
+BPY_VENVS := .venv-bpy420 .venv-bpy42 .venv-bpy43 .venv-bpy44 .venv-bpy45 .venv-bpy51 .venv-bpy52 .venv-bpy53
 NUMBA_311 := numba==0.68.1 llvmlite==0.50.0
 BPY_420 := 4.2.0
 BPY_42 := 4.2.23
@@ -57,6 +57,7 @@ BPY_44 := 4.4.0
 BPY_45 := 4.5.15
 BPY_51 := 5.1.2
 BPY_52 := 5.2.3
+BPY_53 := 5.3.0
 PY_420 := $(PY)
 PY_42 := $(PY)
 PY_43 := $(PY)
@@ -64,6 +65,7 @@ PY_44 := $(PY)
 PY_45 := $(PY)
 PY_51 := $(PY313)
 PY_52 := $(PY313)
+PY_53 := $(PY313)
 EXTRA_420 := $(NUMBA_311)
 EXTRA_42 := $(NUMBA_311)
 EXTRA_43 := $(NUMBA_311)

@@ -1,4 +1,4 @@
-"""Differences between the Blender versions OmniNoise supports (4.2 LTS to 5.2), in one place.
+"""Differences between the Blender versions OmniNoise supports (4.2 LTS to 5.3), in one place.
 
 Every version check of the Blender layer lives here, so the rest of the code
 asks a question ("which EEVEE engine id?") instead of comparing versions.
@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import bpy
 
-__all__ = ["VERSION", "reads_extension_presets", "eevee_engine", "has_gabor_node", "ensure_node_tree", "set_multilayer_exr", "id_property"]
+__all__ = ["VERSION", "reads_extension_presets", "eevee_engine", "has_gabor_node", "ensure_node_tree",
+           "set_multilayer_exr", "id_property"]
 
 VERSION: tuple = tuple(bpy.app.version[:2])
 

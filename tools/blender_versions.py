@@ -1,9 +1,9 @@
 """Run the Blender tests on every supported Blender's ``bpy``: ``python tools/blender_versions.py VENV ...``.
 
 Each VENV is a virtual environment with one ``bpy`` release and the runtime's
-packages (``make test-blender`` builds them: bpy 4.2.0 and the latest 4.2 LTS, 4.3,
-4.4, 4.5 LTS, 5.1 and 5.2 beside the pinned 5.0 of ``.venv``).  The tests that use ``bpy`` run there with pytest's
-JUnit report; the table printed at the end (bpy, Python, passed, skipped,
+packages (``make test-blender`` builds them: bpy 4.2.0 and the latest 4.2 LTS,
+4.3, 4.4, 4.5 LTS, 5.1, 5.2 and 5.3 beside the pinned 5.0 of ``.venv``).  The
+tests that use ``bpy`` run there with pytest's JUnit report; the table printed at the end (bpy, Python, passed, skipped,
 failed, exit status) is the README's support table.  The run fails when any
 test fails or errs, or when a process ends badly, with one exception: the bpy
 4.2 and 4.3 wheels crash at interpreter exit (signal 11) after a complete run
