@@ -192,7 +192,8 @@ def test_model_without_hashes_is_refused(tmp_path):
     (["bake", "{d}/job.toml", "--retries", "5"], "--retries: applies to a farm bake"),
     (["bake", "{d}/job.toml", "--brick-voxels", "64"], "--brick-voxels: applies to a farm bake"),
     (["bake", "{d}/job.toml", "--tls-cert", "c.pem"], "--tls-cert: applies to a farm bake"),
-    (["bake", "{d}/job.toml", "--cluster", "http://host:8786"], "--cluster: expected a Dask scheduler's tcp://"),
+    (["bake", "{d}/job.toml", "--cluster", "http://host:8786"],
+     "--cluster: expected a Dask scheduler's address, tcp://HOST:PORT"),
     (["neural", "--corners", "perlin", "gabor", "spots", "noise", "--sharpness", "2", "-o", "{d}/n.png"],
      "--sharpness: shapes the transitions"),
     # flags the image's layout does not read (each was ignored): a map's regions, a class beside the corners
