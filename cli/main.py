@@ -116,6 +116,26 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(sig, handler)
 
 
+#: what each command's --list prints, and the options it reads beside it (the model it lists and how it loads it)
+LISTS = {"neural": ("the classes and their parameters", ("model", "precision", "threads")),
+         "solid": ("the shipped textures", ()), "zoo": ("the training classes", ())}
+#: the flags of the settings not named --SETTING
+FLAG_OF = {"out": "-o", "periodic": "--no-periodic", "gaussian": "--no-gaussian"}
+
+
+def _check_list_alone(a: argparse.Namespace) -> None:
+    """Refuse an option given beside ``--list`` that the listing does not read (``solid --list -o x.png`` wrote
+    nothing and said nothing), as every option that would change nothing is refused."""
+    if a.command not in LISTS or not a.list:
+        return
+    what, reads = LISTS[a.command]
+    defaults = vars(build_parser().parse_args([a.command]))
+    for key, value in vars(a).items():
+        if key not in ("command", "debug", "list", "quiet") + reads and value != defaults.get(key):
+            flag = FLAG_OF.get(key, "--" + key.replace("_", "-"))
+            raise SettingError(flag, f"--list only prints {what}: leave out {flag}, which would change nothing")
+
+
 def _check_outputs(a: argparse.Namespace) -> None:
     """The files a command will write (-o, --report), checked before any work: a missing or read-only folder, a
     name past the file system's limit (a frame pattern's '#' counted as the widest frame number), a folder in the
@@ -149,6 +169,7 @@ def _run(a: argparse.Namespace) -> int:
         print(f"omninoise {a.command}: {shown(what)}", file=sys.stderr)
 
     try:
+        _check_list_alone(a)
         _check_outputs(a)
         with warnings.catch_warnings():     # numpy's overflow notes: a result they spoil is refused when written
             warnings.simplefilter("ignore", RuntimeWarning)

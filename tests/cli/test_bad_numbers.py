@@ -212,6 +212,11 @@ def test_model_without_hashes_is_refused(tmp_path):
      "--no-periodic: the periodic part is read off a photo; 'grass' is a shipped texture"),
     (["solid", "--exemplar", "grass", "--rest", "upright", "--no-gaussian", "-o", "{d}/s.png"],
      "--rest: orients the Gaussian rest, which --no-gaussian leaves out: it would change nothing"),
+    # options beside --list, which only prints (each was passed over: -o wrote nothing and said nothing)
+    (["solid", "--list", "-o", "{d}/s.png"],
+     "-o: --list only prints the shipped textures: leave out -o, which would change nothing"),
+    (["solid", "--list", "--no-periodic"], "--no-periodic: --list only prints the shipped textures"),
+    (["neural", "--list", "--noise", "perlin", "--size", "64"], "--noise: --list only prints the classes"),
 ])
 def test_bad_neural_solid_zoo_input(tmp_path, capsys, args, setting):
     rc = main([x.format(d=tmp_path) for x in args])
