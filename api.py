@@ -63,6 +63,13 @@ def _plain(value):
     return value
 
 
+def _check_flags(**flags) -> None:
+    """SettingError naming a switch that is not True or False (``half="no"`` would have been read as true)."""
+    for name, value in flags.items():
+        if not isinstance(value, (bool, np.bool_)):
+            raise SettingError(name, f"expected True or False, got {value!r}")
+
+
 def _check_progress(progress) -> None:
     if progress is not None and not callable(progress):
         raise SettingError("progress", f"expected a function of the fraction done, or None, got {progress!r}")
@@ -119,6 +126,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     size = _check_size(size)
     limits.in_range("extent", extent, limits.MIN_LENGTH, limits.MAX_COORD)
     limits.time("time", time)
+    _check_flags(half=half)
     known = [f.name for f in dataclasses.fields(WaveSettings)]
     for name in settings:
         if name not in known:
@@ -300,8 +308,11 @@ def bake(job: str, *, only: list | None = None, force: bool = False, keep_going:
     from .backend.jobs import run_job
 
     _check_progress(progress)
+    _check_flags(force=force, keep_going=keep_going)
     if only is not None and (isinstance(only, (str, bytes)) or not all(isinstance(n, str) for n in only)):
         raise SettingError("only", f"expected a list of bake names, got {only!r}")
-    if not isinstance(job, (str, os.PathLike)) or not os.path.isfile(job):
+    if not isinstance(job, (str, os.PathLike)):
+        raise SettingError("job", f"expected a job file's path, got {job!r}")
+    if not os.path.isfile(job):
         raise SettingError("job", f"job file not found: {job!r}")
     return run_job(os.fspath(job), keep_going=keep_going, force=force, only=only, progress=progress)
