@@ -311,6 +311,8 @@ def bake(job: str, *, only: list | None = None, force: bool = False, keep_going:
     _check_flags(force=force, keep_going=keep_going)
     if only is not None and (isinstance(only, (str, bytes)) or not all(isinstance(n, str) for n in only)):
         raise SettingError("only", f"expected a list of bake names, got {only!r}")
+    if only is not None and len(only) == 0:
+        raise SettingError("only", "names no bake: leave it out to run every bake of the job")
     if not isinstance(job, (str, os.PathLike)):
         raise SettingError("job", f"expected a job file's path, got {job!r}")
     if not os.path.isfile(job):

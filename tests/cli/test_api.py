@@ -26,6 +26,7 @@ CASES = [
     (lambda: omninoise.bake("job.toml", progress=1), "progress", "expected a function"),
     (lambda: omninoise.bake("job.toml", only="clouds"), "only", "expected a list of bake names"),
     (lambda: omninoise.bake(3), "job", "expected a job file's path, got 3"),
+    (lambda: omninoise.bake("job.toml", only=[]), "only", "names no bake: leave it out to run every bake"),
     (lambda: omninoise.bake("job.toml", force="no"), "force", "expected True or False, got 'no'"),
     (lambda: omninoise.bake("job.toml", keep_going=1), "keep_going", "expected True or False, got 1"),
     (lambda: omninoise.wave(8, half="no", out="x.exr"), "half", "expected True or False, got 'no'"),
