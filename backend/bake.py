@@ -44,7 +44,7 @@ from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
 __all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "check_one_file",
-           "check_not_read", "output_type", "FORMATS", "KEY_NAME", "Cancelled"]
+           "check_not_read", "output_type", "still", "FORMATS", "NPY_RAMP", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
@@ -125,8 +125,7 @@ class BakeSpec:
                 raise SettingError("output", f"{os.path.basename(self.output)}: a frame range needs '#' in the file name "
                                    "(e.g. clouds_####.vdb)")
             if not self.source.animated:
-                how = getattr(self.source, "animated_by", None)
-                raise SettingError("frames", "this source does not change over time" + (f" ({how})" if how else ""))
+                raise SettingError("frames", still(self.source))
         else:
             check_one_file(self.output, "output", " (or give a frame range)")
         folder = os.path.dirname(os.path.abspath(self.output))
@@ -192,6 +191,13 @@ def check_one_file(path: str, setting: str, or_else: str = "") -> None:
     if has_frame_field(path):
         raise SettingError(setting, f"{os.path.basename(path)}: '#' stands for the frame number of a sequence, and "
                                     f"this writes one file: take it out of the name{or_else}")
+
+
+def still(source) -> str:
+    """Why a setting of time reads nothing of ``source``, a source that does not change over time: what would
+    animate its kind (its ``animated_by``), where it has that."""
+    how = getattr(source, "animated_by", None)
+    return "this source does not change over time" + (f" ({how})" if how else "")
 
 
 def output_type(path: str, allowed: tuple, what: str, setting: str) -> str:

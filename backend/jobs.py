@@ -124,7 +124,7 @@ import os
 from dataclasses import dataclass
 from typing import Callable
 
-from .bake import BakeResult, BakeSpec, Cancelled, check_not_read, frame_path, run_bake
+from .bake import BakeResult, BakeSpec, Cancelled, check_not_read, frame_path, run_bake, still
 from .documents import read_document
 from .errors import SettingError
 from .schema import did_you_mean, shown_value
@@ -184,9 +184,7 @@ def _spec(d: dict, base_dir: str, index: int, own: frozenset = frozenset()) -> B
     if keys:  # animated neural noise: the bake's time is the frame number its keyframes name
         time0, dt = float(frames[0] if frames else keys[0].frame), 1.0
     if "time" in own and not source.animated:
-        how = getattr(source, "animated_by", None)
-        raise SettingError("time", "this source does not change over time" + (f" ({how})" if how else "")
-                           + "; its time changes nothing")
+        raise SettingError("time", f"{still(source)}; its time changes nothing")
     if "time_step" in own and frames is None:
         raise SettingError("time_step", "sets the time between the frames of a sequence; without frames it changes "
                                         "nothing")

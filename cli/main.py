@@ -120,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
 LISTS = {"neural": ("the classes and their parameters", ("model", "precision", "threads")),
          "solid": ("the shipped textures", ()), "zoo": ("the training classes", ())}
 #: the flags of the settings not named --SETTING
-FLAG_OF = {"out": "-o", "periodic": "--no-periodic", "gaussian": "--no-gaussian"}
+FLAG_OF = {"out": "-o", **solid.FLAGS}
 
 
 def _check_list_alone(a: argparse.Namespace) -> None:
