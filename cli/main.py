@@ -149,7 +149,7 @@ def _check_outputs(a: argparse.Namespace) -> None:
     for flag, attr in outputs:
         path = getattr(a, attr, None)
         if isinstance(path, str) and path:
-            if not (flag == "-o" and getattr(a, "frames", None)):       # neural --frames writes a sequence
+            if not (flag == "-o" and (getattr(a, "frames", None) or getattr(a, "keys", None))):  # neural animations
                 check_one_file(path, flag)
             check_not_read(path, flag, read)
             try:

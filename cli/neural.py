@@ -120,6 +120,9 @@ def check_reads(a: argparse.Namespace) -> None:
     asked for; and two ways of laying out the classes at once."""
     from omninoise.backend.neural.request import check_layout_reads
 
+    if bool(a.keys) != bool(a.frames):      # named by the one given, before the layout's reads speak of the other
+        raise SettingError("--keys" if a.keys else "--frames",
+                           "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
     if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
         raise SettingError("--blend", "choose one of --blend, --corners and --map")
     for flag, given in (("--report", a.report), ("--fit-size", a.fit_size != 64)):
@@ -229,8 +232,6 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     from omninoise.backend.neural.animate import animate, check_keys, read_keys
     from omninoise.export.images import write_unit_image
 
-    if not (a.keys and a.frames):
-        raise SettingError("--keys", "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
     if a.noise or a.corners or a.map or a.blend:
         raise SettingError("--keys", "the keyframes set the classes; leave out --noise, --corners, --map and --blend")
     if not a.out or not has_frame_field(a.out):

@@ -205,6 +205,11 @@ def test_model_without_hashes_is_refused(tmp_path):
      "--noise: is the class of the whole image, or of a blend's unmasked part; with --corners"),
     (["neural", "--noise", "perlin", "--fit-size", "32", "-o", "{d}/n.png"],
      "--fit-size: a fit window size needs --fit"),
+    # half an animation is named by the half given (it was told that --noise changes nothing with --keys)
+    (["neural", "--noise", "perlin", "--frames", "1", "3", "-o", "{d}/n_#.png"],
+     "--frames: an animation needs both --keys KEYS.toml and --frames FIRST LAST"),
+    (["neural", "--keys", "{d}/keys.toml", "-o", "{d}/n_#.png"],
+     "--keys: an animation needs both --keys KEYS.toml and --frames FIRST LAST"),
     # a photo's settings for a shipped texture, a rest's orientation without the rest (each was ignored)
     (["solid", "--exemplar", "grass", "--refine", "2", "-o", "{d}/s.png"],
      "--refine: refinement fits the code to a photo; 'grass' is a shipped texture, drawn from the model's own code"),
