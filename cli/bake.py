@@ -69,6 +69,20 @@ def check_cluster(a: argparse.Namespace) -> None:
             raise SettingError(flag, f"no such file: {path}")
 
 
+def check_precision(a: argparse.Namespace) -> None:
+    """Refuse ``--precision int8`` for a job (or the bakes ``--only`` names) with no neural noise bake, every bake
+    valid: int8 is the denoiser's arithmetic, and the files would be those of fp32. (An invalid bake is reported by
+    the job's own check.)"""
+    from omninoise.backend.jobs import JobError, load_job, select_bakes
+
+    if a.precision == "fp32":
+        return
+    entries = select_bakes(load_job(a.job), a.only)
+    if not any(isinstance(s, JobError) or getattr(s.source, "kind", None) == "neural" for _, s in entries):
+        raise SettingError("--precision", "sets the neural noise's arithmetic, and no bake of the job is neural "
+                                          "noise: it would change nothing")
+
+
 def run(a: argparse.Namespace) -> int:
     from omninoise.backend.jobs import JobError, load_job, run_job
 
@@ -79,6 +93,7 @@ def run(a: argparse.Namespace) -> int:
             raise SettingError(flag, "applies to a farm bake: give --workers N or --cluster ADDRESS too")
     if a.cluster is not None:
         check_cluster(a)
+    check_precision(a)
     if a.dry_run:
         entries = load_job(a.job)
         bad = [s for _, s in entries if isinstance(s, JobError)]

@@ -289,3 +289,31 @@ def test_a_neural_transition_without_a_blend_or_map_is_refused(tmp_path, capsys,
                                        f'[bake.source]\nkind = "neural"\nnoise = "perlin"\n{key}\n')
     assert main(["bake", str(tmp_path / "job.toml"), "--dry-run"]) == 2
     assert f"source.{key.split()[0]}: shapes the transitions of blend and map" in capsys.readouterr().out
+
+
+NEURAL_BAKE = """
+[[bake]]
+name = "spots"
+output = "out/spots.png"
+resolution = [16, 16]
+[bake.source]
+kind = "neural"
+noise = "spots"
+steps = 1
+"""
+
+
+def test_int8_beside_a_job_without_neural_noise_is_refused(job, capsys):
+    """--precision int8 sets the denoiser's arithmetic: a job (or the bakes --only names) with no neural noise bake
+    would write what fp32 writes, so it is refused, naming the flag, before any work; beside a neural bake it
+    stands."""
+    assert main(["bake", str(job), "--precision", "int8", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["omninoise bake: error: --precision: sets the neural noise's arithmetic, and no bake of the job is "
+                   "neural noise: it would change nothing"]
+    assert os.listdir(job.parent / "out") == []
+    job.write_text(JOB + NEURAL_BAKE)
+    assert main(["bake", str(job), "--precision", "int8", "--dry-run"]) == 0
+    assert main(["bake", str(job), "--precision", "int8", "--dry-run", "--only", "marble"]) == 2
+    assert "--precision: sets the neural noise's arithmetic" in capsys.readouterr().err
+    assert main(["bake", str(job), "--precision", "fp32", "--dry-run", "--only", "marble"]) == 0
