@@ -69,8 +69,9 @@ class TransferFunction:
                 raise SettingError("stops", f"the alpha of the stop at {p:g} must lie in [0, 1] (density_scale "
                                             f"scales a volume's density), got {c[3]:g}")
         v0, v1 = self.range
-        if v0 == v1:
-            raise SettingError("range", f"needs two different values, got {tuple(self.range)}")
+        if abs(v1 - v0) < MIN_SPAN:
+            raise SettingError("range", f"needs two different values, at least {MIN_SPAN:g} apart, got "
+                                        f"{tuple(self.range)}")
         tp = [p for p, _ in self.temperature]
         if any(b < a for a, b in zip(tp, tp[1:])):
             raise SettingError("temperature", f"positions must be sorted, got {tp}")
@@ -232,11 +233,16 @@ def preset(name: str) -> TransferFunction:
                             density_scale=p["density_scale"], temperature=p.get("temperature", ())).validate()
 
 
+#: a ramp's range: its ends lie within +-RANGE_LIMIT and at least MIN_SPAN apart (the noise's float32 values are
+#: mapped as (v - v0) / (v1 - v0): past these the positions turn infinite or NaN)
+RANGE_LIMIT, MIN_SPAN = 1e6, 1e-6
+
 #: the keys of a ramp table (a job file's ``transfer = {...}``, a ramp .json file)
 COLOR = ListOf(Float(0.0, 1e6), 3, 4)     #: scene-linear r, g, b (above 1 for a glow) and alpha
 TRANSFER = Table({
     "preset": Field(Choice(tuple(PRESETS)), "start from a preset; other keys override it"),
-    "range": Field(Items((Float(), Float()), "[v0, v1]"), "noise values mapped to ramp positions 0 and 1",
+    "range": Field(Items((Float(-RANGE_LIMIT, RANGE_LIMIT),) * 2, "[v0, v1]"),
+                   "noise values mapped to ramp positions 0 and 1 (each in [-1e6, 1e6], at least 1e-6 apart)",
                    default="[-1.5, 1.5]"),
     "interpolation": Field(Choice(INTERPOLATIONS), "how colours blend between stops", default="linear"),
     "density_scale": Field(Float(0.0, 1e6), "a volume's density is density_scale times alpha", default="1"),

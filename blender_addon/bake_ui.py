@@ -23,6 +23,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 from . import tasks
 from .tasks import TaskOperator
 from .. import backend
+from ..backend.transfer import RANGE_LIMIT
 from .bake_blender import (load_image, load_volume, output_folder, ramp_node,
                            set_ramp, transfer_from_color_ramp, world_bounds)
 from .common import Sidebar
@@ -109,8 +110,10 @@ class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
     # transfer function
     use_ramp: BoolProperty(name="Use Ramp", description="Map values through the ramp (off: raw values)",
                            default=True)
-    range_min: FloatProperty(name="From", description="Noise value at the ramp's left end", default=-0.2)
-    range_max: FloatProperty(name="To", description="Noise value at the ramp's right end", default=1.6)
+    range_min: FloatProperty(name="From", description="Noise value at the ramp's left end", default=-0.2,
+                             min=-RANGE_LIMIT, max=RANGE_LIMIT)
+    range_max: FloatProperty(name="To", description="Noise value at the ramp's right end", default=1.6,
+                             min=-RANGE_LIMIT, max=RANGE_LIMIT)
     density_scale: FloatProperty(name="Density", description="Density = alpha x this", default=4.0, min=0.0,
                                  soft_max=50.0)
     use_temperature: BoolProperty(name="Temperature", description="Write a temperature grid (blackbody)",

@@ -48,7 +48,14 @@ class _Version(argparse.Action):
 
 class Parser(argparse.ArgumentParser):
     """argparse with a bad flag reported as every other bad input is: one line naming it, exit 2 (not the usage
-    first); the subcommands' parsers are of this class too."""
+    first); the subcommands' parsers are of this class too. A negative number in any form Python reads (``-1e-3``,
+    ``-.5``, ``-inf``) is a value, not an unknown flag (argparse takes only ``-1`` and ``-1.5`` so)."""
+
+    NEGATIVE = re.compile(r"^-(\d+\.?\d*(e[+-]?\d+)?|\.\d+(e[+-]?\d+)?|inf(inity)?|nan)$", re.IGNORECASE)
+
+    def __init__(self, *args, **kw):
+        super().__init__(*args, **kw)
+        self._negative_number_matcher = self.NEGATIVE
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message}; see '{self.prog} --help'\n")

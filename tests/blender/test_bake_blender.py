@@ -225,8 +225,11 @@ def test_bad_settings_report_one_line(scene, tmp_path):
     with pytest.raises(RuntimeError, match=r"Min Frequency: 9 is greater than fmax \d"):
         bpy.ops.omninoise.bake_image()
     p.wave.fmin, p.range_min, p.range_max = 2.0, 0.5, 0.5
-    with pytest.raises(RuntimeError, match=r"From and To: needs two different values, got \(0.5, 0.5\)"):
+    with pytest.raises(RuntimeError, match=r"From and To: needs two different values, at least 1e-06 apart, "
+                                           r"got \(0.5, 0.5\)"):
         bpy.ops.omninoise.bake_image()
+    p.range_min, p.range_max = -1e300, 1e300      # held where the ramp's positions stay finite
+    assert (p.range_min, p.range_max) == (-1e6, 1e6)
     p.range_max, p.animated, p.time_per_frame = 1.0, True, float("nan")
     with pytest.raises(RuntimeError, match="Time per Frame: must be a finite number, got nan"):
         bpy.ops.omninoise.bake_image()

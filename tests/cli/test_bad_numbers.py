@@ -43,6 +43,11 @@ def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
     (["--transition", "gaussian:1:2", "--transition-length", "0"], "--transition-length: must lie in [1e-06"),
     (["--transfer", "fire", "--range", "nan", "1"], "--range: must be a finite number, got nan"),
     (["--transfer", "fire", "--range", "1", "1"], "--range: needs two different values"),
+    # past these the ramp's positions were infinite and the file was refused after the work as NaN (exit 1)
+    (["--transfer", "fire", "--range", "-1e308", "1e308"], "--range: must lie in [-1000000, 1000000], got -1e+308"),
+    (["--transfer", "fire", "--range", "0", "1e-9"], "--range: needs two different values, at least 1e-06 apart"),
+    # a negative number in scientific notation is a value (argparse took it for an unknown flag)
+    (["--time", "-1e-3"], "--time: is read only with --speed"),
     (["--time", "2"], "--time: is read only with --speed (animated noise) or --dim 4 (its fourth coordinate)"),
 ])
 def test_settings_that_join_flags_are_named_by_the_flag(tmp_path, capsys, args, message):
