@@ -217,7 +217,11 @@ def run(a: argparse.Namespace) -> int:
             raise SettingError("--range", exc.message) from None
     from omninoise.backend.sources import WaveSource
 
-    WaveSource(s).check_extent(a.extent, abs(a.time), ("--extent", "--time"))
+    try:
+        source = WaveSource(s)      # the tables' own rules, named as the flag the user typed
+    except SettingError as exc:
+        raise SettingError(_flag(a, exc.setting), exc.message) from None
+    source.check_extent(a.extent, abs(a.time), ("--extent", "--time"))
     if not a.quiet:
         from omninoise.backend.wavenoise.fast import engine_path
 
@@ -226,19 +230,19 @@ def run(a: argparse.Namespace) -> int:
     if a.fmax > nyq and a.cellular == "none" and not a.quiet:
         print(f"omninoise wave: warning: --fmax {a.fmax:g} is above the grid's Nyquist {nyq:g}; "
               "the image will alias", file=sys.stderr)
-    return _bake(a, s, tf, ext)
+    return _bake(a, source, tf, ext)
 
 
-def _bake(a: argparse.Namespace, s: WaveSettings, tf, ext: str) -> int:
+def _bake(a: argparse.Namespace, source, tf, ext: str) -> int:
     """``wave``, every output type, through the bake pipeline: one sampling convention (docs/conventions.md:
     sample centres (i + 1/2) E / N over [0, E)^d; .npy indexed [y, x] / [z, y, x]; images with +y up), the
     ramp, an atomic write."""
     from omninoise.backend.bake import BakeSpec, run_bake
-    from omninoise.backend.sources import BoxGrid, WaveSource
+    from omninoise.backend.sources import BoxGrid
 
     rank = 3 if ext == ".vdb" or (ext == ".npy" and a.dim > 2) else 2
     grid = BoxGrid((a.size,) * rank, ((0.0, 0.0, 0.0), (a.extent,) * 3))
-    spec = BakeSpec("wave", WaveSource(s), grid, a.out, tf, time=a.time, half=a.half)
+    spec = BakeSpec("wave", source, grid, a.out, tf, time=a.time, half=a.half)
     run_bake(spec, Bar(a.quiet), force=True)
     return 0
 

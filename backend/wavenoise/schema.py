@@ -53,7 +53,7 @@ WAVE_SETTINGS = Table({
     "cell_size": Field(Float(1e-6, limits.MAX_COORD), "cellular: spacing of the cutting planes, world units",
                        default="from the spectrum"),
     "stit_probability": Field(Float(0.0, 1.0), "stit: chance that a cell splits again", default="0.5"),
-    "stit_depth": Field(Int(0, 16), "stit: how many times cells split", default="3"),
+    "stit_depth": Field(Int(0, 8), "stit: how many times cells split", default="3"),
     "anisotropy": Field(Choice(ANISOTROPY), "directions: all, one spectrum per axis, or lobes", default="none"),
     "axis_spectra": Field(ListOf(SPECTRUM, 1, 4), "axes: one spectrum table per axis"),
     "lobes": Field(ListOf(Items((VECTOR, Float(0.0, 1e6)), "[[axis x, y(, z(, w))], weight]"), 1, 64),

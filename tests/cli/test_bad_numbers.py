@@ -46,6 +46,9 @@ def test_bad_wave_numbers_fail_with_one_line(tmp_path, capsys, args, setting):
     # past these the ramp's positions were infinite and the file was refused after the work as NaN (exit 1)
     (["--transfer", "fire", "--range", "-1e308", "1e308"], "--range: must lie in [-1000000, 1000000], got -1e+308"),
     (["--transfer", "fire", "--range", "0", "1e-9"], "--range: needs two different values, at least 1e-06 apart"),
+    (["--period", "1e-6"], "--spectrum: the band holds no table harmonic; widen [fmin, fmax] or raise the period"),
+    (["--anisotropy", "lobes", "--lobe", "1,0:0"], "--lobe: lobe weights must not all be zero"),
+    (["--cellular", "stit", "--stit-depth", "9"], "--stit-depth: must lie in [0, 8], got 9"),
     # a negative number in scientific notation is a value (argparse took it for an unknown flag)
     (["--time", "-1e-3"], "--time: is read only with --speed"),
     (["--time", "2"], "--time: is read only with --speed (animated noise) or --dim 4 (its fourth coordinate)"),
@@ -122,6 +125,12 @@ def test_a_neural_image_is_refused_by_what_it_takes_drawn_whole_or_in_tiles(monk
     (("seed = 4", 'seed = 4\nanisotropy = "lobes"\nlobes = [[[1, 0], 1]]'),
      r"source.lobes\[0\]: lobe axis \(1.0, 0.0\) must be a non-zero 3-vector"),
     (("half = true", 'half = "no"'), "half: expected true or false"),                 # "no" was taken as true
+    # the tables' own rules: found while baking (exit 1, the bakes before it written), now when the job is read
+    (("seed = 4", 'seed = 4\nanisotropy = "lobes"\nlobes = [[[1, 0, 0], 0]]'),
+     "source.lobes: lobe weights must not all be zero"),
+    (("seed = 4", "seed = 4\ntable_period = 1e-6"), "source.spectrum: the band holds no table harmonic"),
+    (("seed = 4", "seed = 4\ntable_period = 1e6"),
+     "source.fmax: 4 cycles/unit is at or above the wave table's Nyquist"),
     (("resolution = [32, 16]", "resolution = [100000000, 100000]"), "resolution"),
     (("bounds = [[-1, -1, 0], [1, 1, 1]]", "bounds = [[-1, -1, 0], [inf, 1, 1]]"), r"bounds\[1\]\[0\]: must be a finite number, got inf"),
     (('[[bake]]\nname = "marble"', '[[bake]]\nname = "first"\noutput = "out/../out/marble.exr"\n'
