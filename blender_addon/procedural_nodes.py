@@ -91,28 +91,30 @@ def _socket_values(field) -> dict:
 
 
 def _bounds(family: str) -> dict:
-    """{socket name: (min, max or None)} of a family's float parameters, where the engine draws them
-    (family.Param.check): a length, size or frequency no smaller than the engine's smallest, so no slider reaches a
-    division by 0; a noise's amplitude no smaller than 0; a share (of a unit, a cube, a course) within its range (a
-    cell's feature point beyond its cube, Jitter over 1, would lie outside the 27 cubes the group searches)."""
+    """{socket name: (min, max)} of a family's parameters, where the engine draws them (family.Param.check): a
+    length, size or frequency no smaller than the engine's smallest, so no slider reaches a division by 0; a noise's
+    amplitude no smaller than 0; a share (of a unit, a cube, a course) within its range (a cell's feature point
+    beyond its cube, Jitter over 1, would lie outside the 27 cubes the group searches); every one, the vectors'
+    components too, within +-MAX_PARAM."""
+    from ..backend.solid.procedural.family import MAX_PARAM
     from ..backend.solid.procedural.field import FAMILIES
 
     ranges = {q.name: q for q in FAMILIES[family].params()}
     out = {}
     for name, key in PARAMETERS[family] + SHARED:
         q = ranges.get(key)
-        if q is not None and q.floor:
-            out[name] = (q.lo, q.hi if q.cap else None)
+        out[name] = (q.lo if q is not None and q.floor else -MAX_PARAM, q.hi if q is not None and q.cap else MAX_PARAM)
     return out
 
 
 def _interface(tree, field) -> None:
+    from ..backend.solid.procedural.family import MAX_PARAM
     from ..backend.solid.procedural.field import FAMILIES
 
     values = _socket_values(field)
     bounds = _bounds(field.family)
     if field.tint is not None:
-        bounds.update({"Tint": (0.0, None), "Tint Frequency": (0.01, None)})
+        bounds.update({"Tint": (0.0, MAX_PARAM), "Tint Frequency": (0.01, MAX_PARAM)})
     tint = TINT if field.tint is not None else ()
     for name in ["Vector", "Scale"] + [n for n, _ in PARAMETERS[field.family] + SHARED] + list(tint):
         vector = name in ("Vector", "Axis", "Centre", "Normal")
@@ -126,9 +128,7 @@ def _interface(tree, field) -> None:
         else:
             s.default_value = values[name]
             if name in bounds:
-                s.min_value, top = bounds[name]
-                if top is not None:
-                    s.max_value = top
+                s.min_value, s.max_value = bounds[name]
     tree.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
     tree.interface.new_socket("sRGB", in_out="OUTPUT", socket_type="NodeSocketColor")
     tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")

@@ -107,22 +107,24 @@ def test_the_group_exposes_the_fitted_parameters_and_stores_the_field():
 
 def test_the_group_s_sliders_stop_where_the_engine_s_parameters_do():
     """Lengths, sizes and frequencies stop at the engine's least (no slider reaches a division by 0), shares at
-    their range's top (a cell's Jitter over 1 would leave the cubes the group searches), amplitudes at 0."""
-    want = {"cells": {"Size": (0.01, None), "Stretch": (0.3, None), "Jitter": (0.0, 1.0), "Gap": (0.0, 0.45),
-                      "Turbulence Frequency": (0.25, None), "Detail": (0.0, None)},
-            "bonds": {"Length": (0.02, None), "Height": (0.01, None), "Offset": (0.0, 1.0), "Joint": (0.0, 0.5),
-                      "Turbulence": (0.0, None)},
-            "rings": {"Spacing": (0.005, None), "Grain": (0.0, None)}}
+    their range's top (a cell's Jitter over 1 would leave the cubes the group searches), amplitudes at 0, and every
+    one, a vector's components too, at +-MAX_PARAM, past which the engine refuses them (drawn in float32, a Centre
+    of 1e39 is infinite)."""
+    from omninoise.backend.solid.procedural.family import MAX_PARAM as M
+
+    want = {"cells": {"Size": (0.01, M), "Stretch": (0.3, M), "Jitter": (0.0, 1.0), "Gap": (0.0, 0.45),
+                      "Turbulence Frequency": (0.25, M), "Detail": (0.0, M)},
+            "bonds": {"Length": (0.02, M), "Height": (0.01, M), "Offset": (0.0, 1.0), "Joint": (0.0, 0.5),
+                      "Turbulence": (0.0, M)},
+            "rings": {"Spacing": (0.005, M), "Grain": (0.0, M), "Centre": (-M, M), "Axis": (-M, M)},
+            "layers": {"Normal": (-M, M)}}
     for family, bounds in want.items():
         grp = build_procedural_group(_field(family))
         try:
             for name, (lo, hi) in bounds.items():
                 s = grp.interface.items_tree[name]
                 assert s.min_value == pytest.approx(lo), (family, name, s.min_value)
-                if hi is None:
-                    assert s.max_value > 1e30, (family, name, s.max_value)
-                else:
-                    assert s.max_value == pytest.approx(hi), (family, name, s.max_value)
+                assert s.max_value == pytest.approx(hi), (family, name, s.max_value)
         finally:
             bpy.data.node_groups.remove(grp)
 

@@ -11,7 +11,7 @@ from omninoise.backend.solid.model import slice_points
 from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
 from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_cubes, cell_w, voronoi
 from omninoise.backend.solid.procedural.estimate import GRID, Estimates, estimate, grid_repeat, repeat_length
-from omninoise.backend.solid.procedural.family import Param, axis_vector, dot3
+from omninoise.backend.solid.procedural.family import MAX_PARAM, Param, axis_vector, dot3
 from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
 from omninoise.backend.solid.procedural.fit import (FIT_PLANES, STRUCTURE_MARGIN, STRUCTURE_SIDE, ProceduralConfig,
                                                    fit_procedural, oblique_points, pick, plane_group, walls_structure)
@@ -347,6 +347,26 @@ def test_a_field_reads_back_from_json_and_refuses_bad_parameters():
     np.testing.assert_allclose(t.evaluate(pts), np.clip(a + tint(pts, 3), 0, 1), atol=1e-6)
     with pytest.raises(SettingError, match="the tint's frequency must be a positive number"):
         ProceduralField("bonds", p, ramp, tint=Tint(0.0, (0.0, 1.0), (0.0, 0.1), (1.0, 0.0, 0.0)))
+
+
+@pytest.mark.parametrize("family", sorted(FAMILIES))
+def test_every_parameter_is_drawn_finite_up_to_its_limit_and_refused_past_it(family):
+    """A saved solid edited by hand (or a node group's inputs) may take any parameter up to +-MAX_PARAM, each drawn
+    finite; past it the parameter is refused, naming it (a rings centre of 1e300 drew NaN, a turbulence frequency
+    of 1e300 infinite points)."""
+    ramp = Ramp((-1.0, 0.0, 2.0), ((0.2, 0.1, 0.1), (0.5, 0.3, 0.2), (0.8, 0.6, 0.5)))
+    params = FAMILIES[family].params()
+    base = {q.name: q.lo for q in params} | {"layers": {"profile": "tri"}}.get(family, {})
+    pts = _points(500)
+    for q in params:
+        for sign in (1, -1):
+            v = sign * MAX_PARAM
+            if (q.floor and v < q.lo) or (q.cap and v > q.hi):
+                continue                # outside what the parameter takes anyway
+            drawn = ProceduralField(family, dict(base, **{q.name: v}), ramp).evaluate(pts)
+            assert np.isfinite(drawn).all(), (q.name, v)
+            with pytest.raises(SettingError, match=f"{q.name} must lie within"):
+                ProceduralField(family, dict(base, **{q.name: 10 * v}), ramp)
 
 
 def test_oblique_planes_are_square_grids_of_photo_pixels():

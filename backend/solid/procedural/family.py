@@ -16,14 +16,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...limits import MAX_COORD
 from ...schema import shown_value
 from ...wavenoise.hashing import white_noise4
 from .turbulence import turbulence
 
 __all__ = ["Param", "Family", "cell_random", "axis_vector", "axis_angles", "dot3", "gapped", "inside", "SHARED",
-           "DETAIL_FREQ"]
+           "DETAIL_FREQ", "MAX_PARAM"]
 
 DETAIL_FREQ = 16.0    #: the detail noise's lowest frequency, cycles per unit (8 photo px at 128 px per unit)
+#: the largest magnitude of any parameter a drawn solid takes (a length, a frequency, an angle, the rings' centre):
+#: the value is drawn in float32, where 1e300 turns infinite and the solid NaN (limits.MAX_COORD)
+MAX_PARAM = MAX_COORD
 
 
 @dataclass(frozen=True)
@@ -31,7 +35,8 @@ class Param:
     """A parameter ``name`` searched in [lo, hi] (``log``: on a log axis); ``doc`` says what it is and its unit.
     A solid drawn with edited parameters (the node group's inputs, a saved solid) keeps ``lo`` as its least value
     where ``floor`` (a length, size or frequency above 0, an amplitude at least 0; not an angle or an offset) and
-    ``hi`` as its greatest where ``cap`` (a share of a unit, a cube or a course): :meth:`check`."""
+    ``hi`` as its greatest where ``cap`` (a share of a unit, a cube or a course), and every one within
+    +-:data:`MAX_PARAM`: :meth:`check`."""
     name: str
     lo: float
     hi: float
@@ -46,6 +51,8 @@ class Param:
         v = float(v) if ok else v
         if not ok or not np.isfinite(v):
             raise ValueError(f"{self.name} must be a finite number, got {shown_value(v)}")
+        if abs(v) > MAX_PARAM:
+            raise ValueError(f"{self.name} must lie within +-{MAX_PARAM:g}, got {v!r}")
         if self.cap and not self.lo <= v <= self.hi:
             raise ValueError(f"{self.name} must be in [{self.lo}, {self.hi}], got {v!r}")
         if self.floor and v < self.lo:

@@ -12,6 +12,7 @@ from ...errors import SettingError, check_points
 from ...grid import Cancelled
 from .bonds import PATTERNS, Bonds
 from .cells import Cells
+from .family import MAX_PARAM
 from .layers import PROFILES, Layers
 from .ramp import Ramp
 from .rings import Rings
@@ -57,8 +58,9 @@ class ProceduralField:
             p["pattern"] = params.get("pattern", "courses")
         self.family, self.params, self.ramp, self.seed = family, p, ramp, int(seed)
         self.px_per_unit = float(px_per_unit)
-        if tint is not None and not (np.isfinite(tint.frequency) and tint.frequency > 0):
-            raise SettingError("tint", f"the tint's frequency must be a positive number, got {tint.frequency!r}")
+        if tint is not None and not (np.isfinite(tint.frequency) and 0 < tint.frequency <= MAX_PARAM):
+            raise SettingError("tint", f"the tint's frequency must be a positive number up to {MAX_PARAM:g}, got "
+                                       f"{tint.frequency!r}")
         self.tint = tint
 
     def values(self, points: np.ndarray) -> np.ndarray:

@@ -25,6 +25,7 @@ import numpy as np
 
 from ...errors import SettingError
 from ...schema import shown_value
+from .family import MAX_PARAM
 from .field import ProceduralField
 from .ramp import Ramp
 from .tint import Tint
@@ -134,6 +135,8 @@ def _known_params(family: str, params: dict) -> None:
 def _number(v, where: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
         raise SettingError(where, f"expected a finite number, got {shown_value(v)}")
+    if abs(v) > MAX_PARAM:          # drawn in float32: past it a value turns infinite and the solid NaN
+        raise SettingError(where, f"must lie within +-{MAX_PARAM:g}, got {shown_value(v)}")
     return float(v)
 
 
