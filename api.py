@@ -209,7 +209,7 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     return out
 
 
-def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: str = "neural", seed: int = 0,
+def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: str | None = None, seed: int = 0,
           scale: float = 1.0, refine: int = 0, periodic: bool = True, model: str | None = None,
           families: tuple | None = None, out: str | None = None, progress: Progress = None):
     """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, as a string or
@@ -217,12 +217,13 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
 
     ``method`` is ``"neural"`` (the models' texture, 2D or 3D), ``"spectral"`` (the photo's spectrum and colours
     on every cut, 2D or 3D), ``"procedural"`` (rings, layers, cells or bricks fitted to the photo, 2D or 3D) or
-    ``"synthesis"`` (a seamless 2D image); ``scale`` is output pixels per exemplar
+    ``"synthesis"`` (a seamless 2D image); left out, ``"neural"``, or ``"procedural"`` for a saved procedural
+    solid; ``scale`` is output pixels per exemplar
     pixel; ``refine`` search steps improve a photo's code; ``periodic`` keeps a photo's courses and planks;
     ``families`` are the kinds of solid a procedural fit tries (of ``"rings"``, ``"layers"``, ``"cells"``,
     ``"bonds"`` and ``"herringbone"``; all but ``"herringbone"`` by default).  With ``method="procedural"`` the
     fitted solid itself is saved by an ``out`` ending in ``.json``, and drawn again, without fitting, from that file
-    (or a ``ProceduralField``) given as the exemplar.
+    (or a ``ProceduralField``) given as the exemplar, with no method.
 
     Returns scene-linear RGB float32: ``(size, size, 3)`` for ``dim=2`` (the front view: x right, z up, top row
     first) or ``(size, size, size, 3)`` indexed ``[z, y, x]`` for ``dim=3``; or, with ``out``, writes it as
@@ -234,10 +235,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     ((16, 16, 3), dtype('float32'))
     """
     from .backend.colour import srgb_to_linear
-    from .backend.solid.request import SolidRequest, pixels_as_rgb
+    from .backend.solid.request import SolidRequest, method_for, pixels_as_rgb
 
     _check_progress(progress)
     exemplar, model = (os.fspath(x) if isinstance(x, os.PathLike) else x for x in (exemplar, model))  # Paths too
+    method = method_for(exemplar, method)
     exemplar = pixels_as_rgb(exemplar, "exemplar")      # grey or RGBA pixels, as an image file's are read
     size = _check_size(size)
     if dim not in (2, 3) or isinstance(dim, bool):

@@ -72,7 +72,7 @@ NEURAL_SOURCE = Table({
 
 SOLID_SOURCE = Table({
     "kind": Field(Choice(("solid",)), "a solid texture from a photo (Henzler et al. 2020)", True),
-    "method": Field(Choice(METHODS), "neural solid, 2D synthesis, spectral solid, procedural solid, or auto (procedural where closer and as structured, else neural)", default="neural"),
+    "method": Field(Choice(METHODS), "neural solid, 2D synthesis, spectral solid, procedural solid, or auto (procedural where closer and as structured, else neural)", default="neural; procedural for a saved procedural solid (.json)"),
     "model": Field(FILE, "a shipped model's name or a model folder", default="chosen from the exemplar"),
     "exemplar": Field(FILE, "the photo (an image file or a training exemplar's name); method procedural: also a "
                             "solid saved as .json (omninoise solid -o)"),

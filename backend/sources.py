@@ -743,7 +743,7 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     import os
 
     from .solid.procedural.field import DEFAULT_KINDS
-    from .solid.request import SolidRequest
+    from .solid.request import SolidRequest, method_for
 
     _check_keys(d, _SOLID_KEYS, "solid")
     if "mix" in d and "to" not in d:
@@ -752,11 +752,11 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     def path(v):
         return os.path.join(base_dir, v) if isinstance(v, str) and os.path.exists(os.path.join(base_dir, v)) else v
 
-    to = path(d.get("to"))
+    to, exemplar = path(d.get("to")), path(d.get("exemplar"))
     mix = d.get("mix", 0.5)
-    return SolidRequest(path(d.get("model")), path(d.get("exemplar")), to, mix, d.get("refine", 0),
+    return SolidRequest(path(d.get("model")), exemplar, to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
-                        d.get("rest", "auto"), d.get("method", "neural"), d.get("tile", 256),
+                        d.get("rest", "auto"), method_for(exemplar, d.get("method")), d.get("tile", 256),
                         d.get("families", DEFAULT_KINDS)).check("source.").check_reads(
         [k for k in d if k not in ("method", "scale", "density")], "source.")
 

@@ -11,7 +11,7 @@ import numpy as np
 from omninoise.backend import limits
 from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
-from omninoise.backend.solid.request import METHODS
+from omninoise.backend.solid.request import METHODS, method_for
 from omninoise.backend.solid.gaussian_rest import REST_CHOICES
 from omninoise.backend.solid.procedural.field import DEFAULT_KINDS, KINDS
 
@@ -41,7 +41,7 @@ omninoise solid --exemplar gravel --to marble --mix 0.5 -o halfway.png
 omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 128 -o rock.vdb
 omninoise solid --method procedural --exemplar bricks.jpg --dim 3 --size 128 -o wall.vdb
 omninoise solid --method procedural --exemplar bricks.jpg -o wall.json
-omninoise solid --method procedural --exemplar wall.json --dim 3 --size 256 -o wall.vdb
+omninoise solid --exemplar wall.json --dim 3 --size 256 -o wall.vdb
 omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png""")
     g = s.add_argument_group("texture and output")
     g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file; --method procedural: "
@@ -52,11 +52,12 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
     g.add_argument("--size", type=int, default=256, help="pixels (or voxels) per side")
     g.add_argument("--scale", type=float, default=1.0, help="zoom: output pixels per exemplar pixel")
     g.add_argument("--seed", type=int, default=0, help="another seed gives another texture of the same kind")
-    g.add_argument("--method", default="neural", choices=METHODS,
+    g.add_argument("--method", choices=METHODS,
                    help="neural: the models' texture, 2D or 3D; spectral: the photo's spectrum and colours on every "
                         "cut, 2D or 3D, no network; procedural: rings, layers, cells or bricks fitted to the photo, "
                         "2D or 3D, no network; auto: procedural where it is closer to the photo than neural and keeps "
-                        "its structure as well, else neural; synthesis: a seamless 2D image copied from the photo")
+                        "its structure as well, else neural; synthesis: a seamless 2D image copied from the photo "
+                        "(default: neural; procedural for a saved procedural solid, a .json exemplar)")
     g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
     g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
                                    "texture-space model)")
@@ -107,6 +108,7 @@ def run(a: argparse.Namespace) -> int:
         return 0
     if not a.exemplar or not a.out:
         raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")
+    a.method = method_for(a.exemplar, a.method)
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.scale("--scale", a.scale)
@@ -163,8 +165,7 @@ def run(a: argparse.Namespace) -> int:
         field = req.procedural_field("--", Bar(a.quiet, stage))
         saved.save(a.out, field)
         if not a.quiet:
-            print(f"saved the fitted {field.family} to {a.out}: draw it with --method procedural --exemplar "
-                  f"{a.out}", file=sys.stderr)
+            print(f"saved the fitted {field.family} to {a.out}: draw it with --exemplar {a.out}", file=sys.stderr)
         return 0
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
         from omninoise.backend.bake import BakeSpec, run_bake

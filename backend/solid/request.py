@@ -38,9 +38,18 @@ from .procedural.field import DEFAULT_KINDS
 from .pixels import MIN_SIDE
 from .procedural.saved import is_saved
 
-__all__ = ["SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
+__all__ = ["method_for", "SolidRequest", "MAX_SEED", "METHODS", "IMAGE_METHODS"]
 
 MAX_SEED = 2 ** 32 - 1   #: seeds are 32-bit (the value noise hash, backend/solid/value_noise.py)
+
+
+def method_for(exemplar, method: str | None = None) -> str:
+    """The method a request draws by where its front end was given none: a saved procedural solid (a ``.json``
+    exemplar) is drawn by ``"procedural"``, the one method that draws it; anything else by ``"neural"``. A method
+    given is kept (and checked by :meth:`SolidRequest.check`)."""
+    if method is not None:
+        return method
+    return "procedural" if is_saved(exemplar) else "neural"
 
 
 def _pixels_sha(x: np.ndarray) -> str:

@@ -72,6 +72,11 @@ def test_the_saved_file_is_the_fit_and_draws_as_the_fit_from_every_front_end(fit
     np.testing.assert_array_equal(np.load(drawn), np.load(direct))
     np.testing.assert_array_equal(api.solid(path, 32, dim=3, method="procedural"), np.load(direct))
     np.testing.assert_array_equal(api.solid(saved.read(path), 32, dim=3, method="procedural"), np.load(direct))
+    # no method: a saved solid is drawn by the one method that draws it (it was refused as not neural)
+    unnamed = str(tmp_path / "unnamed.npy")
+    assert main(["solid", "--quiet", "--exemplar", path, "--size", "32", "--dim", "3", "-o", unnamed]) == 0
+    np.testing.assert_array_equal(np.load(unnamed), np.load(direct))
+    np.testing.assert_array_equal(api.solid(path, 32, dim=3), np.load(direct))
 
     shutil.copy(path, tmp_path / "kept.json")
     shutil.copy(PHOTO, tmp_path / "bricks.jpg")
@@ -83,10 +88,10 @@ output = "{name}.exr"
 resolution = [32, 32]
 [bake.source]
 kind = "solid"
-method = "procedural"
 exemplar = "{exemplar}"
-{seed}
-""" for name, exemplar, seed in (("saved", "kept.json", ""), ("photo", "bricks.jpg", "seed = 3"))))
+{more}
+""" for name, exemplar, more in (("saved", "kept.json", ""),          # drawn by method procedural, unnamed
+                                 ("photo", "bricks.jpg", 'method = "procedural"\nseed = 3'))))
     monkeypatch.undo()
     small(monkeypatch)
     assert main(["bake", str(job), "--quiet"]) == 0
