@@ -116,6 +116,13 @@ class BakeSpec:
             raise SettingError("transfer", "a solid texture has its own colours; remove the transfer function")
         if ext == ".npy" and self.transfer is not None:
             raise SettingError("transfer", NPY_RAMP)
+        if self.half and self.transfer is not None and ext in (".exr", ".vdb"):
+            from ..export.atomic import HALF_MAX
+
+            top = self.transfer.largest(volume=ext == ".vdb")
+            if top > HALF_MAX:
+                raise SettingError("half", f"the ramp writes values up to {top:g} (colour, density or temperature), "
+                                           f"past {HALF_MAX:g}, the largest 16-bit half float: leave out half")
         if self.frames is not None:
             a, b = self.frames
             if int(a) != a or int(b) != b or b < a:

@@ -123,6 +123,15 @@ class TransferFunction:
             o += cols[i]
         return out
 
+    def largest(self, volume: bool) -> float:
+        """The largest value the ramp writes: its stops' colours and alpha (an image), and for a volume the density
+        (density_scale x alpha) and temperature too; every interpolation stays within its stops."""
+        top = max(max(c) for _, c in self.stops)
+        if volume:
+            top = max(top, self.density_scale * max(c[3] for _, c in self.stops),
+                      max((k for _, k in self.temperature), default=0.0))
+        return float(top)
+
     def density(self, rgba: np.ndarray) -> np.ndarray:
         """Density from :meth:`rgba`'s alpha: float32 (...)."""
         return rgba[..., 3] * _F(self.density_scale)

@@ -216,7 +216,7 @@ def _message(text: str) -> None:
 BAKE_LABELS = {"cell size": "Cell Size", "stit probability": "Split Probability", "stit depth": "Split Depth",
                "range": "From and To", "range[0]": "From", "range[1]": "To", "density_scale": "Density",
                "time": "Time", "time_step": "Time per Frame", "frames": "Start and End",
-               "temperature[0][0]": "Temperature Start", "temperature[1][1]": "Temperature Max"}
+               "temperature[0][0]": "Temperature Start", "temperature[1][1]": "Temperature Max", "half": "Half Float"}
 
 
 class _BakeOperator(TaskOperator):

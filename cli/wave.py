@@ -243,6 +243,10 @@ def _bake(a: argparse.Namespace, source, tf, ext: str) -> int:
     rank = 3 if ext == ".vdb" or (ext == ".npy" and a.dim > 2) else 2
     grid = BoxGrid((a.size,) * rank, ((0.0, 0.0, 0.0), (a.extent,) * 3))
     spec = BakeSpec("wave", source, grid, a.out, tf, time=a.time, half=a.half)
+    try:
+        spec.validate()
+    except SettingError as exc:     # the bake's own rules (a ramp past what --half holds), named by their flags
+        raise SettingError(_flag(a, exc.setting), exc.message) from None
     run_bake(spec, Bar(a.quiet), force=True)
     return 0
 

@@ -33,13 +33,22 @@ class NonFiniteError(ValueError):
     """A result holds NaN or infinite values; nothing is written."""
 
 
-def require_finite(array, path: str) -> None:
-    """NonFiniteError naming ``path`` unless every value of ``array`` is finite (the writers' last check)."""
+#: the largest finite 16-bit half float: a value past it is written as infinite
+HALF_MAX = 65504.0
+
+
+def require_finite(array, path: str, half: bool = False) -> None:
+    """NonFiniteError naming ``path`` unless every value of ``array`` is finite, and with ``half`` (16-bit half
+    floats) within +-:data:`HALF_MAX` (the writers' last check)."""
     a = np.asarray(array)
     if a.dtype.kind in "fc" and not np.isfinite(a).all():
         bad = int(a.size - np.count_nonzero(np.isfinite(a)))
         raise NonFiniteError(f"not writing {os.path.basename(path)}: {bad} of {a.size} values are NaN or infinite "
                              "(a setting out of range?)")
+    if half and a.dtype.kind in "fc" and a.size and float(np.max(np.abs(a))) > HALF_MAX:
+        bad = int(np.count_nonzero(np.abs(a) > HALF_MAX))
+        raise NonFiniteError(f"not writing {os.path.basename(path)}: {bad} of {a.size} values lie past {HALF_MAX:g}, "
+                             "the largest 16-bit half float, and would be infinite: write 32-bit floats (no half)")
 
 
 @contextlib.contextmanager

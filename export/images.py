@@ -83,7 +83,7 @@ def write_exr(path: str, array: np.ndarray, half: bool = False, channels: str | 
     import OpenEXR
 
     a = np.asarray(array, dtype=np.float32)
-    require_finite(a, path)
+    require_finite(a, path, half)
     if a.ndim == 2:
         a = a[:, :, None]
     c = a.shape[2]

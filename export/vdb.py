@@ -70,13 +70,14 @@ class VolumeWriter:
                 g.gridClass = self.vdb.GridClass.FOG_VOLUME
             g.saveFloatAsHalf = bool(half)
             self.grids[name] = (g, kind)
+        self.half = bool(half)
         self.metadata = {str(k): str(v) for k, v in (metadata or {}).items()}
 
     def add(self, name: str, z0: int, slab: np.ndarray) -> None:
         """Store ``slab`` float32 (nz, ny, nx) or (nz, ny, nx, 3) at z = z0 ... z0 + nz - 1."""
         g, kind = self.grids[name]
         a = np.asarray(slab, _F)
-        require_finite(a, f"grid {name!r}")
+        require_finite(a, f"grid {name!r}", self.half)
         if kind == "float":
             if a.ndim != 3:
                 raise ValueError(f"grid {name!r} takes (nz, ny, nx) slabs, got {a.shape}")

@@ -230,6 +230,14 @@ def test_bad_settings_report_one_line(scene, tmp_path):
         bpy.ops.omninoise.bake_image()
     p.range_min, p.range_max = -1e300, 1e300      # held where the ramp's positions stay finite
     assert (p.range_min, p.range_max) == (-1e6, 1e6)
+    from omninoise.blender_addon.bake_blender import ramp_node
+
+    p.range_min, p.range_max, p.half = -0.2, 1.6, True     # a colour past a half float's 65504 was written infinite
+    element = ramp_node().color_ramp.elements[-1]
+    colour, element.color = tuple(element.color), (1e5, 1.0, 1.0, 1.0)
+    with pytest.raises(RuntimeError, match="Half Float: the ramp writes values up to 100000"):
+        bpy.ops.omninoise.bake_image()
+    element.color, p.half = colour, False
     p.range_max, p.animated, p.time_per_frame = 1.0, True, float("nan")
     with pytest.raises(RuntimeError, match="Time per Frame: must be a finite number, got nan"):
         bpy.ops.omninoise.bake_image()

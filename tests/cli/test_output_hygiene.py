@@ -68,6 +68,37 @@ def test_no_writer_writes_nan_or_infinity(tmp_path, ext):
     assert os.listdir(tmp_path) == []
 
 
+def test_half_floats_refuse_values_they_would_write_as_infinite(tmp_path, capsys):
+    """A 16-bit half holds up to 65504: past it the file held infinities unsaid (a ramp colour of 1e5 with
+    --half). The writers refuse such values; a bake whose ramp reaches past it is refused before any work."""
+    out = str(tmp_path / "x.exr")
+    big = np.zeros((4, 4), np.float32)
+    big[0, 0], big[1, 1] = 65504.0, -7e4
+    with pytest.raises(export.NonFiniteError, match="1 of 16 values lie past 65504, the largest 16-bit half"):
+        export.write_exr(out, big, half=True)
+    assert os.listdir(tmp_path) == []
+    export.write_exr(out, big)                          # 32-bit floats hold them
+    try:
+        w = export.VolumeWriter((1, 1, 1), (0, 0, 0), {"density": "float"}, half=True)
+    except RuntimeError:
+        w = None
+    if w is not None:
+        with pytest.raises(export.NonFiniteError, match="grid 'density'.*past 65504"):
+            w.add("density", 0, big[None] * 2)
+    (tmp_path / "hot.json").write_text('{"stops": [[0, [0, 0, 0, 1]], [1, [100000, 1, 1, 1]]]}')
+    (tmp_path / "dense.json").write_text('{"density_scale": 1e5, "stops": [[0, [0, 0, 0, 1]], [1, [1, 1, 1, 1]]]}')
+    cases = [("hot.json", "h.exr", [])] + ([("dense.json", "d.vdb", ["--dim", "3"])] if w is not None else [])
+    for ramp, name, extra in cases:         # the colours of an image, the density of a volume
+        target = str(tmp_path / name)
+        assert main(["wave", "--quiet", "--size", "8", "--transfer", str(tmp_path / ramp), "--half", "-o", target,
+                     *extra]) == 2
+        err = capsys.readouterr().err
+        assert "--half: the ramp writes values up to 100000" in err and not os.path.exists(target), err
+    # an image writes the ramp's colours and alpha, not its density: a density_scale past 65504 is no matter there
+    assert main(["wave", "--quiet", "--size", "8", "--transfer", str(tmp_path / "dense.json"), "--half", "-o",
+                 str(tmp_path / "d.exr")]) == 0
+
+
 def test_a_volume_writer_refuses_nan_slabs():
     try:
         w = export.VolumeWriter((1, 1, 1), (0, 0, 0), {"density": "float"})
