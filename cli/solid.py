@@ -93,7 +93,8 @@ def solid_request(a: argparse.Namespace):
                                 ("gaussian", True), ("rest", "auto"), ("tile", 256), ("families", DEFAULT_KINDS))
              if getattr(a, k) != unset]
     return SolidRequest(a.model, a.exemplar, a.to, a.mix, a.refine, a.seed, a.periodic, a.gaussian,
-                        a.rest, a.method, a.tile, a.families).check("--").check_reads(given, "--", FLAGS)
+                        a.rest, method_for(a.exemplar, a.method), a.tile, a.families).check("--").check_reads(
+        given, "--", FLAGS)
 
 
 def run(a: argparse.Namespace) -> int:
