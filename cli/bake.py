@@ -84,7 +84,7 @@ def check_precision(a: argparse.Namespace) -> None:
 
 
 def run(a: argparse.Namespace) -> int:
-    from omninoise.backend.jobs import JobError, load_job, run_job
+    from omninoise.backend.jobs import JobError, load_job, run_job, select_bakes
 
     farm = a.workers is not None or a.cluster is not None
     for flag, given in (("--retries", a.retries != 2), ("--brick-voxels", a.brick_voxels is not None),
@@ -94,15 +94,15 @@ def run(a: argparse.Namespace) -> int:
     if a.cluster is not None:
         check_cluster(a)
     check_precision(a)
-    if a.dry_run:
-        entries = load_job(a.job)
+    if a.dry_run:       # what the run would do: the bakes --only names, up-to-date ones baked again with --force
+        entries = select_bakes(load_job(a.job), a.only)
         bad = [s for _, s in entries if isinstance(s, JobError)]
         for name, spec in entries:
             if isinstance(spec, JobError):
                 print(f"  invalid  {shown(spec)}")
             else:
                 frames = spec.frame_list()
-                fresh = sum(spec.is_up_to_date(f) for f in frames)
+                fresh = 0 if a.force else sum(spec.is_up_to_date(f) for f in frames)
                 state = "up to date" if fresh == len(frames) else "to bake"
                 print(f"  {state:10s} {shown(name)}: {list(spec.grid.resolution)} -> {shown(spec.output)}"
                       + (f" ({len(frames)} frames, {fresh} up to date)" if spec.frames else ""))

@@ -140,6 +140,14 @@ def test_cli_exit_codes_and_messages(job, capsys):
     assert main(["bake", str(job), "--only", "nope"]) == 2
     assert "no bake named 'nope'" in capsys.readouterr().err
     assert main(["bake", str(job), "--dry-run"]) == 2
+    # a dry run says what the run would do: the bakes --only names (the run of marble alone bakes it), and with
+    # --force the up-to-date ones baked again (it listed every bake, and the invalid clouds failed it)
+    capsys.readouterr()
+    assert main(["bake", str(job), "--dry-run", "--only", "marble"]) == 0
+    assert capsys.readouterr().out.splitlines() == [f"  up to date marble: [32, 16] -> {job.parent}/out/marble.exr"]
+    assert main(["bake", str(job), "--dry-run", "--only", "marble", "--force"]) == 0
+    assert capsys.readouterr().out.startswith("  to bake    marble")
+    assert main(["bake", str(job), "--quiet", "--only", "marble"]) == 0
     # a failure while running (the output folder is a file) exits 1
     job.write_text(JOB.replace('output = "out/marble.exr"', 'output = "blocker/marble.exr"'))
     (job.parent / "blocker").write_text("a file where a folder belongs")
