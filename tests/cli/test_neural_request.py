@@ -165,3 +165,21 @@ def test_a_mask_or_map_of_another_size_is_drawn_at_the_images_size(layout, model
                                            "but the resolution is 32x32"):
         source_from_dict(dict(kind="neural", model=TINY, **dict(table, **{"blend" if layout == "blend" else "map":
                                                                           "wide.png"})), str(maps)).check_grid((32, 32))
+
+
+def test_a_map_with_soft_edges_is_told_apart_from_one_missing_colour():
+    """A map painted with a soft or anti-aliased brush blends its regions' colours at their edges: every blend is a
+    colour of no spec. The message names the first and says how many there are (it named one colour of hundreds)."""
+    from omninoise.backend.neural.request import regions_from_map
+
+    px = np.zeros((8, 32, 3), np.float32)
+    px[:, :, 0] = np.clip((np.arange(32) - 12) / 8.0, 0, 1)     # black to red over 8 px
+    with pytest.raises(SettingError, match=r"the map uses \(32, 0, 0\) but no spec is given for it \(7 colours have "
+                                           r"none, on 56 px: paint the map with hard edges"):
+        regions_from_map(px, [(0, 0, 0), (255, 0, 0)], "--map")
+    with pytest.raises(SettingError, match=r"uses 10 but no spec is given for it \(7 grey levels have none"):
+        regions_from_map(px, [0, 76], "--map")
+    hard = np.round(px)
+    with pytest.raises(SettingError, match=r"uses \(255, 0, 0\) but no spec is given for it$"):
+        regions_from_map(hard, [(0, 0, 0)], "--map")
+    assert set(np.unique(regions_from_map(hard, [(0, 0, 0), (255, 0, 0)]))) == {0, 1}
