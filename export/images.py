@@ -229,18 +229,26 @@ def _decode_pillow(path: str) -> tuple:
 OPAQUE = 254.5 / 255.0   #: the least alpha an input's pixel may have (an 8-bit 255; 254 is partly transparent)
 
 
-def opaque(a: np.ndarray, name: str) -> np.ndarray:
-    """The colour channels of an input image (H, W, C): with alpha (C 2 or 4) it must be opaque everywhere, since
-    what lies under a transparent pixel is no colour of the picture (a cutout's is often black, a pixel's edge
-    half its background's): ImageError naming ``name`` and the share of partly transparent pixels."""
+def transparency(a: np.ndarray) -> str | None:
+    """Why an input image (H, W, C) with alpha (C 2 or 4) cannot be read as opaque colours (the share of its partly
+    transparent pixels), or None where it can: what lies under a transparent pixel is no colour of the picture (a
+    cutout's is often black, a pixel's edge half its background's)."""
     if a.shape[2] not in (2, 4):
-        return a
+        return None
     clear = float(np.mean(a[..., -1] < OPAQUE))
-    if clear > 0.0:
-        raise ImageError(f"{name}: the image is partly transparent (alpha below 1 on {100 * clear:.3g} % of its "
-                         "pixels); inputs are read as opaque colours: flatten it onto a background or crop it to its "
-                         "opaque part")
-    return a[..., :-1]
+    if clear == 0.0:
+        return None
+    return (f"the image is partly transparent (alpha below 1 on {100 * clear:.3g} % of its pixels); inputs are read "
+            "as opaque colours: flatten it onto a background or crop it to its opaque part")
+
+
+def opaque(a: np.ndarray, name: str) -> np.ndarray:
+    """The colour channels of an input image (H, W, C), its alpha dropped where it is opaque everywhere; ImageError
+    naming ``name`` where it is not (:func:`transparency`)."""
+    why = transparency(a)
+    if why is not None:
+        raise ImageError(f"{name}: {why}")
+    return a[..., :-1] if a.shape[2] in (2, 4) else a
 
 
 def read_image(path: str) -> np.ndarray:

@@ -111,12 +111,12 @@ def pixels_as_rgb(x, setting: str):
     if x.ndim == 2:
         x = x[..., None]
     if x.shape[2] in (2, 4):
-        from ...export.images import ImageError, opaque
+        from ...export.images import transparency
 
-        try:
-            x = opaque(x, setting)
-        except ImageError as exc:
-            raise SettingError(setting, str(exc).split(": ", 1)[1]) from None
+        why = transparency(x)
+        if why is not None:
+            raise SettingError(setting, why)
+        x = x[..., :-1]
     return np.repeat(x, 3, axis=2) if x.shape[2] == 1 else x
 
 
