@@ -95,8 +95,7 @@ class BakeSpec:
         ext = os.path.splitext(self.output)[1].lower()
         if os.path.isdir(self.output):
             raise SettingError("output", f"output path is a folder, not a file: {self.output}")
-        if ext not in FORMATS:
-            raise SettingError("output", f"{self.output!r}: unsupported type {ext or '(none)'}; use {', '.join(FORMATS)}")
+        output_type(self.output, FORMATS, "a bake", "output")
         rank = self.grid.rank
         if ext == ".vdb" and rank != 3:
             raise SettingError("output", f"{os.path.basename(self.output)}: .vdb needs a 3D grid (resolution [nx, ny, nz])")
@@ -212,6 +211,9 @@ def output_type(path: str, allowed: tuple, what: str, setting: str) -> str:
     ``allowed`` (what ``what``, "a neural noise image", is written as)."""
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in allowed:
+        base = os.path.basename(os.fspath(path))
+        if base.lower() in allowed:         # '.png': a hidden file's name, with no type after it
+            raise SettingError(setting, f"{base!r} is a name without a type: give the file a name before {base}")
         raise SettingError(setting, f"{what} is written as {', '.join(allowed)}, not {ext or os.fspath(path)!r}")
     return ext
 

@@ -146,8 +146,9 @@ def test_sequences_number_frames_and_move(tmp_path):
 @pytest.mark.parametrize("kw, match", [
     (dict(output="v.vdb", grid=BoxGrid((8, 8))), "needs a 3D grid"),
     (dict(output="v.png", grid=BoxGrid((8, 8, 8))), "needs a 2D grid"),
-    (dict(output="v.tif"), "unsupported type"),
+    (dict(output="v.tif"), r"a bake is written as .vdb, .exr, .png, .npy, not '.tif'"),
     (dict(output=""), "output path is a folder, not a file"),      # not "unsupported type (none)"
+    (dict(output=".exr"), "'.exr' is a name without a type: give the file a name before .exr"),   # a hidden file
     (dict(output="v_##.vdb", frames=(1, 2)), "does not change over time"),
     (dict(output="v.vdb", frames=(1, 2), source=WaveSource(S3.replace(speed=1.0))), "needs '#'"),
     (dict(output="v.vdb", frames=(3, 1), source=WaveSource(S3.replace(speed=1.0))), "end >= start"),
