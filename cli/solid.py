@@ -166,7 +166,8 @@ def run(a: argparse.Namespace) -> int:
         field = req.procedural_field("--", Bar(a.quiet, stage))
         saved.save(a.out, field)
         if not a.quiet:
-            print(f"saved the fitted {field.family} to {a.out}: draw it with --exemplar {a.out}", file=sys.stderr)
+            what = "a copy of the saved" if saved.is_saved(a.exemplar) else "the fitted"
+            print(f"wrote {what} {field.family} to {a.out}: draw it with --exemplar {a.out}", file=sys.stderr)
         return 0
     if a.dim == 3:  # volumes through the bake pipeline: .vdb color + density grids, or linear RGB .npy
         from omninoise.backend.bake import BakeSpec, run_bake
