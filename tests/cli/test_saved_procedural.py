@@ -54,7 +54,7 @@ def no_fit(monkeypatch):
     monkeypatch.setattr(fit, "fit_procedural", lambda *a, **k: pytest.fail("a saved solid was fitted again"))
 
 
-def test_the_saved_file_is_the_fit_and_draws_as_the_fit_from_every_front_end(fitted, tmp_path, monkeypatch):
+def test_the_saved_file_is_the_fit_and_draws_as_the_fit_from_every_front_end(fitted, tmp_path, monkeypatch, capsys):
     path, field = fitted
     doc = json.load(open(path))
     assert doc["format"] == saved.FORMAT and doc["family"] == field.family and doc["seed"] == 3
@@ -77,6 +77,10 @@ def test_the_saved_file_is_the_fit_and_draws_as_the_fit_from_every_front_end(fit
     assert main(["solid", "--quiet", "--exemplar", path, "--size", "32", "--dim", "3", "-o", unnamed]) == 0
     np.testing.assert_array_equal(np.load(unnamed), np.load(direct))
     np.testing.assert_array_equal(api.solid(path, 32, dim=3), np.load(direct))
+    copy = str(tmp_path / "copy.json")        # a .json from a saved solid is a copy of it, and says so
+    capsys.readouterr()
+    assert main(["solid", "--exemplar", path, "-o", copy]) == 0
+    assert json.load(open(copy)) == doc and "wrote a copy of the saved" in capsys.readouterr().err
 
     shutil.copy(path, tmp_path / "kept.json")
     shutil.copy(PHOTO, tmp_path / "bricks.jpg")
