@@ -67,10 +67,15 @@ def attach():
         copy_presets(lambda sub: bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", sub), create=True))
 
 
+#: the file in a user's presets folder that lists the shipped presets copied there (Blender's menus list .py only)
+COPIED_RECORD = ".omninoise_shipped"
+
+
 def copy_presets(folder_of) -> list:
     """Copy each shipped preset into ``folder_of(subdir)`` (the user's presets folder of a kind, made if need be)
-    where that folder has no file of its name, as add-ons did before Blender read presets from an extension's
-    folder: an artist's own edit of a preset stays, and a preset the artist removed comes back on the next start.
+    once, as add-ons did before Blender read presets from an extension's folder: a preset is copied where that
+    folder has no file of its name and its :data:`COPIED_RECORD` does not list it, so an artist's own edit of a
+    preset stays, a preset the artist removed stays removed, and one shipped later is copied at the next start.
     Returns the files copied; a folder that cannot be written leaves that kind without its shipped presets, with a
     line on the console, and the extension starts."""
     copied = []
@@ -80,10 +85,16 @@ def copy_presets(folder_of) -> list:
             dst = folder_of(sub)
             if not dst or not os.path.isdir(dst):       # Blender gives "" for a folder it could not make
                 raise NotADirectoryError(f"no folder {dst!r}")
-            for name in sorted(os.listdir(src)):
-                if name.endswith(".py") and not os.path.exists(os.path.join(dst, name)):
+            record = os.path.join(dst, COPIED_RECORD)
+            done = set(open(record, encoding="utf-8").read().split()) if os.path.isfile(record) else set()
+            shipped = sorted(n for n in os.listdir(src) if n.endswith(".py"))
+            for name in shipped:
+                if name not in done and not os.path.exists(os.path.join(dst, name)):
                     shutil.copyfile(os.path.join(src, name), os.path.join(dst, name))
                     copied.append(os.path.join(dst, name))
+            if not done.issuperset(shipped):
+                with open(record, "w", encoding="utf-8") as fh:
+                    fh.write("".join(f"{n}\n" for n in sorted(done.union(shipped))))
         except OSError as exc:
             print(f"OmniNoise: the shipped {sub.split('/')[-1]} presets are not available: {exc}")
     return copied

@@ -17,15 +17,23 @@ def test_every_shipped_preset_is_copied_and_an_artists_edit_stays(tmp_path, caps
 
     copied = presets.copy_presets(folder_of)
     for sub in presets.SUBDIRS.values():
-        assert _shipped(sub) and sorted(os.listdir(tmp_path / sub)) == _shipped(sub), sub
+        listed = sorted(f for f in os.listdir(tmp_path / sub) if f.endswith(".py"))
+        assert _shipped(sub) and listed == _shipped(sub), sub
     assert len(copied) == sum(len(_shipped(s)) for s in presets.SUBDIRS.values())
     wave = presets.SUBDIRS["wave"]
     edited = tmp_path / wave / _shipped(wave)[0]
     edited.write_text("# the artist's own\n")
-    (tmp_path / wave / _shipped(wave)[1]).unlink()         # removed in Blender's preset menu
-    again = presets.copy_presets(folder_of)
-    assert again == [str(tmp_path / wave / _shipped(wave)[1])]          # back, and only it
+    removed = tmp_path / wave / _shipped(wave)[1]
+    removed.unlink()                                        # removed in Blender's preset menu
+    assert presets.copy_presets(folder_of) == [] and not removed.exists()     # it stays removed (it came back)
     assert edited.read_text() == "# the artist's own\n"
+    record = tmp_path / wave / presets.COPIED_RECORD        # a preset shipped later: copied once, at the next start
+    record.write_text("".join(f"{n}\n" for n in _shipped(wave)[1:]))
+    assert presets.copy_presets(folder_of) == []            # its name is taken by the artist's edit: kept
+    record.write_text("".join(f"{n}\n" for n in _shipped(wave) if n != _shipped(wave)[2]))
+    (tmp_path / wave / _shipped(wave)[2]).unlink()
+    assert presets.copy_presets(folder_of) == [str(tmp_path / wave / _shipped(wave)[2])]
+    assert presets.copy_presets(folder_of) == []
     assert capsys.readouterr().out == ""
 
 
