@@ -121,6 +121,7 @@ from __future__ import annotations
 
 import copy
 import os
+import re
 from dataclasses import dataclass
 from typing import Callable
 
@@ -145,6 +146,18 @@ class JobOutcome:
     status: str  # "baked" | "up to date" | "invalid" (bad settings, nothing run) | "failed" | "cancelled"
     message: str = ""
     result: BakeResult | None = None
+
+
+def _defaulted(setting: str, own: dict, defaults: dict) -> bool:
+    """Whether the key a bake's error names (``source.fmax``, ``source.spectrum.fmax``, ``frames[1]``) comes from
+    ``[defaults]``, not the bake's own table: a wave setting given there is unknown to a neural bake."""
+    here, there = own, defaults
+    for part in re.sub(r"\[\d+\]", "", setting).split("."):
+        if isinstance(here, dict) and part in here:
+            here, there = here[part], there.get(part) if isinstance(there, dict) else None
+        else:
+            return isinstance(there, dict) and part in there
+    return False
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -228,7 +241,9 @@ def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
         try:
             spec = _spec(d, base_dir, i, frozenset(b))
         except (SettingError, FileNotFoundError) as exc:
-            out.append((name, JobError(f"bake {name!r}: {exc}{_written_before(d, base_dir, outputs)}")))
+            given = " (set in [defaults], which every bake takes)" if isinstance(exc, SettingError) and \
+                _defaulted(exc.setting, b, defaults) else ""
+            out.append((name, JobError(f"bake {name!r}: {exc}{given}{_written_before(d, base_dir, outputs)}")))
             continue
         real = os.path.realpath(spec.output)
         try:

@@ -325,3 +325,30 @@ def test_int8_beside_a_job_without_neural_noise_is_refused(job, capsys):
     assert main(["bake", str(job), "--precision", "int8", "--dry-run", "--only", "marble"]) == 2
     assert "--precision: sets the neural noise's arithmetic" in capsys.readouterr().err
     assert main(["bake", str(job), "--precision", "fp32", "--dry-run", "--only", "marble"]) == 0
+
+
+def test_a_bad_key_from_defaults_says_it_came_from_there(tmp_path):
+    """[defaults] is merged into every bake: a wave setting there is unknown to a neural bake, and the message
+    said so without saying where the key came from (the bake's own table does not hold it)."""
+    (tmp_path / "job.toml").write_text("""
+[defaults]
+resolution = [8, 8]
+[defaults.source]
+kind = "wave"
+fmax = 4
+
+[[bake]]
+name = "wave"
+output = "w.exr"
+
+[[bake]]
+name = "own"
+output = "o.exr"
+[bake.source]
+fmax = -1
+""" + NEURAL_BAKE.replace("out/spots.png", "n.png"))
+    res = {n: s for n, s in load_job(str(tmp_path / "job.toml"))}
+    assert not isinstance(res["wave"], JobError)
+    assert str(res["spots"]).startswith("bake 'spots': source.fmax: unknown key;")
+    assert str(res["spots"]).endswith("(set in [defaults], which every bake takes)")
+    assert str(res["own"]) == "bake 'own': source.fmax: must lie in (0, 100000], got -1"     # its own key
