@@ -23,6 +23,10 @@ from .common import Bar, add_command, flag_image
 __all__ = ["add_parser", "run", "settings_from_args"]
 
 
+#: the spectra a flag names (a custom spectrum's amplitudes are given in a job file or from Python)
+FLAG_SPECTRA = tuple(k for k in SPECTRUM_KINDS if k != "custom")
+
+
 def spectrum_arg(text: str) -> Spectrum:
     """'kind:fmin:fmax[:exponent]' -> Spectrum."""
     parts = text.split(":")
@@ -31,6 +35,9 @@ def spectrum_arg(text: str) -> Spectrum:
         exponent = float(parts[3]) if len(parts) > 3 else 1.0
     except (IndexError, ValueError):
         raise argparse.ArgumentTypeError(f"expected kind:fmin:fmax[:exponent], got {text!r}") from None
+    if kind not in FLAG_SPECTRA:
+        why = " (a custom spectrum's amplitudes are given in a job file or from Python)" if kind == "custom" else ""
+        raise argparse.ArgumentTypeError(f"expected a kind of {', '.join(FLAG_SPECTRA)}, got {kind!r}{why}")
     return Spectrum(kind, fmin, fmax, exponent)
 
 
@@ -70,7 +77,7 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
     g.add_argument("--seed", type=int, default=0, help="another seed draws other directions and phases")
     g.add_argument("--quiet", action="store_true", help="no progress bar or notes")
     g = w.add_argument_group("spectrum")
-    g.add_argument("--spectrum", choices=[k for k in SPECTRUM_KINDS if k != "custom"], default="gaussian",
+    g.add_argument("--spectrum", choices=FLAG_SPECTRA, default="gaussian",
                    help="amplitude profile over the band")
     g.add_argument("--fmin", type=float, default=2.0, help="band low, cycles per unit")
     g.add_argument("--fmax", type=float, default=8.0, help="band high, cycles per unit")

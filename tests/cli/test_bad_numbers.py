@@ -64,6 +64,16 @@ def test_settings_that_join_flags_are_named_by_the_flag(tmp_path, capsys, args, 
     assert not out.exists()
 
 
+def test_a_custom_spectrum_is_no_flag_s_kind(capsys):
+    """A custom spectrum's amplitudes cannot be flags: KIND:FMIN:FMAX took it, then refused it for amplitudes no
+    flag gives."""
+    with pytest.raises(SystemExit) as e:
+        main(["wave", "--size", "8", "--transition", "custom:1:2", "-o", "x.png"])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and "argument --transition: expected a kind of gaussian, white, blue, brown, fractal, " \
+        "bandpass, twolevel, got 'custom' (a custom spectrum's amplitudes are given in a job file" in err, err
+
+
 @pytest.mark.parametrize("args,setting", [
     (["--steps", "0"], "--steps: must be a whole number"),
     (["--sampler", "bogus"], "--sampler: unknown sampler"),
