@@ -41,7 +41,7 @@ def _spectrum(value, name: str = "spectrum"):
 
     if value is None or isinstance(value, (Spectrum, dict)) or (name == "spectrum" and isinstance(value, str)):
         return value            # a dict's keys and a kind's name are checked with the settings, naming the setting
-    if isinstance(value, (tuple, list)) and value and isinstance(value[0], str):
+    if isinstance(value, (tuple, list)) and len(value) in (3, 4) and isinstance(value[0], str):
         return Spectrum(*value)
     raise SettingError(name, f"expected a Spectrum, a dict or a (kind, fmin, fmax[, exponent]) tuple, got {value!r}")
 

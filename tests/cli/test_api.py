@@ -9,6 +9,9 @@ from omninoise.backend.errors import SettingError
 CASES = [
     (lambda: omninoise.wave(8, seed=None), "seed", "expected a value, got None"),
     (lambda: omninoise.wave(8, spectrum=None), "spectrum", "expected a value, got None"),
+    # a tuple of another length: fmax was taken as 8 unsaid, a fifth number as a split bandpass does not read
+    (lambda: omninoise.wave(8, spectrum=("bandpass", 4)), "spectrum", r"\(kind, fmin, fmax\[, exponent\]\) tuple"),
+    (lambda: omninoise.wave(8, spectrum=("bandpass", 4, 8, 1, 5)), "spectrum", r"tuple, got \('bandpass', 4, 8"),
     (lambda: omninoise.wave(8, directions=None), "directions", "expected a value, got None"),
     (lambda: omninoise.wave(8, extent=1e300), "extent", r"must lie in \[1e-06, 1e\+07\]"),
     (lambda: omninoise.wave(8, extent=0), "extent", "must lie in"),
