@@ -192,8 +192,10 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     if out is not None:
         _check_out(out, (".png", ".exr", ".npy"), "a neural noise image")
     neural_memory("size", size, size)
+    if model is not None and (not isinstance(model, (str, os.PathLike)) or not os.fspath(model)):
+        raise SettingError("model", f"expected a model folder's path, got {model!r}")
     try:
-        net = NeuralNoiseModel(model or neural_model())
+        net = NeuralNoiseModel(os.fspath(model) if model is not None else neural_model())
     except ModelError as exc:
         raise SettingError("model", str(exc)) from None
     req = NeuralRequest("uniform", [(noise, params)], width=size, height=size, seed=seed,

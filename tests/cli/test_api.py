@@ -9,6 +9,7 @@ from omninoise.backend.errors import SettingError
 CASES = [
     (lambda: omninoise.wave(8, seed=None), "seed", "expected a value, got None"),
     (lambda: omninoise.wave(8, spectrum=None), "spectrum", "expected a value, got None"),
+    (lambda: omninoise.neural("perlin", 16, model=3), "model", "expected a model folder's path, got 3"),  # TypeError
     # a tuple of another length: fmax was taken as 8 unsaid, a fifth number as a split bandpass does not read
     (lambda: omninoise.wave(8, spectrum=("bandpass", 4)), "spectrum", r"\(kind, fmin, fmax\[, exponent\]\) tuple"),
     (lambda: omninoise.wave(8, spectrum=("bandpass", 4, 8, 1, 5)), "spectrum", r"tuple, got \('bandpass', 4, 8"),
