@@ -86,7 +86,10 @@ def copy_presets(folder_of) -> list:
             if not dst or not os.path.isdir(dst):       # Blender gives "" for a folder it could not make
                 raise NotADirectoryError(f"no folder {dst!r}")
             record = os.path.join(dst, COPIED_RECORD)
-            done = set(open(record, encoding="utf-8").read().split()) if os.path.isfile(record) else set()
+            done = set()
+            if os.path.isfile(record):
+                with open(record, encoding="utf-8") as fh:
+                    done = set(fh.read().split())
             shipped = sorted(n for n in os.listdir(src) if n.endswith(".py"))
             for name in shipped:
                 if name not in done and not os.path.exists(os.path.join(dst, name)):

@@ -109,14 +109,13 @@ def run(a: argparse.Namespace) -> int:
         return 0
     if not a.exemplar or not a.out:
         raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")
-    a.method = method_for(a.exemplar, a.method)
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.scale("--scale", a.scale)
     limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     ext = os.path.splitext(a.out)[1].lower()
     if ext == ".json":          # the fitted procedural solid itself, drawn later at any size
-        if a.method != "procedural":
+        if method_for(a.exemplar, a.method) != "procedural":
             raise SettingError("-o", "a .json output is a fitted procedural solid: give --method procedural")
         for flag, value, unset in (("--dim", a.dim, 2), ("--size", a.size, 256), ("--scale", a.scale, 1.0)):
             if value != unset:

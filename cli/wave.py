@@ -251,10 +251,9 @@ def _bake(a: argparse.Namespace, source, tf, ext: str) -> int:
     grid = BoxGrid((a.size,) * rank, ((0.0, 0.0, 0.0), (a.extent,) * 3))
     spec = BakeSpec("wave", source, grid, a.out, tf, time=a.time, half=a.half)
     try:
-        spec.validate()
+        run_bake(spec, Bar(a.quiet), force=True)
     except SettingError as exc:     # the bake's own rules (a ramp past what --half holds), named by their flags
         raise SettingError(_flag(a, exc.setting), exc.message) from None
-    run_bake(spec, Bar(a.quiet), force=True)
     return 0
 
 
