@@ -105,6 +105,12 @@ def _reader_left() -> int:
 
 def main(argv: list[str] | None = None) -> int:
     ap = build_parser()
+    if not (sys.argv[1:] if argv is None else argv):      # 'omninoise' alone: what it does and its subcommands
+        try:
+            ap.print_help()
+        except BrokenPipeError:
+            return _reader_left()
+        return 0
     try:
         a = ap.parse_args(argv)
     except BrokenPipeError:             # --help or --version into a pipe whose reader left

@@ -64,3 +64,11 @@ def test_a_flag_argparse_cannot_read_is_one_line_and_exit_2(argv, first, capsys)
     err = capsys.readouterr().err
     assert e.value.code == 2 and err.count("\n") == 1 and err.startswith(first), err
     assert err.rstrip().endswith("--help'")
+
+
+def test_the_command_alone_prints_its_help(capsys):
+    """``omninoise`` with nothing after it is a reader asking what it does: the help and its subcommands, exit 0."""
+    from omninoise.cli.main import main
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("usage: omninoise") and all(name in out for name in SUBCOMMANDS)
