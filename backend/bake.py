@@ -92,10 +92,7 @@ class BakeSpec:
             if not abs(last) <= limits.MAX_TIME:
                 raise SettingError("time_step", f"the last frame's time, {last:g}, passes {limits.MAX_TIME:g}; use a "
                                                 "smaller time_step or fewer frames")
-        ext = os.path.splitext(self.output)[1].lower()
-        if os.path.isdir(self.output):
-            raise SettingError("output", f"output path is a folder, not a file: {self.output}")
-        output_type(self.output, FORMATS, "a bake", "output")
+        ext = output_type(self.output, FORMATS, "a bake", "output")
         rank = self.grid.rank
         if ext == ".vdb" and rank != 3:
             raise SettingError("output", f"{os.path.basename(self.output)}: .vdb needs a 3D grid (resolution [nx, ny, nz])")
@@ -207,8 +204,10 @@ def still(source) -> str:
 
 
 def output_type(path: str, allowed: tuple, what: str, setting: str) -> str:
-    """The extension of the output file ``path``, lower case; SettingError naming ``setting`` where it is none of
-    ``allowed`` (what ``what``, "a neural noise image", is written as)."""
+    """The extension of the output file ``path``, lower case; SettingError naming ``setting`` where ``path`` is a
+    folder or its type none of ``allowed`` (what ``what``, "a neural noise image", is written as)."""
+    if os.path.isdir(path):
+        raise SettingError(setting, f"output path is a folder, not a file: {os.fspath(path)}")
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in allowed:
         base = os.path.basename(os.fspath(path))

@@ -17,6 +17,8 @@ CASES = [
     (lambda: omninoise.wave(8, extent=1e300), "extent", r"must lie in \[1e-06, 1e\+07\]"),
     (lambda: omninoise.wave(8, extent=0), "extent", "must lie in"),
     (lambda: omninoise.wave(8, out=3), "out", "expected a file path, got 3"),
+    (lambda: omninoise.wave(8, out="/"), "out", "output path is a folder, not a file: /"),    # not "written as"
+    (lambda: omninoise.solid("grass", 8, out="/"), "out", "output path is a folder, not a file: /"),
     (lambda: omninoise.wave(8, transfer=3, out="x.png"), "transfer", "expected a preset name or a ramp .json file"),
     (lambda: omninoise.neural("perlin", 16, steps=1, params={"scale": "x"}), "param", "scale: expected a number"),
     (lambda: omninoise.neural("perlin", 16, steps=1, params=[1]), "param", "expected a table of parameter values"),
