@@ -10,12 +10,12 @@
    noise for each platform (``tools/build_kernel.py``: Zig cross-compiles it) as the wheel
    ``omninoise_rows``, so installed extensions bake wave noise with it instead of numpy.
 2. Stage the runtime files only (extension root, ``blender_addon``, ``backend``,
-   ``export``; no tests, bench, demo or training code) into ``build/extension``
-   and list the platforms and wheels in the staged manifest.
+   ``export``; no tests, bench, demo or training code) into ``build/extension`` (``--work`` names
+   another folder than ``build``) and list the platforms and wheels in the staged manifest.
 3. Run ``blender_ext.py build --split-platforms`` from the ``bpy`` wheel (the
    same as ``blender --command extension build``), then ``validate`` each zip.
 
-Usage: python tools/build_dist.py [--out dist] [--no-wheels [--kernel]]
+Usage: python tools/build_dist.py [--out dist] [--work build] [--no-wheels [--kernel]]
 (``--no-wheels`` builds one zip without bundled wheels, which the tests install; the wheels are only needed
 by the neural features.  ``--kernel`` adds this machine's kernel wheel, built with its own C compiler, to
 that zip, for this machine's platform only.)
@@ -129,8 +129,10 @@ def write_third_party(dst: str, wheels: list[str]) -> str:
     return path
 
 
-def stage(wheels: list[str], platforms=tuple(PLATFORMS)) -> str:
-    dst = os.path.join(ROOT, "build", "extension-nowheels" if not wheels else "extension")
+def stage(wheels: list[str], platforms=tuple(PLATFORMS), work: str = os.path.join(ROOT, "build")) -> str:
+    """The runtime files, ``wheels`` and a manifest listing them and ``platforms``, staged in a folder of
+    ``work``; its path."""
+    dst = os.path.join(work, "extension-nowheels" if not wheels else "extension")
     shutil.rmtree(dst, ignore_errors=True)
     os.makedirs(os.path.join(dst, "wheels"))
     for item in RUNTIME:
@@ -163,6 +165,9 @@ def stage(wheels: list[str], platforms=tuple(PLATFORMS)) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "dist"))
+    ap.add_argument("--work", default=os.path.join(ROOT, "build"),
+                    help="the folder the files are staged and the kernel built in (builds that may run at once, as "
+                         "the tests on several Blenders, each name their own)")
     ap.add_argument("--no-wheels", action="store_true", help="one zip without bundled wheels")
     ap.add_argument("--kernel", action="store_true",
                     help="with --no-wheels: add this machine's C kernel wheel (linux-x64 only)")
@@ -171,12 +176,12 @@ def main() -> None:
     if a.no_wheels and a.kernel:
         if not sys.platform.startswith("linux"):
             sys.exit("--kernel builds the linux-x64 kernel wheel with this machine's compiler: Linux only")
-        wheel = build_kernel.kernel_wheel("linux-x64", os.path.join(ROOT, "build", "kernel-native"), native=True)
+        wheel = build_kernel.kernel_wheel("linux-x64", os.path.join(a.work, "kernel-native"), native=True)
         if not wheel:
             sys.exit("--kernel: the C kernel did not build (see above)")
-        src = stage([wheel], ("linux-x64",))
+        src = stage([wheel], ("linux-x64",), a.work)
     else:
-        src = stage([] if a.no_wheels else download_wheels())
+        src = stage([] if a.no_wheels else download_wheels(), work=a.work)
     os.makedirs(a.out, exist_ok=True)
     split = [] if a.no_wheels else ["--split-platforms"]
     subprocess.run([sys.executable, tool, "build", "--source-dir", src, "--output-dir", a.out] + split, check=True)

@@ -17,9 +17,11 @@ KERNEL = sys.platform.startswith("linux") and bool(shutil.which(os.environ.get("
 
 @pytest.fixture(scope="module")
 def built_zip(tmp_path_factory):
-    out = tmp_path_factory.mktemp("dist")
+    # staged and built in a folder of this run: the runs on several Blenders at once share no build/ folder
+    out, work = tmp_path_factory.mktemp("dist"), tmp_path_factory.mktemp("build")
     r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "build_dist.py"), "--no-wheels", "--out",
-                        str(out)] + (["--kernel"] if KERNEL else []), capture_output=True, text=True)
+                        str(out), "--work", str(work)] + (["--kernel"] if KERNEL else []), capture_output=True,
+                       text=True)
     assert r.returncode == 0, r.stdout + r.stderr
     zips = [f for f in os.listdir(out) if f.endswith(".zip")]
     assert len(zips) == 1 and "valid" in r.stdout
