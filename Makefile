@@ -46,7 +46,7 @@ test-long: $(STAMP) $(VENV)/.train kernel
 
 # The Blender tests on the other supported Blenders' bpy modules, one cached venv each: 4.2 LTS (4.2.0, the extension's
 # least version, and the latest 4.2), 4.3, 4.4 and 4.5 LTS (Python 3.11), 5.1, 5.2 and 5.3 (Python 3.13; Blender 5.1+
-# runs 3.13). .venv keeps the pinned 5.0.1 of requirements.txt.
+# runs 3.13), two at once. .venv keeps the pinned 5.0.1 of requirements.txt.
 PY313 ?= $(firstword $(wildcard $(HOME)/.pyenv/versions/3.13*/bin/python3.13) $(shell command -v python3.13))
 BPY_VENVS := .venv-bpy420 .venv-bpy42 .venv-bpy43 .venv-bpy44 .venv-bpy45 .venv-bpy51 .venv-bpy52 .venv-bpy53
 NUMBA_311 := numba==0.68.1 llvmlite==0.50.0
