@@ -31,6 +31,8 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: where the files are staged and the kernel built, unless --work names another folder
+BUILD = os.path.join(ROOT, "build")
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 
 import build_kernel  # noqa: E402
@@ -129,7 +131,7 @@ def write_third_party(dst: str, wheels: list[str]) -> str:
     return path
 
 
-def stage(wheels: list[str], platforms=tuple(PLATFORMS), work: str = os.path.join(ROOT, "build")) -> str:
+def stage(wheels: list[str], platforms=tuple(PLATFORMS), work: str = BUILD) -> str:
     """The runtime files, ``wheels`` and a manifest listing them and ``platforms``, staged in a folder of
     ``work``; its path."""
     dst = os.path.join(work, "extension-nowheels" if not wheels else "extension")
@@ -165,7 +167,7 @@ def stage(wheels: list[str], platforms=tuple(PLATFORMS), work: str = os.path.joi
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "dist"))
-    ap.add_argument("--work", default=os.path.join(ROOT, "build"),
+    ap.add_argument("--work", default=BUILD,
                     help="the folder the files are staged and the kernel built in (builds that may run at once, as "
                          "the tests on several Blenders, each name their own)")
     ap.add_argument("--no-wheels", action="store_true", help="one zip without bundled wheels")
@@ -179,7 +181,7 @@ def main() -> None:
         wheel = build_kernel.kernel_wheel("linux-x64", os.path.join(a.work, "kernel-native"), native=True)
         if not wheel:
             sys.exit("--kernel: the C kernel did not build (see above)")
-        src = stage([wheel], ("linux-x64",), a.work)
+        src = stage([wheel], ("linux-x64",), work=a.work)
     else:
         src = stage([] if a.no_wheels else download_wheels(), work=a.work)
     os.makedirs(a.out, exist_ok=True)
