@@ -4,20 +4,21 @@ Headless Cycles (CPU), orthographic camera on a plane filling the frame,
 emission shader, R x R pixels, S samples; each shader is rendered once to
 compile, then timed over ``--repeat`` renders (the minimum is kept).  Prints ns
 per pixel-sample (from the difference between S and 2S samples, so set-up and
-shader compilation cancel) and ratios against Blender's Gabor Texture (the issue's target),
-the node count of each built tree, and writes out/bench/node.json.  Two "floor"
+shader compilation cancel) and ratios against Blender's Gabor Texture (the built-in noise
+nearest to wave noise: a sum of random waves), the node count of each built tree, and writes
+docs/benchmarks/node.json with Blender's version (``docs/benchmarks.md`` shows it).  Two "floor"
 rows time the cheapest trees any table-lookup wave node could be at 16
 directions (see :func:`lookup_floor`): what Alg. 1 costs in SVM at the least.  The
 "OSL:" rows render with Cycles' Open Shading Language, the Wave Noise group in its
 OSL form (blender_addon/wave_osl.py), and Gabor under OSL for comparison.
 
-    python -m bench node [--res 256] [--samples 4] [--repeat 2]
+    python -m bench node [--res 256] [--samples 4] [--repeat 2] [-o JSON]
 """
 from __future__ import annotations
 
 import argparse
-import json
 import os
+import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -25,9 +26,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 import bpy
 import numpy as np
 
+from bench.stamp import stamp
 from omninoise.backend import Spectrum, WaveSettings
 from omninoise.blender_addon.compat import ensure_node_tree
 from omninoise.blender_addon.wave_nodes import build_wave_group
+from omninoise.export.atomic import write_json
 
 
 def scene(res: int, samples: int, osl: bool = False):
@@ -156,15 +159,17 @@ def lookup_floor(k: int, sliced: bool):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--res", type=int, default=256)
     ap.add_argument("--samples", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "node.json"))
     a = ap.parse_args(argv)
     # (name, tree maker, OSL shading system)
     cases = [
         ("Blender Noise detail 5", texture("ShaderNodeTexNoise", Detail=5.0, Scale=5.0), False),
         ("Blender Voronoi", texture("ShaderNodeTexVoronoi", Scale=5.0), False),
+        ("Blender Wave Texture", texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0), False),
         ("Blender Gabor", texture("ShaderNodeTexGabor", Scale=5.0), False),
         ("Wave Noise 8 dirs", wave(8), False),
         ("Wave Noise 16 dirs", wave(16), False),
@@ -188,17 +193,17 @@ def main(argv=None):
         # per pixel-sample cost from the difference of S and 2S samples: scene set-up and shader
         # compilation (OSL's JIT) are paid once per render and cancel out; reported apart as set-up
         per = (times[2 * a.samples] - times[a.samples]) / (a.res * a.res * a.samples)
-        res[name] = dict(ns_per_pixel_sample=per * 1e9, nodes=nodes, osl=osl,
-                         setup_s=times[a.samples] - per * a.res * a.res * a.samples, seconds=times)
-    ref = res["Blender Gabor"]["ns_per_pixel_sample"]
+        res[name] = dict(ns_per_pixel_sample=round(per * 1e9, 1), nodes=nodes, osl=osl,
+                         setup_s=round(times[a.samples] - per * a.res * a.res * a.samples, 3))
+    for name, r in res.items():     # each against Gabor rendered as it is, by SVM or by OSL
+        ref = res[("OSL: " if r["osl"] else "") + "Blender Gabor"]["ns_per_pixel_sample"]
+        r["vs_gabor"] = round(r["ns_per_pixel_sample"] / ref, 2)
     print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
     print(f"  {'shader':26s} {'ns/px-sample':>12s} {'vs Gabor':>9s} {'nodes':>6s} {'set-up s':>9s}")
     for name, r in res.items():
-        print(f"  {name:26s} {r['ns_per_pixel_sample']:12.1f} {r['ns_per_pixel_sample'] / ref:8.2f}x {r['nodes']:6d}"
-              f" {r['setup_s']:9.2f}")
-    os.makedirs(os.path.join(ROOT, "out", "bench"), exist_ok=True)
-    with open(os.path.join(ROOT, "out", "bench", "node.json"), "w") as fh:
-        json.dump(dict(res=a.res, samples=a.samples, results=res), fh, indent=1)
+        print(f"  {name:26s} {r['ns_per_pixel_sample']:12.1f} {r['vs_gabor']:8.2f}x {r['nodes']:6d} {r['setup_s']:9.2f}")
+    write_json(a.out, dict(stamp=stamp(), blender=bpy.app.version_string, res=a.res, samples=a.samples, results=res))
+    return 0
 
 
 def _timed() -> float:
@@ -208,4 +213,4 @@ def _timed() -> float:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -162,6 +162,21 @@ def procedural(doc: dict) -> list:
     return out
 
 
+def node(doc: dict) -> list:
+    blender = f"Blender {doc['blender']}, " if doc.get("blender") else ""
+    out = [f"Cycles render time of the Wave Noise node (3D, Gaussian band 2 to 6 cycles per unit) against Blender's own "
+           f"textures: a plane filling a {doc.get('res')}² px frame, emission, {blender}CPU; nanoseconds per "
+           f"pixel-sample from {doc.get('samples')} and {2 * doc.get('samples', 0)} samples (set-up and shader "
+           "compilation cancel). Rows \"OSL:\" render with Cycles' Open Shading Language, where the node is one "
+           "compiled script, against Gabor rendered by OSL too. The two \"floor\" rows are the cheapest node trees "
+           "any table-lookup wave noise could be at 16 directions: one image read per direction, and two reads with "
+           "one hash (slicing without jittered directions or blend weights).", "",
+           "| shader | ns per pixel-sample | vs Gabor | nodes |", "|---|---|---|---|"]
+    for name, r in doc.get("results", {}).items():
+        out.append(f"| {name} | {r['ns_per_pixel_sample']} | {r['vs_gabor']}x | {r['nodes']} |")
+    return out + [""]
+
+
 def procedural_node(doc: dict) -> list:
     blender = f"Blender {doc['blender']}, " if doc.get("blender") else ""
     out = [f"Cycles render time of the procedural solids' live node groups against Blender's Wave Texture: a plane "
@@ -181,6 +196,7 @@ def procedural_node(doc: dict) -> list:
 #: (JSON file, heading, renderer, the command that makes it)
 BENCHES = (
     ("wave.json", "Wave noise", wave, "python -m bench wave"),
+    ("node.json", "Wave Noise node: render time", node, "python -m bench node"),
     ("neural_speed.json", "Neural noise", neural, "python -m bench neural --sizes 256 512 1024"),
     ("solid_eval.json", "Solid textures", solid, "python -m bench solid --only-speed"),
     ("solid_ablation.json", "Solid textures: what each stage is worth, held-out photos", ablation,
