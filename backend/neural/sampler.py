@@ -184,7 +184,7 @@ SAMPLERS: dict = {
     "heun": (heun_sample, lambda n: 2 * (n - 1)),
 }
 #: chosen by measurement (README, "Sampling"): DPM-Solver++(2M) on the truncated grid with 10 evaluations is as
-#: near the converged probability-flow solution as DDIM 30 (docs/img/neural_solver_error_64.json: 0.031 against 0.034
+#: near the converged probability-flow solution as DDIM 30 (docs/evaluations/neural_solver_error_64.json: 0.031 against 0.034
 #: mean |Δ| at 256²) and no worse by the evaluation (python -m bench neural-eval, 64² instrument, all 23 classes);
 #: the previous default, 15 timesteps even in log-SNR, made 13 evaluations, four of them below λ = -4.5
 DEFAULT_SAMPLER = "dpmpp_2m"

@@ -38,7 +38,7 @@ SPACINGS = ("uniform", "logsnr", "karras", "truncated")
 #: λ = -3.5 (SNR e^-7) the data prediction hardly changes, so one first-order step crosses it; above
 #: λ = 3.5 (σ/α = 0.03, a quarter of an 8-bit level's worth of noise after the final denoising) the
 #: last evaluation's data prediction is the image.  Chosen by the distance to the converged ODE solution
-#: (README, "Sampling"; docs/img/neural_solver_error_64.json)
+#: (README, "Sampling"; docs/evaluations/neural_solver_error_64.json)
 TRUNCATED_LAMBDA = (-3.5, 3.5)
 
 

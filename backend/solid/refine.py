@@ -21,7 +21,7 @@ the patch distance of ``python -m bench solid-photos`` (x, y and z slices pooled
 grew by more than 5 % on 39 of 80 training photos and fell on 11; this search,
 40 steps: 5 farther, 7 closer (on the walls, x and y slices: 6 and 15; before 33
 and 17).  ``python -m bench solid-photos --split train --limit 80 --refine
-40 --against ENCODER.json``; ``docs/img/solid_refine_train_*.json``.
+40 --against ENCODER.json``; ``docs/evaluations/solid_refine_train_*.json``.
 
 Photo models carry the exemplar's measured colour (mean and covariance) after
 the latent: the search moves only the latent, so refinement never changes the

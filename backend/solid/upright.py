@@ -24,7 +24,7 @@ cut shows only the horizontal frequencies, isotropically, so it loses the photo'
 The gate: the check chooses among the rests it is offered, and each offer is one more chance for the check's
 noise (structure at the scale of its 128² planes) to choose.  The upright rest is offered only where the rest's
 spectrum is oriented: :func:`orientation`'s coherence above UPRIGHT_GATE.  Calibrated on the training split (80
-photos, every sixth; ``docs/img/solid_upright_gate_train_*.json``): offered to
+photos, every sixth; ``docs/evaluations/solid_upright_gate_train_*.json``): offered to
 every photo, the check took it for 26, and by the held-out evaluation's distance against the texture without it
 (photos more than 5 % closer / farther): coherence above 0.15, 9 photos, pooled x, y and z slices 6 / 1, their
 band-pass levels 7 / 0, walls 5 / 1, floors 0 / 6 (the trade-off above); from 0.10 to 0.15, 6 photos, 4 / 1; at

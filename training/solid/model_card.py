@@ -195,8 +195,8 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "python -m omninoise.training.solid.train --config configs/solid/photo_singles/NAME.json --out runs/solid/NAME",
          "python -m omninoise.training.solid.export runs/solid/NAME models/solid/NAME",
          "python -m bench solid --speed",
-         "python -m bench solid-singles --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/img/solid_singles.json",
-         "python -m omninoise.training.solid.model_card --singles docs/img/solid_singles.json -o models/solid/MODEL_CARD.md",
+         "python -m bench solid-singles --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/evaluations/solid_singles.json",
+         "python -m omninoise.training.solid.model_card --singles docs/evaluations/solid_singles.json -o models/solid/MODEL_CARD.md",
          "```", "",
          "- **Exemplars:** the single-exemplar models named by a photo were each fitted to one colour photo of "
          "the photo set's training split (`data/photos/`: package, licence, author and sha256 per file in its "
