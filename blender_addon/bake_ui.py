@@ -280,7 +280,10 @@ class OMNINOISE_OT_cancel(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return tasks.current() is not None
+        if tasks.current() is None:
+            cls.poll_message_set("OmniNoise is not running a bake, preview or fit")
+            return False
+        return True
 
     def execute(self, context):
         tasks.cancel()

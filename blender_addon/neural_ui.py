@@ -445,7 +445,10 @@ class OMNINOISE_OT_swatch_remove(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return len(context.scene.omninoise_neural.swatches) > 0
+        if not context.scene.omninoise_neural.swatches:
+            cls.poll_message_set("There is no swatch to remove")
+            return False
+        return True
 
     def execute(self, context):
         p = context.scene.omninoise_neural

@@ -549,7 +549,7 @@ class OMNINOISE_OT_solid_tile_material(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return tasks.current() is None
+        return tasks.idle(cls)
 
     def execute(self, context):
         p = context.scene.omninoise_solid
@@ -801,7 +801,7 @@ class OMNINOISE_OT_solid_load_procedural(bpy.types.Operator, ImportHelper):
 
     @classmethod
     def poll(cls, context):
-        return tasks.current() is None
+        return tasks.idle(cls)
 
     def execute(self, context):
         p = context.scene.omninoise_solid

@@ -23,7 +23,7 @@ from bpy.props import BoolProperty
 
 from .. import backend
 
-__all__ = ["Task", "TaskOperator", "start", "current", "cancel", "wait", "shutdown", "POLL_SECONDS"]
+__all__ = ["Task", "TaskOperator", "start", "current", "idle", "cancel", "wait", "shutdown", "POLL_SECONDS"]
 
 POLL_SECONDS = 0.1
 _current: "Task | None" = None
@@ -136,6 +136,16 @@ def current() -> "Task | None":
     return _current
 
 
+def idle(cls) -> bool:
+    """An operator's poll: True while no task runs; else False, and the disabled button's tooltip says which task
+    holds OmniNoise (Blender's ``poll_message_set``)."""
+    task = current()
+    if task is None:
+        return True
+    cls.poll_message_set(f"OmniNoise is busy with {task.label}: wait for it, or press Esc to cancel it")
+    return False
+
+
 def start(task: Task, blocking: bool = False) -> Task:
     """Run ``task``: on a thread polled by a timer, or inline when ``blocking``."""
     global _current
@@ -216,7 +226,7 @@ class TaskOperator:
 
     @classmethod
     def poll(cls, context):
-        return current() is None
+        return idle(cls)
 
     def _start(self, context, blocking: bool):
         """Start the task: a :class:`Task`, or None after reporting why it could not start.  A setting error,

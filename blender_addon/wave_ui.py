@@ -267,8 +267,11 @@ class _AddGroupNode:
     @classmethod
     def poll(cls, context):
         space = context.space_data
-        return (space is not None and space.type == "NODE_EDITOR" and space.edit_tree is not None
-                and space.tree_type in ("ShaderNodeTree", "GeometryNodeTree"))
+        if (space is not None and space.type == "NODE_EDITOR" and space.edit_tree is not None
+                and space.tree_type in ("ShaderNodeTree", "GeometryNodeTree")):
+            return True
+        cls.poll_message_set("Adds a node to a shader or geometry node tree: open one in a node editor")
+        return False
 
     def execute(self, context):
         space = context.space_data

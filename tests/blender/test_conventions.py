@@ -131,6 +131,44 @@ def test_every_operator_but_the_ui_ones_is_in_a_blender_menu():
             "node.omninoise_add_wave_noise"} <= drawn
 
 
+def _disabled() -> dict:
+    """{bl_idname: the error a script calling it gets} of every operator of the extension whose poll fails now."""
+    out = {}
+    for cls, op in _operators():
+        if not op.poll():
+            with pytest.raises(RuntimeError) as err:
+                op()
+            out[cls.bl_idname] = str(err.value)
+    return out
+
+
+def test_a_disabled_command_says_why(scene):
+    """Blender shows an operator's poll message as the disabled button's tooltip, and a script calling it gets that
+    message: no command of the extension is disabled without its reason, and while a task runs, every command that
+    starts work names the task."""
+    import threading
+
+    from omninoise.blender_addon import tasks
+
+    idle = _disabled()
+    assert "OmniNoise is not running a bake, preview or fit" in idle["omninoise.cancel"]
+    assert "open one in a node editor" in idle["node.omninoise_add_wave_noise"]
+    gate = threading.Event()
+    task = tasks.start(tasks.Task("Solid preview", lambda progress, cancel: gate.wait(60)))
+    try:
+        busy = _disabled()
+    finally:
+        gate.set()
+        tasks.wait(task)
+    starts = sorted(set(busy) - set(idle))
+    assert "omninoise.cancel" not in busy and {"omninoise.solid_preview", "omninoise.neural_bake",
+                                              "omninoise.bake_volume", "omninoise.run_job"} <= set(starts)
+    assert all("OmniNoise is busy with Solid preview" in busy[name] for name in starts), busy
+    assert not [m for m in {**idle, **busy}.values() if "context is incorrect" in m]
+    scene.omninoise_neural.swatches.clear()
+    assert "no swatch to remove" in _disabled()["omninoise.swatch_remove"]
+
+
 def test_operators_that_change_data_record_an_undo_step():
     changing = {"omninoise.bake_volume", "omninoise.bake_image", "omninoise.neural_bake",
                 "omninoise.neural_bake_sequence", "omninoise.neural_fit", "omninoise.swatch_add",
