@@ -79,7 +79,7 @@ class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
                          description="Which value of the noise is baked")
     cellular: EnumProperty(name="Cellular", items=_CELLULAR, default="none",
                            description="Bake cells cut by the waves' planes instead of the noise itself")
-    cell_size: FloatProperty(name="Cell Size", default=0.0, min=0.0, soft_max=10.0,
+    cell_size: FloatProperty(name="Cell Size", default=0.0, min=0.0, soft_max=10.0, subtype="DISTANCE",
                              description="Distance between the planes of one family, in scene units (0: from the "
                                          "frequency band, as the command line's default)")
     stit_probability: FloatProperty(name="Split Probability", default=0.5, min=0.0, max=1.0,
@@ -90,9 +90,9 @@ class OMNINOISE_PG_bake(bpy.types.PropertyGroup):
     bounds_mode: EnumProperty(name="Bounds", description="The box in the scene that the bake fills", items=[
         ("OBJECT", "Active Object", "The active object's world bounding box"),
         ("CUSTOM", "Custom", "The box below")], default="OBJECT")
-    bounds_min: FloatVectorProperty(name="Min", size=3, default=(-1.0, -1.0, -1.0), subtype="XYZ",
+    bounds_min: FloatVectorProperty(name="Min", size=3, default=(-1.0, -1.0, -1.0), subtype="XYZ_LENGTH",
                                     description="The box's lowest corner, in scene units")
-    bounds_max: FloatVectorProperty(name="Max", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ",
+    bounds_max: FloatVectorProperty(name="Max", size=3, default=(1.0, 1.0, 1.0), subtype="XYZ_LENGTH",
                                     description="The box's highest corner, in scene units")
     volume_resolution: IntVectorProperty(name="Resolution", size=3, default=(128, 128, 128), min=1, max=4096,
                                          description="Voxels along X, Y and Z; memory grows with their product")

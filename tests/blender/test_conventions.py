@@ -88,6 +88,19 @@ def test_every_property_and_operator_has_a_plain_words_tooltip():
     assert checked > 150 and not bad, bad
 
 
+def test_a_setting_in_scene_units_shows_blenders_length_unit():
+    """A distance or a point in the scene is typed and shown in the scene's units (metres, feet), as Blender's own
+    are: a property whose tooltip says "scene units" has a length subtype."""
+    found = {}
+    for name in UI_MODULES:
+        for cls in importlib.import_module(f"omninoise.blender_addon.{name}").classes:
+            if issubclass(cls, bpy.types.PropertyGroup):
+                for p in cls.bl_rna.properties:
+                    if p.type == "FLOAT" and "scene units" in p.description:
+                        found[f"{cls.__name__}.{p.identifier}"] = p.subtype
+    assert len(found) >= 3 and set(found.values()) <= {"DISTANCE", "XYZ_LENGTH", "TRANSLATION"}, found
+
+
 # -- menus and F3 -----------------------------------------------------------------------------------------
 
 class _MenuLayout:
