@@ -201,7 +201,8 @@ def main(argv=None):
     print(f"Cycles CPU, {os.cpu_count()} cores, {a.res}^2 px, {a.samples} and {2 * a.samples} samples")
     print(f"  {'shader':26s} {'ns/px-sample':>12s} {'vs Gabor':>9s} {'nodes':>6s} {'set-up s':>9s}")
     for name, r in res.items():
-        print(f"  {name:26s} {r['ns_per_pixel_sample']:12.1f} {r['vs_gabor']:8.2f}x {r['nodes']:6d} {r['setup_s']:9.2f}")
+        print(f"  {name:26s} {r['ns_per_pixel_sample']:12.1f} {r['vs_gabor']:8.2f}x {r['nodes']:6d}"
+              f" {r['setup_s']:9.2f}")
     write_json(a.out, dict(stamp=stamp(), blender=bpy.app.version_string, res=a.res, samples=a.samples, results=res))
     return 0
 

@@ -164,8 +164,8 @@ def procedural(doc: dict) -> list:
 
 def node(doc: dict) -> list:
     blender = f"Blender {doc['blender']}, " if doc.get("blender") else ""
-    out = [f"Cycles render time of the Wave Noise node (3D, Gaussian band 2 to 6 cycles per unit) against Blender's own "
-           f"textures: a plane filling a {doc.get('res')}² px frame, emission, {blender}CPU; nanoseconds per "
+    out = [f"Cycles render time of the Wave Noise node (3D, Gaussian band 2 to 6 cycles per unit) against Blender's "
+           f"own textures: a plane filling a {doc.get('res')}² px frame, emission, {blender}CPU; nanoseconds per "
            f"pixel-sample from {doc.get('samples')} and {2 * doc.get('samples', 0)} samples (set-up and shader "
            "compilation cancel). Rows \"OSL:\" render with Cycles' Open Shading Language, where the node is one "
            "compiled script, against Gabor rendered by OSL too. The two \"floor\" rows are the cheapest node trees "

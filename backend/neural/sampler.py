@@ -184,9 +184,9 @@ SAMPLERS: dict = {
     "heun": (heun_sample, lambda n: 2 * (n - 1)),
 }
 #: chosen by measurement (README, "Sampling"): DPM-Solver++(2M) on the truncated grid with 10 evaluations is as
-#: near the converged probability-flow solution as DDIM 30 (docs/evaluations/neural_solver_error_64.json: 0.031 against 0.034
-#: mean |Δ| at 256²) and no worse by the evaluation (python -m bench neural-eval, 64² instrument, all 23 classes);
-#: the previous default, 15 timesteps even in log-SNR, made 13 evaluations, four of them below λ = -4.5
+#: near the converged probability-flow solution as DDIM 30 (docs/evaluations/neural_solver_error_64.json: 0.031
+#: against 0.034 mean |Δ| at 256²) and no worse by the evaluation (python -m bench neural-eval, 64² instrument, all
+#: 23 classes); 15 timesteps even in log-SNR would make 13 evaluations, four of them below λ = -4.5
 DEFAULT_SAMPLER = "dpmpp_2m"
 DEFAULT_STEPS = 10
 #: the step noise η each sampler uses unless told (None in the front ends): the SDE form of DPM-Solver++(2M) with
@@ -203,7 +203,7 @@ def sampler_eta(sampler: str, eta: float | None) -> float:
 
 
 #: the timestep spacing each sampler uses unless told: the truncated λ grid for DPM-Solver++, uniform t for
-#: DDIM (the images of earlier versions) and Heun (it overshoots on λ grids' long first intervals)
+#: DDIM (its usual grid) and Heun (it overshoots on λ grids' long first intervals)
 DEFAULT_SPACING = {"ddim": "uniform", "dpmpp_2m": "truncated", "heun": "uniform"}
 
 

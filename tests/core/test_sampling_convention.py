@@ -45,8 +45,8 @@ def test_2d_npy_exr_half_and_png_hold_the_same_field(tmp_path):
     assert corr > 0.999, corr  # the 8-bit preview of the same field, same orientation
 
 
-def test_the_old_corner_sampling_is_gone(tmp_path):
-    """`-o x.npy` used to sample at i E / N (grid corners) while .vdb and --half used centres."""
+def test_an_npy_grid_is_not_sampled_at_the_grid_corners(tmp_path):
+    """`-o x.npy` samples at the cell centres, as .vdb and --half do, not at i E / N (the grid's corners)."""
     out = str(tmp_path / "a.npy")
     assert main(ARGS + ["--size", "32", "-o", out]) == 0
     corners = evaluate_grid(compile_noise(settings(2)), 32, 2.0)

@@ -277,8 +277,8 @@ def _nan_batches(monkeypatch, bad_calls):
 
 
 def test_a_non_finite_batch_is_skipped_not_learned(monkeypatch, tmp_path):
-    """One NaN pixel used to turn every weight NaN through the clipped update (a GPU stage did at step ~1000):
-    the update is skipped, counted in the log, and the weights stay finite."""
+    """One NaN pixel would turn every weight NaN through the clipped update: the update is skipped, counted in the
+    log, and the weights stay finite."""
     _nan_batches(monkeypatch, {1})
     msgs = []
     cfg = TrainConfig.from_dict(dict(TINY, steps=3))
