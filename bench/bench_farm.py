@@ -1,9 +1,9 @@
-"""Farm speed-up, measured: `python -m bench farm [--frames 12] [--size 48]`.
+"""Farm speed-up, measured: `python -m bench farm [--frames 12] [--size 48] [-o JSON]`.
 
 The same job (an animated 3D wave-noise sequence through the fire ramp, one .vdb per frame) baked three ways
 in one run: on this machine as `omninoise bake` does, and on local Dask clusters of 1 and 2 worker processes.
 Prints seconds, the speed-up of 2 workers over 1, the overhead per task (cluster time minus the one-machine
-time, per frame) and the bytes per frame, which the README's 16-node estimate uses.
+time, per frame) and the bytes per frame; writes them to docs/benchmarks/farm.json (``docs/benchmarks.md``).
 """
 from __future__ import annotations
 
@@ -13,9 +13,10 @@ import sys
 import tempfile
 import time
 
-
-from omninoise.cli import farm
+from bench.stamp import DATA, stamp
 from omninoise.backend.jobs import run_job
+from omninoise.cli import farm
+from omninoise.export.atomic import write_json
 
 JOB = """
 [[bake]]
@@ -37,6 +38,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=12)
     ap.add_argument("--size", type=int, default=48)
+    ap.add_argument("-o", "--out", default=os.path.join(DATA, "farm.json"))
     a = ap.parse_args(argv)
     text = JOB.format(n=a.size, frames=a.frames)
     res = {}
@@ -70,8 +72,11 @@ def main(argv=None) -> int:
     print("|---|---|---|")
     for k, v in res.items():
         print(f"| {k} | {v:.2f} | {v / a.frames:.3f} |")
-    print(f"speed-up 2 workers / 1 worker: {res['1 worker'] / res['2 workers']:.2f}x; overhead per task on 1 worker: "
-          f"{(res['1 worker'] - res['one machine']) / a.frames * 1000:.0f} ms")
+    speedup, overhead = res["1 worker"] / res["2 workers"], (res["1 worker"] - res["one machine"]) / a.frames
+    print(f"speed-up 2 workers / 1 worker: {speedup:.2f}x; overhead per task on 1 worker: {overhead * 1000:.0f} ms")
+    write_json(a.out, dict(stamp=stamp(), frames=a.frames, size=a.size, bytes_per_frame=size,
+                           seconds={k: round(v, 3) for k, v in res.items()}, speedup_2_over_1=round(speedup, 2),
+                           overhead_per_task_ms=round(overhead * 1000, 1)))
     return 0
 
 

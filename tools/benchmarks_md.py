@@ -162,6 +162,18 @@ def procedural(doc: dict) -> list:
     return out
 
 
+def farm(doc: dict) -> list:
+    n, frames = doc.get("size"), doc.get("frames", 1)
+    out = [f"One job, {frames} frames of an animated {n}³ wave noise volume through the fire ramp (16 directions, "
+           f"{doc.get('bytes_per_frame', 0) / 1024:.0f} KiB per frame), baked as `omninoise bake` does on one "
+           "machine and on local Dask clusters of 1 and 2 worker processes (`--workers`), each warmed up first.", "",
+           "| run | seconds | per frame |", "|---|---|---|"]
+    for k, v in doc.get("seconds", {}).items():
+        out.append(f"| {k} | {v} | {v / frames:.3f} |")
+    return out + ["", f"2 workers bake {doc.get('speedup_2_over_1')} times as fast as 1; a task on the cluster costs "
+                      f"{doc.get('overhead_per_task_ms')} ms more than the same frame on one machine.", ""]
+
+
 def node(doc: dict) -> list:
     blender = f"Blender {doc['blender']}, " if doc.get("blender") else ""
     out = [f"Cycles render time of the Wave Noise node (3D, Gaussian band 2 to 6 cycles per unit) against Blender's "
@@ -209,6 +221,7 @@ BENCHES = (
      "python -m bench solid-procedural --set stochastic -o docs/benchmarks/solid_procedural_stochastic"),
     ("procedural_node.json", "Procedural solids: node group render time", procedural_node,
      "python -m bench procedural-node"),
+    ("farm.json", "Farm bakes", farm, "python -m bench farm"),
     ("solid_ablation_crops.json", "Solid textures: what each reading is worth, held-out structured photos cut off their "
      "period", ablation, "python -m bench solid-ablation --folder CROPS --only 'lattice motif' 'main lobes' "
      "'few repeats' lines -o docs/benchmarks/solid_ablation_crops.json"),
