@@ -169,9 +169,10 @@ def farm(doc: dict) -> list:
            "machine and on local Dask clusters of 1 and 2 worker processes (`--workers`), each warmed up first.", "",
            "| run | seconds | per frame |", "|---|---|---|"]
     for k, v in doc.get("seconds", {}).items():
-        out.append(f"| {k} | {v} | {v / frames:.3f} |")
+        out.append(f"| {k} | {v:.2f} | {v / frames:.3f} |")
     return out + ["", f"2 workers bake {doc.get('speedup_2_over_1')} times as fast as 1; a task on the cluster costs "
-                      f"{doc.get('overhead_per_task_ms')} ms more than the same frame on one machine.", ""]
+                      f"{doc.get('overhead_per_task_ms')} ms more than the same frame on one machine. The machine's "
+                      "cores are shared by its workers: a farm's gain comes from more machines.", ""]
 
 
 def node(doc: dict) -> list:
