@@ -5,7 +5,8 @@ weights into a temporary folder) sampled by DDIM with 30 steps; the default is
 the split export (encoder once, denoiser per step) with the default sampler and
 step count, in tiles above 1024 px.  Every configuration runs in a process of its
 own, so its peak resident memory is its own.  Per size it prints seconds per step
-(one network evaluation), seconds per image, where the time goes (encoder,
+(one network evaluation), seconds per image (the default also with its int8 denoiser,
+``--precision int8``), where the time goes (encoder,
 denoiser, numpy around them) and peak RSS; below 1024² the image is generated in
 full, above it the per-image figure is encoder + steps x measured step (tiles:
 a measured tiled step) and marked "est.".  The network's FLOP count (from torch's
@@ -42,7 +43,7 @@ def _worker(a) -> dict:
     from omninoise.backend.neural.sampler import DEFAULT_SPACING, evaluations
 
     t0 = time.perf_counter()
-    m = NeuralNoiseModel(a.model, threads=a.threads)
+    m = NeuralNoiseModel(a.model, threads=a.threads, precision=a.precision)
     S = a.size
     cond = C.uniform(m, ("cells_f1", {}), S, S)
     x = np.random.default_rng(0).standard_normal((1, 1, S, S)).astype(np.float32)
@@ -164,6 +165,7 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=256, help=argparse.SUPPRESS)
     ap.add_argument("--sampler", default="ddim", help=argparse.SUPPRESS)
     ap.add_argument("--steps", type=int, default=30, help=argparse.SUPPRESS)
+    ap.add_argument("--precision", default="fp32", help=argparse.SUPPRESS)
     ap.add_argument("--sizes", type=int, nargs="+", default=[256, 512, 1024, 2048])
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="256² and 512² only")
@@ -180,7 +182,10 @@ def main(argv=None) -> int:
     reexport(a.model, tmp, one_piece=True)  # the one-piece network, from the shipped weights
     from bench.stamp import stamp
 
-    res = dict(stamp=stamp(), threads=a.threads, matmul_gflops=round(matmul_gflops(a.threads), 1), rows=[])
+    from omninoise.backend.neural.precision import int8_dot_products
+
+    res = dict(stamp=stamp(), threads=a.threads, matmul_gflops=round(matmul_gflops(a.threads), 1),
+               int8_dot_products=int8_dot_products(), rows=[])
     flops = network_gflop(a.model, 256)
     print(f"float32 matmul 2048²: {res['matmul_gflops']} GFLOP/s on {a.threads} threads")
     if flops:
@@ -191,10 +196,12 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|---|")
     for S in sizes:
         pair = []
-        for label, folder, sampler, steps in (("one-piece, DDIM 30", tmp, "ddim", 30),
-                                              (f"default: split, {DEFAULT_SAMPLER} {DEFAULT_STEPS}", a.model,
-                                               DEFAULT_SAMPLER, DEFAULT_STEPS)):
-            r = _run(dict(model=folder, size=S, sampler=sampler, steps=steps, threads=a.threads))
+        default = f"default: split, {DEFAULT_SAMPLER} {DEFAULT_STEPS}"
+        for label, folder, sampler, steps, precision in (
+                ("one-piece, DDIM 30", tmp, "ddim", 30, "fp32"),
+                (default, a.model, DEFAULT_SAMPLER, DEFAULT_STEPS, "fp32"),
+                (f"{default}, int8 (--precision int8)", a.model, DEFAULT_SAMPLER, DEFAULT_STEPS, "int8")):
+            r = _run(dict(model=folder, size=S, sampler=sampler, steps=steps, threads=a.threads, precision=precision))
             r["path"] = label
             if "failed" in r:
                 res["rows"].append(r)
@@ -210,7 +217,7 @@ def main(argv=None) -> int:
             tiles = f" ({r['tiles']} tiles)" if r.get("tiles") else ""
             print(f"| {S}² | {label}{tiles} | {r['step_s']} | {r['encoder_s']} | {r['image_s']}{est} | "
                   f"{r.get('numpy_share', '')} | {r['peak_rss_mib']} | {r.get('gflops_per_s', '')} |", flush=True)
-        if None not in pair:
+        if None not in pair[:2]:
             print(f"|  | speed-up per image | {pair[0]['step_s'] / pair[1]['step_s']:.2f}x per step | | "
                   f"{pair[0]['image_s'] / pair[1]['image_s']:.2f}x | | | |", flush=True)
     old = whole_command(["--model", tmp, "--sampler", "ddim", "--steps", "30"], a.threads)

@@ -53,7 +53,9 @@ def wave(doc: dict) -> list:
 def neural(doc: dict) -> list:
     out = [f"Neural noise on {doc.get('threads')} threads: seconds per network evaluation (step) and per image; "
            f"float32 matrix products run at {doc.get('matmul_gflops')} GFLOP/s on the same machine. "
-           "`est.`: encoder + steps × a measured step.", "",
+           "`est.`: encoder + steps × a measured step." + (
+               "" if "int8_dot_products" not in doc else
+               " This CPU " + ("has" if doc["int8_dot_products"] else "has no") + " int8 dot products (VNNI)."), "",
            "| size | path | s per step | encoder s | s per image | peak RSS MiB |", "|---|---|---|---|---|---|"]
     for r in doc.get("rows", []):
         if "failed" in r:
