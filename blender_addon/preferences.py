@@ -125,8 +125,8 @@ class OMNINOISE_AP_preferences(bpy.types.AddonPreferences):
         name="Neural Precision", default="fp32",
         description="Arithmetic of the neural noise denoiser",
         items=[("fp32", "Float32", "Full precision: the reference images"),
-               ("int8", "int8 (Draft)", "Quantized convolutions: about 1.7x faster steps on CPUs with int8 dot "
-                                        "products (VNNI), images slightly further from the reference")])
+               ("int8", "int8 (Draft)", "Quantized convolutions: about 1.8x faster steps on CPUs with int8 dot "
+                                        "products (VNNI), images slightly different from the reference")])
     cache_dir: StringProperty(name="Cache Folder", subtype="DIR_PATH", default="",
                               description="Where bakes and previews are cached (empty = Blender's "
                                           "extension user folder)")

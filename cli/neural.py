@@ -77,7 +77,7 @@ omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
                         "0: never)")
     g.add_argument("--threads", type=int, default=0, help="CPU threads (0: all cores)")
     g.add_argument("--precision", default="fp32", choices=PRECISIONS,
-                   help="int8: about 1.7x faster steps on CPUs with int8 dot products (VNNI), a draft")
+                   help="int8: about 1.8x faster steps on CPUs with int8 dot products (VNNI), a draft")
     return n
 
 

@@ -1,8 +1,9 @@
 """Which arithmetic the neural noise denoiser runs in: float32 (the default), or the int8 export.
 
-The int8 denoisers (``training/quantize_onnx.py``) are a faster draft mode, not a free gain: about 1.7x faster
-steps on CPUs with int8 dot products (x86 VNNI), little without them, and images measurably further from the zoo
-(the model card and docs/decisions/neural.md).  So float32 stays the default and int8 is opt-in.
+The int8 denoisers (``training/quantize_onnx.py``) are a faster draft mode, not a free gain: about 1.8x faster
+steps on CPUs with int8 dot products (x86 VNNI), little without them, and images that are not the trained
+network's own (single classes' distances to the zoo move by up to 15 %, blends are less local; the model card and
+docs/decisions/neural.md).  So float32 stays the default and int8 is opt-in.
 """
 from __future__ import annotations
 
