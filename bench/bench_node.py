@@ -21,12 +21,10 @@ import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
 import bpy
 import numpy as np
 
-from bench.stamp import stamp
+from bench.stamp import DATA, stamp
 from omninoise.backend import Spectrum, WaveSettings
 from omninoise.blender_addon.compat import ensure_node_tree
 from omninoise.blender_addon.wave_nodes import build_wave_group
@@ -163,7 +161,7 @@ def main(argv=None):
     ap.add_argument("--res", type=int, default=256)
     ap.add_argument("--samples", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=2)
-    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "node.json"))
+    ap.add_argument("-o", "--out", default=os.path.join(DATA, "node.json"))
     a = ap.parse_args(argv)
     # (name, tree maker, OSL shading system)
     cases = [

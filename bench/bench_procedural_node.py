@@ -21,13 +21,11 @@ import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
 import bpy  # noqa: F401  (the scene below is Blender's)
 import numpy as np
 
 from bench.bench_node import _timed, scene, shade, texture
-from bench.stamp import stamp
+from bench.stamp import DATA, stamp
 from omninoise.backend.solid.procedural.field import ProceduralField
 from omninoise.backend.solid.procedural.ramp import fit_ramp
 from omninoise.backend.solid.procedural.tint import fit_tint
@@ -77,7 +75,7 @@ def main(argv=None) -> int:
     ap.add_argument("--res", type=int, default=128)
     ap.add_argument("--samples", type=int, default=4)
     ap.add_argument("--repeat", type=int, default=2)
-    ap.add_argument("-o", "--out", default=os.path.join(ROOT, "docs", "benchmarks", "procedural_node.json"))
+    ap.add_argument("-o", "--out", default=os.path.join(DATA, "procedural_node.json"))
     a = ap.parse_args(argv)
     wave = texture("ShaderNodeTexWave", Scale=5.0, Distortion=2.0, Detail=2.0)
     cases = [("Blender Wave Texture", wave, False)]
