@@ -31,7 +31,7 @@ omninoise bake job.toml --workers 4""")
     b.add_argument("--threads", type=int, default=0, help="CPU threads for the neural models (0: all cores)")
     b.add_argument("--precision", default="fp32", choices=PRECISIONS,
                    help="neural noise arithmetic (int8: a faster draft on CPUs with int8 dot products)")
-    b.add_argument("--quiet", action="store_true", help="no progress bars")
+    b.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     farm = b.add_argument_group("farm (Dask; pip install 'omninoise[farm]')")
     farm.add_argument("--workers", type=int, metavar="N", help="bake on a local cluster of N worker processes")
     farm.add_argument("--cluster", metavar="ADDRESS", help="bake on a running Dask scheduler (tcp:// or tls://)")

@@ -61,7 +61,7 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
     g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
     g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
                                    "texture-space model)")
-    g.add_argument("--quiet", action="store_true", help="no progress or notes")
+    g.add_argument("-q", "--quiet", action="store_true", help="no progress or notes")
     g = s.add_argument_group("photos (the texture-space model)")
     g.add_argument("--refine", type=int, default=0, metavar="N", help="improve a photo's code with N search steps")
     g.add_argument("--to", metavar="EXEMPLAR", help="interpolate towards this exemplar")

@@ -75,7 +75,7 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
                    help="noise values mapped to the ramp's ends (default: the ramp's own)")
     g.add_argument("--half", action="store_true", help="16-bit half floats (.exr and .vdb)")
     g.add_argument("--seed", type=int, default=0, help="another seed draws other directions and phases")
-    g.add_argument("--quiet", action="store_true", help="no progress bar or notes")
+    g.add_argument("-q", "--quiet", action="store_true", help="no progress bar or notes")
     g = w.add_argument_group("spectrum")
     g.add_argument("--spectrum", choices=FLAG_SPECTRA, default="gaussian",
                    help="amplitude profile over the band")

@@ -170,3 +170,18 @@ def test_a_by_example_plane_is_read_in_3d_only(tmp_path, capsys):
         assert rc == 2 and f"{flag}: is read only with " in err and "--example with --dim 3" in err, err
         rc, err = run(capsys, "--size", "8", "--quiet", "--dim", "3", "--example", ex, flag, value, "-o", out)
         assert rc == 0, err
+
+
+@pytest.mark.parametrize("argv", [
+    ["wave", "--size", "16", "-o", "{d}/w.npy"],
+    ["neural", "--noise", "perlin", "--size", "16", "--steps", "1", "-o", "{d}/n.npy"],
+    ["solid", "--exemplar", "wood_3d", "--size", "16", "-o", "{d}/s.npy"],
+    ["bake", "{d}/job.toml"],
+])
+def test_q_is_quiet(tmp_path, capsys, argv):
+    """`-q` is `--quiet`, as in most command-line tools: the command writes its file and nothing to stderr."""
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "a"\noutput = "j.npy"\nresolution = [8, 8]\n'
+                                       '[bake.source]\nkind = "wave"\n')
+    assert main([x.format(d=tmp_path) for x in argv] + ["-q"]) == 0
+    assert capsys.readouterr().err == ""
+    assert len(list(tmp_path.glob("*.npy"))) == 1
