@@ -39,7 +39,8 @@ def class_args(g) -> None:
     g.add_argument("--size", type=int, default=256, help="output side in pixels")
     g.add_argument("--seed", type=int, default=0, help="another seed draws another image")
     g.add_argument("-o", "--out", help="output: .png, .exr or .npy")
-    g.add_argument("--list", action="store_true", help="print the classes and their parameters as JSON")
+    g.add_argument("--list", action="store_true", help="print the classes and their parameters")
+    g.add_argument("--json", action="store_true", help="with --list: print it as JSON")
 
 
 class Bar:

@@ -139,12 +139,16 @@ FLAG_OF = {"out": "-o", **solid.FLAGS}
 def _check_list_alone(a: argparse.Namespace) -> None:
     """Refuse an option given beside ``--list`` that the listing does not read (``solid --list -o x.png`` wrote
     nothing and said nothing), as every option that would change nothing is refused."""
-    if a.command not in LISTS or not a.list:
+    if a.command not in LISTS:
+        return
+    if a.json and not a.list:
+        raise SettingError("--json", "prints --list as JSON: give --list too")
+    if not a.list:
         return
     what, reads = LISTS[a.command]
     defaults = vars(build_parser().parse_args([a.command]))
     for key, value in vars(a).items():
-        if key not in ("command", "debug", "list", "quiet") + reads and value != defaults.get(key):
+        if key not in ("command", "debug", "list", "json", "quiet") + reads and value != defaults.get(key):
             flag = FLAG_OF.get(key, "--" + key.replace("_", "-"))
             raise SettingError(flag, f"--list only prints {what}: leave out {flag}, which would change nothing")
 

@@ -14,6 +14,7 @@ from omninoise.backend.neural.generate import check_memory as neural_memory
 from omninoise.backend.neural.precision import PRECISIONS
 from omninoise.backend.paths import neural_model
 
+from . import listing
 from .common import Bar, add_command, class_args, flag_image, param_items, set_threads
 
 IMAGE_TYPES = (".png", ".exr", ".npy")   #: what a neural noise image is written as
@@ -173,8 +174,6 @@ def neural_request(a: argparse.Namespace, model):
 
 
 def run(a: argparse.Namespace) -> int:
-    import json
-
     from omninoise.backend.neural.model import ModelError, NeuralNoiseModel, PrecisionUnavailable
     from omninoise.backend.neural.request import generate_request
 
@@ -202,7 +201,8 @@ def run(a: argparse.Namespace) -> int:
     except ModelError as exc:
         raise SettingError("--model", f"{exc}; train and export one (see models/README.md) or pass --model") from None
     if a.list:
-        print(json.dumps(dict(classes=model.class_params, trained=model.config.get("trained_classes")), indent=2))
+        listing.show(dict(classes=model.class_params, trained=model.config.get("trained_classes")),
+                     listing.classes_text(model.class_params), a.json)
         return 0
     check_reads(a)
     if a.keys or a.frames:

@@ -15,6 +15,7 @@ from omninoise.backend.solid.request import METHODS, method_for
 from omninoise.backend.solid.gaussian_rest import REST_CHOICES
 from omninoise.backend.solid.procedural.field import DEFAULT_KINDS, KINDS
 
+from . import listing
 from .common import Bar, add_command
 
 __all__ = ["add_parser", "run", "solid_request"]
@@ -58,7 +59,8 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
                         "2D or 3D, no network; auto: procedural where it is closer to the photo than neural and keeps "
                         "its structure as well, else neural; synthesis: a seamless 2D image copied from the photo "
                         "(default: neural; procedural for a saved procedural solid, a .json exemplar)")
-    g.add_argument("--list", action="store_true", help="print the shipped textures as JSON")
+    g.add_argument("--list", action="store_true", help="print the shipped textures")
+    g.add_argument("--json", action="store_true", help="with --list: print it as JSON")
     g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
                                    "texture-space model)")
     g.add_argument("-q", "--quiet", action="store_true", help="no progress or notes")
@@ -98,14 +100,12 @@ def solid_request(a: argparse.Namespace):
 
 
 def run(a: argparse.Namespace) -> int:
-    import json
-
     from omninoise.backend.solid.model import load_models
 
     if a.list:
         out = {name: dict(mode=m.mode, dim=m.dim, exemplars=m.config["exemplars"], codes=sorted(m.codes))
                for name, m in load_models().items()}
-        print(json.dumps(out, indent=2))
+        listing.show(out, listing.textures_text(out), a.json)
         return 0
     if not a.exemplar or not a.out:
         raise SettingError("solid", "give --exemplar (a shipped texture or an image file) and -o OUT (or --list)")

@@ -7,6 +7,7 @@ from omninoise.backend import limits
 from omninoise.backend.bake import output_type
 from omninoise.backend.errors import SettingError
 
+from . import listing
 from .common import add_command, class_args
 
 __all__ = ["add_parser", "run"]
@@ -24,14 +25,12 @@ omninoise zoo --noise damascus --param frequency=6 --size 256 -o damascus.png"""
 
 
 def run(a: argparse.Namespace) -> int:
-    import json
-
     try:
         from omninoise.training import zoo
     except ImportError as exc:
         raise SettingError("zoo", f"needs torch ({exc})") from None
     if a.list:
-        print(json.dumps(zoo.describe(), indent=2))
+        listing.show(zoo.describe(), listing.classes_text(zoo.describe()), a.json)
         return 0
     if not a.noise or not a.out:
         raise SettingError("zoo", "give --noise CLASS and -o OUT (or --list)")

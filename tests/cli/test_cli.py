@@ -1,4 +1,5 @@
 """The `omninoise wave` command-line contract."""
+import json
 import os
 import subprocess
 import sys
@@ -185,3 +186,30 @@ def test_q_is_quiet(tmp_path, capsys, argv):
     assert main([x.format(d=tmp_path) for x in argv] + ["-q"]) == 0
     assert capsys.readouterr().err == ""
     assert len(list(tmp_path.glob("*.npy"))) == 1
+
+
+def test_list_prints_a_table_to_read_and_json_with_json(capsys):
+    """`--list` is read by people: one row per noise class or shipped texture, with the parameters' ranges and units;
+    `--list --json` gives scripts the same as JSON. `--json` alone would change nothing and is refused."""
+    import doctest
+
+    from omninoise.cli import listing
+    assert doctest.testmod(listing).failed == 0
+    assert main(["neural", "--list"]) == 0
+    text = capsys.readouterr().out
+    assert main(["neural", "--list", "--json"]) == 0
+    classes = json.loads(capsys.readouterr().out)["classes"]
+    rows = [ln for ln in text.splitlines() if ln and not ln.startswith(" ")]
+    assert [r.split()[0] for r in rows[:-1]] == list(classes) and rows[-1].startswith(f"{len(classes)} classes")
+    assert "scale 4 to 20 (cells per 128 px), jitter 0.2 to 1 (cell jitter)" in text
+    assert "detail 2 to 8 (octaves, whole numbers)" in text and max(map(len, text.splitlines())) <= listing.WIDTH
+    assert main(["solid", "--list"]) == 0
+    text = capsys.readouterr().out
+    assert main(["solid", "--list", "--json"]) == 0
+    textures = json.loads(capsys.readouterr().out)
+    singles = [name for name, t in textures.items() if t["mode"] == "single"]
+    assert [ln.split()[0] for ln in text.splitlines()[:len(singles)]] == singles
+    assert "wood_3d     3D solid from wood__oldwood.jpg" in text and "by name (the space model): brick, concrete" in text
+    for command in ("neural", "solid"):
+        assert main([command, "--json"]) == 2
+        assert "--json: prints --list as JSON: give --list too" in capsys.readouterr().err

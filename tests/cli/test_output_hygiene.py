@@ -199,7 +199,7 @@ def test_a_damaged_model_folder_is_left_out_and_the_others_listed(tmp_path, monk
             shutil.copy(src / name, root / "solid" / "broken" / name)
         (root / "solid" / "broken" / "solid.json").write_text(json.dumps(sealed(doc)))
     monkeypatch.setenv("OMNINOISE_MODELS", str(root))
-    assert main(["solid", "--list"]) == 0
+    assert main(["solid", "--list", "--json"]) == 0
     assert list(json.loads(capsys.readouterr().out)) == ["gravel_3d"]
     assert main(["solid", "--model", str(root / "solid" / "broken"), "--exemplar", "x", "-o",
                  str(tmp_path / "s.png")]) == 2

@@ -163,7 +163,7 @@ def test_neural_cli(tiny, tmp_path, capsys):
     assert main(base + ["--map", str(tmp_path / "map.png"), "--region", "#000000=spots", "--size", "32",
                         "-o", png]) == 2
     assert "uses (255, 0, 0) but no spec" in capsys.readouterr().err
-    assert main(["neural", "--model", str(out), "--list"]) == 0          # the listing reads the model alone
+    assert main(["neural", "--model", str(out), "--list", "--json"]) == 0          # the listing reads the model alone
     assert "spots" in json.loads(capsys.readouterr().out)["classes"]
     for args, msg in [(["--noise", "lava", "-o", png], "unknown class 'lava'"),
                       (["--noise", "spots", "--param", "coverage=9", "-o", png], "outside [0.2, 0.8]"),

@@ -121,7 +121,7 @@ def test_zoo_cli(tmp_path, capsys):
     assert main(["zoo", "--noise", "spots", "--param", "coverage=0.7", "--size", "48", "--seed", "3", "-o", out]) == 0
     ref = zoo.generate("spots", dict(zoo.default_params("spots"), coverage=0.7), [3], 48)[0].numpy()
     np.testing.assert_array_equal(np.load(out), ref)
-    assert main(["zoo", "--list"]) == 0
+    assert main(["zoo", "--list", "--json"]) == 0
     listed = json.loads(capsys.readouterr().out)
     assert listed["gabor"]["params"][0] == dict(name="frequency", min=0.02, max=0.08, unit="cycles per px", integer=False)
     for args, msg in [(["--noise", "lava"], "unknown noise class 'lava'"),
