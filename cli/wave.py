@@ -230,9 +230,10 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError(_flag(a, exc.setting), exc.message) from None
     source.check_extent(a.extent, abs(a.time), ("--extent", "--time"))
     if not a.quiet:
-        from omninoise.backend.wavenoise.fast import engine_path
+        from omninoise.backend.wavenoise import fast
 
-        print(f"omninoise wave: {engine_path()}", file=sys.stderr)
+        if not fast.compiled():     # the one case worth a note: several times slower (--version names the kernel)
+            print(f"omninoise wave: note: wave noise runs on {fast.engine_path()}", file=sys.stderr)
     nyq = a.size / (2.0 * a.extent)
     if a.fmax > nyq and a.cellular == "none" and not a.quiet:
         print(f"omninoise wave: warning: --fmax {a.fmax:g} is above the grid's Nyquist {nyq:g}; "

@@ -29,7 +29,7 @@ from . import ckernel
 #: so importing the engine, the command line or the add-on does not load numba (0.2 s)
 numba = bool(importlib.util.find_spec("numba")) and not os.environ.get("OMNINOISE_NO_JIT")
 
-__all__ = ["available", "supports", "evaluate"]
+__all__ = ["available", "compiled", "supports", "evaluate"]
 
 _F = np.float32
 #: fall back to numpy when one stratum would need more slice records than this
@@ -44,6 +44,11 @@ def _kernels():
 
 def available() -> bool:
     return bool(numba)
+
+
+def compiled() -> bool:
+    """Whether a compiled kernel (the C row kernel or numba's) evaluates wave noise grids here."""
+    return ckernel.available() or bool(numba)
 
 
 def engine_path() -> str:

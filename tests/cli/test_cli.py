@@ -213,3 +213,17 @@ def test_list_prints_a_table_to_read_and_json_with_json(capsys):
     for command in ("neural", "solid"):
         assert main([command, "--json"]) == 2
         assert "--json: prints --list as JSON: give --list too" in capsys.readouterr().err
+
+
+def test_wave_notes_the_kernel_only_when_no_compiled_one_runs(tmp_path, capsys, monkeypatch):
+    """Which kernel runs is `--version`'s to say; `omninoise wave` notes it only where numpy runs, several times
+    slower, with what brings a compiled one."""
+    from omninoise.backend.wavenoise import fast
+    out = str(tmp_path / "w.npy")
+    monkeypatch.setattr(fast, "compiled", lambda: True)
+    rc, err = run(capsys, "--size", "16", "-o", out)
+    assert rc == 0 and "kernel" not in err and "numpy" not in err
+    monkeypatch.setattr(fast, "compiled", lambda: False)
+    rc, err = run(capsys, "--size", "16", "-o", out)
+    assert rc == 0 and "omninoise wave: note: wave noise runs on " in err
+    assert "kernel" not in run(capsys, "--size", "16", "--quiet", "-o", out)[1]
