@@ -11,6 +11,7 @@ export (the zoo is append-only, see :mod:`.zoo`):
   (``/down.0.0/norm1/Mul`` -> ``down.0.0.norm1.weight``);
 - a folded export's 2x2 stride-2 downsampling kernels (see :mod:`.unet`) go back to the 1x1
   convolution over unshuffled channels they were made from;
+- a parameter the exporter gave as an ``Identity`` of another, equal one takes that one's values;
 - the class embedding comes from the JSON's ``class_embedding`` table;
 - a grown class table keeps its fresh N(0, 1) rows (the spherical prior of
   Sec. 3.1.1) for the new classes; a grown parameter vector gets zero input
@@ -43,6 +44,11 @@ def _graph_weights(path: str) -> dict:
     out = {k.removeprefix("net."): v for k, v in inits.items() if not k.startswith("onnx::")}
     affine = {"Mul": "weight", "Add": "bias"}
     for node in graph.node:
+        if node.op_type == "Identity" and node.input[0] in inits and not node.output[0].startswith("onnx::"):
+            # the exporter keeps one of two equal parameters and gives the other as its Identity (a run's first
+            # steps leave GroupNorm weights of several blocks bit for bit equal)
+            out[node.output[0].removeprefix("net.")] = inits[node.input[0]]
+            continue
         scope, _, op = node.name.rpartition("/")
         name = scope.strip("/").removeprefix("net/").replace("/", ".")
         anon = [i for i in node.input if i in inits and i.startswith("onnx::")]
