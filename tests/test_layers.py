@@ -181,10 +181,11 @@ def test_files_are_replaced_only_by_the_atomic_helper():
 #: the test files that exercise training and evaluation (training, torch); every other test file must run
 #: without torch (the runtime's tests use tests/data/tiny_* and the shipped models)
 TORCH_TEST_FILES = {"test_conv_generator.py", "test_neural_deep.py", "test_neural_eval.py", "test_neural_int8.py",
-                    "test_neural_line.py", "test_neural_runtime.py", "test_neural_training.py", "test_solid_card.py",
+                    "test_neural_runtime.py", "test_neural_training.py", "test_solid_card.py",
                     "test_solid_eval.py", "test_solid_harmonics_tool.py", "test_solid_model.py",
                     "test_solid_morphology.py", "test_solid_morphology_loss.py", "test_solid_photos.py",
-                    "test_solid_spectrum.py", "test_structure_features.py", "test_zoo.py", "test_zoo_blender.py"}
+                    "test_solid_spectrum.py", "test_structure_features.py", "test_training_line.py", "test_zoo.py",
+                    "test_zoo_blender.py"}
 
 def test_only_training_and_evaluation_tests_need_torch(tmp_path):
     import re

@@ -1,24 +1,32 @@
-"""Train the neural noise model's whole line of stages with one command:
-``python -m omninoise.training.line configs/neural_noise_line.json --out runs/line``.
+"""Train a model's whole line of stages with one command:
+``python -m omninoise.training.line configs/neural_noise_line.json --out runs/line`` (or
+``configs/solid/space_line.json``).
 
-The shipped weights are the end of a line of stages, each a config trained from the export of the stage before
-(the ledger: ``python tools/ledger.py models/neural_noise``). A line file lists them in order::
+A shipped model is the end of a line of stages, each a config trained from the export of the stage before (the
+ledgers: ``python tools/ledger.py models/neural_noise``). A line file lists them in order::
 
-    {"model": "neural_noise", "stages": [{"name": "zoo", "config": "configs/neural_noise_cpu_zoo.json",
-                                          "steps": 5600}, ...]}
+    {"model": "neural_noise", "stages": [{"name": "zoo", "config": "neural_noise_cpu_zoo.json", "steps": 5600}, ...]}
 
-``config`` is a path from the line file's folder; ``steps`` is where the stage stops (the configs' learning rate is
-constant, so a stage stopped early is its config with fewer steps). Stage k trains in ``OUT/NAME``
-(:func:`.train.train`, which resumes from the folder's checkpoint) and is exported to ``OUT/NAME/export``
-(:func:`.export_onnx.export`); stage k + 1 starts from that export: its config's ``init_onnx`` and ``init_sha256``,
-which pin the exports of the shipped line, name the new export instead. The first stage keeps its config's start
-(none: a fresh network). The last export gains the int8 denoisers (:func:`.quantize_onnx.quantize_folder`) and is
-the line's model, to be evaluated (``python -m bench neural-eval --model OUT/NAME/export``) before it replaces
-``models/neural_noise``. A stage whose export holds its last step is done, so the same command goes on where it
-stopped (a stage stopped partway resumes from its checkpoint).
+``config`` is a path from the line file's folder. ``steps`` is the step the stage stops at, as its trainer counts:
+a neural noise stage counts from 0 (its learning rate is constant, so a stage stopped early is its config with
+fewer steps); a solid texture stage goes on from its start's step under its config's cosine schedule. Stage k
+trains in ``OUT/NAME`` (resuming from the folder's checkpoint) and is exported to ``OUT/NAME/export``; stage k + 1
+starts from that export: its config's ``init_onnx`` and ``init_sha256``, which pin the exports of the shipped line,
+name the new export instead (the first stage keeps its config's start: none, a fresh network). A solid texture
+line may also hold
 
-``--steps N`` stops every stage after at most N steps: the whole line in minutes, a check of the line itself (its
-model is no trained model).
+* ``{"name": ..., "structure_net": STEPS}``: the structure term's network (:mod:`.solid.structure_features`),
+  trained once into ``OUT/NAME/net.pt``, which every later config with a structure term reads;
+* ``{"name": ..., "average": [STAGE, ...]}``: the mean of those stages' weights (:mod:`.solid.average`),
+  exported as a stage of its own (no training);
+
+and a line's ``finish`` ends it: ``"int8"`` (neural noise: :func:`.quantize_onnx.quantize_folder`) or ``"spin
+octave"`` (solid texture: octaves turned by their seeds, the codes' harmonic parts measured again:
+:mod:`.solid.harmonics`). The last export is the line's model, to be evaluated before it replaces the shipped one.
+A stage whose export holds its last step is done, so the same command goes on where it stopped.
+
+``--steps N`` trains every stage for at most N steps: the whole line in minutes, a check of the line itself (its
+model is no trained model). ``--device`` trains every stage there (a line of GPU stages on the CPU, slowly).
 """
 from __future__ import annotations
 
@@ -35,134 +43,290 @@ __all__ = ["Stage", "load_line", "run_line", "main"]
 
 NAME = re.compile(r"[a-z0-9_]+")
 EXPORT = "export"           #: a stage's export folder, inside its run folder
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 @dataclasses.dataclass(frozen=True)
 class Stage:
-    """One stage of a line: its run folder's ``name``, its training ``config`` (a path) and the step it stops at."""
+    """One stage of a line: its run folder's ``name`` and what it does: train ``config`` (a path) until ``steps``,
+    train the structure network for ``steps`` (``kind`` "structure_net"), or average the stages ``average``."""
 
     name: str
-    config: str
-    steps: int
+    kind: str               # "train", "structure_net" or "average"
+    config: str = ""
+    steps: int = 0
+    average: tuple = ()
 
 
-def load_line(path: str) -> list:
-    """The stages of a line file (module docstring), checked: ValueError naming the first bad entry. Each config is
-    read (:func:`.train.load_config`), so a line whose config would fail at its stage fails here, before any work."""
-    from .train import load_config
+class _Neural:
+    """What a line needs of the neural noise model's training code."""
 
+    json = "neural_noise.json"
+    kinds = ("train",)
+    finishes = ("int8",)
+
+    @staticmethod
+    def config(path: str):
+        from .config import load_config
+        return load_config(path)
+
+    @staticmethod
+    def train(cfg, run: str, start_step: int, stop: int, log) -> None:
+        from .train import train
+        train(dataclasses.replace(cfg, steps=stop), run, log=log)
+
+    @staticmethod
+    def export(run: str, out: str) -> None:
+        from .export_onnx import export
+        export(run, out)
+
+    @staticmethod
+    def finished(doc: dict, finish: str) -> bool:
+        return "int8" in doc
+
+    @staticmethod
+    def finish(folder: str, finish: str, log) -> None:
+        from .quantize_onnx import quantize_folder
+        quantize_folder(folder, log=log)
+
+
+class _Solid:
+    """What a line needs of the solid texture model's training code."""
+
+    json = "solid.json"
+    kinds = ("train", "structure_net", "average")
+    finishes = ("spin octave", "spin lattice")
+
+    @staticmethod
+    def config(path: str):
+        from .solid.train import load_config
+        return load_config(path)
+
+    @staticmethod
+    def train(cfg, run: str, start_step: int, stop: int, log) -> None:
+        import torch
+
+        from .solid.train import train
+        ckpt = os.path.join(run, "ckpt.pt")
+        at = torch.load(ckpt, map_location="cpu", weights_only=False)["step"] if os.path.isfile(ckpt) else start_step
+        train(cfg, run, max_steps=max(stop - at, 0), log=log)
+
+    @staticmethod
+    def export(run: str, out: str) -> None:
+        from .solid.export import export
+        export(run, out)
+
+    @staticmethod
+    def finished(doc: dict, finish: str) -> bool:
+        return doc.get("spin") == finish.split()[1] and "code_harmonics" in doc
+
+    @staticmethod
+    def finish(folder: str, finish: str, log) -> None:
+        from .solid import harmonics
+        if harmonics.main([folder, "--spin", finish.split()[1], "--root", ROOT]) != 0:
+            raise RuntimeError(f"finish {finish!r} failed on {folder}")
+
+
+MODELS = {"neural_noise": _Neural, "solid": _Solid}
+
+
+def _stage(entry, where: str, folder: str, names: set, model) -> Stage:
+    """One entry of a line file as a Stage, checked (ValueError naming what is wrong)."""
+    keys = set(entry) if isinstance(entry, dict) else set()
+    kind = {frozenset({"name", "config", "steps"}): "train", frozenset({"name", "structure_net"}): "structure_net",
+            frozenset({"name", "average"}): "average"}.get(frozenset(keys))
+    if kind not in model.kinds:
+        shapes = {"train": "name, config, steps", "structure_net": "name, structure_net", "average": "name, average"}
+        raise ValueError(f"{where}: needs exactly " + " or ".join(shapes[k] for k in model.kinds))
+    name = entry["name"]
+    if not isinstance(name, str) or not NAME.fullmatch(name) or name in names:
+        raise ValueError(f"{where}: name must be a new name of a-z, 0-9 and _, got {name!r}")
+    if kind == "average":
+        runs = entry["average"]
+        if not isinstance(runs, list) or len(runs) < 2 or any(r not in names for r in runs):
+            raise ValueError(f"{where}: average names two or more stages before it, got {runs!r}")
+        return Stage(name, kind, average=tuple(runs))
+    steps = entry["steps" if kind == "train" else "structure_net"]
+    if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
+        raise ValueError(f"{where}: steps must be a whole number >= 1, got {steps!r}")
+    if kind == "structure_net":
+        return Stage(name, kind, steps=steps)
+    config = os.path.join(folder, entry["config"])
+    try:
+        cfg = model.config(config)
+    except (OSError, ValueError, TypeError) as exc:
+        raise ValueError(f"{where}: config {entry['config']}: {exc}") from None
+    if steps > cfg.steps:
+        raise ValueError(f"{where}: steps {steps} is past its config's {cfg.steps}")
+    return Stage(name, kind, config, steps)
+
+
+def load_line(path: str) -> tuple:
+    """(model, stages, finish) of a line file (module docstring), checked: ValueError naming the first bad entry.
+    Each config is read, so a line whose config would fail at its stage fails here, before any work."""
     with open(path, encoding="utf-8") as fh:
         doc = json.load(fh)
-    entries = doc.get("stages") if isinstance(doc, dict) else None
+    if not isinstance(doc, dict) or doc.get("model") not in MODELS:
+        raise ValueError(f"{path}: 'model' must be one of {', '.join(MODELS)}")
+    model = MODELS[doc["model"]]
+    entries = doc.get("stages")
     if not isinstance(entries, list) or not entries:
-        raise ValueError(f"{path}: a line needs 'stages', a list of {{name, config, steps}}")
+        raise ValueError(f"{path}: a line needs 'stages', a list of stages")
+    finish = doc.get("finish", "")
+    if finish and finish not in model.finishes:
+        raise ValueError(f"{path}: finish must be one of {', '.join(model.finishes)}, got {finish!r}")
     stages, names = [], set()
     for i, e in enumerate(entries):
-        where = f"{path}: stages[{i}]"
-        if not isinstance(e, dict) or set(e) != {"name", "config", "steps"}:
-            raise ValueError(f"{where}: needs exactly name, config and steps")
-        if not isinstance(e["name"], str) or not NAME.fullmatch(e["name"]) or e["name"] in names:
-            raise ValueError(f"{where}: name must be a new name of a-z, 0-9 and _, got {e['name']!r}")
-        steps = e["steps"]
-        if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
-            raise ValueError(f"{where}: steps must be a whole number >= 1, got {steps!r}")
-        config = os.path.join(os.path.dirname(os.path.abspath(path)), e["config"])
-        try:
-            cfg = load_config(config)
-        except (OSError, ValueError) as exc:
-            raise ValueError(f"{where}: config {e['config']}: {exc}") from None
-        if steps > cfg.steps:
-            raise ValueError(f"{where}: steps {steps} is past its config's {cfg.steps}")
-        names.add(e["name"])
-        stages.append(Stage(e["name"], config, steps))
-    return stages
+        stages.append(_stage(e, f"{path}: stages[{i}]", os.path.dirname(os.path.abspath(path)), names, model))
+        names.add(stages[-1].name)
+    if stages[-1].kind == "structure_net":
+        raise ValueError(f"{path}: the last stage gives no model")
+    return model, stages, finish
 
 
-def _exported_step(folder: str) -> int | None:
-    """The training step of the export in ``folder``, None where there is none."""
+def _json(folder: str, name: str) -> dict | None:
     try:
-        with open(os.path.join(folder, "neural_noise.json"), encoding="utf-8") as fh:
-            return json.load(fh).get("step")
+        with open(os.path.join(folder, name), encoding="utf-8") as fh:
+            return json.load(fh)
     except (OSError, ValueError):
         return None
 
 
 def _started_from(run: str) -> str | None:
     """The fingerprint of the weights a run folder's training began from ("" for a fresh network; None where
-    nothing was trained there): its ``config.json``, which :func:`.train.train` writes."""
-    try:
-        with open(os.path.join(run, "config.json"), encoding="utf-8") as fh:
-            return json.load(fh).get("init_sha256", "")
-    except (OSError, ValueError):
-        return None
+    nothing was trained there), from the config its checkpoint or ``config.json`` records."""
+    doc = _json(run, "config.json")
+    if doc is None and os.path.isfile(os.path.join(run, "ckpt.pt")):
+        import torch
+        doc = torch.load(os.path.join(run, "ckpt.pt"), map_location="cpu", weights_only=False).get("config")
+    return None if doc is None else doc.get("init_sha256", "")
 
 
-def _export_fingerprint(folder: str) -> str:
-    from omninoise.backend.onnx_models import fingerprint, load_model_json
+def _structure_net(stage: Stage, out: str, max_steps: int | None, log) -> str:
+    """Train the structure network into OUT/NAME/net.pt unless it holds as many steps; returns its path."""
+    import torch
 
-    return fingerprint(load_model_json(folder, "neural_noise.json")["files"])
+    from omninoise import export as _ex
+    from .solid import exemplars as ex
+    from .solid.structure_features import train_structure_net
+    from .threads import cpu_threads
+
+    path = os.path.join(out, stage.name, "net.pt")
+    steps = min(stage.steps, max_steps or stage.steps)
+    if os.path.isfile(path) and torch.load(path, weights_only=False)["record"]["steps"] == steps:
+        log(f"{stage.name}: done ({path})")
+        return path
+    log(f"{stage.name}: the structure network, to step {steps}")
+    with cpu_threads(2):
+        train = [im for im in map(ex.load_image, ex.photo_set("train")) if min(im.shape[1:]) >= 64]
+        val = [im for im in map(ex.load_image, ex.photo_set("val")) if min(im.shape[1:]) >= 64]
+        net, record = train_structure_net(train, val, steps=steps, log=lambda s: log(f"  {s}"))
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with _ex.atomic_path(path) as tmp:
+        torch.save(dict(weights=net.state_dict(), record=record), tmp)
+    return path
 
 
-def run_line(stages: list, out: str, max_steps: int | None = None, log=print) -> str:
-    """Train and export each stage in turn into ``out`` (module docstring); returns the last export's folder.
-    ``max_steps`` caps every stage's steps (a quick run of the line)."""
-    from .export_onnx import export
-    from .quantize_onnx import quantize_folder
-    from .train import load_config, train
+def run_line(line: tuple, out: str, max_steps: int | None = None, device: str | None = None, log=print) -> str:
+    """Train and export each stage of ``line`` (:func:`load_line`) in turn into ``out`` (module docstring); returns
+    the last export's folder. ``max_steps`` caps every stage's steps (a quick run of the line); ``device`` trains
+    every stage there."""
+    from omninoise.backend.onnx_models import fingerprint
 
-    start = None                    # (export folder, its weights' fingerprint) the next stage starts from
+    model, stages, finish = line
+    start, net = None, None             # the export the next stage starts from, and the structure network
     for k, stage in enumerate(stages, 1):
-        run = os.path.join(out, stage.name)
-        done = os.path.join(run, EXPORT)
-        steps = min(stage.steps, max_steps or stage.steps)
-        if _exported_step(done) == steps:
-            log(f"[{k}/{len(stages)}] {stage.name}: done ({done})")
+        say = f"[{k}/{len(stages)}] {stage.name}"
+        if stage.kind == "structure_net":
+            net = _structure_net(stage, out, max_steps, lambda s: log(f"[{k}/{len(stages)}] {s}"))
+            continue
+        run, done = os.path.join(out, stage.name), os.path.join(out, stage.name, EXPORT)
+        start_step = 0 if start is None or model is _Neural else int(_json(start, model.json).get("step", 0))
+        if stage.kind == "average":
+            stop = int(_json(os.path.join(out, stage.average[-1], EXPORT), model.json)["step"])
         else:
-            cfg = dataclasses.replace(load_config(stage.config), steps=steps)
+            stop = min(stage.steps, start_step + max_steps) if max_steps else stage.steps
+        if (_json(done, model.json) or {}).get("step") == stop:
+            log(f"{say}: done ({done})")
+        elif stage.kind == "average":
+            from .solid.average import average_checkpoints
+            from omninoise import export as _ex
+            import torch
+
+            log(f"{say}: the mean of {', '.join(stage.average)}")
+            os.makedirs(run, exist_ok=True)
+            state = average_checkpoints([os.path.join(out, name) for name in stage.average])
+            with _ex.atomic_path(os.path.join(run, "ckpt.pt")) as tmp:
+                torch.save(state, tmp)
+            model.export(run, done)
+        else:
+            cfg = model.config(stage.config)
             if start is not None:
-                cfg = dataclasses.replace(cfg, init_onnx=start[0], init_sha256=start[1])
-            log(f"[{k}/{len(stages)}] {stage.name}: {os.path.relpath(stage.config)}, {cfg.steps} steps, from "
-                + (f"{start[0]}" if start else (cfg.init_onnx or "a fresh network")))
+                cfg = dataclasses.replace(cfg, init_onnx=start,
+                                          init_sha256=fingerprint(_json(start, model.json)["files"]))
+            if net is not None and getattr(cfg, "structure_weight", 0):
+                cfg = dataclasses.replace(cfg, structure_net=net)
+            if device:
+                cfg = dataclasses.replace(cfg, device=device)
+            origin = start or cfg.init_onnx or "a fresh network"
+            log(f"{say}: {os.path.relpath(stage.config)}, to step {stop}, from {origin}")
             if _started_from(run) not in (None, cfg.init_sha256):   # its run began from another export
                 log(f"  {run} began from other weights than the stage before's export: training it again")
                 shutil.rmtree(run)
             t0 = time.time()
-            train(cfg, run, log=lambda text: log(f"  {text}"))
-            export(run, done)       # its JSON, with the step, is written last: a cut-short export is not done
+            model.train(cfg, run, start_step, stop, lambda text: log(f"  {text}"))
+            model.export(run, done)     # its JSON, with the step, is written last: a cut-short export is not done
             log(f"  exported to {done} ({time.time() - t0:.0f} s)")
-        start = (done, _export_fingerprint(done))
-    with open(os.path.join(start[0], "neural_noise.json"), encoding="utf-8") as fh:
-        if "int8" not in json.load(fh):
-            quantize_folder(start[0])
-            log(f"  int8 denoisers added to {start[0]}")
-    return start[0]
+        start = done
+    if finish and not model.finished(_json(start, model.json), finish):
+        model.finish(start, finish, lambda text: log(f"  {text}"))
+        log(f"  {finish}: {start}")
+    return start
+
+
+def _check_devices(line: tuple) -> None:
+    """ValueError naming the first stage whose config trains on a GPU that torch does not see here."""
+    import torch
+
+    for s in line[1]:
+        if s.kind == "train" and line[0].config(s.config).device.startswith("cuda") and not torch.cuda.is_available():
+            raise ValueError(f"stage {s.name} trains on {line[0].config(s.config).device} and torch sees no CUDA "
+                             "device here: give --device cpu to train every stage on the CPU")
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m omninoise.training.line", description=__doc__.split("\n")[0])
-    ap.add_argument("line", help="a line file (configs/neural_noise_line.json)")
+    ap.add_argument("line", help="a line file (configs/neural_noise_line.json, configs/solid/space_line.json)")
     ap.add_argument("--out", required=True, help="the folder of the stages' runs and exports")
-    ap.add_argument("--steps", type=int, help="stop every stage after at most this many steps (a check of the line)")
+    ap.add_argument("--steps", type=int, help="train every stage for at most this many steps (a check of the line)")
+    ap.add_argument("--device", help="train every stage on this torch device (cpu, cuda)")
     ap.add_argument("--dry-run", action="store_true", help="list the stages and where each starts, train nothing")
     a = ap.parse_args(argv)
     try:
         if a.steps is not None and a.steps < 1:
             raise ValueError(f"--steps must be >= 1, got {a.steps}")
-        stages = load_line(a.line)
+        line = load_line(a.line)
+        if not a.device:
+            _check_devices(line)
     except (OSError, ValueError) as exc:
         print(f"line: error: {exc}", file=sys.stderr)
         return 2
     if a.dry_run:
-        from .train import load_config
-
+        stages = line[1]
         for k, s in enumerate(stages, 1):
-            start = f"the export of {stages[k - 2].name}" if k > 1 else (load_config(s.config).init_onnx
-                                                                          or "a fresh network")
-            print(f"[{k}/{len(stages)}] {s.name}: {os.path.relpath(s.config)}, {min(s.steps, a.steps or s.steps)} "
-                  f"steps, from {start}")
+            what = {"structure_net": f"the structure network, {s.steps} steps",
+                    "average": f"the mean of {', '.join(s.average)}"}.get(s.kind)
+            if what is None:
+                before = [p for p in stages[:k - 1] if p.kind != "structure_net"]
+                start = f"the export of {before[-1].name}" if before else (line[0].config(s.config).init_onnx
+                                                                            or "a fresh network")
+                what = f"{os.path.relpath(s.config)}, to step {s.steps}, from {start}"
+            print(f"[{k}/{len(stages)}] {s.name}: {what}")
+        if line[2]:
+            print(f"then {line[2]}")
         return 0
-    model = run_line(stages, a.out, a.steps)
-    print(f"line: the model is {model}; evaluate it: python -m bench neural-eval --model {model}")
+    model = run_line(line, a.out, a.steps, a.device)
+    print(f"line: the model is {model}")
     return 0
 
 

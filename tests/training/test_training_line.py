@@ -1,5 +1,6 @@
-"""One command trains the neural noise model's whole line of stages (training/line.py): each stage from the export
-of the one before, resumable, the last export with its int8 denoisers; and the line file is the shipped line."""
+"""One command trains a model's whole line of stages (training/line.py): each stage from the export of the one
+before, resumable, the last export finished (int8 denoisers, turned octaves); and the line files are the shipped
+lines."""
 import dataclasses
 import json
 import os
@@ -17,14 +18,18 @@ from omninoise.training.config import load_config  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SHIPPED = os.path.join(ROOT, "configs", "neural_noise_line.json")
+SOLID = os.path.join(ROOT, "configs", "solid", "space_line.json")
+#: a tiny solid texture config (tests/training/test_solid_model.py's)
+TINY_SOLID = dict(name="tiny", mode="single", dim=3, crop=32, batch=2, steps=4, width=32, log_every=2,
+                  checkpoint_every=2, threads=1, exemplars=["gravel"])
 
 
-def _line(tmp_path, stages):
+def _line(tmp_path, stages, model="neural_noise", finish="int8", extra=()):
     for name, cfg in stages:
         (tmp_path / f"{name}.json").write_text(json.dumps(cfg))
     path = tmp_path / "line.json"
-    path.write_text(json.dumps({"model": "neural_noise", "stages": [
-        {"name": name, "config": f"{name}.json", "steps": cfg["steps"]} for name, cfg in stages]}))
+    path.write_text(json.dumps({"model": model, "finish": finish, "stages": [
+        {"name": name, "config": f"{name}.json", "steps": cfg["steps"]} for name, cfg in stages] + list(extra)}))
     return str(path)
 
 
@@ -49,7 +54,7 @@ def test_the_line_trains_each_stage_from_the_export_before_and_goes_on_where_it_
 
 
 def test_a_stage_stopped_partway_resumes_and_max_steps_caps_every_stage(tmp_path):
-    path = _line(tmp_path, [("a", dict(TINY, steps=3))])
+    path = _line(tmp_path, [("a", dict(TINY, steps=3))], finish="")
     out = tmp_path / "out"
     assert line.run_line(line.load_line(path), str(out), max_steps=1, log=lambda s: None)
     assert json.loads((out / "a" / "export" / "neural_noise.json").read_text())["step"] == 1
@@ -64,11 +69,12 @@ def test_a_stage_stopped_partway_resumes_and_max_steps_caps_every_stage(tmp_path
     ({"name": "a", "config": "a.json", "steps": 0}, "steps must be a whole number >= 1"),
     ({"name": "a", "config": "a.json", "steps": 4}, "steps 4 is past its config's 3"),
     ({"name": "a", "config": "missing.json", "steps": 1}, "config missing.json"),
-    ({"name": "a", "config": "a.json"}, "needs exactly name, config and steps"),
+    ({"name": "a", "config": "a.json"}, "needs exactly name, config, steps"),
+    ({"name": "a", "average": ["a", "b"]}, "needs exactly name, config, steps"),   # solid lines only
 ])
 def test_a_bad_line_is_one_line_before_any_work(tmp_path, capsys, entry, message):
     (tmp_path / "a.json").write_text(json.dumps(dict(TINY, steps=3)))
-    (tmp_path / "line.json").write_text(json.dumps({"stages": [entry]}))
+    (tmp_path / "line.json").write_text(json.dumps({"model": "neural_noise", "stages": [entry]}))
     assert line.main([str(tmp_path / "line.json"), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and message in err[0] and not (tmp_path / "out").exists()
@@ -76,7 +82,8 @@ def test_a_bad_line_is_one_line_before_any_work(tmp_path, capsys, entry, message
 
 def test_the_line_file_is_the_shipped_line():
     """Its last stage is the config and step the shipped weights record; every config reads."""
-    stages = line.load_line(SHIPPED)
+    _, stages, finish = line.load_line(SHIPPED)
+    assert finish == "int8"
     shipped = json.loads(open(os.path.join(ROOT, "models", "neural_noise", "neural_noise.json")).read())
     last = stages[-1]
     assert shipped["step"] == last.steps
@@ -90,7 +97,7 @@ def test_the_line_file_is_the_shipped_line():
 def test_a_stage_whose_start_changed_trains_again(tmp_path):
     """A quick run (`--steps 1`) then the real one: the second stage's checkpoint began from the quick first stage,
     so it is trained again from the new export, not resumed."""
-    path = _line(tmp_path, [("a", dict(TINY, steps=3)), ("b", dict(TINY, steps=2))])
+    path = _line(tmp_path, [("a", dict(TINY, steps=3)), ("b", dict(TINY, steps=2))], finish="")
     out = str(tmp_path / "out")
     line.run_line(line.load_line(path), out, max_steps=1, log=lambda s: None)
     logs = []
@@ -98,3 +105,41 @@ def test_a_stage_whose_start_changed_trains_again(tmp_path):
     assert any("began from other weights than the stage before's export" in ln for ln in logs)
     assert not any("resumed" in ln for ln in logs if "b" in ln) and sum("resumed at step 1" in ln for ln in logs) == 1
     assert json.loads((tmp_path / "out" / "b" / "export" / "neural_noise.json").read_text())["step"] == 2
+
+
+def test_a_solid_line_goes_on_from_each_export_s_step_and_averages_two_stages(tmp_path):
+    """Solid texture stages count on from their start's step under their own schedule; an average stage exports the
+    mean of two stages' weights at the last one's step."""
+    import torch
+
+    path = _line(tmp_path, [("a", dict(TINY_SOLID, steps=4)), ("b", dict(TINY_SOLID, steps=8))], model="solid",
+                 finish="", extra=[{"name": "mean", "average": ["a", "b"]}])
+    logs = []
+    model = line.run_line(line.load_line(path), str(tmp_path / "out"), max_steps=2, log=logs.append)
+    steps = {n: json.loads((tmp_path / "out" / n / "export" / "solid.json").read_text())["step"] for n in "ab"}
+    assert steps == {"a": 2, "b": 4} and any("started from " + str(tmp_path / "out" / "a" / "export") + " (" in ln
+                                             and ln.endswith("at step 2") for ln in logs)
+    assert json.loads((tmp_path / "out" / "mean" / "export" / "solid.json").read_text())["step"] == 4
+    runs = [torch.load(tmp_path / "out" / n / "ckpt.pt", weights_only=False)["model"] for n in ("a", "b", "mean")]
+    k = next(k for k, v in runs[0].items() if v.is_floating_point() and not torch.equal(v, runs[1][k]))
+    assert torch.allclose(runs[2][k], (runs[0][k] + runs[1][k]) / 2, atol=1e-6)
+    assert model == str(tmp_path / "out" / "mean" / "export")
+    logs.clear()
+    line.run_line(line.load_line(path), str(tmp_path / "out"), max_steps=2, log=logs.append)
+    assert all(ln.endswith("export)") and ": done (" in ln for ln in logs)
+
+
+def test_the_solid_line_file_is_the_shipped_space_line():
+    """Its last training stage is the config and step the shipped space model records, its finish the shipped
+    model's spin, and a GPU stage is refused here without --device, before any work."""
+    import torch
+
+    model, stages, finish = line.load_line(SOLID)
+    shipped = json.loads(open(os.path.join(ROOT, "models", "solid", "space", "solid.json")).read())
+    last = [s for s in stages if s.kind == "train"][-1]
+    assert shipped["step"] == last.steps and shipped["name"] == model.config(last.config).name
+    assert finish == "spin " + shipped["spin"] and stages[-1].average == ("cont", "cont2")
+    assert [s.kind for s in stages[:2]] == ["structure_net", "train"] and not model.config(stages[1].config).init_onnx
+    if not torch.cuda.is_available():
+        with pytest.raises(ValueError, match="stage cont trains on cuda .* give --device cpu"):
+            line._check_devices((model, stages, finish))
