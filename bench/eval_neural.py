@@ -17,6 +17,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 from omninoise.backend.neural.model import NeuralNoiseModel
+from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 from omninoise.export.atomic import write_json
 from omninoise.training.evaluate import evaluate, step_seconds
 from omninoise.training.threads import cpu_threads
@@ -33,13 +34,16 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=0, help="CPU threads for torch and numba (0: their defaults); "
                                                            "the classifier is reproducible for a fixed count")
     ap.add_argument("--n", type=int, default=32, help="samples per class")
-    ap.add_argument("--steps", type=int, default=30, help="sampler steps")
-    ap.add_argument("--sampler", default="ddim", help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py)")
-    ap.add_argument("--eta", type=float, default=0.0, help="step noise of ddim or dpmpp_2m (0: deterministic)")
+    # the defaults are the model card's instrument: the runtime's sampler, a classifier of 6000 steps and 3 stages
+    ap.add_argument("--steps", type=int, default=DEFAULT_STEPS, help="sampler steps (default: the runtime's)")
+    ap.add_argument("--sampler", default=DEFAULT_SAMPLER,
+                    help="ddim, dpmpp_2m or heun (see backend/neural/sampler.py; default: the runtime's)")
+    ap.add_argument("--eta", type=float, help="step noise of ddim or dpmpp_2m (0: deterministic; default: the "
+                                              "sampler's own)")
     ap.add_argument("--spacing", help="timestep spacing: uniform, logsnr, karras or truncated (default: the sampler's own)")
     ap.add_argument("--precision", default="fp32", help="the denoiser's arithmetic: fp32, int8 or auto "
                                                          "(int8 needs the folder's int8 files, training/quantize_onnx.py)")
-    ap.add_argument("--clf-steps", type=int, default=600)
+    ap.add_argument("--clf-steps", type=int, default=6000, help="the classifier's training steps")
     ap.add_argument("--classifier-cache", metavar="DIR",
                     help="keep the trained classifier here and reuse it (same classes, size, steps, threads)")
     ap.add_argument("--size", type=int, default=256, help="resolution for the step timing")
@@ -47,13 +51,14 @@ def main(argv=None) -> int:
                                                   "training size); compare two models at one size")
     ap.add_argument("--clf-threads", type=int, help="torch threads the classifier is trained with (and cached "
                                                     "under); default: --threads")
-    ap.add_argument("--clf-stages", type=int, default=2, help="stride-2 stages of the classifier (3 or more for "
+    ap.add_argument("--clf-stages", type=int, default=3, help="stride-2 stages of the classifier (3 or more for "
                                                               "64² and larger: a wider receptive field)")
     ap.add_argument("--timing-only", action="store_true",
                     help="re-time the DDIM step (on a quiet machine) and keep the quality results already in --out")
     ap.add_argument("--no-timing", action="store_true", help="skip the DDIM step timing (a busy machine)")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "neural_eval.json"))
     a = ap.parse_args(argv)
+    a.eta = sampler_eta(a.sampler, a.eta)
     model = NeuralNoiseModel(a.model, threads=a.threads, precision=a.precision)
     classes = tuple(model.config["trained_classes"])
     if a.classes:
