@@ -19,7 +19,9 @@ HISTORY = {
     "a round of work": re.compile(r"\b(session|sprint)s? \d+\b|\b" + _ORDINAL + r" (session|sprint)\b"
                                   r"|\brounds? of (work|development)\b", re.I),
     "a borrowed machine": re.compile(r"\b(lent|borrowed|loaned)( an?| the| one)?( NVIDIA)? (GPU|H100|H200|machine|"
-                                     r"device|accelerator)s?\b|\bdevice tool\b", re.I),
+                                     r"device|accelerator)s?\b|\bdevice tool\b|\b(GPU|H100|H200|machine|device|"
+                                     r"accelerator)s? (has|have|was|were|is|are)( not)?( been)? (lent|borrowed|"
+                                     r"loaned)\b", re.I),
     "a date of work": re.compile(r"\b(January|February|March|April|May|June|July|August|September|October|November|"
                                  r"December) \d{1,2}(, \d{4})?\b|\b(January|February|March|April|May|June|July|"
                                  r"August|September|October|November|December) 20\d\d\b"),
@@ -71,6 +73,7 @@ CAUGHT = [(" ".join(words), what) for words, what in (
     (("as the", "twenty-third", "session", "found"), "a round of work"),
     (("the second", "round of", "work on it"), "a round of work"),
     (("trained on a", "lent", "H200"), "a borrowed machine"),
+    (("on the CPU (no GPU", "was lent)"), "a borrowed machine"),
     (("measured on", "November", "27, 2026"), "a date of work"),
 )]
 

@@ -257,10 +257,9 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
     if continued:
         L += ["", f"{', '.join(continued)}: trained by the first config, then continued by the second "
               "(`init_from` names the first run; a longer `steps` restarts the cosine learning-rate decay at the "
-              "step where the first run ended), each with the `train` command above. Wall time and loss cover "
-              "both stages. This is the longest CPU training the session allowed (no GPU was lent): "
+              "step where the first run ended), each with the `train` command above: "
               "`python -m omninoise.training.solid.train --config configs/solid/NAME_long.json "
-              "--out runs/solid/NAME_long` after the first run."]
+              "--out runs/solid/NAME_long` after the first run. Wall time and loss cover both stages."]
     L += ["", "Full sha256 of every file: each model's `solid.json` (`files`); the runtime refuses a file whose "
           "hash differs. Configs: the configs column, under `configs/solid/`.", ""]
     q = ev.get("quality")
