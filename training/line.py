@@ -1,11 +1,12 @@
 """Train a model's whole line of stages with one command:
-``python -m omninoise.training.line configs/neural_noise_line.json --out runs/line`` (or
-``configs/solid/space_line.json``).
+``python -m omninoise.training.line configs/lines/neural_noise.json --out runs/line`` (or
+``configs/lines/solid_space.json``).
 
 A shipped model is the end of a line of stages, each a config trained from the export of the stage before (the
 ledgers: ``python tools/ledger.py models/neural_noise``). A line file lists them in order::
 
-    {"model": "neural_noise", "stages": [{"name": "zoo", "config": "neural_noise_cpu_zoo.json", "steps": 5600}, ...]}
+    {"model": "neural_noise", "stages": [{"name": "zoo", "config": "../neural_noise_cpu_zoo.json", "steps": 5600},
+                                         ...], "finish": "int8"}
 
 ``config`` is a path from the line file's folder. ``steps`` is the step the stage stops at, as its trainer counts:
 a neural noise stage counts from 0 (its learning rate is constant, so a stage stopped early is its config with
@@ -296,7 +297,7 @@ def _check_devices(line: tuple) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m omninoise.training.line", description=__doc__.split("\n")[0])
-    ap.add_argument("line", help="a line file (configs/neural_noise_line.json, configs/solid/space_line.json)")
+    ap.add_argument("line", help="a line file (configs/lines/neural_noise.json, configs/lines/solid_space.json)")
     ap.add_argument("--out", required=True, help="the folder of the stages' runs and exports")
     ap.add_argument("--steps", type=int, help="train every stage for at most this many steps (a check of the line)")
     ap.add_argument("--device", help="train every stage on this torch device (cpu, cuda)")
@@ -306,7 +307,7 @@ def main(argv=None) -> int:
         if a.steps is not None and a.steps < 1:
             raise ValueError(f"--steps must be >= 1, got {a.steps}")
         line = load_line(a.line)
-        if not a.device:
+        if not a.device and not a.dry_run:
             _check_devices(line)
     except (OSError, ValueError) as exc:
         print(f"line: error: {exc}", file=sys.stderr)

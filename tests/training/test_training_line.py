@@ -17,8 +17,8 @@ from omninoise.training import line  # noqa: E402
 from omninoise.training.config import load_config  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SHIPPED = os.path.join(ROOT, "configs", "neural_noise_line.json")
-SOLID = os.path.join(ROOT, "configs", "solid", "space_line.json")
+SHIPPED = os.path.join(ROOT, "configs", "lines", "neural_noise.json")
+SOLID = os.path.join(ROOT, "configs", "lines", "solid_space.json")
 #: a tiny solid texture config (tests/training/test_solid_model.py's)
 TINY_SOLID = dict(name="tiny", mode="single", dim=3, crop=32, batch=2, steps=4, width=32, log_every=2,
                   checkpoint_every=2, threads=1, exemplars=["gravel"])
