@@ -31,9 +31,10 @@ def _param(p: dict) -> str:
     return f"{p['name']} {_number(p['min'])} to {_number(p['max'])}" + (f" ({unit})" if unit else "")
 
 
-def classes_text(classes: dict) -> str:
+def classes_text(classes: dict, untrained=()) -> str:
     """Noise classes ({name: {doc, params: [{name, min, max, unit, integer}]}}) as a table: each name and what it
-    draws, and under it its parameters' ranges and units."""
+    draws, and under it its parameters' ranges and units; then the ``untrained`` classes a model also takes (they
+    draw, but not as their class looks)."""
     width = max(map(len, classes)) + 2
     lines = []
     for name, c in classes.items():
@@ -43,8 +44,11 @@ def classes_text(classes: dict) -> str:
             lines.append(textwrap.fill(params, WIDTH, initial_indent=" " * width, subsequent_indent=" " * width,
                                        break_on_hyphens=False).replace("\xa0", " "))
     n = len(classes)
-    return "\n".join(lines + ["", f"{n} class{'es' if n != 1 else ''}: --noise CLASS, --param NAME=VALUE; "
-                                  "--list --json prints this as JSON."])
+    lines += ["", f"{n} class{'es' if n != 1 else ''}: --noise CLASS, --param NAME=VALUE; --list --json prints this "
+              "as JSON."]
+    if untrained:
+        lines.append(textwrap.fill(f"The model was not trained on {', '.join(untrained)}.", WIDTH))
+    return "\n".join(lines)
 
 
 def textures_text(textures: dict) -> str:

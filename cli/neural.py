@@ -201,8 +201,10 @@ def run(a: argparse.Namespace) -> int:
     except ModelError as exc:
         raise SettingError("--model", f"{exc}; train and export one (see models/README.md) or pass --model") from None
     if a.list:
-        listing.show(dict(classes=model.class_params, trained=model.config.get("trained_classes")),
-                     listing.classes_text(model.class_params), a.json)
+        trained = model.config.get("trained_classes") or list(model.class_params)
+        text = listing.classes_text({n: model.class_params[n] for n in trained if n in model.class_params},
+                                    [n for n in model.class_params if n not in trained])
+        listing.show(dict(classes=model.class_params, trained=trained), text, a.json)
         return 0
     check_reads(a)
     if a.keys or a.frames:

@@ -210,6 +210,11 @@ def test_list_prints_a_table_to_read_and_json_with_json(capsys):
     singles = [name for name, t in textures.items() if t["mode"] == "single"]
     assert [ln.split()[0] for ln in text.splitlines()[:len(singles)]] == singles
     assert "wood_3d     3D solid from wood__oldwood.jpg" in text and "by name (the space model): brick, concrete" in text
+    tiny = os.path.join(ROOT, "tests", "data", "tiny_neural")     # trained on three of the classes
+    assert main(["neural", "--model", tiny, "--list"]) == 0
+    text = capsys.readouterr().out
+    assert [ln.split()[0] for ln in text.splitlines()[:6:2]] == ["perlin", "spots", "cells_f1"]
+    assert "3 classes:" in text and "The model was not trained on cells_borders," in text
     for command in ("neural", "solid"):
         assert main([command, "--json"]) == 2
         assert "--json: prints --list as JSON: give --list too" in capsys.readouterr().err
