@@ -296,7 +296,10 @@ def _check_devices(line: tuple) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m omninoise.training.line", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m omninoise.training.line",
+                                 description="Train a model's whole line of stages, each from the export of the one "
+                                             "before, where the shipped line stopped it; run again, it goes on "
+                                             "where it stopped.")
     ap.add_argument("line", help="a line file (configs/lines/neural_noise.json, configs/lines/solid_space.json)")
     ap.add_argument("--out", required=True, help="the folder of the stages' runs and exports")
     ap.add_argument("--steps", type=int, help="train every stage for at most this many steps (a check of the line)")
