@@ -168,3 +168,28 @@ def test_a_broken_ledger_is_one_line_and_exit_2(tmp_path, ledger, capsys):
     (tmp_path / "ledger.json").write_text('{"columns": ["a", "b"], "rows": [["only one"]]}')
     assert ledger.main([str(tmp_path)]) == 2
     assert "ledger needs" in capsys.readouterr().err
+
+
+def test_the_command_line_guide_sets_each_solid_preset_as_the_panel_does():
+    """The command-line guide's table of solid flags by kind of photo is the Solid Texture panel's shipped presets:
+    the same method and procedural kinds, a row for each preset."""
+    def key(words: str) -> str:     # "a brick wall or tiles", "brick_wall_or_tiles" -> "brick wall or tiles"
+        return " ".join(w for w in re.split(r"[ _,]+", words) if w not in ("a", "and", ""))
+
+    every = ["bonds", "cells", "layers", "rings"]   # the procedural kinds a preset of another method leaves set
+    folder = os.path.join(ROOT, "blender_addon", "presets", "omninoise", "solid")
+    presets = {}
+    for name in os.listdir(folder):
+        text = open(os.path.join(folder, name), encoding="utf-8").read()
+        method = re.search(r"p\.method = '(\w+)'", text).group(1).lower()
+        families = sorted(f.lower() for f in re.findall(r"'(\w+)'", re.search(r"p\.families = \{(.*)\}", text)[1]))
+        presets[key(name[:-3])] = (method, families)
+    guide = open(os.path.join(ROOT, "docs", "guide", "cli.md"), encoding="utf-8").read()
+    table = guide.split("**By kind of photo**")[1].split("\n\n")[1]
+    rows = {}
+    for photo, flags in re.findall(r"^\| ([a-z, ]+) \| (.+) \|$", table, re.M)[1:]:    # after the header
+        method = re.search(r"--method (\w+)", flags)
+        families = re.search(r"--families ([\w,]+)", flags)
+        rows[key(photo)] = (method.group(1) if method else "neural",
+                            sorted(families.group(1).split(",")) if families else every)
+    assert rows == presets
