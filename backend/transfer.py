@@ -27,7 +27,7 @@ import numpy as np
 from .errors import SettingError
 from .schema import AnyOf, Choice, Field, Float, Items, ListOf, Table
 
-__all__ = ["TransferFunction", "PRESETS", "preset", "load_transfer", "transfer_from_dict"]
+__all__ = ["TransferFunction", "PRESETS", "PRESET_NOTES", "preset", "load_transfer", "transfer_from_dict"]
 
 _F = np.float32
 _BLOCK = 1 << 14
@@ -207,30 +207,36 @@ def load_transfer(spec: str, where: str = "transfer") -> TransferFunction:
     return transfer_from_dict(d, f"{where}: {os.path.basename(spec)}")
 
 
-#: presets for the wave noise's real output (mean 0, std ~0.7); ``range`` adapts them to others
+#: presets for the wave noise's real output (mean 0, std ~0.7); ``range`` adapts them to others; each one's look
+#: in :data:`PRESET_NOTES`
 PRESETS = {
-    # white puffs with soft edges, empty where the noise is low
     "clouds": dict(range=(0.1, 1.8), interpolation="ease", density_scale=3.0,
                    stops=((0.0, (1.0, 1.0, 1.0, 0.0)), (0.25, (0.95, 0.96, 1.0, 0.15)),
                           (1.0, (1.0, 1.0, 1.0, 1.0)))),
-    # thin grey smoke with dark cores
     "smoke": dict(range=(-0.5, 1.8), interpolation="linear", density_scale=2.0,
                   stops=((0.0, (0.4, 0.4, 0.42, 0.0)), (0.4, (0.25, 0.25, 0.26, 0.2)),
                          (1.0, (0.05, 0.05, 0.05, 1.0)))),
-    # dark red to yellow-white, with blackbody temperature rising to 1800 K
     "fire": dict(range=(0.0, 1.8), interpolation="linear", density_scale=3.0,
                  stops=((0.0, (0.1, 0.0, 0.0, 0.0)), (0.3, (0.8, 0.1, 0.0, 0.3)),
                         (0.7, (1.0, 0.5, 0.05, 0.7)), (1.0, (1.0, 0.95, 0.7, 1.0))),
                  temperature=((0.2, 0.0), (1.0, 1800.0))),
-    # dense stone with thin dark veins at the noise's zero crossings (use the real output)
     "marble": dict(range=(-1.2, 1.2), interpolation="ease", density_scale=10.0,
                    stops=((0.0, (0.92, 0.9, 0.86, 1.0)), (0.46, (0.85, 0.83, 0.8, 1.0)),
                           (0.5, (0.15, 0.14, 0.14, 1.0)), (0.54, (0.85, 0.83, 0.8, 1.0)),
                           (1.0, (0.95, 0.94, 0.92, 1.0)))),
-    # hard-edged blue-green facets: constant steps, for crystal waveforms and cellular noise
     "crystal": dict(range=(-1.2, 1.2), interpolation="constant", density_scale=6.0,
                     stops=((0.0, (0.0, 0.0, 0.0, 0.0)), (0.45, (0.2, 0.5, 0.7, 0.4)),
                            (0.6, (0.4, 0.8, 0.9, 0.8)), (0.8, (0.8, 0.95, 1.0, 1.0)))),
+}
+
+
+#: what each preset draws, in a line (``omninoise transfer --list``)
+PRESET_NOTES = {
+    "clouds": "white puffs with soft edges, empty where the noise is low",
+    "smoke": "thin grey smoke with dark cores",
+    "fire": "dark red to yellow-white, with a blackbody temperature rising to 1800 K",
+    "marble": "dense stone with thin dark veins at the zero crossings of the noise's real output",
+    "crystal": "hard-edged blue-green facets in constant steps, for crystal waveforms and cellular noise",
 }
 
 

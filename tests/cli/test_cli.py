@@ -232,3 +232,12 @@ def test_wave_notes_the_kernel_only_when_no_compiled_one_runs(tmp_path, capsys, 
     rc, err = run(capsys, "--size", "16", "-o", out)
     assert rc == 0 and "omninoise wave: note: wave noise runs on " in err
     assert "kernel" not in run(capsys, "--size", "16", "--quiet", "-o", out)[1]
+
+
+def test_transfer_list_names_each_preset_and_its_look(capsys):
+    """`omninoise transfer --list`: a line per preset, its name first (what scripts read) and what it looks like."""
+    from omninoise.backend.transfer import PRESET_NOTES, PRESETS
+    assert main(["transfer", "--list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [ln.split()[0] for ln in lines] == list(PRESETS) and set(PRESET_NOTES) == set(PRESETS)
+    assert all(ln.endswith(PRESET_NOTES[ln.split()[0]]) for ln in lines)
