@@ -207,10 +207,7 @@ def _structure_net(stage: Stage, out: str, max_steps: int | None, log) -> str:
     """Train the structure network into OUT/NAME/net.pt unless it holds as many steps; returns its path."""
     import torch
 
-    from omninoise import export as _ex
-    from .solid import exemplars as ex
-    from .solid.structure_features import train_structure_net
-    from .threads import cpu_threads
+    from .solid.structure_features import save_photo_set_net
 
     path = os.path.join(out, stage.name, "net.pt")
     steps = min(stage.steps, max_steps or stage.steps)
@@ -218,13 +215,7 @@ def _structure_net(stage: Stage, out: str, max_steps: int | None, log) -> str:
         log(f"{stage.name}: done ({path})")
         return path
     log(f"{stage.name}: the structure network, to step {steps}")
-    with cpu_threads(2):
-        train = [im for im in map(ex.load_image, ex.photo_set("train")) if min(im.shape[1:]) >= 64]
-        val = [im for im in map(ex.load_image, ex.photo_set("val")) if min(im.shape[1:]) >= 64]
-        net, record = train_structure_net(train, val, steps=steps, log=lambda s: log(f"  {s}"))
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with _ex.atomic_path(path) as tmp:
-        torch.save(dict(weights=net.state_dict(), record=record), tmp)
+    save_photo_set_net(path, steps, log=lambda s: log(f"  {s}"))
     return path
 
 

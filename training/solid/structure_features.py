@@ -21,6 +21,7 @@ Shapes: images (B, 3, H, W) float32 in [0, 1]; the network itself reads (B, 1, H
 from __future__ import annotations
 
 import math
+import os
 import time
 
 import numpy as np
@@ -30,7 +31,7 @@ from torch import nn
 
 from .arrangement import gaussianise, luminance
 
-__all__ = ["StructureNet", "StructureFeatures", "phase_randomised", "structure_batch", "train_structure_net",
+__all__ = ["StructureNet", "StructureFeatures", "phase_randomised", "structure_batch", "train_structure_net", "save_photo_set_net",
            "load_structure_net"]
 
 
@@ -154,14 +155,28 @@ class StructureFeatures(nn.Module):
         return self.net.taps(_gauss(img))
 
 
-def main(argv=None) -> int:
-    import argparse
-    import os
-
+def save_photo_set_net(out: str, steps: int = 1500, width: int = 32, seed: int = 0, threads: int = 2,
+                       log=print) -> dict:
+    """Train the structure network on the photo set (its training photos, held out on its validation photos, each
+    at least 64 px a side) and write it to ``out`` atomically (weights and record); returns the record."""
     from omninoise import export as _ex
 
     from . import exemplars as ex
     from ..threads import cpu_threads
+
+    size = 64
+    with cpu_threads(threads):
+        train = [im for im in map(ex.load_image, ex.photo_set("train")) if min(im.shape[1:]) >= size]
+        val = [im for im in map(ex.load_image, ex.photo_set("val")) if min(im.shape[1:]) >= size]
+        net, record = train_structure_net(train, val, steps=steps, width=width, seed=seed, log=log)
+    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+    with _ex.atomic_path(out) as tmp:
+        torch.save(dict(weights=net.state_dict(), record=record), tmp)
+    return record
+
+
+def main(argv=None) -> int:
+    import argparse
 
     ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.structure_features",
                                  description="Train the structure network on the photo set.")
@@ -173,16 +188,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     if a.steps < 1 or a.width < 1:
         ap.error("--steps and --width must be at least 1")
-    with cpu_threads(a.threads):
-        size = 64
-        train = [im for im in map(ex.load_image, ex.photo_set("train")) if min(im.shape[1:]) >= size]
-        val = [im for im in map(ex.load_image, ex.photo_set("val")) if min(im.shape[1:]) >= size]
-        net, record = train_structure_net(train, val, steps=a.steps, width=a.width, seed=a.seed,
-                                          log=lambda s: print(s, flush=True))
-    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-    with _ex.atomic_path(a.out) as tmp:
-        torch.save(dict(weights=net.state_dict(), record=record), tmp)
-    print(record)
+    print(save_photo_set_net(a.out, a.steps, a.width, a.seed, a.threads, log=lambda s: print(s, flush=True)))
     return 0
 
 
