@@ -57,6 +57,7 @@ class Stage:
     config: str = ""
     steps: int = 0
     average: tuple = ()
+    cfg: object = dataclasses.field(default=None, compare=False)    # ``config`` as read and checked by load_line
 
 
 class _Neural:
@@ -159,7 +160,7 @@ def _stage(entry, where: str, folder: str, names: set, model) -> Stage:
         raise ValueError(f"{where}: config {entry['config']}: {exc}") from None
     if steps > cfg.steps:
         raise ValueError(f"{where}: steps {steps} is past its config's {cfg.steps}")
-    return Stage(name, kind, config, steps)
+    return Stage(name, kind, config, steps, cfg=cfg)
 
 
 def load_line(path: str) -> tuple:
@@ -252,7 +253,7 @@ def run_line(line: tuple, out: str, max_steps: int | None = None, device: str | 
                 torch.save(state, tmp)
             model.export(run, done)
         else:
-            cfg = model.config(stage.config)
+            cfg = stage.cfg
             if start is not None:
                 cfg = dataclasses.replace(cfg, init_onnx=start,
                                           init_sha256=fingerprint(_json(start, model.json)["files"]))
@@ -281,9 +282,9 @@ def _check_devices(line: tuple) -> None:
     import torch
 
     for s in line[1]:
-        if s.kind == "train" and line[0].config(s.config).device.startswith("cuda") and not torch.cuda.is_available():
-            raise ValueError(f"stage {s.name} trains on {line[0].config(s.config).device} and torch sees no CUDA "
-                             "device here: give --device cpu to train every stage on the CPU")
+        if s.kind == "train" and s.cfg.device.startswith("cuda") and not torch.cuda.is_available():
+            raise ValueError(f"stage {s.name} trains on {s.cfg.device} and torch sees no CUDA device here: give "
+                             "--device cpu to train every stage on the CPU")
 
 
 def main(argv=None) -> int:
@@ -313,8 +314,7 @@ def main(argv=None) -> int:
                     "average": f"the mean of {', '.join(s.average)}"}.get(s.kind)
             if what is None:
                 before = [p for p in stages[:k - 1] if p.kind != "structure_net"]
-                start = f"the export of {before[-1].name}" if before else (line[0].config(s.config).init_onnx
-                                                                            or "a fresh network")
+                start = f"the export of {before[-1].name}" if before else (s.cfg.init_onnx or "a fresh network")
                 what = f"{os.path.relpath(s.config)}, to step {s.steps}, from {start}"
             print(f"[{k}/{len(stages)}] {s.name}: {what}")
         if line[2]:
