@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import textwrap
 
-__all__ = ["show", "classes_text", "textures_text"]
+__all__ = ["show", "classes_text", "textures_text", "presets_text"]
 
 WIDTH = 100     #: the tables' lines are wrapped at this many characters
 
@@ -63,3 +63,9 @@ def textures_text(textures: dict) -> str:
             lines += ["", textwrap.fill(f"3D solids of kinds of photo, by name (the {name} model): "
                                         + ", ".join(t["codes"]) + ".", WIDTH)]
     return "\n".join(lines + ["", "--exemplar NAME, or any photo's file; --list --json prints this as JSON."])
+
+
+def presets_text(notes: dict) -> str:
+    """Presets ({name: what it looks like}) a line each, the name first (what a script reads: ``cut -d' ' -f1``)."""
+    width = max(map(len, notes)) + 2
+    return "\n".join(f"{name:<{width}}{note}" for name, note in notes.items())

@@ -5,6 +5,7 @@ import argparse
 
 from omninoise.backend.transfer import PRESETS
 
+from . import listing
 from .common import add_command
 
 __all__ = ["add_parser", "run"]
@@ -36,10 +37,9 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("-o", f"saves a preset: give its name ({', '.join(PRESETS)})")
     if a.out:
         output_type(a.out, (".json",), "a ramp", "-o")
-    if a.list or not a.preset:     # a name and its look a line (the names alone: cut -d' ' -f1)
+    if a.list or not a.preset:
         from omninoise.backend.transfer import PRESET_NOTES
-        width = max(map(len, PRESETS)) + 2
-        print("\n".join(f"{name:<{width}}{PRESET_NOTES[name]}" for name in PRESETS))
+        print(listing.presets_text({name: PRESET_NOTES[name] for name in PRESETS}))
         return 0
     text = json.dumps(preset(a.preset).to_dict(), indent=2)
     if not a.out:
