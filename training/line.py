@@ -242,15 +242,10 @@ def run_line(line: tuple, out: str, max_steps: int | None = None, device: str | 
         if (_json(done, model.json) or {}).get("step") == stop:
             log(f"{say}: done ({done})")
         elif stage.kind == "average":
-            from .solid.average import average_checkpoints
-            from omninoise import export as _ex
-            import torch
+            from .solid.average import average_checkpoints, write_checkpoint
 
             log(f"{say}: the mean of {', '.join(stage.average)}")
-            os.makedirs(run, exist_ok=True)
-            state = average_checkpoints([os.path.join(out, name) for name in stage.average])
-            with _ex.atomic_path(os.path.join(run, "ckpt.pt")) as tmp:
-                torch.save(state, tmp)
+            write_checkpoint(run, average_checkpoints([os.path.join(out, name) for name in stage.average]))
             model.export(run, done)
         else:
             cfg = stage.cfg

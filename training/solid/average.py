@@ -33,7 +33,7 @@ import torch
 
 from omninoise import export as _ex
 
-__all__ = ["average_checkpoints", "snapshots", "main"]
+__all__ = ["average_checkpoints", "write_checkpoint", "snapshots", "main"]
 
 
 def _load(src: str) -> dict:
@@ -86,6 +86,13 @@ def average_checkpoints(runs: list, base: str | None = None) -> dict:
     return out
 
 
+def write_checkpoint(run: str, state: dict) -> None:
+    """Write ``state`` (:func:`average_checkpoints`) as run folder ``run``'s ``ckpt.pt``, atomically."""
+    os.makedirs(run, exist_ok=True)
+    with _ex.atomic_path(os.path.join(run, "ckpt.pt")) as tmp:
+        torch.save(state, tmp)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m omninoise.training.solid.average", description=__doc__.split("\n")[0])
     ap.add_argument("--out", required=True, help="the run folder to write (ckpt.pt)")
@@ -102,9 +109,7 @@ def main(argv=None) -> int:
     except ValueError as err:
         print(f"solid average: error: {err}", file=sys.stderr)
         return 2
-    os.makedirs(a.out, exist_ok=True)
-    with _ex.atomic_path(os.path.join(a.out, "ckpt.pt")) as tmp:
-        torch.save(state, tmp)
+    write_checkpoint(a.out, state)
     print(f"{a.out}: the mean of " + ", ".join(f"{s['run']} (step {s['step']})" for s in state["averaged_from"]))
     return 0
 
