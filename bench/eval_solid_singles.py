@@ -1,5 +1,7 @@
 """Single-exemplar solid textures fitted to photos, measured on pixels they never saw:
-`python -m bench solid-singles [--models DIR] [--prev DIR] [-o JSON] [--sheet PNG]`.
+`python -m bench solid-singles [--models DIR] [--prev DIR] [-o JSON] [--sheet PNG]`.  ``--models`` is a folder of
+model folders (default: the shipped ones) or a line's output (``python -m omninoise.training.line
+configs/lines/solid_singles.json --out DIR``: each model in ``DIR/NAME/export``).
 
 A single-exemplar model trained with ``hold_out`` saw only its photo's left three quarters
 (``training.solid.exemplars.train_region``); the right quarter (H x W/4) is the reference here.  For each
@@ -141,17 +143,30 @@ def summary(rows: dict) -> dict:
                 beats=beats)
 
 
+def models_in(folder: str) -> dict:
+    """{name: model} of the model folders in ``folder``, or of a training line's exports there (NAME/export)."""
+    models = load_models(folder)
+    if not models and os.path.isdir(folder):
+        for name in sorted(os.listdir(folder)):
+            if os.path.isfile(os.path.join(folder, name, "export", "solid.json")):
+                models[name] = SolidTextureModel(os.path.join(folder, name, "export"))
+    return models
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--models", default=solid_models(), help="folder of solid models (default: the shipped ones)")
-    ap.add_argument("--space", default=None, help="space model folder (default: the models folder's 'space')")
+    ap.add_argument("--models", default=solid_models(),
+                    help="folder of solid models, or a training line's output (default: the shipped models)")
+    ap.add_argument("--space", default=None,
+                    help="space model folder (default: the models folder's 'space', else the shipped one)")
     ap.add_argument("--prev", default=None, help="folder of the previous models of the same names")
     ap.add_argument("--only", default="", help="comma-separated model names")
     ap.add_argument("-o", "--out", default=os.path.join(ROOT, "out", "bench", "solid_singles.json"))
     ap.add_argument("--sheet", default=None, help="write the picture here (PNG)")
     a = ap.parse_args(argv)
-    models = load_models(a.models)
-    space_dir = a.space or os.path.join(a.models, "space")
+    models = models_in(a.models)
+    space_dir = a.space or next((d for d in (os.path.join(a.models, "space"), os.path.join(solid_models(), "space"))
+                                 if os.path.isfile(os.path.join(d, "solid.json"))), "")
     space = SolidTextureModel(space_dir) if os.path.isfile(os.path.join(space_dir, "solid.json")) else None
     only = [s for s in a.only.split(",") if s]
     rows, sheet = {}, []

@@ -11,20 +11,23 @@ ledgers: ``python tools/ledger.py models/neural_noise``). A line file lists them
 ``config`` is a path from the line file's folder. ``steps`` is the step the stage stops at, as its trainer counts:
 a neural noise stage counts from 0 (its learning rate is constant, so a stage stopped early is its config with
 fewer steps); a solid texture stage goes on from its start's step under its config's cosine schedule. Stage k
-trains in ``OUT/NAME`` (resuming from the folder's checkpoint) and is exported to ``OUT/NAME/export``; stage k + 1
-starts from that export: its config's ``init_onnx`` and ``init_sha256``, which pin the exports of the shipped line,
-name the new export instead (the first stage keeps its config's start: none, a fresh network). A solid texture
-line may also hold
+trains in ``OUT/NAME`` (resuming from the folder's checkpoint) and is exported to ``OUT/NAME/export``. A stage whose
+config continues an export (its ``init_onnx`` and ``init_sha256``, which pin the exports of the shipped line) or a
+solid texture run (``init_from``) starts from the export of the stage before instead (its step and schedule go on;
+Adam's moments start afresh); a config that starts from a fresh network begins a new model, so one line may also train several models side by side (``configs/lines/solid_singles.json``:
+one per shipped texture). A stage's ``finish`` (``"finish": "harmonics"``: a single-photo solid model's harmonic
+part, :mod:`.solid.harmonics`) runs on its export. A solid texture line may also hold
 
 * ``{"name": ..., "structure_net": STEPS}``: the structure term's network (:mod:`.solid.structure_features`),
   trained once into ``OUT/NAME/net.pt``, which every later config with a structure term reads;
 * ``{"name": ..., "average": [STAGE, ...]}``: the mean of those stages' weights (:mod:`.solid.average`),
   exported as a stage of its own (no training);
 
-and a line's ``finish`` ends it: ``"int8"`` (neural noise: :func:`.quantize_onnx.quantize_folder`) or ``"spin
-octave"`` (solid texture: octaves turned by their seeds, the codes' harmonic parts measured again:
-:mod:`.solid.harmonics`). The last export is the line's model, to be evaluated before it replaces the shipped one.
-A stage whose export holds its last step is done, so the same command goes on where it stopped.
+and a line's ``finish`` ends it, the last stage's: ``"int8"`` (neural noise: :func:`.quantize_onnx.quantize_folder`)
+or ``"spin octave"`` (solid texture: octaves turned by their seeds, the codes' harmonic parts measured again:
+:mod:`.solid.harmonics`). The line's models are the exports that no later stage continues or averages (the last
+one where each stage continues the one before), to be evaluated before they replace the shipped ones. A stage whose
+export holds its last step is done, so the same command goes on where it stopped.
 
 ``--steps N`` trains every stage for at most N steps: the whole line in minutes, a check of the line itself (its
 model is no trained model). ``--device`` trains every stage there (a line of GPU stages on the CPU, slowly).
@@ -40,7 +43,7 @@ import shutil
 import sys
 import time
 
-__all__ = ["Stage", "load_line", "run_line", "main"]
+__all__ = ["Stage", "load_line", "run_line", "line_models", "main"]
 
 NAME = re.compile(r"[a-z0-9_]+")
 EXPORT = "export"           #: a stage's export folder, inside its run folder
@@ -58,6 +61,13 @@ class Stage:
     steps: int = 0
     average: tuple = ()
     cfg: object = dataclasses.field(default=None, compare=False)    # ``config`` as read and checked by load_line
+    finish: str = ""        # run on the stage's export once it is done ("" none; the line's finish on the last)
+
+    @property
+    def continues(self) -> bool:
+        """Whether the stage starts from the export before it (its config continues an export or a run), not
+        afresh."""
+        return self.kind == "train" and bool(self.cfg.init_onnx or getattr(self.cfg, "init_from", ""))
 
 
 class _Neural:
@@ -97,7 +107,7 @@ class _Solid:
 
     json = "solid.json"
     kinds = ("train", "structure_net", "average")
-    finishes = ("spin octave", "spin lattice")
+    finishes = ("spin octave", "spin lattice", "harmonics")
 
     @staticmethod
     def config(path: str):
@@ -120,12 +130,15 @@ class _Solid:
 
     @staticmethod
     def finished(doc: dict, finish: str) -> bool:
+        if finish == "harmonics":           # a single-photo model's harmonic part
+            return "harmonics" in doc
         return doc.get("spin") == finish.split()[1] and "code_harmonics" in doc
 
     @staticmethod
     def finish(folder: str, finish: str, log) -> None:
         from .solid import harmonics
-        if harmonics.main([folder, "--spin", finish.split()[1], "--root", ROOT]) != 0:
+        spin = [] if finish == "harmonics" else ["--spin", finish.split()[1]]
+        if harmonics.main([folder, *spin, "--root", ROOT]) != 0:
             raise RuntimeError(f"finish {finish!r} failed on {folder}")
 
 
@@ -136,10 +149,14 @@ def _stage(entry, where: str, folder: str, names: set, model) -> Stage:
     """One entry of a line file as a Stage, checked (ValueError naming what is wrong)."""
     keys = set(entry) if isinstance(entry, dict) else set()
     kind = {frozenset({"name", "config", "steps"}): "train", frozenset({"name", "structure_net"}): "structure_net",
-            frozenset({"name", "average"}): "average"}.get(frozenset(keys))
-    if kind not in model.kinds:
+            frozenset({"name", "average"}): "average"}.get(frozenset(keys - {"finish"}))
+    if kind not in model.kinds or ("finish" in keys and kind == "structure_net"):
         shapes = {"train": "name, config, steps", "structure_net": "name, structure_net", "average": "name, average"}
-        raise ValueError(f"{where}: needs exactly " + " or ".join(shapes[k] for k in model.kinds))
+        raise ValueError(f"{where}: needs exactly " + " or ".join(shapes[k] for k in model.kinds)
+                         + " (and, but for a structure network, a finish)")
+    finish = entry.get("finish", "")
+    if "finish" in keys and finish not in model.finishes:
+        raise ValueError(f"{where}: finish must be one of {', '.join(model.finishes)}, got {finish!r}")
     name = entry["name"]
     if not isinstance(name, str) or not NAME.fullmatch(name) or name in names:
         raise ValueError(f"{where}: name must be a new name of a-z, 0-9 and _, got {name!r}")
@@ -147,7 +164,7 @@ def _stage(entry, where: str, folder: str, names: set, model) -> Stage:
         runs = entry["average"]
         if not isinstance(runs, list) or len(runs) < 2 or any(r not in names for r in runs):
             raise ValueError(f"{where}: average names two or more stages before it, got {runs!r}")
-        return Stage(name, kind, average=tuple(runs))
+        return Stage(name, kind, average=tuple(runs), finish=finish)
     steps = entry["steps" if kind == "train" else "structure_net"]
     if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
         raise ValueError(f"{where}: steps must be a whole number >= 1, got {steps!r}")
@@ -160,7 +177,7 @@ def _stage(entry, where: str, folder: str, names: set, model) -> Stage:
         raise ValueError(f"{where}: config {entry['config']}: {exc}") from None
     if steps > cfg.steps:
         raise ValueError(f"{where}: steps {steps} is past its config's {cfg.steps}")
-    return Stage(name, kind, config, steps, cfg=cfg)
+    return Stage(name, kind, config, steps, cfg=cfg, finish=finish)
 
 
 def load_line(path: str) -> tuple:
@@ -183,7 +200,28 @@ def load_line(path: str) -> tuple:
         names.add(stages[-1].name)
     if stages[-1].kind == "structure_net":
         raise ValueError(f"{path}: the last stage gives no model")
+    if finish and stages[-1].finish:
+        raise ValueError(f"{path}: the line's finish and its last stage's are both given")
+    if finish and len(line_models(stages)) > 1:
+        raise ValueError(f"{path}: a line of several models gives a finish to each stage that needs one, not to "
+                         "the line")
     return model, stages, finish
+
+
+def _start(stages: list, k: int) -> Stage | None:
+    """The stage whose export stage ``k`` (0-based) starts from: the model-giving stage before it where its config
+    continues an export, else None (a fresh network)."""
+    if not stages[k].continues:
+        return None
+    before = [s for s in stages[:k] if s.kind != "structure_net"]
+    return before[-1] if before else None
+
+
+def line_models(stages: list) -> list:
+    """The stages whose exports are the line's models: those no later stage continues or averages."""
+    used = {b.name for b in (_start(stages, k) for k in range(len(stages))) if b is not None}
+    used |= {name for s in stages for name in s.average}
+    return [s for s in stages if s.kind != "structure_net" and s.name not in used]
 
 
 def _json(folder: str, name: str) -> dict | None:
@@ -227,13 +265,15 @@ def run_line(line: tuple, out: str, max_steps: int | None = None, device: str | 
     from omninoise.backend.onnx_models import fingerprint
 
     model, stages, finish = line
-    start, net = None, None             # the export the next stage starts from, and the structure network
+    net = None                          # the structure network
     for k, stage in enumerate(stages, 1):
         say = f"[{k}/{len(stages)}] {stage.name}"
         if stage.kind == "structure_net":
             net = _structure_net(stage, out, max_steps, lambda s: log(f"[{k}/{len(stages)}] {s}"))
             continue
         run, done = os.path.join(out, stage.name), os.path.join(out, stage.name, EXPORT)
+        before = _start(stages, k - 1)
+        start = None if before is None else os.path.join(out, before.name, EXPORT)   # None: the config's own start
         start_step = 0 if start is None or model is _Neural else int(_json(start, model.json).get("step", 0))
         if stage.kind == "average":
             stop = int(_json(os.path.join(out, stage.average[-1], EXPORT), model.json)["step"])
@@ -251,7 +291,8 @@ def run_line(line: tuple, out: str, max_steps: int | None = None, device: str | 
             cfg = stage.cfg
             if start is not None:
                 cfg = dataclasses.replace(cfg, init_onnx=start,
-                                          init_sha256=fingerprint(_json(start, model.json)["files"]))
+                                          init_sha256=fingerprint(_json(start, model.json)["files"]),
+                                          **({"init_from": ""} if getattr(cfg, "init_from", "") else {}))
             if net is not None and getattr(cfg, "structure_weight", 0):
                 cfg = dataclasses.replace(cfg, structure_net=net)
             if device:
@@ -265,11 +306,12 @@ def run_line(line: tuple, out: str, max_steps: int | None = None, device: str | 
             model.train(cfg, run, start_step, stop, lambda text: log(f"  {text}"))
             model.export(run, done)     # its JSON, with the step, is written last: a cut-short export is not done
             log(f"  exported to {done} ({time.time() - t0:.0f} s)")
-        start = done
-    if finish and not model.finished(_json(start, model.json), finish):
-        model.finish(start, finish, lambda text: log(f"  {text}"))
-        log(f"  {finish}: {start}")
-    return start
+        last = finish if k == len(stages) else ""
+        for end in filter(None, (stage.finish, last)):
+            if not model.finished(_json(done, model.json), end):
+                model.finish(done, end, lambda text: log(f"  {text}"))
+                log(f"  {end}: {done}")
+    return done
 
 
 def _check_devices(line: tuple) -> None:
@@ -308,15 +350,16 @@ def main(argv=None) -> int:
             what = {"structure_net": f"the structure network, {s.steps} steps",
                     "average": f"the mean of {', '.join(s.average)}"}.get(s.kind)
             if what is None:
-                before = [p for p in stages[:k - 1] if p.kind != "structure_net"]
-                start = f"the export of {before[-1].name}" if before else (s.cfg.init_onnx or "a fresh network")
+                before = _start(stages, k - 1)
+                start = f"the export of {before.name}" if before else (s.cfg.init_onnx or "a fresh network")
                 what = f"{os.path.relpath(s.config)}, to step {s.steps}, from {start}"
-            print(f"[{k}/{len(stages)}] {s.name}: {what}")
+            print(f"[{k}/{len(stages)}] {s.name}: {what}" + (f", then {s.finish}" if s.finish else ""))
         if line[2]:
             print(f"then {line[2]}")
         return 0
-    model = run_line(line, a.out, a.steps, a.device)
-    print(f"line: the model is {model}")
+    run_line(line, a.out, a.steps, a.device)
+    models = [os.path.join(a.out, s.name, EXPORT) for s in line_models(line[1])]
+    print(f"line: the model is {models[0]}" if len(models) == 1 else "line: the models are " + ", ".join(models))
     return 0
 
 

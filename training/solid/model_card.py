@@ -190,12 +190,12 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "Solid textures after Henzler, Mitra and Ritschel, \"Learning a Neural 3D Texture Space from 2D "
          "Exemplars\" (CVPR 2020), trained by this project's code (`training/solid/`) on CPU.", "",
          "## How they were made", "", "```sh",
-         "# one model per config (the table's configs column; configs/solid/ holds them): exemplar, dimension, schedule",
-         "python -m omninoise.training.solid.structure_features --out runs/structnet/net_cmd.pt   # models with a structure term",
-         "python -m omninoise.training.solid.train --config configs/solid/photo_singles/NAME.json --out runs/solid/NAME",
-         "python -m omninoise.training.solid.export runs/solid/NAME models/solid/NAME",
+         "# one model per config (the table's configs column; configs/solid/ holds them): exemplar, dimension, schedule;",
+         "# the line trains the structure term's network, then each model from its config, and exports it",
+         "python -m omninoise.training.line configs/lines/solid_singles.json --out runs/singles",
          "python -m bench solid --speed",
-         "python -m bench solid-singles --prev OLD_MODELS --sheet docs/img/solid_singles.png -o docs/evaluations/solid_singles.json",
+         "python -m bench solid-singles --models runs/singles --prev models/solid --sheet docs/img/solid_singles.png "
+         "-o docs/evaluations/solid_singles.json",
          "python -m omninoise.training.solid.model_card --singles docs/evaluations/solid_singles.json -o models/solid/MODEL_CARD.md",
          "```", "",
          "- **Exemplars:** the single-exemplar models named by a photo were each fitted to one colour photo of "
