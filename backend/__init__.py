@@ -13,7 +13,7 @@ from .wavenoise.spectra import Spectrum
 from .wavenoise.tables import WaveTable, build_table
 from .wavenoise.settings import WaveSettings, compile_noise
 from .grid import evaluate_grid, evaluate_points, Cancelled
-from . import bake, jobs, sources, transfer  # noqa: E402  (bake pipeline: sources -> ramp -> files)
+from . import bake, jobs, job_file, sources, transfer  # noqa: E402  (bake pipeline: sources -> ramp -> files)
 
 __all__ = ["SettingError", "Spectrum", "WaveTable", "build_table", "WaveSettings", "compile_noise",
            "evaluate_grid", "evaluate_points", "Cancelled"]

@@ -163,7 +163,8 @@ class BakeSpec:
         ext = os.path.splitext(self.output)[1].lower()
         doc = dict(version=__version__, source=self.source.to_dict(), grid=self.grid.to_dict(),
                    transfer=None if self.transfer is None else self.transfer.to_dict(),
-                   time=self.frame_time(frame), half=bool(self.half and ext in (".exr", ".vdb")), format=ext)
+                   time=self.frame_time(frame) if self.source.animated else 0.0,    # still noise reads no time
+                   half=bool(self.half and ext in (".exr", ".vdb")), format=ext)
         return hashlib.sha256(describe(doc).encode()).hexdigest()
 
     def is_up_to_date(self, frame, key: str | None = None) -> bool:

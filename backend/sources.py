@@ -170,9 +170,11 @@ class WaveSource:
                             s.cellular, progress=progress, cancel=cancel, start=start)
 
     def to_dict(self) -> dict:
-        from .wavenoise.settings import settings_to_dict
+        """The settings the noise reads (:func:`~backend.wavenoise.settings.read_settings`), ``w_offset`` and the
+        by-example image's hash."""
+        from .wavenoise.settings import read_settings, settings_to_dict
 
-        d = dict(kind=self.kind, settings=settings_to_dict(self.settings), w_offset=self.w_offset)
+        d = dict(kind=self.kind, settings=settings_to_dict(read_settings(self.settings)), w_offset=self.w_offset)
         if self.settings.example is not None:
             ex = np.ascontiguousarray(self.settings.example, _F)
             d["example_sha256"] = hashlib.sha256(ex.tobytes() + str(ex.shape).encode()).hexdigest()

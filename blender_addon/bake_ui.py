@@ -17,6 +17,7 @@ import os
 import bpy
 from bl_operators.presets import AddPresetBase
 from bl_ui.utils import PresetPanel
+from bpy_extras.io_utils import ExportHelper
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, \
     IntVectorProperty, PointerProperty, StringProperty
 
@@ -271,6 +272,54 @@ class OMNINOISE_OT_bake_image(_BakeOperator, bpy.types.Operator):
     target = "IMAGE"
 
 
+class OMNINOISE_OT_save_job(bpy.types.Operator, ExportHelper):
+    """Save this bake, as the panel sets it, as a TOML job file that `omninoise bake`, a farm or the Batch Job panel
+    bakes again without Blender"""
+
+    bl_idname = "omninoise.save_job"
+    bl_label = "Save as Job File"
+    bl_options = {"REGISTER"}      # writes a file only: nothing in the .blend to undo
+
+    filename_ext = ".toml"
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+    target: EnumProperty(name="Bake", default="VOLUME", description="Which of the panel's bakes the job holds",
+                         items=[("VOLUME", "Volume", "The volume bake: an OpenVDB file or sequence"),
+                                ("IMAGE", "Image", "The image bake: an EXR or PNG image or sequence")])
+
+    @classmethod
+    def description(cls, context, properties):
+        return (f"Save the panel's {properties.target.lower()} bake as a TOML job file, for `omninoise bake`, a "
+                "farm or the Batch Job panel to bake the same files without Blender")
+
+    def invoke(self, context, event):
+        """The file browser, at ``<bake name>.toml`` in the bake's output folder (the job then needs no output
+        root, and the folder travels whole to another machine)."""
+        p = context.scene.omninoise_bake
+        if not self.filepath:
+            try:
+                folder = output_folder(p.folder)
+            except backend.SettingError as exc:
+                self.report({"ERROR"}, str(exc))
+                return {"CANCELLED"}
+            self.filepath = os.path.join(folder, bpy.path.clean_name(p.name or "Noise") + self.filename_ext)
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        try:
+            if not self.filepath:
+                raise backend.SettingError("file", "no file to save to: pick one in the file browser (a script: "
+                                                   "filepath=...)")
+            path = bpy.path.abspath(self.filepath)
+            backend.job_file.write_job(path, [build_spec(context, self.target)])
+        except (backend.SettingError, OSError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        context.scene.omninoise_bake.job_file = path     # the Batch Job panel runs it next
+        self.report({"INFO"}, f"Saved the job to {path}: omninoise bake {os.path.basename(path)}")
+        return {"FINISHED"}
+
+
 class OMNINOISE_OT_cancel(bpy.types.Operator):
     """Stop the running OmniNoise bake (nothing half-written is kept)"""
 
@@ -462,17 +511,19 @@ class OMNINOISE_PT_bake_output(_Panel, bpy.types.Panel):
         busy = tasks.current() is not None
         box = layout.box()
         box.prop(p, "volume_resolution")
-        row = box.row()
+        row = box.row(align=True)
         row.enabled = not busy
         row.operator(OMNINOISE_OT_bake_volume.bl_idname, icon="VOLUME_DATA")
+        row.operator(OMNINOISE_OT_save_job.bl_idname, text="", icon="EXPORT").target = "VOLUME"
         box = layout.box()
         box.prop(p, "image_resolution")
         box.prop(p, "image_format")
         if p.image_format == "EXR":
             box.prop(p, "half")
-        row = box.row()
+        row = box.row(align=True)
         row.enabled = not busy
         row.operator(OMNINOISE_OT_bake_image.bl_idname, icon="IMAGE_DATA")
+        row.operator(OMNINOISE_OT_save_job.bl_idname, text="", icon="EXPORT").target = "IMAGE"
 
 
 class OMNINOISE_PT_bake_job(_Panel, bpy.types.Panel):
@@ -553,8 +604,8 @@ def _statusbar(self, context):
     row.operator(OMNINOISE_OT_cancel.bl_idname, text="", icon="CANCEL")
 
 
-classes = (OMNINOISE_PG_bake, OMNINOISE_OT_bake_volume, OMNINOISE_OT_bake_image, OMNINOISE_OT_cancel,
-           OMNINOISE_OT_run_job, OMNINOISE_OT_init_ramp, OMNINOISE_PT_bake, OMNINOISE_PT_bake_ramp,
+classes = (OMNINOISE_PG_bake, OMNINOISE_OT_bake_volume, OMNINOISE_OT_bake_image, OMNINOISE_OT_save_job,
+           OMNINOISE_OT_cancel, OMNINOISE_OT_run_job, OMNINOISE_OT_init_ramp, OMNINOISE_PT_bake, OMNINOISE_PT_bake_ramp,
            OMNINOISE_PT_bake_output, OMNINOISE_PT_bake_job, OMNINOISE_OT_set_transfer, OMNINOISE_PT_transfer_presets,
            OMNINOISE_OT_transfer_preset_add)
 

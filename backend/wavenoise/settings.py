@@ -23,7 +23,7 @@ from .wave import Transition, WaveNoise
 
 __all__ = ["ANISOTROPY", "WaveSettings", "compile_noise", "table_rng", "settings_to_dict", "settings_from_dict",
            "READ_WITH", "check_none", "check_read", "check_time", "field_of",
-           "spectrum_to_dict"]
+           "spectrum_to_dict", "read_settings"]
 
 
 
@@ -230,6 +230,23 @@ READ_WITH = {
     "sectors": (lambda s: s.example is not None, ((("example", None),),)),
     "transition_length": (lambda s: s.transition_to is not None, ((("transition_to", None),),)),
 }
+
+
+def _read_spectrum(sp: Spectrum | None) -> Spectrum | None:
+    """``sp`` with the exponent at its default where its kind does not read it (all but fractal)."""
+    if sp is None or sp.kind == "fractal":
+        return sp
+    return replace(sp, exponent=Spectrum().exponent)
+
+
+def read_settings(s: WaveSettings) -> WaveSettings:
+    """``s`` with every setting the noise does not read (:data:`READ_WITH`) at its default: the same noise, one
+    form of it (a bake's key, a job file)."""
+    defaults = {f.name: getattr(WaveSettings(), f.name) for f in fields(WaveSettings)}
+    kept = replace(s, **{name: defaults[name] for name, (reads, _) in READ_WITH.items()
+                         if name != "exponent" and not reads(s)})
+    return replace(kept, spectrum=_read_spectrum(kept.spectrum), transition_to=_read_spectrum(kept.transition_to),
+                   axis_spectra=tuple(_read_spectrum(a) for a in kept.axis_spectra))
 
 
 def check_read(s: WaveSettings, given, shown=None) -> None:

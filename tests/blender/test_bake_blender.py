@@ -321,3 +321,53 @@ def test_job_in_blender_matches_the_command_line(tmp_path):
     (tmp_path / "bpy" / "job.toml").write_text(JOB.replace("seed = 9", "sed = 9"))
     with pytest.raises(RuntimeError, match=r"bake 'vol': source.sed: unknown key \(did you mean seed\?\)"):
         bpy.ops.omninoise.run_job(filepath=str(tmp_path / "bpy" / "job.toml"))
+
+
+@needs_openvdb
+@pytest.mark.parametrize("target", ["VOLUME", "IMAGE"])
+def test_a_bake_saved_as_a_job_bakes_the_same_files_without_blender(scene, tmp_path, target):
+    """Save as Job File writes the panel's bake (its wave settings, a sampled B-spline ramp, frames, box) as a job;
+    `omninoise bake` finds the panel's files up to date, and baked again (--force) they are the same values."""
+    from omninoise.backend.jobs import run_job
+    from omninoise.blender_addon.bake_ui import build_spec
+    from omninoise.cli.main import main
+    from omninoise.export.images import decode
+
+    p = scene.omninoise_bake
+    p.wave.spectrum, p.wave.exponent, p.wave.speed = "bandpass", 1.7, 0.4    # the exponent reads nothing here
+    p.use_ramp = True
+    _ramp("B_SPLINE")
+    p.animated, p.frame_start, p.frame_end, p.time_per_frame = True, 2, 3, 0.25
+    p.name, p.image_format = "Saved", "EXR"
+    bake = bpy.ops.omninoise.bake_volume if target == "VOLUME" else bpy.ops.omninoise.bake_image
+    assert bake() == {"FINISHED"}
+    spec = build_spec(bpy.context, target)
+    frames = [spec.output.replace("####", f"{f:04d}") for f in (2, 3)]
+
+    def values(path):
+        if target == "VOLUME":
+            return np.concatenate([read_volume(path, "density", (12, 24, 24))[..., None],
+                                   read_volume(path, "color", (12, 24, 24))], axis=3)
+        return decode(path)
+    panel = [values(f) for f in frames]
+    job = tmp_path / "jobs" / "saved.toml"
+    job.parent.mkdir()
+    assert bpy.ops.omninoise.save_job(filepath=str(job), target=target) == {"FINISHED"}
+    assert scene.omninoise_bake.job_file == str(job)            # the Batch Job panel runs it next
+    text = job.read_text()
+    assert "exponent" not in text and "[bake.transfer]" in text and "output_root" in text
+    assert [o.status for o in run_job(str(job))] == ["up to date"]
+    assert main(["bake", str(job), "--force", "-q"]) == 0
+    for f, want in zip(frames, panel):
+        np.testing.assert_array_equal(values(f), want)
+
+
+def test_save_as_job_file_refuses_what_a_job_cannot_hold(scene, tmp_path):
+    p = scene.omninoise_bake
+    p.wave.dimensions = "2"
+    with pytest.raises(RuntimeError, match="a volume needs 3D or 4D noise"):
+        bpy.ops.omninoise.save_job(filepath=str(tmp_path / "a.toml"), target="VOLUME")
+    p.wave.dimensions = "3"
+    with pytest.raises(RuntimeError, match="a job file is a .toml file"):
+        bpy.ops.omninoise.save_job(filepath=str(tmp_path / "a.json"), target="IMAGE")
+    assert not [f for f in os.listdir(tmp_path) if f.endswith((".toml", ".json"))]

@@ -1,0 +1,141 @@
+"""A bake written as a job file (backend/job_file.py, the Bake Noise panel's Save as Job File) bakes the same files
+again through ``omninoise bake``: the same values, frames and ramps; settings that change nothing are left out, as
+the job reader refuses them; what cannot be a job is refused in one line, before anything is written."""
+import doctest
+import os
+
+import numpy as np
+import pytest
+
+from omninoise.backend import Spectrum, WaveSettings
+from omninoise.backend.bake import BakeSpec, frame_path, run_bake
+from omninoise.backend.errors import SettingError
+from omninoise.backend.jobs import load_job, run_job
+from omninoise.backend.sources import BoxGrid, WaveSource, source_from_dict
+from omninoise.backend.transfer import TransferFunction, preset
+from omninoise.backend import job_file
+from omninoise.cli.main import main
+from omninoise.export import read_volume
+from omninoise.export.images import decode
+
+BOX = ((-1.0, -0.5, 0.0), (1.0, 0.5, 1.25))
+
+
+def _spec(tmp_path, output, settings, resolution=(12, 10, 6), **kw):
+    return BakeSpec("noise", WaveSource(settings, kw.pop("w_offset", 0.0)), BoxGrid(resolution, BOX),
+                    str(tmp_path / output), make_folders=True, **kw).validate()
+
+
+def _read(spec, frame):
+    path = frame_path(spec.output, frame)
+    ext = os.path.splitext(path)[1]
+    if ext == ".vdb":        # every grid a fire ramp writes
+        grids = [read_volume(path, name, spec.grid.shape) for name in ("density", "color", "temperature")]
+        return np.concatenate([g.reshape(g.shape[:3] + (-1,)) for g in grids], axis=3)
+    return np.load(path) if ext == ".npy" else decode(path)
+
+
+def _baked(spec) -> list:
+    run_bake(spec)
+    out = [_read(spec, f) for f in spec.frame_list()]
+    for f in spec.frame_list():
+        os.remove(frame_path(spec.output, f))
+    return out
+
+
+RAMP = TransferFunction(stops=tuple((i / 256, (i / 256, (i / 256) ** 2, 0.3 + i / 1000, 1.0 - i / 300))
+                                    for i in range(257)), range=(-0.7, 0.9)).validate()   # a sampled B-spline's 257
+
+CASES = {
+    "animated volume through fire": dict(
+        output="vol/fire_###.vdb", frames=(3, 4), time=0.25, time_step=0.125, transfer=preset("fire"),
+        settings=WaveSettings(dim=3, spectrum=Spectrum("fractal", 0.5, 12.0, 1.2), speed=0.7, seed=11)),
+    "4D image, half EXR, a sampled ramp": dict(
+        output="img/w.exr", resolution=(16, 12), time=0.6, half=True, transfer=RAMP, w_offset=0.3,
+        settings=WaveSettings(dim=4, spectrum=Spectrum("bandpass", 2.0, 5.0), directions=24, seed=3)),
+    "STIT cells, raw": dict(
+        output="cells.npy", settings=WaveSettings(dim=3, spectrum=Spectrum("gaussian", 2.0, 6.0),
+                                                  cellular="stit", stit_probability=0.3, stit_depth=2, seed=5)),
+    "lobes, crystal waves": dict(
+        output="lobes.npy", settings=WaveSettings(dim=3, waveform="crystal", anisotropy="lobes",
+                                                  lobes=(((0.0, 0.6, 0.8), 1.0),), spread=12.0, output="modulus")),
+    "per-axis spectra, a transition": dict(
+        output="axes.npy", settings=WaveSettings(dim=3, anisotropy="axes", axis_spectra=(
+            Spectrum("bandpass", 1, 2), Spectrum("bandpass", 4, 6), Spectrum("fractal", 2, 8, 1.5)),
+            transition_to=Spectrum("gaussian", 6, 9), transition_origin=(0.0, 0.0, 0.0),
+            transition_axis=(1.0, 0.0, 0.0), transition_length=1.5)),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_a_saved_job_bakes_the_same_files(tmp_path, case):
+    kw = dict(CASES[case])
+    spec = _spec(tmp_path, kw.pop("output"), kw.pop("settings"), **kw)
+    expected = _baked(spec)
+    job = tmp_path / "job.toml"
+    text = job_file.write_job(str(job), [spec])
+    assert job.read_text() == text and text.startswith(job_file.HEADER)
+    (name, parsed), = load_job(str(job))
+    assert name == "noise" and parsed.frame_list() == spec.frame_list()
+    assert [o.status for o in run_job(str(job))] == ["baked"]
+    for f, want in zip(spec.frame_list(), expected):
+        got = _read(spec, f)
+        assert got.dtype == want.dtype and np.array_equal(got, want), case
+    assert all(parsed.key(f) == spec.key(f) for f in spec.frame_list())    # its files are up to date for both
+
+
+def test_settings_that_change_nothing_are_left_out(tmp_path):
+    """A band-pass spectrum's exponent, a cell size without cells, a lobe spread without lobes and the time of still
+    noise change no value; the job reader refuses each, so the job leaves them out and bakes the same values."""
+    settings = WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5, exponent=2.5), cell_size=0.3, spread=40.0,
+                            stit_depth=5, seed=2)
+    spec = _spec(tmp_path, "still.npy", settings, time=0.5)
+    expected = _baked(spec)
+    text = job_file.write_job(str(tmp_path / "job.toml"), [spec])
+    for key in ("exponent", "cell_size", "spread", "stit_depth", "time"):
+        assert f"{key} =" not in text, key
+    assert run_job(str(tmp_path / "job.toml"))[0].status == "baked"
+    assert np.array_equal(np.load(spec.output), expected[0])
+
+
+def test_outputs_outside_the_job_folder_get_an_output_root(tmp_path):
+    spec = _spec(tmp_path, "renders/a.npy", WaveSettings(dim=3))
+    (tmp_path / "jobs").mkdir()
+    text = job_file.write_job(str(tmp_path / "jobs" / "a.toml"), [spec])
+    assert 'output_root = "../renders"' in text and 'output = "../renders/a.npy"' in text
+    assert main(["bake", str(tmp_path / "jobs" / "a.toml"), "-q"]) == 0
+    assert np.load(spec.output).shape == (6, 10, 12)
+
+
+def test_what_a_job_cannot_hold_is_refused_before_anything_is_written(tmp_path):
+    spec = _spec(tmp_path, "a.npy", WaveSettings(dim=3))
+    with pytest.raises(SettingError, match="a job file is a .toml file"):
+        job_file.write_job(str(tmp_path / "job.json"), [spec])
+    example = np.random.default_rng(0).random((32, 32)).astype(np.float32)
+    by_example = _spec(tmp_path, "b.npy", WaveSettings(dim=2, example=example), resolution=(8, 8))
+    with pytest.raises(SettingError, match="by-example noise reads its example image from a file"):
+        job_file.write_job(str(tmp_path / "job.toml"), [by_example])
+    solid = BakeSpec("rock", source_from_dict({"kind": "solid", "model": "gravel_3d"}), BoxGrid((8, 8, 8), BOX),
+                     str(tmp_path / "rock.npy"))
+    with pytest.raises(SettingError, match="only wave noise bakes are saved as job files"):
+        job_file.write_job(str(tmp_path / "job.toml"), [solid])
+    assert sorted(os.listdir(tmp_path)) == []
+
+
+def test_the_module_example_runs():
+    res = doctest.testmod(job_file, optionflags=doctest.ELLIPSIS)
+    assert res.attempted > 0 and res.failed == 0
+
+
+def test_a_bakes_key_holds_what_determines_its_file_only(tmp_path):
+    """Settings the noise does not read (a band-pass exponent, the time of still noise) leave a bake's key as it is,
+    so a file baked with them is up to date for its job; a setting it reads changes the key."""
+    base = _spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5)))
+    same = [_spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5, exponent=3.0))),
+            _spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5)), time=0.7),
+            _spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5), cell_size=0.2))]
+    other = [_spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 6))),
+             _spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("fractal", 2, 5, exponent=3.0))),
+             _spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5), speed=0.1), time=0.7)]
+    assert all(s.key(None) == base.key(None) for s in same)
+    assert len({s.key(None) for s in other} | {base.key(None)}) == 4
