@@ -99,8 +99,10 @@ def _value(v) -> str:
     to the same double), lists and inline tables."""
     if isinstance(v, bool):
         return "true" if v else "false"
-    if isinstance(v, (int, float, str)):
-        return json.dumps(v, ensure_ascii=False) if isinstance(v, str) else repr(v)
+    if isinstance(v, str):      # JSON escapes every control character TOML refuses but DEL
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
+    if isinstance(v, (int, float)):
+        return repr(v)
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_value(x) for x in v) + "]"
     if isinstance(v, dict):

@@ -139,3 +139,15 @@ def test_a_bakes_key_holds_what_determines_its_file_only(tmp_path):
              _spec(tmp_path, "a.npy", WaveSettings(dim=3, spectrum=Spectrum("bandpass", 2, 5), speed=0.1), time=0.7)]
     assert all(s.key(None) == base.key(None) for s in same)
     assert len({s.key(None) for s in other} | {base.key(None)}) == 4
+
+
+def test_names_and_paths_of_any_characters_survive_the_job(tmp_path):
+    """Quotes, backslashes, tabs, DEL and characters past the BMP in a bake's name and file name: TOML's basic
+    strings take them escaped, and the job names the same bake and file."""
+    name = 'wall "A"\\\t\x7f \U0001f9f1 é'
+    folder = tmp_path / "ü \U0001f9f1"
+    spec = BakeSpec(name, WaveSource(WaveSettings(dim=3)), BoxGrid((4, 4, 2), BOX), str(folder / "v\x7fol.npy"),
+                    make_folders=True).validate()
+    job_file.write_job(str(tmp_path / "job.toml"), [spec])
+    (got, parsed), = load_job(str(tmp_path / "job.toml"))
+    assert got == name and parsed.output == spec.output
