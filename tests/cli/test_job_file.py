@@ -151,3 +151,54 @@ def test_names_and_paths_of_any_characters_survive_the_job(tmp_path):
     job_file.write_job(str(tmp_path / "job.toml"), [spec])
     (got, parsed), = load_job(str(tmp_path / "job.toml"))
     assert got == name and parsed.output == spec.output
+
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, assume, given, settings, strategies as st  # noqa: E402
+
+SPECTRA = st.builds(Spectrum, kind=st.sampled_from(["gaussian", "white", "blue", "brown", "fractal", "bandpass",
+                                                    "twolevel", "custom"]),
+                    fmin=st.sampled_from([0.5, 1.0, 2.0, 3.3]), fmax=st.sampled_from([4.0, 6.5, 9.0]),
+                    exponent=st.sampled_from([1.0, 0.5, 2.25]), split=st.sampled_from([0.25, 0.6]),
+                    ratio=st.sampled_from([0.35, 0.8]), samples=st.sampled_from([(), (1.0, 0.5, 0.2)]))
+WAVES = st.fixed_dictionaries({"dim": st.sampled_from([2, 3, 4]), "spectrum": SPECTRA}, optional={
+    "directions": st.sampled_from([1, 5, 24]), "seed": st.sampled_from([0, 9, 2 ** 24 - 1]),
+    "output": st.sampled_from(["real", "imag", "modulus", "phase"]), "speed": st.sampled_from([0.0, 0.4, -1.5]),
+    "slice_width": st.sampled_from([None, 0.8]), "waveform": st.sampled_from(["gaussian", "crystal", "wired"]),
+    "cellular": st.sampled_from(["none", "polytope", "code", "stit"]), "cell_size": st.sampled_from([None, 0.3]),
+    "stit_probability": st.sampled_from([0.5, 0.2]), "stit_depth": st.sampled_from([3, 1]),
+    "anisotropy": st.sampled_from(["none", "axes", "lobes"]), "spread": st.sampled_from([20.0, 7.5]),
+    "transition_to": st.sampled_from([None, Spectrum("bandpass", 5, 7)]),
+    "transition_length": st.sampled_from([1.0, 2.5]), "table_size": st.sampled_from([1024, 64]),
+    "table_period": st.sampled_from([None, 30.0])})
+
+
+@settings(deadline=None, database=None, derandomize=True, max_examples=120,
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.filter_too_much])
+@given(kw=WAVES, volume=st.booleans(), frames=st.booleans(), ramp=st.sampled_from([None, "fire", "marble", "RAMP"]),
+       half=st.booleans(), time=st.sampled_from([0.0, 0.75]))
+def test_any_wave_bake_is_written_as_a_job_that_reads_back_the_same(tmp_path_factory, kw, volume, frames, ramp, half,
+                                                                     time):
+    """Wave settings of every kind (spectra, waveforms, cellular modes, anisotropy, transitions, tables), volumes and
+    images, sequences, ramps and half floats: each bake a spec takes is written, and write_job's own read-back finds
+    the same keys and files (it raises otherwise)."""
+    dim = kw["dim"]
+    if kw.get("anisotropy") == "axes":
+        kw["axis_spectra"] = tuple(Spectrum("bandpass", 1 + a, 3 + a) for a in range(dim))
+    if kw.get("anisotropy") == "lobes":
+        kw["lobes"] = ((tuple([0.6, 0.8, 0.0, 0.0][:dim]), 1.0),)
+    if kw.get("transition_to") is not None:
+        kw.update(transition_origin=(0.0,) * dim, transition_axis=(1.0,) + (0.0,) * (dim - 1))
+    tmp = tmp_path_factory.mktemp("job")
+    ext = (".vdb" if ramp else ".npy") if volume else (".exr" if half else ".png" if ramp else ".npy")
+    try:
+        s = WaveSettings(**kw).validate()
+        spec = BakeSpec("b", WaveSource(s), BoxGrid((4, 3, 2) if volume else (4, 3), BOX),
+                        str(tmp / ("out" + ("_##" if frames else "") + ext)), make_folders=True,
+                        transfer={None: None, "RAMP": RAMP}.get(ramp, preset(ramp) if ramp else None),
+                        frames=(1, 2) if frames else None, time=time, half=half).validate()
+    except SettingError:
+        assume(False)
+    text = job_file.write_job(str(tmp / "job.toml"), [spec])
+    (name, parsed), = load_job(str(tmp / "job.toml"))
+    assert name == "b" and all(parsed.key(f) == spec.key(f) for f in spec.frame_list()), text
