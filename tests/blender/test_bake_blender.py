@@ -370,3 +370,29 @@ def test_save_as_job_file_refuses_what_a_job_cannot_hold(scene, tmp_path):
     with pytest.raises(RuntimeError, match="a job file is a .toml file"):
         bpy.ops.omninoise.save_job(filepath=str(tmp_path / "a.json"), target="IMAGE")
     assert not [f for f in os.listdir(tmp_path) if f.endswith((".toml", ".json"))]
+
+
+def test_a_node_group_bake_saved_as_a_job_holds_the_groups_settings(scene, tmp_path):
+    """Source Node Group: the job holds the Wave Noise group's own settings (not the panel's), with the bake's
+    output part and cellular mode, and bakes the panel's image."""
+    from omninoise.backend import Spectrum, WaveSettings
+    from omninoise.backend.jobs import run_job
+    from omninoise.blender_addon.wave_nodes import build_wave_group
+    from omninoise.export.images import decode
+
+    group = build_wave_group(WaveSettings(dim=3, spectrum=Spectrum("fractal", 1.0, 5.0, 0.75), waveform="crystal",
+                                          directions=7, seed=12), name="Grain")
+    p = scene.omninoise_bake
+    p.source, p.node_group, p.output, p.cellular = "NODE", group, "modulus", "polytope"
+    p.name, p.image_format = "FromGroup", "EXR"
+    assert bpy.ops.omninoise.bake_image() == {"FINISHED"}
+    path = str(tmp_path / "FromGroup.exr")
+    baked = decode(path)
+    job = tmp_path / "group.toml"
+    assert bpy.ops.omninoise.save_job(filepath=str(job), target="IMAGE") == {"FINISHED"}
+    text = job.read_text()
+    for line in ('directions = 7', 'seed = 12', 'waveform = "crystal"', 'output = "modulus"',
+                 'cellular = "polytope"', 'exponent = 0.75'):
+        assert line in text, line
+    assert [o.status for o in run_job(str(job), force=True)] == ["baked"]
+    np.testing.assert_array_equal(decode(path), baked)
