@@ -160,9 +160,9 @@ def _check_outputs(a: argparse.Namespace) -> None:
     from omninoise.backend.bake import check_not_read, check_one_file
     from omninoise.export.atomic import check_target
 
-    outputs = (("-o", "out"), ("--report", "report"))
+    outputs = (("-o", "out"), ("--report", "report"), ("--save-job", "save_job"))
     read = [(f"--{k.replace('_', '-')}" if k != "job" else "the job", v) for k, v in vars(a).items()
-            if isinstance(v, str) and k not in ("command", "out", "report")]     # the files given, by their flags
+            if isinstance(v, str) and k not in ("command", "out", "report", "save_job")]     # the files given
     for flag, attr in outputs:
         path = getattr(a, attr, None)
         if isinstance(path, str) and path:

@@ -59,7 +59,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     """omninoise wave --size 512 --spectrum bandpass --fmin 4 --fmax 8 -o band.png
 omninoise wave --dim 3 --size 128 --fmin 1 --fmax 6 --transfer clouds -o clouds.vdb
 omninoise wave --dim 3 --size 128 --speed 0.5 --time 2.0 -o frame.npy
-omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
+omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png
+omninoise wave --dim 3 --size 256 --transfer fire -o fire.vdb --save-job fire.toml   # for omninoise bake or a farm""")
     g = w.add_argument_group("grid and output")
     g.add_argument("-o", "--out", required=True,
                    help="output: .npy (raw float32), .exr or .png (2D), .vdb (3D: density [+ color])")
@@ -75,6 +76,9 @@ omninoise wave --size 512 --cellular stit --stit-depth 3 -o cracks.png""")
                    help="noise values mapped to the ramp's ends (default: the ramp's own)")
     g.add_argument("--half", action="store_true", help="16-bit half floats (.exr and .vdb)")
     g.add_argument("--seed", type=int, default=0, help="another seed draws other directions and phases")
+    g.add_argument("--save-job", metavar="JOB.toml",
+                   help="write a job file that bakes -o with these settings (omninoise bake JOB.toml, a farm) "
+                        "instead of baking it now")
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar or notes")
     g = w.add_argument_group("spectrum")
     g.add_argument("--spectrum", choices=FLAG_SPECTRA, default="gaussian",
@@ -206,6 +210,11 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("--range", "maps values onto a ramp; give --transfer too")
     if a.half and ext not in (".exr", ".vdb"):
         raise SettingError("--half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
+    if a.save_job and not a.save_job.lower().endswith(".toml"):
+        raise SettingError("--save-job", f"a job file is a .toml file, not {os.path.basename(a.save_job)!r}")
+    if a.save_job and a.example:
+        raise SettingError("--save-job", "a job reads --example's image from a file: write its job by hand, with "
+                                         "example = \"IMAGE\" in [bake.source] (docs/guide/jobs.md)")
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.in_range("--extent", a.extent, limits.MIN_LENGTH, limits.MAX_COORD)
@@ -251,6 +260,16 @@ def _bake(a: argparse.Namespace, source, tf, ext: str) -> int:
     rank = 3 if ext == ".vdb" or (ext == ".npy" and a.dim > 2) else 2
     grid = BoxGrid((a.size,) * rank, ((0.0, 0.0, 0.0), (a.extent,) * 3))
     spec = BakeSpec("wave", source, grid, a.out, tf, time=a.time, half=a.half)
+    if a.save_job:
+        from omninoise.backend.job_file import write_job
+
+        try:
+            write_job(a.save_job, [spec.validate()])
+        except SettingError as exc:      # what a job cannot hold (a by-example noise), named by the flag
+            raise SettingError("--save-job", exc.message) from None
+        if not a.quiet:
+            print(f"omninoise wave: wrote {a.save_job}: omninoise bake {a.save_job} bakes {a.out}", file=sys.stderr)
+        return 0
     try:
         run_bake(spec, Bar(a.quiet), force=True)
     except SettingError as exc:     # the bake's own rules (a ramp past what --half holds), named by their flags

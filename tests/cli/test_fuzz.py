@@ -138,6 +138,21 @@ def test_fuzz_wave(tmp_path_factory, flags, size, ext):
         run(_argv("wave", flags) + ["--size", size, "--quiet", "-o", out], out)
 
 
+@settings(FUZZ, max_examples=40)
+@given(flags=WAVE_FLAGS, size=st.sampled_from(SMALL_SIZES), ext=st.sampled_from([".npy", ".exr", ".png", ".vdb"]),
+       job=st.sampled_from(["job.toml", "job.json", "no/such/job.toml", "folder.toml", ""]))
+def test_fuzz_wave_save_job(tmp_path_factory, flags, size, ext, job):
+    """``wave --save-job``: exit 0 with a job that ``bake --dry-run`` takes, or one line, exit 2."""
+    with _fresh(tmp_path_factory) as tmp:
+        os.makedirs(os.path.join(tmp, "folder.toml"))
+        path = os.path.join(tmp, job)
+        run(_argv("wave", flags) + ["--size", size, "--quiet", "-o", output_path(tmp, ext), "--save-job", path],
+            path)
+        if os.path.isfile(path):
+            run(["bake", path, "--quiet", "--dry-run"], None)
+            assert not os.path.exists(output_path(tmp, ext)), "--save-job baked the file too"
+
+
 NEURAL_FLAGS = st.lists(st.one_of(
     flag("--noise", st.sampled_from(["perlin", "spots", "bogus", ""])),
     flag("--param", st.sampled_from(["scale=8", "scale=nan", "scale=1e9", "bogus=1", "scale", "=3"])),

@@ -202,3 +202,32 @@ def test_any_wave_bake_is_written_as_a_job_that_reads_back_the_same(tmp_path_fac
     text = job_file.write_job(str(tmp / "job.toml"), [spec])
     (name, parsed), = load_job(str(tmp / "job.toml"))
     assert name == "b" and all(parsed.key(f) == spec.key(f) for f in spec.frame_list()), text
+
+
+def test_omninoise_wave_saves_its_bake_as_a_job(tmp_path, capsys, monkeypatch):
+    """`omninoise wave ... --save-job JOB.toml` writes the job instead of the file; `omninoise bake JOB.toml` then
+    writes what `omninoise wave` writes."""
+    flags = ["--dim", "3", "--size", "12", "--spectrum", "fractal", "--fmin", "1", "--fmax", "5", "--exponent",
+             "1.4", "--speed", "0.3", "--time", "0.5", "--transfer", "marble", "--seed", "4"]
+    monkeypatch.chdir(tmp_path)
+    assert main(["wave", *flags, "-o", "direct.vdb", "-q"]) == 0
+    assert main(["wave", *flags, "-o", "jobbed.vdb", "--save-job", "jobs.toml"]) == 0
+    assert "wrote jobs.toml: omninoise bake jobs.toml bakes jobbed.vdb" in capsys.readouterr().err
+    assert not os.path.exists("jobbed.vdb")
+    assert main(["bake", "jobs.toml", "-q"]) == 0
+    for grid, shape in (("density", (12, 12, 12)), ("color", (12, 12, 12))):
+        np.testing.assert_array_equal(read_volume("jobbed.vdb", grid, shape), read_volume("direct.vdb", grid, shape))
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--save-job", "job.json"], "--save-job: a job file is a .toml file"),
+    (["--save-job", "job.toml", "--example", "photo.png"], "--save-job: a job reads --example's image from a file"),
+    (["--save-job", "no/such/job.toml"], "--save-job: output folder does not exist"),
+])
+def test_omninoise_wave_refuses_a_job_it_cannot_save_before_any_work(tmp_path, capsys, monkeypatch, extra, message):
+    monkeypatch.chdir(tmp_path)
+    from PIL import Image
+    Image.new("L", (16, 16), 128).save("photo.png")
+    assert main(["wave", "--size", "8", "-o", "a.png", *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert message in err[-1] and sorted(os.listdir(tmp_path)) == ["photo.png"]
