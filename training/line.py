@@ -13,9 +13,10 @@ a neural noise stage counts from 0 (its learning rate is constant, so a stage st
 fewer steps); a solid texture stage goes on from its start's step under its config's cosine schedule. Stage k
 trains in ``OUT/NAME`` (resuming from the folder's checkpoint) and is exported to ``OUT/NAME/export``. A stage whose
 config continues an export (its ``init_onnx`` and ``init_sha256``, which pin the exports of the shipped line) or a
-solid texture run (``init_from``) starts from the export of the stage before instead (its step and schedule go on;
-Adam's moments start afresh); a config that starts from a fresh network begins a new model, so one line may also train several models side by side (``configs/lines/solid_singles.json``:
-one per shipped texture). A stage's ``finish`` (``"finish": "harmonics"``: a single-photo solid model's harmonic
+solid texture run (``init_from``) starts from the export of the stage before instead (a solid texture stage's step
+and schedule go on; Adam's moments start afresh); a config that starts from a fresh network begins a new model, so
+one line may also train several models side by side (``configs/lines/solid_singles.json``: one per shipped
+texture). A stage's ``finish`` (``"finish": "harmonics"``: a single-photo solid model's harmonic
 part, :mod:`.solid.harmonics`) runs on its export. A solid texture line may also hold
 
 * ``{"name": ..., "structure_net": STEPS}``: the structure term's network (:mod:`.solid.structure_features`),

@@ -190,7 +190,7 @@ def card(models: str, runs: str, eval_path: str | None, configs: str = "configs/
          "Solid textures after Henzler, Mitra and Ritschel, \"Learning a Neural 3D Texture Space from 2D "
          "Exemplars\" (CVPR 2020), trained by this project's code (`training/solid/`) on CPU.", "",
          "## How they were made", "", "```sh",
-         "# one model per config (the table's configs column; configs/solid/ holds them): exemplar, dimension, schedule;",
+         "# one model per config (the table's configs column, under configs/solid/): exemplar, dimension, schedule;",
          "# the line trains the structure term's network, then each model from its config, and exports it",
          "python -m omninoise.training.line configs/lines/solid_singles.json --out runs/singles",
          "python -m bench solid --speed",
