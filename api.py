@@ -98,7 +98,8 @@ def _check_size(size, low: int = 1) -> int:
 
 
 def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | None = None,
-         transfer: str | None = None, half: bool = False, progress: Progress = None, **settings):
+         transfer: str | None = None, half: bool = False, progress: Progress = None, save_job: str | None = None,
+         **settings):
     """Wave noise (Guehl et al. 2025) on a ``size``-sample grid over ``[0, extent)`` per axis.
 
     ``settings`` are :class:`~omninoise.backend.wavenoise.settings.WaveSettings` fields (``dim`` 2, 3 or 4,
@@ -110,7 +111,9 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
 
     Returns float32 ``(size, size)`` for ``dim=2`` and ``(size, size, size)`` (``[z, y, x]``) for 3D and 4D, or,
     with ``out``, writes ``.npy``, ``.exr``, ``.png`` (2D) or ``.vdb`` (3D) as ``omninoise wave -o`` does, through
-    the RGBA ramp ``transfer`` (a preset name or a ramp ``.json``) where given, and returns the path.
+    the RGBA ramp ``transfer`` (a preset name or a ramp ``.json``) where given, and returns the path.  With
+    ``save_job`` too (a ``.toml`` path), it writes the job file that bakes ``out`` so (``omninoise bake``, a farm)
+    instead of baking it, as ``omninoise wave --save-job`` does, and returns the job's path.
 
     >>> vol = wave(16, dim=3, spectrum=("fractal", 1, 6), directions=8)
     >>> vol.shape
@@ -152,16 +155,30 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
                          (("transfer", transfer),))
         if half and ext not in (".exr", ".vdb"):
             raise SettingError("half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
-    elif transfer is not None or half:
-        raise SettingError("transfer" if transfer is not None else "half",
+    elif transfer is not None or half or save_job is not None:
+        raise SettingError("transfer" if transfer is not None else "half" if half else "save_job",
                            "applies to a written file; give out= too")
+    if save_job is not None:
+        if not isinstance(save_job, (str, os.PathLike)) or not os.fspath(save_job).lower().endswith(".toml"):
+            raise SettingError("save_job", f"a job file is a .toml path, got {save_job!r}")
+        if not os.path.isdir(os.path.dirname(os.path.abspath(save_job))):
+            raise SettingError("save_job", f"folder does not exist: {os.path.dirname(os.path.abspath(save_job))}")
+        if example is not None:
+            raise SettingError("save_job", "a job reads an example image from a file: write its job by hand, with "
+                                           "example = \"IMAGE\" in [bake.source] (docs/guide/jobs.md)")
     limits.check_memory("size", float(size) ** rank * 4 * 2, f"a {size}-sample {s.dim}D grid")
     grid = BoxGrid((size,) * rank, ((0.0, 0.0, 0.0), (float(extent),) * 3))
     source = WaveSource(s)
     if out is None:
         return evaluate_values(source, grid.validate(), float(time), progress)
     tf = load_transfer(transfer) if transfer else None
-    run_bake(BakeSpec("wave", source, grid, out, tf, time=float(time), half=half), progress, force=True)
+    spec = BakeSpec("wave", source, grid, out, tf, time=float(time), half=half)
+    if save_job is not None:
+        from .backend.job_file import write_job
+
+        write_job(os.fspath(save_job), [spec.validate()])
+        return save_job
+    run_bake(spec, progress, force=True)
     return out
 
 

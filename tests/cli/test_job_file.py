@@ -231,3 +231,26 @@ def test_omninoise_wave_refuses_a_job_it_cannot_save_before_any_work(tmp_path, c
     assert main(["wave", "--size", "8", "-o", "a.png", *extra]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert message in err[-1] and sorted(os.listdir(tmp_path)) == ["photo.png"]
+
+
+def test_the_python_api_saves_a_wave_bake_as_a_job(tmp_path):
+    """omninoise.wave(..., out=, save_job=) writes the job, not the file; its bake is the file out= alone writes."""
+    import omninoise
+
+    kw = dict(dim=3, spectrum=("fractal", 1, 5, 1.3), speed=0.2, time=0.4, transfer="fire")
+    assert omninoise.wave(10, out=str(tmp_path / "direct.vdb"), **kw) == str(tmp_path / "direct.vdb")
+    job = tmp_path / "j.toml"
+    assert omninoise.wave(10, out=str(tmp_path / "later.vdb"), save_job=str(job), **kw) == str(job)
+    assert not (tmp_path / "later.vdb").exists() and run_job(str(job))[0].status == "baked"
+    np.testing.assert_array_equal(read_volume(str(tmp_path / "later.vdb"), "temperature", (10, 10, 10)),
+                                  read_volume(str(tmp_path / "direct.vdb"), "temperature", (10, 10, 10)))
+    for bad, message in ((dict(save_job=str(job)), "save_job: applies to a written file; give out= too"),
+                         (dict(out=str(tmp_path / "a.npy"), save_job="j.json"), "a job file is a .toml path"),
+                         (dict(out=str(tmp_path / "a.npy"), save_job=str(tmp_path / "no" / "j.toml")),
+                          "folder does not exist"),
+                         (dict(out=str(tmp_path / "a.npy"), save_job=str(job), dim=2,
+                               example=np.random.default_rng(0).random((16, 16)).astype(np.float32)),
+                          "a job reads an example image")):
+        with pytest.raises(SettingError, match=message):
+            omninoise.wave(8, **bad)
+    assert sorted(os.listdir(tmp_path)) == ["direct.vdb", "j.toml", "later.vdb"]
