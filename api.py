@@ -159,13 +159,9 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
         raise SettingError("transfer" if transfer is not None else "half" if half else "save_job",
                            "applies to a written file; give out= too")
     if save_job is not None:
-        if not isinstance(save_job, (str, os.PathLike)) or not os.fspath(save_job).lower().endswith(".toml"):
-            raise SettingError("save_job", f"a job file is a .toml path, got {save_job!r}")
-        if not os.path.isdir(os.path.dirname(os.path.abspath(save_job))):
-            raise SettingError("save_job", f"folder does not exist: {os.path.dirname(os.path.abspath(save_job))}")
-        if example is not None:
-            raise SettingError("save_job", "a job reads an example image from a file: write its job by hand, with "
-                                           "example = \"IMAGE\" in [bake.source] (docs/guide/jobs.md)")
+        from .backend.job_file import check_job_file
+
+        save_job = check_job_file(save_job, "save_job", "the example" if example is not None else None)
     limits.check_memory("size", float(size) ** rank * 4 * 2, f"a {size}-sample {s.dim}D grid")
     grid = BoxGrid((size,) * rank, ((0.0, 0.0, 0.0), (float(extent),) * 3))
     source = WaveSource(s)
@@ -176,7 +172,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     if save_job is not None:
         from .backend.job_file import write_job
 
-        write_job(os.fspath(save_job), [spec.validate()])
+        write_job(save_job, [spec.validate()])
         return save_job
     run_bake(spec, progress, force=True)
     return out

@@ -38,9 +38,30 @@ from .errors import SettingError
 from .sources import WaveSource, describe
 from .wavenoise.settings import WaveSettings, read_settings, settings_to_dict
 
-__all__ = ["bake_table", "job_text", "write_job"]
+__all__ = ["bake_table", "job_text", "check_job_file", "write_job"]
 
 HEADER = "# An OmniNoise bake job: omninoise bake FILE.toml bakes it (docs/guide/jobs.md)."
+
+
+def _by_example(image: str) -> str:
+    """Why a by-example noise is not saved as a job: its image (``image``, as the front end names it) is in memory."""
+    return (f"a job reads {image}'s image from a file: write its job by hand, with example = \"IMAGE\" in "
+            "[bake.source] (docs/guide/jobs.md)")
+
+
+def check_job_file(path, where: str = "file", example: str | None = None) -> str:
+    """``path`` as a job file to write, checked before any work: SettingError naming ``where`` (the setting as the
+    front end names it) for a name not ending in .toml or a folder that does not exist, and, where ``example``
+    names a by-example image given beside it, for that image (a job reads it from a file)."""
+    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path).lower().endswith(".toml"):
+        shown = os.path.basename(os.fspath(path)) if isinstance(path, (str, os.PathLike)) else path
+        raise SettingError(where, f"a job file is a .toml file, not {shown!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise SettingError(where, f"folder does not exist: {folder}")
+    if example:
+        raise SettingError(where, _by_example(example))
+    return os.fspath(path)
 
 
 def _spectrum_table(d: dict) -> dict:
@@ -54,8 +75,7 @@ def _source_table(source) -> dict:
                                      "only wave noise bakes are saved as job files")
     s = source.settings
     if s.example is not None:
-        raise SettingError("source", "by-example noise reads its example image from a file: write its job by hand "
-                                     "with example = \"IMAGE\" (docs/guide/jobs.md)")
+        raise SettingError("source", _by_example("a by-example noise"))
     ours, default = settings_to_dict(read_settings(s)), settings_to_dict(WaveSettings())
     table = {"kind": "wave", "dim": ours.pop("dim")}
     table.update({k: v for k, v in ours.items() if v != default.get(k)})
@@ -150,13 +170,13 @@ def _same(a: BakeSpec, b: BakeSpec) -> bool:
 
 def write_job(path: str, specs: list) -> str:
     """Write the job file ``path`` (.toml) that bakes ``specs``, atomically; returns its text. SettingError naming
-    what cannot be written (a source other than wave noise, a by-example noise), and RuntimeError where the text
+    what cannot be written (:func:`check_job_file`, a source other than wave noise, a by-example noise), and
+    RuntimeError where the text
     would bake anything else than ``specs``, before anything is written."""
     from ..export.atomic import write_text
     from .jobs import JobError, parse_job
 
-    if not str(path).lower().endswith(".toml"):
-        raise SettingError("file", f"a job file is a .toml file, not {os.path.basename(path)!r}")
+    path = check_job_file(path)
     job_dir = os.path.dirname(os.path.abspath(path))
     text = job_text(specs, job_dir)
     parsed = parse_job(tomllib.loads(text), job_dir, path)

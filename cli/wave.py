@@ -210,11 +210,10 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("--range", "maps values onto a ramp; give --transfer too")
     if a.half and ext not in (".exr", ".vdb"):
         raise SettingError("--half", f"writes 16-bit floats into .exr and .vdb only, not {ext}")
-    if a.save_job and not a.save_job.lower().endswith(".toml"):
-        raise SettingError("--save-job", f"a job file is a .toml file, not {os.path.basename(a.save_job)!r}")
-    if a.save_job and a.example:
-        raise SettingError("--save-job", "a job reads --example's image from a file: write its job by hand, with "
-                                         "example = \"IMAGE\" in [bake.source] (docs/guide/jobs.md)")
+    if a.save_job:
+        from omninoise.backend.job_file import check_job_file
+
+        check_job_file(a.save_job, "--save-job", "--example" if a.example else None)
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.in_range("--extent", a.extent, limits.MIN_LENGTH, limits.MAX_COORD)

@@ -113,7 +113,7 @@ def test_what_a_job_cannot_hold_is_refused_before_anything_is_written(tmp_path):
         job_file.write_job(str(tmp_path / "job.json"), [spec])
     example = np.random.default_rng(0).random((32, 32)).astype(np.float32)
     by_example = _spec(tmp_path, "b.npy", WaveSettings(dim=2, example=example), resolution=(8, 8))
-    with pytest.raises(SettingError, match="by-example noise reads its example image from a file"):
+    with pytest.raises(SettingError, match="a job reads a by-example noise's image from a file"):
         job_file.write_job(str(tmp_path / "job.toml"), [by_example])
     solid = BakeSpec("rock", source_from_dict({"kind": "solid", "model": "gravel_3d"}), BoxGrid((8, 8, 8), BOX),
                      str(tmp_path / "rock.npy"))
@@ -245,12 +245,12 @@ def test_the_python_api_saves_a_wave_bake_as_a_job(tmp_path):
     np.testing.assert_array_equal(read_volume(str(tmp_path / "later.vdb"), "temperature", (10, 10, 10)),
                                   read_volume(str(tmp_path / "direct.vdb"), "temperature", (10, 10, 10)))
     for bad, message in ((dict(save_job=str(job)), "save_job: applies to a written file; give out= too"),
-                         (dict(out=str(tmp_path / "a.npy"), save_job="j.json"), "a job file is a .toml path"),
+                         (dict(out=str(tmp_path / "a.npy"), save_job="j.json"), "a job file is a .toml file"),
                          (dict(out=str(tmp_path / "a.npy"), save_job=str(tmp_path / "no" / "j.toml")),
                           "folder does not exist"),
                          (dict(out=str(tmp_path / "a.npy"), save_job=str(job), dim=2,
                                example=np.random.default_rng(0).random((16, 16)).astype(np.float32)),
-                          "a job reads an example image")):
+                          "a job reads the example's image from a file")):
         with pytest.raises(SettingError, match=message):
             omninoise.wave(8, **bad)
     assert sorted(os.listdir(tmp_path)) == ["direct.vdb", "j.toml", "later.vdb"]
