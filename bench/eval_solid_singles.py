@@ -165,9 +165,9 @@ def main(argv=None) -> int:
     ap.add_argument("--sheet", default=None, help="write the picture here (PNG)")
     a = ap.parse_args(argv)
     models = models_in(a.models)
-    space_dir = a.space or next((d for d in (os.path.join(a.models, "space"), os.path.join(solid_models(), "space"))
-                                 if os.path.isfile(os.path.join(d, "solid.json"))), "")
-    space = SolidTextureModel(space_dir) if os.path.isfile(os.path.join(space_dir, "solid.json")) else None
+    places = [a.space] if a.space else [os.path.join(a.models, "space"), os.path.join(solid_models(), "space")]
+    space_dir = next((d for d in places if os.path.isfile(os.path.join(d, "solid.json"))), None)
+    space = SolidTextureModel(space_dir) if space_dir else None
     only = [s for s in a.only.split(",") if s]
     rows, sheet = {}, []
     for name, m in sorted(models.items()):

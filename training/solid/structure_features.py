@@ -31,8 +31,8 @@ from torch import nn
 
 from .arrangement import gaussianise, luminance
 
-__all__ = ["StructureNet", "StructureFeatures", "phase_randomised", "structure_batch", "train_structure_net", "save_photo_set_net",
-           "load_structure_net"]
+__all__ = ["StructureNet", "StructureFeatures", "phase_randomised", "structure_batch", "train_structure_net",
+           "save_photo_set_net", "load_structure_net"]
 
 
 class StructureNet(nn.Module):
