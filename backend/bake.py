@@ -13,8 +13,8 @@ Outputs by extension:
           where the ramp has temperature stops, ``temperature`` (Kelvin).
           Voxels of zero density are inactive (sparse).
     .exr  2D grid.  ``Y`` (raw value) or ``RGBA`` (through the ramp), half or float.
-    .png  2D grid.  8-bit preview: sRGB-encoded RGBA through the ramp, else grey
-          over the 0.5th..99.5th percentiles.
+    .png  2D grid.  8-bit: sRGB-encoded RGBA through the ramp, else grey: a source's values in [0, 1] as
+          they are (neural noise, ``unit``), others (a preview) over their 0.5th..99.5th percentiles.
     .npy  raw float32 values (2D or 3D), indexed (y, x) or (z, y, x).
 
 Image files put +y up (row 0 is the top row, y = y1).
@@ -165,6 +165,8 @@ class BakeSpec:
                    transfer=None if self.transfer is None else self.transfer.to_dict(),
                    time=self.frame_time(frame) if self.source.animated else 0.0,    # still noise reads no time
                    half=bool(self.half and ext in (".exr", ".vdb")), format=ext)
+        if ext == ".png" and self.transfer is None and getattr(self.source, "unit", False):
+            doc["png"] = "as is"    # a [0, 1] source's grey levels are its values, not a preview's stretch
         return hashlib.sha256(describe(doc).encode()).hexdigest()
 
     def is_up_to_date(self, frame, key: str | None = None) -> bool:
@@ -373,7 +375,12 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
         else:
             export.write_exr(path, tf.rgba(values), half=spec.half, metadata=meta)
     elif ext == ".png":
-        img = export.encode_srgb8(tf.rgba(values)) if tf is not None else export.preview_8bit(values)
+        if tf is not None:
+            img = export.encode_srgb8(tf.rgba(values))
+        elif getattr(spec.source, "unit", False):       # values in [0, 1]: as they are (omninoise neural -o's PNG)
+            img = export.preview_8bit(values, 0.0, 1.0)
+        else:
+            img = export.preview_8bit(values)
         export.write_png(path, img, metadata=meta)
 
 

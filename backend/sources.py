@@ -99,6 +99,8 @@ class Source(Protocol):
     animated  True when the output changes with time (``animated_by``, where a kind has it: the settings that
               make it change, for a frame range of one that does not)
     chunkable True when any sub-box may be evaluated alone (else the whole grid at once)
+    unit      (optional, False when absent) True when every value lies in [0, 1] (neural noise): an 8-bit PNG holds
+              the values as they are, not stretched over their percentiles as a preview of unbounded noise is
     """
 
     kind: str
@@ -197,6 +199,7 @@ class NeuralSource:
     dim = 2
     animated = False
     chunkable = False
+    unit = True
     animated_by = "give keys: keyframes of its classes"
 
     def __init__(self, model_folder: str, noise: str, params: dict | None = None, noise2: str | None = None,

@@ -183,3 +183,23 @@ def test_a_map_with_soft_edges_is_told_apart_from_one_missing_colour():
     with pytest.raises(SettingError, match=r"uses \(255, 0, 0\) but no spec is given for it$"):
         regions_from_map(hard, [(0, 0, 0)], "--map")
     assert set(np.unique(regions_from_map(hard, [(0, 0, 0), (255, 0, 0)]))) == {0, 1}
+
+
+def test_a_jobs_png_holds_the_noise_as_the_command_line_writes_it(tmp_path):
+    """Neural noise lies in [0, 1]: a job's 8-bit PNG holds its grey levels as they are, as `omninoise neural -o`
+    writes them, not stretched over their percentiles as a preview of wave noise is (the shipped model, whose perlin
+    spans part of the range: the tiny model's images fill it, where a stretch changes nothing)."""
+    from omninoise.export.images import read_image
+
+    assert main(["neural", "--noise", "perlin", "--size", "32", "--steps", "2", "--seed", "1", "--quiet",
+                 "-o", str(tmp_path / "cli.png")]) == 0
+    assert main(["neural", "--noise", "perlin", "--size", "32", "--steps", "2", "--seed", "1", "--quiet",
+                 "-o", str(tmp_path / "cli.npy")]) == 0
+    (tmp_path / "job.toml").write_text('[[bake]]\nname = "n"\noutput = "job.png"\nresolution = [32, 32]\n'
+                                       '[bake.source]\nkind = "neural"\nnoise = "perlin"\nsteps = 2\nseed = 1\n')
+    assert main(["bake", str(tmp_path / "job.toml"), "--quiet"]) == 0
+    job, cli, raw = read_image(str(tmp_path / "job.png")), read_image(str(tmp_path / "cli.png")), \
+        np.load(tmp_path / "cli.npy")
+    assert 0.05 < raw.min() and raw.max() < 0.95            # a stretch would move these grey levels
+    np.testing.assert_array_equal(job, cli)
+    np.testing.assert_allclose(job, raw, atol=0.5 / 255 + 1e-6)
