@@ -55,6 +55,8 @@ NEURAL_SOURCE = Table({
     "noise2": Field(Text("a class name", 256), "blend: the class where the mask is white"),
     "params2": Field(PARAMS, "blend: the second class's parameters"),
     "blend": Field(FILE, "a grey mask image: white takes noise2"),
+    "gradient": Field(ListOf(CLASS_SPEC, 2, 2), "two class specs: the first on the left edge blending evenly into "
+                                                "the second on the right"),
     "corners": Field(ListOf(CLASS_SPEC, 4, 4), "four class specs: top-left, top-right, bottom-left, bottom-right"),
     "map": Field(FILE, "a painted map whose colours name classes"),
     "regions": Field(MapOf(CLASS_SPEC, '"#rrggbb" or grey level "0".."255"'), "map: each colour's class spec"),

@@ -185,8 +185,8 @@ class WaveSource:
 
 class NeuralSource:
     """Neural noise (Maesumi et al. 2024) as a 2D bake source: any layout of a
-    :class:`backend.neural.request.NeuralRequest` (one class, a mask blend of two, four corners, a painted map),
-    or keyframed classes (animation).
+    :class:`backend.neural.request.NeuralRequest` (one class, a mask blend of two, two from left to right, four
+    corners, a painted map), or keyframed classes (animation).
 
     The whole image is denoised at once (``chunkable`` is False); progress is per
     sampler step and cancel is polled after each step.  Pixels are the model's
@@ -206,7 +206,8 @@ class NeuralSource:
                  params2: dict | None = None, mask: np.ndarray | None = None, width: float = 32.0,
                  sharpness: float = 1.0, steps: int | None = None, seed: int = 0, tileable: bool = False,
                  sampler: str | None = None, keys: list | None = None, latent: str = "fixed", drift: float = 0.05,
-                 corners: list | None = None, regions: np.ndarray | None = None, region_specs: list | None = None):
+                 corners: list | None = None, regions: np.ndarray | None = None, region_specs: list | None = None,
+                 gradient: list | None = None, colours: list | None = None):
         from .neural.generate import check_sampler
         from .neural.model import ModelError, NeuralNoiseModel
         from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
@@ -226,8 +227,13 @@ class NeuralSource:
         self.spec2 = None if mask is None else (noise2 or noise, dict(params2 or {}))
         self.mask = None if mask is None else np.asarray(mask, np.float32)
         self.regions = None if regions is None else np.asarray(regions, np.int64)
+        #: the painted map's colours, one 8-bit (r, g, b) per region spec, or None: how a job file written from
+        #: this source paints its map (:mod:`backend.job_file`); the regions, not their colours, set the image
+        self.colours = None if colours is None else [tuple(int(v) for v in c) for c in colours]
         if corners is not None:
             self.layout, self.specs = "corners", [tuple(c) for c in corners]
+        elif gradient is not None:
+            self.layout, self.specs = "gradient", [tuple(c) for c in gradient]
         elif self.regions is not None:
             self.layout, self.specs = "painted", [tuple(c) for c in region_specs]
         elif self.mask is not None:
@@ -303,12 +309,13 @@ class NeuralSource:
                  specs=[[n, dict(sorted(p.items()))] for n, p in self.specs], sampler=self.sampler, steps=self.steps,
                  seed=self.seed, tileable=self.tileable)
         if self.layout in ("blend", "painted"):
-            arr = self.mask if self.layout == "blend" else self.regions
+            arr = self.mask > 0.5 if self.layout == "blend" else self.regions     # what the request reads
             d.update(width=self.width, sharpness=self.sharpness,
                      map_sha256=hashlib.sha256(np.ascontiguousarray(arr).tobytes()).hexdigest())
         if self.keys is not None:
-            d.update(keys=[[k.frame, k.noise, k.params, k.seed] for k in self.keys], latent=self.latent,
-                     drift=self.drift)
+            d.update(keys=[[k.frame, k.noise, k.params, k.seed] for k in self.keys], latent=self.latent)
+            if self.latent == "drift":      # the other motions do not read its speed
+                d["drift"] = self.drift
         return d
 
 
@@ -610,7 +617,7 @@ class EncodedSource(_Prepared):
 _SOLID_KEYS = ("model", "exemplar", "to", "mix", "seed", "scale", "density", "refine", "periodic", "gaussian",
                "rest", "method", "tile", "families")
 _NEURAL_KEYS = ("model", "noise", "params", "noise2", "params2", "blend", "width", "sharpness", "sampler", "steps",
-                "seed", "tileable", "keys", "latent", "drift", "corners", "map", "regions")
+                "seed", "tileable", "keys", "latent", "drift", "gradient", "corners", "map", "regions")
 
 
 def solid_volume(request, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
@@ -649,10 +656,11 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     from .neural.request import check_layout_reads
 
     _check_keys(d, _NEURAL_KEYS, "neural")
-    layouts = [k for k in ("blend", "corners", "map") if k in d]
+    layouts = [k for k in ("blend", "gradient", "corners", "map") if k in d]
     if len(layouts) > 1:
-        raise SettingError(f"source.{layouts[1]}", f"choose one of blend, corners and map (got {' and '.join(layouts)})")
-    # keys beside blend, corners or map: NeuralSource refuses the pair
+        raise SettingError(f"source.{layouts[1]}",
+                           f"choose one of blend, gradient, corners and map (got {' and '.join(layouts)})")
+    # keys beside blend, gradient, corners or map: NeuralSource refuses the pair
     layout = "animated" if "keys" in d else {"map": "painted"}.get(layouts[0], layouts[0]) if layouts else "uniform"
     try:
         check_layout_reads(layout, list(d))     # a key this layout does not read: the image would not be the one asked
@@ -670,12 +678,18 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
             raise SettingError("source.keys", f"expected a keyframe file or a list of tables, got {d['keys']!r}")
         d.setdefault("noise", keys[0].noise)
         d.setdefault("params", keys[0].params)
-    if "noise" not in d and "corners" not in d and "map" not in d:
-        raise SettingError("source.noise", "a neural source needs noise = CLASS (or corners, or map and regions)")
+    if "noise" not in d and "gradient" not in d and "corners" not in d and "map" not in d:
+        raise SettingError("source.noise", "a neural source needs noise = CLASS (or gradient, corners, or map and "
+                                           "regions)")
     from .paths import neural_model
 
     model = os.path.join(base_dir, d["model"]) if "model" in d else neural_model()
-    corners = regions = region_specs = None
+    corners = regions = region_specs = gradient = colours = None
+    if "gradient" in d:
+        g = d["gradient"]
+        if not isinstance(g, list) or len(g) != 2:
+            raise SettingError("source.gradient", f"expected two class specs (left, right), got {g!r}")
+        gradient = [_spec_value(v, f"source.gradient[{i}]") for i, v in enumerate(g)]
     if "corners" in d:
         c = d["corners"]
         if not isinstance(c, list) or len(c) != 4:
@@ -695,13 +709,15 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         if not isinstance(table, dict) or not table:
             raise SettingError("source.regions", "a map needs regions = {\"#rrggbb\" = SPEC, ...} for its colours")
         region_keys = [region_key(k, "source.regions") for k in table]
+        if all(isinstance(k, tuple) for k in region_keys):
+            colours = region_keys
         region_specs = [_spec_value(v, f"source.regions.{k}") for k, v in table.items()]
         try:
             regions = regions_from_map(export.decode(path), region_keys, "source.map")
         except export.ImageError as exc:
             raise SettingError("source.map", str(exc)) from None
-    if corners is not None or regions is not None:
-        d.setdefault("noise", (corners or region_specs)[0][0])
+    if gradient is not None or corners is not None or regions is not None:
+        d.setdefault("noise", (gradient or corners or region_specs)[0][0])
     mask = None
     if "blend" in d:
         path = os.path.join(base_dir, d["blend"])
@@ -716,7 +732,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
                         d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps"), d.get("seed", 0),
                         d.get("tileable", False), d.get("sampler"), keys, d.get("latent", "fixed"), d.get("drift", 0.05),
-                        corners, regions, region_specs)
+                        corners, regions, region_specs, gradient, colours)
 
 
 def _spec_value(v, where: str) -> tuple:

@@ -26,11 +26,12 @@ def add_parser(sub) -> argparse.ArgumentParser:
     """The subcommand's parser, added to ``sub`` (the top parser's subparsers)."""
     n = add_command(sub, "neural", "neural noise from the trained diffusion model",
                     "Neural noise (Maesumi et al. 2024): one diffusion model for 23 noise classes and their blends, at "
-                    "any size, on the CPU. One class, a blend through a mask, four corners or a painted map; animated "
-                    "between keyframes; or fitted to an image.",
+                    "any size, on the CPU. One class, a blend through a mask, two from left to right, four corners or "
+                    "a painted map; animated between keyframes; or fitted to an image.",
                     """omninoise neural --list
 omninoise neural --noise cells_f1 --param scale=12 --size 256 --seed 7 --tileable -o cells.png
 omninoise neural --noise cells_f1 --blend mask.png --noise2 noise --size 256 -o blend.png
+omninoise neural --gradient spots:coverage=0.3 cells_f1 --size 512 -o gradient.png
 omninoise neural --map painted.png --region '#ff0000=spots' --region '#0000ff=gabor' -o map.png
 omninoise neural --keys anim.toml --frames 1 48 --latent slerp -o morph_####.png
 omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
@@ -47,6 +48,9 @@ omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
                    help="blend transition width, px of the mask or map (one of another size, with the image's "
                         "proportions, is drawn at --size)")
     g.add_argument("--sharpness", type=float, default=1.0, help="blend sharpness exponent (1: linear)")
+    g.add_argument("--gradient", nargs=2, metavar=("LEFT", "RIGHT"),
+                   help="left-to-right blend: LEFT on the left edge blending evenly into RIGHT on the right, each "
+                        "CLASS[:NAME=V,...]")
     g.add_argument("--corners", nargs=4, metavar="SPEC",
                    help="four-corner blend: top-left top-right bottom-left bottom-right, each CLASS[:NAME=V,...]")
     g.add_argument("--map", metavar="PAINTED", help="a painted map: an indexed, grey or colour-coded image")
@@ -124,13 +128,16 @@ def check_reads(a: argparse.Namespace) -> None:
     if bool(a.keys) != bool(a.frames):      # named by the one given, before the layout's reads speak of the other
         raise SettingError("--keys" if a.keys else "--frames",
                            "an animation needs both --keys KEYS.toml and --frames FIRST LAST")
-    if sum(bool(x) for x in (a.blend, a.corners, a.map)) > 1:
-        raise SettingError("--blend", "choose one of --blend, --corners and --map")
+    chosen = [f for f, v in (("--blend", a.blend), ("--gradient", a.gradient), ("--corners", a.corners),
+                             ("--map", a.map)) if v]
+    if len(chosen) > 1:
+        raise SettingError(chosen[1], f"choose one of --blend, --gradient, --corners and --map (got "
+                                      f"{' and '.join(chosen)})")
     for flag, given in (("--report", a.report), ("--fit-size", a.fit_size != 64)):
         if given and not a.fit:
             raise SettingError(flag, f"a fit {'report' if flag == '--report' else 'window size'} needs --fit IMAGE")
     layout = ("animated" if a.keys or a.frames else "fit" if a.fit else "corners" if a.corners
-              else "painted" if a.map else "blend" if a.blend else "uniform")
+              else "gradient" if a.gradient else "painted" if a.map else "blend" if a.blend else "uniform")
     given = [k for k, v in (("noise", a.noise), ("params", a.param), ("noise2", a.noise2), ("params2", a.param2),
                             ("width", a.width != 32.0), ("sharpness", a.sharpness != 1.0), ("regions", a.region),
                             ("latent", a.latent != "fixed"), ("drift", a.drift != 0.05)) if v]
@@ -150,6 +157,8 @@ def neural_request(a: argparse.Namespace, model):
     spec = (a.noise, param_items(a.param, "--param"))
     if a.corners:
         req = NeuralRequest("corners", [_spec_arg(c, "--corners") for c in a.corners], **kw)
+    elif a.gradient:
+        req = NeuralRequest("gradient", [_spec_arg(c, "--gradient") for c in a.gradient], **kw)
     elif a.map:
         regions, specs = _painted_parts(a)
         req = NeuralRequest("painted", specs, regions=regions, **kw)
@@ -168,7 +177,8 @@ def neural_request(a: argparse.Namespace, model):
     except SettingError as exc:  # name the flag where the request's field has one
         flag = {"noise": "--noise", "map": "--map", "blend": "--blend", "size": "--size", "seed": "--seed",
                 "width": "--width", "transition": "--width", "sharpness": "--sharpness",
-                "param": "--corners" if a.corners else ("--region" if a.map else "--param")}.get(exc.setting,
+                "param": "--corners" if a.corners else "--gradient" if a.gradient else ("--region" if a.map else
+                                                                                          "--param")}.get(exc.setting,
                                                                                                  exc.setting)
         raise SettingError(flag, exc.message) from None
 
@@ -211,8 +221,8 @@ def run(a: argparse.Namespace) -> int:
         return _animate(a, model, sampler, steps, tile)
     if a.fit:
         return _fit(a, model, sampler, steps, tile)
-    if not (a.noise or a.corners or a.map) or not a.out:
-        raise SettingError("neural", "give --noise CLASS (or --corners / --map) and -o OUT (or --list)")
+    if not (a.noise or a.gradient or a.corners or a.map) or not a.out:
+        raise SettingError("neural", "give --noise CLASS (or --gradient / --corners / --map) and -o OUT (or --list)")
     output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")
     req = neural_request(a, model)
     bar = Bar(a.quiet)
@@ -234,8 +244,9 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     from omninoise.backend.neural.animate import animate, check_keys, read_keys
     from omninoise.export.images import write_unit_image
 
-    if a.noise or a.corners or a.map or a.blend:
-        raise SettingError("--keys", "the keyframes set the classes; leave out --noise, --corners, --map and --blend")
+    if a.noise or a.gradient or a.corners or a.map or a.blend:
+        raise SettingError("--keys", "the keyframes set the classes; leave out --noise, --gradient, --corners, --map "
+                                     "and --blend")
     if not a.out or not has_frame_field(a.out):
         raise SettingError("-o", "an animation writes one file per frame: put '#' for the frame number in the "
                                  "name, e.g. -o noise_####.png")
@@ -271,8 +282,9 @@ def _fit(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> int:
     from omninoise.backend.onnx_models import ModelError
     from omninoise.backend.paths import fit_bank
 
-    if a.noise or a.corners or a.map or a.blend:
-        raise SettingError("--fit", "the fit finds the classes; leave out --noise, --corners, --map and --blend")
+    if a.noise or a.gradient or a.corners or a.map or a.blend:
+        raise SettingError("--fit", "the fit finds the classes; leave out --noise, --gradient, --corners, --map and "
+                                    "--blend")
     if not a.out:
         raise SettingError("-o", "--fit writes the fitted noise: give -o OUT (.png, .exr or .npy)")
     output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")

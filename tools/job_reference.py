@@ -57,8 +57,8 @@ def page() -> str:
                       "Wave noise; the same settings as `omninoise wave` and the Wave Noise node."),
              table_md("Spectrum tables", SPECTRUM, "`spectrum`, `transition_to` and each of `axis_spectra`."),
              table_md('`[bake.source]` with `kind = "neural"`', SOURCE_TABLES["neural"],
-                      "Neural noise: one class (`noise`), a mask blend (`blend`), four `corners` or a painted "
-                      "`map` with `regions`; `keys` animates."),
+                      "Neural noise: one class (`noise`), a mask blend (`blend`), two from left to right "
+                      "(`gradient`), four `corners` or a painted `map` with `regions`; `keys` animates."),
              table_md('`[bake.source]` with `kind = "solid"`', SOURCE_TABLES["solid"],
                       "A solid texture from a photo. " + _reads()),
              table_md("Ramp tables (`transfer = {...}` or a ramp .json file)", TRANSFER)]

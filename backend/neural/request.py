@@ -47,7 +47,7 @@ READ_BY = {
     "drift": (("animated",), "moves the starting noise from frame to frame of {keys}"),
 }
 #: the setting that lays the classes out in each layout but the uniform one
-CHOSEN_BY = {"blend": "blend", "corners": "corners", "painted": "map", "animated": "keys"}
+CHOSEN_BY = {"blend": "blend", "gradient": "gradient", "corners": "corners", "painted": "map", "animated": "keys"}
 
 
 def check_layout_reads(layout: str, given, shown: Callable[[str], str] = str) -> None:

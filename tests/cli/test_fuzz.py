@@ -102,7 +102,7 @@ def output_path(tmp: str, ext: str) -> str:
 def _argv(cmd: str, flags: list) -> list:
     argv = [cmd]
     for name, value in flags:
-        argv += [name] if value is None else [name, value]
+        argv += [name] if value is None else [name, *value] if isinstance(value, list) else [name, value]
     return argv
 
 
@@ -163,7 +163,9 @@ NEURAL_FLAGS = st.lists(st.one_of(
     flag("--seed", st.sampled_from(["0", "-1", "4294967296", "x"])), flag("--tileable", st.none()),
     flag("--blend", st.sampled_from(broken_files() + ["/no/mask.png"])), flag("--noise2", st.sampled_from(["cells_f1", "x"])),
     flag("--width", num()), flag("--sharpness", num()),
-    flag("--map", st.sampled_from(broken_files())), flag("--model", st.sampled_from(["/no/model", BROKEN]))),
+    flag("--map", st.sampled_from(broken_files())), flag("--model", st.sampled_from(["/no/model", BROKEN])),
+    flag("--gradient", st.sampled_from([["perlin", "spots"], ["perlin", "bogus"], ["perlin:scale=nan", "spots"],
+                                        ["perlin"]]))),
     max_size=2)
 
 
@@ -175,7 +177,7 @@ def test_fuzz_neural(tmp_path_factory, flags, size, ext):
     with _fresh(tmp_path_factory) as tmp:
         out = output_path(tmp, ext)
         argv = _argv("neural", flags)
-        if "--noise" not in argv:
+        if "--noise" not in argv and "--gradient" not in argv:
             argv += ["--noise", "perlin"]
         if "--steps" not in argv:
             argv += ["--steps", "2"]
@@ -243,6 +245,7 @@ HOSTILE_SOURCES = st.fixed_dictionaries({"kind": st.sampled_from(["wave", "neura
     "params": st.sampled_from([{"scale": 8}, {"scale": math.nan}, {"bogus": 1}, "x"]),
     "model": st.sampled_from(["gravel_3d", "/no/model", 3]), "scale": SCALARS, "density": SCALARS,
     "blend": st.sampled_from(["missing.png", "broken.png"]), "bogus": SCALARS,
+    "gradient": st.sampled_from([["perlin", "spots"], ["perlin"], ["perlin", "perlin:scale=x"], "perlin"]),
     "corners": st.sampled_from([["perlin"] * 4, ["perlin"] * 3, ["perlin:scale=x"] * 4, [{"noise": 3}] * 4, [3] * 4,
                                 "perlin", [{"noise": "perlin", "params": {"scale": math.nan}}] * 4]),
     "map": st.sampled_from(["missing.png", "broken.png", 3, ""]),

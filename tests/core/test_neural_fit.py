@@ -104,7 +104,7 @@ def test_the_fit_improves_on_its_start_and_the_cli_gives_the_same(model, tmp_pat
     (["--fit", "small.png", "-o", "o.png"], "small.png: 10x10 px"),
     (["--fit", "small.png", "--noise", "perlin", "-o", "o.png"],
      "--noise: is the class of the whole image, or of a blend's unmasked part; with --fit, it would change nothing"),
-    (["--fit", "small.png", "--blend", "small.png", "-o", "o.png"], "leave out --noise, --corners, --map and --blend"),
+    (["--fit", "small.png", "--blend", "small.png", "-o", "o.png"], "leave out --noise, --gradient, --corners, --map and --blend"),
     (["--fit", "small.png", "--param", "scale=4", "-o", "o.png"],
      "--param: sets the parameters of --noise; with --fit"),
     (["--noise", "perlin", "--fit-size", "32", "-o", "o.png"], "--fit-size: a fit window size needs --fit IMAGE"),
