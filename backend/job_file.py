@@ -1,7 +1,8 @@
 """A bake as the job file that bakes it again: the inverse of :mod:`backend.jobs`' reader.
 
-The Bake Noise panel saves its bake this way (**Save as Job File**), so that ``omninoise bake JOB.toml``, a farm
-(``omninoise farm``) or the Batch Job panel bakes the same files on another machine, without Blender::
+The Bake Noise and Neural Noise panels save their bakes this way (**Save as Job File**), so that ``omninoise bake
+JOB.toml``, a farm (``omninoise farm``) or the Batch Job panel bakes the same files on another machine, without
+Blender::
 
     >>> from omninoise.backend import WaveSettings, Spectrum
     >>> from omninoise.backend.bake import BakeSpec
@@ -24,22 +25,28 @@ The Bake Noise panel saves its bake this way (**Save as Job File**), so that ``o
 
 A job names only what differs from the defaults and what the noise reads: the reader refuses a setting that would
 change nothing (an exponent of a band-pass spectrum, a time of still noise), so such a setting of the bake is left
-out, as it changes no value. :func:`write_job` reads the text back through the job reader and writes it only when
-every bake it holds is the one given (the same source, grid, ramp, times and files), atomically.
+out, as it changes no value. A neural noise's painted map or blend mask, which the job reads from a file, is
+written beside it as a PNG of hard-edged regions (``JOB_map.png``, ``JOB_mask.png``; :func:`side_files`).
+:func:`write_job` reads the text back through the job reader and writes it only when every bake it holds is the
+one given (the same source, grid, ramp, times and files), atomically.
 """
 from __future__ import annotations
 
 import json
 import os
+import re
 import tomllib
 
-from .bake import BakeSpec
+import numpy as np
+
+from .bake import BakeSpec, frame_path
 from .errors import SettingError
-from .sources import WaveSource, describe
+from .sources import NeuralSource, WaveSource, describe
 from .wavenoise.settings import WaveSettings, read_settings, settings_to_dict
 
-__all__ = ["bake_table", "job_text", "check_job_file", "write_job"]
+__all__ = ["bake_table", "job_text", "check_job_file", "side_files", "write_job"]
 
+_BARE = re.compile(r"[A-Za-z0-9_-]+")
 HEADER = "# An OmniNoise bake job: omninoise bake FILE.toml bakes it (docs/guide/jobs.md)."
 
 
@@ -69,10 +76,97 @@ def _spectrum_table(d: dict) -> dict:
     return {k: v for k, v in d.items() if k != "exponent" or d["kind"] == "fractal"}
 
 
-def _source_table(source) -> dict:
+def _class_spec(spec: tuple):
+    """A (class, {parameter: value}) pair as a job writes it: the class alone, or {noise, params}."""
+    name, params = spec
+    return {"noise": name, "params": {k: float(v) for k, v in params.items()}} if params else name
+
+
+def _neural_table(source: NeuralSource, side: str | None, job_dir: str) -> dict:
+    """A neural source's table; ``side``: the file name (from ``job_dir``) of its mask or painted map."""
+    from .neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
+    from .paths import neural_model
+
+    table = {"kind": "neural"}
+    if os.path.abspath(source.model.folder) != os.path.abspath(neural_model()):
+        table["model"] = _relative(source.model.folder, job_dir)
+    if source.keys is not None:     # the keyframes set the classes (the reader takes the first's as the noise)
+        table["keys"] = [dict(frame=k.frame, noise=k.noise, **({"params": dict(k.params)} if k.params else {}),
+                              **({"seed": k.seed} if k.seed else {})) for k in source.keys]
+        if source.latent != "fixed":
+            table["latent"] = source.latent
+        if source.latent == "drift" and source.drift != 0.05:
+            table["drift"] = float(source.drift)
+    elif source.layout in ("uniform", "blend"):
+        table["noise"] = source.spec[0]
+        if source.spec[1]:
+            table["params"] = dict(source.spec[1])
+        if source.layout == "blend":
+            table.update(blend=side, noise2=source.spec2[0])
+            if source.spec2[1]:
+                table["params2"] = dict(source.spec2[1])
+    elif source.layout in ("gradient", "corners"):
+        table[source.layout] = [_class_spec(s) for s in source.specs]
+    else:
+        table.update(map=side, regions={"#%02x%02x%02x" % c: _class_spec(s)
+                                         for c, s in zip(_region_colours(source), source.specs)})
+    if source.layout in ("blend", "painted"):
+        if source.width != 32.0:
+            table["width"] = float(source.width)
+        if source.sharpness != 1.0:
+            table["sharpness"] = float(source.sharpness)
+    if source.sampler != DEFAULT_SAMPLER:
+        table["sampler"] = source.sampler
+    if source.steps != DEFAULT_STEPS:
+        table["steps"] = int(source.steps)
+    if source.seed:
+        table["seed"] = int(source.seed)
+    if source.tileable:
+        table["tileable"] = True
+    return table
+
+
+def _region_colours(source: NeuralSource) -> list:
+    """One distinct 8-bit colour per region of a painted source: its own (the panel's swatch colours) where they
+    are distinct, others for the rest."""
+    own = source.colours if source.colours is not None and len(source.colours) == len(source.specs) else []
+    out, used = [], set()
+    for i in range(len(source.specs)):      # a region's own colour, unless an earlier region has it
+        c = tuple(own[i]) if i < len(own) and tuple(own[i]) not in used else None
+        out.append(c)
+        used.add(c)
+    spare = (c for c in ((r, g, b) for r in range(0, 256, 51) for g in range(0, 256, 51) for b in range(0, 256, 51))
+             if c not in used)
+    return [c if c is not None else next(spare) for c in out]
+
+
+def _side_image(source: NeuralSource) -> np.ndarray:
+    """The mask (0 / 255 grey) or painted map (each region in its colour, (H, W, 3)) a job reads: uint8."""
+    if source.layout == "blend":
+        return np.where(source.mask > 0.5, 255, 0).astype(np.uint8)
+    return np.asarray(_region_colours(source), np.uint8)[source.regions]
+
+
+def side_files(path: str, specs: list) -> dict:
+    """{index of a spec: the absolute path of the file its job reads beside it}: a neural source's blend mask or
+    painted map, ``<job name>_mask.png`` / ``_map.png`` (then ``_map2.png``, ...) in the job file's folder."""
+    stem = os.path.splitext(os.path.abspath(path))[0]
+    out, count = {}, {"blend": 0, "painted": 0}
+    for i, spec in enumerate(specs):
+        src = spec.source
+        if isinstance(src, NeuralSource) and src.keys is None and src.layout in count:
+            count[src.layout] += 1
+            n = count[src.layout]
+            out[i] = f"{stem}_{'mask' if src.layout == 'blend' else 'map'}{n if n > 1 else ''}.png"
+    return out
+
+
+def _source_table(source, side: str | None = None, job_dir: str = ".") -> dict:
+    if isinstance(source, NeuralSource):
+        return _neural_table(source, side, job_dir)
     if not isinstance(source, WaveSource):
         raise SettingError("source", f"a {source.kind} bake is written as a job by hand (docs/guide/jobs.md); "
-                                     "only wave noise bakes are saved as job files")
+                                     "only wave and neural noise bakes are saved as job files")
     s = source.settings
     if s.example is not None:
         raise SettingError("source", _by_example("a by-example noise"))
@@ -98,17 +192,22 @@ def _relative(path: str, folder: str) -> str:
     return rel.replace(os.sep, "/")
 
 
-def bake_table(spec: BakeSpec, job_dir: str) -> dict:
-    """The ``[[bake]]`` table of ``spec`` in a job file in ``job_dir`` (its output from there)."""
+def bake_table(spec: BakeSpec, job_dir: str, side: str | None = None) -> dict:
+    """The ``[[bake]]`` table of ``spec`` in a job file in ``job_dir`` (its output from there; ``side``: the file
+    of its neural source's mask or painted map, :func:`side_files`)."""
     table = dict(name=spec.name, output=_relative(spec.output, job_dir), **spec.grid.to_dict())
+    keys = getattr(spec.source, "keys", None)
     if spec.frames is not None:
-        table.update(frames=[int(f) for f in spec.frames], time_step=float(spec.time_step))
-    if spec.source.animated and spec.time != 0.0:
+        table["frames"] = [int(f) for f in spec.frames]
+        if not keys or spec.time_step != 1.0:   # keyframed neural noise steps a frame a frame by default
+            table["time_step"] = float(spec.time_step)
+    if spec.source.animated and spec.time != (spec.frames[0] if keys and spec.frames else
+                                              keys[0].frame if keys else 0.0):
         table["time"] = float(spec.time)
     ext = os.path.splitext(spec.output)[1].lower()
     if spec.half and ext in (".exr", ".vdb"):
         table["half"] = True
-    table["source"] = _source_table(spec.source)
+    table["source"] = _source_table(spec.source, None if side is None else _relative(side, job_dir), job_dir)
     if spec.transfer is not None:
         table["transfer"] = spec.transfer.to_dict()
     return table
@@ -125,8 +224,8 @@ def _value(v) -> str:
         return repr(v)
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, dict):     # keys bare where TOML allows ("scale"), else quoted ("#ff0000")
+        return "{" + ", ".join(f"{k if _BARE.fullmatch(k) else _value(k)} = {_value(x)}" for k, x in v.items()) + "}"
     raise TypeError(f"no TOML value for {v!r}")
 
 
@@ -140,10 +239,16 @@ def _table(header: str, table: dict) -> list:
     return lines
 
 
-def job_text(specs: list, job_dir: str) -> str:
+def job_text(specs: list, job_dir: str, sides: dict | None = None) -> str:
     """The TOML text of a job file in ``job_dir`` that bakes ``specs`` (:class:`~backend.bake.BakeSpec`); its
-    ``output_root`` is the outputs' common folder where that lies outside ``job_dir``."""
-    tables = [bake_table(s, job_dir) for s in specs]
+    ``output_root`` is the outputs' common folder where that lies outside ``job_dir``. ``sides``: the files of the
+    neural sources' masks and painted maps (:func:`side_files`), which such a source needs."""
+    sides = sides or {}
+    missing = [s.name for i, s in enumerate(specs) if i not in sides and isinstance(s.source, NeuralSource)
+               and s.source.keys is None and s.source.layout in ("blend", "painted")]
+    if missing:
+        raise SettingError("source", f"{missing[0]!r} reads its mask or map from a file: name it (side_files)")
+    tables = [bake_table(s, job_dir, sides.get(i)) for i, s in enumerate(specs)]
     lines = [HEADER]
     folders = [os.path.dirname(os.path.abspath(s.output)) for s in specs]
     try:
@@ -169,22 +274,38 @@ def _same(a: BakeSpec, b: BakeSpec) -> bool:
 
 
 def write_job(path: str, specs: list) -> str:
-    """Write the job file ``path`` (.toml) that bakes ``specs``, atomically; returns its text. SettingError naming
-    what cannot be written (:func:`check_job_file`, a source other than wave noise, a by-example noise), and
-    RuntimeError where the text
-    would bake anything else than ``specs``, before anything is written."""
+    """Write the job file ``path`` (.toml) that bakes ``specs``, atomically, and beside it the masks and painted
+    maps its neural sources read (:func:`side_files`); returns its text. SettingError naming what cannot be
+    written (:func:`check_job_file`, a source other than wave or neural noise, a by-example noise, a map's name
+    that is an output), and RuntimeError where the text would bake anything else than ``specs``, before anything is
+    written (the maps written to check it are removed)."""
     from ..export.atomic import write_text
     from .jobs import JobError, parse_job
 
     path = check_job_file(path)
     job_dir = os.path.dirname(os.path.abspath(path))
-    text = job_text(specs, job_dir)
-    parsed = parse_job(tomllib.loads(text), job_dir, path)
-    for spec, (name, got) in zip(specs, parsed):
-        if isinstance(got, JobError):
-            raise SettingError("job file", str(got))
-        if not _same(spec, got):
-            raise RuntimeError(f"the job file would bake {name!r} otherwise than asked: "
-                               f"{describe(bake_table(got, job_dir))}")
+    sides = side_files(path, specs)
+    text = job_text(specs, job_dir, sides)
+    outputs = {os.path.abspath(frame_path(s.output, f)) for s in specs for f in s.frame_list()}
+    taken = [f for f in sides.values() if f in outputs]
+    if taken:
+        raise SettingError("job file", f"{os.path.basename(taken[0])} is a bake's output; the job writes its map "
+                                       "there: save the job under another name")
+    from ..export.images import write_png
+
+    for i, f in sides.items():      # the job reads them; written before it is read back
+        write_png(f, _side_image(specs[i].source))
+    try:
+        parsed = parse_job(tomllib.loads(text), job_dir, path)
+        for spec, (name, got) in zip(specs, parsed):
+            if isinstance(got, JobError):
+                raise SettingError("job file", str(got))
+            if not _same(spec, got):
+                raise RuntimeError(f"the job file would bake {name!r} otherwise than asked: "
+                                   f"{describe(bake_table(got, job_dir, sides.get(specs.index(spec))))}")
+    except BaseException:
+        for f in sides.values():
+            os.remove(f)
+        raise
     write_text(path, text)
     return text

@@ -259,6 +259,26 @@ class NeuralSource:
                                                     f"{', '.join(LATENT_MODES)}")
             check_keys(self.model, self.keys, "source.keys")
 
+    @classmethod
+    def from_request(cls, model_folder: str, req, colours: list | None = None) -> "NeuralSource":
+        """The source that draws the checked :class:`~backend.neural.request.NeuralRequest` ``req`` (a front end's
+        image, the Neural Noise panel's) on a ``req.width`` x ``req.height`` grid: the same conditioning, sampler
+        and seed. ``colours`` (painted layout): the 8-bit colour of each region, for a job file's map. SettingError
+        for a request's setting a source has no key for (a step spacing, an eta, a tile size)."""
+        for name in ("spacing", "eta", "tile"):
+            if getattr(req, name) is not None:
+                raise SettingError(name, "a bake source (a job file) takes the sampler's own; leave it out")
+        kw = dict(width=req.transition, sharpness=req.sharpness, steps=req.steps, seed=req.seed,
+                  tileable=req.tileable, sampler=req.sampler)
+        specs = [(n, dict(p)) for n, p in req.specs]
+        if req.layout == "blend":
+            kw.update(noise2=specs[1][0], params2=specs[1][1], mask=np.asarray(req.mask, np.float32))
+        elif req.layout in ("gradient", "corners"):
+            kw[req.layout] = specs
+        elif req.layout == "painted":
+            kw.update(regions=req.regions, region_specs=specs, colours=colours)
+        return cls(model_folder, *specs[0], **kw)
+
     def check_grid(self, shape) -> None:
         """SettingError before anything runs when the grid cannot be baked: not an image, or a blend mask or
         painted map of other proportions (one of another size with the same is drawn at the resolution)."""

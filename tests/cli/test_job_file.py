@@ -117,7 +117,7 @@ def test_what_a_job_cannot_hold_is_refused_before_anything_is_written(tmp_path):
         job_file.write_job(str(tmp_path / "job.toml"), [by_example])
     solid = BakeSpec("rock", source_from_dict({"kind": "solid", "model": "gravel_3d"}), BoxGrid((8, 8, 8), BOX),
                      str(tmp_path / "rock.npy"))
-    with pytest.raises(SettingError, match="only wave noise bakes are saved as job files"):
+    with pytest.raises(SettingError, match="only wave and neural noise bakes are saved as job files"):
         job_file.write_job(str(tmp_path / "job.toml"), [solid])
     assert sorted(os.listdir(tmp_path)) == []
 
@@ -254,3 +254,97 @@ def test_the_python_api_saves_a_wave_bake_as_a_job(tmp_path):
         with pytest.raises(SettingError, match=message):
             omninoise.wave(8, **bad)
     assert sorted(os.listdir(tmp_path)) == ["direct.vdb", "j.toml", "later.vdb"]
+
+
+# -- neural noise: the Neural Noise panel's bakes ------------------------------------------------------------------
+
+def _neural_model():
+    from omninoise.backend.neural.model import NeuralNoiseModel
+    from omninoise.backend.paths import neural_model
+
+    return NeuralNoiseModel(neural_model())
+
+
+_REGIONS = np.zeros((24, 24), np.int64)
+_REGIONS[5:15, 3:22], _REGIONS[:, 19:] = 1, 2
+NEURAL = {   # layout -> the request's settings; the painted map's first two colours are alike (the third black)
+    "uniform": dict(specs=[("perlin", {"scale": 6.0})], seed=4, sampler="ddim"),
+    "gradient": dict(specs=[("spots", {"coverage": 0.3}), ("cells_f1", {})], tileable=True),
+    "corners": dict(specs=[("spots", {}), ("perlin", {}), ("cells_f1", {"scale": 10.0}), ("spots", {})], seed=9),
+    "painted": dict(specs=[("spots", {}), ("perlin", {}), ("cells_f1", {})], regions=_REGIONS, transition=5.5,
+                    sharpness=2.0, colours=[(255, 0, 0), (255, 0, 0), (0, 0, 0)]),
+    "blend": dict(specs=[("spots", {}), ("perlin", {"scale": 4.0})], mask=_REGIONS > 0, transition=3.0),
+}
+
+
+@pytest.mark.parametrize("layout", NEURAL)
+@pytest.mark.parametrize("ext", [".png", ".exr"])
+def test_a_saved_neural_job_bakes_the_panels_image(tmp_path, layout, ext):
+    """Each layout of the Neural Noise panel (and a mask blend) as a job: `omninoise bake` writes the request's own
+    image (a PNG's grey levels, an EXR's half floats), its key is the spec's; a painted map and a mask are written
+    beside the job, the map in the given colours where they are distinct."""
+    from omninoise.backend.neural.request import NeuralRequest, generate_request
+    from omninoise.backend.paths import neural_model
+    from omninoise.backend.sources import NeuralSource
+    from omninoise.export.images import preview_8bit
+
+    kw = dict(NEURAL[layout])
+    colours = kw.pop("colours", None)
+    req = NeuralRequest(layout, kw.pop("specs"), 24, 24, steps=2, **kw).check(_neural_model())
+    spec = BakeSpec(layout, NeuralSource.from_request(neural_model(), req, colours), BoxGrid((24, 24)),
+                    str(tmp_path / "out" / f"n{ext}"), half=ext == ".exr", make_folders=True).validate()
+    text = job_file.write_job(str(tmp_path / "job.toml"), [spec])
+    assert "model =" not in text and "time" not in text
+    assert main(["bake", str(tmp_path / "job.toml"), "-q"]) == 0
+    img = generate_request(_neural_model(), req)
+    want = preview_8bit(img, 0.0, 1.0) / 255.0 if ext == ".png" else img.astype(np.float16).astype(np.float32)
+    got = decode(spec.output)
+    assert np.array_equal(got.reshape(want.shape), want.astype(got.dtype)), layout
+    (_, parsed), = load_job(str(tmp_path / "job.toml"))
+    assert parsed.key(None) == spec.key(None)
+    side = sorted(f for f in os.listdir(tmp_path) if f.endswith(".png"))
+    assert side == {"painted": ["job_map.png"], "blend": ["job_mask.png"]}.get(layout, [])
+    if layout == "painted":
+        px = decode(str(tmp_path / "job_map.png"))
+        first, second, third = (tuple(np.rint(px[y, x, :3] * 255)) for y, x in ((0, 0), (7, 5), (0, 23)))
+        assert first == (255, 0, 0) and third == (0, 0, 0) and second not in (first, third)   # region 1's is taken
+        assert '"#ff0000" = "spots"' in text and '"#000000" = "cells_f1"' in text
+        assert "width = 5.5" in text and "sharpness = 2.0" in text
+
+
+def test_a_saved_neural_sequence_bakes_the_panels_frames(tmp_path):
+    """Keyframes as the panel spreads its swatches (seeds, parameters), a drifting latent: the job's frames are the
+    ones the panel's animate() draws; the frame numbers are the bake's times, so no time is written."""
+    from omninoise.backend.neural.animate import animate, even_keys
+    from omninoise.backend.paths import neural_model
+    from omninoise.backend.sources import NeuralSource
+
+    m = _neural_model()
+    keys = even_keys([("perlin", {"scale": 5.0}), ("cells_f1", {}), ("spots", {"coverage": 0.4})], 3, 6, seed=7)
+    src = NeuralSource(neural_model(), keys[0].noise, keys[0].params, steps=2, keys=keys, latent="drift", drift=0.2)
+    spec = BakeSpec("morph", src, BoxGrid((16, 16)), str(tmp_path / "m_##.exr"), frames=(3, 6), time=3.0,
+                    time_step=1.0).validate()
+    text = job_file.write_job(str(tmp_path / "seq.toml"), [spec])
+    assert "time" not in text and 'latent = "drift"' in text and "drift = 0.2" in text and "seed = 9" in text
+    assert main(["bake", str(tmp_path / "seq.toml"), "-q"]) == 0
+    for f, img in animate(m, keys, (3, 6), 16, 16, latent="drift", speed=0.2, steps=2):
+        np.testing.assert_array_equal(decode(frame_path(spec.output, f))[..., 0], img)
+    assert sorted(os.listdir(tmp_path)) == ["m_03.exr", "m_04.exr", "m_05.exr", "m_06.exr", "seq.toml"]
+
+
+def test_a_neural_job_the_writer_cannot_hold_is_refused(tmp_path):
+    """A map named as a bake's output, a sampler setting no job has: one line, nothing written."""
+    from omninoise.backend.neural.request import NeuralRequest
+    from omninoise.backend.paths import neural_model
+    from omninoise.backend.sources import NeuralSource
+
+    m = _neural_model()
+    req = NeuralRequest("painted", NEURAL["painted"]["specs"], 24, 24, regions=_REGIONS, steps=2).check(m)
+    spec = BakeSpec("p", NeuralSource.from_request(neural_model(), req), BoxGrid((24, 24)),
+                    str(tmp_path / "job_map.png")).validate()
+    with pytest.raises(SettingError, match="job_map.png is a bake's output"):
+        job_file.write_job(str(tmp_path / "job.toml"), [spec])
+    spaced = NeuralRequest("uniform", [("perlin", {})], 24, 24, steps=2, spacing="logsnr").check(m)
+    with pytest.raises(SettingError, match="spacing: a bake source"):
+        NeuralSource.from_request(neural_model(), spaced)
+    assert os.listdir(tmp_path) == []
