@@ -180,7 +180,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
 
 def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int = 0, steps: int | None = None,
            sampler: str | None = None, tileable: bool = False, model: str | None = None, out: str | None = None,
-           progress: Progress = None):
+           progress: Progress = None, save_job: str | None = None):
     """Neural noise (Maesumi et al. 2024): one class of the shipped diffusion model, ``size`` x ``size`` pixels.
 
     ``noise`` is a class name (``omninoise neural --list`` lists them with their ``params``), ``seed`` picks the
@@ -188,7 +188,9 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     (``size`` a multiple of 8), ``model`` another model folder.
 
     Returns float32 ``(size, size)`` in [0, 1], top row first, or, with ``out`` (``.png``, ``.exr``, ``.npy``),
-    writes it as ``omninoise neural -o`` does and returns the path.
+    writes it as ``omninoise neural -o`` does and returns the path.  With ``save_job`` too (a ``.toml`` path; ``out``
+    a ``.png`` or ``.exr``), it writes the job file that draws ``out`` so (``omninoise bake``, a farm) instead of
+    drawing it, as ``omninoise neural --save-job`` does, and returns the job's path.
 
     >>> img = neural("perlin", 32, steps=2, seed=1)
     >>> img.shape, bool(0.0 <= img.min() and img.max() <= 1.0)
@@ -204,6 +206,15 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     size = _check_size(size, 8)
     if out is not None:
         _check_out(out, (".png", ".exr", ".npy"), "a neural noise image")
+    elif save_job is not None:
+        raise SettingError("save_job", "applies to a written file; give out= too")
+    if save_job is not None:
+        from .backend.job_file import check_job_file
+
+        save_job = check_job_file(save_job, "save_job")
+        if os.fspath(out).lower().endswith(".npy"):
+            raise SettingError("save_job", "a job's .npy holds an image's rows from the bottom up (+y first, as "
+                                           "every bake's array), out='s from the top: write out as .png or .exr")
     neural_memory("size", size, size)
     if model is not None and (not isinstance(model, (str, os.PathLike)) or not os.fspath(model)):
         raise SettingError("model", f"expected a model folder's path, got {model!r}")
@@ -214,6 +225,15 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
     req = NeuralRequest("uniform", [(noise, params)], width=size, height=size, seed=seed,
                         steps=DEFAULT_STEPS if steps is None else steps, sampler=sampler or DEFAULT_SAMPLER,
                         tileable=tileable).check(net)
+    if save_job is not None:
+        from .backend.bake import BakeSpec
+        from .backend.job_file import write_job
+        from .backend.sources import BoxGrid, NeuralSource
+
+        spec = BakeSpec("neural", NeuralSource.from_request(net.folder, req), BoxGrid((size, size)),
+                        os.path.abspath(os.fspath(out)))
+        write_job(save_job, [spec.validate()])
+        return save_job
     cb = None if progress is None else (lambda i, n, x0: progress((i + 1) / n))
     img = np.asarray(generate_request(net, req, callback=cb), np.float32)
     if out is None:

@@ -33,7 +33,8 @@ from .preferences import precision, threads
 from .wave_nodes import settings_from_json, tree_settings_json
 from .wave_ui import OMNINOISE_PG_wave, draw_wave_presets, draw_wave_settings, setting_label
 
-__all__ = ["OMNINOISE_PG_bake", "build_spec", "transfer", "apply_transfer", "draw_progress", "classes", "attach", "detach"]
+__all__ = ["SaveJobOperator", "OMNINOISE_PG_bake", "build_spec", "transfer", "apply_transfer", "draw_progress",
+           "classes", "attach", "detach"]
 
 _OUTPUTS = [("real", "Value", "Real part"), ("imag", "Imaginary", "Imaginary part"),
             ("modulus", "Modulus", "Ridged: |noise|"), ("phase", "Phase", "Phasor: angle in radians")]
@@ -272,29 +273,28 @@ class OMNINOISE_OT_bake_image(_BakeOperator, bpy.types.Operator):
     target = "IMAGE"
 
 
-class OMNINOISE_OT_save_job(bpy.types.Operator, ExportHelper):
-    """Save this bake, as the panel sets it, as a TOML job file that `omninoise bake`, a farm or the Batch Job panel
-    bakes again without Blender"""
+class SaveJobOperator(ExportHelper):
+    """A panel's bake saved as a TOML job file (:mod:`backend.job_file`), which `omninoise bake`, a farm or the
+    Batch Job panel bakes again without Blender. A subclass names its panel's settings (``settings``: the scene's
+    property group, with ``folder`` and ``name``) and its bakes (``specs(context)``: BakeSpecs, SettingError naming
+    what is wrong); ``check(context, path, specs)`` may refuse a path before anything is written."""
 
-    bl_idname = "omninoise.save_job"
-    bl_label = "Save as Job File"
-    bl_options = {"REGISTER"}      # writes a file only: nothing in the .blend to undo
+    bl_options = {"REGISTER"}      # writes files only: nothing in the .blend to undo
 
     filename_ext = ".toml"
     filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
-    target: EnumProperty(name="Bake", default="VOLUME", description="Which of the panel's bakes the job holds",
-                         items=[("VOLUME", "Volume", "The volume bake: an OpenVDB file or sequence"),
-                                ("IMAGE", "Image", "The image bake: an EXR or PNG image or sequence")])
+    settings = ""
 
-    @classmethod
-    def description(cls, context, properties):
-        return (f"Save the panel's {properties.target.lower()} bake as a TOML job file, for `omninoise bake`, a "
-                "farm or the Batch Job panel to bake the same files without Blender")
+    def specs(self, context) -> list:
+        raise NotImplementedError
+
+    def check_path(self, context, path: str, specs: list) -> None:
+        """SettingError where the job at ``path`` cannot be written (nothing to check by default)."""
 
     def invoke(self, context, event):
         """The file browser, at ``<bake name>.toml`` in the bake's output folder (the job then needs no output
         root, and the folder travels whole to another machine)."""
-        p = context.scene.omninoise_bake
+        p = getattr(context.scene, self.settings)
         if not self.filepath:
             try:
                 folder = output_folder(p.folder)
@@ -310,14 +310,37 @@ class OMNINOISE_OT_save_job(bpy.types.Operator, ExportHelper):
             if not self.filepath:
                 raise backend.SettingError("file", "no file to save to: pick one in the file browser (a script: "
                                                    "filepath=...)")
-            path = bpy.path.abspath(self.filepath)
-            backend.job_file.write_job(path, [build_spec(context, self.target)])
+            path = backend.job_file.check_job_file(bpy.path.abspath(self.filepath))     # its name first
+            specs = self.specs(context)
+            self.check_path(context, path, specs)
+            backend.job_file.write_job(path, specs)
         except (backend.SettingError, OSError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         context.scene.omninoise_bake.job_file = path     # the Batch Job panel runs it next
         self.report({"INFO"}, f"Saved the job to {path}: omninoise bake {os.path.basename(path)}")
         return {"FINISHED"}
+
+
+class OMNINOISE_OT_save_job(SaveJobOperator, bpy.types.Operator):
+    """Save this bake, as the panel sets it, as a TOML job file that `omninoise bake`, a farm or the Batch Job panel
+    bakes again without Blender"""
+
+    bl_idname = "omninoise.save_job"
+    bl_label = "Save as Job File"
+    settings = "omninoise_bake"
+
+    target: EnumProperty(name="Bake", default="VOLUME", description="Which of the panel's bakes the job holds",
+                         items=[("VOLUME", "Volume", "The volume bake: an OpenVDB file or sequence"),
+                                ("IMAGE", "Image", "The image bake: an EXR or PNG image or sequence")])
+
+    @classmethod
+    def description(cls, context, properties):
+        return (f"Save the panel's {properties.target.lower()} bake as a TOML job file, for `omninoise bake`, a "
+                "farm or the Batch Job panel to bake the same files without Blender")
+
+    def specs(self, context) -> list:
+        return [build_spec(context, self.target)]
 
 
 class OMNINOISE_OT_cancel(bpy.types.Operator):

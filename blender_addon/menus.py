@@ -4,7 +4,8 @@ Image Editor > Image > OmniNoise      image bakes (wave noise, neural noise and 
 3D Viewport > Add > OmniNoise         a baked noise volume
 3D Viewport > Object > OmniNoise      bakes onto the active object (solid texture, noise volume and image)
 Shader and Geometry Node Editors > Add > Texture: Wave Noise, Wave Cellular (:mod:`.wave_ui`)
-Render > Run Bake Job, Save Noise Bake as Job    a TOML job file: run one, or save the Bake Noise panel's bake
+Render > Run Bake Job, Save Noise / Neural Bake as Job    a TOML job file: run one, or save the Bake Noise or
+                                                          Neural Noise panel's bake
 """
 from __future__ import annotations
 
@@ -81,6 +82,7 @@ def _render_menu(self, context):
     self.layout.separator()
     self.layout.operator("omninoise.run_job", text="Run Bake Job...", icon="PLAY")
     self.layout.operator("omninoise.save_job", text="Save Noise Bake as Job...", icon="EXPORT")
+    self.layout.operator("omninoise.neural_save_job", text="Save Neural Bake as Job...", icon="EXPORT")
 
 
 #: Blender menu -> the entry this module appends to it

@@ -23,13 +23,14 @@ from bpy.props import BoolProperty, CollectionProperty, EnumProperty, FloatPrope
 
 from . import tasks
 from .. import backend
-from .bake_ui import draw_progress
+from .bake_ui import SaveJobOperator, draw_progress
 from .presets import NEURAL_VALUES, SUBDIRS
 from .common import Sidebar, backend_module as _mod, image_colours, image_pixels, neural_model_folder
 from .tasks import TaskOperator
 from .preferences import precision, threads
 
-__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "thumbnail_name", "attach", "detach"]
+__all__ = ["model", "panel_request", "build_conditioning", "sequence_keys", "job_spec", "thumbnail_name", "attach",
+           "detach"]
 
 _MODEL = {}
 N_PARAMS = 4
@@ -225,9 +226,7 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
 
     def _start(self, context, blocking: bool):
         p = context.scene.omninoise_neural
-        size = 64 if self.preview else p.size
-        if p.tileable and size % 8:
-            size += 8 - size % 8
+        size = 64 if self.preview else _bake_size(p)
         steps = min(p.steps, 10) if self.preview else p.steps
         _mod("neural.generate").check_memory("size", size, size)
         m = model()
@@ -320,7 +319,7 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
         from .bake_blender import output_folder
 
         p = context.scene.omninoise_neural
-        size = p.size + (-p.size) % 8 if p.tileable else p.size
+        size = _bake_size(p)
         _mod("neural.generate").check_memory("size", size, size)
         m = model()                 # its errors, the keys' and the folder's are reported by _begin, in one line
         keys = sequence_keys(p)
@@ -370,6 +369,68 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
 
         task = tasks.Task(f"Neural sequence ({n} frames)", work, done, None, threads())
         return tasks.start(task, blocking=blocking)
+
+
+def _bake_size(p) -> int:
+    """The side of the panel's bakes: its size, a multiple of 8 for a tileable image."""
+    return p.size + (-p.size) % 8 if p.tileable else p.size
+
+
+def job_spec(context, target: str):
+    """The :class:`backend.bake.BakeSpec` a job file bakes for the panel's image bake (``target`` "IMAGE") or its
+    sequence ("SEQUENCE"), as the panel sets them: the same image or frames, into the panel's folder under its
+    name, EXR (16-bit half unless the depth is 32-bit) or PNG as its Save setting says (a Pack Only image: EXR).
+    SettingError naming what is wrong."""
+    from .bake_blender import output_folder
+
+    p = context.scene.omninoise_neural
+    S, B = _mod("sources"), _mod("bake")
+    size = _bake_size(p)
+    ext = ".png" if p.save == "PNG" else ".exr"
+    stem = os.path.join(output_folder(p.folder), bpy.path.clean_name(p.name))
+    kw = dict(grid=S.BoxGrid((size, size)), half=ext == ".exr" and p.depth != "32")
+    if target == "IMAGE":
+        req = panel_request(p, size)
+        colours = [tuple(int(round(c * 255)) for c in s.color) for s in p.swatches]
+        source = S.NeuralSource.from_request(neural_model_folder(), req, colours if req.layout == "painted" else None)
+        return B.BakeSpec(p.name, source, output=stem + ext, **kw).validate()
+    keys = sequence_keys(p)
+    source = S.NeuralSource(neural_model_folder(), keys[0].noise, keys[0].params, steps=p.steps, sampler=p.sampler,
+                            tileable=p.tileable, keys=keys, latent=p.latent, drift=p.drift)
+    return B.BakeSpec(p.name + " Sequence", source, output=stem + "_####" + ext, frames=(p.frame_start, p.frame_end),
+                      time=float(p.frame_start), time_step=1.0, **kw).validate()
+
+
+class OMNINOISE_OT_neural_save_job(SaveJobOperator, bpy.types.Operator):
+    """Save this neural noise bake, as the panel sets it, as a TOML job file that `omninoise bake`, a farm or the
+    Batch Job panel bakes again without Blender"""
+
+    bl_idname = "omninoise.neural_save_job"
+    bl_label = "Save Neural Bake as Job File"
+    settings = "omninoise_neural"
+
+    target: EnumProperty(name="Bake", default="IMAGE", description="Which of the panel's bakes the job holds",
+                         items=[("IMAGE", "Image", "The image bake: one EXR or PNG image"),
+                                ("SEQUENCE", "Sequence", "The sequence bake: one image a frame")])
+
+    @classmethod
+    def description(cls, context, properties):
+        what = "image" if properties.target == "IMAGE" else "sequence"
+        return (f"Save the panel's {what} bake as a TOML job file (a painted blend map beside it as a PNG), for "
+                "`omninoise bake`, a farm or the Batch Job panel to bake the same files without Blender")
+
+    def specs(self, context) -> list:
+        return [job_spec(context, self.target)]
+
+    def check_path(self, context, path: str, specs: list) -> None:
+        """The painted map the job reads is written beside it: never over the blend map's or fit image's file."""
+        p = context.scene.omninoise_neural
+        ours = [os.path.abspath(bpy.path.abspath(ima.filepath)) for ima in (p.blend_map, p.fit_image)
+                if ima is not None and ima.filepath]
+        for side in backend.job_file.side_files(path, specs).values():
+            if os.path.abspath(side) in ours:
+                raise backend.SettingError("file", f"the job writes its map to {os.path.basename(side)}, the "
+                                                   "file of an image the panel reads: save the job under another name")
 
 
 class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):
@@ -587,6 +648,7 @@ def draw_neural(layout, context) -> None:
     row = _idle_row(layout)
     row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Preview", icon="HIDE_OFF").preview = True
     row.operator(OMNINOISE_OT_neural_bake.bl_idname, text="Bake", icon="RENDER_STILL")
+    row.operator(OMNINOISE_OT_neural_save_job.bl_idname, text="", icon="EXPORT").target = "IMAGE"
 
 
 def _draw_transitions(layout, p) -> None:
@@ -619,8 +681,9 @@ def _draw_animation(layout, p) -> None:
     layout.prop(p, "latent")
     if p.latent == "drift":
         layout.prop(p, "drift")
-    _idle_row(layout).operator(OMNINOISE_OT_neural_bake_sequence.bl_idname, text="Bake Sequence",
-                               icon="RENDER_ANIMATION")
+    row = _idle_row(layout)
+    row.operator(OMNINOISE_OT_neural_bake_sequence.bl_idname, text="Bake Sequence", icon="RENDER_ANIMATION")
+    row.operator(OMNINOISE_OT_neural_save_job.bl_idname, text="", icon="EXPORT").target = "SEQUENCE"
 
 
 def _draw_fit(layout, p) -> None:
@@ -706,7 +769,7 @@ PANELS = _panels("IMAGE_EDITOR", "image") + _panels("NODE_EDITOR", "shader", _sh
 
 
 classes = (OMNINOISE_PG_swatch, OMNINOISE_PG_neural, OMNINOISE_OT_neural_bake, OMNINOISE_OT_neural_bake_sequence,
-           OMNINOISE_OT_neural_fit, OMNINOISE_OT_swatch_add,
+           OMNINOISE_OT_neural_save_job, OMNINOISE_OT_neural_fit, OMNINOISE_OT_swatch_add,
            OMNINOISE_OT_swatch_thumbnails,
            OMNINOISE_OT_swatch_remove, OMNINOISE_OT_blend_map_new, OMNINOISE_UL_swatches, OMNINOISE_PT_neural_presets,
            OMNINOISE_OT_neural_preset_add) + PANELS

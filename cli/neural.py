@@ -34,11 +34,15 @@ omninoise neural --noise cells_f1 --blend mask.png --noise2 noise --size 256 -o 
 omninoise neural --gradient spots:coverage=0.3 cells_f1 --size 512 -o gradient.png
 omninoise neural --map painted.png --region '#ff0000=spots' --region '#0000ff=gabor' -o map.png
 omninoise neural --keys anim.toml --frames 1 48 --latent slerp -o morph_####.png
-omninoise neural --fit photo.jpg --report fit.json -o fitted.png""")
+omninoise neural --fit photo.jpg --report fit.json -o fitted.png
+omninoise neural --map painted.png --region '#ff0000=spots' --region '#0000ff=gabor' -o map.exr --save-job map.toml""")
     g = n.add_argument_group("noise and output")
     class_args(g)
     g.add_argument("--tileable", action="store_true", help="a seamless tile (size a multiple of 8)")
     g.add_argument("--model", help="another model folder (default: the shipped model)")
+    g.add_argument("--save-job", metavar="JOB.toml",
+                   help="write a job file that draws -o with these settings (omninoise bake JOB.toml, a farm) "
+                        "instead of drawing it now")
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar or notes")
     g = n.add_argument_group("blends")
     g.add_argument("--blend", metavar="MASK", help="a grayscale mask image: white areas take --noise2 / --param2")
@@ -217,6 +221,8 @@ def run(a: argparse.Namespace) -> int:
         listing.show(dict(classes=model.class_params, trained=trained), text, a.json)
         return 0
     check_reads(a)
+    if a.save_job:
+        _check_save_job(a)
     if a.keys or a.frames:
         return _animate(a, model, sampler, steps, tile)
     if a.fit:
@@ -225,6 +231,13 @@ def run(a: argparse.Namespace) -> int:
         raise SettingError("neural", "give --noise CLASS (or --gradient / --corners / --map) and -o OUT (or --list)")
     output_type(a.out, IMAGE_TYPES, "a neural noise image", "-o")
     req = neural_request(a, model)
+    if a.save_job:
+        from omninoise.backend.neural.request import region_key
+        from omninoise.backend.sources import NeuralSource
+
+        keys = [region_key(r.partition("=")[0], "--region") for r in a.region] if a.map else []
+        colours = [k if isinstance(k, tuple) else (k, k, k) for k in keys] or None     # the job's map keeps them
+        return _save_job(a, NeuralSource.from_request(model.folder, req, colours))
     bar = Bar(a.quiet)
     try:
         img = generate_request(model, req, callback=lambda i, n, x0: bar((i + 1) / n))
@@ -234,6 +247,47 @@ def run(a: argparse.Namespace) -> int:
     from omninoise.export.images import write_unit_image
 
     write_unit_image(a.out, img)
+    return 0
+
+
+def _check_save_job(a: argparse.Namespace) -> None:
+    """``--save-job``, before any work: a .toml name in a folder that exists, and nothing beside it that a job
+    cannot hold (a fit, a sampler setting of this run, int8 arithmetic, a .npy whose rows a bake stores +y first)."""
+    from omninoise.backend.job_file import check_job_file
+
+    check_job_file(a.save_job, "--save-job")
+    if a.fit:
+        raise SettingError("--save-job", "a job draws the classes it is given: fit first (--fit IMAGE --report "
+                                         "FIT.json), then save the fitted noise's flags as a job")
+    for flag, given in (("--spacing", a.spacing), ("--eta", a.eta), ("--tile", a.tile)):
+        if given is not None:
+            raise SettingError(flag, "a job file has no such setting (its bake takes the default): leave it out "
+                                     "beside --save-job")
+    if a.precision != "fp32":
+        raise SettingError("--precision", "sets this run's arithmetic, not the job's: give it to omninoise bake "
+                                          "(--precision int8) where the job runs")
+    if a.out and a.out.lower().endswith(".npy"):
+        raise SettingError("--save-job", "a job's .npy holds an image's rows from the bottom up (+y first, as "
+                                         "every bake's array), -o's from the top: write -o as .png or .exr")
+
+
+def _save_job(a: argparse.Namespace, source, frames: tuple | None = None) -> int:
+    """Write the job (``--save-job``) that draws ``-o`` from ``source``, and its blend mask or painted map beside
+    it; draw nothing."""
+    from omninoise.backend.bake import BakeSpec
+    from omninoise.backend.job_file import side_files, write_job
+    from omninoise.backend.sources import BoxGrid
+
+    spec = BakeSpec("neural", source, BoxGrid((a.size, a.size)), os.path.abspath(a.out), frames=frames,
+                    time=float(frames[0]) if frames else 0.0, time_step=1.0).validate()
+    for side in side_files(a.save_job, [spec]).values():    # the mask or map it writes: never over a file read
+        for flag, read in (("--blend", a.blend), ("--map", a.map)):
+            if read and os.path.realpath(read) == os.path.realpath(side):
+                raise SettingError("--save-job", f"the job writes its map to {os.path.basename(side)}, the file "
+                                                 f"{flag} reads: save the job under another name")
+    write_job(a.save_job, [spec])
+    if not a.quiet:
+        print(f"omninoise neural: wrote {a.save_job}: omninoise bake {a.save_job} draws {a.out}", file=sys.stderr)
     return 0
 
 
@@ -260,6 +314,12 @@ def _animate(a: argparse.Namespace, model, sampler: str, steps: int, tile) -> in
     limits.finite("--drift", a.drift)
     keys = read_keys(a.keys)
     check_keys(model, keys)
+    if a.save_job:
+        from omninoise.backend.sources import NeuralSource
+
+        return _save_job(a, NeuralSource(model.folder, keys[0].noise, keys[0].params, steps=steps,
+                                         tileable=a.tileable, sampler=sampler, keys=keys, latent=a.latent,
+                                         drift=a.drift), (first, last))
     n = last - first + 1
     bar = Bar(a.quiet, "frames ")
     frames = animate(model, keys, (first, last), a.size, a.size, latent=a.latent, speed=a.drift, steps=steps,

@@ -383,3 +383,79 @@ def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
         np.testing.assert_array_equal(panel.conditioning(neural_ui.model()), cli.conditioning(neural_ui.model()))
     else:
         assert panel.key() == cli.key()
+
+
+@pytest.mark.parametrize("mode, save", [("SINGLE", "EXR"), ("GRADIENT", "PNG"), ("CORNERS", "NONE"), ("MAP", "PNG")])
+def test_save_as_job_file_bakes_the_panels_image(scene, tmp_path, mode, save):
+    """Each layout saved as a job (the painted map beside it, in the swatches' colours): `omninoise bake` writes the
+    panel's own file again, value for value (a Pack Only image as an EXR)."""
+    from omninoise.cli.main import main
+    from omninoise.export.images import decode
+
+    p = scene.omninoise_neural
+    p.folder, p.name, p.mode, p.save, p.width = str(tmp_path) + os.sep, "Job", mode, save, 5.0
+    while len(p.swatches) < 4:
+        bpy.ops.omninoise.swatch_add()
+    p.swatches[2].noise, p.swatches[3].noise = "perlin", "cells_f1"
+    if mode == "MAP":
+        bpy.ops.omninoise.blend_map_new()   # swatch 1's colour, swatch 2's on the right half
+    assert bpy.ops.omninoise.neural_bake() == {"FINISHED"}
+    panel = {"NONE": lambda: _pixels("Job"),    # the panel kept it in the .blend: its pixels
+             "EXR": lambda: decode(str(tmp_path / "Job.exr")), "PNG": lambda: decode(str(tmp_path / "Job.png"))}[save]()
+    job = tmp_path / "Job.toml"
+    assert bpy.ops.omninoise.neural_save_job(filepath=str(job), target="IMAGE") == {"FINISHED"}
+    assert scene.omninoise_bake.job_file == str(job)        # the Batch Job panel runs it next
+    text = job.read_text()
+    assert {"SINGLE": 'noise = "', "GRADIENT": "gradient = [", "CORNERS": "corners = [", "MAP": "regions = {"}[mode] \
+        in text
+    assert main(["bake", str(job), "--force", "-q"]) == 0
+    got = decode(str(tmp_path / ("Job.png" if save == "PNG" else "Job.exr")))
+    np.testing.assert_array_equal(got.reshape(panel.shape), panel)
+    if mode == "MAP":
+        sw = ["#%02x%02x%02x" % tuple(round(c * 255) for c in s.color) for s in p.swatches]
+        assert all(f'"{c}" = ' in text for c in sw) and 'map = "Job_map.png"' in text and "width = 5.0" in text
+        assert (tmp_path / "Job_map.png").is_file()
+
+
+def test_save_as_job_file_bakes_the_panels_sequence(scene, tmp_path):
+    """The sequence bake (the swatches spread over the frames, a drifting latent, PNG frames) as a job: the same
+    frames, its keyframes written out."""
+    from omninoise.cli.main import main
+    from omninoise.export.images import decode
+
+    p = scene.omninoise_neural
+    p.size, p.steps, p.frame_start, p.frame_end = 16, 2, 3, 5
+    p.folder, p.name, p.latent, p.drift, p.save = str(tmp_path) + os.sep, "Anim", "drift", 0.25, "PNG"
+    assert bpy.ops.omninoise.neural_bake_sequence() == {"FINISHED"}
+    names = [f"Anim_{f:04d}.png" for f in range(3, 6)]
+    panel = [decode(str(tmp_path / n)) for n in names]
+    job = tmp_path / "anim.toml"
+    assert bpy.ops.omninoise.neural_save_job(filepath=str(job), target="SEQUENCE") == {"FINISHED"}
+    text = job.read_text()
+    assert 'noise = "spots"' in text and "seed = 6" in text and "drift = 0.25" in text and "frames = [3, 5]" in text
+    assert main(["bake", str(job), "--force", "-q"]) == 0
+    for n, want in zip(names, panel):
+        np.testing.assert_array_equal(decode(str(tmp_path / n)), want)
+    assert sorted(os.listdir(tmp_path)) == names + ["anim.toml"]
+
+
+def test_save_as_job_file_says_what_is_wrong(scene, tmp_path):
+    """No swatch, a .json name, a job whose map would be written over the painted blend map's own file: one line,
+    and nothing written."""
+    p = scene.omninoise_neural
+    p.folder, p.mode = str(tmp_path) + os.sep, "MAP"
+    with pytest.raises(RuntimeError, match="a job file is a .toml file"):
+        bpy.ops.omninoise.neural_save_job(filepath=str(tmp_path / "a.json"))
+    bpy.ops.omninoise.blend_map_new()
+    painted = p.blend_map
+    painted.filepath_raw, painted.file_format = str(tmp_path / "paint_map.png"), "PNG"
+    painted.save()
+    kept = (tmp_path / "paint_map.png").read_bytes()
+    with pytest.raises(RuntimeError, match="the job writes its map to paint_map.png, the file of an image the panel"):
+        bpy.ops.omninoise.neural_save_job(filepath=str(tmp_path / "paint.toml"))
+    assert (tmp_path / "paint_map.png").read_bytes() == kept
+    while p.swatches:
+        bpy.ops.omninoise.swatch_remove()
+    with pytest.raises(RuntimeError, match="add a swatch first"):
+        bpy.ops.omninoise.neural_save_job(filepath=str(tmp_path / "a.toml"))
+    assert os.listdir(tmp_path) == ["paint_map.png"]

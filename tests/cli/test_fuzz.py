@@ -184,6 +184,26 @@ def test_fuzz_neural(tmp_path_factory, flags, size, ext):
         run(argv + ["--size", size, "--quiet", "-o", out], out)
 
 
+@settings(FUZZ, max_examples=30)
+@given(flags=NEURAL_FLAGS, ext=st.sampled_from([".npy", ".exr", ".png"]),
+       job=st.sampled_from(["job.toml", "job.json", "no/such/job.toml", "folder.toml", ""]))
+@pytest.mark.long
+def test_fuzz_neural_save_job(tmp_path_factory, flags, ext, job):
+    """``neural --save-job``: exit 0 with a job that ``bake --dry-run`` takes, or one line, exit 2."""
+    with _fresh(tmp_path_factory) as tmp:
+        os.makedirs(os.path.join(tmp, "folder.toml"))
+        path = os.path.join(tmp, job)
+        argv = _argv("neural", flags)
+        if "--noise" not in argv and "--gradient" not in argv:
+            argv += ["--noise", "perlin"]
+        if "--steps" not in argv:
+            argv += ["--steps", "2"]
+        run(argv + ["--size", "16", "--quiet", "-o", output_path(tmp, ext), "--save-job", path], path)
+        if os.path.isfile(path):
+            run(["bake", path, "--quiet", "--dry-run"], None)
+            assert not os.path.exists(output_path(tmp, ext)), "--save-job drew the image too"
+
+
 SOLID_FLAGS = st.lists(st.one_of(
     flag("--exemplar", st.sampled_from(["gravel_3d", "grass", "bogus", ""] + broken_files())),
     flag("--to", st.sampled_from(["rock", "bogus"])), flag("--mix", num()), flag("--scale", num()),

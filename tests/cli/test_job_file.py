@@ -348,3 +348,85 @@ def test_a_neural_job_the_writer_cannot_hold_is_refused(tmp_path):
     with pytest.raises(SettingError, match="spacing: a bake source"):
         NeuralSource.from_request(neural_model(), spaced)
     assert os.listdir(tmp_path) == []
+
+
+NEURAL_FLAGS = {     # -o's type -> the flags of `omninoise neural`
+    "map.exr": ["--map", "paint.png", "--region", "#ff0000=spots", "--region", "#0000ff=perlin:scale=5",
+                "--region", "0=cells_f1", "--width", "4", "--sharpness", "1.5"],
+    "grad.png": ["--gradient", "spots:coverage=0.3", "cells_f1", "--tileable", "--seed", "3", "--sampler", "ddim"],
+    "blend.exr": ["--noise", "spots", "--blend", "mask.png", "--noise2", "perlin", "--param2", "scale=4"],
+    "m_##.png": ["--keys", "keys.toml", "--frames", "2", "4", "--latent", "drift", "--drift", "0.3"],
+}
+
+
+@pytest.fixture
+def neural_inputs(tmp_path, monkeypatch):
+    from omninoise.export.images import write_png
+
+    monkeypatch.chdir(tmp_path)
+    paint = np.zeros((32, 32, 3), np.uint8)
+    paint[6:20, 4:28], paint[:, 26:] = (255, 0, 0), (0, 0, 255)
+    write_png("paint.png", paint)
+    write_png("mask.png", np.where(np.arange(32)[None, :] > 13, 255, 0).astype(np.uint8).repeat(32, 0))
+    (tmp_path / "keys.toml").write_text('[[key]]\nframe = 2\nnoise = "perlin"\nparams = {scale = 4}\n'
+                                        '[[key]]\nframe = 4\nnoise = "cells_f1"\nseed = 2\n')
+    return tmp_path
+
+
+@pytest.mark.parametrize("out", NEURAL_FLAGS)
+def test_omninoise_neural_saves_its_image_as_a_job(neural_inputs, capsys, out):
+    """`omninoise neural ... --save-job JOB.toml` writes the job (a map or mask beside it, a painted map in the
+    --region colours) instead of the image; `omninoise bake JOB.toml` then writes what `omninoise neural` writes."""
+    flags = NEURAL_FLAGS[out] + ["--size", "32", "--steps", "2"]
+    assert main(["neural", *flags, "-o", "direct_" + out, "-q"]) == 0
+    assert main(["neural", *flags, "-o", out, "--save-job", "job.toml"]) == 0
+    assert f"wrote job.toml: omninoise bake job.toml draws {out}" in capsys.readouterr().err
+    frames = [2, 3, 4] if "#" in out else [None]
+    assert not any(os.path.exists(frame_path(out, f)) for f in frames)
+    assert main(["bake", "job.toml", "-q"]) == 0
+    for f in frames:
+        np.testing.assert_array_equal(decode(frame_path(out, f)), decode(frame_path("direct_" + out, f)))
+    if out == "map.exr":
+        px = np.rint(decode("job_map.png") * 255)
+        assert tuple(px[10, 10]) == (255, 0, 0) and tuple(px[0, 30]) == (0, 0, 255) and tuple(px[0, 0]) == (0, 0, 0)
+    assert os.path.exists("job_mask.png") == (out == "blend.exr")
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--noise", "perlin", "-o", "a.png", "--save-job", "job.json"], "--save-job: a job file is a .toml file"),
+    (["--fit", "paint.png", "-o", "a.png", "--save-job", "job.toml"], "--save-job: a job draws the classes it is"),
+    (["--noise", "perlin", "--spacing", "logsnr", "-o", "a.png", "--save-job", "job.toml"],
+     "--spacing: a job file has no such setting"),
+    (["--noise", "perlin", "--tile", "16", "-o", "a.png", "--save-job", "job.toml"], "--tile: a job file has no"),
+    (["--noise", "perlin", "--precision", "int8", "-o", "a.png", "--save-job", "job.toml"],
+     "--precision: sets this run's arithmetic, not the job's"),
+    (["--noise", "perlin", "-o", "a.npy", "--save-job", "job.toml"], "--save-job: a job's .npy holds an image's rows"),
+    (["--map", "paint.png", "--region", "#ff0000=spots", "--region", "#0000ff=perlin", "--region", "0=spots",
+      "-o", "a.png", "--save-job", "paint.toml"], "--save-job: the job writes its map to paint_map.png, the file"),
+])
+def test_omninoise_neural_refuses_a_job_it_cannot_save_before_any_work(neural_inputs, capsys, extra, message):
+    if "paint_map.png" in message:
+        os.rename("paint.png", "paint_map.png")
+        extra = [e.replace("paint.png", "paint_map.png") for e in extra]
+    before = sorted(os.listdir("."))
+    assert main(["neural", "--size", "16", "--steps", "2", *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0] and sorted(os.listdir(".")) == before
+
+
+def test_the_python_api_saves_a_neural_image_as_a_job(tmp_path):
+    """omninoise.neural(..., out=, save_job=) writes the job, not the image; its bake is the image out= writes."""
+    import omninoise
+
+    kw = dict(params={"scale": 5.0}, seed=2, steps=2, tileable=True)
+    omninoise.neural("perlin", 24, out=str(tmp_path / "direct.png"), **kw)
+    job = tmp_path / "n.toml"
+    assert omninoise.neural("perlin", 24, out=str(tmp_path / "later.png"), save_job=str(job), **kw) == str(job)
+    assert not (tmp_path / "later.png").exists() and run_job(str(job))[0].status == "baked"
+    np.testing.assert_array_equal(decode(str(tmp_path / "later.png")), decode(str(tmp_path / "direct.png")))
+    for bad, message in ((dict(save_job=str(job)), "save_job: applies to a written file; give out= too"),
+                         (dict(out=str(tmp_path / "a.png"), save_job="n.json"), "a job file is a .toml file"),
+                         (dict(out=str(tmp_path / "a.npy"), save_job=str(job)), "a job's .npy holds")):
+        with pytest.raises(SettingError, match=message):
+            omninoise.neural("perlin", 16, steps=2, **bad)
+    assert sorted(os.listdir(tmp_path)) == ["direct.png", "later.png", "n.toml"]
