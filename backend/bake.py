@@ -43,7 +43,7 @@ from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
-__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "require_vdb", "frame_path", "check_one_file",
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "write_values", "require_vdb", "frame_path", "check_one_file",
            "check_not_read", "output_type", "still", "FORMATS", "NPY_RAMP", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
@@ -351,8 +351,7 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
             progress = (lambda x, p=progress: p(PREPARE_SHARE + (1.0 - PREPARE_SHARE) * x))
 
     ext = os.path.splitext(path)[1].lower()
-    meta = {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}
-    tf = spec.transfer
+    meta = _meta(spec, key)
     if ext == ".vdb":  # values and colour sources alike: volume_grids / volume_channels
         writer = export.VolumeWriter(spec.grid.voxel, spec.grid.first, volume_grids(spec), meta, half=spec.half)
         for z0, vals in evaluate_slabs(spec.source, spec.grid, time, progress, cancel):
@@ -362,41 +361,49 @@ def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cance
             raise Cancelled("cancelled")
         writer.write(path)
         return
-    if getattr(spec.source, "rgb", False):
-        return _bake_rgb_file(spec, path, time, meta, progress, cancel)
-    values = evaluate_values(spec.source, spec.grid, time, progress, cancel)
+    _write_values(spec, path, evaluate_values(spec.source, spec.grid, time, progress, cancel), meta)
+
+
+def write_values(spec: BakeSpec, frame, values: np.ndarray) -> str:
+    """Write ``values`` drawn elsewhere (as ``spec.source.evaluate`` gives them on ``spec.grid``: float32 (ny, nx)
+    indexed by +y, or (ny, nx, 3) of a colour source) as the image or array file of ``frame`` (None: the single
+    output), with the key that makes it up to date for ``spec``, atomically -> its path. A front end that draws the
+    image itself (the Neural Noise panel) writes through this the file a job of ``spec`` writes."""
+    path = frame_path(spec.output, frame)
+    if os.path.splitext(path)[1].lower() not in (".exr", ".png", ".npy"):
+        raise SettingError("output", f"write_values writes images and arrays, not {os.path.basename(path)}")
+    _write_values(spec, path, np.asarray(values, np.float32), _meta(spec, spec.key(frame)))
+    return path
+
+
+def _meta(spec: BakeSpec, key: str) -> dict:
+    """The metadata every baked file carries."""
+    return {KEY_NAME: key, "omninoise_source": spec.source.kind, "omninoise_bake": spec.name}
+
+
+def _write_values(spec: BakeSpec, path: str, values: np.ndarray, meta: dict) -> None:
+    """An image or array file of a source's values on the grid (+y first; files put +y at the top)."""
+    from .. import export
+
+    ext = os.path.splitext(path)[1].lower()
     if ext == ".npy":
         export.write_npy(path, values)  # indexed (y, x) / (z, y, x) like the grid
         return
     values = values[::-1]  # row 0 of an image file is its top: +y up, as a plane shows it in Blender
-    if ext == ".exr":
-        if tf is None:
+    tf = spec.transfer
+    if getattr(spec.source, "rgb", False):      # scene-linear colours: RGB EXR, sRGB PNG
+        if ext == ".exr":
             export.write_exr(path, values, half=spec.half, metadata=meta)
         else:
-            export.write_exr(path, tf.rgba(values), half=spec.half, metadata=meta)
-    elif ext == ".png":
-        if tf is not None:
-            img = export.encode_srgb8(tf.rgba(values))
-        elif getattr(spec.source, "unit", False):       # values in [0, 1]: as they are (omninoise neural -o's PNG)
-            img = export.preview_8bit(values, 0.0, 1.0)
-        else:
-            img = export.preview_8bit(values)
-        export.write_png(path, img, metadata=meta)
-
-
-def _bake_rgb_file(spec: BakeSpec, path: str, time: float, meta: dict, progress, cancel) -> None:
-    """Image and array files of a colour source (scene-linear RGB values (..., 3)): RGB EXR, sRGB PNG, or
-    (..., 3) .npy (its volumes go through _bake_file's .vdb branch: color + constant density)."""
-    from .. import export
-
-    ext = os.path.splitext(path)[1].lower()
-    values = evaluate_values(spec.source, spec.grid, time, progress, cancel)
-    if ext == ".npy":
-        export.write_npy(path, values)
+            export.write_png(path, export.encode_srgb8(values), metadata=meta)
     elif ext == ".exr":
-        export.write_exr(path, values[::-1], half=spec.half, metadata=meta)
+        export.write_exr(path, values if tf is None else tf.rgba(values), half=spec.half, metadata=meta)
+    elif tf is not None:
+        export.write_png(path, export.encode_srgb8(tf.rgba(values)), metadata=meta)
+    elif getattr(spec.source, "unit", False):       # values in [0, 1]: as they are (omninoise neural -o's PNG)
+        export.write_png(path, export.preview_8bit(values, 0.0, 1.0), metadata=meta)
     else:
-        export.write_png(path, export.encode_srgb8(values[::-1]), metadata=meta)
+        export.write_png(path, export.preview_8bit(values), metadata=meta)
 
 
 def run_bake(spec: BakeSpec, progress: Callable[[float], None] | None = None,

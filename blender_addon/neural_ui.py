@@ -233,14 +233,13 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
         req = panel_request(p, size, steps)
         depth = p.depth
         name = p.name + (" Preview" if self.preview else "")
-        save_path = None
-        if p.save != "NONE" and not self.preview:
-            from .bake_blender import output_folder
-
-            save_path = os.path.join(output_folder(p.folder), bpy.path.clean_name(name) + "." + p.save.lower())
+        spec = None
+        if p.save != "NONE" and not self.preview:   # the file a job of this bake writes (Save as Job File)
+            spec = _image_spec(p, req)
             maps = [(f"the image {ima.name!r}", bpy.path.abspath(ima.filepath)) for ima in (p.blend_map, p.fit_image)
                     if ima is not None and ima.filepath]
-            _mod("bake").check_not_read(save_path, "name", maps)    # a painted map saved under the bake's name
+            _mod("bake").check_not_read(spec.output, "name", maps)    # a painted map saved under the bake's name
+        save_path = None if spec is None else spec.output
         obj, add_node = context.active_object, p.add_node and not self.preview
 
         def work(progress, cancel):
@@ -250,13 +249,8 @@ class OMNINOISE_OT_neural_bake(TaskOperator, bpy.types.Operator):
                     raise backend.Cancelled("cancelled")
 
             img = _mod("neural.request").generate_request(m, req, callback=step)
-            if save_path is not None:  # atomic, off the main thread
-                from .. import export
-
-                if save_path.endswith(".png"):
-                    export.write_png(save_path, export.preview_8bit(img, 0.0, 1.0))
-                else:
-                    export.write_exr(save_path, img, half=depth != "32")
+            if spec is not None:  # atomic, off the main thread; with its key, up to date for the saved job
+                _mod("bake").write_values(spec, None, img[::-1])
             return img
 
         def done(img):
@@ -316,26 +310,21 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     def _start(self, context, blocking: bool):
-        from .bake_blender import output_folder
-
         p = context.scene.omninoise_neural
         size = _bake_size(p)
         _mod("neural.generate").check_memory("size", size, size)
         m = model()                 # its errors, the keys' and the folder's are reported by _begin, in one line
         keys = sequence_keys(p)
-        folder = output_folder(p.folder)
-        ext = "png" if p.save == "PNG" else "exr"  # a sequence lives on disk: EXR unless PNG was picked
-        pattern = os.path.join(folder, bpy.path.clean_name(p.name) + "_####." + ext)
+        spec = _sequence_spec(p, keys)      # a sequence lives on disk: EXR unless PNG was picked
+        pattern = spec.output
         first, last = p.frame_start, p.frame_end
         n = last - first + 1
         kw = dict(latent=p.latent, speed=p.drift, steps=p.steps, sampler=p.sampler, tileable=p.tileable)
-        half, name = p.depth != "32", p.name + " Sequence"
+        name = p.name + " Sequence"
         obj, add_node = context.active_object, p.add_node
-        frame_path = _mod("bake").frame_path
+        write_values = _mod("bake").write_values
 
         def work(progress, cancel):
-            from .. import export
-
             finished = []
 
             def step(i, steps, x0):
@@ -345,12 +334,7 @@ class OMNINOISE_OT_neural_bake_sequence(TaskOperator, bpy.types.Operator):
 
             for f, img in _mod("neural.animate").animate(m, keys, (first, last), size, size, cancel=cancel,
                                                           callback=step, **kw):
-                path = frame_path(pattern, f)
-                if ext == "png":
-                    export.write_png(path, export.preview_8bit(img, 0.0, 1.0))
-                else:
-                    export.write_exr(path, img, half=half)
-                finished.append(path)
+                finished.append(write_values(spec, f, img[::-1]))   # with its key, as the saved job writes it
                 task.label = f"Neural sequence: frame {f} ({len(finished)}/{n})"
             return finished
 
@@ -377,28 +361,43 @@ def _bake_size(p) -> int:
 
 
 def job_spec(context, target: str):
-    """The :class:`backend.bake.BakeSpec` a job file bakes for the panel's image bake (``target`` "IMAGE") or its
-    sequence ("SEQUENCE"), as the panel sets them: the same image or frames, into the panel's folder under its
-    name, EXR (16-bit half unless the depth is 32-bit) or PNG as its Save setting says (a Pack Only image: EXR).
-    SettingError naming what is wrong."""
+    """The :class:`backend.bake.BakeSpec` of the panel's image bake (``target`` "IMAGE") or its sequence
+    ("SEQUENCE"), as the panel sets them: the files the panel writes and a job of them writes again (Save as Job
+    File). SettingError naming what is wrong."""
+    p = context.scene.omninoise_neural
+    if target == "IMAGE":
+        return _image_spec(p, panel_request(p, _bake_size(p)))
+    return _sequence_spec(p, sequence_keys(p))
+
+
+def _files(p) -> dict:
+    """Where and how the panel's bakes are written: into its folder under its name, EXR (16-bit half unless the
+    depth is 32-bit) or PNG as its Save setting says (an image kept in the .blend only: EXR)."""
     from .bake_blender import output_folder
 
-    p = context.scene.omninoise_neural
-    S, B = _mod("sources"), _mod("bake")
-    size = _bake_size(p)
     ext = ".png" if p.save == "PNG" else ".exr"
-    stem = os.path.join(output_folder(p.folder), bpy.path.clean_name(p.name))
-    kw = dict(grid=S.BoxGrid((size, size)), half=ext == ".exr" and p.depth != "32")
-    if target == "IMAGE":
-        req = panel_request(p, size)
-        colours = [tuple(int(round(c * 255)) for c in s.color) for s in p.swatches]
-        source = S.NeuralSource.from_request(neural_model_folder(), req, colours if req.layout == "painted" else None)
-        return B.BakeSpec(p.name, source, output=stem + ext, **kw).validate()
-    keys = sequence_keys(p)
-    source = S.NeuralSource(neural_model_folder(), keys[0].noise, keys[0].params, steps=p.steps, sampler=p.sampler,
-                            tileable=p.tileable, keys=keys, latent=p.latent, drift=p.drift)
-    return B.BakeSpec(p.name + " Sequence", source, output=stem + "_####" + ext, frames=(p.frame_start, p.frame_end),
-                      time=float(p.frame_start), time_step=1.0, **kw).validate()
+    size = _bake_size(p)
+    return dict(stem=os.path.join(output_folder(p.folder), bpy.path.clean_name(p.name)), ext=ext,
+                kw=dict(grid=_mod("sources").BoxGrid((size, size)), half=ext == ".exr" and p.depth != "32"))
+
+
+def _image_spec(p, req):
+    """The image bake's spec: the checked request ``req`` drawn into the panel's file."""
+    f = _files(p)
+    colours = [tuple(int(round(c * 255)) for c in s.color) for s in p.swatches] if req.layout == "painted" else None
+    source = _mod("sources").NeuralSource.from_request(neural_model_folder(), req, colours)
+    return _mod("bake").BakeSpec(p.name, source, output=f["stem"] + f["ext"], **f["kw"]).validate()
+
+
+def _sequence_spec(p, keys: list):
+    """The sequence bake's spec: ``keys`` over the panel's frames, one file a frame."""
+    f = _files(p)
+    source = _mod("sources").NeuralSource(neural_model_folder(), keys[0].noise, keys[0].params, steps=p.steps,
+                                          sampler=p.sampler, tileable=p.tileable, keys=keys, latent=p.latent,
+                                          drift=p.drift)
+    return _mod("bake").BakeSpec(p.name + " Sequence", source, output=f["stem"] + "_####" + f["ext"],
+                                 frames=(p.frame_start, p.frame_end), time=float(p.frame_start), time_step=1.0,
+                                 **f["kw"]).validate()
 
 
 class OMNINOISE_OT_neural_save_job(SaveJobOperator, bpy.types.Operator):

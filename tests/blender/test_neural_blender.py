@@ -387,8 +387,9 @@ def test_the_panel_builds_the_command_lines_request(scene, mode, tmp_path):
 
 @pytest.mark.parametrize("mode, save", [("SINGLE", "EXR"), ("GRADIENT", "PNG"), ("CORNERS", "NONE"), ("MAP", "PNG")])
 def test_save_as_job_file_bakes_the_panels_image(scene, tmp_path, mode, save):
-    """Each layout saved as a job (the painted map beside it, in the swatches' colours): `omninoise bake` writes the
-    panel's own file again, value for value (a Pack Only image as an EXR)."""
+    """Each layout saved as a job (the painted map beside it, in the swatches' colours): the panel's file is up to
+    date for it, and `omninoise bake --force` writes it again value for value (a Pack Only image as an EXR)."""
+    from omninoise.backend.jobs import run_job
     from omninoise.cli.main import main
     from omninoise.export.images import decode
 
@@ -408,6 +409,7 @@ def test_save_as_job_file_bakes_the_panels_image(scene, tmp_path, mode, save):
     text = job.read_text()
     assert {"SINGLE": 'noise = "', "GRADIENT": "gradient = [", "CORNERS": "corners = [", "MAP": "regions = {"}[mode] \
         in text
+    assert [o.status for o in run_job(str(job))] == ["baked" if save == "NONE" else "up to date"]
     assert main(["bake", str(job), "--force", "-q"]) == 0
     got = decode(str(tmp_path / ("Job.png" if save == "PNG" else "Job.exr")))
     np.testing.assert_array_equal(got.reshape(panel.shape), panel)
@@ -418,8 +420,9 @@ def test_save_as_job_file_bakes_the_panels_image(scene, tmp_path, mode, save):
 
 
 def test_save_as_job_file_bakes_the_panels_sequence(scene, tmp_path):
-    """The sequence bake (the swatches spread over the frames, a drifting latent, PNG frames) as a job: the same
-    frames, its keyframes written out."""
+    """The sequence bake (the swatches spread over the frames, a drifting latent, PNG frames) as a job: its frames
+    are up to date for it and drawn again the same, its keyframes written out."""
+    from omninoise.backend.jobs import run_job
     from omninoise.cli.main import main
     from omninoise.export.images import decode
 
@@ -433,6 +436,7 @@ def test_save_as_job_file_bakes_the_panels_sequence(scene, tmp_path):
     assert bpy.ops.omninoise.neural_save_job(filepath=str(job), target="SEQUENCE") == {"FINISHED"}
     text = job.read_text()
     assert 'noise = "spots"' in text and "seed = 6" in text and "drift = 0.25" in text and "frames = [3, 5]" in text
+    assert [o.status for o in run_job(str(job))] == ["up to date"]
     assert main(["bake", str(job), "--force", "-q"]) == 0
     for n, want in zip(names, panel):
         np.testing.assert_array_equal(decode(str(tmp_path / n)), want)

@@ -430,3 +430,27 @@ def test_the_python_api_saves_a_neural_image_as_a_job(tmp_path):
         with pytest.raises(SettingError, match=message):
             omninoise.neural("perlin", 16, steps=2, **bad)
     assert sorted(os.listdir(tmp_path)) == ["direct.png", "later.png", "n.toml"]
+
+
+@pytest.mark.parametrize("output, source", [("w.png", "wave"), ("w.exr", "wave"), ("n.png", "neural"),
+                                            ("r.exr", "ramp"), ("s.png", "solid")])
+def test_values_drawn_elsewhere_are_written_as_a_bake_writes_them(tmp_path, output, source):
+    """write_values (a front end drawing the image itself: the Neural Noise panel) writes the file run_bake writes,
+    key and all, so it is up to date for the spec's job; a volume is refused in one line."""
+    from omninoise.backend.bake import evaluate_values, write_values
+    from omninoise.export import read_metadata
+
+    src = {"wave": {"kind": "wave", "dim": 2, "seed": 3}, "ramp": {"kind": "wave", "dim": 2},
+           "neural": {"kind": "neural", "noise": "perlin", "steps": 2},
+           "solid": {"kind": "solid", "model": "gravel_3d"}}[source]
+    spec = BakeSpec("b", source_from_dict(src), BoxGrid((16, 12)), str(tmp_path / output),
+                    preset("fire") if source == "ramp" else None).validate()
+    run_bake(spec)
+    baked, meta = decode(spec.output), read_metadata(spec.output)
+    os.remove(spec.output)
+    assert write_values(spec, None, evaluate_values(spec.source, spec.grid)) == spec.output
+    np.testing.assert_array_equal(decode(spec.output), baked)
+    assert read_metadata(spec.output) == meta and spec.is_up_to_date(None)
+    vol = BakeSpec("v", source_from_dict({"kind": "wave", "dim": 3}), BoxGrid((4, 4, 4)), str(tmp_path / "v.vdb"))
+    with pytest.raises(SettingError, match="write_values writes images and arrays, not v.vdb"):
+        write_values(vol, None, np.zeros((4, 4, 4), np.float32))
