@@ -289,20 +289,20 @@ def write_job(path: str, specs: list) -> str:
     outputs = {os.path.abspath(frame_path(s.output, f)) for s in specs for f in s.frame_list()}
     taken = [f for f in sides.values() if f in outputs]
     if taken:
-        raise SettingError("job file", f"{os.path.basename(taken[0])} is a bake's output; the job writes its map "
-                                       "there: save the job under another name")
+        raise SettingError("job file", f"{os.path.basename(taken[0])} is a bake's output; the job writes its mask "
+                                       "or map there: save the job under another name")
     from ..export.images import write_png
 
     for i, f in sides.items():      # the job reads them; written before it is read back
         write_png(f, _side_image(specs[i].source))
     try:
         parsed = parse_job(tomllib.loads(text), job_dir, path)
-        for spec, (name, got) in zip(specs, parsed):
+        for i, (spec, (name, got)) in enumerate(zip(specs, parsed)):
             if isinstance(got, JobError):
                 raise SettingError("job file", str(got))
             if not _same(spec, got):
                 raise RuntimeError(f"the job file would bake {name!r} otherwise than asked: "
-                                   f"{describe(bake_table(got, job_dir, sides.get(specs.index(spec))))}")
+                                   f"{describe(bake_table(got, job_dir, sides.get(i)))}")
     except BaseException:
         for f in sides.values():
             os.remove(f)

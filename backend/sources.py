@@ -267,7 +267,8 @@ class NeuralSource:
         for a request's setting a source has no key for (a step spacing, an eta, a tile size)."""
         for name in ("spacing", "eta", "tile"):
             if getattr(req, name) is not None:
-                raise SettingError(name, "a bake source (a job file) takes the sampler's own; leave it out")
+                raise SettingError(name, "a bake source (a job file) has no such setting (its bake takes the default): "
+                                         "leave it out")
         kw = dict(width=req.transition, sharpness=req.sharpness, steps=req.steps, seed=req.seed,
                   tileable=req.tileable, sampler=req.sampler)
         specs = [(n, dict(p)) for n, p in req.specs]
