@@ -32,6 +32,7 @@ one given (the same source, grid, ramp, times and files), atomically.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import re
@@ -135,9 +136,14 @@ def _region_colours(source: NeuralSource) -> list:
         c = tuple(own[i]) if i < len(own) and tuple(own[i]) not in used else None
         out.append(c)
         used.add(c)
-    spare = (c for c in ((r, g, b) for r in range(0, 256, 51) for g in range(0, 256, 51) for b in range(0, 256, 51))
-             if c not in used)
-    return [c if c is not None else next(spare) for c in out]
+    steps = ((r, g, b) for r in range(0, 256, 51) for g in range(0, 256, 51) for b in range(0, 256, 51))
+    every = ((i >> 16, (i >> 8) & 255, i & 255) for i in range(1 << 24))     # past 216 regions
+    spare = itertools.chain(steps, every)
+    for i, c in enumerate(out):
+        if c is None:
+            out[i] = next(x for x in spare if x not in used)
+            used.add(out[i])
+    return out
 
 
 def _side_image(source: NeuralSource) -> np.ndarray:

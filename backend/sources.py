@@ -730,8 +730,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         if not isinstance(table, dict) or not table:
             raise SettingError("source.regions", "a map needs regions = {\"#rrggbb\" = SPEC, ...} for its colours")
         region_keys = [region_key(k, "source.regions") for k in table]
-        if all(isinstance(k, tuple) for k in region_keys):
-            colours = region_keys
+        colours = [k if isinstance(k, tuple) else (k, k, k) for k in region_keys]     # a grey level as its grey
         region_specs = [_spec_value(v, f"source.regions.{k}") for k, v in table.items()]
         try:
             regions = regions_from_map(export.decode(path), region_keys, "source.map")

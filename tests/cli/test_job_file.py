@@ -456,3 +456,25 @@ def test_values_drawn_elsewhere_are_written_as_a_bake_writes_them(tmp_path, outp
     vol = BakeSpec("v", source_from_dict({"kind": "wave", "dim": 3}), BoxGrid((4, 4, 4)), str(tmp_path / "v.vdb"))
     with pytest.raises(SettingError, match="write_values writes images and arrays, not v.vdb"):
         write_values(vol, None, np.zeros((4, 4, 4), np.float32))
+
+
+def test_a_map_of_many_grey_levels_is_written_in_its_own_greys(tmp_path):
+    """A job's painted map of 256 grey levels (an indexed map) written again: each region in its own grey, the
+    same regions read back; without colours of their own, 300 regions get 300 distinct colours."""
+    from omninoise.backend.paths import neural_model
+    from omninoise.backend.sources import NeuralSource
+    from omninoise.export.images import write_png
+
+    write_png(str(tmp_path / "idx.png"), np.arange(256, dtype=np.uint8).reshape(16, 16))
+    src = source_from_dict({"kind": "neural", "map": "idx.png", "steps": 2,
+                            "regions": {str(k): "spots" if k % 2 else "perlin" for k in range(256)}}, str(tmp_path))
+    (tmp_path / "out").mkdir()
+    spec = BakeSpec("idx", src, BoxGrid((16, 16)), str(tmp_path / "out" / "idx.exr")).validate()
+    job_file.write_job(str(tmp_path / "out" / "job.toml"), [spec])
+    np.testing.assert_array_equal(decode(str(tmp_path / "out" / "job_map.png"))[..., 0],
+                                  decode(str(tmp_path / "idx.png"))[..., 0])
+    (_, parsed), = load_job(str(tmp_path / "out" / "job.toml"))
+    np.testing.assert_array_equal(parsed.source.regions, src.regions)
+    many = NeuralSource(neural_model(), "spots", steps=2, regions=np.arange(300).reshape(15, 20),
+                        region_specs=[("spots", {})] * 300)
+    assert len(set(job_file._region_colours(many))) == 300
