@@ -283,8 +283,8 @@ def write_job(path: str, specs: list) -> str:
     """Write the job file ``path`` (.toml) that bakes ``specs``, atomically, and beside it the masks and painted
     maps its neural sources read (:func:`side_files`); returns its text. SettingError naming what cannot be
     written (:func:`check_job_file`, a source other than wave or neural noise, a by-example noise, a map's name
-    that is an output), and RuntimeError where the text would bake anything else than ``specs``, before anything is
-    written (the maps written to check it are removed)."""
+    that is an output), and RuntimeError where the text would bake anything else than ``specs``; then no job is
+    written, and the maps written to check it are removed (one that was there before is put back)."""
     from ..export.atomic import write_text
     from .jobs import JobError, parse_job
 
@@ -297,8 +297,14 @@ def write_job(path: str, specs: list) -> str:
     if taken:
         raise SettingError("job file", f"{os.path.basename(taken[0])} is a bake's output; the job writes its mask "
                                        "or map there: save the job under another name")
+    from ..export.atomic import atomic_path
     from ..export.images import write_png
 
+    kept = {}       # a map saved with the job before: put back if this job is not written
+    for f in sides.values():
+        if os.path.isfile(f):
+            with open(f, "rb") as fh:
+                kept[f] = fh.read()
     for i, f in sides.items():      # the job reads them; written before it is read back
         write_png(f, _side_image(specs[i].source))
     try:
@@ -311,7 +317,12 @@ def write_job(path: str, specs: list) -> str:
                                    f"{describe(bake_table(got, job_dir, sides.get(i)))}")
     except BaseException:
         for f in sides.values():
-            os.remove(f)
+            if f not in kept:
+                os.remove(f)
+                continue
+            with atomic_path(f) as tmp:
+                with open(tmp, "wb") as fh:
+                    fh.write(kept[f])
         raise
     write_text(path, text)
     return text

@@ -478,3 +478,22 @@ def test_a_map_of_many_grey_levels_is_written_in_its_own_greys(tmp_path):
     many = NeuralSource(neural_model(), "spots", steps=2, regions=np.arange(300).reshape(15, 20),
                         region_specs=[("spots", {})] * 300)
     assert len(set(job_file._region_colours(many))) == 300
+
+
+def test_a_job_that_would_bake_otherwise_is_not_written_and_its_maps_are_put_back(tmp_path, monkeypatch):
+    """The written-back check failing (a writer's fault, drawn here by a check that always fails): no job, the
+    map written for it removed, and a map saved with an earlier job put back byte for byte."""
+    from omninoise.backend.neural.request import NeuralRequest
+    from omninoise.backend.paths import neural_model
+    from omninoise.backend.sources import NeuralSource
+
+    req = NeuralRequest("painted", NEURAL["painted"]["specs"], 24, 24, regions=_REGIONS, steps=2).check(_neural_model())
+    mask = NeuralRequest("blend", NEURAL["blend"]["specs"], 24, 24, mask=_REGIONS > 0, steps=2).check(_neural_model())
+    specs = [BakeSpec(n, NeuralSource.from_request(neural_model(), r), BoxGrid((24, 24)),
+                      str(tmp_path / f"{n}.exr")).validate() for n, r in (("p", req), ("b", mask))]
+    (tmp_path / "job_map.png").write_bytes(b"an earlier map")
+    monkeypatch.setattr(job_file, "_same", lambda a, b: False)
+    with pytest.raises(RuntimeError, match="the job file would bake 'p' otherwise than asked"):
+        job_file.write_job(str(tmp_path / "job.toml"), specs)
+    assert sorted(os.listdir(tmp_path)) == ["job_map.png"]
+    assert (tmp_path / "job_map.png").read_bytes() == b"an earlier map"
