@@ -43,8 +43,8 @@ from .grid import Cancelled
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
-__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "write_values", "require_vdb", "frame_path", "check_one_file",
-           "check_not_read", "output_type", "still", "FORMATS", "NPY_RAMP", "KEY_NAME", "Cancelled"]
+__all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "write_values", "require_vdb", "frame_path",
+           "check_one_file", "check_not_read", "output_type", "still", "FORMATS", "NPY_RAMP", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")

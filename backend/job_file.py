@@ -201,14 +201,15 @@ def _relative(path: str, folder: str) -> str:
 def bake_table(spec: BakeSpec, job_dir: str, side: str | None = None) -> dict:
     """The ``[[bake]]`` table of ``spec`` in a job file in ``job_dir`` (its output from there; ``side``: the file
     of its neural source's mask or painted map, :func:`side_files`)."""
+    from .jobs import default_times
+
     table = dict(name=spec.name, output=_relative(spec.output, job_dir), **spec.grid.to_dict())
-    keys = getattr(spec.source, "keys", None)
+    time0, dt = default_times(spec.source, spec.frames)
     if spec.frames is not None:
         table["frames"] = [int(f) for f in spec.frames]
-        if not keys or spec.time_step != 1.0:   # keyframed neural noise steps a frame a frame by default
+        if spec.time_step != dt or not getattr(spec.source, "keys", None):   # a wave bake's step is always written
             table["time_step"] = float(spec.time_step)
-    if spec.source.animated and spec.time != (spec.frames[0] if keys and spec.frames else
-                                              keys[0].frame if keys else 0.0):
+    if spec.source.animated and spec.time != time0:
         table["time"] = float(spec.time)
     ext = os.path.splitext(spec.output)[1].lower()
     if spec.half and ext in (".exr", ".vdb"):
@@ -279,18 +280,25 @@ def _same(a: BakeSpec, b: BakeSpec) -> bool:
             and all(a.key(f) == b.key(f) for f in a.frame_list()))
 
 
-def write_job(path: str, specs: list) -> str:
+def write_job(path: str, specs: list, reads: dict | None = None, where: str = "file") -> str:
     """Write the job file ``path`` (.toml) that bakes ``specs``, atomically, and beside it the masks and painted
     maps its neural sources read (:func:`side_files`); returns its text. SettingError naming what cannot be
     written (:func:`check_job_file`, a source other than wave or neural noise, a by-example noise, a map's name
-    that is an output), and RuntimeError where the text would bake anything else than ``specs``; then no job is
-    written, and the maps written to check it are removed (one that was there before is put back)."""
+    that is an output or one of ``reads``: {path of a file the front end reads: who reads it, "--map reads"}),
+    named as ``where`` where it is the job file's, and RuntimeError where the text would bake anything else than
+    ``specs``; then no job is written, and the maps written to check it are removed (one that was there before is
+    put back)."""
     from ..export.atomic import write_text
     from .jobs import JobError, parse_job
 
-    path = check_job_file(path)
+    path = check_job_file(path, where)
     job_dir = os.path.dirname(os.path.abspath(path))
     sides = side_files(path, specs)
+    read = {os.path.realpath(f): who for f, who in (reads or {}).items() if f}
+    for side in sides.values():     # the mask or map it writes: never over a file read
+        if os.path.realpath(side) in read:
+            raise SettingError(where, f"the job writes its map to {os.path.basename(side)}, the file "
+                                      f"{read[os.path.realpath(side)]}: save the job under another name")
     text = job_text(specs, job_dir, sides)
     outputs = {os.path.abspath(frame_path(s.output, f)) for s in specs for f in s.frame_list()}
     taken = [f for f in sides.values() if f in outputs]

@@ -132,7 +132,7 @@ from .schema import did_you_mean, shown_value
 from .sources import BoxGrid, source_from_dict
 from .transfer import load_transfer, transfer_from_dict
 
-__all__ = ["JobError", "load_job", "parse_job", "run_job", "select_bakes", "JobOutcome"]
+__all__ = ["JobError", "load_job", "parse_job", "run_job", "select_bakes", "JobOutcome", "default_times"]
 
 
 
@@ -170,6 +170,15 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
+def default_times(source, frames: tuple | None) -> tuple:
+    """(time, time_step) of a bake that gives neither: 0 and 1/24 s a frame, but for keyframed neural noise, whose
+    time is the frame number its keyframes name (the first frame's, else the first keyframe's) and steps 1."""
+    keys = getattr(source, "keys", None)
+    if keys:
+        return float(frames[0] if frames else keys[0].frame), 1.0
+    return 0.0, 1.0 / 24.0
+
+
 def _spec(d: dict, base_dir: str, index: int, own: frozenset = frozenset()) -> BakeSpec:
     """One merged ``[[bake]]`` table -> its checked BakeSpec (:data:`~backend.settings_schema.BAKE` first, then
     its source's table, then the rules that join keys).  ``own`` names the keys the bake's own table gives (not
@@ -192,10 +201,7 @@ def _spec(d: dict, base_dir: str, index: int, own: frozenset = frozenset()) -> B
         raise SettingError("transfer", f"expected a preset name, a .json file or a table, got {tf!r}")
     frames = tuple(d["frames"]) if "frames" in d else None
     output = os.path.normpath(os.path.join(base_dir, d["output"]))
-    time0, dt = 0.0, 1.0 / 24.0
-    keys = getattr(source, "keys", None)
-    if keys:  # animated neural noise: the bake's time is the frame number its keyframes name
-        time0, dt = float(frames[0] if frames else keys[0].frame), 1.0
+    time0, dt = default_times(source, frames)
     if "time" in own and not source.animated:
         raise SettingError("time", f"{still(source)}; its time changes nothing")
     if "time_step" in own and frames is None:

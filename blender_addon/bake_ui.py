@@ -276,8 +276,9 @@ class OMNINOISE_OT_bake_image(_BakeOperator, bpy.types.Operator):
 class SaveJobOperator(ExportHelper):
     """A panel's bake saved as a TOML job file (:mod:`backend.job_file`), which `omninoise bake`, a farm or the
     Batch Job panel bakes again without Blender. A subclass names its panel's settings (``settings``: the scene's
-    property group, with ``folder`` and ``name``) and its bakes (``specs(context)``: BakeSpecs, SettingError naming
-    what is wrong); ``check(context, path, specs)`` may refuse a path before anything is written."""
+    property group, with ``folder`` and ``name``), its bakes (``specs(context)``: BakeSpecs, SettingError naming
+    what is wrong) and the files the panel reads (``reads(context)``), which a map beside the job may not
+    replace."""
 
     bl_options = {"REGISTER"}      # writes files only: nothing in the .blend to undo
 
@@ -288,8 +289,9 @@ class SaveJobOperator(ExportHelper):
     def specs(self, context) -> list:
         raise NotImplementedError
 
-    def check_path(self, context, path: str, specs: list) -> None:
-        """SettingError where the job at ``path`` cannot be written (nothing to check by default)."""
+    def reads(self, context) -> dict:
+        """{path of a file the panel reads: who reads it} (none by default; :func:`backend.job_file.write_job`)."""
+        return {}
 
     def invoke(self, context, event):
         """The file browser, at ``<bake name>.toml`` in the bake's output folder (the job then needs no output
@@ -311,9 +313,7 @@ class SaveJobOperator(ExportHelper):
                 raise backend.SettingError("file", "no file to save to: pick one in the file browser (a script: "
                                                    "filepath=...)")
             path = backend.job_file.check_job_file(bpy.path.abspath(self.filepath))     # its name first
-            specs = self.specs(context)
-            self.check_path(context, path, specs)
-            backend.job_file.write_job(path, specs)
+            backend.job_file.write_job(path, self.specs(context), self.reads(context))
         except (backend.SettingError, OSError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}

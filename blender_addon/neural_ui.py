@@ -421,15 +421,11 @@ class OMNINOISE_OT_neural_save_job(SaveJobOperator, bpy.types.Operator):
     def specs(self, context) -> list:
         return [job_spec(context, self.target)]
 
-    def check_path(self, context, path: str, specs: list) -> None:
-        """The painted map the job reads is written beside it: never over the blend map's or fit image's file."""
+    def reads(self, context) -> dict:
+        """The blend map's and fit image's files: the painted map the job reads is never written over them."""
         p = context.scene.omninoise_neural
-        ours = [os.path.abspath(bpy.path.abspath(ima.filepath)) for ima in (p.blend_map, p.fit_image)
-                if ima is not None and ima.filepath]
-        for side in backend.job_file.side_files(path, specs).values():
-            if os.path.abspath(side) in ours:
-                raise backend.SettingError("file", f"the job writes its map to {os.path.basename(side)}, the "
-                                                   "file of an image the panel reads: save the job under another name")
+        return {bpy.path.abspath(ima.filepath): "of an image the panel reads" for ima in (p.blend_map, p.fit_image)
+                if ima is not None and ima.filepath}
 
 
 class OMNINOISE_OT_neural_fit(TaskOperator, bpy.types.Operator):

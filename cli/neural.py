@@ -275,17 +275,12 @@ def _save_job(a: argparse.Namespace, source, frames: tuple | None = None) -> int
     """Write the job (``--save-job``) that draws ``-o`` from ``source``, and its blend mask or painted map beside
     it; draw nothing."""
     from omninoise.backend.bake import BakeSpec
-    from omninoise.backend.job_file import side_files, write_job
+    from omninoise.backend.job_file import write_job
     from omninoise.backend.sources import BoxGrid
 
     spec = BakeSpec("neural", source, BoxGrid((a.size, a.size)), os.path.abspath(a.out), frames=frames,
                     time=float(frames[0]) if frames else 0.0, time_step=1.0).validate()
-    for side in side_files(a.save_job, [spec]).values():    # the mask or map it writes: never over a file read
-        for flag, read in (("--blend", a.blend), ("--map", a.map)):
-            if read and os.path.realpath(read) == os.path.realpath(side):
-                raise SettingError("--save-job", f"the job writes its map to {os.path.basename(side)}, the file "
-                                                 f"{flag} reads: save the job under another name")
-    write_job(a.save_job, [spec])
+    write_job(a.save_job, [spec], {a.blend: "--blend reads", a.map: "--map reads"}, "--save-job")
     if not a.quiet:
         print(f"omninoise neural: wrote {a.save_job}: omninoise bake {a.save_job} draws {a.out}", file=sys.stderr)
     return 0
