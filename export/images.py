@@ -6,7 +6,9 @@ the top of the image.
 from __future__ import annotations
 
 import os
+import re
 import struct
+import sys
 import zlib
 
 import numpy as np
@@ -50,20 +52,23 @@ def encode_srgb8(linear: np.ndarray) -> np.ndarray:
 
 
 def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> None:
-    """Write uint8 (H, W) or (H, W, 3|4) as PNG (zlib, no dependencies); metadata -> tEXt chunks."""
+    """Write uint8 or uint16 (H, W) or (H, W, 2|3|4) as an 8- or 16-bit PNG (zlib, no dependencies); metadata ->
+    tEXt chunks."""
     a = np.asarray(array)
-    if a.dtype != np.uint8:
-        raise TypeError("write_png expects uint8; use preview_8bit for floats")
+    if a.dtype not in (np.uint8, np.uint16):
+        raise TypeError("write_png expects uint8 or uint16; use preview_8bit for floats")
     if a.ndim == 2:
         a = a[:, :, None]
     h, w, c = a.shape
     colour = {1: 0, 2: 4, 3: 2, 4: 6}[c]
+    depth = 8 * a.dtype.itemsize
+    a = a.astype(">u2") if depth == 16 else a       # PNG's samples are big-endian
     raw = b"".join(b"\x00" + a[y].tobytes() for y in range(h))
 
     def chunk(tag: bytes, data: bytes) -> bytes:
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
 
-    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0))
+    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, 0))
            + b"".join(chunk(b"tEXt", f"{k}".encode("latin-1") + b"\0" + f"{v}".encode("latin-1"))
                       for k, v in (metadata or {}).items())
            + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
@@ -190,12 +195,35 @@ def _decode(path: str) -> tuple:
 
 
 _EXIF_ORIENTATION = 0x0112   #: EXIF tag: 1 upright, 2-8 mirrored and/or turned (cameras store the sensor's rows)
+#: the stored pixels (H, W[, C]) of each EXIF orientation as viewers show them (Pillow's ``ImageOps.exif_transpose``)
+_TURNS = {1: lambda a: a, 2: lambda a: a[:, ::-1], 3: lambda a: a[::-1, ::-1], 4: lambda a: a[::-1],
+          5: lambda a: np.swapaxes(a, 0, 1), 6: lambda a: np.rot90(a, -1),
+          7: lambda a: np.swapaxes(a, 0, 1)[::-1, ::-1], 8: lambda a: np.rot90(a, 1)}
+
+
+def _pillow_pixels(im, tiles: list) -> tuple:
+    """(pixels float32 (H, W[, C]) by the file's own range, whether they are floats) of an image Pillow loaded
+    (``tiles``: its tiles before it was loaded)."""
+    wide = _sixteen_bits(im.filename, tiles)
+    if wide is not None:
+        return wide.astype(np.float32) / 65535.0, False
+    mode = im.mode
+    if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
+        return np.asarray(im, dtype=np.float32) / 65535.0, False
+    if mode == "I":        # 16-bit PNGs open as 32-bit integers holding 0..65535
+        a = np.asarray(im, dtype=np.float32)
+        return a / (65535.0 if a.max() <= 65535 else float(2 ** 31 - 1)), False
+    if mode == "F":
+        return np.asarray(im, dtype=np.float32), True
+    if mode not in ("L", "LA", "RGB", "RGBA"):
+        im = im.convert("RGBA" if "A" in mode or "transparency" in im.info else "RGB")
+    return np.asarray(im, dtype=np.float32) / 255.0, False
 
 
 def _decode_pillow(path: str) -> tuple:
     import warnings
 
-    from PIL import Image, ImageOps, UnidentifiedImageError
+    from PIL import Image, UnidentifiedImageError
 
     try:
         with warnings.catch_warnings():
@@ -204,26 +232,55 @@ def _decode_pillow(path: str) -> tuple:
                 w, h = im.size
                 if w * h > MAX_PIXELS:
                     raise ImageError(f"{path}: {w}x{h} px is more than the {MAX_PIXELS} px an input may have")
+                tiles = list(im.tile)       # how the file is decoded (load() lets go of it)
                 im.load()
-                if im.getexif().get(_EXIF_ORIENTATION, 1) != 1:
-                    im = ImageOps.exif_transpose(im)     # a phone photo as every viewer shows it, not as stored
-                mode = im.mode
-                if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
-                    return np.asarray(im, dtype=np.float32) / 65535.0, False
-                if mode == "I":        # 16-bit PNGs open as 32-bit integers holding 0..65535
-                    a = np.asarray(im, dtype=np.float32)
-                    return a / (65535.0 if a.max() <= 65535 else float(2 ** 31 - 1)), False
-                if mode == "F":
-                    return np.asarray(im, dtype=np.float32), True
-                if mode not in ("L", "LA", "RGB", "RGBA"):
-                    im = im.convert("RGBA" if "A" in mode or "transparency" in im.info else "RGB")
-                return np.asarray(im, dtype=np.float32) / 255.0, False
+                turn = _TURNS.get(im.getexif().get(_EXIF_ORIENTATION, 1), _TURNS[1])
+                a, linear = _pillow_pixels(im, tiles)
+                return np.ascontiguousarray(turn(a)), linear      # a phone photo as every viewer shows it
     except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
         if isinstance(exc, UnidentifiedImageError):
             tiff = os.path.splitext(path)[1].lower() in (".tif", ".tiff")   # Pillow reads one float channel only
             raise ImageError(f"{path}: not an image file this reader knows"
                              + ("; a TIFF of float colours is read as .exr: save it as one" if tiff else "")) from None
         raise ImageError(f"{path}: the image is more than the {MAX_PIXELS} px an input may have") from None
+
+
+#: Pillow's raw modes of 16-bit colour files that it opens as 8-bit colour ("RGB", "RGBA"): the 16-bit samples'
+#: byte order (B big-endian, L little, N this machine's)
+_WIDE = re.compile(r"(RGB|RGBA|LA);16([BLN])")
+
+
+def _sixteen_bits(path: str, tiles: list) -> np.ndarray | None:
+    """The samples of the 16-bit colour PNG or TIFF (RGB, RGBA, grey with alpha) at ``path`` as uint16 (H, W, C),
+    from the tiles Pillow opened it with; None for any other image.  Pillow's colour modes hold 8 bits, so it opens
+    such a file as 8-bit colour, each sample's high byte alone: the file is decoded twice here, unpacking the high
+    and then the low bytes (its raw mode told the other byte order), and the bytes are put together.  Grey with
+    alpha, whose 8-bit raw mode has no such twin, is decoded as 8-bit RGBA: the same four bytes a pixel."""
+    if not tiles or not all(hasattr(t, "_replace") and isinstance(getattr(t, "args", None), (str, tuple))
+                            for t in tiles):
+        return None
+    raws = {t.args if isinstance(t.args, str) else t.args[0] for t in tiles}
+    match = _WIDE.fullmatch(next(iter(raws))) if len(raws) == 1 else None
+    if match is None:
+        return None
+    kind, order = match.groups()
+    if order == "N":
+        order = "L" if sys.byteorder == "little" else "B"
+
+    def decoded(raw: str) -> np.ndarray:
+        from PIL import Image
+
+        with Image.open(path) as again:
+            again.tile = [t._replace(args=raw if isinstance(t.args, str) else (raw,) + tuple(t.args[1:]))
+                          for t in again.tile]
+            again.load()
+            return np.asarray(again, dtype=np.uint16)
+
+    if kind == "LA":        # opened as RGBA
+        b = decoded("RGBA")
+        return np.stack([b[..., 0] * 256 + b[..., 1], b[..., 2] * 256 + b[..., 3]], axis=-1)
+    high, low = (f"{kind};16{order}", f"{kind};16{'B' if order == 'L' else 'L'}")
+    return decoded(high) * 256 + decoded(low)
 
 
 OPAQUE = 254.5 / 255.0   #: the least alpha an input's pixel may have (an 8-bit 255; 254 is partly transparent)
