@@ -175,9 +175,11 @@ def _check_outputs(a: argparse.Namespace) -> None:
                     raise IsADirectoryError(f"output path is a folder, not a file: {path}")
             except OSError as exc:
                 raise SettingError(flag, str(exc)) from None
-    named = [os.path.realpath(getattr(a, k)) for _, k in outputs if isinstance(getattr(a, k, None), str)]
-    if len(named) == 2 and named[0] == named[1]:
-        raise SettingError("--report", f"{os.path.basename(a.report)} is also -o: write the report to another file")
+    named = [(flag, getattr(a, k)) for flag, k in outputs if isinstance(getattr(a, k, None), str)]
+    for i, (flag, path) in enumerate(named):
+        twin = next((f for f, p in named[:i] if os.path.realpath(p) == os.path.realpath(path)), None)
+        if twin is not None:
+            raise SettingError(flag, f"{os.path.basename(path)} is also {twin}: write it to another file")
 
 
 def _run(a: argparse.Namespace) -> int:

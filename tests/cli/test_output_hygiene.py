@@ -445,7 +445,15 @@ def test_an_output_written_over_a_file_the_command_reads_is_refused_and_the_file
             (["wave", "--transfer", str(ramp), "-o", str(ramp)], "-o: ramp.json is the file --transfer reads"),
             (["neural", "--fit", str(photo), "-o", str(photo)], "-o: photo.png is the file --fit reads"),
             (["neural", "--fit", str(photo), "-o", str(tmp_path / "f.png"), "--report", str(tmp_path / "f.png")],
-             "--report: f.png is also -o: write the report to another file")):
+             "--report: f.png is also -o: write it to another file"),
+            (["wave", "-o", str(tmp_path / "w.toml"), "--save-job", str(tmp_path / "w.toml")],
+             "--save-job: w.toml is also -o"),
+            (["neural", "--noise", "perlin", "-o", str(tmp_path / "n.png"), "--save-job", str(tmp_path / "n.png")],
+             "--save-job: n.png is also -o"),
+            (["solid", "--exemplar", "gravel_3d", "--dim", "3", "-o", str(tmp_path / "s.npy"), "--save-job",
+              str(tmp_path / "s.npy")], "--save-job: s.npy is also -o: write it to another file"),
+            (["solid", "--exemplar", str(photo), "--dim", "3", "-o", str(tmp_path / "s.npy"), "--save-job",
+              str(photo)], "--save-job: photo.png is the file --exemplar reads")):
         assert main(argv + ["--quiet"]) == 2, argv
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and said in err[0], (argv, err)
