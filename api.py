@@ -246,7 +246,8 @@ def neural(noise: str, size: int = 256, *, params: dict | None = None, seed: int
 
 def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: str | None = None, seed: int = 0,
           scale: float = 1.0, refine: int = 0, periodic: bool = True, model: str | None = None,
-          families: tuple | None = None, out: str | None = None, progress: Progress = None):
+          families: tuple | None = None, out: str | None = None, progress: Progress = None,
+          save_job: str | None = None):
     """A solid texture from a shipped texture's name (``omninoise solid --list``) or a photo (a file, as a string or
     a path, or sRGB float pixels in [0, 1]: ``(H, W, 3)``, grey ``(H, W)`` or with an opaque alpha ``(H, W, 4)``).
 
@@ -263,7 +264,9 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     Returns scene-linear RGB float32: ``(size, size, 3)`` for ``dim=2`` (the front view: x right, z up, top row
     first) or ``(size, size, size, 3)`` indexed ``[z, y, x]`` for ``dim=3``; or, with ``out``, writes it as
     ``omninoise solid -o`` does (2D ``.png``/``.exr``/``.npy``, 3D ``.vdb``/``.npy``; the fitted procedural solid
-    ``.json``) and returns the path.
+    ``.json``) and returns the path.  With ``save_job`` too (a ``.toml`` path; ``out`` a volume, or an image of a
+    2D texture: a 2D model's, ``method="synthesis"``), it writes the job file that draws ``out`` so (``omninoise
+    bake``, a farm) instead of drawing it, as ``omninoise solid --save-job`` does, and returns the job's path.
 
     >>> rgb = solid("grass", 16)
     >>> rgb.shape, rgb.dtype
@@ -288,6 +291,14 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         from .backend.bake import require_vdb
 
         require_vdb("out")
+    if save_job is not None:
+        from .backend.job_file import check_job_file
+
+        if out is None:
+            raise SettingError("save_job", "applies to a written file; give out= too")
+        save_job = check_job_file(save_job, "save_job")
+        if not isinstance(exemplar, str):
+            raise SettingError("exemplar", "a job reads its image or saved solid from a file: give the file's path")
     for name, value, unset in (("dim", dim, 2), ("size", size, 256), ("scale", scale, 1.0)):
         if ext == ".json" and value != unset:
             raise SettingError(name, "a .json output holds the fitted solid, not a drawing of it: leave "
@@ -297,6 +308,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
                             ("families", families is not None)) if v]
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
     req.check_reads(given).check_pixels()      # a photo no method can use is named before any work
+    if save_job is not None:
+        from .backend.job_file import solid_spec, write_job
+
+        write_job(save_job, [solid_spec(req, size, dim, float(scale), os.fspath(out))], None, "save_job")
+        return save_job
     if ext == ".json":          # the fitted procedural solid itself
         from .backend.solid.procedural import saved
 

@@ -45,7 +45,7 @@ from .errors import SettingError
 from .sources import NeuralSource, WaveSource, describe
 from .wavenoise.settings import WaveSettings, read_settings, settings_to_dict
 
-__all__ = ["bake_table", "job_text", "check_job_file", "side_files", "write_job"]
+__all__ = ["bake_table", "job_text", "check_job_file", "side_files", "solid_spec", "write_job"]
 
 _BARE = re.compile(r"[A-Za-z0-9_-]+")
 HEADER = "# An OmniNoise bake job: omninoise bake FILE.toml bakes it (docs/guide/jobs.md)."
@@ -153,26 +153,158 @@ def _side_image(source: NeuralSource) -> np.ndarray:
     return np.asarray(_region_colours(source), np.uint8)[source.regions]
 
 
+#: a side file's kind (:func:`_side_kind`) as a message names it
+_SIDE_WORDS = {"mask": "mask", "map": "map", "photo": "photo", "solid": "procedural solid"}
+
+
+def _side_kind(source) -> tuple | None:
+    """(name, extension) of the file a source's job reads beside it, or None: a neural source's blend mask or
+    painted map; a solid source's photo (pixels) or procedural solid held in memory (a Blender image, a node
+    group's solid)."""
+    if isinstance(source, NeuralSource):
+        if source.keys is None and source.layout in ("blend", "painted"):
+            return ("mask" if source.layout == "blend" else "map", ".png")
+        return None
+    if getattr(source, "kind", None) != "solid" or isinstance(source.request.exemplar, (str, type(None))):
+        return None
+    from .solid.procedural.saved import is_saved
+
+    return ("solid", ".json") if is_saved(source.request.exemplar) else ("photo", ".png")
+
+
 def side_files(path: str, specs: list) -> dict:
-    """{index of a spec: the absolute path of the file its job reads beside it}: a neural source's blend mask or
-    painted map, ``<job name>_mask.png`` / ``_map.png`` (then ``_map2.png``, ...) in the job file's folder."""
+    """{index of a spec: the absolute path of the file its job reads beside it, in the job file's folder}: a neural
+    source's blend mask or painted map, ``<job name>_mask.png`` / ``_map.png``; a solid source's photo or procedural
+    solid held in memory, ``_photo.png`` / ``_solid.json``; a second of a kind ``_map2.png``, and so on."""
     stem = os.path.splitext(os.path.abspath(path))[0]
-    out, count = {}, {"blend": 0, "painted": 0}
+    out, count = {}, {}
     for i, spec in enumerate(specs):
-        src = spec.source
-        if isinstance(src, NeuralSource) and src.keys is None and src.layout in count:
-            count[src.layout] += 1
-            n = count[src.layout]
-            out[i] = f"{stem}_{'mask' if src.layout == 'blend' else 'map'}{n if n > 1 else ''}.png"
+        kind = _side_kind(spec.source)
+        if kind is not None:
+            count[kind] = n = count.get(kind, 0) + 1
+            out[i] = f"{stem}_{kind[0]}{n if n > 1 else ''}{kind[1]}"
     return out
+
+
+def _write_side(path: str, source) -> None:
+    """The file ``path`` beside a job that ``source`` reads (:func:`side_files`): a neural mask or map as an 8-bit
+    PNG; a solid's photo as an 8-bit PNG where its pixels are 8-bit values (an 8-bit photo in Blender), else 16-bit
+    (the digest a solid's key holds is of 16-bit values: the same either way); a procedural solid as saved JSON."""
+    from ..export.images import write_png
+
+    if isinstance(source, NeuralSource):
+        write_png(path, _side_image(source))
+        return
+    x = source.request.exemplar
+    if not isinstance(x, np.ndarray):
+        from .solid.procedural import saved
+
+        saved.save(path, x)
+        return
+    x = np.clip(np.asarray(x, np.float64), 0.0, 1.0)
+    eight = np.round(x * 255.0)
+    write_png(path, eight.astype(np.uint8) if np.abs(x * 255.0 - eight).max() < 1e-3 else
+              np.round(x * 65535.0).astype(np.uint16))
+
+
+def _read_from(spec: BakeSpec, side: str) -> BakeSpec:
+    """``spec`` with its solid source's exemplar read from ``side``, the file written beside the job: what the
+    job's bake reads, to check the text against.  RuntimeError where the file does not hold the same photo or
+    solid (the digest its key holds)."""
+    import dataclasses
+
+    from .sources import solid_source
+
+    src = spec.source
+    again = solid_source(dataclasses.replace(src.request, exemplar=side), src.scale, getattr(src, "density", 1.0))
+    if again.input_sha256 != src.input_sha256:
+        raise RuntimeError(f"{os.path.basename(side)} does not hold the exemplar of {spec.name!r}")
+    return dataclasses.replace(spec, source=again)
+
+
+def _exemplar(x, key: str, job_dir: str) -> str:
+    """A solid request's exemplar (or ``to``) as a job names it: an image or saved solid's file from ``job_dir``, a
+    shipped texture by its name; SettingError for pixels or a solid held in memory (a job reads files)."""
+    if not isinstance(x, str):
+        raise SettingError(f"source.{key}", "a job reads its image or saved solid from a file; this one is held in "
+                                            "memory: write it to a file and name that file")
+    return _relative(x, job_dir) if os.path.isfile(x) else x
+
+
+def _solid_table(source, job_dir: str, side: str | None = None) -> dict:
+    """A solid source's table: its request's method, exemplar (``side``: the file beside the job holding one held
+    in memory) and the settings that method reads where they differ from a job's defaults (a photo's settings of a
+    neural texture only where it reads a photo), its scale and density."""
+    from .paths import solid_models
+    from .solid.methods import READS
+    from .solid.request import PHOTO_READS, SolidRequest
+
+    r, default = source.request, SolidRequest()
+    table = {"kind": "solid", "method": r.method}
+    if side is not None:
+        table["exemplar"] = side
+    elif r.exemplar is not None:      # None: a single-texture model's own
+        table["exemplar"] = _exemplar(r.exemplar, "exemplar", job_dir)
+    photo = r.method != "neural" or side is not None or any(isinstance(x, str) and os.path.isfile(x)
+                                                             for x in (r.exemplar, r.to))
+    for key in READS[r.method]:
+        value = getattr(r, key)
+        if key == "model" and value is not None:
+            shipped = os.path.dirname(os.path.realpath(value)) == os.path.realpath(solid_models())
+            table[key] = (os.path.basename(os.path.realpath(value)) if shipped and os.path.isdir(value)
+                          else _relative(value, job_dir) if os.path.isdir(value) else value)
+        elif key == "to" and value is not None:
+            table.update(to=_exemplar(value, "to", job_dir), mix=float(r.mix))
+        elif key == "families" and tuple(value) != tuple(default.families):
+            table[key] = list(value)
+        elif (key in ("refine", "periodic", "gaussian") or key == "rest" and r.gaussian) and value != getattr(
+                default, key) and (photo or key not in PHOTO_READS):
+            table[key] = {"refine": int, "rest": str}.get(key, bool)(value)
+        elif key == "tile" and value != default.tile:
+            table[key] = int(value)
+    if r.seed:
+        table["seed"] = int(r.seed)
+    if source.scale != 1.0:
+        table["scale"] = float(source.scale)
+    if getattr(source, "dim", 3) == 3 and source.density != 1.0:
+        table["density"] = float(source.density)
+    return table
+
+
+def solid_spec(request, size: int, dim: int, scale: float, out: str, names=("out", "save_job", "")) -> BakeSpec:
+    """The bake of a checked :class:`~backend.solid.request.SolidRequest` that draws ``out`` as ``omninoise solid``
+    does: a volume (``dim`` 3) of ``size`` voxels a side from the origin, ``scale`` voxels per photo pixel; a 2D
+    texture's image (a 2D model's, method synthesis) of the plane z = 0, x right and y up from its top-left corner.
+    ``names``: how the front end names the output, the job file and the request's settings (a prefix).  SettingError
+    for what no job draws so: a fitted solid's .json, a 3D texture's front view (the command line's image of the
+    plane y = 0; a job's 2D bake reads the plane z = 0), an image's .npy (a bake's rows run +y first)."""
+    from .sources import BoxGrid, solid_px_per_unit, solid_source
+
+    named, where, prefix = names
+    ext = os.path.splitext(out)[1].lower()
+    if ext == ".json":
+        raise SettingError(where, f"a .json {named} is the fitted solid itself, which no job writes: fit it first, "
+                                  "then save the job of its volume (the .json as the exemplar, 3D)")
+    if dim == 2 and ext == ".npy":
+        raise SettingError(where, f"a job's .npy holds an image's rows from the bottom up (+y first, as every bake's "
+                                  f"array), {named}'s from the top: write {named} as .png or .exr")
+    if dim == 2 and request.method != "synthesis" and (request.method != "neural" or request.load(prefix).dim != 2):
+        raise SettingError(where, f"{named}'s image is a solid's front view (the plane y = 0), a job's 2D bake its "
+                                  "plane z = 0 (seen from above): save a volume's job (3D), or draw the image")
+    extent = size / (solid_px_per_unit(request, prefix) * scale)
+    box = ((0.0, 0.0, 0.0), (extent,) * 3) if dim == 3 else ((0.0, -extent, 0.0), (extent, 0.0, 0.0))
+    return BakeSpec("solid", solid_source(request, where=f"{prefix}"), BoxGrid((size,) * dim, box),
+                    os.path.abspath(out)).validate()
 
 
 def _source_table(source, side: str | None = None, job_dir: str = ".") -> dict:
     if isinstance(source, NeuralSource):
         return _neural_table(source, side, job_dir)
+    if source.kind == "solid":
+        return _solid_table(source, job_dir, side)
     if not isinstance(source, WaveSource):
         raise SettingError("source", f"a {source.kind} bake is written as a job by hand (docs/guide/jobs.md); "
-                                     "only wave and neural noise bakes are saved as job files")
+                                     "only wave noise, neural noise and solid texture bakes are saved as job files")
     s = source.settings
     if s.example is not None:
         raise SettingError("source", _by_example("a by-example noise"))
@@ -251,10 +383,10 @@ def job_text(specs: list, job_dir: str, sides: dict | None = None) -> str:
     ``output_root`` is the outputs' common folder where that lies outside ``job_dir``. ``sides``: the files of the
     neural sources' masks and painted maps (:func:`side_files`), which such a source needs."""
     sides = sides or {}
-    missing = [s.name for i, s in enumerate(specs) if i not in sides and isinstance(s.source, NeuralSource)
-               and s.source.keys is None and s.source.layout in ("blend", "painted")]
+    missing = [s.name for i, s in enumerate(specs) if i not in sides and _side_kind(s.source) is not None]
     if missing:
-        raise SettingError("source", f"{missing[0]!r} reads its mask or map from a file: name it (side_files)")
+        raise SettingError("source", f"{missing[0]!r} reads its mask, map, photo or solid from a file: name it "
+                                     "(side_files)")
     tables = [bake_table(s, job_dir, sides.get(i)) for i, s in enumerate(specs)]
     lines = [HEADER]
     folders = [os.path.dirname(os.path.abspath(s.output)) for s in specs]
@@ -281,13 +413,13 @@ def _same(a: BakeSpec, b: BakeSpec) -> bool:
 
 
 def write_job(path: str, specs: list, reads: dict | None = None, where: str = "file") -> str:
-    """Write the job file ``path`` (.toml) that bakes ``specs``, atomically, and beside it the masks and painted
-    maps its neural sources read (:func:`side_files`); returns its text. SettingError naming what cannot be
-    written (:func:`check_job_file`, a source other than wave or neural noise, a by-example noise, a map's name
-    that is an output or one of ``reads``: {path of a file the front end reads: who reads it, "--map reads"}),
-    named as ``where`` where it is the job file's, and RuntimeError where the text would bake anything else than
-    ``specs``; then no job is written, and the maps written to check it are removed (one that was there before is
-    put back)."""
+    """Write the job file ``path`` (.toml) that bakes ``specs``, atomically, and beside it the files its sources
+    read that are held in memory (:func:`side_files`: neural masks and painted maps, solid photos and procedural
+    solids); returns its text. SettingError naming what cannot be written (:func:`check_job_file`, a source other
+    than wave noise, neural noise or a solid texture, a by-example noise, a side file's name that is an output or
+    one of ``reads``: {path of a file the front end reads: who reads it, "--map reads"}), named as ``where`` where
+    it is the job file's, and RuntimeError where the text would bake anything else than ``specs``; then no job is
+    written, and the side files written to check it are removed (one that was there before is put back)."""
     from ..export.atomic import write_text
     from .jobs import JobError, parse_job
 
@@ -295,38 +427,41 @@ def write_job(path: str, specs: list, reads: dict | None = None, where: str = "f
     job_dir = os.path.dirname(os.path.abspath(path))
     sides = side_files(path, specs)
     read = {os.path.realpath(f): who for f, who in (reads or {}).items() if f}
-    for side in sides.values():     # the mask or map it writes: never over a file read
+    words = {i: _SIDE_WORDS[_side_kind(specs[i].source)[0]] for i in sides}
+    for i, side in sides.items():     # what it writes beside the job: never over a file read
         if os.path.realpath(side) in read:
-            raise SettingError(where, f"the job writes its map to {os.path.basename(side)}, the file "
+            raise SettingError(where, f"the job writes its {words[i]} to {os.path.basename(side)}, the file "
                                       f"{read[os.path.realpath(side)]}: save the job under another name")
     text = job_text(specs, job_dir, sides)
     outputs = {os.path.abspath(frame_path(s.output, f)) for s in specs for f in s.frame_list()}
-    taken = [f for f in sides.values() if f in outputs]
+    taken = [i for i, f in sides.items() if f in outputs]
     if taken:
-        raise SettingError("job file", f"{os.path.basename(taken[0])} is a bake's output; the job writes its mask "
-                                       "or map there: save the job under another name")
+        raise SettingError("job file", f"{os.path.basename(sides[taken[0]])} is a bake's output; the job writes its "
+                                       f"{words[taken[0]]} there: save the job under another name")
     from ..export.atomic import atomic_path
-    from ..export.images import write_png
 
     kept = {}       # a map saved with the job before: put back if this job is not written
     for f in sides.values():
         if os.path.isfile(f):
             with open(f, "rb") as fh:
                 kept[f] = fh.read()
-    for i, f in sides.items():      # the job reads them; written before it is read back
-        write_png(f, _side_image(specs[i].source))
     try:
+        for i, f in sides.items():      # the job reads them; written before it is read back
+            _write_side(f, specs[i].source)
         parsed = parse_job(tomllib.loads(text), job_dir, path)
         for i, (spec, (name, got)) in enumerate(zip(specs, parsed)):
             if isinstance(got, JobError):
                 raise SettingError("job file", str(got))
+            if i in sides and not isinstance(spec.source, NeuralSource):
+                spec = _read_from(spec, sides[i])
             if not _same(spec, got):
                 raise RuntimeError(f"the job file would bake {name!r} otherwise than asked: "
                                    f"{describe(bake_table(got, job_dir, sides.get(i)))}")
     except BaseException:
         for f in sides.values():
             if f not in kept:
-                os.remove(f)
+                if os.path.exists(f):       # one not written yet stays away
+                    os.remove(f)
                 continue
             with atomic_path(f) as tmp:
                 with open(tmp, "wb") as fh:

@@ -24,7 +24,8 @@ from . import limits
 from .errors import SettingError
 
 __all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "SpectralSource", "AutoSource",
-           "solid_volume", "source_from_dict", "register_source", "source_kinds", "SOURCES"]
+           "solid_volume", "solid_source", "solid_px_per_unit", "source_from_dict", "register_source", "source_kinds",
+           "SOURCES"]
 
 _F = np.float32
 
@@ -360,6 +361,17 @@ def _solid_points(shape, first, step, start=None) -> np.ndarray:
     return pts
 
 
+def _named(exemplar) -> str | None:
+    """An exemplar as a solid source's key names it: a file by its real path (one file however its path is
+    spelled: a job's, relative to its folder, or the command line's), a shipped texture by its name, pixels by
+    none (the key holds their digest)."""
+    import os
+
+    if not isinstance(exemplar, str):
+        return None
+    return os.path.realpath(exemplar) if os.path.isfile(exemplar) else exemplar
+
+
 class SolidSource:
     """A neural solid texture (Henzler et al. 2020) as a bake source of colours (``rgb``).
 
@@ -417,11 +429,11 @@ class SolidSource:
 
     def to_dict(self) -> dict:
         r = self.request
-        named = r.exemplar if isinstance(r.exemplar, str) else None    # pixels are in input_sha256
+        named = _named(r.exemplar)      # pixels are in input_sha256
         d = dict(kind=self.kind, model=self.model.config["files"], exemplar=named, input_sha256=self.input_sha256,
                  refine=int(r.refine), seed=self.seed, scale=self.scale, density=self.density)
         if r.to is not None:
-            d.update(to=r.to if isinstance(r.to, str) else None, mix=float(r.mix))
+            d.update(to=_named(r.to), mix=float(r.mix))
         h = self.code.harmonics     # the harmonic part in use (an encoded photo's, a stored one)
         d["harmonics_sha256"] = None if h is None else hashlib.sha256(h.values().astype("<f8").tobytes()).hexdigest()
         r = self.code.rest          # the Gaussian rest in use (backend/solid/gaussian_rest.py), if the check kept one
@@ -497,7 +509,7 @@ class _Prepared:
 
     def to_dict(self) -> dict:
         r = self.request
-        return dict(self._key, kind=self.kind, exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+        return dict(self._key, kind=self.kind, exemplar=_named(r.exemplar),
                     input_sha256=self.input_sha256, scale=self.scale, density=self.density)
 
     def __getstate__(self) -> dict:
@@ -584,7 +596,7 @@ class SynthesisSource(_Prepared):
         # when they change, not only when the request does
         drawn = image_settings(r.tile, self.photo_shape, r.seed)
         settings = {k: list(v) if isinstance(v, tuple) else v for k, v in dataclasses.asdict(drawn).items()}
-        return dict(kind=self.kind, method="synthesis", exemplar=r.exemplar if isinstance(r.exemplar, str) else None,
+        return dict(kind=self.kind, method="synthesis", exemplar=_named(r.exemplar),
                     input_sha256=self.input_sha256, seed=int(r.seed), tile=int(r.tile), scale=self.scale,
                     settings=settings)
 
@@ -610,14 +622,14 @@ class AutoSource(_Prepared):
 
 
 class EncodedSource(_Prepared):
-    """A neural solid texture of an image file (method "neural" with the texture-space model): :class:`SolidSource`
+    """A neural solid texture of a photo (method "neural" with the texture-space model): :class:`SolidSource`
     once the photo is encoded (:mod:`backend.solid.pipeline`'s stages, seconds a photo), at its first use
     (:class:`_Prepared`) rather than when a job is read.  The key is the request's (the photo's pixels, mix, refine,
     seed, periodic, gaussian, rest) with the model's files."""
 
     def __init__(self, request, model, scale: float = 1.0, density: float = 1.0):
         """request: a checked :class:`~backend.solid.request.SolidRequest` with method "neural" whose exemplar is an
-        image file; model: its loaded :class:`~backend.solid.model.SolidTextureModel`, of mode "space"."""
+        image file or pixels; model: its loaded :class:`~backend.solid.model.SolidTextureModel`, of mode "space"."""
         self.model, self.dim = model, model.dim
         super().__init__(request, scale, density)
 
@@ -802,20 +814,50 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
         [k for k in d if k not in ("method", "scale", "density")], "source.")
 
 
-def _solid_from_dict(d: dict, base_dir: str):
+def solid_source(request, scale: float = 1.0, density: float = 1.0, where: str = "source."):
+    """The bake source of a checked :class:`~backend.solid.request.SolidRequest`, as a job file's solid source is
+    made: a photo's texture is made at its first use (:class:`_Prepared`), a shipped texture's code here; ``where``
+    prefixes the settings a problem names."""
     import os
 
-    req = solid_request_from_dict(d, base_dir)
-    if req.method == "synthesis":
-        return SynthesisSource(req, d.get("scale", 1.0))
-    if req.method in ("spectral", "procedural"):
-        return SpectralSource(req, d.get("scale", 1.0), d.get("density", 1.0))
-    if req.method == "auto":
-        return AutoSource(req, d.get("scale", 1.0), d.get("density", 1.0))
-    model = req.load("source.")
-    if model.mode != "single" and isinstance(req.exemplar, str) and os.path.isfile(req.exemplar):
-        return EncodedSource(req, model, d.get("scale", 1.0), d.get("density", 1.0))
-    return SolidSource(model, req, d.get("scale", 1.0), d.get("density", 1.0))
+    if request.method == "synthesis":
+        return SynthesisSource(request, scale)
+    if request.method in ("spectral", "procedural"):
+        return SpectralSource(request, scale, density)
+    if request.method == "auto":
+        return AutoSource(request, scale, density)
+    model = request.load(where)
+    x = request.exemplar
+    if model.mode != "single" and (isinstance(x, np.ndarray) or isinstance(x, str) and os.path.isfile(x)):
+        return EncodedSource(request, model, scale, density)        # a photo: encoded at its first use
+    return SolidSource(model, request, scale, density)
+
+
+def solid_px_per_unit(request, where: str = "") -> float:
+    """Photo pixels per texture unit of the texture a checked request draws (what a scale of 1 draws), known before
+    it is made: a saved procedural solid's own, a neural model's, else the image methods' 128.  Auto draws either
+    of two: SettingError naming ``where`` + model where the model's differs from the procedural solid's."""
+    from .solid.procedural.field import PX_PER_UNIT
+    from .solid.procedural.saved import is_saved, read
+    from .solid import synthesis
+
+    if is_saved(request.exemplar):
+        field = request.exemplar if not isinstance(request.exemplar, str) else read(request.exemplar,
+                                                                                    f"{where}exemplar")
+        return float(field.px_per_unit)
+    if request.method in ("synthesis", "spectral"):
+        return synthesis.PX_PER_UNIT
+    if request.method == "procedural":
+        return PX_PER_UNIT
+    model = request.load(where)
+    if request.method == "auto" and model.px_per_unit != PX_PER_UNIT:
+        raise SettingError(f"{where}model", f"draws {model.px_per_unit:g} photo pixels per unit, the procedural "
+                                            f"solid {PX_PER_UNIT:g}: auto's scale would depend on its choice")
+    return float(model.px_per_unit)
+
+
+def _solid_from_dict(d: dict, base_dir: str):
+    return solid_source(solid_request_from_dict(d, base_dir), d.get("scale", 1.0), d.get("density", 1.0))
 
 
 def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:

@@ -83,6 +83,7 @@ def _render_menu(self, context):
     self.layout.operator("omninoise.run_job", text="Run Bake Job...", icon="PLAY")
     self.layout.operator("omninoise.save_job", text="Save Noise Bake as Job...", icon="EXPORT")
     self.layout.operator("omninoise.neural_save_job", text="Save Neural Bake as Job...", icon="EXPORT")
+    self.layout.operator("omninoise.solid_save_job", text="Save Solid Bake as Job...", icon="EXPORT")
 
 
 #: Blender menu -> the entry this module appends to it

@@ -47,14 +47,14 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 from . import tasks
 from .. import backend
 from .compat import ensure_node_tree
-from .bake_ui import draw_progress
+from .bake_ui import SaveJobOperator, draw_progress
 from .common import Sidebar, backend_module as _mod, image_srgb, solid_models_folder, store_srgb_image
 from .tasks import TaskOperator
 from .preferences import threads
 from .presets import SOLID_VALUES, SUBDIRS
 
 __all__ = ["models_dir", "load_model", "panel_request", "tile_request", "texture", "remembered", "tile_repeats",
-           "attach", "detach"]
+           "volume_target", "job_spec", "attach", "detach"]
 
 #: another folder of solid texture models than the shipped one (tests point it elsewhere); None: the shipped models
 MODELS_DIR: str | None = None
@@ -644,22 +644,9 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
                 _material_with(obj, name, node)
 
         else:  # VOLUME
-            from .bake_blender import load_volume, output_folder
+            from .bake_blender import load_volume
 
-            lo = np.array([min(c[i] for c in obj.bound_box) for i in range(3)])
-            hi = np.array([max(c[i] for c in obj.bound_box) for i in range(3)])
-            if world:
-                from .bake_blender import world_bounds
-
-                lo, hi = (np.array(b) for b in world_bounds(obj))
-            if float((hi - lo).max()) <= 1e-6:     # a camera, light, empty or empty volume: nothing to fill
-                raise backend.SettingError("object", f"{obj.name!r} has no extent to fill with a volume (its bounding "
-                                                     "box is a point); bake an object with a size")
-            ext = np.maximum(hi - lo, 1e-6)
-            vs = float(ext.max()) / int(p.voxels)
-            res = tuple(int(max(1, round(e / vs))) for e in ext)
-            grid = _mod("sources").BoxGrid(res, (tuple(lo), tuple(lo + np.array(res) * vs))).validate()
-            path = os.path.join(output_folder(p.folder), bpy.path.clean_name(name) + ".vdb")
+            grid, path = volume_target(p, obj, world)
             bake = _mod("solid.bake")
 
             def work(progress, cancel):
@@ -681,6 +668,74 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
                     vol.matrix_world = obj.matrix_world.copy()
 
         return tasks.start(tasks.Task(f"Solid {name}", work, done, None, threads()), blocking=blocking)
+
+
+def volume_target(p, obj, world: bool) -> tuple:
+    """(BoxGrid, path) of the panel's volume bake of ``obj``: its bounding box (world or its own space), Voxels
+    along the longest side, ``<Name>.vdb`` in the panel's folder; SettingError for an object with no extent."""
+    from .bake_blender import output_folder
+
+    lo = np.array([min(c[i] for c in obj.bound_box) for i in range(3)])
+    hi = np.array([max(c[i] for c in obj.bound_box) for i in range(3)])
+    if world:
+        from .bake_blender import world_bounds
+
+        lo, hi = (np.array(b) for b in world_bounds(obj))
+    if float((hi - lo).max()) <= 1e-6:     # a camera, light, empty or empty volume: nothing to fill
+        raise backend.SettingError("object", f"{obj.name!r} has no extent to fill with a volume (its bounding "
+                                             "box is a point); bake an object with a size")
+    ext = np.maximum(hi - lo, 1e-6)
+    vs = float(ext.max()) / int(p.voxels)
+    res = tuple(int(max(1, round(e / vs))) for e in ext)
+    grid = _mod("sources").BoxGrid(res, (tuple(lo), tuple(lo + np.array(res) * vs))).validate()
+    return grid, os.path.join(output_folder(p.folder), bpy.path.clean_name(p.name) + ".vdb")
+
+
+def job_spec(context):
+    """The panel's volume bake as a :class:`~backend.bake.BakeSpec` for a job file: the request the panel draws
+    (a photo or a node group's solid held in memory, which the job writer saves beside the job), at the bake's
+    scale and over its box; SettingError for what a job does not bake (a UV image or colour attribute: written into
+    the mesh) and what the bake refuses."""
+    p = context.scene.omninoise_solid
+    if p.target != "VOLUME":
+        raise backend.SettingError("target", "a job bakes files: a UV image or color attribute is written into the "
+                                             "mesh; set Bake To to Volume")
+    obj = context.active_object
+    if obj is None:
+        raise backend.SettingError("object", "select an object to bake onto")
+    req = panel_request(p)
+    scale, world = _space(p, obj)
+    grid, path = volume_target(p, obj, world)
+    source = _mod("sources").solid_source(req, scale, where="")
+    if source.dim != 3:
+        raise backend.SettingError("model", "the texture is 2D; a volume needs a 3D solid texture")
+    return _mod("bake").BakeSpec(p.name, source, grid, path).validate()
+
+
+class OMNINOISE_OT_solid_save_job(SaveJobOperator, bpy.types.Operator):
+    """Save the panel's volume bake as a TOML job file (the photo or procedural solid beside it), that
+    `omninoise bake`, a farm or the Batch Job panel bakes again without Blender"""
+
+    bl_idname = "omninoise.solid_save_job"
+    bl_label = "Save Solid Bake as Job File"
+    settings = "omninoise_solid"
+
+    @classmethod
+    def poll(cls, context):
+        p = getattr(context.scene, "omninoise_solid", None)
+        if p is not None and p.target != "VOLUME":
+            cls.poll_message_set("A job bakes files: set Bake To to Volume (a UV image or color attribute is "
+                                 "written into the mesh)")
+            return False
+        return True
+
+    def specs(self, context) -> list:
+        return [job_spec(context)]
+
+    def reads(self, context) -> dict:
+        """The exemplar image's file: the photo the job reads is never written over it."""
+        ima = context.scene.omninoise_solid.image
+        return {bpy.path.abspath(ima.filepath): "of the Exemplar image"} if ima is not None and ima.filepath else {}
 
 
 class OMNINOISE_OT_solid_procedural_node(SolidTask, bpy.types.Operator):
@@ -862,6 +917,7 @@ def draw_solid(layout, context) -> None:
     row = _idle_row(layout)
     row.operator(OMNINOISE_OT_solid_preview.bl_idname, text="Preview", icon="HIDE_OFF")
     row.operator(OMNINOISE_OT_solid_bake.bl_idname, text="Bake", icon="RENDER_STILL")
+    row.operator(OMNINOISE_OT_solid_save_job.bl_idname, text="", icon="EXPORT")
 
 
 def _draw_node_group(layout, context) -> None:
@@ -991,7 +1047,8 @@ PANELS = (OMNINOISE_PT_solid,) + tuple(_section_panel(*section) for section in S
 
 
 classes = (OMNINOISE_PG_solid, OMNINOISE_OT_solid_preview, OMNINOISE_OT_solid_tileable,
-           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_OT_solid_procedural_node,
+           OMNINOISE_OT_solid_tile_material, OMNINOISE_OT_solid_bake, OMNINOISE_OT_solid_save_job,
+           OMNINOISE_OT_solid_procedural_node,
            OMNINOISE_OT_solid_save_procedural, OMNINOISE_OT_solid_load_procedural,
            OMNINOISE_PT_solid_presets, OMNINOISE_OT_solid_preset_add) + PANELS
 

@@ -43,7 +43,8 @@ omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 128 -o roc
 omninoise solid --method procedural --exemplar bricks.jpg --dim 3 --size 128 -o wall.vdb
 omninoise solid --method procedural --exemplar bricks.jpg -o wall.json
 omninoise solid --exemplar wall.json --dim 3 --size 256 -o wall.vdb
-omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png""")
+omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -o tileable.png
+omninoise solid --method spectral --exemplar photo.jpg --dim 3 --size 256 -o rock.vdb --save-job rock.toml""")
     g = s.add_argument_group("texture and output")
     g.add_argument("--exemplar", help="a shipped texture (see --list) or an image file; --method procedural: "
                                         "also a fitted solid saved as .json (-o)")
@@ -63,6 +64,9 @@ omninoise solid --method synthesis --exemplar photo.jpg --tile 256 --size 1024 -
     g.add_argument("--json", action="store_true", help="with --list: print it as JSON")
     g.add_argument("--model", help="a model folder (default: the exemplar's own shipped model, else the "
                                    "texture-space model)")
+    g.add_argument("--save-job", metavar="JOB.toml",
+                   help="write a job file that bakes -o (omninoise bake, a farm) instead of drawing it: a volume, "
+                        "or a 2D texture's image (a 2D model's, --method synthesis)")
     g.add_argument("-q", "--quiet", action="store_true", help="no progress or notes")
     g = s.add_argument_group("photos (the texture-space model)")
     g.add_argument("--refine", type=int, default=0, metavar="N", help="improve a photo's code with N search steps")
@@ -128,6 +132,8 @@ def run(a: argparse.Namespace) -> int:
 
         require_vdb("-o")
     req = solid_request(a).check_pixels("--")      # a photo it cannot use is named before any note or work
+    if a.save_job:
+        return _save_job(a, req)
     if not a.quiet and req.repeats_as_grid("--"):
         print("note: the photo repeats across and up as a grid (bricks, tiles?); the kinds besides bonds often draw "
               "stones or blotches there: --families bonds lays it in courses", file=sys.stderr)
@@ -178,6 +184,18 @@ def run(a: argparse.Namespace) -> int:
         return 0
     _write_image(a.out, req.front_image(a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code,
                                               Bar(a.quiet)))
+    return 0
+
+
+def _save_job(a: argparse.Namespace, req) -> int:
+    """``--save-job``: write the job that bakes ``-o`` as this command would draw it, and draw nothing."""
+    from omninoise.backend.job_file import check_job_file, solid_spec, write_job
+
+    check_job_file(a.save_job, "--save-job")
+    write_job(a.save_job, [solid_spec(req, a.size, a.dim, a.scale, a.out, ("-o", "--save-job", "--"))], None,
+              "--save-job")
+    if not a.quiet:
+        print(f"omninoise solid: wrote {a.save_job}: omninoise bake {a.save_job} draws {a.out}", file=sys.stderr)
     return 0
 
 

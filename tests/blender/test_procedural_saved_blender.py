@@ -271,6 +271,20 @@ def test_a_volume_bake_of_the_node_group_fills_the_object_s_bounds_with_the_edit
         z, y, x = np.meshgrid(c, c, c, indexing="ij")
         ref = srgb_to_linear(edited.evaluate(np.stack([x, y, z], -1).reshape(-1, 3) * np.float32(1.3)))
         np.testing.assert_allclose(col.reshape(-1, 3), ref, atol=1e-5)
+
+        # saved as a job: the edited solid beside it as JSON, baked again without Blender to the same volume
+        from omninoise.cli.main import main
+
+        job = tmp_path / "wall.toml"
+        assert bpy.ops.omninoise.solid_save_job(filepath=str(job)) == {"FINISHED"}
+        assert saved.read(str(tmp_path / "wall_solid.json")).to_dict() == edited.to_dict()
+        import tomllib
+
+        table = tomllib.loads(job.read_text())["bake"][0]["source"]
+        assert table["exemplar"] == "wall_solid.json" and table["scale"] == float(np.float32(1.3))   # the node's
+        assert main(["bake", str(job), "--force", "-q"]) == 0
+        again = read_volume(str(tmp_path / "Wall.vdb"), "color", (8, 8, 8))
+        np.testing.assert_allclose(again, col, atol=1e-6)
     finally:
         blender_addon.unregister()
 

@@ -222,6 +222,57 @@ def test_volume_bake(scene, tmp_path):
 
 
 @needs_openvdb
+@pytest.mark.parametrize("source", ["SHIPPED", "IMAGE"])
+def test_save_as_job_file_bakes_the_panels_volume(scene, tmp_path, source):
+    """The volume bake saved as a job (an image exemplar written beside it as a PNG of its pixels): `omninoise bake`
+    writes the panel's volume again, for a shipped texture and a photo's spectral solid, in world positions."""
+    from omninoise.backend.jobs import run_job
+    from omninoise.export.images import decode, write_png
+    from omninoise.export.vdb import read_volume
+
+    p = scene.omninoise_solid
+    p.target, p.coords, p.name = "VOLUME", "WORLD", "Block"
+    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.5, 0.0, 0.0))
+    if source == "IMAGE":
+        rgb = np.random.default_rng(4).integers(0, 256, (64, 72, 3)).astype(np.uint8)
+        write_png(str(tmp_path / "ex.png"), rgb)
+        p.source, p.image, p.method = "IMAGE", bpy.data.images.load(str(tmp_path / "ex.png")), "SPECTRAL"
+    assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+    panel = read_volume(str(tmp_path / "Block.vdb"), "color", (8, 8, 8))
+    job = tmp_path / "block.toml"
+    assert bpy.ops.omninoise.solid_save_job(filepath=str(job)) == {"FINISHED"}
+    assert scene.omninoise_bake.job_file == str(job)        # the Batch Job panel runs it next
+    text = job.read_text()
+    assert "scale = 2.0" in text and "seed = 3" in text and "bounds = [[-0.5, -1.0, -1.0], [1.5, 1.0, 1.0]]" in text
+    if source == "IMAGE":       # the photo's own 8-bit values, named from the job's folder
+        assert 'exemplar = "block_photo.png"' in text and 'method = "spectral"' in text
+        assert np.array_equal(np.rint(decode(str(tmp_path / "block_photo.png")) * 255), rgb)
+    os.remove(tmp_path / "Block.vdb")
+    assert [o.status for o in run_job(str(job))] == ["baked"]
+    np.testing.assert_allclose(read_volume(str(tmp_path / "Block.vdb"), "color", (8, 8, 8)), panel, atol=2e-5)
+
+
+def test_save_as_job_file_says_what_is_wrong(scene, tmp_path):
+    """A UV image bake (written into the mesh), a .json name, a job whose photo would be written over the Exemplar
+    image's own file: one line, nothing written."""
+    from omninoise.export.images import write_png
+
+    bpy.ops.mesh.primitive_cube_add()
+    p = scene.omninoise_solid
+    with pytest.raises(RuntimeError, match="A job bakes files: set Bake To to Volume"):
+        bpy.ops.omninoise.solid_save_job(filepath=str(tmp_path / "a.toml"))
+    p.target = "VOLUME"
+    with pytest.raises(RuntimeError, match="a job file is a .toml file"):
+        bpy.ops.omninoise.solid_save_job(filepath=str(tmp_path / "a.json"))
+    write_png(str(tmp_path / "wall_photo.png"), np.full((64, 64, 3), 90, np.uint8))
+    kept = (tmp_path / "wall_photo.png").read_bytes()
+    p.source, p.image, p.method = "IMAGE", bpy.data.images.load(str(tmp_path / "wall_photo.png")), "SPECTRAL"
+    with pytest.raises(RuntimeError, match="the job writes its photo to wall_photo.png, the file of the Exemplar"):
+        bpy.ops.omninoise.solid_save_job(filepath=str(tmp_path / "wall.toml"))
+    assert os.listdir(tmp_path) == ["wall_photo.png"] and (tmp_path / "wall_photo.png").read_bytes() == kept
+
+
+@needs_openvdb
 def test_the_spectral_solid_previews_and_bakes_as_the_command_line_draws_it(scene, tmp_path):
     """Method Spectral Solid (backend/solid/spectral_solid.py): the panel's request is the command line's (Periodic
     Part included); the preview, a colour attribute and a volume are the request's solid read at the same points;
@@ -521,7 +572,7 @@ def test_panel_draws(scene):
     solid_ui.draw_solid_all(Recorder(log), bpy.context)
     props = [a for n, a, t in log if n == "prop"]
     assert {"source", "texture", "scale", "seed", "coords", "target", "size", "margin", "name"} <= set(props)
-    assert [t for n, a, t in log if n == "operator"] == ["Preview", "Bake"]
+    assert [t for n, a, t in log if n == "operator"] == ["Preview", "Bake", ""]     # and Save as Job File's icon
 
 
 def test_the_panel_builds_the_command_lines_request(scene, tmp_path):

@@ -19,6 +19,7 @@ from omninoise.cli.main import main
 from omninoise.export import read_volume
 from omninoise.export.images import decode
 
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BOX = ((-1.0, -0.5, 0.0), (1.0, 0.5, 1.25))
 
 
@@ -116,11 +117,44 @@ def test_what_a_job_cannot_hold_is_refused_before_anything_is_written(tmp_path):
     by_example = _spec(tmp_path, "b.npy", WaveSettings(dim=2, example=example), resolution=(8, 8))
     with pytest.raises(SettingError, match="a job reads a by-example noise's image from a file"):
         job_file.write_job(str(tmp_path / "job.toml"), [by_example])
-    solid = BakeSpec("rock", source_from_dict({"kind": "solid", "model": "gravel_3d"}), BoxGrid((8, 8, 8), BOX),
-                     str(tmp_path / "rock.npy"))
-    with pytest.raises(SettingError, match="only wave and neural noise bakes are saved as job files"):
-        job_file.write_job(str(tmp_path / "job.toml"), [solid])
     assert sorted(os.listdir(tmp_path)) == []
+
+
+@pytest.mark.parametrize("held", ["8-bit photo", "16-bit photo", "procedural solid"])
+def test_a_solid_exemplar_held_in_memory_is_written_beside_its_job(tmp_path, monkeypatch, held):
+    """A photo's pixels (a Blender image) or a procedural solid (a node group's) are written beside the job, as a
+    PNG of the pixels' own depth or saved JSON, and the job bakes what the spec bakes."""
+    from omninoise.backend.solid import spectral_solid
+    from omninoise.backend.solid.request import SolidRequest
+    from omninoise.backend.sources import solid_source
+    from omninoise.export.images import read_rgb
+
+    monkeypatch.setattr(spectral_solid, "PERIOD", 32)
+    photo = read_rgb(os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg"))[:160, :160]
+    photo = photo if held == "8-bit photo" else np.clip(photo + np.float32(0.3 / 255), 0, 1)   # off the 8-bit grid
+    exemplar = photo
+    if held == "procedural solid":     # a wall of bricks with a turbulent tint ramp
+        from omninoise.backend.solid.procedural.field import ProceduralField
+        from omninoise.backend.solid.procedural.ramp import Ramp
+
+        exemplar = ProceduralField("bonds", dict(length=0.4, height=0.1, offset=0.5, joint=0.2, turbulence=0.3,
+                                                 turb_freq=2.0, detail=0.1),
+                                   Ramp((-1.0, 0.5, 2.0), ((0.8, 0.8, 0.7), (0.5, 0.2, 0.1), (0.7, 0.3, 0.2))), seed=4)
+    req = SolidRequest(exemplar=exemplar, method="procedural" if held == "procedural solid" else "spectral",
+                       seed=0 if held == "procedural solid" else 2).check()      # a saved solid keeps its seed
+    grid = BoxGrid((9, 8, 7), BOX)
+    direct = BakeSpec("rock", solid_source(req, 1.5, 0.7), grid, str(tmp_path / "direct.npy")).validate()
+    run_bake(direct, force=True)
+    spec = BakeSpec("rock", solid_source(req, 1.5, 0.7), grid, str(tmp_path / "job.npy")).validate()
+    text = job_file.write_job(str(tmp_path / "job.toml"), [spec])
+    side = "job_solid.json" if held == "procedural solid" else "job_photo.png"
+    assert f'exemplar = "{side}"' in text and "scale = 1.5" in text and "density = 0.7" in text
+    if held != "procedural solid":
+        depth = (tmp_path / side).read_bytes()[24]          # the PNG header's bit depth
+        assert depth == (8 if held == "8-bit photo" else 16)
+        assert np.abs(read_rgb(str(tmp_path / side)) - photo).max() < (1e-6 if depth == 8 else 1 / 131070 + 1e-7)
+    assert [o.status for o in run_job(str(tmp_path / "job.toml"))] == ["baked"]
+    np.testing.assert_allclose(np.load(tmp_path / "job.npy"), np.load(tmp_path / "direct.npy"), atol=2e-5)
 
 
 def test_the_module_example_runs():
@@ -497,3 +531,104 @@ def test_a_job_that_would_bake_otherwise_is_not_written_and_its_maps_are_put_bac
         job_file.write_job(str(tmp_path / "job.toml"), specs)
     assert sorted(os.listdir(tmp_path)) == ["job_map.png"]
     assert (tmp_path / "job_map.png").read_bytes() == b"an earlier map"
+
+
+SOLID_FLAGS = {     # -o -> the flags of `omninoise solid` (photos/p.jpg: a photo; the job is saved in jobs/)
+    "ship.vdb": ["--exemplar", "gravel_3d", "--seed", "2", "--dim", "3"],
+    "photo.npy": ["--exemplar", "photos/p.jpg", "--no-gaussian", "--seed", "3", "--dim", "3"],
+    "mix.npy": ["--exemplar", "gravel", "--to", "photos/p.jpg", "--mix", "0.3", "--dim", "3"],
+    "spectral.npy": ["--method", "spectral", "--exemplar", "photos/p.jpg", "--scale", "2", "--dim", "3"],
+    "layers.npy": ["--method", "procedural", "--families", "layers", "--exemplar", "photos/p.jpg", "--dim", "3"],
+    "saved.npy": ["--exemplar", "wall.json", "--scale", "0.5", "--dim", "3"],
+    "auto.npy": ["--method", "auto", "--families", "cells", "--exemplar", "photos/p.jpg", "--dim", "3"],
+    "brick.png": ["--exemplar", "brick_2d", "--seed", "1"],
+    "tile.exr": ["--method", "synthesis", "--exemplar", "photos/p.jpg", "--tile", "32", "--seed", "2"],
+}
+
+
+@pytest.fixture
+def solid_inputs(tmp_path, monkeypatch):
+    """A photo in photos/, a folder for jobs, small spectral tiles and procedural fits (the same code, a fraction
+    of the work)."""
+    import shutil
+
+    from omninoise.backend.solid import spectral_solid
+    from omninoise.backend.solid.procedural import fit
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(spectral_solid, "PERIOD", 32)
+    monkeypatch.setattr(fit, "ProceduralConfig", functools.partial(fit.ProceduralConfig, side=32, budget=6,
+                                                                   finalists=1, fit_side=64))
+    os.mkdir("photos")
+    os.mkdir("jobs")
+    shutil.copy(os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg"), "photos/p.jpg")
+    return tmp_path
+
+
+
+@pytest.mark.parametrize("out", [pytest.param(o, marks=pytest.mark.long) if o in ("mix.npy", "auto.npy") else o
+                                 for o in SOLID_FLAGS])      # those two encode a photo with the space model
+def test_omninoise_solid_saves_its_volume_or_image_as_a_job(solid_inputs, capsys, out):
+    """`omninoise solid ... --save-job jobs/JOB.toml` writes the job (the photo named from the job's folder)
+    instead of the volume or image; `omninoise bake` then writes what `omninoise solid` writes, value for value."""
+    if out == "saved.npy":
+        assert main(["solid", "--method", "procedural", "--families", "cells", "--exemplar", "photos/p.jpg", "-o",
+                     "wall.json", "-q"]) == 0
+    flags = SOLID_FLAGS[out] + ["--size", "12" if "--dim" in SOLID_FLAGS[out] else "24"]
+    assert main(["solid", *flags, "-o", "direct_" + out, "-q"]) == 0
+    assert main(["solid", *flags, "-o", out, "--save-job", "jobs/job.toml"]) == 0
+    assert f"wrote jobs/job.toml: omninoise bake jobs/job.toml draws {out}" in capsys.readouterr().err
+    assert not os.path.exists(out)
+    text = open("jobs/job.toml").read()
+    assert ("../photos/p.jpg" in text) == ("photos/p.jpg" in flags) and str(solid_inputs) not in text
+    assert main(["bake", "jobs/job.toml", "-q"]) == 0
+    if out.endswith(".vdb"):
+        got, want = (read_volume(f, "color", (12, 12, 12)) for f in (out, "direct_" + out))
+    elif out.endswith(".npy"):
+        got, want = np.load(out), np.load("direct_" + out)
+    else:
+        got, want = decode(out), decode("direct_" + out)
+    assert got.shape == want.shape and got.std() > 0
+    np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--exemplar", "gravel_3d", "--dim", "3", "-o", "a.npy", "--save-job", "job.json"],
+     "--save-job: a job file is a .toml file"),
+    (["--method", "procedural", "--exemplar", "photos/p.jpg", "-o", "a.json", "--save-job", "job.toml"],
+     "--save-job: a .json -o is the fitted solid itself, which no job writes"),
+    (["--exemplar", "gravel_3d", "-o", "a.png", "--save-job", "job.toml"],
+     "--save-job: -o's image is a solid's front view (the plane y = 0), a job's 2D bake its plane z = 0"),
+    (["--method", "spectral", "--exemplar", "photos/p.jpg", "-o", "a.exr", "--save-job", "job.toml"],
+     "--save-job: -o's image is a solid's front view"),
+    (["--exemplar", "brick_2d", "-o", "a.npy", "--save-job", "job.toml"],
+     "--save-job: a job's .npy holds an image's rows from the bottom up"),
+    (["--exemplar", "gravel_3d", "--dim", "3", "-o", "a.npy", "--save-job", "no/job.toml"],
+     "--save-job: output folder does not exist"),
+])
+def test_omninoise_solid_refuses_a_job_it_cannot_save_before_any_work(solid_inputs, capsys, extra, message):
+    before = sorted(os.listdir("."))
+    assert main(["solid", *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0] and sorted(os.listdir(".")) == before
+
+
+def test_the_python_api_saves_a_solid_volume_as_a_job(solid_inputs):
+    """omninoise.solid(..., out=, save_job=) writes the job, not the volume; its bake is the volume out= writes."""
+    import omninoise
+    from omninoise.export.images import read_rgb
+
+    kw = dict(dim=3, method="spectral", seed=4, scale=1.5)
+    omninoise.solid("photos/p.jpg", 10, out="direct.npy", **kw)
+    assert omninoise.solid("photos/p.jpg", 10, out="later.npy", save_job="jobs/s.toml", **kw) == "jobs/s.toml"
+    assert not os.path.exists("later.npy") and run_job("jobs/s.toml")[0].status == "baked"
+    np.testing.assert_array_equal(np.load("later.npy"), np.load("direct.npy"))
+    for exemplar, bad, message in (
+            ("gravel_3d", dict(save_job="jobs/s.toml"), "save_job: applies to a written file; give out= too"),
+            ("gravel_3d", dict(out="a.npy", dim=3, save_job="s.json"), "a job file is a .toml file"),
+            ("gravel_3d", dict(out="a.png", save_job="jobs/s.toml"), "save_job: out's image is a solid's front view"),
+            (read_rgb("photos/p.jpg"), dict(out="a.npy", dim=3, method="spectral", save_job="jobs/s.toml"),
+             "exemplar: a job reads its image or saved solid from a file")):
+        with pytest.raises(SettingError, match=message):
+            omninoise.solid(exemplar, 16, **bad)
+    assert sorted(os.listdir("jobs")) == ["s.toml"] and not os.path.exists("a.npy")
