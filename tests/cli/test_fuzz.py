@@ -35,6 +35,7 @@ from omninoise.cli.main import main  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BROKEN = os.path.join(ROOT, "tests", "data", "broken")
 ODD = os.path.join(ROOT, "tests", "data", "odd")
+PHOTO = os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg")
 LIMIT_S = 30
 _seed = os.environ.get("OMNINOISE_FUZZ_SEED")
 FUZZ = settings(deadline=None, database=None, derandomize=_seed is None, print_blob=True,
@@ -222,6 +223,26 @@ def test_fuzz_solid(tmp_path_factory, flags, size, ext):
         if "--exemplar" not in argv:
             argv += ["--exemplar", "gravel_3d"]
         run(argv + ["--size", size, "--quiet", "-o", out], out)
+
+
+@settings(FUZZ, max_examples=60)
+@given(flags=SOLID_FLAGS, method=st.sampled_from([[], ["--method", "spectral"], ["--method", "synthesis"],
+                                                  ["--method", "procedural"], ["--method", "auto"]]),
+       dim=st.sampled_from([[], ["--dim", "3"], ["--dim", "3"]]),
+       ext=st.sampled_from([".npy", ".vdb", ".npy", ".vdb", ".exr", ".png", ".json"]),
+       job=st.sampled_from(["job.toml", "job.toml", "job.toml", "job.json", "no/such/job.toml", "folder.toml", ""]))
+def test_fuzz_solid_save_job(tmp_path_factory, flags, method, dim, ext, job):
+    """``solid --save-job``: exit 0 with a job that ``bake --dry-run`` takes, or one line, exit 2; never a drawing."""
+    with _fresh(tmp_path_factory) as tmp:
+        os.makedirs(os.path.join(tmp, "folder.toml"))
+        path, out = os.path.join(tmp, job), output_path(tmp, ext)
+        argv = _argv("solid", flags) + method + (dim if "--dim" not in _argv("solid", flags) else [])
+        if "--exemplar" not in argv:
+            argv += ["--exemplar", "gravel_3d" if not method else PHOTO]
+        run(argv + ["--size", "8", "--quiet", "-o", out, "--save-job", path], path)
+        if os.path.isfile(path):
+            run(["bake", path, "--quiet", "--dry-run"], None)
+            assert not os.path.exists(out), "--save-job drew the texture too"
 
 
 @settings(FUZZ, max_examples=20)
