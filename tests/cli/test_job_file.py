@@ -120,7 +120,7 @@ def test_what_a_job_cannot_hold_is_refused_before_anything_is_written(tmp_path):
     assert sorted(os.listdir(tmp_path)) == []
 
 
-@pytest.mark.parametrize("held", ["8-bit photo", "16-bit photo", "procedural solid"])
+@pytest.mark.parametrize("held", ["8-bit photo", "16-bit photo", "procedural solid", "neural photo"])
 def test_a_solid_exemplar_held_in_memory_is_written_beside_its_job(tmp_path, monkeypatch, held):
     """A photo's pixels (a Blender image) or a procedural solid (a node group's) are written beside the job, as a
     PNG of the pixels' own depth or saved JSON, and the job bakes what the spec bakes."""
@@ -131,7 +131,7 @@ def test_a_solid_exemplar_held_in_memory_is_written_beside_its_job(tmp_path, mon
 
     monkeypatch.setattr(spectral_solid, "PERIOD", 32)
     photo = read_rgb(os.path.join(ROOT, "data", "photos", "val", "rock__cliff_greek.jpg"))[:160, :160]
-    photo = photo if held == "8-bit photo" else np.clip(photo + np.float32(0.3 / 255), 0, 1)   # off the 8-bit grid
+    photo = photo if held != "16-bit photo" else np.clip(photo + np.float32(0.3 / 255), 0, 1)  # off the 8-bit grid
     exemplar = photo
     if held == "procedural solid":     # a wall of bricks with a turbulent tint ramp
         from omninoise.backend.solid.procedural.field import ProceduralField
@@ -140,8 +140,10 @@ def test_a_solid_exemplar_held_in_memory_is_written_beside_its_job(tmp_path, mon
         exemplar = ProceduralField("bonds", dict(length=0.4, height=0.1, offset=0.5, joint=0.2, turbulence=0.3,
                                                  turb_freq=2.0, detail=0.1),
                                    Ramp((-1.0, 0.5, 2.0), ((0.8, 0.8, 0.7), (0.5, 0.2, 0.1), (0.7, 0.3, 0.2))), seed=4)
-    req = SolidRequest(exemplar=exemplar, method="procedural" if held == "procedural solid" else "spectral",
-                       seed=0 if held == "procedural solid" else 2).check()      # a saved solid keeps its seed
+    method = {"procedural solid": "procedural", "neural photo": "neural"}.get(held, "spectral")
+    model = os.path.join(ROOT, "models", "solid", "space") if method == "neural" else None
+    req = SolidRequest(model, exemplar, method=method, seed=0 if method == "procedural" else 2,
+                       gaussian=False).check()      # a saved solid keeps its seed
     grid = BoxGrid((9, 8, 7), BOX)
     direct = BakeSpec("rock", solid_source(req, 1.5, 0.7), grid, str(tmp_path / "direct.npy")).validate()
     run_bake(direct, force=True)
@@ -151,7 +153,7 @@ def test_a_solid_exemplar_held_in_memory_is_written_beside_its_job(tmp_path, mon
     assert f'exemplar = "{side}"' in text and "scale = 1.5" in text and "density = 0.7" in text
     if held != "procedural solid":
         depth = (tmp_path / side).read_bytes()[24]          # the PNG header's bit depth
-        assert depth == (8 if held == "8-bit photo" else 16)
+        assert depth == (16 if held == "16-bit photo" else 8)
         assert np.abs(read_rgb(str(tmp_path / side)) - photo).max() < (1e-6 if depth == 8 else 1 / 131070 + 1e-7)
     assert [o.status for o in run_job(str(tmp_path / "job.toml"))] == ["baked"]
     np.testing.assert_allclose(np.load(tmp_path / "job.npy"), np.load(tmp_path / "direct.npy"), atol=2e-5)
