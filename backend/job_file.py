@@ -1,8 +1,8 @@
 """A bake as the job file that bakes it again: the inverse of :mod:`backend.jobs`' reader.
 
-The Bake Noise and Neural Noise panels save their bakes this way (**Save as Job File**), so that ``omninoise bake
-JOB.toml``, a farm (``omninoise farm``) or the Batch Job panel bakes the same files on another machine, without
-Blender::
+The Bake Noise, Neural Noise and Solid Texture panels save their bakes this way (**Save as Job File**), as do
+``omninoise wave``, ``neural`` and ``solid --save-job``, so that ``omninoise bake JOB.toml``, a farm (``omninoise
+farm``) or the Batch Job panel bakes the same files on another machine, without Blender::
 
     >>> from omninoise.backend import WaveSettings, Spectrum
     >>> from omninoise.backend.bake import BakeSpec
@@ -25,8 +25,10 @@ Blender::
 
 A job names only what differs from the defaults and what the noise reads: the reader refuses a setting that would
 change nothing (an exponent of a band-pass spectrum, a time of still noise), so such a setting of the bake is left
-out, as it changes no value. A neural noise's painted map or blend mask, which the job reads from a file, is
-written beside it as a PNG of hard-edged regions (``JOB_map.png``, ``JOB_mask.png``; :func:`side_files`).
+out, as it changes no value. What a bake holds in memory and its job reads from a file is written beside it
+(:func:`side_files`): a neural noise's painted map or blend mask as a PNG of hard-edged regions (``JOB_map.png``,
+``JOB_mask.png``), a solid texture's photo as a PNG of its pixels (``JOB_photo.png``) and a procedural solid as
+saved JSON (``JOB_solid.json``).
 :func:`write_job` reads the text back through the job reader and writes it only when every bake it holds is the
 one given (the same source, grid, ramp, times and files), atomically.
 """
@@ -380,8 +382,8 @@ def _table(header: str, table: dict) -> list:
 
 def job_text(specs: list, job_dir: str, sides: dict | None = None) -> str:
     """The TOML text of a job file in ``job_dir`` that bakes ``specs`` (:class:`~backend.bake.BakeSpec`); its
-    ``output_root`` is the outputs' common folder where that lies outside ``job_dir``. ``sides``: the files of the
-    neural sources' masks and painted maps (:func:`side_files`), which such a source needs."""
+    ``output_root`` is the outputs' common folder where that lies outside ``job_dir``. ``sides``: the files written
+    beside the job (:func:`side_files`), which a source holding its mask, map, photo or solid in memory needs."""
     sides = sides or {}
     missing = [s.name for i, s in enumerate(specs) if i not in sides and _side_kind(s.source) is not None]
     if missing:
