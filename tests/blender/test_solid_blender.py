@@ -253,10 +253,7 @@ def test_save_as_job_file_bakes_the_panels_volume(scene, tmp_path, source):
 
 
 def test_save_as_job_file_says_what_is_wrong(scene, tmp_path):
-    """A UV image bake (written into the mesh), a .json name, a job whose photo would be written over the Exemplar
-    image's own file: one line, nothing written."""
-    from omninoise.export.images import write_png
-
+    """A UV image bake (written into the mesh), a .json name: one line, nothing written."""
     bpy.ops.mesh.primitive_cube_add()
     p = scene.omninoise_solid
     with pytest.raises(RuntimeError, match="A job bakes files: set Bake To to Volume"):
@@ -264,6 +261,17 @@ def test_save_as_job_file_says_what_is_wrong(scene, tmp_path):
     p.target = "VOLUME"
     with pytest.raises(RuntimeError, match="a job file is a .toml file"):
         bpy.ops.omninoise.solid_save_job(filepath=str(tmp_path / "a.json"))
+    assert os.listdir(tmp_path) == []
+
+
+@needs_openvdb
+def test_save_as_job_file_never_writes_the_photo_over_the_exemplars_file(scene, tmp_path):
+    """A job whose photo would be written over the Exemplar image's own file: one line, the file as it was."""
+    from omninoise.export.images import write_png
+
+    bpy.ops.mesh.primitive_cube_add()
+    p = scene.omninoise_solid
+    p.target = "VOLUME"
     write_png(str(tmp_path / "wall_photo.png"), np.full((64, 64, 3), 90, np.uint8))
     kept = (tmp_path / "wall_photo.png").read_bytes()
     p.source, p.image, p.method = "IMAGE", bpy.data.images.load(str(tmp_path / "wall_photo.png")), "SPECTRAL"
