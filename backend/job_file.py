@@ -290,13 +290,13 @@ def solid_spec(request, size: int, dim: int, scale: float, out: str, names=("out
     if dim == 2 and ext == ".npy":
         raise SettingError(where, f"a job's .npy holds an image's rows from the bottom up (+y first, as every bake's "
                                   f"array), {named}'s from the top: write {named} as .png or .exr")
-    if dim == 2 and request.method != "synthesis" and (request.method != "neural" or request.load(prefix).dim != 2):
+    source = solid_source(request, where=prefix)     # made at its first use: no fit or encoding here
+    if dim == 2 and source.dim != 2:
         raise SettingError(where, f"{named}'s image is a solid's front view (the plane y = 0), a job's 2D bake its "
                                   "plane z = 0 (seen from above): save a volume's job (3D), or draw the image")
     extent = size / (solid_px_per_unit(request, prefix) * scale)
     box = ((0.0, 0.0, 0.0), (extent,) * 3) if dim == 3 else ((0.0, -extent, 0.0), (extent, 0.0, 0.0))
-    return BakeSpec("solid", solid_source(request, where=f"{prefix}"), BoxGrid((size,) * dim, box),
-                    os.path.abspath(out)).validate()
+    return BakeSpec("solid", source, BoxGrid((size,) * dim, box), os.path.abspath(out)).validate()
 
 
 def _source_table(source, side: str | None = None, job_dir: str = ".") -> dict:
