@@ -201,12 +201,8 @@ _TURNS = {1: lambda a: a, 2: lambda a: a[:, ::-1], 3: lambda a: a[::-1, ::-1], 4
           7: lambda a: np.swapaxes(a, 0, 1)[::-1, ::-1], 8: lambda a: np.rot90(a, 1)}
 
 
-def _pillow_pixels(im, tiles: list) -> tuple:
-    """(pixels float32 (H, W[, C]) by the file's own range, whether they are floats) of an image Pillow loaded
-    (``tiles``: its tiles before it was loaded)."""
-    wide = _sixteen_bits(im.filename, tiles)
-    if wide is not None:
-        return wide.astype(np.float32) / 65535.0, False
+def _pillow_pixels(im) -> tuple:
+    """(pixels float32 (H, W[, C]) by the file's own range, whether they are floats) of an image Pillow loaded."""
     mode = im.mode
     if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
         return np.asarray(im, dtype=np.float32) / 65535.0, False
@@ -232,10 +228,14 @@ def _decode_pillow(path: str) -> tuple:
                 w, h = im.size
                 if w * h > MAX_PIXELS:
                     raise ImageError(f"{path}: {w}x{h} px is more than the {MAX_PIXELS} px an input may have")
-                tiles = list(im.tile)       # how the file is decoded (load() lets go of it)
-                im.load()
-                turn = _TURNS.get(im.getexif().get(_EXIF_ORIENTATION, 1), _TURNS[1])
-                a, linear = _pillow_pixels(im, tiles)
+                wide = _sixteen_bits(path, list(im.tile))     # 16-bit colour: decoded there, not here
+                if wide is not None:
+                    (a, orientation), linear = wide, False
+                else:
+                    im.load()
+                    orientation = im.getexif().get(_EXIF_ORIENTATION, 1)
+                    a, linear = _pillow_pixels(im)
+                turn = _TURNS.get(orientation, _TURNS[1])
                 return np.ascontiguousarray(turn(a)), linear      # a phone photo as every viewer shows it
     except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
         if isinstance(exc, UnidentifiedImageError):
@@ -250,12 +250,13 @@ def _decode_pillow(path: str) -> tuple:
 _WIDE = re.compile(r"(RGB|RGBA|LA);16([BLN])")
 
 
-def _sixteen_bits(path: str, tiles: list) -> np.ndarray | None:
-    """The samples of the 16-bit colour PNG or TIFF (RGB, RGBA, grey with alpha) at ``path`` as uint16 (H, W, C),
-    from the tiles Pillow opened it with; None for any other image.  Pillow's colour modes hold 8 bits, so it opens
-    such a file as 8-bit colour, each sample's high byte alone: the file is decoded twice here, unpacking the high
-    and then the low bytes (its raw mode told the other byte order), and the bytes are put together.  Grey with
-    alpha, whose 8-bit raw mode has no such twin, is decoded as 8-bit RGBA: the same four bytes a pixel."""
+def _sixteen_bits(path: str, tiles: list) -> tuple | None:
+    """(samples float32 (H, W, C) in [0, 1], EXIF orientation) of the 16-bit colour PNG or TIFF (RGB, RGBA, grey
+    with alpha) at ``path``, from the tiles Pillow opened it with (before loading it); None for any other image.
+    Pillow's colour modes hold 8 bits, so it opens such a file as 8-bit colour, each sample's high byte alone: the
+    file is decoded twice here, unpacking the high and then the low bytes (its raw mode told the other byte order),
+    and the bytes are put together.  Grey with alpha, whose 8-bit raw mode has no such twin, is decoded as 8-bit
+    RGBA: the same four bytes a pixel."""
     if not tiles or not all(hasattr(t, "_replace") and isinstance(getattr(t, "args", None), (str, tuple))
                             for t in tiles):
         return None
@@ -267,6 +268,8 @@ def _sixteen_bits(path: str, tiles: list) -> np.ndarray | None:
     if order == "N":
         order = "L" if sys.byteorder == "little" else "B"
 
+    orientation = []        # the file's, read by the decoding (Pillow reads a PNG's eXIf chunk as it loads)
+
     def decoded(raw: str) -> np.ndarray:
         from PIL import Image
 
@@ -274,13 +277,16 @@ def _sixteen_bits(path: str, tiles: list) -> np.ndarray | None:
             again.tile = [t._replace(args=raw if isinstance(t.args, str) else (raw,) + tuple(t.args[1:]))
                           for t in again.tile]
             again.load()
+            orientation.append(again.getexif().get(_EXIF_ORIENTATION, 1))
             return np.asarray(again, dtype=np.uint16)
 
     if kind == "LA":        # opened as RGBA
         b = decoded("RGBA")
-        return np.stack([b[..., 0] * 256 + b[..., 1], b[..., 2] * 256 + b[..., 3]], axis=-1)
-    high, low = (f"{kind};16{order}", f"{kind};16{'B' if order == 'L' else 'L'}")
-    return decoded(high) * 256 + decoded(low)
+        wide = np.stack([b[..., 0] * 256 + b[..., 1], b[..., 2] * 256 + b[..., 3]], axis=-1)
+    else:
+        high, low = (f"{kind};16{order}", f"{kind};16{'B' if order == 'L' else 'L'}")
+        wide = decoded(high) * 256 + decoded(low)
+    return wide.astype(np.float32) / np.float32(65535.0), orientation[0]
 
 
 OPAQUE = 254.5 / 255.0   #: the least alpha an input's pixel may have (an 8-bit 255; 254 is partly transparent)

@@ -91,6 +91,12 @@ def test_sixteen_bit_colour_files_keep_all_sixteen_bits(tmp_path):
         assert np.array_equal(decode(str(tmp_path / name)), rgb / np.float32(65535)), name
     assert np.array_equal(read_rgb(str(tmp_path / "la.png")), np.repeat(rgb[..., :1], 3, -1) / np.float32(65535))
     assert np.array_equal(read_rgb(str(tmp_path / "rgba.png")), rgb / np.float32(65535))
+    exif = Image.Exif()         # a 16-bit photo with an EXIF orientation (6: turned) is turned too
+    exif[0x0112] = 6
+    data = (tmp_path / "rgb.png").read_bytes()
+    at = data.index(b"IDAT") - 4
+    (tmp_path / "turned.png").write_bytes(data[:at] + _chunk(b"eXIf", exif.tobytes()[6:]) + data[at:])
+    assert np.array_equal(read_rgb(str(tmp_path / "turned.png")), np.rot90(rgb, -1) / np.float32(65535))
 
 
 def test_float_files_hold_scene_linear_colour_and_exemplars_read_them_as_blender_shows_them(tmp_path):
