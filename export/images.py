@@ -212,7 +212,7 @@ def _pillow_pixels(im) -> tuple:
     if mode == "F":
         return np.asarray(im, dtype=np.float32), True
     if mode not in ("L", "LA", "RGB", "RGBA"):
-        im = im.convert("RGBA" if "A" in mode or "transparency" in im.info else "RGB")
+        im = im.convert("RGBA" if im.has_transparency_data else "RGB")     # "LAB" has no alpha
     return np.asarray(im, dtype=np.float32) / 255.0, False
 
 
@@ -257,11 +257,14 @@ def _sixteen_bits(path: str, tiles: list) -> tuple | None:
     file is decoded twice here, unpacking the high and then the low bytes (its raw mode told the other byte order),
     and the bytes are put together.  Grey with alpha, whose 8-bit raw mode has no such twin, is decoded as 8-bit
     RGBA: the same four bytes a pixel."""
-    if not tiles or not all(hasattr(t, "_replace") and isinstance(getattr(t, "args", None), (str, tuple))
-                            for t in tiles):
-        return None
-    raws = {t.args if isinstance(t.args, str) else t.args[0] for t in tiles}
-    match = _WIDE.fullmatch(next(iter(raws))) if len(raws) == 1 else None
+    def raw(tile):          # the raw mode a tile is unpacked by; a GIF's args begin with a number, a WebP has none
+        args = getattr(tile, "args", None)
+        return args if isinstance(args, str) else (args[0] if isinstance(args, tuple) and args else None)
+
+    raws = {raw(t) for t in tiles}
+    match = None
+    if len(raws) == 1 and isinstance(next(iter(raws)), str) and all(hasattr(t, "_replace") for t in tiles):
+        match = _WIDE.fullmatch(next(iter(raws)))
     if match is None:
         return None
     kind, order = match.groups()

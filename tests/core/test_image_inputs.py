@@ -311,3 +311,26 @@ def test_a_float_colour_tiff_is_refused_saying_to_save_it_as_exr(tmp_path):
                                          r"\.exr: save it as one") as exc:
         decode(str(p))
     assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("name, mode, frames", [
+    ("photo.gif", "P", 1), ("animation.gif", "P", 2), ("pages.tif", "RGB", 2), ("photo.bmp", "RGB", 1),
+    ("photo.tga", "RGB", 1), ("photo.ppm", "RGB", 1), ("photo.webp", "RGB", 1), ("print.jpg", "CMYK", 1),
+    ("print.tif", "CMYK", 1), ("lab.tif", "LAB", 1), ("palette.png", "P", 1), ("bits.png", "1", 1),
+])
+def test_every_pillow_format_reads_as_its_first_frame_in_rgb(tmp_path, name, mode, frames):
+    """A GIF, a CMYK print file, a LAB TIFF, a palette or 1-bit PNG: the first frame's colours as Pillow converts
+    them to RGB (a multi-page TIFF or an animated GIF is read by its first frame, as Blender reads one), three
+    channels, with no alpha where the file has no transparency."""
+    rng = np.random.default_rng(3)
+    first = Image.fromarray((rng.random((24, 20, 3)) * 255).astype(np.uint8)).convert(mode)
+    later = [Image.fromarray((rng.random((24, 20, 3)) * 255).astype(np.uint8)).convert(mode)
+             for _ in range(frames - 1)]
+    path = tmp_path / name
+    first.save(path, save_all=frames > 1, append_images=later, **({"lossless": True} if name.endswith(".webp") else {}))
+    with Image.open(path) as im:
+        want = np.asarray(im.convert("RGB"), dtype=np.float32) / 255
+    got = decode(str(path))
+    assert got.shape == (24, 20, 3)
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    assert read_rgb(str(path)).shape == (24, 20, 3)
