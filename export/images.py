@@ -172,8 +172,11 @@ def _decode(path: str) -> tuple:
 
             with OpenEXR.File(path) as f:
                 chans = f.channels()
-                key = "Y" if "Y" in chans else ("RGBA" if "RGBA" in chans else
-                                                ("RGB" if "RGB" in chans else next(iter(chans))))
+                key = next((k for k in ("Y", "RGBA", "RGB") if k in chans), next(iter(chans)) if len(chans) == 1
+                           else None)
+                if key is None:     # an alpha, a depth or a render layer's colours: which is the picture?
+                    raise ImageError(f"{path}: an EXR image must hold RGB, RGBA, Y or one channel, not "
+                                     f"{', '.join(sorted(chans))}; save the picture's layer as an RGB(A) EXR")
                 a = np.asarray(chans[key].pixels, dtype=np.float32)
             linear = True
         else:

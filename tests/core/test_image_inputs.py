@@ -334,3 +334,31 @@ def test_every_pillow_format_reads_as_its_first_frame_in_rgb(tmp_path, name, mod
     assert got.shape == (24, 20, 3)
     np.testing.assert_allclose(got, want, atol=1e-6)
     assert read_rgb(str(path)).shape == (24, 20, 3)
+
+
+def _exr(path, chans):
+    import OpenEXR
+    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, chans) as f:
+        f.write(str(path))
+
+
+def test_an_exr_is_read_by_its_picture_and_one_of_several_layers_is_refused(tmp_path):
+    """RGB, RGBA, Y or a sole channel is the picture (a depth channel beside RGB is left); an EXR of an alpha and a
+    render layer's colours, or of R and G alone, names no picture: it is refused naming its channels (the alpha
+    was read as the picture, all white)."""
+    rng = np.random.default_rng(4)
+    plane = lambda: rng.random((8, 6)).astype(np.float32)    # noqa: E731
+    rgb = rng.random((8, 6, 3)).astype(np.float32)
+    _exr(tmp_path / "beauty.exr", {"RGB": rgb, "Z": plane() * 100})
+    np.testing.assert_array_equal(decode(str(tmp_path / "beauty.exr")), rgb)
+    mask = plane()
+    _exr(tmp_path / "mask.exr", {"mask": mask})
+    np.testing.assert_array_equal(decode(str(tmp_path / "mask.exr"))[..., 0], mask)
+    _exr(tmp_path / "layers.exr", {"diffuse.R": plane(), "diffuse.G": plane(), "diffuse.B": plane(),
+                                   "A": np.ones((8, 6), np.float32)})
+    _exr(tmp_path / "rg.exr", {"R": plane(), "G": plane()})
+    for name, names in (("layers.exr", "A, diffuse"), ("rg.exr", "G, R")):
+        with pytest.raises(ImageError, match=f"{name}: an EXR image must hold RGB, RGBA, Y or one channel, not "
+                                             f"{names}; save") as exc:
+            decode(str(tmp_path / name))
+        assert "\n" not in str(exc.value)
