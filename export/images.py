@@ -164,9 +164,13 @@ def _decode(path: str) -> tuple:
             a = np.load(path, allow_pickle=False)
             if a.dtype.kind not in "fiub":
                 raise ImageError(f"{path}: a .npy image must hold numbers, got {a.dtype}")
+            if a.dtype.kind in "iu" and a.dtype not in (np.uint8, np.uint16):     # 0..255 in int64 would clip white
+                raise ImageError(f"{path}: a .npy image of {a.dtype} has no range; save it as uint8 (0 to 255), "
+                                 "uint16 (0 to 65535) or floats")
             linear = a.dtype.kind == "f"
             scale = {np.dtype(np.uint8): 255.0, np.dtype(np.uint16): 65535.0}.get(a.dtype, 1.0)
-            a = a.astype(np.float32) / np.float32(scale)     # 8- and 16-bit arrays as 8- and 16-bit files
+            with np.errstate(over="ignore"):                 # a float64 past float32's range is refused below
+                a = a.astype(np.float32) / np.float32(scale)     # 8- and 16-bit arrays as 8- and 16-bit files
         elif ext == ".exr":
             import OpenEXR
 

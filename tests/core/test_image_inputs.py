@@ -181,6 +181,16 @@ def test_bad_npy_inputs(tmp_path):
     np.save(tmp_path / "nan.npy", np.array([[0.0, np.nan]], np.float32))
     with pytest.raises(ImageError, match="NaN or infinite"):
         decode(str(tmp_path / "nan.npy"))
+    for dtype in (np.int32, np.int64, np.int8, np.uint32):      # 0..255 in int32 was read clipped, all white
+        np.save(tmp_path / "ints.npy", np.full((4, 4, 3), 200, dtype) if dtype != np.int8 else np.ones((4, 4), dtype))
+        with pytest.raises(ImageError, match=f"ints.npy: a .npy image of {np.dtype(dtype)} has no range; save it as "
+                                             r"uint8 \(0 to 255\), uint16 \(0 to 65535\) or floats"):
+            decode(str(tmp_path / "ints.npy"))
+    np.save(tmp_path / "wide.npy", np.full((4, 4), 1e300))
+    with pytest.raises(ImageError, match="NaN or infinite"):
+        decode(str(tmp_path / "wide.npy"))
+    np.save(tmp_path / "mask.npy", np.eye(4, dtype=bool))
+    np.testing.assert_array_equal(decode(str(tmp_path / "mask.npy"))[..., 0], np.eye(4))
     np.save(tmp_path / "cube.npy", np.zeros((4, 4, 4, 4), np.float32))
     with pytest.raises(ImageError, match="expected an image"):
         decode(str(tmp_path / "cube.npy"))
