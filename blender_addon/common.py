@@ -32,14 +32,21 @@ class Sidebar:
 
 def image_pixels(ima, setting: str) -> np.ndarray:
     """An image datablock's pixels as stored, float32 (H, W, C), top row first (Blender keeps rows bottom-up);
-    an image without pixels (a missing file, the Render Result) or with a NaN or infinite one (a float render's) is
-    a SettingError naming ``setting``."""
+    an image without pixels (a missing file, the Render Result), with a NaN or infinite one (a float render's), of
+    more than ``export.images.MAX_PIXELS`` pixels or of UDIM tiles is a SettingError naming ``setting``."""
     if ima.type in ("RENDER_RESULT", "COMPOSITING"):      # Blender shows these; their pixels are not readable
         raise backend.SettingError(setting, f"image {ima.name!r} is Blender's render view, whose pixels scripts "
                                             "cannot read: save it (Image > Save As) and open the saved file")
+    from ..export import images
+
+    if ima.source == "TILED":       # its pixels are the first tile's alone
+        raise backend.SettingError(setting, f"image {ima.name!r} is a UDIM tiled image; pick the image of one tile")
     w, h = ima.size
     if w * h == 0:
         raise backend.SettingError(setting, f"image {ima.name!r} has no pixels (is its file missing?)")
+    if w * h > images.MAX_PIXELS:     # as an image file is refused
+        raise backend.SettingError(setting, f"image {ima.name!r} is {w}x{h} px, more than the {images.MAX_PIXELS} px "
+                                            "an input may have")
     px = np.empty(w * h * ima.channels, np.float32)
     ima.pixels.foreach_get(px)
     if not np.isfinite(px).all():

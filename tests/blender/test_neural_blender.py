@@ -10,6 +10,7 @@ from omninoise import blender_addon  # noqa: E402
 from conftest import Recorder  # noqa: E402
 from omninoise.blender_addon import neural_ui, tasks  # noqa: E402
 from omninoise.blender_addon.compat import ensure_node_tree  # noqa: E402
+from omninoise.export import images  # noqa: E402
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -96,7 +97,7 @@ def test_painted_regions_carry_their_swatch(scene):
     np.testing.assert_allclose(cond[:, 0, -1], C.uniform(m, p.swatches[1].spec(), 1, 1)[:, 0, 0], atol=1e-5)
 
 
-def test_clear_messages(scene):
+def test_clear_messages(scene, monkeypatch):
     p = scene.omninoise_neural
     p.mode = "CORNERS"
     with pytest.raises(RuntimeError, match="needs four swatches"):
@@ -120,6 +121,18 @@ def test_clear_messages(scene):
     hot.pixels.foreach_set(px)
     p.blend_map = hot
     with pytest.raises(RuntimeError, match="blend map: image 'hot' holds NaN or infinite values"):
+        bpy.ops.omninoise.neural_bake()
+    p.blend_map = bpy.data.images.new("wide", 64, 64)
+    monkeypatch.setattr(images, "MAX_PIXELS", 64 * 63)     # read as a file is: one of 2^27 + 1 px is refused
+    with pytest.raises(RuntimeError, match="blend map: image 'wide' is 64x64 px, more than the 4032 px an input "
+                                           "may have"):
+        bpy.ops.omninoise.neural_bake()
+    monkeypatch.undo()
+    tiles = bpy.data.images.new("tiles", 16, 16, tiled=True)
+    tiles.tiles.new(tile_number=1002)
+    p.blend_map = tiles
+    with pytest.raises(RuntimeError, match="blend map: image 'tiles' is a UDIM tiled image; pick the image of one "
+                                           "tile"):
         bpy.ops.omninoise.neural_bake()
     sq = bpy.data.images.new("green", 16, 16)
     sq.colorspace_settings.name = "Non-Color"
