@@ -216,7 +216,10 @@ def output_type(path: str, allowed: tuple, what: str, setting: str) -> str:
         base = os.path.basename(os.fspath(path))
         if base.lower() in allowed:         # '.png': a hidden file's name, with no type after it
             raise SettingError(setting, f"{base!r} is a name without a type: give the file a name before {base}")
-        raise SettingError(setting, f"{what} is written as {', '.join(allowed)}, not {ext or os.fspath(path)!r}")
+        if not ext:
+            raise SettingError(setting, f"{os.fspath(path)!r} is a name without a type: {what} is written as "
+                                        f"{', '.join(allowed)}")
+        raise SettingError(setting, f"{what} is written as {', '.join(allowed)}, not {ext!r}")
     return ext
 
 

@@ -516,6 +516,8 @@ def test_every_command_names_the_types_its_output_is_written_as(tmp_path, capsys
     assert os.listdir(tmp_path) == []
     if "--keys" in args:        # an animation's name needs its '#' first
         return
+    assert main(args + ["-o", "x"]) == 2
+    assert capsys.readouterr().err.strip().endswith(f"-o: 'x' is a name without a type: {said}")
     hidden = said.split(" is written as ")[1].split(",")[0]           # '.png': a name with no type (was 'not .png')
     assert main(args + ["-o", hidden]) == 2
     assert capsys.readouterr().err.strip().endswith(f"-o: '{hidden}' is a name without a type: give the file a "
