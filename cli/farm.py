@@ -197,8 +197,46 @@ def local_client(workers: int, memory_limit: str = "auto"):
     return Client(cluster)
 
 
+#: seconds a scheduler has to take a connection and greet it (Dask's own connect timeout, and the greeting's)
+CONNECT_TIMEOUT = 30.0
+
+
+def probe_scheduler(address: str, security=None, timeout: float | None = None) -> None:
+    """Connect to ``address`` as Dask's client does and close again; OSError where no Dask scheduler greets it within
+    ``timeout`` (:data:`CONNECT_TIMEOUT`) seconds.  Dask's own connection waits for a scheduler's greeting without a
+    deadline, so a server that says nothing (a web server, such as a scheduler's dashboard) holds it for ever, and
+    one that says something else can make it read any length (an internal error allocating exabytes)."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    timeout = CONNECT_TIMEOUT if timeout is None else float(timeout)
+    args = security.get_connection_args("client") if security is not None else {}
+
+    async def greet():
+        comm = await connect(address, timeout=timeout, **args)
+        await comm.close()
+
+    async def within():
+        try:
+            await asyncio.wait_for(greet(), timeout + 1.0)
+        except asyncio.TimeoutError:
+            return f"it took the connection but sent nothing in {timeout:g} s, where a Dask scheduler greets at once"
+        except OSError:         # refused, unreachable, timed out connecting: Dask's own words
+            raise
+        except Exception:  # noqa: BLE001  (a greeting Dask cannot read: any of its decoders' errors)
+            return "it answered, but not as a Dask scheduler does"
+        return None
+
+    said = asyncio.run(within())
+    if said is not None:
+        raise OSError(f"{said} (a web page's port, such as the dashboard's? a scheduler listens on port 8786 "
+                      "unless told otherwise)")
+
+
 def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None = None, tls_key: str | None = None):
-    """A client of a running scheduler; ``tls://`` addresses take Dask's Security from the certificate files."""
+    """A client of a running scheduler, once :func:`probe_scheduler` finds one greeting at ``address``; ``tls://``
+    addresses take Dask's Security from the certificate files."""
     from distributed import Client
 
     security = None
@@ -209,7 +247,8 @@ def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None 
             raise JobError("a tls:// scheduler needs --tls-ca-file, --tls-cert and --tls-key")
         security = Security(tls_ca_file=tls_ca, tls_client_cert=tls_cert, tls_client_key=tls_key,
                             require_encryption=True)
-    return Client(address, security=security, timeout="30s")
+    probe_scheduler(address, security)
+    return Client(address, security=security, timeout=f"{CONNECT_TIMEOUT:g}s")
 
 
 def invalid_bakes(entries: list) -> list:

@@ -226,6 +226,46 @@ def test_a_farm_job_s_bad_bake_is_named_before_the_scheduler_is_reached(tmp_path
     assert "resolution" in err and "scheduler" not in err, err
 
 
+@pytest.mark.parametrize("says, message", [
+    (None, "it took the connection but sent nothing in 1 s, where a Dask scheduler greets at once"),
+    (b"HTTP/1.0 400 Bad Request\r\nContent-Length: 0\r\n\r\n", "it answered, but not as a Dask scheduler does"),
+])
+def test_an_address_where_no_scheduler_greets_is_refused_in_one_line(tmp_path, capsys, monkeypatch, says, message):
+    """A server that takes the connection and says nothing (a web server: a scheduler's dashboard) held Dask's
+    connection for ever; one that says something else made it allocate the length its first bytes read as (an
+    internal MemoryError). Both are named, the job left undone."""
+    import socket
+    import threading
+
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+
+    def serve():
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            held.append(conn)
+            if says:
+                conn.sendall(says)
+
+    threading.Thread(target=serve, daemon=True).start()
+    monkeypatch.setattr(farm, "CONNECT_TIMEOUT", 1.0)
+    try:
+        job = job_in(tmp_path, JOB.split("[[bake]]\nname = \"seq\"")[0])
+        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        assert main(["bake", job, "--quiet", "--cluster", address]) == 2
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+    err = capsys.readouterr().err.strip()
+    assert err == (f"omninoise bake: error: --cluster: cannot reach the scheduler {address}: {message} (a web page's "
+                   "port, such as the dashboard's? a scheduler listens on port 8786 unless told otherwise)"), err
+    assert not (tmp_path / "out" / "img.exr").exists()
+
+
 def _certs(folder) -> tuple:
     """A throwaway CA and one certificate for 127.0.0.1 signed by it (openssl), as a farm's admin would make."""
     ca_key, ca, key, csr, cert = (str(folder / n) for n in ("ca.key", "ca.pem", "node.key", "node.csr", "node.pem"))
