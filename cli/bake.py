@@ -167,6 +167,9 @@ def _farm_outcomes(a: argparse.Namespace, farm) -> list:
             cluster.close()
 
 
+MAX_RETRIES = 100     #: the most runs of a failed farm task after its first
+
+
 def _on_farm(a: argparse.Namespace) -> int:
     """``bake --workers N`` / ``--cluster ADDRESS``: the job on Dask (cli/farm.py); exit codes as locally."""
     from omninoise.backend.jobs import JobError, load_job, select_bakes
@@ -175,8 +178,8 @@ def _on_farm(a: argparse.Namespace) -> int:
         raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
     if a.workers is not None and not 1 <= a.workers <= 512:
         raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
-    if a.retries < 0:
-        raise SettingError("--retries", f"must be >= 0, got {a.retries}")
+    if not 0 <= a.retries <= MAX_RETRIES:       # a task that always fails would run that many times
+        raise SettingError("--retries", f"must be 0 to {MAX_RETRIES}, got {a.retries}")
     if a.brick_voxels is not None and a.brick_voxels < 1:
         raise SettingError("--brick-voxels", f"must be >= 1, got {a.brick_voxels}")
     if not os.path.isfile(a.job):

@@ -197,6 +197,10 @@ def test_the_cli_runs_a_job_on_a_local_cluster(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("flags, message", [
+    (["--workers", "513"], "--workers: must be 1 to 512, got 513"),
+    (["--workers", "1", "--retries", "101"], "--retries: must be 0 to 100, got 101"),
+    (["--workers", "1", "--retries", "-1"], "--retries: must be 0 to 100, got -1"),
+    (["--workers", "1", "--brick-voxels", "0"], "--brick-voxels: must be >= 1, got 0"),
     (["--cluster", "farmhead"], "--cluster: expected a Dask scheduler's address, tcp://HOST:PORT or tls://HOST:PORT, "
                                 "got 'farmhead'"),
     (["--cluster", "tcp://farmhead"], "--cluster: expected a Dask scheduler's address"),
