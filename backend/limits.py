@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 
 from .errors import SettingError
 
@@ -49,16 +50,23 @@ MAX_CYCLES = 1e8
 _DEFAULT_MEMORY = 16 << 30
 
 
+#: a number of bytes: digits (a fraction, an exponent) and a binary unit, 8G, 512M, 8GB, 8GiB, 1.5T, 2e9
+_BYTES = re.compile(r"((?:\d+(?:\.\d*)?|\.\d+)(?:E[+-]?\d+)?)\s*([KMGT]?)(?:I?B)?")
+_UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
+
+
 def memory_limit() -> int:
-    """Bytes a single result may take: OMNINOISE_MEMORY_LIMIT (bytes, or with a K/M/G suffix), default 16 GiB."""
-    v = os.environ.get("OMNINOISE_MEMORY_LIMIT", "").strip().upper()
-    if not v:
+    """Bytes a single result may take: OMNINOISE_MEMORY_LIMIT (bytes, or with a K/M/G/T suffix), default 16 GiB;
+    a value that is no positive number of bytes up to 2^60 is a SettingError (it would refuse every result, or none)."""
+    given = os.environ.get("OMNINOISE_MEMORY_LIMIT", "").strip()
+    if not given:
         return _DEFAULT_MEMORY
-    mult = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30}.get(v[-1], 1)
-    try:
-        return int(float(v.rstrip("KMG")) * mult)
-    except ValueError:
-        raise SettingError("OMNINOISE_MEMORY_LIMIT", f"expected bytes like 8G, got {v!r}") from None
+    m = _BYTES.fullmatch(given.upper())
+    n = float(m[1]) * _UNITS[m[2]] if m else 0.0
+    if not 1.0 <= n <= 2.0 ** 60:
+        raise SettingError("OMNINOISE_MEMORY_LIMIT", f"expected a positive number of bytes like 8G (a K, M, G or T "
+                                                     f"suffix), got {given!r}")
+    return int(n)
 
 
 def _num(name: str, value) -> float:
@@ -119,5 +127,10 @@ def check_memory(name: str, n_bytes: float, what: str) -> None:
     """Refuse a result of ``n_bytes`` above :func:`memory_limit`, saying how much it would need."""
     limit = memory_limit()
     if n_bytes > limit:
-        raise SettingError(name, f"{what} needs {n_bytes / 2 ** 30:.1f} GiB, above the limit of "
-                                 f"{limit / 2 ** 30:.1f} GiB (set OMNINOISE_MEMORY_LIMIT to raise it)")
+        raise SettingError(name, f"{what} needs {_gib(n_bytes)}, above the limit of {_gib(limit)} (set "
+                                 "OMNINOISE_MEMORY_LIMIT to raise it)")
+
+
+def _gib(n_bytes: float) -> str:
+    """``n_bytes`` as GiB to one decimal, or MiB below 0.1 GiB (a limit of 1M is not "0.0 GiB")."""
+    return f"{n_bytes / 2 ** 30:.1f} GiB" if n_bytes >= 0.1 * 2 ** 30 else f"{n_bytes / 2 ** 20:.1f} MiB"

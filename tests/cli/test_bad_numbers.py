@@ -92,11 +92,33 @@ def test_bad_sampler_settings_name_their_flag(tmp_path, capsys, args, setting):
 def test_memory_error_says_how_much(monkeypatch):
     monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "1M")
     assert limits.memory_limit() == 1 << 20
-    with pytest.raises(SettingError, match=r"needs 0\.0 GiB|needs .* GiB, above the limit of 0\.0 GiB"):
+    with pytest.raises(SettingError, match=r"size: a grid needs 2\.0 MiB, above the limit of 1\.0 MiB \(set "):
         limits.check_memory("size", 2 << 20, "a grid")
-    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "lots")
-    with pytest.raises(SettingError, match="OMNINOISE_MEMORY_LIMIT"):
+    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "16G")
+    with pytest.raises(SettingError, match=r"needs 20\.0 GiB, above the limit of 16\.0 GiB"):
+        limits.check_memory("size", 20 << 30, "a grid")
+
+
+@pytest.mark.parametrize("given, limit", [("8G", 8 << 30), ("8g", 8 << 30), ("8GB", 8 << 30), ("8 GiB", 8 << 30),
+                                          ("512M", 512 << 20), ("1.5T", 3 << 39), ("2e9", 2_000_000_000),
+                                          ("100", 100), (" 4K ", 4096), ("", 16 << 30)])
+def test_the_memory_limit_reads_bytes_with_a_unit(monkeypatch, given, limit):
+    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", given)
+    assert limits.memory_limit() == limit
+
+
+@pytest.mark.parametrize("given", ["lots", "-5", "0", "0.5", "nan", "inf", "1e400", "1e18G", "8X", "8 G B"])
+def test_a_memory_limit_of_no_positive_bytes_is_refused_naming_it(monkeypatch, capsys, tmp_path, given):
+    """A negative or zero limit refused every result as needing more than "-0.0 GiB"; an infinite one ended the
+    command with an internal OverflowError."""
+    monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", given)
+    with pytest.raises(SettingError, match=f"OMNINOISE_MEMORY_LIMIT: expected a positive number of bytes like 8G "
+                                           rf"\(a K, M, G or T suffix\), got '{given}'"):
         limits.memory_limit()
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "w.png")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("omninoise wave: error: OMNINOISE_MEMORY_LIMIT: ") and "\n" not in err, err
+    assert not (tmp_path / "w.png").exists()
 
 
 def test_a_neural_image_is_refused_by_what_it_takes_drawn_whole_or_in_tiles(monkeypatch, capsys, tmp_path):
