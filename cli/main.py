@@ -206,7 +206,7 @@ def _run(a: argparse.Namespace) -> int:
     except Exception as exc:
         from omninoise.backend.grid import Cancelled
         from omninoise.backend.jobs import JobError
-        from omninoise.export import NonFiniteError
+        from omninoise.export import NonFiniteError, WriteError
 
         if isinstance(exc, JobError):
             say(f"error: {exc}")
@@ -214,7 +214,7 @@ def _run(a: argparse.Namespace) -> int:
         if isinstance(exc, Cancelled):
             say("cancelled")
             return 130
-        if isinstance(exc, NonFiniteError):     # the writers' last check: nothing was written
+        if isinstance(exc, (NonFiniteError, WriteError)):     # the writers' last check, a full disk: nothing written
             say(f"error: {exc}")
             return 1
         if a.debug:

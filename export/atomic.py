@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import errno
 import hashlib
 import os
 import tempfile
@@ -68,6 +69,15 @@ class OutputNameError(OSError):
     """An output's file name is longer than its file system allows."""
 
 
+class WriteError(OSError):
+    """An output could not be written (its disk full, a read error of the device): the message names the file and
+    the system's reason; nothing was written and an earlier file at the path is as it was."""
+
+    def __init__(self, path: str, reason: str):
+        super().__init__(f"cannot write {os.path.basename(path)}: {reason}")
+        self.path, self.reason = path, reason
+
+
 def name_limit(folder: str) -> int:
     """Bytes a file name may take in ``folder`` (or its nearest existing parent): the file system's limit, 255
     where it does not say."""
@@ -110,16 +120,43 @@ def atomic_path(path: str, suffix: str | None = None):
     check_target(path)
     remove_stale(folder)
     suffix = (suffix if suffix is not None else os.path.splitext(path)[1])[-SUFFIX_PART:]
-    fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)
+    except OSError as exc:
+        raise WriteError(path, exc.strerror or str(exc)) from None
     os.close(fd)
     try:
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; results get the usual permissions
         _fsync(tmp)
         os.replace(tmp, path)
+    except (OSError, RuntimeError) as exc:       # OpenEXR's and OpenVDB's failures are RuntimeErrors
+        why = None if isinstance(exc, WriteError) else failed_write(exc, folder)
+        if why is None:
+            raise
+        raise WriteError(path, why) from exc
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
+
+
+def failed_write(exc: BaseException, folder: str) -> str | None:
+    """The system's reason where ``exc``, raised while a file was written in ``folder``, is a failure to write (an
+    OSError with an errno; any error where the folder's disk is now full: numpy's and OpenEXR's say it in words of
+    their own, or none); None where it is something else."""
+    if isinstance(exc, OSError) and exc.errno is not None and not isinstance(exc, (FileNotFoundError, PermissionError,
+                                                                                   IsADirectoryError)):
+        return os.strerror(exc.errno)
+    return os.strerror(errno.ENOSPC) if disk_full(folder) else None
+
+
+def disk_full(folder: str) -> bool:
+    """Whether the file system of ``folder`` has no block left that this process may write."""
+    try:
+        st = os.statvfs(folder)
+    except (OSError, AttributeError):       # no statvfs (Windows) or no folder: not known to be full
+        return False
+    return st.f_bavail == 0
 
 
 def _fsync(path: str) -> None:

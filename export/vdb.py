@@ -11,6 +11,7 @@ Voxels equal to zero stay inactive (sparse), so empty space costs nothing.
 """
 from __future__ import annotations
 
+import errno
 import glob
 import importlib.util
 import os
@@ -18,7 +19,7 @@ import sys
 
 import numpy as np
 
-from .atomic import atomic_path, require_finite
+from .atomic import WriteError, atomic_path, disk_full, require_finite
 
 __all__ = ["openvdb_module", "VolumeWriter", "read_volume", "read_vdb_metadata"]
 
@@ -92,13 +93,32 @@ class VolumeWriter:
         return int(self.grids[name][0].activeVoxelCount())
 
     def write(self, path: str) -> None:
-        """Prune and write all grids to ``path`` (temporary file, then rename)."""
+        """Prune and write all grids to ``path`` (temporary file, then rename).  OpenVDB does not say when it cannot
+        write (a full disk leaves a cut file and no error), so the file is read back before the rename: each grid
+        with its active voxels, else :class:`~.atomic.WriteError` and nothing written.  The writer is spent: its
+        grids are let go before the file is read back, so that the two are not held at once."""
         grids = []
         for g, kind in self.grids.values():
             g.prune(0.0) if kind == "float" else g.prune((0.0, 0.0, 0.0))
             grids.append(g)
+        voxels = {g.name: int(g.activeVoxelCount()) for g in grids}
         with atomic_path(path, suffix=".vdb") as tmp:
             self.vdb.write(tmp, grids=grids, metadata=self.metadata)
+            grids.clear()
+            self.grids.clear()      # the file holds them now: read back in their place, not beside them
+            self._check_written(tmp, path, voxels)
+
+    def _check_written(self, tmp: str, path: str, voxels: dict) -> None:
+        """WriteError naming ``path`` unless the file ``tmp`` reads back as the grids ``voxels`` {name: active}."""
+        try:
+            back = self.vdb.readAll(tmp)[0]
+            read = {g.name: int(g.activeVoxelCount()) for g in back}
+        except Exception:  # noqa: BLE001  (a cut file fails in any of OpenVDB's readers: KeyError, RuntimeError...)
+            read = None
+        if read != voxels:
+            folder = os.path.dirname(os.path.abspath(path))
+            raise WriteError(path, os.strerror(errno.ENOSPC) if disk_full(folder) else
+                             "the file read back is not the volume written (a failing disk or a full quota?)")
 
 
 #: bounds of read_vdb_metadata: the bytes it reads at most, entries, and one entry's name or value
