@@ -120,12 +120,10 @@ def atomic_path(path: str, suffix: str | None = None):
     check_target(path)
     remove_stale(folder)
     suffix = (suffix if suffix is not None else os.path.splitext(path)[1])[-SUFFIX_PART:]
+    tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)
-    except OSError as exc:
-        raise WriteError(path, exc.strerror or str(exc)) from None
-    os.close(fd)
-    try:
+        os.close(fd)
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; results get the usual permissions
         _fsync(tmp)
@@ -136,7 +134,7 @@ def atomic_path(path: str, suffix: str | None = None):
             raise
         raise WriteError(path, why) from exc
     finally:
-        if os.path.exists(tmp):
+        if tmp is not None and os.path.exists(tmp):
             os.remove(tmp)
 
 
@@ -147,6 +145,11 @@ def failed_write(exc: BaseException, folder: str) -> str | None:
     if isinstance(exc, OSError) and exc.errno is not None and not isinstance(exc, (FileNotFoundError, PermissionError,
                                                                                    IsADirectoryError)):
         return os.strerror(exc.errno)
+    return no_space(folder)
+
+
+def no_space(folder: str) -> str | None:
+    """ENOSPC's reason where the disk of ``folder`` is full (:func:`disk_full`), else None."""
     return os.strerror(errno.ENOSPC) if disk_full(folder) else None
 
 

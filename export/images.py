@@ -269,9 +269,8 @@ def _sixteen_bits(path: str, tiles: list) -> tuple | None:
         return args if isinstance(args, str) else (args[0] if isinstance(args, tuple) and args else None)
 
     raws = {raw(t) for t in tiles}
-    match = None
-    if len(raws) == 1 and isinstance(next(iter(raws)), str) and all(hasattr(t, "_replace") for t in tiles):
-        match = _WIDE.fullmatch(next(iter(raws)))
+    mode = raws.pop() if len(raws) == 1 and all(hasattr(t, "_replace") for t in tiles) else None
+    match = _WIDE.fullmatch(mode) if isinstance(mode, str) else None
     if match is None:
         return None
     kind, order = match.groups()

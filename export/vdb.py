@@ -11,7 +11,6 @@ Voxels equal to zero stay inactive (sparse), so empty space costs nothing.
 """
 from __future__ import annotations
 
-import errno
 import glob
 import importlib.util
 import os
@@ -19,7 +18,7 @@ import sys
 
 import numpy as np
 
-from .atomic import WriteError, atomic_path, disk_full, require_finite
+from .atomic import WriteError, atomic_path, no_space, require_finite
 
 __all__ = ["openvdb_module", "VolumeWriter", "read_volume", "read_vdb_metadata"]
 
@@ -116,8 +115,7 @@ class VolumeWriter:
         except Exception:  # noqa: BLE001  (a cut file fails in any of OpenVDB's readers: KeyError, RuntimeError...)
             read = None
         if read != voxels:
-            folder = os.path.dirname(os.path.abspath(path))
-            raise WriteError(path, os.strerror(errno.ENOSPC) if disk_full(folder) else
+            raise WriteError(path, no_space(os.path.dirname(os.path.abspath(path))) or
                              "the file read back is not the volume written (a failing disk or a full quota?)")
 
 
