@@ -175,6 +175,10 @@ def _decode(path: str) -> tuple:
             import OpenEXR
 
             with OpenEXR.File(path) as f:
+                if len(f.parts) > 1:     # a renderer's passes, one a part: which is the picture?
+                    raise ImageError(f"{path}: an EXR image must be one part, not {len(f.parts)} ("
+                                     f"{', '.join(p.name() or '(unnamed)' for p in f.parts)}); save the picture's "
+                                     "part as an EXR of its own")
                 chans = f.channels()
                 key = next((k for k in ("Y", "RGBA", "RGB") if k in chans), next(iter(chans)) if len(chans) == 1
                            else None)

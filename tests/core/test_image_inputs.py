@@ -372,3 +372,25 @@ def test_an_exr_is_read_by_its_picture_and_one_of_several_layers_is_refused(tmp_
                                              f"{names}; save") as exc:
             decode(str(tmp_path / name))
         assert "\n" not in str(exc.value)
+
+
+def test_an_exr_of_several_parts_is_refused_naming_them(tmp_path):
+    """A compositor's multi-part EXR (one pass a part) was read by its first part, whichever pass that was: refused
+    naming the parts, as an EXR of several layers is; an EXR of one named part reads as before."""
+    import OpenEXR
+    rng = np.random.default_rng(5)
+
+    def part(name, pixels):
+        return OpenEXR.Part({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, "name": name},
+                            {"RGB": pixels}, name)
+
+    depth, beauty = (rng.random((8, 6, 3)).astype(np.float32) for _ in range(2))
+    with OpenEXR.File([part("depth", depth), part("beauty", beauty)]) as f:
+        f.write(str(tmp_path / "passes.exr"))
+    with pytest.raises(ImageError, match=r"passes\.exr: an EXR image must be one part, not 2 \(depth, beauty\); "
+                                         "save the picture's part as an EXR of its own") as exc:
+        decode(str(tmp_path / "passes.exr"))
+    assert "\n" not in str(exc.value)
+    with OpenEXR.File([part("beauty", beauty)]) as f:
+        f.write(str(tmp_path / "one.exr"))
+    np.testing.assert_array_equal(decode(str(tmp_path / "one.exr")), beauty)
