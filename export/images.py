@@ -51,9 +51,19 @@ def encode_srgb8(linear: np.ndarray) -> np.ndarray:
     return (out * 255.0 + 0.5).astype(np.uint8)
 
 
+def _text_chunk(chunk, key: str, value: str) -> bytes:
+    """A PNG text chunk of ``key`` (Latin-1) and ``value``: tEXt where the value is Latin-1 (the text every reader
+    reads), else iTXt's uncompressed UTF-8 (PNG specification 11.3.4.3 and 11.3.4.5), for a bake named in any
+    script."""
+    try:
+        return chunk(b"tEXt", key.encode("latin-1") + b"\0" + value.encode("latin-1"))
+    except UnicodeEncodeError:      # iTXt: keyword, 0, compression flag and method 0, no language, no translation
+        return chunk(b"iTXt", key.encode("latin-1") + b"\0\0\0\0\0" + value.encode("utf-8"))
+
+
 def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> None:
     """Write uint8 or uint16 (H, W) or (H, W, 2|3|4) as an 8- or 16-bit PNG (zlib, no dependencies); metadata ->
-    tEXt chunks."""
+    text chunks (keys Latin-1, values any text)."""
     a = np.asarray(array)
     if a.dtype not in (np.uint8, np.uint16):
         raise TypeError("write_png expects uint8 or uint16; use preview_8bit for floats")
@@ -69,8 +79,7 @@ def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> Non
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
 
     png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, 0))
-           + b"".join(chunk(b"tEXt", f"{k}".encode("latin-1") + b"\0" + f"{v}".encode("latin-1"))
-                      for k, v in (metadata or {}).items())
+           + b"".join(_text_chunk(chunk, str(k), str(v)) for k, v in (metadata or {}).items())
            + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
@@ -368,6 +377,11 @@ def _png_text(path: str) -> dict:
             if tag == b"tEXt" and b"\0" in data:
                 k, v = data.split(b"\0", 1)
                 out[k.decode("latin-1")] = v.decode("latin-1")
+            elif tag == b"iTXt" and b"\0" in data:
+                k, rest = data.split(b"\0", 1)
+                parts = rest[2:].split(b"\0", 2)    # language, translated keyword, the text
+                if rest[:1] == b"\0" and len(parts) == 3:     # uncompressed
+                    out[k.decode("latin-1")] = parts[2].decode("utf-8", "replace")
 
 
 def read_metadata(path: str) -> dict:

@@ -178,6 +178,25 @@ def test_up_to_date_skips_and_changes_rebake(tmp_path):
     assert run_bake(BakeSpec("u", WaveSource(S3.replace(seed=12)), grid, out)).written == [out]
 
 
+@pytest.mark.parametrize("name", ["Ziegel über Grün", "木目 2", "Кирпич"])
+@pytest.mark.parametrize("ext", ["png", "exr", "vdb"])
+def test_a_bake_named_in_any_script_writes_and_reads_back_its_name(tmp_path, name, ext):
+    """A PNG's text chunks hold Latin-1 only: a bake named beyond it stopped with "'latin-1' codec can't
+    encode". Its name is stored as UTF-8 (PNG's iTXt) and read back, by us and by Pillow; the bake is then up to
+    date."""
+    from PIL import Image
+
+    grid = BoxGrid((6, 6, 6)) if ext == "vdb" else BoxGrid((6, 5))
+    out = str(tmp_path / f"{name}.{ext}")
+    spec = BakeSpec(name, WaveSource(S3), grid, out)
+    assert run_bake(spec).written == [out]
+    assert read_metadata(out)["omninoise_bake"] == name
+    assert run_bake(spec).skipped == [out]
+    if ext == "png":
+        with Image.open(out) as im:
+            assert im.text["omninoise_bake"] == name and im.text[bake_mod.KEY_NAME] == spec.key(None)
+
+
 @pytest.mark.parametrize("ext", ["vdb", "exr", "png"])
 def test_cancel_leaves_earlier_result_untouched(tmp_path, monkeypatch, ext):
     monkeypatch.setattr(bake_mod, "SLAB_VOXELS", 16 * 4)
