@@ -122,7 +122,10 @@ def atomic_path(path: str, suffix: str | None = None):
     suffix = (suffix if suffix is not None else os.path.splitext(path)[1])[-SUFFIX_PART:]
     tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=partial_prefix(path, _TAG.get()), suffix=suffix, dir=folder)
+        except (FileNotFoundError, PermissionError) as exc:    # gone since the check, or a folder such as /proc
+            raise type(exc)(f"output folder takes no new file: {folder} ({exc.strerror})") from None
         os.close(fd)
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; results get the usual permissions
@@ -142,8 +145,9 @@ def failed_write(exc: BaseException, folder: str) -> str | None:
     """The system's reason where ``exc``, raised while a file was written in ``folder``, is a failure to write (an
     OSError with an errno; any error where the folder's disk is now full: numpy's and OpenEXR's say it in words of
     their own, or none); None where it is something else."""
-    if isinstance(exc, OSError) and exc.errno is not None and not isinstance(exc, (FileNotFoundError, PermissionError,
-                                                                                   IsADirectoryError)):
+    if isinstance(exc, (FileNotFoundError, PermissionError, IsADirectoryError)):     # the folder's own, said so
+        return None
+    if isinstance(exc, OSError) and exc.errno is not None:
         return os.strerror(exc.errno)
     return no_space(folder)
 
@@ -154,12 +158,13 @@ def no_space(folder: str) -> str | None:
 
 
 def disk_full(folder: str) -> bool:
-    """Whether the file system of ``folder`` has no block left that this process may write."""
+    """Whether the file system of ``folder`` has no block left that this process may write (one of no blocks at
+    all, such as /proc, is not a disk)."""
     try:
         st = os.statvfs(folder)
     except (OSError, AttributeError):       # no statvfs (Windows) or no folder: not known to be full
         return False
-    return st.f_bavail == 0
+    return st.f_blocks > 0 and st.f_bavail == 0
 
 
 def _fsync(path: str) -> None:

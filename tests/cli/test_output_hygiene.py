@@ -579,6 +579,32 @@ def test_a_full_disk_is_named_in_one_line_and_the_earlier_file_kept(tmp_path, ca
     assert out.read_bytes() == before and os.listdir(tmp_path) == [out.name]
 
 
+def test_a_folder_that_takes_no_file_is_said_so_not_a_full_disk(tmp_path, capsys, monkeypatch):
+    """A folder that refuses the new file where its permissions said yes (/proc, a pseudo file system of no blocks,
+    even for root; a folder made read-only or removed while the work ran): one line naming the folder and the
+    system's reason, exit 2, nothing written. /proc's 0 free blocks of 0 were read as a full disk ("No space left
+    on device")."""
+    import errno as errnos
+    import tempfile
+
+    from omninoise.export import atomic
+
+    if sys.platform.startswith("linux") and os.path.isdir("/proc"):
+        assert not atomic.disk_full("/proc")
+        assert main(["wave", "--size", "8", "--quiet", "-o", "/proc/omninoise_w.png"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("omninoise wave: error: output folder takes no new file: /proc (") and "space" not in err
+    monkeypatch.setattr(atomic, "disk_full", lambda folder: True)       # whatever the disk: not its reason
+
+    def refused(**kw):
+        raise PermissionError(errnos.EACCES, os.strerror(errnos.EACCES), os.path.join(kw["dir"], "tmpx"))
+    monkeypatch.setattr(tempfile, "mkstemp", refused)
+    assert main(["wave", "--size", "8", "--quiet", "-o", str(tmp_path / "w.png")]) == 2
+    assert capsys.readouterr().err.strip() == (f"omninoise wave: error: output folder takes no new file: {tmp_path} "
+                                               "(Permission denied)")
+    assert os.listdir(tmp_path) == []
+
+
 @needs_openvdb
 def test_a_volume_that_reads_back_cut_is_not_written(tmp_path, capsys, monkeypatch):
     """OpenVDB writes a cut file on a full disk and says nothing: the file is read back before it takes the
