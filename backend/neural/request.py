@@ -235,7 +235,7 @@ def regions_from_colours(rgb: np.ndarray, colours: list, tolerance: float | None
             out[code == c] = i
         if (out < 0).any():
             y, x = np.argwhere(out < 0)[0]
-            raise _unmatched(where, tuple(int(v) for v in q[y, x]), code[out < 0], "colours")
+            raise _unmatched(where, tuple(int(v) for v in q[y, x]), code[out < 0], "colours", (x, y))
         return out
     d = np.abs(px[:, :, None, :] - cols[None, None]).max(-1)  # (H, W, colours)
     nearest, err = d.argmin(-1), d.min(-1)
@@ -280,14 +280,18 @@ def regions_from_map(px: np.ndarray, keys: list, where: str = "map") -> np.ndarr
     for i, k in enumerate(keys):
         regions[grey == k] = i
     if (regions < 0).any():
-        raise _unmatched(where, int(grey[regions < 0][0]), grey[regions < 0], "grey levels")
+        y, x = np.argwhere(regions < 0)[0]
+        raise _unmatched(where, int(grey[y, x]), grey[regions < 0], "grey levels", (x, y))
     return regions
 
 
-def _unmatched(where: str, first, values: np.ndarray, noun: str) -> SettingError:
-    """The error of a map's pixels of no key: the first one's value, and where there are more such values, how many
-    and on how many pixels (a map painted with soft or anti-aliased edges blends its regions' colours)."""
+def _unmatched(where: str, first, values: np.ndarray, noun: str, at: tuple) -> SettingError:
+    """The error of a map's pixels of no key: the first one's value and place ``at`` (x, y: px from the top left
+    of the file, as image editors count), and where there are more such values, how many and on how many pixels
+    (a map painted with soft or anti-aliased edges blends its regions' colours)."""
     kinds = len(np.unique(values))
-    more = "" if kinds == 1 else (f" ({kinds} {noun} have none, on {values.size} px: paint the map with hard edges, "
-                                  "one flat colour per region, or give each a spec)")
+    place = f"the first at x {int(at[0])}, y {int(at[1])} from the top left"
+    more = (f" (on {values.size} px, {place})" if kinds == 1 else
+            f" ({kinds} {noun} have none, on {values.size} px, {place}: paint the map with hard edges, one flat "
+            "colour per region, or give each a spec)")
     return SettingError(where, f"the map uses {first} but no spec is given for it{more}")

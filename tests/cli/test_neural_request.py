@@ -183,13 +183,21 @@ def test_a_map_with_soft_edges_is_told_apart_from_one_missing_colour():
     px = np.zeros((8, 32, 3), np.float32)
     px[:, :, 0] = np.clip((np.arange(32) - 12) / 8.0, 0, 1)     # black to red over 8 px
     with pytest.raises(SettingError, match=r"the map uses \(32, 0, 0\) but no spec is given for it \(7 colours have "
-                                           r"none, on 56 px: paint the map with hard edges"):
+                                           r"none, on 56 px, the first at x 13, y 0 from the top left: paint the map "
+                                           "with hard edges"):
         regions_from_map(px, [(0, 0, 0), (255, 0, 0)], "--map")
-    with pytest.raises(SettingError, match=r"uses 10 but no spec is given for it \(7 grey levels have none"):
+    with pytest.raises(SettingError, match=r"uses 10 but no spec is given for it \(7 grey levels have none, on 56 px, "
+                                           "the first at x 13, y 0 "):
         regions_from_map(px, [0, 76], "--map")
     hard = np.round(px)
-    with pytest.raises(SettingError, match=r"uses \(255, 0, 0\) but no spec is given for it$"):
+    with pytest.raises(SettingError, match=r"uses \(255, 0, 0\) but no spec is given for it \(on 120 px, the first "
+                                           r"at x 17, y 0 from the top left\)$"):     # 15 columns of red, 8 rows
         regions_from_map(hard, [(0, 0, 0)], "--map")
+    stray = np.zeros((8, 32, 3), np.float32)
+    stray[5, 20] = (1 / 255, 0, 0)          # one pixel a brush left a shade off black: where to find it
+    with pytest.raises(SettingError, match=r"uses \(1, 0, 0\) but no spec is given for it \(on 1 px, the first at "
+                                           r"x 20, y 5 from the top left\)$"):
+        regions_from_map(stray, [(0, 0, 0)], "--map")
     assert set(np.unique(regions_from_map(hard, [(0, 0, 0), (255, 0, 0)]))) == {0, 1}
 
 
