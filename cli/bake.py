@@ -142,8 +142,9 @@ def run(a: argparse.Namespace) -> int:
 def _farm_outcomes(a: argparse.Namespace, farm) -> list:
     """The job's outcomes from a run on the cluster ``a`` names (``farm`` is cli/farm.py)."""
     try:
+        note = None if a.quiet else (lambda text: print(f"omninoise bake: {text}", file=sys.stderr))
         client = farm.local_client(a.workers) if a.workers else farm.remote_client(a.cluster, a.tls_ca_file,
-                                                                                   a.tls_cert, a.tls_key)
+                                                                                   a.tls_cert, a.tls_key, note)
     except ImportError as exc:
         raise SettingError("--workers" if a.workers else "--cluster",
                            f"needs Dask distributed ({exc}); pip install 'dask[distributed]'") from None

@@ -201,17 +201,37 @@ def local_client(workers: int, memory_limit: str = "auto"):
 CONNECT_TIMEOUT = 30.0
 
 
-def probe_scheduler(address: str, security=None, timeout: float | None = None) -> None:
+def refused(address: str) -> bool:
+    """Whether ``address`` (``tcp://HOST:PORT``, ``tls://HOST:PORT`` or ``HOST:PORT``) refuses a connection now:
+    its host answers that nothing listens on the port (a scheduler not started yet, or a wrong port)."""
+    import socket
+
+    host, _, port = address.partition("://")[2 if "://" in address else 0].rpartition(":")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=2.0):
+            return False
+    except ConnectionRefusedError:
+        return True
+    except (OSError, ValueError):       # unreachable, slow or unnamed: Dask's own connection says what it finds
+        return False
+
+
+def probe_scheduler(address: str, security=None, timeout: float | None = None, note=None) -> None:
     """Connect to ``address`` as Dask's client does and close again; OSError where no Dask scheduler greets it within
     ``timeout`` (:data:`CONNECT_TIMEOUT`) seconds.  Dask's own connection waits for a scheduler's greeting without a
     deadline, so a server that says nothing (a web server, such as a scheduler's dashboard) holds it for ever, and
-    one that says something else can make it read any length (an internal error allocating exabytes)."""
+    one that says something else can make it read any length (an internal error allocating exabytes).  Where
+    nothing listens on the port yet, Dask tries again until the timeout (a scheduler may be starting):
+    ``note(text)`` is told so first, and the error says the port refused."""
     import asyncio
 
     from distributed.comm import connect
 
     timeout = CONNECT_TIMEOUT if timeout is None else float(timeout)
     args = security.get_connection_args("client") if security is not None else {}
+    waiting = refused(address)
+    if waiting and note is not None:
+        note(f"nothing listens at {address} yet; waiting up to {timeout:g} s for a scheduler to start")
 
     async def greet():
         comm = await connect(address, timeout=timeout, **args)
@@ -222,7 +242,10 @@ def probe_scheduler(address: str, security=None, timeout: float | None = None) -
             await asyncio.wait_for(greet(), timeout + 1.0)
         except asyncio.TimeoutError:
             return f"it took the connection but sent nothing in {timeout:g} s, where a Dask scheduler greets at once"
-        except OSError:         # refused, unreachable, timed out connecting: Dask's own words
+        except OSError as exc:      # refused, unreachable, timed out connecting: Dask's own words
+            if waiting and refused(address):
+                raise OSError(f"nothing listens on its port (the connection was refused for {timeout:g} s): start "
+                              "the scheduler (dask scheduler) or check the address") from exc
             raise
         except Exception:  # noqa: BLE001  (a greeting Dask cannot read: any of its decoders' errors)
             return "it answered, but not as a Dask scheduler does"
@@ -234,9 +257,10 @@ def probe_scheduler(address: str, security=None, timeout: float | None = None) -
                       "unless told otherwise)")
 
 
-def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None = None, tls_key: str | None = None):
+def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None = None, tls_key: str | None = None,
+                  note=None):
     """A client of a running scheduler, once :func:`probe_scheduler` finds one greeting at ``address``; ``tls://``
-    addresses take Dask's Security from the certificate files."""
+    addresses take Dask's Security from the certificate files.  ``note(text)``: :func:`probe_scheduler`'s."""
     from distributed import Client
 
     security = None
@@ -247,7 +271,7 @@ def remote_client(address: str, tls_ca: str | None = None, tls_cert: str | None 
             raise JobError("a tls:// scheduler needs --tls-ca-file, --tls-cert and --tls-key")
         security = Security(tls_ca_file=tls_ca, tls_client_cert=tls_cert, tls_client_key=tls_key,
                             require_encryption=True)
-    probe_scheduler(address, security)
+    probe_scheduler(address, security, note=note)
     return Client(address, security=security, timeout=f"{CONNECT_TIMEOUT:g}s")
 
 

@@ -270,6 +270,60 @@ def test_an_address_where_no_scheduler_greets_is_refused_in_one_line(tmp_path, c
     assert not (tmp_path / "out" / "img.exr").exists()
 
 
+def _free_port() -> int:
+    import socket
+
+    with socket.create_server(("127.0.0.1", 0)) as s:
+        return s.getsockname()[1]
+
+
+def test_a_port_where_nothing_listens_is_said_so_while_waiting_and_after(tmp_path, capsys, monkeypatch):
+    """Dask tries a refused port again until its timeout (a scheduler may be starting), 30 s of silence that ended
+    in 'Timed out trying to connect': the wait is said when it starts, and the error says nothing listens."""
+    monkeypatch.setattr(farm, "CONNECT_TIMEOUT", 1.0)
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    import socket
+
+    assert farm.refused(address) and farm.refused(address.replace("tcp://", ""))
+    with socket.create_server(("127.0.0.1", 0)) as listening:
+        assert not farm.refused(f"tcp://127.0.0.1:{listening.getsockname()[1]}")
+    job = job_in(tmp_path, JOB.split("[[bake]]\nname = \"seq\"")[0])
+    assert main(["bake", job, "--cluster", address]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"omninoise bake: nothing listens at {address} yet; waiting up to 1 s for a scheduler to start",
+        f"omninoise bake: error: --cluster: cannot reach the scheduler {address}: nothing listens on its port (the "
+        "connection was refused for 1 s): start the scheduler (dask scheduler) or check the address"]
+    assert main(["bake", job, "--cluster", address, "--quiet"]) == 2
+    assert "waiting" not in capsys.readouterr().err
+    assert not (tmp_path / "out" / "img.exr").exists()
+
+
+def test_a_scheduler_that_starts_while_the_client_waits_is_reached(tmp_path):
+    """The port refuses at first; the scheduler started meanwhile is reached within the wait, as Dask's own
+    retries reach it."""
+    import sys
+    import threading
+
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    assert farm.refused(address)
+    procs = []
+    start = threading.Timer(0.5, lambda: procs.append(subprocess.Popen(
+        [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+         "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)))
+    notes = []
+    start.start()
+    try:
+        farm.probe_scheduler(address, note=notes.append)
+        assert not farm.refused(address)
+    finally:
+        start.join()
+        for p in procs:
+            p.terminate()
+            p.wait(10)
+    assert notes == [f"nothing listens at {address} yet; waiting up to 30 s for a scheduler to start"]
+
+
 def _certs(folder) -> tuple:
     """A throwaway CA and one certificate for 127.0.0.1 signed by it (openssl), as a farm's admin would make."""
     ca_key, ca, key, csr, cert = (str(folder / n) for n in ("ca.key", "ca.pem", "node.key", "node.csr", "node.pem"))
