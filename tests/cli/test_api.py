@@ -126,13 +126,13 @@ def test_grey_and_rgba_pixels_are_read_as_their_files_are():
     (H, W, 3), as a grey or RGBA image file is read; a transparent pixel is refused as in a file."""
     grey = np.random.default_rng(2).random((40, 40)).astype(np.float32)
     rgb = np.repeat(grey[..., None], 3, axis=2)
-    ref = omninoise.solid(rgb, 8, method="spectral", seed=1)
+    ref = omninoise.solid(rgb, 8, method="neural", seed=1)
     rgba = np.concatenate([rgb, np.ones((40, 40, 1), np.float32)], axis=2)
     for pixels in (grey, grey[..., None], rgba, grey.astype(np.float64)):
-        np.testing.assert_array_equal(omninoise.solid(pixels, 8, method="spectral", seed=1), ref)
+        np.testing.assert_array_equal(omninoise.solid(pixels, 8, method="neural", seed=1), ref)
     rgba[3, 4, 3] = 0.5
     with pytest.raises(SettingError, match=r"^exemplar: the image is partly transparent \(alpha below 1 on 0.0625 %"):
-        omninoise.solid(rgba, 8, method="spectral")
+        omninoise.solid(rgba, 8, method="neural")
 
 
 def test_an_unknown_wave_setting_is_a_type_error_naming_wave_and_its_settings():
