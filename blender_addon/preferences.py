@@ -47,8 +47,12 @@ def cache_dir() -> str:
 
 
 def threads() -> int:
+    """The CPU Threads preference, at most the CPUs this machine gives Blender (0: all of them): preferences
+    travel between machines, and more threads than CPUs wait on each other (``backend.limits.threads``)."""
+    from ..backend.limits import cpus
+
     prefs = get()
-    return prefs.threads if prefs is not None and prefs.threads > 0 else (os.cpu_count() or 1)
+    return min(prefs.threads, cpus()) if prefs is not None and prefs.threads > 0 else cpus()
 
 
 def precision() -> str:
@@ -119,8 +123,9 @@ def get():
 class OMNINOISE_AP_preferences(bpy.types.AddonPreferences):
     bl_idname = ROOT_PACKAGE or "omninoise"
 
-    threads: IntProperty(name="CPU Threads", description="Threads for bakes (0 = all cores)",
-                         default=0, min=0, max=256)
+    threads: IntProperty(name="CPU Threads", default=0, min=0, max=256,
+                         description="Threads for bakes (0 = all cores; more than this machine has are read as all "
+                                     "of them)")
     neural_precision: EnumProperty(
         name="Neural Precision", default="fp32",
         description="Arithmetic of the neural noise denoiser",

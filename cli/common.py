@@ -96,9 +96,7 @@ def set_threads(n: int, precision: str = "fp32") -> None:
     from omninoise.backend.neural.precision import set_default_precision
     from omninoise.backend.onnx_models import set_default_threads
 
-    if not 0 <= n <= limits.MAX_THREADS:
-        raise SettingError("--threads", f"must lie in [0, {limits.MAX_THREADS}] (0: all cores), got {n}")
-    set_default_threads(n)
+    set_default_threads(limits.threads("--threads", n))
     set_default_precision(precision)
 
 

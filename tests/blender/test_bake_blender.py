@@ -200,6 +200,23 @@ def test_an_unsaved_files_bake_goes_to_the_user_cache_where_a_script_registered_
     assert path.startswith(os.path.join(cache, "omninoise")) and not path.startswith(bpy.app.tempdir)
 
 
+def test_the_threads_preference_is_at_most_the_machine_s_cpus(monkeypatch):
+    """Preferences travel between machines: CPU Threads 256 saved on a workstation, on a machine of 2 CPUs, would
+    make every bake's threads wait on each other (neural noise 15 times as long at 64 threads). It is read as at
+    most the CPUs this machine gives Blender; 0 is all of them."""
+    from types import SimpleNamespace
+
+    from omninoise.backend import limits
+    from omninoise.blender_addon import preferences
+
+    monkeypatch.setattr(limits, "cpus", lambda: 2)
+    for asked, got in ((0, 2), (1, 1), (2, 2), (256, 2)):
+        monkeypatch.setattr(preferences, "get", lambda: SimpleNamespace(threads=asked))
+        assert preferences.threads() == got
+    monkeypatch.setattr(preferences, "get", lambda: None)
+    assert preferences.threads() == 2
+
+
 def test_bad_settings_report_one_line(scene, tmp_path):
     p = scene.omninoise_bake
     p.wave.dimensions = "2"
