@@ -5,6 +5,7 @@ import argparse
 import os
 import sys
 
+from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.neural.precision import PRECISIONS
 
@@ -22,7 +23,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                     """omninoise bake job.toml
 omninoise bake job.toml --only clouds --force
 omninoise bake job.toml --dry-run
-omninoise bake job.toml --workers 4""")
+omninoise bake job.toml --workers 2""")
     b.add_argument("job", help="job file (.toml)")
     b.add_argument("--only", action="append", metavar="NAME", help="bake only these (repeatable)")
     b.add_argument("--force", action="store_true", help="re-bake outputs that are up to date")
@@ -33,7 +34,8 @@ omninoise bake job.toml --workers 4""")
                    help="neural noise arithmetic (int8: a faster draft on CPUs with int8 dot products)")
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     farm = b.add_argument_group("farm (Dask; pip install 'omninoise[farm]')")
-    farm.add_argument("--workers", type=int, metavar="N", help="bake on a local cluster of N worker processes")
+    farm.add_argument("--workers", type=int, metavar="N",
+                      help="bake on a local cluster of N worker processes (at most one per CPU)")
     farm.add_argument("--cluster", metavar="ADDRESS", help="bake on a running Dask scheduler (tcp:// or tls://)")
     farm.add_argument("--retries", type=int, default=2, help="runs of a failed task after the first")
     farm.add_argument("--brick-voxels", type=int, help="voxels per brick of a large volume (default: from the "
@@ -179,6 +181,9 @@ def _on_farm(a: argparse.Namespace) -> int:
         raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
     if a.workers is not None and not 1 <= a.workers <= 512:
         raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
+    if a.workers is not None and a.workers > limits.cpus():     # they share its CPUs: 32 on 2 took 10 times as long
+        raise SettingError("--workers", f"{a.workers} workers is more than the {limits.cpus()} CPUs this machine has, "
+                                        f"which a local cluster's workers share; ask for at most {limits.cpus()}")
     if not 0 <= a.retries <= MAX_RETRIES:       # a task that always fails would run that many times
         raise SettingError("--retries", f"must be 0 to {MAX_RETRIES}, got {a.retries}")
     if a.brick_voxels is not None and a.brick_voxels < 1:
