@@ -22,7 +22,8 @@ MAX_CYCLES         wave cycles (or cellular cells) from the origin to the farthe
                    into a few flat values
 SCALE_RANGE        a solid texture's scale, texture units per world unit (past it, points overflow or one texel
                    fills the output)
-MEMORY_LIMIT       bytes one request may allocate for its result, OMNINOISE_MEMORY_LIMIT overrides
+MEMORY_LIMIT       bytes one request may allocate for its result: 16 GiB, or half the machine's memory where that
+                   is less; OMNINOISE_MEMORY_LIMIT overrides
 """
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ MIN_LENGTH = 1e-6
 MAX_COORD = 1e7
 MAX_FREQUENCY = 1e5
 MAX_CYCLES = 1e8
-_DEFAULT_MEMORY = 16 << 30
+_DEFAULT_MEMORY = 16 << 30     #: the default limit where half the machine's memory is more
 
 
 #: a number of bytes: digits (a fraction, an exponent) and a binary unit, 8G, 512M, 8GB, 8GiB, 1.5T, 2e9
@@ -55,12 +56,37 @@ _BYTES = re.compile(r"((?:\d+(?:\.\d*)?|\.\d+)(?:E[+-]?\d+)?)\s*([KMGT]?)(?:I?B)
 _UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
 
 
+def physical_memory() -> int | None:
+    """Bytes of memory this process may use: the machine's, or its container's (cgroup v2) where less; None where
+    the system does not say (Windows)."""
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
+    try:
+        with open("/sys/fs/cgroup/memory.max", encoding="ascii") as fh:
+            capped = fh.read().strip()
+        total = min(total, int(capped)) if capped.isdigit() else total
+    except OSError:
+        pass
+    return total if total > 0 else None
+
+
+def default_memory() -> int:
+    """The limit without OMNINOISE_MEMORY_LIMIT: 16 GiB, or half of :func:`physical_memory` where that is less.  A
+    result's estimate is what it holds; the peak is more (a 512^3 cloud volume: 2.5 GiB estimated, 3.6 GiB peak),
+    and past the memory the system kills the process, Blender and its unsaved file with it."""
+    ram = physical_memory()
+    return _DEFAULT_MEMORY if ram is None else min(_DEFAULT_MEMORY, ram // 2)
+
+
 def memory_limit() -> int:
-    """Bytes a single result may take: OMNINOISE_MEMORY_LIMIT (bytes, or with a K/M/G/T suffix), default 16 GiB;
-    a value that is no positive number of bytes up to 2^60 is a SettingError (it would refuse every result, or none)."""
+    """Bytes a single result may take: OMNINOISE_MEMORY_LIMIT (bytes, or with a K/M/G/T suffix), default
+    :func:`default_memory`; a value that is no positive number of bytes up to 2^60 is a SettingError (it would
+    refuse every result, or none)."""
     given = os.environ.get("OMNINOISE_MEMORY_LIMIT", "").strip()
     if not given:
-        return _DEFAULT_MEMORY
+        return default_memory()
     m = _BYTES.fullmatch(given.upper())
     n = float(m[1]) * _UNITS[m[2]] if m else 0.0
     if not 1.0 <= n <= 2.0 ** 60:
@@ -145,7 +171,9 @@ def check_memory(name: str, n_bytes: float, what: str) -> None:
     """Refuse a result of ``n_bytes`` above :func:`memory_limit`, saying how much it would need."""
     limit = memory_limit()
     if n_bytes > limit:
-        raise SettingError(name, f"{what} needs {_gib(n_bytes)}, above the limit of {_gib(limit)} (set "
+        half = ", half this machine's memory" if limit < _DEFAULT_MEMORY and not os.environ.get(
+            "OMNINOISE_MEMORY_LIMIT", "").strip() else ""
+        raise SettingError(name, f"{what} needs {_gib(n_bytes)}, above the limit of {_gib(limit)}{half} (set "
                                  "OMNINOISE_MEMORY_LIMIT to raise it)")
 
 

@@ -104,7 +104,32 @@ def test_memory_error_says_how_much(monkeypatch):
                                           ("100", 100), (" 4K ", 4096), ("", 16 << 30)])
 def test_the_memory_limit_reads_bytes_with_a_unit(monkeypatch, given, limit):
     monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", given)
+    monkeypatch.setattr(limits, "physical_memory", lambda: 64 << 30)
     assert limits.memory_limit() == limit
+
+
+@pytest.mark.parametrize("ram, limit", [(64 << 30, 16 << 30), (32 << 30, 16 << 30), (24 << 30, 12 << 30),
+                                        (8 << 30, 4 << 30), (None, 16 << 30)])
+def test_the_default_memory_limit_is_at_most_half_the_machine_s_memory(monkeypatch, capsys, tmp_path, ram, limit):
+    """16 GiB let a machine of 16 GB or less take a result its memory cannot hold (a 512^3 cloud volume estimated
+    at 2.5 GiB peaks at 3.6 GiB), and the system kills such a process, in Blender with the unsaved file: the
+    default is half the machine's (or its container's) memory where that is less, and the message says so."""
+    monkeypatch.delenv("OMNINOISE_MEMORY_LIMIT", raising=False)
+    monkeypatch.setattr(limits, "physical_memory", lambda: ram)
+    assert limits.memory_limit() == limit
+    assert main(["wave", "--size", "1100", "--dim", "3", "--quiet", "-o", str(tmp_path / "w.npy")]) == 2
+    err = capsys.readouterr().err.strip()
+    half = ", half this machine's memory" if limit < 16 << 30 else ""
+    assert err.startswith("omninoise wave: error: ") and "\n" not in err and err.endswith(
+        f"GiB, above the limit of {limit / 2 ** 30:.1f} GiB{half} (set OMNINOISE_MEMORY_LIMIT to raise it)"), err
+    assert os.listdir(tmp_path) == []
+
+
+def test_the_machine_s_memory_is_read():
+    """Where the system says (Linux, macOS): a positive number of bytes, at most what the machine has."""
+    ram = limits.physical_memory()
+    if hasattr(os, "sysconf") and "SC_PHYS_PAGES" in os.sysconf_names:
+        assert ram is not None and 0 < ram <= os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
 
 
 @pytest.mark.parametrize("given", ["lots", "-5", "0", "0.5", "nan", "inf", "1e400", "1e18G", "8X", "8 G B"])
