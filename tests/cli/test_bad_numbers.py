@@ -151,10 +151,12 @@ def test_a_neural_image_is_refused_by_what_it_takes_drawn_whole_or_in_tiles(monk
     tiles: what a size takes grows by the piece drawn at once plus a little per pixel."""
     from omninoise.backend.neural import generate as G
 
+    monkeypatch.delenv("OMNINOISE_MEMORY_LIMIT", raising=False)
+    monkeypatch.setattr(limits, "physical_memory", lambda: 64 << 30)     # the 16 GiB default, whatever this machine
     assert G.peak_bytes(1024, 1024) == 1024 ** 2 * (G.PIECE_BYTES + G.IMAGE_BYTES)
     assert G.peak_bytes(4096, 4096) == 512 ** 2 * G.PIECE_BYTES + 4096 ** 2 * G.IMAGE_BYTES
     assert G.peak_bytes(2048, 2048, tile=0) == 2048 ** 2 * (G.PIECE_BYTES + G.IMAGE_BYTES)
-    G.check_memory("size", 4096, 4096)                      # about 5 GiB: drawn in tiles under the default limit
+    G.check_memory("size", 4096, 4096)                      # about 5 GiB: drawn in tiles under 16 GiB
     with pytest.raises(SettingError, match=r"size: a 9000 x 9000 neural image needs 20\.1 GiB, above the limit"):
         G.check_memory("size", 9000, 9000)
     monkeypatch.setenv("OMNINOISE_MEMORY_LIMIT", "2G")
