@@ -117,6 +117,8 @@ def photo_code(model: SolidTextureModel, image: np.ndarray, config: PhotoConfig 
     if config.refine > 0:                                                                           # 4. refine
         z, history = refine_code(model, z, img, steps=config.refine, progress=progress, harmonics=h)
     code = model.translate(z, h)                                                                    # 5. translate
+    if code.L is not None and not np.ptp(img.reshape(-1, 3), axis=0).any():   # one colour: nothing varies to draw
+        code = dataclasses.replace(code, L=np.zeros_like(code.L))
     r = gaussian_rest(model, img, code, config.rest, config.check) if config.gaussian else None     # 6. rest
     return PhotoCode(code if r is None else dataclasses.replace(code, rest=r), z, h, r, history, img)
 

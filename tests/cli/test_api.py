@@ -135,6 +135,21 @@ def test_grey_and_rgba_pixels_are_read_as_their_files_are():
         omninoise.solid(rgba, 8, method="neural")
 
 
+def test_a_photo_of_one_colour_draws_that_colour():
+    """Nothing varies in a photo of one colour: the neural texture draws the colour alone, as the spectral and
+    procedural solids do. It drew a mottle of its own (up to 0.03 off in sRGB) with a tint: the colour covariance
+    its decoder is scaled by is floored (1e-4) as the model was trained."""
+    from omninoise.export.images import linear_to_srgb
+
+    colour = np.array([0.5, 0.3, 0.2], np.float32)
+    photo = np.broadcast_to(colour, (48, 48, 3)).copy()
+    for method, dim, size in (("neural", 2, 32), ("neural", 3, 12)):
+        out = omninoise.solid(photo, size, dim=dim, method=method, seed=2)
+        assert out.shape == (size,) * dim + (3,)
+        np.testing.assert_allclose(linear_to_srgb(out).reshape(-1, 3), np.broadcast_to(colour, (size ** dim, 3)),
+                                   atol=2e-6, err_msg=method)
+
+
 def test_an_unknown_wave_setting_is_a_type_error_naming_wave_and_its_settings():
     """As for any Python function, an unknown keyword is a TypeError, from ``wave`` itself (not from the settings
     class behind it), listing the settings it takes."""
