@@ -160,10 +160,10 @@ def cpus() -> int:
 def threads(name: str, n) -> int:
     """A count of CPU threads asked for: 0 (all CPUs) up to :func:`cpus`.  More threads than CPUs wait on each
     other: neural noise at 64 px on 2 CPUs took 1.1 s with 2 threads, 16.5 s with 64 and 265 s with 1000."""
-    n = check_int(name, n, 0, MAX_THREADS)
-    if n > cpus():
-        raise SettingError(name, f"{n} threads is more than the {cpus()} CPUs this machine gives it; ask for at most "
-                                 f"{cpus()} (0: all of them)")
+    n, have = check_int(name, n, 0, MAX_THREADS), cpus()
+    if n > have:
+        raise SettingError(name, f"{n} threads is more than the {have} CPUs this machine gives it; ask for at most "
+                                 f"{have} (0: all of them)")
     return n
 
 

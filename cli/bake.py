@@ -9,7 +9,7 @@ from omninoise.backend import limits
 from omninoise.backend.errors import SettingError
 from omninoise.backend.neural.precision import PRECISIONS
 
-from .common import Bar, add_command, set_threads, shown
+from .common import Bar, add_command, set_threads, shown, split_address
 
 __all__ = ["add_parser", "run"]
 
@@ -53,12 +53,8 @@ def check_cluster(a: argparse.Namespace) -> None:
     """Refuse, before any work, a ``--cluster`` that is not a scheduler's address (``tcp://HOST:PORT``,
     ``tls://HOST:PORT`` or ``HOST:PORT``, which is tcp), a tls:// address without its three certificate files (each
     an existing file), and those files beside an address that is not tls://."""
-    scheme, sep, rest = a.cluster.partition("://")
-    if not sep:
-        scheme, rest = "tcp", a.cluster
-    host, colon, port = rest.rpartition(":")
-    if scheme not in ("tcp", "tls") or not colon or not host.strip("[]") or not port.isdigit() \
-            or not 1 <= int(port) <= 65535:
+    scheme, host, port = split_address(a.cluster)
+    if scheme not in ("tcp", "tls") or not host.strip("[]") or not port.isdigit() or not 1 <= int(port) <= 65535:
         raise SettingError("--cluster", "expected a Dask scheduler's address, tcp://HOST:PORT or tls://HOST:PORT, "
                                         f"got {a.cluster!r}")
     for flag, key in TLS_FLAGS:
@@ -181,9 +177,10 @@ def _on_farm(a: argparse.Namespace) -> int:
         raise SettingError("--workers", "choose one of --workers (a local cluster) and --cluster (a scheduler)")
     if a.workers is not None and not 1 <= a.workers <= 512:
         raise SettingError("--workers", f"must be 1 to 512, got {a.workers}")
-    if a.workers is not None and a.workers > limits.cpus():     # they share its CPUs: 32 on 2 took 10 times as long
-        raise SettingError("--workers", f"{a.workers} workers is more than the {limits.cpus()} CPUs this machine has, "
-                                        f"which a local cluster's workers share; ask for at most {limits.cpus()}")
+    cpus = limits.cpus()
+    if a.workers is not None and a.workers > cpus:     # they share its CPUs: 32 on 2 took 10 times as long
+        raise SettingError("--workers", f"{a.workers} workers is more than the {cpus} CPUs this machine has, which a "
+                                        f"local cluster's workers share; ask for at most {cpus}")
     if not 0 <= a.retries <= MAX_RETRIES:       # a task that always fails would run that many times
         raise SettingError("--retries", f"must be 0 to {MAX_RETRIES}, got {a.retries}")
     if a.brick_voxels is not None and a.brick_voxels < 1:

@@ -100,6 +100,16 @@ def set_threads(n: int, precision: str = "fp32") -> None:
     set_default_precision(precision)
 
 
+def split_address(address: str) -> tuple:
+    """A Dask scheduler's address ``tcp://HOST:PORT``, ``tls://HOST:PORT`` or ``HOST:PORT`` (tcp) -> (scheme, host,
+    port) as written (the port a string, unchecked; an IPv6 host keeps its brackets)."""
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    host, _, port = rest.rpartition(":")
+    return scheme, host, port
+
+
 def param_items(items: list, flag: str) -> dict:
     out = {}
     for item in items:

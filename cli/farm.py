@@ -206,7 +206,9 @@ def refused(address: str) -> bool:
     its host answers that nothing listens on the port (a scheduler not started yet, or a wrong port)."""
     import socket
 
-    host, _, port = address.partition("://")[2 if "://" in address else 0].rpartition(":")
+    from .common import split_address
+
+    _, host, port = split_address(address)
     try:
         with socket.create_connection((host.strip("[]"), int(port)), timeout=2.0):
             return False

@@ -51,14 +51,14 @@ def encode_srgb8(linear: np.ndarray) -> np.ndarray:
     return (out * 255.0 + 0.5).astype(np.uint8)
 
 
-def _text_chunk(chunk, key: str, value: str) -> bytes:
-    """A PNG text chunk of ``key`` (Latin-1) and ``value``: tEXt where the value is Latin-1 (the text every reader
-    reads), else iTXt's uncompressed UTF-8 (PNG specification 11.3.4.3 and 11.3.4.5), for a bake named in any
-    script."""
+def _text_chunk(key: str, value: str) -> tuple:
+    """A PNG text chunk's (tag, data) of ``key`` (Latin-1) and ``value``: tEXt where the value is Latin-1 (the text
+    every reader reads), else iTXt's uncompressed UTF-8 (PNG specification 11.3.4.3 and 11.3.4.5), for a bake named
+    in any script."""
     try:
-        return chunk(b"tEXt", key.encode("latin-1") + b"\0" + value.encode("latin-1"))
+        return b"tEXt", key.encode("latin-1") + b"\0" + value.encode("latin-1")
     except UnicodeEncodeError:      # iTXt: keyword, 0, compression flag and method 0, no language, no translation
-        return chunk(b"iTXt", key.encode("latin-1") + b"\0\0\0\0\0" + value.encode("utf-8"))
+        return b"iTXt", key.encode("latin-1") + b"\0\0\0\0\0" + value.encode("utf-8")
 
 
 def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> None:
@@ -79,7 +79,7 @@ def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> Non
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
 
     png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, 0))
-           + b"".join(_text_chunk(chunk, str(k), str(v)) for k, v in (metadata or {}).items())
+           + b"".join(chunk(*_text_chunk(str(k), str(v))) for k, v in (metadata or {}).items())
            + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
