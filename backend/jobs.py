@@ -127,6 +127,7 @@ from typing import Callable
 
 from .bake import BakeResult, BakeSpec, Cancelled, check_not_read, frame_path, run_bake, still
 from .documents import read_document
+from .paths import in_job
 from .errors import SettingError
 from .schema import did_you_mean, shown_value
 from .sources import BoxGrid, source_from_dict
@@ -193,14 +194,14 @@ def _spec(d: dict, base_dir: str, index: int, own: frozenset = frozenset()) -> B
     grid = BoxGrid(tuple(d["resolution"]), bounds).validate()
     tf = d.get("transfer")
     if isinstance(tf, str):
-        path = os.path.join(base_dir, tf)
+        path = in_job(base_dir, tf)
         tf = load_transfer(path if os.path.isfile(path) else tf)
     elif isinstance(tf, dict):
         tf = transfer_from_dict(tf)
     elif tf is not None:
         raise SettingError("transfer", f"expected a preset name, a .json file or a table, got {tf!r}")
     frames = tuple(d["frames"]) if "frames" in d else None
-    output = os.path.normpath(os.path.join(base_dir, d["output"]))
+    output = os.path.normpath(in_job(base_dir, d["output"]))
     time0, dt = default_times(source, frames)
     if "time" in own and not source.animated:
         raise SettingError("time", f"{still(source)}; its time changes nothing")
@@ -230,7 +231,7 @@ def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
         if exc.setting == "bake" and "bake" not in doc:
             raise JobError("no [[bake]] tables: nothing to do") from None
         raise JobError(str(exc)) from None
-    root = os.path.realpath(os.path.join(base_dir, doc.get("output_root", ".")))
+    root = os.path.realpath(in_job(base_dir, doc.get("output_root", ".")))
     bakes, defaults = doc["bake"], doc.get("defaults", {})
     out, seen, outputs = [], set(), {}
     for i, b in enumerate(bakes):
@@ -269,7 +270,7 @@ def parse_job(doc: dict, base_dir: str, job_path: str | None = None) -> list:
                                        f"{outputs[clash]!r}")))
             continue
         try:        # a bake written over a file it reads (its photo, mask, ramp) or the job file would lose it
-            read = [(key, os.path.join(base_dir, v)) for key, v in _strings(d) if key != "output"]
+            read = [(key, in_job(base_dir, v)) for key, v in _strings(d) if key != "output"]
             for f in files:
                 check_not_read(f, "output", read + [("the job", job_path)])
         except SettingError as exc:
@@ -284,7 +285,7 @@ def _written_before(d: dict, base_dir: str, outputs: dict) -> str:
     """Where a bake reads a file that is not there yet but an earlier bake of the job writes: a hint that a job's
     bakes are checked before any runs (and a farm runs them at once), so the file must exist first."""
     for _, v in _strings(d):
-        f = os.path.normcase(os.path.realpath(os.path.join(base_dir, v)))
+        f = os.path.normcase(os.path.realpath(in_job(base_dir, v)))
         if f in outputs and not os.path.exists(f):
             return (f" (bake {outputs[f]!r} writes it: a job is checked before any bake runs; bake that one first, "
                     "on its own or with --only)")

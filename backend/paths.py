@@ -9,7 +9,7 @@ import os
 
 from .errors import SettingError
 
-__all__ = ["models_root", "neural_model", "solid_models", "fit_bank"]
+__all__ = ["models_root", "neural_model", "solid_models", "fit_bank", "in_job"]
 
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the package folder, holding backend/
 
@@ -39,3 +39,15 @@ def solid_models() -> str:
 def fit_bank() -> str:
     """The folder of the inverse-design bank (statistics of zoo images, ``tools`` of training.fit_bank)."""
     return os.path.join(models_root(), "fit_bank")
+
+
+def in_job(base_dir: str, value: str) -> str:
+    """A path a job file names: ``~`` and ``~user`` are a home folder, a relative path lies in ``base_dir`` (the job
+    file's folder), an absolute one stands.
+
+    >>> in_job("/jobs", "noise.png"), in_job("/jobs", "/tmp/a.vdb")
+    ('/jobs/noise.png', '/tmp/a.vdb')
+    >>> in_job("/jobs", "~/renders/a.exr") == os.path.join(os.path.expanduser("~"), "renders", "a.exr")
+    True
+    """
+    return os.path.join(base_dir, os.path.expanduser(value))

@@ -22,6 +22,7 @@ import numpy as np
 
 from . import limits
 from .errors import SettingError
+from .paths import in_job
 
 __all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "SpectralSource", "AutoSource",
            "solid_volume", "solid_source", "solid_px_per_unit", "source_from_dict", "register_source", "source_kinds",
@@ -704,7 +705,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         from .neural.animate import parse_keys, read_keys
 
         if isinstance(d["keys"], str):
-            keys = read_keys(os.path.join(base_dir, d["keys"]), "source.keys")
+            keys = read_keys(in_job(base_dir, d["keys"]), "source.keys")
         elif isinstance(d["keys"], list):
             keys = parse_keys({"key": d["keys"]}, "source.keys")
         else:
@@ -716,7 +717,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
                                            "regions)")
     from .paths import neural_model
 
-    model = os.path.join(base_dir, d["model"]) if "model" in d else neural_model()
+    model = in_job(base_dir, d["model"]) if "model" in d else neural_model()
     corners = regions = region_specs = gradient = colours = None
     if "gradient" in d:
         g = d["gradient"]
@@ -735,7 +736,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
 
         if not isinstance(d["map"], str):
             raise SettingError("source.map", f"expected an image file name, got {d['map']!r}")
-        path = os.path.join(base_dir, d["map"])
+        path = in_job(base_dir, d["map"])
         if not os.path.isfile(path):
             raise SettingError("source.map", f"map not found: {path}")
         table = d.get("regions")
@@ -752,7 +753,7 @@ def _neural_from_dict(d: dict, base_dir: str) -> NeuralSource:
         d.setdefault("noise", (gradient or corners or region_specs)[0][0])
     mask = None
     if "blend" in d:
-        path = os.path.join(base_dir, d["blend"])
+        path = in_job(base_dir, d["blend"])
         if not os.path.isfile(path):
             raise SettingError("source.blend", f"mask not found: {path}")
         from .. import export
@@ -803,7 +804,7 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
         raise SettingError("source.mix", "weighs the texture of to: give to = EXEMPLAR too")
 
     def path(v):
-        return os.path.join(base_dir, v) if isinstance(v, str) and os.path.exists(os.path.join(base_dir, v)) else v
+        return in_job(base_dir, v) if isinstance(v, str) and os.path.exists(in_job(base_dir, v)) else v
 
     to, exemplar = path(d.get("to")), path(d.get("exemplar"))
     mix = d.get("mix", 0.5)
@@ -867,7 +868,7 @@ def _wave_from_dict(d: dict, base_dir: str) -> WaveSource:
 
     example = None
     if "example" in d:
-        path = os.path.join(base_dir, d.pop("example"))
+        path = in_job(base_dir, d.pop("example"))
         if not os.path.isfile(path):
             raise SettingError("source.example", f"image not found: {path}")
         from .. import export

@@ -216,6 +216,21 @@ def test_a_symlink_does_not_lead_outside_the_output_root(tmp_path):
     assert isinstance(entry[1], JobError) and "outside the output root" in str(entry[1])
 
 
+def test_a_tilde_is_the_home_folder(tmp_path, monkeypatch):
+    """'~/renders/x.exr' in a job writes in the home folder, not in a folder named '~' beside the job; files the
+    job reads (a ramp) are found there too."""
+    home, jobdir = tmp_path / "home", tmp_path / "jobs"
+    (home / "ramps").mkdir(parents=True)
+    jobdir.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    (home / "ramps" / "grey.json").write_text(RAMP)
+    (jobdir / "job.toml").write_text('output_root = "~/renders"\n[[bake]]\nname = "w"\n'
+                                     'output = "~/renders/w.exr"\nresolution = [8, 8]\n'
+                                     'transfer = "~/ramps/grey.json"\n[bake.source]\ndim = 2\ndirections = 2\n')
+    assert [o.status for o in run_job(str(jobdir / "job.toml"))] == ["baked"]
+    assert os.listdir(home / "renders") == ["w.exr"] and os.listdir(jobdir) == ["job.toml"]
+
+
 def test_a_new_source_kind_is_one_class_and_one_registration(tmp_path, monkeypatch):
     """Sources by registry: a registered kind bakes from a job file through the whole pipeline
     (validation, slabs, writers, keys) with no edit to the CLI, jobs or bake code."""
