@@ -25,7 +25,7 @@ from .wavenoise.schema import COORD, FREQUENCY, SEED, SPECTRUM, WAVE_SETTINGS
 __all__ = ["SEED", "SPECTRUM", "WAVE_SETTINGS", "WAVE_SOURCE", "NEURAL_SOURCE", "SOLID_SOURCE", "TRANSFER",
            "SOURCE_TABLES", "BAKE", "JOB"]
 
-FILE = Text("a file path (relative to the job file; ~ is the home folder)")
+FILE = Text("a file path (relative to the job file)")
 
 WAVE_SOURCE = Table({
     "kind": Field(Choice(("wave",)), "wave noise (Guehl et al. 2025)", default="wave"),
