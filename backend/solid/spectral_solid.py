@@ -324,6 +324,11 @@ def spectral_field(photo: np.ndarray, seed: int = 0, harmonics=None, progress=No
     and (``marginals``) its values mapped onto the marginals of the photo's rest (:func:`fit_marginals`).
     ``progress``, ``cancel`` and ``isotropic_iterations`` as :func:`spectral_tile`'s."""
     img = check_photo(photo)
+    colours = np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3)
+    if not np.ptp(colours, axis=0).any():      # one colour: no power to lift, the solid is the colour
+        if progress is not None:
+            progress(1.0)
+        return SplineField(np.zeros((4, 4, 4, 3), np.float32), colours[0], seed=seed)
     rest = photo_rest(img, harmonics)       # once: the tile's spectrum and the marginals both read it
     coeffs = spectral_tile(rest, seed, progress=progress, cancel=cancel,     # the rest has no part left to take out
                            isotropic_iterations=isotropic_iterations)

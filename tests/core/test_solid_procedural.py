@@ -12,9 +12,10 @@ from omninoise.backend.solid.procedural.bonds import Bonds, herringbone
 from omninoise.backend.solid.procedural.cells import NEIGHBOURS, Cells, _unique_cubes, cell_w, voronoi
 from omninoise.backend.solid.procedural.estimate import GRID, Estimates, estimate, grid_repeat, repeat_length
 from omninoise.backend.solid.procedural.family import MAX_PARAM, Param, axis_vector, dot3
-from omninoise.backend.solid.procedural.field import FAMILIES, PX_PER_UNIT, ProceduralField
+from omninoise.backend.solid.procedural.field import DEFAULT_KINDS, FAMILIES, PX_PER_UNIT, ProceduralField
 from omninoise.backend.solid.procedural.fit import (FIT_PLANES, STRUCTURE_MARGIN, STRUCTURE_SIDE, ProceduralConfig,
-                                                   fit_procedural, oblique_points, pick, plane_group, walls_structure)
+                                                   fit_procedural, kind_starts, oblique_points, pick, plane_group,
+                                                   walls_structure)
 from omninoise.backend.solid.procedural.structure import TOLERANCE, photo_structure
 from omninoise.backend.solid.procedural.loss import SliceLoss
 from omninoise.backend.solid.procedural.layers import Layers
@@ -525,9 +526,12 @@ def test_a_herringbone_photo_asked_for_herringbones_is_fitted_by_its_own(pattern
 
 
 def test_a_flat_or_tiny_photo():
-    flat = fit_procedural(np.full((64, 64, 3), 0.4, np.float32), ProceduralConfig(side=32, budget=6, finalists=1))
+    """A photo of one colour is drawn by the first kind's first start, not searched: every kind draws it alike."""
+    flat = fit_procedural(np.full((64, 64, 3), 0.4, np.float32), ProceduralConfig(side=32, budget=6))
     img = flat.field.image(32)
     assert np.isfinite(img).all() and np.abs(img - 0.4).max() < 1e-5
+    starts = kind_starts(DEFAULT_KINDS[0], estimate(np.full((64, 64, 3), 0.4), PX_PER_UNIT))
+    assert flat.field.family == DEFAULT_KINDS[0] and flat.tried == len(starts) + len(FREQUENCIES) + 1, flat
     with pytest.raises(SettingError, match="at least 16 x 16 px, got 12 x 40"):
         fit_procedural(np.zeros((40, 12, 3)))
 

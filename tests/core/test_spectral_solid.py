@@ -200,6 +200,21 @@ def test_a_flat_photo_gives_its_flat_colour():
     np.testing.assert_allclose(f.image(16), np.broadcast_to((0.2, 0.4, 0.6), (16, 16, 3)), atol=1e-4)
 
 
+def test_a_photo_of_one_colour_is_that_colour_without_lifting_a_spectrum(monkeypatch):
+    """Method "spectral" on a photo of one colour: no power to lift (the tile took its seconds for zeros)."""
+    import omninoise.backend.solid.spectral_solid as spectral
+
+    def lifted(*args, **kwargs):
+        raise AssertionError("a spectrum was lifted")
+
+    monkeypatch.setattr(spectral, "spectral_tile", lifted)
+    seen = []
+    f = spectral.spectral_field(np.full((64, 64, 3), (0.2, 0.4, 0.6)), seed=3, progress=seen.append)
+    out = f.evaluate(np.random.default_rng(0).normal(0.0, 50.0, (500, 3)))
+    assert (out == np.float32([0.2, 0.4, 0.6])).all()
+    assert seen == [1.0]
+
+
 def test_a_large_photo_is_read_from_its_central_crop():
     """A photo larger than MAX_READ px gives the tile of its central MAX_READ crop (a 4096² photo then takes seconds
     and about 1.3 GB, not 4 GB)."""

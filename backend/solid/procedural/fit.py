@@ -202,6 +202,8 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     ``cancel()`` returning True stops the search with the best so far."""
     img = check_photo(photo)                                                                # 1. read
     img, ppu = at_most(img, PX_PER_UNIT, config.fit_side)
+    if not np.ptp(img.reshape(-1, 3), axis=0).any():    # one colour: every kind draws it alike, nothing to search
+        config = replace(config, families=config.families[:1], budget=0, finalists=1, textured=False)
     est = estimate(img, ppu)                                                                # 2. estimate
     side, seed = config.side, config.seed
     planes = np.concatenate([oblique_points(side, ppu, n, o) for n, o in FIT_PLANES])
