@@ -19,11 +19,14 @@ def register():
     entries, handlers)."""
     import bpy
 
+    from . import tasks
+
     for m in _modules():
         for cls in m.classes:
             bpy.utils.register_class(cls)
         if hasattr(m, "attach"):
             m.attach()
+    tasks.attach()  # a task still running when another file opens is cancelled and dropped
 
 
 def unregister():
@@ -32,6 +35,7 @@ def unregister():
     from . import tasks
 
     tasks.shutdown()  # a bake still running is cancelled and joined, its timer dropped: nothing keeps running
+    tasks.detach()
     for m in reversed(_modules()):
         if hasattr(m, "detach"):
             m.detach()

@@ -10,6 +10,9 @@ which create Blender data.  One task runs at a time.
 In background mode (``blender -b``, the ``bpy`` module) there is no event loop
 to fire timers, so :func:`start` with ``blocking=True`` runs the work and its
 callbacks inline instead.
+
+Opening another file (File > New, Open, Revert) cancels a task that still runs and drops it with its callbacks:
+the data they would fill belongs to the file being closed, and Blender drops the task's timer with that file.
 """
 from __future__ import annotations
 
@@ -19,13 +22,17 @@ import traceback
 from typing import Callable
 
 import bpy
+from bpy.app.handlers import persistent
 from bpy.props import BoolProperty
 
 from .. import backend
 
-__all__ = ["Task", "TaskOperator", "start", "current", "idle", "cancel", "wait", "shutdown", "POLL_SECONDS"]
+__all__ = ["Task", "TaskOperator", "start", "current", "idle", "cancel", "wait", "shutdown", "attach", "detach",
+           "POLL_SECONDS", "CLOSE_SECONDS"]
 
 POLL_SECONDS = 0.1
+#: how long opening another file waits for a cancelled task's worker to stop (a neural step, a chunk of a bake)
+CLOSE_SECONDS = 2.0
 _current: "Task | None" = None
 
 
@@ -171,8 +178,9 @@ def cancel() -> bool:
 
 
 def shutdown(timeout: float = 10.0) -> None:
-    """Leave nothing running (the add-on is being disabled): cancel the task, wait for its worker thread, drop
-    its timer.  Its callbacks do not run: the classes they would use are going away."""
+    """Leave nothing running (the add-on is being disabled, another file opens): cancel the task, wait up to
+    ``timeout`` seconds for its worker thread, drop its timer.  Its callbacks do not run: the classes or the data
+    they would use are going away."""
     global _current
     task = _current
     if task is None:
@@ -186,6 +194,28 @@ def shutdown(timeout: float = 10.0) -> None:
         task.status = "cancelled"
     task._finished = True
     _current = None
+
+
+@persistent
+def _file_closing(*_args) -> None:
+    """``load_pre`` handler: the running task cancelled and dropped (:func:`shutdown`) before another file opens.
+    Left running, its timer (dropped by Blender with the file) never finished it, and OmniNoise stayed busy with it
+    until Blender was restarted."""
+    task = _current
+    if task is not None and task.running:
+        print(f"OmniNoise: {task.label} cancelled: another file was opened")
+    shutdown(CLOSE_SECONDS)
+
+
+def attach() -> None:
+    """What register() adds for tasks: the handler that drops a running task when another file opens."""
+    if _file_closing not in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.append(_file_closing)
+
+
+def detach() -> None:
+    if _file_closing in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.remove(_file_closing)
 
 
 def wait(task: Task, timeout: float = 600.0) -> Task:

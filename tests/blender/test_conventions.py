@@ -182,6 +182,27 @@ def test_a_disabled_command_says_why(scene):
     assert "no swatch to remove" in _disabled()["omninoise.swatch_remove"]
 
 
+def test_opening_another_file_cancels_a_running_task_and_frees_the_commands(scene):
+    """File > New or Open while a bake runs: Blender drops the task's timer with the file, so the task was never
+    finished and every command stayed disabled ("busy with ...") until Blender restarted. The task is cancelled,
+    its worker stopped, and its callbacks, which would fill the closed file's data, do not run."""
+    import time
+
+    from omninoise.blender_addon import tasks
+
+    def work(progress, cancel):
+        while not cancel():
+            time.sleep(0.02)
+
+    done = []
+    task = tasks.start(tasks.Task("Solid preview", work, done.append))
+    assert not bpy.ops.omninoise.solid_preview.poll()
+    bpy.ops.wm.read_homefile(use_empty=True)
+    assert tasks.current() is None and task.status == "cancelled" and not done
+    assert not task._thread.is_alive() and not bpy.app.timers.is_registered(task.timer)
+    assert bpy.ops.omninoise.solid_preview.poll()
+
+
 def test_operators_that_change_data_record_an_undo_step():
     changing = {"omninoise.bake_volume", "omninoise.bake_image", "omninoise.neural_bake",
                 "omninoise.neural_bake_sequence", "omninoise.neural_fit", "omninoise.swatch_add",
