@@ -127,8 +127,8 @@ from typing import Callable
 
 from .bake import BakeResult, BakeSpec, Cancelled, check_not_read, frame_path, run_bake, still
 from .documents import read_document
-from .paths import in_job
 from .errors import SettingError
+from .paths import in_job
 from .schema import did_you_mean, shown_value
 from .sources import BoxGrid, source_from_dict
 from .transfer import load_transfer, transfer_from_dict
