@@ -4,7 +4,8 @@
     2. estimate  its strongest wave and its spacings across and up (estimate.py)
     3. start     the starts of every kind tried (``families``: rings, layers, cells, bonds in courses by default;
                  herringbone where asked), each as it comes and textured (TEXTURED: more turbulence and detail, at
-                 a higher frequency), drawn on the fit's planes and scored
+                 a higher frequency), drawn on the fit's planes and scored; a photo of one colour, which every
+                 kind draws alike, gets the first kind's starts as they come and no search
     4. search    the best start of the ``finalists`` best kinds refined by Nelder-Mead (search.py) over its
                  parameters, ``budget`` calls each
     5. ramp      each finalist's colour ramp from its values over a block of space (ramp.py)
