@@ -80,11 +80,16 @@ def default_memory() -> int:
     return _DEFAULT_MEMORY if ram is None else min(_DEFAULT_MEMORY, ram // 2)
 
 
+def _given_memory() -> str:
+    """OMNINOISE_MEMORY_LIMIT as set, "" where it is not."""
+    return os.environ.get("OMNINOISE_MEMORY_LIMIT", "").strip()
+
+
 def memory_limit() -> int:
     """Bytes a single result may take: OMNINOISE_MEMORY_LIMIT (bytes, or with a K/M/G/T suffix), default
     :func:`default_memory`; a value that is no positive number of bytes up to 2^60 is a SettingError (it would
     refuse every result, or none)."""
-    given = os.environ.get("OMNINOISE_MEMORY_LIMIT", "").strip()
+    given = _given_memory()
     if not given:
         return default_memory()
     m = _BYTES.fullmatch(given.upper())
@@ -171,8 +176,7 @@ def check_memory(name: str, n_bytes: float, what: str) -> None:
     """Refuse a result of ``n_bytes`` above :func:`memory_limit`, saying how much it would need."""
     limit = memory_limit()
     if n_bytes > limit:
-        half = ", half this machine's memory" if limit < _DEFAULT_MEMORY and not os.environ.get(
-            "OMNINOISE_MEMORY_LIMIT", "").strip() else ""
+        half = ", half this machine's memory" if limit < _DEFAULT_MEMORY and not _given_memory() else ""
         raise SettingError(name, f"{what} needs {_gib(n_bytes)}, above the limit of {_gib(limit)}{half} (set "
                                  "OMNINOISE_MEMORY_LIMIT to raise it)")
 

@@ -35,7 +35,7 @@ from .gaussian_rest import CHECK_SEEDS, MARGIN, MIXES, RENDER, REST_CHOICES, Gau
     choose_mix, mix_rests, wall_planes
 from .harmonic import HARMONIC_SIDE, HarmonicConfig, Harmonics, measure_harmonics, mix_harmonics, remove_harmonics
 from .model import SolidTextureModel, TextureCode, slice_points
-from .pixels import at_most, rgb_pixels
+from .pixels import at_most, one_colour, rgb_pixels
 from .refine import refine_code
 from .upright import UPRIGHT_GATE, candidates
 
@@ -117,7 +117,7 @@ def photo_code(model: SolidTextureModel, image: np.ndarray, config: PhotoConfig 
     if config.refine > 0:                                                                           # 4. refine
         z, history = refine_code(model, z, img, steps=config.refine, progress=progress, harmonics=h)
     code = model.translate(z, h)                                                                    # 5. translate
-    if code.L is not None and not np.ptp(img.reshape(-1, 3), axis=0).any():   # one colour: nothing varies to draw
+    if code.L is not None and one_colour(img):      # nothing varies to draw
         code = dataclasses.replace(code, L=np.zeros_like(code.L))
     r = gaussian_rest(model, img, code, config.rest, config.check) if config.gaussian else None     # 6. rest
     return PhotoCode(code if r is None else dataclasses.replace(code, rest=r), z, h, r, history, img)

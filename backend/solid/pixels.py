@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import SettingError
 
-__all__ = ["rgb_pixels", "resize_rgb", "at_most", "MIN_SIDE"]
+__all__ = ["rgb_pixels", "resize_rgb", "at_most", "one_colour", "MIN_SIDE"]
 
 MIN_SIDE = 16    #: px a photo's shorter side keeps in :func:`at_most` (all of its own, where it has fewer)
 
@@ -29,6 +29,11 @@ def rgb_pixels(image) -> np.ndarray:
     if not np.all(np.isfinite(img)):
         raise SettingError("exemplar", "the pixels hold NaN or infinite values")
     return img
+
+
+def one_colour(pixels: np.ndarray) -> bool:
+    """Whether every pixel of ``pixels`` (..., 3) is the same colour: nothing varies for a texture to draw."""
+    return not np.ptp(np.reshape(pixels, (-1, 3)), axis=0).any()
 
 
 def resize_rgb(img: np.ndarray, h: int, w: int) -> np.ndarray:

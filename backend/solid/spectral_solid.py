@@ -83,6 +83,7 @@ from ..errors import SettingError, check_points
 from ..grid import Cancelled
 from ..periodic import periodic_component
 from .model import plane_points
+from .pixels import one_colour
 from .synthesis import PX_PER_UNIT
 
 __all__ = ["PERIOD", "OVERSAMPLE", "ITERATIONS", "ISOTROPIC_ITERATIONS", "MIN_PHOTO", "MAX_READ", "QUANTILES",
@@ -325,14 +326,14 @@ def spectral_field(photo: np.ndarray, seed: int = 0, harmonics=None, progress=No
     ``progress``, ``cancel`` and ``isotropic_iterations`` as :func:`spectral_tile`'s."""
     img = check_photo(photo)
     colours = np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3)
-    if not np.ptp(colours, axis=0).any():      # one colour: no power to lift, the solid is the colour
+    if one_colour(colours):      # no power to lift: the solid is the colour
         if progress is not None:
             progress(1.0)
         return SplineField(np.zeros((4, 4, 4, 3), np.float32), colours[0], seed=seed)
     rest = photo_rest(img, harmonics)       # once: the tile's spectrum and the marginals both read it
     coeffs = spectral_tile(rest, seed, progress=progress, cancel=cancel,     # the rest has no part left to take out
                            isotropic_iterations=isotropic_iterations)
-    mean = np.clip(img[..., :3], 0.0, 1.0).reshape(-1, 3).astype(np.float64).mean(0)
+    mean = colours.astype(np.float64).mean(0)
     field = SplineField(coeffs, mean, harmonics=harmonics, seed=seed)
     if not marginals:
         return field

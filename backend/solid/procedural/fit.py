@@ -32,7 +32,7 @@ import numpy as np
 
 from ...errors import SettingError
 from ..model import slice_points
-from ..pixels import at_most, rgb_pixels
+from ..pixels import at_most, one_colour, rgb_pixels
 from .estimate import estimate
 from .bonds import units_long
 from .field import DEFAULT_KINDS, FAMILIES, KINDS, PX_PER_UNIT, ProceduralField
@@ -203,7 +203,7 @@ def fit_procedural(photo: np.ndarray, config: ProceduralConfig = ProceduralConfi
     ``cancel()`` returning True stops the search with the best so far."""
     img = check_photo(photo)                                                                # 1. read
     img, ppu = at_most(img, PX_PER_UNIT, config.fit_side)
-    if not np.ptp(img.reshape(-1, 3), axis=0).any():    # one colour: every kind draws it alike, nothing to search
+    if one_colour(img):     # every kind draws it alike: nothing to search
         config = replace(config, families=config.families[:1], budget=0, finalists=1, textured=False)
     est = estimate(img, ppu)                                                                # 2. estimate
     side, seed = config.side, config.seed
