@@ -9,7 +9,7 @@ import os
 
 from .errors import SettingError
 
-__all__ = ["models_root", "neural_model", "solid_models", "fit_bank", "in_job"]
+__all__ = ["models_root", "neural_model", "solid_models", "fit_bank", "in_job", "in_job_or_name"]
 
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # the package folder, holding backend/
 
@@ -51,3 +51,18 @@ def in_job(base_dir: str, value: str) -> str:
     True
     """
     return os.path.join(base_dir, os.path.expanduser(value))
+
+
+def in_job_or_name(base_dir: str, value):
+    """A job's exemplar, ``to`` or ``model``: a shipped texture's or model's name (a word with no '.', '/', '\\' or
+    '~', such as ``marble_3d`` or ``wood``) stands where nothing of that name lies beside the job; anything else is a
+    path, :func:`in_job` (never looked up from the folder the job runs in).  A value that is not a string stands.
+
+    >>> in_job_or_name("/jobs", "photo.png"), in_job_or_name("/jobs", "marble_3d"), in_job_or_name("/jobs", 3)
+    ('/jobs/photo.png', 'marble_3d', 3)
+    """
+    if not isinstance(value, str):
+        return value
+    path = in_job(base_dir, value)
+    word = value and not any(c in value for c in "./\\~")
+    return value if word and not os.path.exists(path) else path

@@ -22,7 +22,7 @@ import numpy as np
 
 from . import limits
 from .errors import SettingError
-from .paths import in_job
+from .paths import in_job, in_job_or_name
 
 __all__ = ["BoxGrid", "Source", "WaveSource", "NeuralSource", "SolidSource", "SpectralSource", "AutoSource",
            "solid_volume", "solid_source", "solid_px_per_unit", "source_from_dict", "register_source", "source_kinds",
@@ -794,8 +794,6 @@ def _spec_value(v, where: str) -> tuple:
 def solid_request_from_dict(d: dict, base_dir: str = "."):
     """The :class:`backend.solid.request.SolidRequest` of a job file's solid source, checked (paths relative to
     the job file; ``model`` a folder, a shipped model's name, or left out as on the command line)."""
-    import os
-
     from .solid.procedural.field import DEFAULT_KINDS
     from .solid.request import SolidRequest, method_for
 
@@ -803,12 +801,9 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     if "mix" in d and "to" not in d:
         raise SettingError("source.mix", "weighs the texture of to: give to = EXEMPLAR too")
 
-    def path(v):
-        return in_job(base_dir, v) if isinstance(v, str) and os.path.exists(in_job(base_dir, v)) else v
-
-    to, exemplar = path(d.get("to")), path(d.get("exemplar"))
+    to, exemplar = (in_job_or_name(base_dir, d.get(k)) for k in ("to", "exemplar"))
     mix = d.get("mix", 0.5)
-    return SolidRequest(path(d.get("model")), exemplar, to, mix, d.get("refine", 0),
+    return SolidRequest(in_job_or_name(base_dir, d.get("model")), exemplar, to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),
                         d.get("rest", "auto"), method_for(exemplar, d.get("method")), d.get("tile", 256),
                         d.get("families", DEFAULT_KINDS)).check("source.").check_reads(

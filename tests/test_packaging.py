@@ -141,16 +141,26 @@ def test_omninoise_models_points_every_front_end_at_another_model_folder(tmp_pat
     assert not (tmp_path / "n.png").exists()
 
 
-def test_the_api_examples_run():
-    """The API's docstring examples (and the package's) are doctests."""
+def test_the_docstring_examples_run():
+    """Every docstring example of the runtime (the package, its API, the backend, the writers and the command
+    line) is a doctest: each module that shows one runs it."""
     import doctest
+    import importlib
 
-    import omninoise
-    import omninoise.api
-
-    for mod in (omninoise, omninoise.api):
-        res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
-        assert res.attempted > 0 and res.failed == 0, (mod.__name__, res)
+    names = []
+    for folder in ("", "backend", "export", "cli"):
+        for dirpath, _, files in os.walk(os.path.normpath(os.path.join(ROOT, folder))):
+            if folder == "" and dirpath != ROOT:
+                continue
+            for f in sorted(files):
+                path = os.path.join(dirpath, f)
+                if f.endswith(".py") and ">>> " in open(path, encoding="utf-8").read():
+                    rel = os.path.relpath(path, ROOT)[:-3].replace(os.sep, ".")
+                    names.append("omninoise" + ("" if rel == "__init__" else "." + rel.removesuffix(".__init__")))
+    assert {"omninoise", "omninoise.api", "omninoise.backend.paths"} <= set(names)
+    for name in names:
+        res = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
+        assert res.attempted > 0 and res.failed == 0, (name, res)
 
 
 def test_the_extension_lists_each_bundled_wheels_licence(tmp_path):

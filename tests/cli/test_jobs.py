@@ -291,6 +291,26 @@ def test_a_solid_mix_without_to_is_refused(tmp_path, capsys):
     assert "bake 's': source.mix: weighs the texture of to" in capsys.readouterr().out
 
 
+def test_a_solid_photo_is_read_beside_the_job_not_where_it_runs(tmp_path, monkeypatch, capsys):
+    """A job's photo lies in the job's folder: one of the same name in the folder the command runs in is not read;
+    a shipped texture's name still names the shipped texture."""
+    from PIL import Image
+
+    (tmp_path / "jobs").mkdir()
+    Image.fromarray(np.full((32, 32, 3), 200, np.uint8)).save(tmp_path / "photo.png")
+    job = tmp_path / "jobs" / "job.toml"
+    head = ('[[bake]]\nname = "s"\noutput = "s.png"\nresolution = [8, 8]\n'
+            '[bake.source]\nkind = "solid"\n')
+    job.write_text(head + 'exemplar = "photo.png"\nmethod = "spectral"\n')
+    monkeypatch.chdir(tmp_path)
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    out = capsys.readouterr().out
+    assert f"source.exemplar: spectral works from an image file; there is no file {str(job.parent / 'photo.png')!r}" \
+        in out
+    job.write_text(head + 'exemplar = "grass"\n')
+    assert main(["bake", str(job), "--dry-run"]) == 0
+
+
 @pytest.mark.parametrize("source, key, needs", [
     ('cell_size = 2', "cell_size", "cellular"),
     ('spectrum = {kind = "bandpass", fmin = 1, fmax = 4, exponent = 2}', "exponent", 'spectrum = "fractal"'),
