@@ -221,14 +221,25 @@ _TURNS = {1: lambda a: a, 2: lambda a: a[:, ::-1], 3: lambda a: a[::-1, ::-1], 4
           7: lambda a: np.swapaxes(a, 0, 1)[::-1, ::-1], 8: lambda a: np.rot90(a, 1)}
 
 
-def _pillow_pixels(im) -> tuple:
-    """(pixels float32 (H, W[, C]) by the file's own range, whether they are floats) of an image Pillow loaded."""
+#: Pillow's raw modes of unsigned 32-bit samples, which it opens as signed 32-bit integers (mode "I")
+_UNSIGNED_32 = ("I;32", "I;32L", "I;32B", "I;32N")
+
+
+def _pillow_pixels(im, raw: str | None) -> tuple:
+    """(pixels float32 (H, W[, C]) by the file's own range, whether they are floats) of an image Pillow loaded;
+    ``raw`` the raw mode its tiles were unpacked by.  Integer samples are divided by their type's largest value, as
+    Blender and OpenImageIO read them: 8-bit by 255, 16-bit by 65535, signed 32-bit by 2^31 - 1 (negative values
+    are below black) and unsigned 32-bit by 2^32 - 1."""
     mode = im.mode
     if mode in ("I;16", "I;16B", "I;16L", "I;16N"):
         return np.asarray(im, dtype=np.float32) / 65535.0, False
-    if mode == "I":        # 16-bit PNGs open as 32-bit integers holding 0..65535
-        a = np.asarray(im, dtype=np.float32)
-        return a / (65535.0 if a.max() <= 65535 else float(2 ** 31 - 1)), False
+    if mode == "I":        # 32-bit integers; some Pillow versions open 16-bit PNGs so too (raw mode "I;16B")
+        a = np.asarray(im, dtype=np.int32)
+        if isinstance(raw, str) and raw.startswith("I;16"):
+            return a.astype(np.float32) / np.float32(65535.0), False
+        if raw in _UNSIGNED_32:
+            return (a.view(np.uint32).astype(np.float64) / (2.0 ** 32 - 1)).astype(np.float32), False
+        return (a.astype(np.float64) / (2.0 ** 31 - 1)).astype(np.float32), False
     if mode == "F":
         return np.asarray(im, dtype=np.float32), True
     if mode not in ("L", "LA", "RGB", "RGBA"):
@@ -252,9 +263,10 @@ def _decode_pillow(path: str) -> tuple:
                 if wide is not None:
                     (a, orientation), linear = wide, False
                 else:
+                    raws = {_raw_mode(t) for t in im.tile}
                     im.load()
                     orientation = im.getexif().get(_EXIF_ORIENTATION, 1)
-                    a, linear = _pillow_pixels(im)
+                    a, linear = _pillow_pixels(im, raws.pop() if len(raws) == 1 else None)
                 turn = _TURNS.get(orientation, _TURNS[1])
                 return np.ascontiguousarray(turn(a)), linear      # a phone photo as every viewer shows it
     except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
@@ -270,6 +282,13 @@ def _decode_pillow(path: str) -> tuple:
 _WIDE = re.compile(r"(RGB|RGBA|LA);16([BLN])")
 
 
+def _raw_mode(tile) -> str | None:
+    """The raw mode Pillow unpacks a tile by, where it names one (a GIF's args begin with a number, a WebP has
+    none)."""
+    args = getattr(tile, "args", None)
+    return args if isinstance(args, str) else (args[0] if isinstance(args, tuple) and args else None)
+
+
 def _sixteen_bits(path: str, tiles: list) -> tuple | None:
     """(samples float32 (H, W, C) in [0, 1], EXIF orientation) of the 16-bit colour PNG or TIFF (RGB, RGBA, grey
     with alpha) at ``path``, from the tiles Pillow opened it with (before loading it); None for any other image.
@@ -277,11 +296,7 @@ def _sixteen_bits(path: str, tiles: list) -> tuple | None:
     file is decoded twice here, unpacking the high and then the low bytes (its raw mode told the other byte order),
     and the bytes are put together.  Grey with alpha, whose 8-bit raw mode has no such twin, is decoded as 8-bit
     RGBA: the same four bytes a pixel."""
-    def raw(tile):          # the raw mode a tile is unpacked by; a GIF's args begin with a number, a WebP has none
-        args = getattr(tile, "args", None)
-        return args if isinstance(args, str) else (args[0] if isinstance(args, tuple) and args else None)
-
-    raws = {raw(t) for t in tiles}
+    raws = {_raw_mode(t) for t in tiles}
     mode = raws.pop() if len(raws) == 1 and all(hasattr(t, "_replace") for t in tiles) else None
     match = _WIDE.fullmatch(mode) if isinstance(mode, str) else None
     if match is None:
@@ -345,7 +360,7 @@ def read_image(path: str) -> np.ndarray:
 
 def read_rgb(path: str) -> np.ndarray:
     """Read an image file as sRGB-encoded float32 (H, W, 3) in [0, 1], the exemplar format of the solid textures:
-    an 8- or 16-bit file's stored values; a float file's (EXR, float TIFF, float .npy) scene-linear values encoded
+    an integer file's stored values over its type's range (8, 16 or 32 bits); a float file's (EXR, float TIFF, float .npy) scene-linear values encoded
     (:func:`linear_to_srgb`, clipped to [0, 1] first), as Blender shows a float image; a float file of whole numbers
     above 1 (8- or 16-bit values stored as floats, which would read as white) is refused.  Greyscale is repeated,
     an alpha channel must be opaque (:func:`opaque`)."""

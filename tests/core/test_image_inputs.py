@@ -69,6 +69,29 @@ def _tiff16(path, a, order):
     path.write_bytes(head + ifd + struct.pack(order + "I", 0) + struct.pack(order + "HHH", 16, 16, 16) + data)
 
 
+def _tiff32(path, a, signed):
+    """A grey TIFF of 32-bit samples, signed or unsigned (its SampleFormat), little-endian, one strip."""
+    h, w = a.shape
+    data = a.astype("<i4" if signed else "<u4").tobytes()
+    entries = [(256, 1, w), (257, 1, h), (258, 1, 32), (259, 1, 1), (262, 1, 1), (273, 1, 8 + 2 + 12 * 10 + 4),
+               (277, 1, 1), (278, 1, h), (279, 1, len(data)), (339, 1, 2 if signed else 1)]
+    ifd = struct.pack("<H", len(entries)) + b"".join(struct.pack("<HHII", tag, 4, n, v) for tag, n, v in entries)
+    path.write_bytes(b"II*\x00" + struct.pack("<I", 8) + ifd + struct.pack("<I", 0) + data)
+
+
+def test_thirty_two_bit_integer_files_are_read_by_their_type(tmp_path):
+    """A 32-bit integer TIFF is divided by its type's largest value, as Blender and OpenImageIO read it (a quarter,
+    a half and three quarters of the range are 0.25, 0.5 and 0.75), whatever values it holds: an unsigned file's
+    upper half is no negative number, and small values are dark, not a 16-bit file's."""
+    for signed, full in ((True, 2 ** 31 - 1), (False, 2 ** 32 - 1)):
+        a = np.round(np.array([[0.25, 0.5], [0.75, 1.0]]) * full)
+        _tiff32(tmp_path / "wide.tif", np.repeat(np.repeat(a, 8, 0), 8, 1), signed)
+        got = read_rgb(str(tmp_path / "wide.tif"))
+        assert got.shape == (16, 16, 3) and np.allclose(got[::8, ::8, 0], [[0.25, 0.5], [0.75, 1.0]], atol=1e-6)
+        _tiff32(tmp_path / "small.tif", np.full((4, 4), 40000), signed)
+        assert read_image(str(tmp_path / "small.tif")).max() == pytest.approx(40000 / full)
+
+
 def test_sixteen_bit_colour_files_keep_all_sixteen_bits(tmp_path):
     """A 16-bit RGB, RGBA or grey-and-alpha PNG (interlaced too) and a 16-bit RGB TIFF of either byte order are read
     sample for sample (Pillow opens them as 8-bit colour, each sample's high byte: 0.4 % of the range lost, and a
