@@ -45,7 +45,7 @@ import numpy as np
 from ..errors import SettingError, check_points
 from ..grid import Cancelled
 from .model import plane_points
-from .pixels import resize_rgb
+from .pixels import one_colour, resize_rgb
 
 __all__ = ["SynthesisSettings", "synthesise", "TileField", "image_settings", "PLANES", "PX_PER_UNIT", "MIN_TILE",
            "MAX_TILE", "TILE_STEP", "COARSE_SHARPNESS", "FINE_SHARPNESS", "MIN_LEVELS", "COARSEST_PATCHES",
@@ -320,6 +320,10 @@ def synthesise(photo: np.ndarray, settings: SynthesisSettings = SynthesisSetting
     s = settings
     img = check_photo(photo, s)
     img = np.clip(img[::-1], 0.0, 1.0)      # row 0 at the bottom: rows run up the tile (module doc)
+    if one_colour(img):                     # every neighbourhood alike: the tile is the colour
+        if progress is not None:
+            progress(1.0)
+        return np.broadcast_to(img[0, 0], (s.size,) * s.dim + (3,)).copy()
     rng = np.random.default_rng(s.seed)
     fams = _families(s.dim, s.planes)
     # progress in work done: a slice family's pass over a level costs about its voxel count

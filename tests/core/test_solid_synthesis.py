@@ -181,6 +181,21 @@ def test_the_search_cuts_out_only_the_neighbourhoods_it_keeps():
     assert every.X.shape == (37 * 47, 48)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_photo_of_one_colour_is_that_colour_without_a_search(monkeypatch, dim):
+    """Every neighbourhood of a photo of one colour is alike: the tile is the colour, and no level is searched."""
+    import omninoise.backend.solid.synthesis as synthesis
+
+    def searched(*args, **kwargs):
+        raise AssertionError("a level was searched")
+
+    monkeypatch.setattr(synthesis, "_level", searched)
+    seen = []
+    s = SynthesisSettings(dim=dim, size=32, levels=2, patch=5, iterations=(1, 1), sharpness=(1.0, 1.0))
+    tile = synthesise(np.full((48, 48, 3), (0.2, 0.4, 0.6), np.float32), s, progress=seen.append)
+    assert tile.shape == (32,) * dim + (3,) and (tile == np.float32([0.2, 0.4, 0.6])).all() and seen == [1.0]
+
+
 def test_tile_field_samples_voxel_centres_and_wraps():
     rng = np.random.default_rng(1)
     tile = rng.random((8, 8, 8, 3)).astype(np.float32)
