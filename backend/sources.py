@@ -795,13 +795,15 @@ def solid_request_from_dict(d: dict, base_dir: str = "."):
     """The :class:`backend.solid.request.SolidRequest` of a job file's solid source, checked (paths relative to
     the job file; ``model`` a folder, a shipped model's name, or left out as on the command line)."""
     from .solid.procedural.field import DEFAULT_KINDS
-    from .solid.request import SolidRequest, method_for
+    from .solid.request import IMAGE_METHODS, SolidRequest, method_for
 
     _check_keys(d, _SOLID_KEYS, "solid")
     if "mix" in d and "to" not in d:
         raise SettingError("source.mix", "weighs the texture of to: give to = EXEMPLAR too")
 
     to, exemplar = (in_job_or_name(base_dir, d.get(k)) for k in ("to", "exemplar"))
+    if d.get("method") in IMAGE_METHODS + ("auto",) and isinstance(d.get("exemplar"), str):
+        exemplar = in_job(base_dir, d["exemplar"])       # these read files only: no shipped texture's name
     mix = d.get("mix", 0.5)
     return SolidRequest(in_job_or_name(base_dir, d.get("model")), exemplar, to, mix, d.get("refine", 0),
                         d.get("seed", 0), d.get("periodic", True), d.get("gaussian", True),

@@ -309,6 +309,9 @@ def test_a_solid_photo_is_read_beside_the_job_not_where_it_runs(tmp_path, monkey
         in out
     job.write_text(head + 'exemplar = "grass"\n')
     assert main(["bake", str(job), "--dry-run"]) == 0
+    job.write_text(head + 'exemplar = "IMG_0001"\nmethod = "procedural"\n')     # a photo's file: no name
+    assert main(["bake", str(job), "--dry-run"]) == 2
+    assert f"there is no file {str(job.parent / 'IMG_0001')!r}" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("source, key, needs", [
