@@ -49,8 +49,11 @@ def in_job(base_dir: str, value: str) -> str:
     ('/jobs/noise.png', '/tmp/a.vdb')
     >>> in_job("/jobs", "~/renders/a.exr") == os.path.join(os.path.expanduser("~"), "renders", "a.exr")
     True
+    >>> in_job(".", "photo.png")      # a table read in no job's folder: the path as given
+    'photo.png'
     """
-    return os.path.join(base_dir, os.path.expanduser(value))
+    value = os.path.expanduser(value)
+    return value if base_dir in ("", os.curdir) else os.path.join(base_dir, value)
 
 
 def in_job_or_name(base_dir: str, value):
