@@ -24,18 +24,22 @@ import bpy
 import numpy as np
 
 from .. import backend
-from .wave_nodes import (INPUTS, SETTINGS_KEY, TUNED_KEY, NodeBuilder, Tuned, clear_tree, copy_or_build, group_io,
-                         new_group, settings_to_json)
+from .wave_nodes import (INPUTS, SETTINGS_KEY, TUNED_KEY, NodeBuilder, Tuned, clear_tree, copy_or_build, describe,
+                         group_io, new_group, settings_to_json)
+from .wave_nodes import TIPS as WAVE_TIPS
 
 __all__ = ["build_cellular_group", "new_cellular_tree", "CELL_OUTPUTS"]
 
 CELL_OUTPUTS = ("Cell", "Distance")
+#: the Wave Cellular group's tooltips: the Wave Noise group's, but its cells stand still
+TIPS = {**WAVE_TIPS, "Time": "Not read: cellular noise stands still"}
 _F = np.float32
 _OFFSET, _PLANE, _CODE = 24, 25, 26  # backend.wavenoise.cellular streams
 
 
 def new_cellular_tree(name: str = "Wave Cellular", tree_type: str = "ShaderNodeTree") -> bpy.types.NodeTree:
     tree = new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in CELL_OUTPUTS))
+    describe(tree, TIPS)
     tree.interface.items_tree["Scale"].min_value = -1000.0
     return tree
 
@@ -121,6 +125,7 @@ def build_cellular_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.
         tree = new_cellular_tree(name, tree_type)
     else:
         clear_tree(tree)
+        describe(tree, TIPS)
     tree[SETTINGS_KEY] = settings_to_json(settings)
     b = NodeBuilder(tree)
     _, go, x, w = group_io(b)

@@ -66,7 +66,11 @@ TIPS = {"Spacing": "Distance between rings or layers (texture units)",
                 "its own (1: the photo's, 0: none)",
         "Tint Frequency": "The tint's patches' frequency (cycles per texture unit)",
         "Gap Mask": "1 in the joints and gaps, 0 on the bricks and cells, between at their edges (into a Bump "
-                    "node's Height with Invert on, the mortar sinks)"}
+                    "node's Height with Invert on, the mortar sinks)",
+        "Vector": "Where the solid is read (the object's own coordinates when the node is added)",
+        "Color": "The solid's colour, scene-linear: for a Base Color",
+        "sRGB": "The solid's colour as sRGB-encoded values, as a baked 8-bit image stores them",
+        "Value": "The pattern's value, which its colours are read from (about 0 to 1; detail may pass the ends)"}
 
 
 def _socket_values(field) -> dict:
@@ -129,12 +133,11 @@ def _interface(tree, field) -> None:
             s.default_value = values[name]
             if name in bounds:
                 s.min_value, s.max_value = bounds[name]
-    tree.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
-    tree.interface.new_socket("sRGB", in_out="OUTPUT", socket_type="NodeSocketColor")
-    tree.interface.new_socket("Value", in_out="OUTPUT", socket_type="NodeSocketFloat")
-    if FAMILIES[field.family].GAPPED:
-        s = tree.interface.new_socket("Gap Mask", in_out="OUTPUT", socket_type="NodeSocketFloat")
-        s.description = TIPS["Gap Mask"]
+    gapped = ("Gap Mask",) if FAMILIES[field.family].GAPPED else ()
+    for name in ("Color", "sRGB", "Value") + gapped:
+        s = tree.interface.new_socket(name, in_out="OUTPUT",
+                                      socket_type="NodeSocketColor" if name in ("Color", "sRGB") else "NodeSocketFloat")
+        s.description = TIPS[name]
 
 
 def _plus(b, amplitude, noise, base):

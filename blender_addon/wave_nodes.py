@@ -46,9 +46,9 @@ from .compat import id_property
 from .wave_constants import OUTPUTS, stratum_constants
 
 __all__ = ["build_wave_group", "new_wave_tree", "add_wave_node", "ensure_table_image", "settings_to_json",
-           "settings_from_json", "INPUTS", "OUTPUTS", "SETTINGS_KEY", "tree_settings_json", "NodeBuilder", "new_group",
-           "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY", "tree_implementation", "check_form",
-           "SHAPE_KEY", "Tuned", "TUNED_KEY", "copy_or_build", "retune_tree"]
+           "settings_from_json", "INPUTS", "OUTPUTS", "TIPS", "describe", "SETTINGS_KEY", "tree_settings_json",
+           "NodeBuilder", "new_group", "clear_tree", "group_io", "IMPLEMENTATIONS", "IMPLEMENTATION_KEY",
+           "tree_implementation", "check_form", "SHAPE_KEY", "Tuned", "TUNED_KEY", "copy_or_build", "retune_tree"]
 
 _F = np.float32
 SETTINGS_KEY = "omninoise_wave_settings"
@@ -106,6 +106,17 @@ def tree_implementation(tree) -> str:
 #: (name, socket type, default) of the group's inputs and outputs
 INPUTS = (("Vector", "NodeSocketVector", (0.0, 0.0, 0.0)), ("W", "NodeSocketFloat", 0.0),
           ("Scale", "NodeSocketFloat", 1.0), ("Time", "NodeSocketFloat", 0.0))
+#: the tooltips of the Wave Noise and Wave Cellular groups' inputs and outputs (both forms, OSL and nodes)
+TIPS = {"Vector": "Where the noise is read (the object's own coordinates when the node is added)",
+        "W": "The fourth coordinate, read by 4D noise: move it to slide through the noise",
+        "Scale": "Multiplies Vector and W: larger values draw smaller features",
+        "Time": "Moves the waves at the panel's Speed; key it or drive it with the frame to animate",
+        "Value": "The noise: the real part of the sum of waves",
+        "Imaginary": "The imaginary part of the sum of waves: a second noise of the same look",
+        "Modulus": "The size of the sum of waves (0 or more): ridges where the waves add up",
+        "Phase": "The angle of the sum of waves, radians from -pi to pi",
+        "Cell": "One grey level in [0, 1] for each cell",
+        "Distance": "Distance to the nearest cell border, in units of Vector after Scale"}
 STREAM = backend.wavenoise.wave.STREAM
 
 
@@ -475,10 +486,19 @@ def clear_tree(tree: bpy.types.NodeTree) -> None:
             tree.nodes.remove(n)
 
 
+def describe(tree: bpy.types.NodeTree, tips: dict = TIPS) -> None:
+    """Put ``tips`` on the group's inputs and outputs of those names: the tooltips of its sockets, as Blender's
+    own texture nodes have (a group saved without them gets them when it is rebuilt)."""
+    for item in tree.interface.items_tree:
+        if getattr(item, "item_type", "") == "SOCKET" and item.name in tips:
+            item.description = tips[item.name]
+
+
 def new_wave_tree(name: str = "Wave Noise", tree_type: str = "ShaderNodeTree") -> bpy.types.NodeTree:
     """An empty group with the Wave Noise interface (INPUTS in, OUTPUTS out), ready for build_wave_group."""
     tree = new_group(name, tree_type, INPUTS, tuple((o, "NodeSocketFloat") for o in OUTPUTS))
     tree.interface.items_tree["Scale"].min_value = -1000.0
+    describe(tree)
     return tree
 
 
@@ -551,6 +571,8 @@ def build_wave_group(settings, tree_type: str = "ShaderNodeTree", tree: bpy.type
     shapes = [_stratum_shape(c) for c in strata]
     shape = json.dumps([own, shapes])
     img = ensure_table_image(table.values) if implementation == "nodes" else None
+    if tree is not None:
+        describe(tree)
     if tree is not None and implementation == "nodes" and _retune(tree, shape, shapes, strata, top, img):
         tree[SETTINGS_KEY] = settings_to_json(settings)
         return tree
