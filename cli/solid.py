@@ -103,6 +103,22 @@ def solid_request(a: argparse.Namespace):
         given, "--", FLAGS)
 
 
+#: the share of a float photo's pixels past white (read as white) from which the command says so
+PAST_WHITE_NOTE = 0.01
+
+
+def _past_white(path: str) -> float:
+    """:func:`export.images.past_white` of a photo's file; 0 for a shipped texture's name or a saved solid."""
+    from omninoise.export.images import ImageError, past_white
+
+    if not os.path.isfile(path) or path.lower().endswith(".json"):
+        return 0.0
+    try:
+        return past_white(path)
+    except ImageError:
+        return 0.0
+
+
 def run(a: argparse.Namespace) -> int:
     from omninoise.backend.solid.model import load_models
 
@@ -137,6 +153,10 @@ def run(a: argparse.Namespace) -> int:
     if not a.quiet and req.repeats_as_grid("--"):
         print("note: the photo repeats across and up as a grid (bricks, tiles?); the kinds besides bonds often draw "
               "stones or blotches there: --families bonds lays it in courses", file=sys.stderr)
+    bright = _past_white(a.exemplar)
+    if not a.quiet and bright >= PAST_WHITE_NOTE:
+        print(f"note: {100 * bright:.3g} % of the photo's pixels are brighter than white (above 1) and are read as "
+              "white; lower its exposure to keep their colours", file=sys.stderr)
     t0 = time.perf_counter()
     if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
         print(f"encoding {a.exemplar} ...", end="", file=sys.stderr, flush=True)

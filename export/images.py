@@ -15,7 +15,8 @@ import numpy as np
 
 from .atomic import atomic_path, require_finite
 
-__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image", "write_unit_image", "read_image", "read_rgb", "opaque", "preview_8bit", "read_metadata",
+__all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image",
+           "write_unit_image", "read_image", "read_rgb", "past_white", "opaque", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -373,6 +374,17 @@ def read_rgb(path: str) -> np.ndarray:
     if a.shape[2] == 1:
         a = np.repeat(a, 3, axis=2)
     return linear_to_srgb(a) if linear else np.clip(a, 0.0, 1.0)
+
+
+def past_white(path: str) -> float:
+    """The share of the pixels of a float image file (EXR, float TIFF, float .npy) with a colour above 1, which
+    :func:`read_rgb` reads as white (an HDR photo's highlights, or all of an overexposed one); 0 for an integer
+    file, whose values cannot pass white."""
+    a, linear = _decode(path)
+    if not linear:
+        return 0.0
+    c = a[..., :3] if a.shape[2] in (3, 4) else a[..., :1]
+    return float(np.mean((c > 1.0).any(axis=2)))
 
 
 def _png_text(path: str) -> dict:

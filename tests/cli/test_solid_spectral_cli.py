@@ -124,3 +124,25 @@ def test_an_image_and_one_line_errors(tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert msg in err and len(err.splitlines()) == 1
     assert not os.path.exists(tmp_path / "b.png")
+
+
+def test_a_photo_brighter_than_white_is_said_to_be(tmp_path, capsys):
+    """A float photo whose pixels pass 1 is read as white there (an HDR photo, an overexposed one): the command says
+    how much of it, before any work; a photo within [0, 1] and a quiet command say nothing."""
+    from omninoise.export import write_exr
+    from omninoise.export.images import past_white
+
+    hot = np.full((40, 40, 3), 0.5, np.float32)
+    hot[:10] = 4.5                                              # a quarter of the pixels past white
+    write_exr(str(tmp_path / "hot.exr"), hot)
+    write_exr(str(tmp_path / "cool.exr"), np.full((40, 40, 3), 0.5, np.float32))
+    assert past_white(str(tmp_path / "hot.exr")) == 0.25 and past_white(str(tmp_path / "cool.exr")) == 0.0
+    for name, said in (("hot", True), ("cool", False)):
+        write_exr(str(tmp_path / "p.exr"), np.full((40, 40, 3), 4.5 if said else 0.5, np.float32))
+        assert main(["solid", "--exemplar", str(tmp_path / "p.exr"), "--method", "spectral", "--size", "16",
+                     "-o", str(tmp_path / f"{name}.png")]) == 0
+        err = capsys.readouterr().err
+        assert ("note: 100 % of the photo's pixels are brighter than white" in err) == said, err
+    assert main(["solid", "--exemplar", str(tmp_path / "p.exr"), "--method", "spectral", "--size", "16", "-q",
+                 "-o", str(tmp_path / "q.png")]) == 0
+    assert capsys.readouterr().err == ""
