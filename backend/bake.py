@@ -347,7 +347,7 @@ PREPARE_SHARE = 0.5
 def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:
     from .. import export
 
-    if not getattr(spec.source, "ready", True):     # a texture made at its first use (sources._Prepared)
+    if not getattr(spec.source, "ready", True):     # a texture made at its first use (sources.solid._Prepared)
         part = None if progress is None else (lambda x: progress(PREPARE_SHARE * x))
         spec.source.prepare(part, cancel)
         if progress is not None:
