@@ -110,9 +110,9 @@ class Source(Protocol):
     def to_dict(self) -> dict:
         """Everything that determines the values, as plain JSON types (for up-to-date checks)."""
 
-    # A source may also make its texture at its first use (a fit, a choice: :class:`~.solid._Prepared`): ``ready`` says
-    # whether it is made, ``prepare(progress, cancel)`` makes it; a bake makes it before drawing a file that is not
-    # up to date, and ``to_dict`` does not need it.
+    # A source may also make its texture at its first use (a fit, a choice: :class:`~.solid._Prepared`): ``ready``
+    # says whether it is made, ``prepare(progress, cancel)`` makes it; a bake makes it before drawing a file that is
+    # not up to date, and ``to_dict`` does not need it.
 
 
 def grid_points(shape, first, step, start=None) -> np.ndarray:
