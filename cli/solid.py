@@ -109,9 +109,10 @@ PAST_WHITE_NOTE = 0.01
 
 def _past_white(path: str) -> float:
     """:func:`export.images.past_white` of a photo's file; 0 for a shipped texture's name or a saved solid."""
+    from omninoise.backend.solid.procedural.saved import is_saved
     from omninoise.export.images import ImageError, past_white
 
-    if not os.path.isfile(path) or path.lower().endswith(".json"):
+    if not os.path.isfile(path) or is_saved(path):
         return 0.0
     try:
         return past_white(path)

@@ -361,9 +361,10 @@ def read_image(path: str) -> np.ndarray:
 
 def read_rgb(path: str) -> np.ndarray:
     """Read an image file as sRGB-encoded float32 (H, W, 3) in [0, 1], the exemplar format of the solid textures:
-    an integer file's stored values over its type's range (8, 16 or 32 bits); a float file's (EXR, float TIFF, float .npy) scene-linear values encoded
-    (:func:`linear_to_srgb`, clipped to [0, 1] first), as Blender shows a float image; a float file of whole numbers
-    above 1 (8- or 16-bit values stored as floats, which would read as white) is refused.  Greyscale is repeated,
+    an integer file's stored values over its type's range (8, 16 or 32 bits); a float file's (EXR, float TIFF, float
+    .npy) scene-linear values encoded (:func:`linear_to_srgb`, clipped to [0, 1] first), as Blender shows a float
+    image; a float file of whole numbers above 1 (8- or 16-bit values stored as floats, which would read as white) is
+    refused.  Greyscale is repeated,
     an alpha channel must be opaque (:func:`opaque`)."""
     a, linear = _decode(path)
     a = opaque(a, path)

@@ -14,8 +14,9 @@ import numpy as np
 
 from .. import limits
 from ..errors import SettingError
+from ..paths import in_job
 
-__all__ = ["BoxGrid", "Source", "grid_points", "check_keys"]
+__all__ = ["BoxGrid", "Source", "grid_points", "check_keys", "job_image"]
 
 
 @dataclass(frozen=True)
@@ -130,3 +131,20 @@ def check_keys(d: dict, known: tuple, kind: str) -> None:
     unknown = sorted(set(d) - set(known))
     if unknown:
         raise SettingError(f"source.{unknown[0]}", f"unknown {kind} setting; known: {', '.join(known)}")
+
+
+def job_image(base_dir: str, value: str, key: str, what: str) -> np.ndarray:
+    """The image a job's ``source.KEY`` names (a path beside the job, :func:`~backend.paths.in_job`) read as
+    float32 (H, W) by ``export.read_image``; SettingError naming ``source.KEY`` for a missing file ("WHAT not found:
+    PATH") or one that cannot be read."""
+    import os
+
+    from ... import export
+
+    path = in_job(base_dir, value)
+    if not os.path.isfile(path):
+        raise SettingError(f"source.{key}", f"{what} not found: {path}")
+    try:
+        return export.read_image(path)
+    except export.ImageError as exc:
+        raise SettingError(f"source.{key}", str(exc)) from None

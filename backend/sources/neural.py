@@ -8,7 +8,7 @@ import numpy as np
 from .. import limits
 from ..errors import SettingError
 from ..paths import in_job
-from .base import check_keys
+from .base import check_keys, job_image
 
 __all__ = ["NeuralSource", "from_dict", "spec_value"]
 
@@ -243,15 +243,7 @@ def from_dict(d: dict, base_dir: str) -> NeuralSource:
         d.setdefault("noise", (gradient or corners or region_specs)[0][0])
     mask = None
     if "blend" in d:
-        path = in_job(base_dir, d["blend"])
-        if not os.path.isfile(path):
-            raise SettingError("source.blend", f"mask not found: {path}")
-        from ... import export
-
-        try:
-            mask = export.read_image(path)
-        except export.ImageError as exc:
-            raise SettingError("source.blend", str(exc)) from None
+        mask = job_image(base_dir, d["blend"], "blend", "mask")
     return NeuralSource(model, d["noise"], d.get("params"), d.get("noise2"), d.get("params2"), mask,
                         d.get("width", 32.0), d.get("sharpness", 1.0), d.get("steps"), d.get("seed", 0),
                         d.get("tileable", False), d.get("sampler"), keys, d.get("latent", "fixed"),

@@ -7,7 +7,7 @@ import numpy as np
 
 from .. import limits
 from ..errors import SettingError
-from ..paths import in_job
+from .base import job_image
 
 __all__ = ["WaveSource", "from_dict"]
 
@@ -72,21 +72,11 @@ class WaveSource:
 
 
 def from_dict(d: dict, base_dir: str) -> WaveSource:
-    import os
-
     from ..wavenoise.settings import check_read, settings_from_dict
 
     example = None
     if "example" in d:
-        path = in_job(base_dir, d.pop("example"))
-        if not os.path.isfile(path):
-            raise SettingError("source.example", f"image not found: {path}")
-        from ... import export
-
-        try:
-            example = export.read_image(path)
-        except export.ImageError as exc:
-            raise SettingError("source.example", str(exc)) from None
+        example = job_image(base_dir, d.pop("example"), "example", "image")
     w_offset = limits.finite("source.w_offset", d.pop("w_offset", 0.0))
     spectrum = d.get("spectrum")
     given = list(d) + (["exponent"] if isinstance(spectrum, dict) and "exponent" in spectrum else [])
