@@ -16,7 +16,7 @@ import numpy as np
 from .atomic import atomic_path, require_finite
 
 __all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image",
-           "write_unit_image", "read_image", "read_rgb", "past_white", "opaque", "preview_8bit", "read_metadata",
+           "write_unit_image", "read_image", "read_rgb", "outside_unit", "opaque", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -377,15 +377,20 @@ def read_rgb(path: str) -> np.ndarray:
     return linear_to_srgb(a) if linear else np.clip(a, 0.0, 1.0)
 
 
-def past_white(path: str) -> float:
-    """The share of the pixels of a float image file (EXR, float TIFF, float .npy) with a colour above 1, which
-    :func:`read_rgb` reads as white (an HDR photo's highlights, or all of an overexposed one); 0 for an integer
-    file, whose values cannot pass white."""
+#: linear values above this, below zero, still encode to an 8-bit 0 (half a step of sRGB's 12.92 slope at black)
+BLACK_TOLERANCE = 0.5 / 255 / 12.92
+
+
+def outside_unit(path: str) -> tuple[float, float]:
+    """The shares of the pixels of a float image file (EXR, float TIFF, float .npy) with a colour above 1 and with
+    one below 0, which :func:`read_rgb` reads as white and as black: an HDR photo's highlights (or all of an
+    overexposed one), and values a processing step pushed under black (those within :data:`BLACK_TOLERANCE` of 0
+    are black to begin with).  (0, 0) for an integer file, whose values cannot leave [0, 1]."""
     a, linear = _decode(path)
     if not linear:
-        return 0.0
+        return 0.0, 0.0
     c = a[..., :3] if a.shape[2] in (3, 4) else a[..., :1]
-    return float(np.mean((c > 1.0).any(axis=2)))
+    return float(np.mean((c > 1.0).any(axis=2))), float(np.mean((c < -BLACK_TOLERANCE).any(axis=2)))
 
 
 def _png_text(path: str) -> dict:

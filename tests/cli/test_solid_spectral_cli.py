@@ -126,23 +126,29 @@ def test_an_image_and_one_line_errors(tmp_path, capsys):
     assert not os.path.exists(tmp_path / "b.png")
 
 
-def test_a_photo_brighter_than_white_is_said_to_be(tmp_path, capsys):
-    """A float photo whose pixels pass 1 is read as white there (an HDR photo, an overexposed one): the command says
-    how much of it, before any work; a photo within [0, 1] and a quiet command say nothing."""
+def test_a_photo_brighter_than_white_or_darker_than_black_is_said_to_be(tmp_path, capsys):
+    """A float photo whose pixels pass 1 is read as white there (an HDR photo, an overexposed one), and one whose
+    pixels fall below 0 as black (all of a photo offset below black came out black without a word): the command says
+    how much of it, before any work; a photo within [0, 1], values under black by less than an 8-bit step, and a
+    quiet command say nothing."""
     from omninoise.export import write_exr
-    from omninoise.export.images import past_white
+    from omninoise.export.images import BLACK_TOLERANCE, outside_unit
 
     hot = np.full((40, 40, 3), 0.5, np.float32)
     hot[:10] = 4.5                                              # a quarter of the pixels past white
+    hot[10:14, :, 2] = -0.2                                     # a tenth under black in blue
+    hot[14:, :, 1] = -0.9 * BLACK_TOLERANCE                     # the rest black within the tolerance
     write_exr(str(tmp_path / "hot.exr"), hot)
     write_exr(str(tmp_path / "cool.exr"), np.full((40, 40, 3), 0.5, np.float32))
-    assert past_white(str(tmp_path / "hot.exr")) == 0.25 and past_white(str(tmp_path / "cool.exr")) == 0.0
-    for name, said in (("hot", True), ("cool", False)):
-        write_exr(str(tmp_path / "p.exr"), np.full((40, 40, 3), 4.5 if said else 0.5, np.float32))
-        assert main(["solid", "--exemplar", str(tmp_path / "p.exr"), "--method", "spectral", "--size", "16",
-                     "-o", str(tmp_path / f"{name}.png")]) == 0
-        err = capsys.readouterr().err
-        assert ("note: 100 % of the photo's pixels are brighter than white" in err) == said, err
-    assert main(["solid", "--exemplar", str(tmp_path / "p.exr"), "--method", "spectral", "--size", "16", "-q",
-                 "-o", str(tmp_path / "q.png")]) == 0
-    assert capsys.readouterr().err == ""
+    assert outside_unit(str(tmp_path / "hot.exr")) == (0.25, 0.1)
+    assert outside_unit(str(tmp_path / "cool.exr")) == (0.0, 0.0)
+    for name, value, said in (("hot", 4.5, "brighter than white (above 1) and are read as white"),
+                              ("dark", -0.5, "darker than black (below 0) and are read as black"), ("cool", 0.5, "")):
+        write_exr(str(tmp_path / "p.exr"), np.full((40, 40, 3), value, np.float32))
+        for quiet in ([], ["-q"]):
+            assert main(["solid", "--exemplar", str(tmp_path / "p.exr"), "--method", "spectral", "--size", "16",
+                         "-o", str(tmp_path / f"{name}.png")] + quiet) == 0
+            err = capsys.readouterr().err
+            notes = [line for line in err.splitlines() if line.startswith("note:")]
+            assert len(notes) == (1 if said and not quiet else 0), err
+            assert not notes or notes[0].startswith(f"note: 100 % of the photo's pixels are {said}"), err
