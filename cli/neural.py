@@ -176,15 +176,27 @@ def neural_request(a: argparse.Namespace, model):
         req = NeuralRequest("blend", [spec, spec2], mask=mask > 0.5, **kw)
     else:
         req = NeuralRequest("uniform", [spec], **kw)
+    for spec, (class_flag, param_flag) in zip(req.specs, _spec_flags(a)):    # each class named by its own flag
+        try:
+            model.param_vector(*spec)
+        except SettingError as exc:
+            raise SettingError(class_flag if exc.setting == "noise" else param_flag, exc.message) from None
     try:
         return req.check(model)
     except SettingError as exc:  # name the flag where the request's field has one
         flag = {"noise": "--noise", "map": "--map", "blend": "--blend", "size": "--size", "seed": "--seed",
-                "width": "--width", "transition": "--width", "sharpness": "--sharpness",
-                "param": "--corners" if a.corners else "--gradient" if a.gradient else ("--region" if a.map else
-                                                                                          "--param")}.get(exc.setting,
-                                                                                                 exc.setting)
+                "width": "--width", "transition": "--width", "sharpness": "--sharpness"}.get(exc.setting,
+                                                                                           exc.setting)
         raise SettingError(flag, exc.message) from None
+
+
+def _spec_flags(a: argparse.Namespace) -> list:
+    """(flag of the class, flag of its parameters) of each of the request's specs, in order."""
+    if a.corners or a.gradient or a.map:
+        flag = "--corners" if a.corners else "--gradient" if a.gradient else "--region"
+        return [(flag, flag)] * len(a.corners or a.gradient or a.region)
+    second = [("--noise2" if a.noise2 else "--noise", "--param2")] if a.blend else []
+    return [("--noise", "--param")] + second
 
 
 def run(a: argparse.Namespace) -> int:

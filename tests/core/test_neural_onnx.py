@@ -165,7 +165,15 @@ def test_neural_cli(tiny, tmp_path, capsys):
     assert "uses (255, 0, 0) but no spec" in capsys.readouterr().err
     assert main(["neural", "--model", str(out), "--list", "--json"]) == 0          # the listing reads the model alone
     assert "spots" in json.loads(capsys.readouterr().out)["classes"]
-    for args, msg in [(["--noise", "lava", "-o", png], "unknown class 'lava'"),
+    wide = str(tmp_path / "wide.png")
+    for args, msg in [(["--noise", "lava", "-o", png], "--noise: unknown class 'lava'"),
+                      (["--noise", "spots", "--blend", wide, "--noise2", "lava", "-o", png],
+                       "--noise2: unknown class 'lava'"),           # each class named by the flag that gave it
+                      (["--noise", "spots", "--blend", wide, "--param2", "coverage=9", "-o", png],
+                       "--param2: coverage=9 is outside"),
+                      (["--corners", "spots", "spots", "lava", "spots", "-o", png], "--corners: unknown class 'lava'"),
+                      (["--map", str(tmp_path / "map.png"), "--region", "#000000=spots", "--region", "#ff0000=lava",
+                        "-o", png], "--region: unknown class 'lava'"),
                       (["--noise", "spots", "--param", "coverage=9", "-o", png], "outside [0.2, 0.8]"),
                       (["--noise", "spots", "--blend", str(tmp_path / "wide.png"), "--size", "16", "-o", png],
                        "--blend: mask is 32x16 but the image is 16x16"),
