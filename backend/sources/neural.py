@@ -76,8 +76,11 @@ class NeuralSource:
             self.layout, self.specs = "uniform", [self.spec]
         self.width, self.sharpness = float(width), float(sharpness)
         self.steps, self.seed, self.tileable = int(steps), int(seed), bool(tileable)
-        for spec in self.specs if not keys else ():     # keyframes are checked below, each named by its frame
-            self.model.param_vector(*spec)  # unknown classes / parameters fail now, with their names
+        for spec, (noise_key, params_key) in zip(self.specs if not keys else (), self._spec_keys(noise2)):
+            try:        # unknown classes / parameters fail now, named by the key that gave them; keyframes below
+                self.model.param_vector(*spec)
+            except SettingError as exc:
+                raise SettingError(noise_key if exc.setting == "noise" else params_key, exc.message) from None
         # animation: keyframes whose `frame` is the bake's time (a job sets time = frame number)
         from ..neural.animate import LATENT_MODES, check_keys
 
@@ -92,6 +95,15 @@ class NeuralSource:
                 raise SettingError("source.latent", f"unknown latent motion {self.latent!r}; choose one of "
                                                     f"{', '.join(LATENT_MODES)}")
             check_keys(self.model, self.keys, "source.keys")
+
+    def _spec_keys(self, noise2: str | None) -> list:
+        """(key of the class, key of its parameters) of each of :attr:`specs`, as a job file names them."""
+        if self.layout in ("corners", "gradient"):
+            return [(f"source.{self.layout}[{i}]",) * 2 for i in range(len(self.specs))]
+        if self.layout == "painted":
+            return [("source.regions",) * 2] * len(self.specs)
+        second = [("source.noise2" if noise2 else "source.noise", "source.params2")] if self.layout == "blend" else []
+        return [("source.noise", "source.params")] + second
 
     @classmethod
     def from_request(cls, model_folder: str, req, colours: list | None = None) -> "NeuralSource":
