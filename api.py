@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import warnings
 from typing import Callable
 
 import numpy as np
@@ -267,6 +268,8 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     ``.json``) and returns the path.  With ``save_job`` too (a ``.toml`` path; ``out`` a volume, or an image of a
     2D texture: a 2D model's, ``method="synthesis"``), it writes the job file that draws ``out`` so (``omninoise
     bake``, a farm) instead of drawing it, as ``omninoise solid --save-job`` does, and returns the job's path.
+    A float photo file whose pixels pass white or fall under black (where 1 % or more do) is read clipped to
+    [0, 1], with a ``UserWarning`` saying how much.
 
     >>> rgb = solid("grass", 16)
     >>> rgb.shape, rgb.dtype
@@ -308,6 +311,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
                             ("families", families is not None)) if v]
     req = SolidRequest(model, exemplar, None, 0.0, refine, seed, periodic, method=method, **kinds).check()
     req.check_reads(given).check_pixels()      # a photo no method can use is named before any work
+    if isinstance(exemplar, str):
+        from .export.images import clipped_notes
+
+        for note in clipped_notes(exemplar):        # a float photo's colours past white or under black
+            warnings.warn(note, UserWarning, stacklevel=2)
     if save_job is not None:
         from .backend.job_file import solid_spec, write_job
 

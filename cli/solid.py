@@ -103,37 +103,6 @@ def solid_request(a: argparse.Namespace):
         given, "--", FLAGS)
 
 
-#: the share of a float photo's pixels past white (or under black) from which the command says they are clipped
-OUTSIDE_NOTE = 0.01
-
-
-def _outside_unit(path: str) -> tuple[float, float]:
-    """:func:`export.images.outside_unit` of a photo's file: the shares read as white and as black where they
-    pass white and black; (0, 0) for a shipped texture's name or a saved solid."""
-    from omninoise.backend.solid.procedural.saved import is_saved
-    from omninoise.export.images import ImageError, outside_unit
-
-    if not os.path.isfile(path) or is_saved(path):
-        return 0.0, 0.0
-    try:
-        return outside_unit(path)
-    except ImageError:
-        return 0.0, 0.0
-
-
-def _clipped_notes(path: str) -> list[str]:
-    """The notes on a float photo's pixels past white and under black, where OUTSIDE_NOTE of them or more are."""
-    bright, dark = _outside_unit(path)
-    notes = []
-    if bright >= OUTSIDE_NOTE:
-        notes.append(f"note: {100 * bright:.3g} % of the photo's pixels are brighter than white (above 1) and are "
-                     "read as white; lower its exposure to keep their colours")
-    if dark >= OUTSIDE_NOTE:
-        notes.append(f"note: {100 * dark:.3g} % of the photo's pixels are darker than black (below 0) and are read "
-                     "as black; raise or offset its values into [0, 1] to keep their colours")
-    return notes
-
-
 def run(a: argparse.Namespace) -> int:
     from omninoise.backend.solid.model import load_models
 
@@ -168,8 +137,10 @@ def run(a: argparse.Namespace) -> int:
     if not a.quiet and req.repeats_as_grid("--"):
         print("note: the photo repeats across and up as a grid (bricks, tiles?); the kinds besides bonds often draw "
               "stones or blotches there: --families bonds lays it in courses", file=sys.stderr)
-    for note in [] if a.quiet else _clipped_notes(a.exemplar):
-        print(note, file=sys.stderr)
+    from omninoise.export.images import clipped_notes
+
+    for note in [] if a.quiet else clipped_notes(a.exemplar):
+        print("note: " + note, file=sys.stderr)
     t0 = time.perf_counter()
     if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
         print(f"encoding {a.exemplar} ...", end="", file=sys.stderr, flush=True)

@@ -16,7 +16,7 @@ import numpy as np
 from .atomic import atomic_path, require_finite
 
 __all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image",
-           "write_unit_image", "read_image", "read_rgb", "outside_unit", "opaque", "preview_8bit", "read_metadata",
+           "write_unit_image", "read_image", "read_rgb", "outside_unit", "clipped_notes", "opaque", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -391,6 +391,28 @@ def outside_unit(path: str) -> tuple[float, float]:
         return 0.0, 0.0
     c = a[..., :3] if a.shape[2] in (3, 4) else a[..., :1]
     return float(np.mean((c > 1.0).any(axis=2))), float(np.mean((c < -BLACK_TOLERANCE).any(axis=2)))
+
+
+#: the share of a float photo's pixels past white (or under black) from which :func:`clipped_notes` says so
+CLIPPED_NOTE = 0.01
+
+
+def clipped_notes(path: str) -> list[str]:
+    """What a user is told of a photo file read as colours in [0, 1]: the share of its pixels past white and under
+    black, each where it is :data:`CLIPPED_NOTE` or more (the command line prints them as notes, the Python API
+    warns); none for an integer file, and for anything that is no image file (a shipped texture's name)."""
+    try:
+        bright, dark = outside_unit(path) if os.path.isfile(path) else (0.0, 0.0)
+    except ImageError:
+        return []
+    notes = []
+    if bright >= CLIPPED_NOTE:
+        notes.append(f"{100 * bright:.3g} % of the photo's pixels are brighter than white (above 1) and are read as "
+                     "white; lower its exposure to keep their colours")
+    if dark >= CLIPPED_NOTE:
+        notes.append(f"{100 * dark:.3g} % of the photo's pixels are darker than black (below 0) and are read as "
+                     "black; raise or offset its values into [0, 1] to keep their colours")
+    return notes
 
 
 def _png_text(path: str) -> dict:

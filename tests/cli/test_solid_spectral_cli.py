@@ -4,9 +4,12 @@ spectral`; the same volume from a job file's bake; one-line errors for what it c
 small period keep it to seconds."""
 import os
 import shutil
+import warnings
 
 import numpy as np
 import pytest
+
+import omninoise
 
 from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import SolidRequest
@@ -129,8 +132,8 @@ def test_an_image_and_one_line_errors(tmp_path, capsys):
 def test_a_photo_brighter_than_white_or_darker_than_black_is_said_to_be(tmp_path, capsys):
     """A float photo whose pixels pass 1 is read as white there (an HDR photo, an overexposed one), and one whose
     pixels fall below 0 as black (all of a photo offset below black came out black without a word): the command says
-    how much of it, before any work; a photo within [0, 1], values under black by less than an 8-bit step, and a
-    quiet command say nothing."""
+    how much of it, before any work, and ``omninoise.solid`` warns so; a photo within [0, 1], values under black by
+    less than an 8-bit step, and a quiet command say nothing."""
     from omninoise.export import write_exr
     from omninoise.export.images import BLACK_TOLERANCE, outside_unit
 
@@ -152,3 +155,9 @@ def test_a_photo_brighter_than_white_or_darker_than_black_is_said_to_be(tmp_path
             notes = [line for line in err.splitlines() if line.startswith("note:")]
             assert len(notes) == (1 if said and not quiet else 0), err
             assert not notes or notes[0].startswith(f"note: 100 % of the photo's pixels are {said}"), err
+        with warnings.catch_warnings(record=True) as caught:          # the Python API warns the same
+            warnings.simplefilter("always")
+            assert omninoise.solid(str(tmp_path / "p.exr"), 16, method="spectral").shape == (16, 16, 3)
+        told = [str(w.message) for w in caught]
+        assert len(told) == (1 if said else 0) and all(t.startswith(f"100 % of the photo's pixels are {said}")
+                                                      for t in told), told
