@@ -44,12 +44,24 @@ def linear_to_srgb(linear: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055).astype(np.float32)
 
 
+#: values encode_srgb8 converts at a time: its float temporaries stay a few MiB whatever the image's size
+_ENCODE_BLOCK = 1 << 18
+
+
 def encode_srgb8(linear: np.ndarray) -> np.ndarray:
-    """Scene-linear float (..., C) -> sRGB-encoded uint8; a 4th (alpha) channel stays linear."""
-    out = np.clip(np.asarray(linear, np.float32), 0.0, 1.0)
-    c = out[..., :3] if out.ndim == 3 and out.shape[-1] >= 3 else out
-    c[...] = linear_to_srgb(c)
-    return (out * 255.0 + 0.5).astype(np.uint8)
+    """Scene-linear float (..., C) -> sRGB-encoded uint8; a 4th (alpha) channel stays linear.  Rows are encoded a
+    block at a time, so that the float temporaries of a large image (several times its size) are never held."""
+    a = np.asarray(linear)
+    if a.ndim == 0:
+        return encode_srgb8(a[None])[0]
+    out = np.empty(a.shape, np.uint8)
+    rows = max(1, _ENCODE_BLOCK // max(1, a[:1].size))
+    for i in range(0, a.shape[0], rows):
+        block = np.clip(np.asarray(a[i: i + rows], np.float32), 0.0, 1.0)
+        c = block[..., :3] if block.ndim == 3 and block.shape[-1] >= 3 else block
+        c[...] = linear_to_srgb(c)
+        out[i: i + rows] = block * 255.0 + 0.5
+    return out
 
 
 def _text_chunk(key: str, value: str) -> tuple:
@@ -73,15 +85,16 @@ def write_png(path: str, array: np.ndarray, metadata: dict | None = None) -> Non
     h, w, c = a.shape
     colour = {1: 0, 2: 4, 3: 2, 4: 6}[c]
     depth = 8 * a.dtype.itemsize
-    a = a.astype(">u2") if depth == 16 else a       # PNG's samples are big-endian
-    raw = b"".join(b"\x00" + a[y].tobytes() for y in range(h))
+    deflate = zlib.compressobj(6)       # row by row: the filtered rows are never held whole beside the image
+    idat = [deflate.compress(b"\x00" + (a[y].astype(">u2") if depth == 16 else a[y]).tobytes()) for y in range(h)]
+    idat.append(deflate.flush())         # PNG's samples are big-endian; filter type 0 on every row
 
     def chunk(tag: bytes, data: bytes) -> bytes:
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
 
     png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, colour, 0, 0, 0))
            + b"".join(chunk(*_text_chunk(str(k), str(v))) for k, v in (metadata or {}).items())
-           + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
+           + chunk(b"IDAT", b"".join(idat)) + chunk(b"IEND", b""))
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
             fh.write(png)

@@ -417,3 +417,29 @@ def test_an_exr_of_several_parts_is_refused_naming_them(tmp_path):
     with OpenEXR.File([part("beauty", beauty)]) as f:
         f.write(str(tmp_path / "one.exr"))
     np.testing.assert_array_equal(decode(str(tmp_path / "one.exr")), beauty)
+
+
+def test_writing_a_large_png_holds_no_float_copies_of_it(tmp_path):
+    """A ramp's colours written as an 8-bit PNG: encoding and compressing take a few MiB beside the image and its
+    bytes, whatever its size (the whole-image float temporaries took 87 bytes a pixel at 4096^2, four times what a
+    bake is allowed for), and give the pixels IEC 61966-2-1's formula gives, block boundaries included."""
+    import tracemalloc
+
+    from omninoise.export.images import encode_srgb8, write_png
+
+    n = 1024
+    y, x = np.mgrid[0:n, 0:n].astype(np.float32) / n
+    rgba = np.stack([x, y, x * y, 1.0 - x], axis=-1) * np.float32(1.2) - np.float32(0.1)   # past both ends too
+    tracemalloc.start()
+    try:
+        base = tracemalloc.get_traced_memory()[0]
+        encoded = encode_srgb8(rgba)
+        write_png(str(tmp_path / "ramp.png"), encoded)
+        peak = tracemalloc.get_traced_memory()[1] - base
+    finally:
+        tracemalloc.stop()
+    assert peak < encoded.nbytes + 16 * 2 ** 20, peak / 2 ** 20                # the input is 16 MiB, 4 MiB out
+    c = np.clip(rgba.astype(np.float64), 0.0, 1.0)
+    c[..., :3] = np.where(c[..., :3] <= 0.0031308, 12.92 * c[..., :3], 1.055 * c[..., :3] ** (1 / 2.4) - 0.055)
+    assert np.abs(encoded.astype(int) - np.floor(c * 255 + 0.5)).max() <= 1    # float32 rounding at half steps
+    np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "ramp.png")), encoded)
