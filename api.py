@@ -120,7 +120,7 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
     >>> vol.shape
     (16, 16, 16)
     """
-    from .backend.bake import BakeSpec, evaluate_values, run_bake
+    from .backend.bake import BakeSpec, check_bake_memory, evaluate_values, run_bake
     from .backend.sources import BoxGrid, WaveSource
     from .backend.transfer import load_transfer
     from .backend.wavenoise.schema import WAVE_SETTINGS
@@ -163,7 +163,8 @@ def wave(size: int = 256, extent: float = 4.0, *, time: float = 0.0, out: str | 
         from .backend.job_file import check_job_file
 
         save_job = check_job_file(save_job, "save_job", "the example" if example is not None else None)
-    limits.check_memory("size", float(size) ** rank * 4 * 2, f"a {size}-sample {s.dim}D grid")
+    check_bake_memory("size", (size,) * rank, ext if out is not None else None,
+                      "ramp" if transfer is not None else "values", f"a {size}-sample {s.dim}D grid")
     grid = BoxGrid((size,) * rank, ((0.0, 0.0, 0.0), (float(extent),) * 3))
     source = WaveSource(s)
     if out is None:
@@ -286,10 +287,13 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
     if dim not in (2, 3) or isinstance(dim, bool):
         raise SettingError("dim", f"must be 2 or 3, got {dim!r}")
     limits.scale("scale", scale)
-    limits.check_memory("size", float(size) ** dim * 4 * 4, f"a {size}-sample {dim}D texture")
     allowed = (".png", ".exr", ".npy") if dim == 2 else (".vdb", ".npy")
     ext = None if out is None else _check_out(out, allowed + ((".json",) if method == "procedural" else ()),
                                               f"a {dim}D texture", (("exemplar", exemplar),))
+    if ext != ".json":      # a fitted solid's .json draws nothing
+        from .backend.bake import check_bake_memory
+
+        check_bake_memory("size", (size,) * dim, ext, "rgb", f"a {size}-sample {dim}D texture")
     if ext == ".vdb":
         from .backend.bake import require_vdb
 
@@ -337,12 +341,11 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
         run_bake(BakeSpec("solid", source, grid, out), progress, force=True)
         return out
     rgb = req.front_image(size, float(scale), draw_progress=progress)
-    linear = srgb_to_linear(rgb)       # float32, as the command line's .npy holds it
     if out is None:
-        return linear
+        return srgb_to_linear(rgb)     # float32, as the command line's .npy holds it
     from .export.images import write_unit_image
 
-    write_unit_image(out, rgb, linear)
+    write_unit_image(out, rgb, None if ext == ".png" else srgb_to_linear(rgb))
     return out
 
 

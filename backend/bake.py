@@ -44,7 +44,8 @@ from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
 __all__ = ["BakeSpec", "BakeResult", "run_bake", "evaluate_values", "write_values", "require_vdb", "frame_path",
-           "check_one_file", "check_not_read", "output_type", "still", "FORMATS", "NPY_RAMP", "KEY_NAME", "Cancelled"]
+           "check_one_file", "check_not_read", "output_type", "still", "check_bake_memory", "PEAK_BYTES", "FORMATS",
+           "NPY_RAMP", "KEY_NAME", "Cancelled"]
 
 _F = np.float32
 FORMATS = (".vdb", ".exr", ".png", ".npy")
@@ -54,6 +55,25 @@ KEY_NAME = "omninoise_key"
 #: voxels per slab: ~2 MiB of values plus ~8 MiB of colour at a time
 SLAB_VOXELS = 1 << 19
 _FRAME = re.compile(r"#+")
+
+#: bytes a result holds at its peak per sample of its grid, by the file it is written to (None: returned in memory)
+#: and what it holds: a source's values ("values"), a ramp's colours from them ("ramp"), a solid texture's RGB
+#: ("rgb"). The growth of `omninoise wave` and `omninoise solid`'s peak resident memory from 2048^2 to 4096^2 px
+#: (1024^2 to 1792^2 for RGB) and from 192^3 to 256^3 voxels (96^3 to 144^3 for RGB), rounded up: the values, a
+#: ramp's RGBA, the writers' copies (an EXR's channels, OpenVDB's grids, a PNG's bytes). A model's or a tile's own
+#: memory, the same at every size, comes on top (the neural models: about 0.2 GiB)
+PEAK_BYTES = {None: {"values": 6, "rgb": 26}, ".npy": {"values": 6, "rgb": 20},
+              ".png": {"values": 14, "ramp": 28, "rgb": 16}, ".exr": {"values": 10, "ramp": 42, "rgb": 26},
+              ".vdb": {"values": 10, "ramp": 36, "rgb": 18}}
+
+
+def check_bake_memory(setting: str, shape, ext: str | None, holds: str, what: str) -> None:
+    """SettingError naming ``setting`` where a result of grid ``shape`` written as ``ext`` (None: kept in memory),
+    holding ``holds`` ("values", "ramp" or "rgb"), would take more than :func:`limits.memory_limit` at its peak
+    (:data:`PEAK_BYTES`); ``what`` names it in the message ("a [512, 512, 512] grid")."""
+    per_sample = PEAK_BYTES[ext].get(holds)
+    if per_sample is not None:          # none: a pair refused on its own (a ramp into .npy)
+        limits.check_memory(setting, float(np.prod(np.asarray(shape, np.float64))) * per_sample, what)
 
 
 @dataclass(frozen=True)
@@ -119,6 +139,8 @@ class BakeSpec:
             if top > HALF_MAX:
                 raise SettingError("half", f"the ramp writes values up to {top:g} (colour, density or temperature), "
                                            f"past {HALF_MAX:g}, the largest 16-bit half float: leave out half")
+        holds = "rgb" if getattr(self.source, "rgb", False) else "values" if self.transfer is None else "ramp"
+        check_bake_memory("resolution", self.grid.shape, ext, holds, f"a {list(self.grid.resolution)} grid")
         if self.frames is not None:
             a, b = self.frames
             if int(a) != a or int(b) != b or b < a:

@@ -73,9 +73,10 @@ def physical_memory() -> int | None:
 
 
 def default_memory() -> int:
-    """The limit without OMNINOISE_MEMORY_LIMIT: 16 GiB, or half of :func:`physical_memory` where that is less.  A
-    result's estimate is what it holds; the peak is more (a 512^3 cloud volume: 2.5 GiB estimated, 3.6 GiB peak),
-    and past the memory the system kills the process, Blender and its unsaved file with it."""
+    """The limit without OMNINOISE_MEMORY_LIMIT: 16 GiB, or half of :func:`physical_memory` where that is less: a
+    model's own memory and the rest of the process come on top of a result's peak (a 512^3 cloud volume: 4.5 GiB
+    estimated by ``backend.bake.PEAK_BYTES``, 3.5 GiB measured), and past the memory the system kills the process,
+    Blender and its unsaved file with it."""
     ram = physical_memory()
     return _DEFAULT_MEMORY if ram is None else min(_DEFAULT_MEMORY, ram // 2)
 

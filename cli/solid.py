@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from omninoise.backend import limits
-from omninoise.backend.bake import output_type
+from omninoise.backend.bake import check_bake_memory, output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.solid.request import METHODS, method_for
 from omninoise.backend.solid.gaussian_rest import REST_CHOICES
@@ -116,7 +116,6 @@ def run(a: argparse.Namespace) -> int:
     if a.size < 1:
         raise SettingError("--size", f"must be >= 1, got {a.size}")
     limits.scale("--scale", a.scale)
-    limits.check_memory("--size", float(a.size) ** a.dim * 4 * 4, f"a {a.size}-sample {a.dim}D texture")
     ext = os.path.splitext(a.out)[1].lower()
     if ext == ".json":          # the fitted procedural solid itself, drawn later at any size
         if method_for(a.exemplar, a.method) != "procedural":
@@ -127,6 +126,7 @@ def run(a: argparse.Namespace) -> int:
                                          f"{flag} out, and give it when the .json is drawn (--exemplar)")
     else:
         output_type(a.out, (".png", ".exr", ".npy") if a.dim == 2 else (".vdb", ".npy"), f"a {a.dim}D result", "-o")
+        check_bake_memory("--size", (a.size,) * a.dim, ext, "rgb", f"a {a.size}-sample {a.dim}D texture")
     if ext == ".vdb":
         from omninoise.backend.bake import require_vdb
 
@@ -208,4 +208,4 @@ def _write_image(out: str, rgb: np.ndarray) -> None:
     from omninoise.backend.colour import srgb_to_linear
     from omninoise.export.images import write_unit_image
 
-    write_unit_image(out, rgb, srgb_to_linear(rgb))
+    write_unit_image(out, rgb, None if out.lower().endswith(".png") else srgb_to_linear(rgb))

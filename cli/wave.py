@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 
 from omninoise.backend import limits
-from omninoise.backend.bake import NPY_RAMP, output_type
+from omninoise.backend.bake import NPY_RAMP, check_bake_memory, output_type
 from omninoise.backend.errors import SettingError
 from omninoise.backend.transfer import PRESETS, load_transfer
 from omninoise.backend.wavenoise.cellular import CELLULAR_MODES
@@ -220,8 +220,8 @@ def run(a: argparse.Namespace) -> int:
     limits.time("--time", a.time)
     if a.example_extent is not None:
         limits.positive("--example-extent", a.example_extent)
-    limits.check_memory("--size", float(a.size) ** (min(a.dim, 3) if ext in (".npy", ".vdb") else 2)
-                        * 4 * (5 if a.transfer else 2), f"a {a.size}-sample {a.dim}D grid")
+    check_bake_memory("--size", (a.size,) * (2 if a.dim == 2 else 3), ext, "ramp" if a.transfer else "values",
+                      f"a {a.size}-sample {a.dim}D grid")
     s = settings_from_args(a)
     check_time("--time", a.time, s, "--speed", "--dim 4")
     tf = load_transfer(a.transfer, "--transfer") if a.transfer else None

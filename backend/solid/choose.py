@@ -128,8 +128,9 @@ class AutoTexture:
               axis: str = "y", **kw) -> np.ndarray:
         """A (size, size, 3) image of the plane through ``offset`` normal to ``axis`` (the front view, "y", by
         default)."""
-        from .model import slice_points
+        from .model import plane_image
 
         ppu = code.field.px_per_unit if code.method == "procedural" else code.model.px_per_unit
-        pts = slice_points(size, ppu * scale, axis, offset)
-        return self.evaluate(pts, code, seed, **kw).reshape(size, size, 3)
+        progress = kw.pop("progress", None)
+        return plane_image(lambda pts, rows: self.evaluate(pts, code, seed, **kw), size, ppu * scale, axis, offset,
+                           progress)

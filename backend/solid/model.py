@@ -44,21 +44,55 @@ ENCODE_SIDE = 8           #: the encoder reads at most this many crops along eac
 ENCODE_BATCH = 16         #: ... this many at a time (a 4096 px photo: 64 crops, not 3969 in one 13 GB batch)
 
 
-def plane_points(size: int, px_per_unit: float) -> np.ndarray:
-    """Pixel centres of a size x size image in texture units, row 0 at the top: float64 (size*size, 2) (u, -v)."""
+def plane_points(size: int, px_per_unit: float, rows: slice = slice(None)) -> np.ndarray:
+    """Pixel centres of a size x size image in texture units, row 0 at the top: float64 (size*size, 2) (u, -v);
+    ``rows``: only those rows' (a slice of range(size))."""
     u = (np.arange(size, dtype=np.float64) + 0.5) / px_per_unit
-    vv, uu = np.meshgrid(u, u, indexing="ij")
-    return np.stack([uu.ravel(), -vv.ravel()], axis=1)
+    v = u[rows]
+    pts = np.empty((v.size * size, 2))
+    pts[:, 0], pts[:, 1] = np.tile(u, v.size), -np.repeat(v, size)
+    return pts
 
 
-def slice_points(size: int, px_per_unit: float, axis: str, offset=(0.0, 0.0, 0.0)) -> np.ndarray:
+def slice_points(size: int, px_per_unit: float, axis: str, offset=(0.0, 0.0, 0.0),
+                 rows: slice = slice(None)) -> np.ndarray:
     """Pixel centres of a size x size image of the plane through ``offset`` normal to ``axis`` ("y": x to the right
-    and z up; "z": x right, y up; "x": y right, z up), row 0 at the top: float64 (size*size, 3) in units."""
-    plane = plane_points(size, px_per_unit)
+    and z up; "z": x right, y up; "x": y right, z up), row 0 at the top: float64 (size*size, 3) in units; ``rows``:
+    only those rows'."""
+    plane = plane_points(size, px_per_unit, rows)
     a, b = {"z": (0, 1), "y": (0, 2), "x": (1, 2)}[axis]
-    pts = np.zeros((plane.shape[0], 3))
-    pts[:, a], pts[:, b] = plane[:, 0], plane[:, 1]
-    return pts + np.asarray(offset, np.float64)
+    pts = np.empty((plane.shape[0], 3))
+    pts[:] = np.asarray(offset, np.float64)
+    pts[:, a] += plane[:, 0]
+    pts[:, b] += plane[:, 1]
+    return pts
+
+
+#: pixels an image of a plane is drawn at a time (:func:`plane_image`)
+IMAGE_BLOCK = 1 << 16
+
+
+def plane_image(draw, size: int, px_per_unit: float, axis: str | None = "y", offset=(0.0, 0.0, 0.0),
+                progress=None) -> np.ndarray:
+    """A (size, size, 3) float32 image of a plane, drawn a block of rows at a time so that its points (24 bytes a
+    pixel) and an evaluator's temporaries are never held for the whole image (a 2048^2 front view held 73 bytes a
+    pixel).  ``draw(points, rows)`` -> float32 (n, 3) at ``points`` float64 (n, 3), the pixel centres of ``rows``
+    (a slice of range(size)) of :func:`slice_points`' plane through ``offset`` normal to ``axis``, or (n, 2) those
+    of :func:`plane_points` moved by ``offset[:2]`` where ``axis`` is None (a 2D texture);
+    ``progress(fraction)`` after each block."""
+    out = np.empty((size, size, 3), _F)
+    step = max(1, IMAGE_BLOCK // max(1, size))
+    for r in range(0, size, step):
+        rows = slice(r, min(size, r + step))
+        if axis is None:
+            pts = plane_points(size, px_per_unit, rows)
+            pts += np.asarray(offset[:2], np.float64)
+        else:
+            pts = slice_points(size, px_per_unit, axis, offset, rows)
+        out[rows] = np.asarray(draw(pts, rows), _F).reshape(-1, size, 3)
+        if progress is not None:
+            progress(rows.stop / size)
+    return out
 
 
 def load_models(root: str | None = None, threads: int = 0, cache: dict | None = None) -> dict:
@@ -423,8 +457,10 @@ class SolidTextureModel:
         view (x to the right, z up), where models trained with ``fixed_axis`` "rows" and an encoded photo's
         harmonic part (harmonic.py) show the photo upright; "z" looks down (x right, y up), "x" from the side
         (y right, z up)."""
-        if self.dim == 2:
-            pts = plane_points(size, self.px_per_unit * scale) + np.asarray(offset[:2], np.float64)
-        else:
-            pts = slice_points(size, self.px_per_unit * scale, axis, offset)
-        return self.evaluate(pts, code, seed, **kw).reshape(size, size, 3)
+        progress = kw.pop("progress", None)
+
+        def draw(pts, rows):
+            e = code.e if code.e.ndim == 1 else code.e[rows.start * size: rows.stop * size]   # a code per pixel
+            return self.evaluate(pts, code if e is code.e else dataclasses.replace(code, e=e), seed, **kw)
+
+        return plane_image(draw, size, self.px_per_unit * scale, None if self.dim == 2 else axis, offset, progress)

@@ -82,7 +82,7 @@ import numpy as np
 from ..errors import SettingError, check_points
 from ..grid import Cancelled
 from ..periodic import periodic_component
-from .model import plane_points
+from .model import plane_image
 from .pixels import one_colour
 from .synthesis import PX_PER_UNIT
 
@@ -414,7 +414,7 @@ class SplineField:
     def image(self, size: int, scale: float = 1.0) -> np.ndarray:
         """A (size, size, 3) float32 image of the plane z = 0 (x right, y up; row 0 at the top) at ``scale``
         output pixels per photo pixel."""
-        return self.evaluate(plane_points(size, self.px_per_unit * scale)).reshape(size, size, 3)
+        return plane_image(lambda pts, rows: self.evaluate(pts), size, self.px_per_unit * scale, None)
 
 
 class SpectralTexture:
@@ -440,7 +440,6 @@ class SpectralTexture:
               axis: str = "y", **kw) -> np.ndarray:
         """A (size, size, 3) image of the plane through ``offset`` normal to ``axis`` (as SolidTextureModel.image:
         "y", the default, is the front view, x right and z up)."""
-        from .model import slice_points
-
-        pts = slice_points(size, self.px_per_unit * scale, axis, offset)
-        return self.evaluate(pts, code, seed, **kw).reshape(size, size, 3)
+        progress = kw.pop("progress", None)
+        return plane_image(lambda pts, rows: self.evaluate(pts, code, seed, **kw), size, self.px_per_unit * scale,
+                           axis, offset, progress)

@@ -44,7 +44,7 @@ import numpy as np
 
 from ..errors import SettingError, check_points
 from ..grid import Cancelled
-from .model import plane_points
+from .model import plane_image
 from .pixels import one_colour, resize_rgb
 
 __all__ = ["SynthesisSettings", "synthesise", "TileField", "image_settings", "PLANES", "PX_PER_UNIT", "MIN_TILE",
@@ -368,7 +368,7 @@ class TileField:
     def image(self, size: int, scale: float = 1.0) -> np.ndarray:
         """A (size, size, 3) float32 image of the plane z = 0 (x right, y up; row 0 at the top) at ``scale`` output
         pixels per tile pixel: at scale 1 the tile's own pixels, repeated beyond its size."""
-        return self.evaluate(plane_points(size, self.px_per_unit * scale)).reshape(size, size, 3)
+        return plane_image(lambda pts, rows: self.evaluate(pts), size, self.px_per_unit * scale, None)
 
     def evaluate(self, points: np.ndarray, chunk: int = 1 << 18) -> np.ndarray:
         """points float (P, 2 or 3) in texture units (x, y[, z]) -> float32 (P, 3)."""

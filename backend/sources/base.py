@@ -49,8 +49,6 @@ class BoxGrid:
                                          f"y{', z' if n == 3 else ''}: {self.bounds}")
         if np.prod(np.asarray(res, np.float64)) > 2 ** 34:
             raise SettingError("resolution", f"{list(res)} is more than 2^34 voxels")
-        # the baked field (float32), with RGBA colour four times that
-        limits.check_memory("resolution", float(np.prod(np.asarray(res, np.float64))) * 4 * 5, f"a {list(res)} grid")
         return self
 
     @property

@@ -100,10 +100,9 @@ class ProceduralField:
     def image(self, size: int, scale: float = 1.0, axis: str = "y", offset=(0.0, 0.0, 0.0)) -> np.ndarray:
         """A (size, size, 3) image of the plane through ``offset`` normal to ``axis`` ("y": the front view, x right
         and z up) at ``scale`` output pixels per photo pixel."""
-        from ..model import slice_points
+        from ..model import plane_image
 
-        pts = slice_points(size, self.px_per_unit * scale, axis, offset)
-        return self.evaluate(pts).reshape(size, size, 3)
+        return plane_image(lambda pts, rows: self.evaluate(pts), size, self.px_per_unit * scale, axis, offset)
 
     def to_dict(self) -> dict:
         d = dict(family=self.family, params=dict(self.params), ramp=self.ramp.to_dict(), seed=self.seed,
