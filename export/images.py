@@ -414,8 +414,9 @@ def clipped_notes(path: str) -> list[str]:
     """What a user is told of a photo file read as colours in [0, 1]: the share of its pixels past white and under
     black, each where it is :data:`CLIPPED_NOTE` or more (the command line prints them as notes, the Python API
     warns); none for an integer file, and for anything that is no image file (a shipped texture's name)."""
+    floats = os.path.splitext(path)[1].lower() in (".exr", ".npy", ".tif", ".tiff")   # others store integers
     try:
-        bright, dark = outside_unit(path) if os.path.isfile(path) else (0.0, 0.0)
+        bright, dark = outside_unit(path) if floats and os.path.isfile(path) else (0.0, 0.0)
     except ImageError:
         return []
     notes = []
