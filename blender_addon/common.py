@@ -13,8 +13,8 @@ import numpy as np
 from .. import backend
 from ..backend import paths
 
-__all__ = ["backend_module", "Sidebar", "image_pixels", "image_srgb", "store_srgb_image", "neural_model_folder",
-           "solid_models_folder"]
+__all__ = ["backend_module", "Sidebar", "image_pixels", "image_srgb", "image_clipped_notes", "store_srgb_image",
+           "neural_model_folder", "solid_models_folder"]
 
 
 def backend_module(name: str):
@@ -78,6 +78,18 @@ def image_srgb(ima, setting: str) -> np.ndarray:
 
         rgb = export.linear_to_srgb(rgb)
     return np.ascontiguousarray(rgb, np.float32)
+
+
+def image_clipped_notes(ima) -> list[str]:
+    """What the artist is told of a float image read as colours in [0, 1] (:func:`image_srgb`): how much of it is
+    past white or under black (``export.images.clipped_text``), as the command line's notes say; none for an 8- or
+    16-bit image. Blender's default view (AgX) shows values above 1 as bright colours, not as the white they are
+    read as."""
+    if not ima.is_float:
+        return []
+    from ..export import images
+
+    return images.clipped_text(*images.outside_shares(image_colours(ima, "image")))
 
 
 def store_srgb_image(name: str, rgb: np.ndarray):

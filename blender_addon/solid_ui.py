@@ -48,7 +48,8 @@ from . import tasks
 from .. import backend
 from .compat import ensure_node_tree
 from .bake_ui import SaveJobOperator, draw_progress
-from .common import Sidebar, backend_module as _mod, image_srgb, solid_models_folder, store_srgb_image
+from .common import (Sidebar, backend_module as _mod, image_clipped_notes, image_srgb, solid_models_folder,
+                     store_srgb_image)
 from .tasks import TaskOperator
 from .preferences import threads
 from .presets import SOLID_VALUES, SUBDIRS
@@ -442,9 +443,18 @@ def _material_with(obj, name: str, make_node):
 
 
 class SolidTask(TaskOperator):
-    """The Solid Texture panel's operators: the request's exemplar is the panel's Image in their errors."""
+    """The Solid Texture panel's operators: the request's exemplar is the panel's Image in their errors, and a
+    float Image past white or under black is reported as a warning once the work starts."""
 
     setting_names = {"exemplar": "image"}
+
+    def _begin(self, context, blocking: bool):
+        task = TaskOperator._begin(self, context, blocking)
+        p = context.scene.omninoise_solid
+        if task is not None and p.source == "IMAGE" and p.image is not None:
+            for note in image_clipped_notes(p.image):
+                self.report({"WARNING"}, f"Image {p.image.name!r}: {note}")
+        return task
 
 
 class OMNINOISE_OT_solid_preview(SolidTask, bpy.types.Operator):

@@ -16,7 +16,7 @@ import numpy as np
 from .atomic import atomic_path, require_finite
 
 __all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image",
-           "write_unit_image", "read_image", "read_rgb", "outside_unit", "clipped_notes", "opaque", "preview_8bit", "read_metadata",
+           "write_unit_image", "read_image", "read_rgb", "outside_unit", "outside_shares", "clipped_notes", "clipped_text", "opaque", "preview_8bit", "read_metadata",
            "encode_srgb8", "linear_to_srgb"]
 
 
@@ -395,30 +395,39 @@ BLACK_TOLERANCE = 0.5 / 255 / 12.92
 
 
 def outside_unit(path: str) -> tuple[float, float]:
-    """The shares of the pixels of a float image file (EXR, float TIFF, float .npy) with a colour above 1 and with
-    one below 0, which :func:`read_rgb` reads as white and as black: an HDR photo's highlights (or all of an
-    overexposed one), and values a processing step pushed under black (those within :data:`BLACK_TOLERANCE` of 0
-    are black to begin with).  (0, 0) for an integer file, whose values cannot leave [0, 1]."""
+    """:func:`outside_shares` of a float image file (EXR, float TIFF, float .npy), as :func:`read_rgb` reads it;
+    (0, 0) for an integer file, whose values cannot leave [0, 1]."""
     a, linear = _decode(path)
-    if not linear:
-        return 0.0, 0.0
-    c = a[..., :3] if a.shape[2] in (3, 4) else a[..., :1]
+    return outside_shares(a) if linear else (0.0, 0.0)
+
+
+def outside_shares(pixels: np.ndarray) -> tuple[float, float]:
+    """The shares of the pixels of float (H, W, C) scene-linear colours (an alpha channel aside) with a colour above
+    1 and with one below 0, which are read as white and as black: an HDR photo's highlights (or all of an
+    overexposed one), and values a processing step pushed under black (those within :data:`BLACK_TOLERANCE` of 0
+    are black to begin with)."""
+    c = pixels[..., :3] if pixels.shape[2] in (3, 4) else pixels[..., :1]
     return float(np.mean((c > 1.0).any(axis=2))), float(np.mean((c < -BLACK_TOLERANCE).any(axis=2)))
 
 
-#: the share of a float photo's pixels past white (or under black) from which :func:`clipped_notes` says so
+#: the share of a float photo's pixels past white (or under black) from which :func:`clipped_text` says so
 CLIPPED_NOTE = 0.01
 
 
 def clipped_notes(path: str) -> list[str]:
-    """What a user is told of a photo file read as colours in [0, 1]: the share of its pixels past white and under
-    black, each where it is :data:`CLIPPED_NOTE` or more (the command line prints them as notes, the Python API
-    warns); none for an integer file, and for anything that is no image file (a shipped texture's name)."""
+    """What a user is told of a photo file read as colours in [0, 1]: :func:`clipped_text` of its shares past white
+    and under black (the command line prints them as notes, the Python API warns); none for an integer file, and
+    for anything that is no image file (a shipped texture's name)."""
     floats = os.path.splitext(path)[1].lower() in (".exr", ".npy", ".tif", ".tiff")   # others store integers
     try:
-        bright, dark = outside_unit(path) if floats and os.path.isfile(path) else (0.0, 0.0)
+        return clipped_text(*outside_unit(path)) if floats and os.path.isfile(path) else []
     except ImageError:
         return []
+
+
+def clipped_text(bright: float, dark: float) -> list[str]:
+    """The notes on a photo's shares of pixels past white and under black, each where it is :data:`CLIPPED_NOTE`
+    or more (the command line's notes, the Python API's warnings, Blender's reports)."""
     notes = []
     if bright >= CLIPPED_NOTE:
         notes.append(f"{100 * bright:.3g} % of the photo's pixels are brighter than white (above 1) and are read as "

@@ -651,3 +651,35 @@ def test_a_models_folder_that_is_no_folder_is_said_in_the_texture_menu_and_by_th
     bpy.ops.mesh.primitive_cube_add()
     with pytest.raises(RuntimeError, match=said):
         bpy.ops.omninoise.solid_preview()
+
+
+def test_a_float_image_past_white_or_under_black_is_reported(scene, capfd):
+    """A float Image is read as colours in [0, 1]: where 1 % or more of it is past white or under black, the
+    operator reports it as a warning (Blender's default view, AgX, shows values above 1 as bright colours, not as
+    the white they are read as), as the command line's notes say; an 8-bit image and one within [0, 1] are not."""
+    p = scene.omninoise_solid
+    rgba = np.ones((64, 64, 4), np.float32)
+    rgba[..., :3] = 0.4
+    rgba[:16, :, :3] = 4.5                                      # a quarter past white
+    rgba[16:24, :, 2] = -0.2                                    # an eighth under black
+    hdr = bpy.data.images.new("HDR", 64, 64, float_buffer=True)
+    hdr.pixels.foreach_set(rgba.ravel())
+    assert common.image_clipped_notes(hdr) == [
+        "25 % of the photo's pixels are brighter than white (above 1) and are read as white; lower its exposure to "
+        "keep their colours",
+        "12.5 % of the photo's pixels are darker than black (below 0) and are read as black; raise or offset its "
+        "values into [0, 1] to keep their colours"]
+    p.source, p.method, p.image = "IMAGE", "NEURAL", hdr
+    capfd.readouterr()
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    out = capfd.readouterr()
+    said = out.out + out.err
+    assert "Image 'HDR': 25 % of the photo's pixels are brighter than white" in said, said
+    assert "Image 'HDR': 12.5 % of the photo's pixels are darker than black" in said, said
+    rgba[..., :3] = np.clip(rgba[..., :3], 0.0, 1.0)
+    hdr.pixels.foreach_set(rgba.ravel())
+    assert common.image_clipped_notes(hdr) == [] and common.image_clipped_notes(_stripes_image()) == []
+    p.image = _stripes_image()
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    out = capfd.readouterr()
+    assert "Image '" not in out.out + out.err
