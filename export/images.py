@@ -16,8 +16,8 @@ import numpy as np
 from .atomic import atomic_path, require_finite
 
 __all__ = ["ImageError", "decode", "MAX_PIXELS", "write_npy", "write_png", "write_exr", "write_image",
-           "write_unit_image", "read_image", "read_rgb", "outside_unit", "outside_shares", "clipped_notes", "clipped_text", "opaque", "preview_8bit", "read_metadata",
-           "encode_srgb8", "linear_to_srgb"]
+           "write_unit_image", "read_image", "read_rgb", "outside_unit", "outside_shares", "clipped_notes",
+           "clipped_text", "opaque", "preview_8bit", "read_metadata", "encode_srgb8", "linear_to_srgb"]
 
 
 def write_npy(path: str, array: np.ndarray) -> None:
