@@ -155,7 +155,7 @@ def run(a: argparse.Namespace) -> int:
     def on_code(code):
         if a.quiet:
             return
-        if os.path.isfile(a.exemplar):
+        if req.method == "neural" and os.path.isfile(a.exemplar):       # after "encoding PHOTO ..."
             print(f" done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
         if code.harmonics is not None:
             h = code.harmonics
@@ -166,6 +166,12 @@ def run(a: argparse.Namespace) -> int:
             print(f"gaussian rest: {100 * code.rest.mix:.0f} % of the rest's variance drawn as "
                   f"{KIND_WORDS[code.rest.kind]}, found closer to the image than the decoder alone (--no-gaussian "
                   "leaves it out)", file=sys.stderr)
+
+    def on_fit(fitted):
+        """The kind the procedural fit drew, or what auto kept and why."""
+        if not a.quiet:
+            print(fitted.summary() if hasattr(fitted, "summary") else f"procedural: fitted {fitted.family}",
+                  file=sys.stderr)
 
     stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid ",
              "procedural": "procedural fit ", "auto": "procedural fit "}[req.method]
@@ -182,12 +188,12 @@ def run(a: argparse.Namespace) -> int:
         from omninoise.backend.bake import BakeSpec, run_bake
         from omninoise.backend.sources import BoxGrid, solid_volume
 
-        source, extent = solid_volume(req, a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code)
+        source, extent = solid_volume(req, a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code, on_fit)
         grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
-        run_bake(BakeSpec("solid", source, grid, a.out), Bar(a.quiet), force=True)
+        run_bake(BakeSpec("solid", source, grid, a.out), Bar(a.quiet, "drawing "), force=True)
         return 0
     _write_image(a.out, req.front_image(a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code,
-                                              Bar(a.quiet)))
+                                        Bar(a.quiet, "drawing "), on_fit))
     return 0
 
 

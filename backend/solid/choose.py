@@ -78,6 +78,14 @@ class Choice:
     code: object
     distances: dict
 
+    def summary(self) -> str:
+        """One line of what was kept and the check's figures that kept it (the command line says it)."""
+        p, n = self.distances["procedural"], self.distances["neural"]
+        kept = f"the procedural {self.field.family}" if self.method == "procedural" else "the neural texture"
+        return (f"auto: kept {kept} (distance on axis and oblique cuts, structure error: procedural "
+                f"{self.field.family} {p['axes']:.1f}, {p['oblique']:.1f}, {p['structure']:.2f}; neural texture "
+                f"{n['axes']:.1f}, {n['oblique']:.1f}, {n['structure']:.2f})")
+
 
 def choose(request, where: str = "", progress=None, report=None, on_code=None, field=None, cancel=None) -> Choice:
     """The stages (module doc) for a checked request with method "auto" and an image exemplar; ``field``: its

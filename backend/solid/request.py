@@ -508,20 +508,26 @@ class SolidRequest:
         return choose(self, where, progress, report, on_code, field, cancel)
 
     def front_image(self, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
-                    on_code=None, draw_progress=None) -> np.ndarray:
+                    on_code=None, draw_progress=None, on_fit=None) -> np.ndarray:
         """The texture's 2D image: the plane y = 0 seen from the front (x right, z up), as the command line's
         ``--dim 2`` writes it: sRGB float32 (size, size, 3) in [0, 1], ``scale`` output pixels per exemplar pixel.
         ``progress`` hears the synthesis, the spectral solid or the refinement, ``draw_progress`` the drawing of
         a neural texture; ``report`` hears the refinement as in :meth:`code`; ``on_code(code)`` gets the texture
-        code before it is drawn (the neural texture only)."""
+        code before it is drawn (the neural texture only); ``on_fit`` the fitted procedural solid (method
+        "procedural") or auto's :class:`~backend.solid.choose.Choice`."""
         if self.method == "synthesis":
             return self.synthesis_field(where, progress).image(size, scale)
         if self.method in ("spectral", "procedural"):
             from .spectral_solid import SpectralTexture
 
-            return SpectralTexture(self).image(size, self.solid_field(where, progress), scale=scale)
+            field = self.solid_field(where, progress)
+            if on_fit is not None and self.method == "procedural":
+                on_fit(field)
+            return SpectralTexture(self).image(size, field, scale=scale)
         if self.method == "auto":
             c = self.choose(where, progress, report, on_code)
+            if on_fit is not None:
+                on_fit(c)
             if c.method == "procedural":
                 from .spectral_solid import SpectralTexture
 

@@ -319,19 +319,23 @@ class EncodedSource(_Prepared):
 
 
 def solid_volume(request, size: int, scale: float = 1.0, where: str = "", progress=None, report=None,
-                 on_code=None) -> tuple:
+                 on_code=None, on_fit=None) -> tuple:
     """(source, extent) of a ``size``-voxel cube of a :class:`~backend.solid.request.SolidRequest`: the colour source
     that fills it and its side in world units (``size`` voxels at ``scale`` voxels per exemplar pixel), as
-    ``omninoise solid --dim 3`` bakes it; ``progress``, ``report`` and ``on_code`` as in
+    ``omninoise solid --dim 3`` bakes it; ``progress``, ``report``, ``on_code`` and ``on_fit`` as in
     :meth:`~backend.solid.request.SolidRequest.front_image`.  SettingError for a 2D model or method synthesis."""
     if request.method == "synthesis":
         raise SettingError(f"{where}method", f"synthesis makes 2D images ({where}dim 2); volumes come from the "
                                              f"neural texture or {where}method spectral or procedural")
     if request.method in ("spectral", "procedural"):
         field = request.solid_field(where, progress)
+        if on_fit is not None and request.method == "procedural":
+            on_fit(field)
         return SpectralSource(request, field=field), size / (field.px_per_unit * scale)
     if request.method == "auto":
         c = request.choose(where, progress, report, on_code)
+        if on_fit is not None:
+            on_fit(c)
         if c.method == "procedural":
             return SpectralSource(c.request, field=c.field), size / (c.field.px_per_unit * scale)
         return SolidSource(c.model, c.request, code=c.code), size / (c.model.px_per_unit * scale)

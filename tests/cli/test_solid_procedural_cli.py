@@ -111,7 +111,7 @@ seed = 1
     np.testing.assert_allclose(np.load(tmp_path / "job.npy"), vol, atol=2e-5)
 
 
-def test_auto_keeps_what_its_check_finds_closer(tmp_path):
+def test_auto_keeps_what_its_check_finds_closer(tmp_path, capsys):
     """Auto keeps the procedural solid where its planes find it closer by the margin on both the axis and the oblique
     cuts and its walls hold the photo's structure about as well; its image is that texture's."""
     from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE
@@ -138,8 +138,15 @@ def test_auto_keeps_what_its_check_finds_closer(tmp_path):
     else:
         np.testing.assert_allclose(img, c.model.image(32, c.code, 2), atol=1e-6)
     out = str(tmp_path / "auto.png")
-    assert main(["solid", "--quiet", "--method", "auto", "--exemplar", PHOTO, "--size", "32", "-o", out]) == 0
+    capsys.readouterr()
+    assert main(["solid", "--method", "auto", "--exemplar", PHOTO, "--seed", "2", "--size", "32", "-o", out]) == 0
     assert os.path.getsize(out) > 0
+    err = capsys.readouterr().err           # the command says what it kept and the figures that kept it
+    assert c.summary() in err.splitlines(), err
+    assert c.summary().startswith(f"auto: kept the {'procedural ' + c.field.family if closer else 'neural texture'} "
+                                  f"(distance on axis and oblique cuts, structure error: procedural {c.field.family} "
+                                  f"{d['procedural']['axes']:.1f}, ")
+    assert " done (" not in err         # "done" follows the neural method's "encoding PHOTO ...", not auto's fit
 
 
 @pytest.mark.parametrize("args, note", [(["--method", "procedural"], True), (["--method", "auto"], True),
