@@ -135,10 +135,10 @@ print(re.search(r"VmHWM:\\s*(\\d+) kB", open("/proc/self/status").read())[1])"""
 
 @pytest.mark.skipif(not os.path.exists("/proc/self/status"), reason="the peak resident memory read from /proc")
 @pytest.mark.parametrize("args, sizes, ext, holds", [
-    (["--transfer", "fire"], (1024, 2048), ".exr", "ramp"),
-    (["--transfer", "fire"], (1024, 2048), ".png", "ramp"),
-    (["--transfer", "clouds", "--dim", "3"], (96, 160), ".vdb", "ramp"),
-    ([], (1024, 2048), ".png", "values"),
+    (["--transfer", "fire"], (2048, 4096), ".exr", "ramp"),
+    (["--transfer", "fire"], (2048, 4096), ".png", "ramp"),
+    (["--transfer", "clouds", "--dim", "3"], (128, 192), ".vdb", "ramp"),
+    ([], (2048, 4096), ".png", "values"),
 ])
 def test_a_bake_s_memory_estimate_is_not_below_its_peak(tmp_path, args, sizes, ext, holds):
     """What a result is refused by is what it holds at its peak: the growth of a bake's peak resident memory from
