@@ -144,11 +144,13 @@ def test_a_bake_s_memory_estimate_is_not_below_its_peak(tmp_path, args, sizes, e
     """What a result is refused by is what it holds at its peak: the growth of a bake's peak resident memory from
     one size to the next, per sample, stays within :data:`backend.bake.PEAK_BYTES` and near it (an estimate of the
     values alone let a ramp's EXR take 36 bytes a pixel against the 20 allowed for, and its PNG 87)."""
-    from omninoise.backend.bake import PEAK_BYTES
-    from conftest import _has_openvdb
+    from omninoise.backend.bake import PEAK_BYTES, require_vdb
 
-    if ext == ".vdb" and not _has_openvdb():
-        pytest.skip("this Python has no OpenVDB module")
+    if ext == ".vdb":
+        try:
+            require_vdb("-o")
+        except SettingError:
+            pytest.skip("this Python has no OpenVDB module")
     peaks, samples = [], []
     for n in sizes:     # VmHWM: this process's own peak (ru_maxrss keeps the forking test process's across exec)
         out = str(tmp_path / f"w{n}{ext}")
