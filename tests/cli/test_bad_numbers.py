@@ -133,6 +133,7 @@ assert main(sys.argv[1:] + ["--quiet"]) == 0
 print(re.search(r"VmHWM:\\s*(\\d+) kB", open("/proc/self/status").read())[1])"""
 
 
+@pytest.mark.long          # eight whole commands at sizes where the bake sets the peak
 @pytest.mark.skipif(not os.path.exists("/proc/self/status"), reason="the peak resident memory read from /proc")
 @pytest.mark.parametrize("args, sizes, ext, holds", [
     (["--transfer", "fire"], (2048, 4096), ".exr", "ramp"),
