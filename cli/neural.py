@@ -150,7 +150,7 @@ def check_reads(a: argparse.Namespace) -> None:
 
 def neural_request(a: argparse.Namespace, model):
     """The :class:`backend.neural.request.NeuralRequest` of ``omninoise neural`` flags (checked)."""
-    from omninoise.backend.neural.request import NeuralRequest
+    from omninoise.backend.neural.request import NeuralRequest, check_specs
     from omninoise.backend.neural.sampler import DEFAULT_SAMPLER, DEFAULT_STEPS
 
     if a.size < 8:
@@ -176,11 +176,7 @@ def neural_request(a: argparse.Namespace, model):
         req = NeuralRequest("blend", [spec, spec2], mask=mask > 0.5, **kw)
     else:
         req = NeuralRequest("uniform", [spec], **kw)
-    for spec, (class_flag, param_flag) in zip(req.specs, _spec_flags(a)):    # each class named by its own flag
-        try:
-            model.param_vector(*spec)
-        except SettingError as exc:
-            raise SettingError(class_flag if exc.setting == "noise" else param_flag, exc.message) from None
+    check_specs(model, req.specs, _spec_flags(a))       # each class named by its own flag
     try:
         return req.check(model)
     except SettingError as exc:  # name the flag where the request's field has one

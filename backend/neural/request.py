@@ -25,7 +25,7 @@ from ..errors import SettingError
 from . import conditioning as C
 from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 
-__all__ = ["LAYOUTS", "NeuralRequest", "generate_request", "regions_from_colours", "region_key", "regions_from_map",
+__all__ = ["LAYOUTS", "NeuralRequest", "check_specs", "generate_request", "regions_from_colours", "region_key", "regions_from_map",
            "map_error", "map_at", "READ_BY", "check_layout_reads"]
 
 #: layout -> how many specs it takes (None: any number, one per painted region)
@@ -64,6 +64,17 @@ def check_layout_reads(layout: str, given, shown: Callable[[str], str] = str) ->
                 else f"without {' or '.join(choosers)}")
         does = does.format(**{name: shown(name) for name in ("noise", "noise2", "blend", "map", "keys")})
         raise SettingError(shown(key), f"{does}; {here}, it would change nothing")
+
+
+def check_specs(model, specs, names) -> None:
+    """Each class spec (name, params) of ``specs`` known to ``model`` with its parameters in range; else the
+    SettingError naming the setting that gave it: ``names`` holds, spec by spec, (the setting of its class, the
+    setting of its parameters), as a front end calls them (``--noise2`` and ``--param2``; ``source.corners[2]``)."""
+    for spec, (noise, params) in zip(specs, names):
+        try:
+            model.param_vector(*spec)
+        except SettingError as exc:
+            raise SettingError(noise if exc.setting == "noise" else params, exc.message) from None
 
 
 def map_error(arr, height: int, width: int, what: str, image: str = "the image",

@@ -76,11 +76,10 @@ class NeuralSource:
             self.layout, self.specs = "uniform", [self.spec]
         self.width, self.sharpness = float(width), float(sharpness)
         self.steps, self.seed, self.tileable = int(steps), int(seed), bool(tileable)
-        for spec, (noise_key, params_key) in zip(self.specs if not keys else (), self._spec_keys(noise2)):
-            try:        # unknown classes / parameters fail now, named by the key that gave them; keyframes below
-                self.model.param_vector(*spec)
-            except SettingError as exc:
-                raise SettingError(noise_key if exc.setting == "noise" else params_key, exc.message) from None
+        if not keys:    # unknown classes / parameters fail now, named by the key that gave them; keyframes below
+            from ..neural.request import check_specs
+
+            check_specs(self.model, self.specs, self._spec_keys(noise2))
         # animation: keyframes whose `frame` is the bake's time (a job sets time = frame number)
         from ..neural.animate import LATENT_MODES, check_keys
 
