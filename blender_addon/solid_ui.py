@@ -292,10 +292,11 @@ def texture(req):
     if req.method == "auto":         # the "code" is the choice (backend.solid.choose)
         keys = _memo_keys(req)                       # a procedural preview's fit (keys[1]) is auto's own
         return (_mod("solid.choose").AutoTexture(req),
-                remembered(req, lambda progress=None, cancel=None: req.choose("", progress, field=_known(keys[1])),
+                remembered(req, lambda progress=None, cancel=None: req.choose("", progress, field=_known(keys[1]),
+                                                                             cancel=cancel),
                            keys))
     m = load_model(os.path.basename(req.model))
-    return m, remembered(req, lambda progress=None, cancel=None: req.code(m)[0])
+    return m, remembered(req, lambda progress=None, cancel=None: req.code(m, "", progress)[0])
 
 
 def periodic_info(code) -> str:
@@ -355,6 +356,9 @@ def active_mesh(context, purpose: str):
 #: bytes a UV image bake holds per texel at its peak: each texel's surface point (float64), its color, the image's
 #: pixels (123 measured on a plane filling a 2048² image)
 UV_BAKE_BYTES = 128
+#: the share of a surface or volume bake's progress that making its texture takes (a fit of about 12 s, an auto
+#: choice of about 17 s, an encoding of about 3 s; none where the panel made it already)
+CODE_SHARE = 0.5
 
 
 def _store_vertex_colors(obj, name: str, rgb: np.ndarray) -> None:
@@ -471,9 +475,9 @@ class OMNINOISE_OT_solid_preview(SolidTask, bpy.types.Operator):
         seed, name = p.seed, f"{p.name} Preview"
 
         def work(progress, cancel):
-            code = code_fn(lambda f: progress(0.2 * f), cancel)
-            progress(0.2)
-            img = m.image(128, code, seed, progress=lambda f: progress(0.2 + 0.8 * f), cancel=cancel)
+            code = code_fn(lambda f: progress(0.8 * f), cancel)          # a fit or an encoding: seconds
+            progress(0.8)
+            img = m.image(128, code, seed, progress=lambda f: progress(0.8 + 0.2 * f), cancel=cancel)
             return img, periodic_info(code), gaussian_info(code), grid_info(req)
 
         def done(result):
@@ -609,14 +613,14 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             unwrap = f"the UV map of {obj.name!r} covers no pixel of the image: unwrap it (UV > Smart UV Project)"
 
             def work(progress, cancel):
-                mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.3 * f), cancel)
+                mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.2 * f), cancel)
                 if not mask.any():          # UVs at a point, or faces too small to hold a pixel's centre: refused
                     raise backend.SettingError("uv", unwrap)        # before the texture is made (a fit: seconds)
-                code = code_fn(None, cancel)
+                code = code_fn(lambda f: progress(0.2 + (CODE_SHARE - 0.2) * f), cancel)
                 mask, pts = surface.dilate(mask, pts, margin)
                 rgb = np.zeros((size, size, 3), np.float32)
                 rgb[mask] = m.evaluate(pts[mask] * scale, code, seed,
-                                       progress=lambda f: progress(0.3 + 0.7 * f), cancel=cancel)
+                                       progress=lambda f: progress(CODE_SHARE + (1 - CODE_SHARE) * f), cancel=cancel)
                 return rgb
 
             def done(rgb):
@@ -638,8 +642,9 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             linear = _mod("solid.bake").srgb_to_linear
 
             def work(progress, cancel):
-                code = code_fn(None, cancel)
-                rgb = m.evaluate(co * scale, code, seed, progress=progress, cancel=cancel)
+                code = code_fn(lambda f: progress(CODE_SHARE * f), cancel)
+                rgb = m.evaluate(co * scale, code, seed, progress=lambda f: progress(CODE_SHARE + (1 - CODE_SHARE) * f),
+                                 cancel=cancel)
                 return linear(rgb)
 
             def done(rgb):
@@ -660,7 +665,8 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             bake = _mod("solid.bake")
 
             def work(progress, cancel):
-                code, model = code_fn(None, cancel), m
+                code, model = code_fn(lambda f: progress(CODE_SHARE * f), cancel), m
+                progress = (lambda f, p=progress: p(CODE_SHARE + (1 - CODE_SHARE) * f))
                 if isinstance(model, _mod("solid.choose").AutoTexture):      # what Auto chose
                     model, code = ((_mod("solid.spectral_solid").SpectralTexture(code.request), code.field)
                                    if code.method == "procedural" else (code.model, code.code))

@@ -56,6 +56,10 @@ class Bar:
         self.tty = sys.stderr.isatty()
         self.drawn_at, self.step = -float("inf"), -1
 
+    def restart(self) -> None:
+        """Start the clock again: a bar made before the stage it shows begins (the drawing after a fit)."""
+        self.t0 = time.perf_counter()
+
     def __call__(self, frac: float, text: str | None = None) -> None:
         """Show ``frac`` of the work done, as the bar or as ``text``."""
         if self.quiet or self.done:

@@ -152,7 +152,10 @@ def run(a: argparse.Namespace) -> int:
                   + (" on the searched planes, not closer on fresh ones: the encoder's code is kept" if kept else ""),
                   file=sys.stderr)
 
+    draw_bar = Bar(a.quiet, "drawing ")
+
     def on_code(code):
+        draw_bar.restart()                 # the drawing begins once the code is made (or auto's check is done)
         if a.quiet:
             return
         if req.method == "neural" and os.path.isfile(a.exemplar):       # after "encoding PHOTO ..."
@@ -169,12 +172,13 @@ def run(a: argparse.Namespace) -> int:
 
     def on_fit(fitted):
         """The kind the procedural fit drew, or what auto kept and why."""
+        draw_bar.restart()
         if not a.quiet:
             print(fitted.summary() if hasattr(fitted, "summary") else f"procedural: fitted {fitted.family}",
                   file=sys.stderr)
 
     stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid ",
-             "procedural": "procedural fit ", "auto": "procedural fit "}[req.method]
+             "procedural": "procedural fit ", "auto": "auto: fit, encoding, check "}[req.method]
     if ext == ".json":
         from omninoise.backend.solid.procedural import saved
 
@@ -192,8 +196,8 @@ def run(a: argparse.Namespace) -> int:
         grid = BoxGrid((a.size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
         run_bake(BakeSpec("solid", source, grid, a.out), Bar(a.quiet, "drawing "), force=True)
         return 0
-    _write_image(a.out, req.front_image(a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code,
-                                        Bar(a.quiet, "drawing "), on_fit))
+    _write_image(a.out, req.front_image(a.size, a.scale, "--", Bar(a.quiet, stage), report, on_code, draw_bar,
+                                        on_fit))
     return 0
 
 

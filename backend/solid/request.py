@@ -512,7 +512,7 @@ class SolidRequest:
         """The texture's 2D image: the plane y = 0 seen from the front (x right, z up), as the command line's
         ``--dim 2`` writes it: sRGB float32 (size, size, 3) in [0, 1], ``scale`` output pixels per exemplar pixel.
         ``progress`` hears the synthesis, the spectral solid or the refinement, ``draw_progress`` the drawing of
-        a neural texture; ``report`` hears the refinement as in :meth:`code`; ``on_code(code)`` gets the texture
+        a neural texture or a procedural solid; ``report`` hears the refinement as in :meth:`code`; ``on_code(code)`` gets the texture
         code before it is drawn (the neural texture only); ``on_fit`` the fitted procedural solid (method
         "procedural") or auto's :class:`~backend.solid.choose.Choice`."""
         if self.method == "synthesis":
@@ -523,7 +523,7 @@ class SolidRequest:
             field = self.solid_field(where, progress)
             if on_fit is not None and self.method == "procedural":
                 on_fit(field)
-            return SpectralTexture(self).image(size, field, scale=scale)
+            return SpectralTexture(self).image(size, field, scale=scale, progress=draw_progress)
         if self.method == "auto":
             c = self.choose(where, progress, report, on_code)
             if on_fit is not None:
@@ -531,7 +531,7 @@ class SolidRequest:
             if c.method == "procedural":
                 from .spectral_solid import SpectralTexture
 
-                return SpectralTexture(c.request).image(size, c.field, scale=scale)
+                return SpectralTexture(c.request).image(size, c.field, scale=scale, progress=draw_progress)
             return c.model.image(size, c.code, int(self.seed), scale=scale, progress=draw_progress)
         model = self.load(where)
         code, _ = self.code(model, where, progress, report, on_code)

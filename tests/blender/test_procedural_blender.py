@@ -319,6 +319,28 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
         blender_addon.unregister()
 
 
+def test_a_bake_shows_the_fit_it_starts_with(small_fit, monkeypatch):
+    """A bake that fits its procedural solid first shows the fit's progress in the first part of its bar
+    (solid_ui.CODE_SHARE), then the drawing's, up to the end."""
+    from omninoise.blender_addon import solid_ui, tasks
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    blender_addon.register()
+    try:
+        path = os.path.join(ROOT, "data", "photos", "val", "brick__tex_trak_trak4_brick2a.jpg")
+        p = bpy.context.scene.omninoise_solid
+        p.source, p.image, p.method, p.target = "IMAGE", bpy.data.images.load(path), "PROCEDURAL", "COLOR_ATTRIBUTE"
+        bpy.ops.mesh.primitive_cube_add()
+        seen, report = [], tasks.Task._report
+        monkeypatch.setattr(tasks.Task, "_report", lambda self, f: seen.append(f) or report(self, f))
+        assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
+        assert small_fit[0] == 1
+        assert len([f for f in seen if 0 < f < solid_ui.CODE_SHARE]) >= 3, seen       # the fit moves the bar
+        assert seen == sorted(seen) and seen[-1] == 1.0
+    finally:
+        blender_addon.unregister()
+
+
 def test_eevee_render_equals_engine(tmp_path):
     """EEVEE (Mesa's llvmpipe without a GPU) renders the groups as the engine draws them: its film holds half floats,
     so within 2e-3 on 99 % of pixels (a pixel whose centre a float32 position puts across an edge differs).  Rings

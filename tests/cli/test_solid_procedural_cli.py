@@ -114,17 +114,20 @@ seed = 1
 def test_auto_keeps_what_its_check_finds_closer(tmp_path, capsys):
     """Auto keeps the procedural solid where its planes find it closer by the margin on both the axis and the oblique
     cuts and its walls hold the photo's structure about as well; its image is that texture's."""
-    from omninoise.backend.solid.choose import STRUCTURE_TOLERANCE
+    from omninoise.backend.solid.choose import PLANES, SHARES, STRUCTURE_TOLERANCE
     from omninoise.backend.solid.gaussian_rest import MARGIN
 
     from omninoise import export
 
     req = SolidRequest(exemplar=PHOTO, method="auto", seed=2).check()
-    reads = []
+    reads, seen = [], []
     with pytest.MonkeyPatch.context() as mp:       # the fit, the encoding and the check share one read of the file
         mp.setattr(export, "read_rgb", lambda path: reads.append(path) or read_rgb(path))
-        c = req.choose()
+        c = req.choose(progress=seen.append)
     assert reads == [PHOTO]
+    fitted, encoded = SHARES["fit"], SHARES["fit"] + SHARES["encode"]     # progress runs on through the three stages
+    assert seen == sorted(seen) and seen[-1] == 1.0 and fitted in seen and encoded in seen
+    assert sum(encoded < f < 1.0 for f in seen) >= len(PLANES)           # the check's planes move it on
     d = c.distances
     assert set(d) == {"procedural", "neural"}
     assert all(set(d[m]) == {"axes", "oblique", "structure"} for m in d)
@@ -147,6 +150,21 @@ def test_auto_keeps_what_its_check_finds_closer(tmp_path, capsys):
                                   f"(distance on axis and oblique cuts, structure error: procedural {c.field.family} "
                                   f"{d['procedural']['axes']:.1f}, ")
     assert " done (" not in err         # "done" follows the neural method's "encoding PHOTO ...", not auto's fit
+    assert "auto: fit, encoding, check [" in err
+
+
+def test_auto_stops_between_its_stages_when_cancelled():
+    """A cancel asked for during the fit stops auto before the encoding starts (the Blender panel's Esc)."""
+    from omninoise.backend.grid import Cancelled
+
+    req = SolidRequest(exemplar=PHOTO, method="auto", seed=2).check()
+    field = req.replace(method="procedural").procedural_field()
+    seen, loads = [], []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(SolidRequest, "load", lambda self, where="": loads.append(self) or pytest.fail("encoded"))
+        with pytest.raises(Cancelled):
+            req.choose(progress=seen.append, field=field, cancel=lambda: bool(seen))
+    assert seen == [0.7] and loads == []
 
 
 @pytest.mark.parametrize("args, note", [(["--method", "procedural"], True), (["--method", "auto"], True),
