@@ -76,20 +76,28 @@ def image_srgb(ima, setting: str) -> np.ndarray:
     if ima.is_float:
         from .. import export
 
+        _SHARES[ima.as_pointer()] = export.images.outside_shares(px)
         rgb = export.linear_to_srgb(rgb)
     return np.ascontiguousarray(rgb, np.float32)
+
+
+#: the shares past white and under black of the float images :func:`image_srgb` read last, by the image's pointer:
+#: :func:`image_clipped_notes` takes them (a read after it measures again) in place of reading the pixels a second
+#: time on the main thread (about 1 s for a 4096^2 float image)
+_SHARES: dict = {}
 
 
 def image_clipped_notes(ima) -> list[str]:
     """What the artist is told of a float image read as colours in [0, 1] (:func:`image_srgb`): how much of it is
     past white or under black (``export.images.clipped_text``), as the command line's notes say; none for an 8- or
     16-bit image. Blender's default view (AgX) shows values above 1 as bright colours, not as the white they are
-    read as."""
+    read as; the shares the request's own read of it measured where it made one."""
     if not ima.is_float:
         return []
     from ..export import images
 
-    return images.clipped_text(*images.outside_shares(image_colours(ima, "image")))
+    shares = _SHARES.pop(ima.as_pointer(), None)
+    return images.clipped_text(*(shares or images.outside_shares(image_colours(ima, "image"))))
 
 
 def store_srgb_image(name: str, rgb: np.ndarray):

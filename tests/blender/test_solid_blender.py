@@ -653,7 +653,7 @@ def test_a_models_folder_that_is_no_folder_is_said_in_the_texture_menu_and_by_th
         bpy.ops.omninoise.solid_preview()
 
 
-def test_a_float_image_past_white_or_under_black_is_reported(scene, capfd):
+def test_a_float_image_past_white_or_under_black_is_reported(scene, capfd, monkeypatch):
     """A float Image is read as colours in [0, 1]: where 1 % or more of it is past white or under black, the
     operator reports it as a warning (Blender's default view, AgX, shows values above 1 as bright colours, not as
     the white they are read as), as the command line's notes say; an 8-bit image and one within [0, 1] are not."""
@@ -671,7 +671,10 @@ def test_a_float_image_past_white_or_under_black_is_reported(scene, capfd):
         "values into [0, 1] to keep their colours"]
     p.source, p.method, p.image = "IMAGE", "NEURAL", hdr
     capfd.readouterr()
+    reads, read = [], common.image_pixels
+    monkeypatch.setattr(common, "image_pixels", lambda ima, setting: reads.append(ima.name) or read(ima, setting))
     assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    assert reads == ["HDR"]             # the warning's shares come from the request's own read of the pixels
     out = capfd.readouterr()
     said = out.out + out.err
     assert "Image 'HDR': 25 % of the photo's pixels are brighter than white" in said, said
