@@ -71,6 +71,16 @@ def _check_flags(**flags) -> None:
             raise SettingError(name, f"expected True or False, got {value!r}")
 
 
+def _split(progress) -> tuple:
+    """(making, drawing): ``progress`` over a texture's making (a fit, a choice, a refined encoding: the first
+    ``backend.bake.PREPARE_SHARE`` of it) and then its drawing (the rest)."""
+    if progress is None:
+        return None, None
+    from .backend.bake import PREPARE_SHARE as share
+
+    return (lambda f: progress(share * f)), (lambda f: progress(share + (1.0 - share) * f))
+
+
 def _check_progress(progress) -> None:
     if progress is not None and not callable(progress):
         raise SettingError("progress", f"expected a function of the fraction done, or None, got {progress!r}")
@@ -330,17 +340,20 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
 
         saved.save(os.fspath(out), req.procedural_field(progress=progress))
         return os.fspath(out)
+    making, drawing = _split(progress)
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake
         from .backend.sources import BoxGrid, solid_volume
 
-        source, extent = solid_volume(req, size, float(scale))
+        source, extent = solid_volume(req, size, float(scale), progress=making)
         grid = BoxGrid((size,) * 3, ((0.0, 0.0, 0.0), (extent,) * 3))
         if out is None:
-            return evaluate_values(source, grid.validate(), 0.0, progress)
-        run_bake(BakeSpec("solid", source, grid, out), progress, force=True)
+            return evaluate_values(source, grid.validate(), 0.0, drawing)
+        run_bake(BakeSpec("solid", source, grid, out), drawing, force=True)
         return out
-    rgb = req.front_image(size, float(scale), draw_progress=progress)
+    rgb = req.front_image(size, float(scale), progress=making, draw_progress=drawing)
+    if drawing is not None and req.method == "synthesis":        # a synthesised tile's image is drawn at once
+        drawing(1.0)
     if out is None:
         return srgb_to_linear(rgb)     # float32, as the command line's .npy holds it
     from .export.images import write_unit_image

@@ -362,7 +362,9 @@ def bake_frame(spec: BakeSpec, frame, progress=None, cancel=None) -> str:
     return path
 
 
-#: the share of a file's progress that making a source's texture takes where the bake makes it (a fit, a choice)
+#: the share of a result's progress that making its texture takes where it is made first (a procedural fit of
+#: about 12 s, auto's choice of about 17 s, an encoding of about 3 s): a job's bake, a Solid Texture panel's bake,
+#: ``omninoise.solid``
 PREPARE_SHARE = 0.5
 
 

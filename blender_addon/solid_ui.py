@@ -356,9 +356,6 @@ def active_mesh(context, purpose: str):
 #: bytes a UV image bake holds per texel at its peak: each texel's surface point (float64), its color, the image's
 #: pixels (123 measured on a plane filling a 2048² image)
 UV_BAKE_BYTES = 128
-#: the share of a surface or volume bake's progress that making its texture takes (a fit of about 12 s, an auto
-#: choice of about 17 s, an encoding of about 3 s; none where the panel made it already)
-CODE_SHARE = 0.5
 
 
 def _store_vertex_colors(obj, name: str, rgb: np.ndarray) -> None:
@@ -604,6 +601,7 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
     def _start_target(self, context, p, obj, m, code_fn, blocking):
         scale, world = _space(p, obj)
         seed, name = int(p.seed), p.name
+        share = _mod("bake").PREPARE_SHARE      # of the bar: making the texture (nothing where the panel made it)
         surface = _mod("solid.surface")
         if p.target == "UV_IMAGE":
             size, margin = int(p.size), int(p.margin)
@@ -616,11 +614,11 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
                 mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.2 * f), cancel)
                 if not mask.any():          # UVs at a point, or faces too small to hold a pixel's centre: refused
                     raise backend.SettingError("uv", unwrap)        # before the texture is made (a fit: seconds)
-                code = code_fn(lambda f: progress(0.2 + (CODE_SHARE - 0.2) * f), cancel)
+                code = code_fn(lambda f: progress(0.2 + (share - 0.2) * f), cancel)
                 mask, pts = surface.dilate(mask, pts, margin)
                 rgb = np.zeros((size, size, 3), np.float32)
                 rgb[mask] = m.evaluate(pts[mask] * scale, code, seed,
-                                       progress=lambda f: progress(CODE_SHARE + (1 - CODE_SHARE) * f), cancel=cancel)
+                                       progress=lambda f: progress(share + (1 - share) * f), cancel=cancel)
                 return rgb
 
             def done(rgb):
@@ -642,8 +640,8 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             linear = _mod("solid.bake").srgb_to_linear
 
             def work(progress, cancel):
-                code = code_fn(lambda f: progress(CODE_SHARE * f), cancel)
-                rgb = m.evaluate(co * scale, code, seed, progress=lambda f: progress(CODE_SHARE + (1 - CODE_SHARE) * f),
+                code = code_fn(lambda f: progress(share * f), cancel)
+                rgb = m.evaluate(co * scale, code, seed, progress=lambda f: progress(share + (1 - share) * f),
                                  cancel=cancel)
                 return linear(rgb)
 
@@ -665,8 +663,8 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             bake = _mod("solid.bake")
 
             def work(progress, cancel):
-                code, model = code_fn(lambda f: progress(CODE_SHARE * f), cancel), m
-                progress = (lambda f, p=progress: p(CODE_SHARE + (1 - CODE_SHARE) * f))
+                code, model = code_fn(lambda f: progress(share * f), cancel), m
+                progress = (lambda f, p=progress: p(share + (1 - share) * f))
                 if isinstance(model, _mod("solid.choose").AutoTexture):      # what Auto chose
                     model, code = ((_mod("solid.spectral_solid").SpectralTexture(code.request), code.field)
                                    if code.method == "procedural" else (code.model, code.code))

@@ -321,8 +321,9 @@ def test_the_panel_fits_previews_and_gives_a_live_node_group(small_fit, tmp_path
 
 def test_a_bake_shows_the_fit_it_starts_with(small_fit, monkeypatch):
     """A bake that fits its procedural solid first shows the fit's progress in the first part of its bar
-    (solid_ui.CODE_SHARE), then the drawing's, up to the end."""
-    from omninoise.blender_addon import solid_ui, tasks
+    (backend.bake.PREPARE_SHARE), then the drawing's, up to the end."""
+    from omninoise.backend.bake import PREPARE_SHARE
+    from omninoise.blender_addon import tasks
 
     bpy.ops.wm.read_homefile(use_empty=True)
     blender_addon.register()
@@ -335,7 +336,7 @@ def test_a_bake_shows_the_fit_it_starts_with(small_fit, monkeypatch):
         monkeypatch.setattr(tasks.Task, "_report", lambda self, f: seen.append(f) or report(self, f))
         assert bpy.ops.omninoise.solid_bake() == {"FINISHED"}
         assert small_fit[0] == 1
-        assert len([f for f in seen if 0 < f < solid_ui.CODE_SHARE]) >= 3, seen       # the fit moves the bar
+        assert len([f for f in seen if 0 < f < PREPARE_SHARE]) >= 3, seen       # the fit moves the bar
         assert seen == sorted(seen) and seen[-1] == 1.0
     finally:
         blender_addon.unregister()

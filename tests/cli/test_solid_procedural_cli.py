@@ -282,3 +282,16 @@ def test_a_job_holds_no_photo_s_pixels_until_it_makes_the_texture(tmp_path):
     src = specs["procedural"].source
     assert src.evaluate((2, 2), np.zeros(3), np.full(2, 0.1), 0.0).shape == (2, 2, 3) and src.ready
     assert not holds_pixels(src.request)
+
+
+@pytest.mark.parametrize("dim, size", [(2, 32), (3, 8)])
+def test_the_api_s_progress_runs_over_the_fit_and_then_the_drawing(dim, size):
+    """``omninoise.solid(..., progress=)`` hears the fit over the first PREPARE_SHARE of the work and the drawing
+    over the rest, up to 1 (the fit's seconds were silent)."""
+    import omninoise
+    from omninoise.backend.bake import PREPARE_SHARE
+
+    seen = []
+    omninoise.solid(PHOTO, size, dim=dim, method="procedural", seed=2, progress=seen.append)
+    assert seen == sorted(seen) and seen[-1] == 1.0
+    assert sum(0 < f < PREPARE_SHARE for f in seen) >= 3 and any(PREPARE_SHARE < f for f in seen), seen
