@@ -111,6 +111,7 @@ seed = 1
     np.testing.assert_allclose(np.load(tmp_path / "job.npy"), vol, atol=2e-5)
 
 
+@pytest.mark.long       # a whole auto choice twice: 25 s
 def test_auto_keeps_what_its_check_finds_closer(tmp_path, capsys):
     """Auto keeps the procedural solid where its planes find it closer by the margin on both the axis and the oblique
     cuts and its walls hold the photo's structure about as well; its image is that texture's."""
