@@ -13,8 +13,8 @@ import numpy as np
 from .. import backend
 from ..backend import paths
 
-__all__ = ["backend_module", "Sidebar", "image_pixels", "image_srgb", "image_clipped_notes", "store_srgb_image",
-           "neural_model_folder", "solid_models_folder"]
+__all__ = ["backend_module", "Sidebar", "image_pixels", "image_colours", "holds_linear", "image_srgb",
+           "image_clipped_notes", "store_srgb_image", "neural_model_folder", "solid_models_folder"]
 
 
 def backend_module(name: str):
@@ -54,26 +54,74 @@ def image_pixels(ima, setting: str) -> np.ndarray:
     return np.flipud(px.reshape(h, w, ima.channels))
 
 
+#: the image file formats that store floats; Blender reads the others (a 16-bit PNG or TIFF) into float pixels too
+FLOAT_FILES = ("OPEN_EXR", "OPEN_EXR_MULTILAYER", "HDR")
+
+
+def holds_linear(ima) -> bool:
+    """Whether an image datablock's colours are scene-linear, as a float file's are (an EXR, an HDR, a float image
+    made or painted in Blender), not an integer file's stored values (8 or 16 bits: the command line reads those as
+    they are, sRGB-encoded)."""
+    return ima.is_float and not (ima.source in ("FILE", "SEQUENCE", "MOVIE") and ima.file_format not in FLOAT_FILES)
+
+
 def image_colours(ima, setting: str) -> np.ndarray:
-    """An input image datablock's colour channels, float32 (H, W, 1 or 3), top row first: its alpha must be opaque
-    everywhere (:func:`export.opaque`; a SettingError naming ``setting``) unless the image's Alpha is set to None."""
+    """An input image datablock's colour channels, float32 (H, W, 1 or 3), top row first, as the command line reads
+    its file (``export.decode``): an integer file's stored values over their range (Blender reads a 16-bit PNG or
+    TIFF into floats linearised from the image's colour space, unless that is Non-Color: they are encoded again), a
+    float file's scene-linear values (:func:`holds_linear`).  Its alpha must be opaque everywhere
+    (:func:`export.opaque`; a SettingError naming ``setting``) unless the image's Alpha is set to None."""
     from .. import export
 
     px = image_pixels(ima, setting)
     if ima.alpha_mode == "NONE" and px.shape[2] in (2, 4):
-        return px[..., :-1]
+        px = px[..., :-1]
+    else:
+        try:
+            px = export.opaque(px, f"image {ima.name!r}")
+        except export.ImageError as exc:
+            raise backend.SettingError(setting, str(exc)) from None
+    if ima.is_float and not holds_linear(ima):
+        if not ima.colorspace_settings.is_data:             # sRGB's inverse: the stored values within 1e-5
+            px = export.linear_to_srgb(px)
+        stored = _stored(ima, px)
+        if stored is not None:
+            px = stored
+    return px
+
+
+#: how far a file's decoded colours may be from Blender's pixels of it (sRGB's inverse) and still be taken for them
+STORED_TOLERANCE = 1e-4
+
+
+def _stored(ima, px: np.ndarray):
+    """The colours of an integer file Blender read into floats, as the command line decodes them (to the bit), where
+    the image still holds that file (not painted, not packed) and they are Blender's pixels ``px`` (H, W, 1 or 3)
+    within :data:`STORED_TOLERANCE` (a colour space Blender read it in other than sRGB, or an EXIF turn, shows
+    another picture: Blender's stands); else None."""
+    if ima.source != "FILE" or ima.packed_file is not None or ima.is_dirty:
+        return None
+    from .. import export
+
+    path = bpy.path.abspath(ima.filepath, library=ima.library)
     try:
-        return export.opaque(px, f"image {ima.name!r}")
-    except export.ImageError as exc:
-        raise backend.SettingError(setting, str(exc)) from None
+        a, linear = export.images.decode_kind(path)
+    except (OSError, export.ImageError):
+        return None
+    if a.shape[2] in (2, 4):          # its alpha: opaque, or set aside (Alpha None), as Blender's pixels' was
+        a = a[..., :-1]
+    if a.shape[2] == 1 and px.shape[2] == 3:          # Blender holds a grey file as RGB
+        a = np.repeat(a, 3, axis=2)
+    same = not linear and a.shape == px.shape and float(np.abs(a - px).max()) <= STORED_TOLERANCE
+    return a if same else None
 
 
 def image_srgb(ima, setting: str) -> np.ndarray:
-    """An input image datablock as sRGB-encoded RGB, float32 (H, W, 3), top row first (:func:`image_colours`): float
-    images hold scene-linear values and are encoded; grey images are repeated into three channels."""
+    """An input image datablock as sRGB-encoded RGB, float32 (H, W, 3), top row first (:func:`image_colours`):
+    scene-linear colours (:func:`holds_linear`) are encoded; grey images are repeated into three channels."""
     px = image_colours(ima, setting)
     rgb = px if px.shape[2] == 3 else np.repeat(px[..., :1], 3, axis=2)
-    if ima.is_float:
+    if holds_linear(ima):
         from .. import export
 
         _SHARES[ima.as_pointer()] = export.images.outside_shares(px)
@@ -90,9 +138,9 @@ _SHARES: dict = {}
 def image_clipped_notes(ima) -> list[str]:
     """What the artist is told of a float image read as colours in [0, 1] (:func:`image_srgb`): how much of it is
     past white or under black (``export.images.clipped_text``), as the command line's notes say; none for an 8- or
-    16-bit image. Blender's default view (AgX) shows values above 1 as bright colours, not as the white they are
-    read as; the shares the request's own read of it measured where it made one."""
-    if not ima.is_float:
+    16-bit image (:func:`holds_linear`). Blender's default view (AgX) shows values above 1 as bright colours, not
+    as the white they are read as; the shares the request's own read of it measured where it made one."""
+    if not holds_linear(ima):
         return []
     from ..export import images
 

@@ -174,6 +174,11 @@ def decode(path: str) -> np.ndarray:
     return _decode(path)[0]
 
 
+def decode_kind(path: str) -> tuple:
+    """(:func:`decode`'s pixels, whether the file stores scene-linear floats: EXR, float TIFF, float .npy)."""
+    return _decode(path)
+
+
 def _decode(path: str) -> tuple:
     """(:func:`decode`'s pixels, whether the file stores floats: scene-linear values by the convention of EXR,
     float TIFF and float .npy, as Blender reads a float image, where 8- and 16-bit files store display values)."""

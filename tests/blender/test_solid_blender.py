@@ -653,6 +653,45 @@ def test_a_models_folder_that_is_no_folder_is_said_in_the_texture_menu_and_by_th
         bpy.ops.omninoise.solid_preview()
 
 
+@pytest.mark.parametrize("channels", [1, 3, 4])
+def test_a_16_bit_photo_is_read_as_the_command_line_reads_its_file(scene, tmp_path, channels):
+    """Blender reads a 16-bit PNG into floats, linearised from its colour space (or left as stored where that is
+    Non-Color): the panel reads the file's own values, as the command line does, to the bit, so a bake and the job
+    saved from it share one key; a painted image is read as Blender holds it (sRGB's inverse, within 1e-5), and
+    one whose colour space makes another picture of the file (Linear) as Blender shows it."""
+    from omninoise.backend.solid.request import SolidRequest
+    from omninoise.export import read_rgb
+    from omninoise.export.images import linear_to_srgb, write_png
+
+    rng = np.random.default_rng(channels)
+    v = rng.integers(0, 65536, (40, 56, channels)).astype(np.uint16)
+    if channels == 4:
+        v[..., 3] = 65535
+    path = str(tmp_path / f"photo{channels}.png")
+    write_png(path, v[..., 0] if channels == 1 else v)
+    want = read_rgb(path)
+    p = scene.omninoise_solid
+    p.source, p.method = "IMAGE", "SPECTRAL"
+    for space in ("sRGB", "Non-Color"):
+        ima = bpy.data.images.load(path, check_existing=False)
+        ima.colorspace_settings.name = space
+        assert ima.is_float
+        np.testing.assert_array_equal(common.image_srgb(ima, "image"), want, err_msg=space)
+        p.image = ima
+        assert solid_ui.panel_request(p).key() == SolidRequest(exemplar=path, method="spectral", seed=3).check().key()
+    ima = bpy.data.images.load(path, check_existing=False)
+    px = np.empty(len(ima.pixels), np.float32)
+    ima.pixels.foreach_get(px)
+    ima.pixels.foreach_set(px)                        # painted: Blender's pixels are read
+    assert ima.is_dirty
+    got = common.image_srgb(ima, "image")
+    assert 0 < np.abs(got - want).max() < 2e-5
+    ima = bpy.data.images.load(path, check_existing=False)
+    ima.colorspace_settings.name = "Linear Rec.709"     # the file's values taken as linear: a brighter picture
+    raw = np.flipud(np.asarray(ima.pixels[:], np.float32).reshape(40, 56, -1))[..., :3]
+    np.testing.assert_allclose(common.image_srgb(ima, "image"), linear_to_srgb(raw), atol=1e-6)
+
+
 def test_a_float_image_past_white_or_under_black_is_reported(scene, capfd, monkeypatch):
     """A float Image is read as colours in [0, 1]: where 1 % or more of it is past white or under black, the
     operator reports it as a warning (Blender's default view, AgX, shows values above 1 as bright colours, not as
