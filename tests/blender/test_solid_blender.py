@@ -656,12 +656,13 @@ def test_a_models_folder_that_is_no_folder_is_said_in_the_texture_menu_and_by_th
 @pytest.mark.parametrize("channels", [1, 3, 4])
 def test_a_16_bit_photo_is_read_as_the_command_line_reads_its_file(scene, tmp_path, channels):
     """Blender reads a 16-bit PNG into floats, linearised from its colour space (or left as stored where that is
-    Non-Color): the panel reads the file's own values, as the command line does, to the bit, so a bake and the job
-    saved from it share one key; a painted image is read as Blender holds it (sRGB's inverse, within 1e-5), and
-    one whose colour space makes another picture of the file (Linear) as Blender shows it."""
+    Non-Color): the panels read the file's own values, as the command line does, to the bit, so a bake and the job
+    saved from it share one key (the Neural Noise panel's Fit to Image reads it so too); a painted image is read as
+    Blender holds it (sRGB's inverse, within 1e-5), and one whose colour space makes another picture of the file
+    (Linear) as Blender shows it."""
     from omninoise.backend.solid.request import SolidRequest
     from omninoise.export import read_rgb
-    from omninoise.export.images import linear_to_srgb, write_png
+    from omninoise.export.images import linear_to_srgb, read_image, write_png
 
     rng = np.random.default_rng(channels)
     v = rng.integers(0, 65536, (40, 56, channels)).astype(np.uint16)
@@ -677,6 +678,7 @@ def test_a_16_bit_photo_is_read_as_the_command_line_reads_its_file(scene, tmp_pa
         ima.colorspace_settings.name = space
         assert ima.is_float
         np.testing.assert_array_equal(common.image_srgb(ima, "image"), want, err_msg=space)
+        np.testing.assert_allclose(common.image_colours(ima, "fit image").mean(axis=2), read_image(path), atol=1e-7)
         p.image = ima
         assert solid_ui.panel_request(p).key() == SolidRequest(exemplar=path, method="spectral", seed=3).check().key()
     ima = bpy.data.images.load(path, check_existing=False)
