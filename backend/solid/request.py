@@ -511,10 +511,11 @@ class SolidRequest:
                     on_code=None, draw_progress=None, on_fit=None) -> np.ndarray:
         """The texture's 2D image: the plane y = 0 seen from the front (x right, z up), as the command line's
         ``--dim 2`` writes it: sRGB float32 (size, size, 3) in [0, 1], ``scale`` output pixels per exemplar pixel.
-        ``progress`` hears the synthesis, the spectral solid or the refinement, ``draw_progress`` the drawing of
-        a neural texture or a procedural solid; ``report`` hears the refinement as in :meth:`code`; ``on_code(code)`` gets the texture
-        code before it is drawn (the neural texture only); ``on_fit`` the fitted procedural solid (method
-        "procedural") or auto's :class:`~backend.solid.choose.Choice`."""
+        ``progress`` hears the synthesis, the spectral solid, the procedural fit, auto's stages or the refinement,
+        ``draw_progress`` the drawing of a neural texture or a procedural solid; ``report`` hears the refinement as
+        in :meth:`code`; ``on_code(code)`` gets the texture code before it is drawn (the neural texture only);
+        ``on_fit`` the fitted procedural solid (method "procedural") or auto's
+        :class:`~backend.solid.choose.Choice`."""
         if self.method == "synthesis":
             return self.synthesis_field(where, progress).image(size, scale)
         if self.method in ("spectral", "procedural"):
