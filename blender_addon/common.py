@@ -5,6 +5,7 @@ Cheap to import (``bpy``, numpy and ``backend.paths``); nothing here loads a mod
 """
 from __future__ import annotations
 
+import contextlib
 import importlib
 
 import bpy
@@ -14,7 +15,7 @@ from .. import backend
 from ..backend import paths
 
 __all__ = ["backend_module", "Sidebar", "image_pixels", "image_colours", "holds_linear", "image_srgb",
-           "image_clipped_notes", "store_srgb_image", "neural_model_folder", "solid_models_folder"]
+           "image_clipped_notes", "measured_reads", "store_srgb_image", "neural_model_folder", "solid_models_folder"]
 
 
 def backend_module(name: str):
@@ -124,27 +125,39 @@ def image_srgb(ima, setting: str) -> np.ndarray:
     if holds_linear(ima):
         from .. import export
 
-        _SHARES[ima.as_pointer()] = export.images.outside_shares(px)
+        if _MEASURED:
+            _MEASURED[-1][ima.as_pointer()] = export.images.outside_shares(px)
         rgb = export.linear_to_srgb(rgb)
     return np.ascontiguousarray(rgb, np.float32)
 
 
-#: the shares past white and under black of the float images :func:`image_srgb` read last, by the image's pointer:
-#: :func:`image_clipped_notes` takes them (a read after it measures again) in place of reading the pixels a second
-#: time on the main thread (about 1 s for a 4096^2 float image)
-_SHARES: dict = {}
+#: the blocks of :func:`measured_reads` open now, innermost last
+_MEASURED: list = []
 
 
-def image_clipped_notes(ima) -> list[str]:
+@contextlib.contextmanager
+def measured_reads():
+    """``with measured_reads() as shares:`` -- {image pointer: (share past white, share under black)} of the float
+    images :func:`image_srgb` reads inside the block, for :func:`image_clipped_notes` to take in place of reading the
+    pixels a second time on the main thread (about 1 s for a 4096^2 float image)."""
+    shares = {}
+    _MEASURED.append(shares)
+    try:
+        yield shares
+    finally:
+        _MEASURED.remove(shares)
+
+
+def image_clipped_notes(ima, shares: tuple | None = None) -> list[str]:
     """What the artist is told of a float image read as colours in [0, 1] (:func:`image_srgb`): how much of it is
     past white or under black (``export.images.clipped_text``), as the command line's notes say; none for an 8- or
     16-bit image (:func:`holds_linear`). Blender's default view (AgX) shows values above 1 as bright colours, not
-    as the white they are read as; the shares the request's own read of it measured where it made one."""
+    as the white they are read as; ``shares``: those a read of it measured (:func:`measured_reads`), else it is
+    read."""
     if not holds_linear(ima):
         return []
     from ..export import images
 
-    shares = _SHARES.pop(ima.as_pointer(), None)
     return images.clipped_text(*(shares or images.outside_shares(image_colours(ima, "image"))))
 
 

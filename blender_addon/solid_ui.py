@@ -48,8 +48,8 @@ from . import tasks
 from .. import backend
 from .compat import ensure_node_tree
 from .bake_ui import SaveJobOperator, draw_progress
-from .common import (Sidebar, backend_module as _mod, image_clipped_notes, image_srgb, solid_models_folder,
-                     store_srgb_image)
+from .common import (Sidebar, backend_module as _mod, image_clipped_notes, image_srgb, measured_reads,
+                     solid_models_folder, store_srgb_image)
 from .tasks import TaskOperator
 from .preferences import threads
 from .presets import SOLID_VALUES, SUBDIRS
@@ -450,10 +450,11 @@ class SolidTask(TaskOperator):
     setting_names = {"exemplar": "image"}
 
     def _begin(self, context, blocking: bool):
-        task = TaskOperator._begin(self, context, blocking)
+        with measured_reads() as shares:          # the request's read of the Image measures what the warning says
+            task = TaskOperator._begin(self, context, blocking)
         p = context.scene.omninoise_solid
         if task is not None and p.source == "IMAGE" and p.image is not None:
-            for note in image_clipped_notes(p.image):
+            for note in image_clipped_notes(p.image, shares.get(p.image.as_pointer())):
                 self.report({"WARNING"}, f"Image {p.image.name!r}: {note}")
         return task
 

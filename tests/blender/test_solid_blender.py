@@ -704,6 +704,8 @@ def test_a_float_image_past_white_or_under_black_is_reported(scene, capfd, monke
     rgba[:16, :, :3] = 4.5                                      # a quarter past white
     rgba[16:24, :, 2] = -0.2                                    # an eighth under black
     hdr = bpy.data.images.new("HDR", 64, 64, float_buffer=True)
+    hdr.pixels.foreach_set(np.clip(rgba, 0.0, 1.0).ravel())
+    common.image_srgb(hdr, "image")                 # a read before the pixels change is not what the notes measure
     hdr.pixels.foreach_set(rgba.ravel())
     assert common.image_clipped_notes(hdr) == [
         "25 % of the photo's pixels are brighter than white (above 1) and are read as white; lower its exposure to "
