@@ -71,16 +71,6 @@ def _check_flags(**flags) -> None:
             raise SettingError(name, f"expected True or False, got {value!r}")
 
 
-def _split(progress) -> tuple:
-    """(making, drawing): ``progress`` over a texture's making (a fit, a choice, a refined encoding: the first
-    ``backend.bake.PREPARE_SHARE`` of it) and then its drawing (the rest)."""
-    if progress is None:
-        return None, None
-    from .backend.bake import PREPARE_SHARE as share
-
-    return (lambda f: progress(share * f)), (lambda f: progress(share + (1.0 - share) * f))
-
-
 def _check_progress(progress) -> None:
     if progress is not None and not callable(progress):
         raise SettingError("progress", f"expected a function of the fraction done, or None, got {progress!r}")
@@ -340,7 +330,9 @@ def solid(exemplar: str | np.ndarray, size: int = 256, *, dim: int = 2, method: 
 
         saved.save(os.fspath(out), req.procedural_field(progress=progress))
         return os.fspath(out)
-    making, drawing = _split(progress)
+    from .backend.bake import split_progress
+
+    making, drawing = split_progress(progress)
     if dim == 3:
         from .backend.bake import BakeSpec, evaluate_values, run_bake
         from .backend.sources import BoxGrid, solid_volume

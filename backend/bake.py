@@ -368,14 +368,20 @@ def bake_frame(spec: BakeSpec, frame, progress=None, cancel=None) -> str:
 PREPARE_SHARE = 0.5
 
 
+def split_progress(progress, share: float = PREPARE_SHARE) -> tuple:
+    """(making, drawing): ``progress(fraction)`` (None: none) heard over the first ``share`` of the work (making the
+    texture) and then over the rest (drawing it)."""
+    if progress is None:
+        return None, None
+    return (lambda f: progress(share * f)), (lambda f: progress(share + (1.0 - share) * f))
+
+
 def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:
     from .. import export
 
     if not getattr(spec.source, "ready", True):     # a texture made at its first use (sources.solid._Prepared)
-        part = None if progress is None else (lambda x: progress(PREPARE_SHARE * x))
-        spec.source.prepare(part, cancel)
-        if progress is not None:
-            progress = (lambda x, p=progress: p(PREPARE_SHARE + (1.0 - PREPARE_SHARE) * x))
+        making, progress = split_progress(progress)
+        spec.source.prepare(making, cancel)
 
     ext = os.path.splitext(path)[1].lower()
     meta = _meta(spec, key)

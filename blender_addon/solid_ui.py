@@ -602,7 +602,6 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
     def _start_target(self, context, p, obj, m, code_fn, blocking):
         scale, world = _space(p, obj)
         seed, name = int(p.seed), p.name
-        share = _mod("bake").PREPARE_SHARE      # of the bar: making the texture (nothing where the panel made it)
         surface = _mod("solid.surface")
         if p.target == "UV_IMAGE":
             size, margin = int(p.size), int(p.margin)
@@ -610,6 +609,7 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             uv, pos = _mesh_arrays(context, obj, world, uv=True)
 
             unwrap = f"the UV map of {obj.name!r} covers no pixel of the image: unwrap it (UV > Smart UV Project)"
+            share = _mod("bake").PREPARE_SHARE      # of the bar: the texels, then the texture's making, to here
 
             def work(progress, cancel):
                 mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.2 * f), cancel)
@@ -641,9 +641,9 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             linear = _mod("solid.bake").srgb_to_linear
 
             def work(progress, cancel):
-                code = code_fn(lambda f: progress(share * f), cancel)
-                rgb = m.evaluate(co * scale, code, seed, progress=lambda f: progress(share + (1 - share) * f),
-                                 cancel=cancel)
+                making, drawing = _mod("bake").split_progress(progress)
+                code = code_fn(making, cancel)
+                rgb = m.evaluate(co * scale, code, seed, progress=drawing, cancel=cancel)
                 return linear(rgb)
 
             def done(rgb):
@@ -664,8 +664,8 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             bake = _mod("solid.bake")
 
             def work(progress, cancel):
-                code, model = code_fn(lambda f: progress(share * f), cancel), m
-                progress = (lambda f, p=progress: p(share + (1 - share) * f))
+                making, progress = _mod("bake").split_progress(progress)
+                code, model = code_fn(making, cancel), m
                 if isinstance(model, _mod("solid.choose").AutoTexture):      # what Auto chose
                     model, code = ((_mod("solid.spectral_solid").SpectralTexture(code.request), code.field)
                                    if code.method == "procedural" else (code.model, code.code))

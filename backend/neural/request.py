@@ -25,8 +25,8 @@ from ..errors import SettingError
 from . import conditioning as C
 from .sampler import DEFAULT_SAMPLER, DEFAULT_STEPS, sampler_eta
 
-__all__ = ["LAYOUTS", "NeuralRequest", "check_specs", "generate_request", "regions_from_colours", "region_key", "regions_from_map",
-           "map_error", "map_at", "READ_BY", "check_layout_reads"]
+__all__ = ["LAYOUTS", "NeuralRequest", "check_specs", "generate_request", "regions_from_colours", "region_key",
+           "regions_from_map", "map_error", "map_at", "READ_BY", "check_layout_reads"]
 
 #: layout -> how many specs it takes (None: any number, one per painted region)
 LAYOUTS = {"uniform": 1, "blend": 2, "gradient": 2, "corners": 4, "painted": None}
