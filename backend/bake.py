@@ -40,6 +40,7 @@ import numpy as np
 from . import limits
 from .errors import SettingError
 from .grid import Cancelled
+from .progress import part
 from .sources import BoxGrid, Source, describe
 from .transfer import TransferFunction
 
@@ -371,9 +372,7 @@ PREPARE_SHARE = 0.5
 def split_progress(progress, share: float = PREPARE_SHARE) -> tuple:
     """(making, drawing): ``progress(fraction)`` (None: none) heard over the first ``share`` of the work (making the
     texture) and then over the rest (drawing it)."""
-    if progress is None:
-        return None, None
-    return (lambda f: progress(share * f)), (lambda f: progress(share + (1.0 - share) * f))
+    return part(progress, 0.0, share), part(progress, share, 1.0 - share)
 
 
 def _bake_file(spec: BakeSpec, path: str, time: float, key: str, progress, cancel) -> None:

@@ -296,7 +296,7 @@ def texture(req):
                                                                              cancel=cancel),
                            keys))
     m = load_model(os.path.basename(req.model))
-    return m, remembered(req, lambda progress=None, cancel=None: req.code(m, "", progress)[0])
+    return m, remembered(req, lambda progress=None, cancel=None: req.code(m, "", progress, cancel=cancel)[0])
 
 
 def periodic_info(code) -> str:

@@ -4,7 +4,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -141,9 +140,6 @@ def run(a: argparse.Namespace) -> int:
 
     for note in [] if a.quiet else clipped_notes(a.exemplar):
         print("note: " + note, file=sys.stderr)
-    t0 = time.perf_counter()
-    if not a.quiet and req.method == "neural" and os.path.isfile(a.exemplar):
-        print(f"encoding {a.exemplar} ...", end="", file=sys.stderr, flush=True)
 
     def report(name, hist):
         if not a.quiet:
@@ -158,8 +154,6 @@ def run(a: argparse.Namespace) -> int:
         draw_bar.restart()                 # the drawing begins once the code is made (or auto's check is done)
         if a.quiet:
             return
-        if req.method == "neural" and os.path.isfile(a.exemplar):       # after "encoding PHOTO ..."
-            print(f" done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
         if code.harmonics is not None:
             h = code.harmonics
             print(f"periodic part: {len(h)} waves at spectral peaks, {100 * h.share:.0f} % of the photo's variance "
@@ -177,7 +171,7 @@ def run(a: argparse.Namespace) -> int:
             print(fitted.summary() if hasattr(fitted, "summary") else f"procedural: fitted {fitted.family}",
                   file=sys.stderr)
 
-    stage = {"neural": "refine ", "synthesis": "synthesis ", "spectral": "spectral solid ",
+    stage = {"neural": "encoding ", "synthesis": "synthesis ", "spectral": "spectral solid ",
              "procedural": "procedural fit ", "auto": "auto: fit, encoding, check "}[req.method]
     if ext == ".json":
         from omninoise.backend.solid.procedural import saved

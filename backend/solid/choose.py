@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..grid import Cancelled
+from ..progress import part, step
 from .band_distance import band_distance
 from .gaussian_rest import MARGIN
 from .procedural.fit import oblique_points, plane_group
@@ -98,44 +98,34 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
     procedural solid when it is fitted already (the evaluation measures it on its own too); ``progress(fraction)``
     over the three stages (:data:`SHARES`), ``cancel()`` -> True stops it between steps (raises
     :class:`~backend.grid.Cancelled`), as the fit's (:func:`~backend.solid.procedural.fit.fit_procedural`)."""
-    def part(lo: float, share: float):
-        return None if progress is None else (lambda f: progress(lo + share * min(max(f, 0.0), 1.0)))
-
     fit_share, code_share = SHARES["fit"], SHARES["encode"]
+    fitting, encoding = part(progress, 0.0, fit_share), part(progress, fit_share, code_share)
     img = np.asarray(request.exemplar_pixels(where), np.float32)     # a file is read once: every stage takes these
     proc = request.replace(method="procedural")
     if field is None:                                                                   # 1. fit
-        field = dataclasses.replace(proc, exemplar=img).procedural_field(where, part(0.0, fit_share), cancel)
-    _step(part(0.0, fit_share), 1.0, cancel)
+        field = dataclasses.replace(proc, exemplar=img).procedural_field(where, fitting, cancel)
+    step(fitting, 1.0, cancel)
     neural = request.replace(method="neural")
     model = neural.load(where)
     named = None if report is None else (lambda _, history: report(request.exemplar, history))
-    code, _ = dataclasses.replace(neural, exemplar=img).code(model, where, part(fit_share, code_share), named,
-                                                             on_code)                   # 2. encode
-    _step(part(fit_share, code_share), 1.0, cancel)
+    code, _ = dataclasses.replace(neural, exemplar=img).code(model, where, encoding, named, on_code,
+                                                             cancel)                    # 2. encode
+    step(encoding, 1.0, cancel)
     ppu = model.px_per_unit
     planes = [oblique_points(SIDE, ppu, n, o) for n, o in PLANES]                      # 3. check
-    checked = part(fit_share + code_share, 1.0 - fit_share - code_share)
+    checked = part(progress, fit_share + code_share, 1.0 - fit_share - code_share)
     drawn = {"procedural": [], "neural": []}
     for i, p in enumerate(planes):
         drawn["procedural"].append(field.evaluate(p, cancel=cancel).reshape(SIDE, SIDE, 3))
         drawn["neural"].append(model.evaluate(p, code, int(request.seed), cancel=cancel).reshape(SIDE, SIDE, 3))
-        _step(checked, 0.4 * (i + 1) / len(planes), cancel)            # drawing the planes: 0.8 s of 2.2 s
+        step(checked, 0.4 * (i + 1) / len(planes), cancel)            # drawing the planes: 0.8 s of 2.2 s
     structure = photo_structure(img)
     d = {k: dict(check_figures(v, img), structure=wall_structure(v, structure)) for k, v in drawn.items()}
-    _step(checked, 1.0, None)
+    step(checked, 1.0, None)
     closer = (all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
               and d["procedural"]["structure"] <= d["neural"]["structure"] + STRUCTURE_TOLERANCE)
     keep = "procedural" if closer else "neural"
     return Choice(keep, proc if keep == "procedural" else neural, field, model, code, d)
-
-
-def _step(progress, fraction: float, cancel) -> None:
-    """Report ``fraction`` of a stage done and stop where ``cancel()`` asks."""
-    if progress is not None:
-        progress(fraction)
-    if cancel is not None and cancel():
-        raise Cancelled("cancelled")
 
 
 class AutoTexture:

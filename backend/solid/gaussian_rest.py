@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..periodic import periodic_component
+from ..progress import step
 from .band_distance import band_distance
 from .harmonic import mix_waves, read_waves, wave_sum
 
@@ -216,28 +217,37 @@ def rest_field(points: np.ndarray, r: GaussianRest, seed: int = 0) -> np.ndarray
 
 
 def choose_mix(layers, photo: np.ndarray, offered: dict, planes=CHECK_PLANES, margin: float = MARGIN,
-               mixes: tuple = MIXES) -> GaussianRest | None:
+               mixes: tuple = MIXES, progress=None, cancel=None) -> GaussianRest | None:
     """The Gaussian rest to mix in, or None (module doc). ``layers(seed, axis, offset)`` gives a check plane's (fixed,
     decoder, points): parts float32 (RENDER^2, 3) (fixed: mean colour plus harmonic part; decoder: k L d) and the
     plane's points float64 (RENDER^2, 3); ``offered`` is :func:`~backend.solid.upright.candidates`' result ({kind:
     (freq, amp)}, empty: nothing to mix). Every kind at every t of ``mixes`` meets the check; the closest is kept if
     it is ``margin`` times as close as the decoder alone (ties go to the kind offered first), on ``planes`` ((seed,
-    axis, offset) as CHECK_PLANES)."""
+    axis, offset) as CHECK_PLANES). ``progress(fraction)`` hears each plane, rest and distance (about 2 s in all for
+    one kind on 2 cores); ``cancel()`` -> True stops between them (:class:`~backend.grid.Cancelled`)."""
     if not offered:
         return None
-    planes = [layers(seed, axis, offset) + (seed,) for seed, axis, offset in planes]
+    steps, done = len(planes) + 1 + len(offered) * (len(planes) + len(mixes)), 0
+
+    def tick(value):
+        nonlocal done
+        done += 1
+        step(progress, done / steps, cancel)
+        return value
+
+    planes = [tick(layers(seed, axis, offset) + (seed,)) for seed, axis, offset in planes]
 
     def renders(g, t):
         return [np.clip(f + np.float32(np.sqrt(1.0 - t)) * d + np.float32(np.sqrt(t)) * gi, 0.0, 1.0)
                 .reshape(RENDER, RENDER, 3) for (f, d, _, _), gi in zip(planes, g)]
 
-    base = band_distance(renders([0.0] * len(planes), 0.0), photo)
+    base = tick(band_distance(renders([0.0] * len(planes), 0.0), photo))
     best = None
     for kind, (freq, amp) in offered.items():
         full = GaussianRest(freq, amp, 1.0, kind)
-        g = [rest_field(pts, full, seed) for _, _, pts, seed in planes]
+        g = [tick(rest_field(pts, full, seed)) for _, _, pts, seed in planes]
         for t in mixes:
-            dist = band_distance(renders(g, t), photo)
+            dist = tick(band_distance(renders(g, t), photo))
             if best is None or dist < best[0]:
                 best = (dist, kind, t)
     dist, kind, t = best

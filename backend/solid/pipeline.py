@@ -31,6 +31,7 @@ import numpy as np
 
 from ... import export
 from ..errors import SettingError
+from ..progress import part, step
 from .gaussian_rest import CHECK_SEEDS, MARGIN, MIXES, RENDER, REST_CHOICES, GaussianRest, check_planes, \
     choose_mix, mix_rests, wall_planes
 from .harmonic import HARMONIC_SIDE, HarmonicConfig, Harmonics, measure_harmonics, mix_harmonics, remove_harmonics
@@ -40,7 +41,7 @@ from .refine import refine_code
 from .upright import UPRIGHT_GATE, candidates
 
 __all__ = ["PhotoConfig", "RestCheck", "PhotoCode", "measure_harmonics", "photo_code", "gaussian_rest",
-           "texture_code"]
+           "texture_code", "stage_shares", "STAGE_STEPS"]
 
 
 @dataclass(frozen=True)
@@ -85,11 +86,12 @@ class PhotoCode:
 
 
 def gaussian_rest(model: SolidTextureModel, image: np.ndarray, code: TextureCode, rest: str = "auto",
-                  check: RestCheck = RestCheck()) -> GaussianRest | None:
+                  check: RestCheck = RestCheck(), progress=None, cancel=None) -> GaussianRest | None:
     """Stage 6: the Gaussian share of a photo's rest to mix into ``code`` (the photo's, without one), or None where
     the check keeps the decoder alone (:mod:`backend.solid.gaussian_rest`).  ``rest`` (REST_CHOICES): "auto", the
     check's choice among the rests :func:`~backend.solid.upright.candidates` offers on walls and floors;
-    "isotropic"; "upright", checked on walls alone.  Photo models of 3D space only (the rest is a solid)."""
+    "isotropic"; "upright", checked on walls alone.  Photo models of 3D space only (the rest is a solid).
+    ``progress`` and ``cancel`` as :func:`~backend.solid.gaussian_rest.choose_mix`'s."""
     if model.mode != "space" or not model.colour_stats or model.dim != 3 or code.rest is not None:
         return None
     img, ppu = at_most(image, model.px_per_unit, HARMONIC_SIDE)
@@ -103,32 +105,59 @@ def gaussian_rest(model: SolidTextureModel, image: np.ndarray, code: TextureCode
         return fixed, dec, pts
 
     return choose_mix(layers, rgb_pixels(image), offered, check.planes(walls=rest == "upright"), check.margin,
-                      check.mixes)
+                      check.mixes, progress, cancel)
+
+
+#: the stages' times in steps of the refinement (about 0.2 s each for a 256 px photo on 2 cores), for their shares
+#: of a photo's progress: stages 2 to 5 about one, the refinement its steps and about three more (its start and final
+#: check), stage 6's check about ten
+STAGE_STEPS = {"encode": 1.0, "refine": 3.0, "rest": 10.0}
+
+
+def stage_shares(config: PhotoConfig) -> tuple:
+    """(encode, refine, rest): the shares of :func:`photo_code`'s progress its stages take with ``config``
+    (:data:`STAGE_STEPS`); a stage that does not run takes none.
+
+    >>> stage_shares(PhotoConfig(gaussian=False))
+    (1.0, 0.0, 0.0)
+    >>> [round(s, 3) for s in stage_shares(PhotoConfig(refine=7))]
+    [0.048, 0.476, 0.476]
+    """
+    w = (STAGE_STEPS["encode"], STAGE_STEPS["refine"] + config.refine if config.refine > 0 else 0.0,
+         STAGE_STEPS["rest"] if config.gaussian else 0.0)
+    return tuple(x / sum(w) for x in w)
 
 
 def photo_code(model: SolidTextureModel, image: np.ndarray, config: PhotoConfig = PhotoConfig(), progress=None,
-               setting: str = "exemplar") -> PhotoCode:
-    """Stages 2 to 6 on a photo's pixels float (H, W, 3) sRGB (space models); ``progress`` hears the refinement."""
+               setting: str = "exemplar", cancel=None) -> PhotoCode:
+    """Stages 2 to 6 on a photo's pixels float (H, W, 3) sRGB (space models); ``progress(fraction)`` hears them in
+    their shares (:func:`stage_shares`), ``cancel()`` -> True stops between their steps (raises
+    :class:`~backend.grid.Cancelled`)."""
     img = np.asarray(image, np.float32)
     if img.ndim != 3 or img.shape[2] != 3 or not np.all(np.isfinite(img)):
         raise SettingError(setting, f"expected finite RGB pixels (H, W, 3), got shape {img.shape}")
+    enc, ref, _ = stage_shares(config)
     h = model.harmonics(img, config.harmonic) if config.periodic else None                        # 2. measure
     z, history = model.encode(img, h), []                                                           # 3. encode
+    step(part(progress, 0.0, enc), 1.0, cancel)
     if config.refine > 0:                                                                           # 4. refine
-        z, history = refine_code(model, z, img, steps=config.refine, progress=progress, harmonics=h)
+        z, history = refine_code(model, z, img, steps=config.refine, progress=part(progress, enc, ref),
+                                 cancel=cancel, harmonics=h)
     code = model.translate(z, h)                                                                    # 5. translate
     if code.L is not None and one_colour(img):      # nothing varies to draw
         code = dataclasses.replace(code, L=np.zeros_like(code.L))
-    r = gaussian_rest(model, img, code, config.rest, config.check) if config.gaussian else None     # 6. rest
+    r = gaussian_rest(model, img, code, config.rest, config.check, part(progress, enc + ref, 1.0 - enc - ref),
+                      cancel) if config.gaussian else None                                          # 6. rest
+    step(progress, 1.0, None)
     return PhotoCode(code if r is None else dataclasses.replace(code, rest=r), z, h, r, history, img)
 
 
 def _exemplar_code(model: SolidTextureModel, exemplar, config: PhotoConfig, setting: str, progress,
-                   read=None) -> PhotoCode:
+                   read=None, cancel=None) -> PhotoCode:
     """Stage 1, then :func:`photo_code` for pixels: a training exemplar's name gives its stored code, part and rest;
     an image file is read (by ``read``, default ``export.read_rgb``); pixels are taken as they are."""
     if isinstance(exemplar, np.ndarray):
-        return photo_code(model, exemplar, config, progress, setting)
+        return photo_code(model, exemplar, config, progress, setting, cancel)
     if exemplar in model.codes:
         z, h = model.codes[exemplar], model.code_harmonics.get(exemplar) if config.periodic else None
         r = model.code_rests.get(exemplar) if config.gaussian else None
@@ -141,18 +170,20 @@ def _exemplar_code(model: SolidTextureModel, exemplar, config: PhotoConfig, sett
         img = (read or export.read_rgb)(exemplar)
     except ValueError as exc:
         raise SettingError(setting, str(exc)) from None
-    return photo_code(model, img, config, progress, setting)
+    return photo_code(model, img, config, progress, setting, cancel)
 
 
 def texture_code(model: SolidTextureModel, exemplar=None, to=None, mix: float = 0.0,
-                 config: PhotoConfig = PhotoConfig(), where: str = "", progress=None, report=None, read=None):
+                 config: PhotoConfig = PhotoConfig(), where: str = "", progress=None, report=None, read=None,
+                 cancel=None):
     """A texture request's code, every stage: (TextureCode, the input images' sha256 or None).
 
     A single-exemplar model gives its own texture (``to``, ``refine`` and an ``exemplar`` other than its own are
     errors); a space model gives ``exemplar`` (a training exemplar's name, an image file or pixels), mixed with
     ``to`` by ``mix`` in [0, 1] (stage 7).  ``where`` prefixes the setting names in errors ("source." for job
     files, "--" for flags); ``report(name, history)`` hears each refinement's distances; ``read(path)`` decodes
-    an image file (default ``export.read_rgb``; a request passes the decoding its checks made)."""
+    an image file (default ``export.read_rgb``; a request passes the decoding its checks made); ``progress`` hears
+    each exemplar's stages (:func:`photo_code`) in an equal share, and ``cancel`` stops them."""
     def name(key):
         return f"{where}{key}"
 
@@ -173,11 +204,10 @@ def texture_code(model: SolidTextureModel, exemplar=None, to=None, mix: float = 
     if exemplar is None:
         raise SettingError(name("exemplar"), f"the space model needs an exemplar (one of {', '.join(model.codes)}, "
                                              "or an image file)")
-    codes = []
-    for ex, key in ((exemplar, "exemplar"), (to, "to")):
-        if ex is None:
-            continue
-        c = _exemplar_code(model, ex, config, name(key), progress, read)
+    codes, given = [], [(ex, key) for ex, key in ((exemplar, "exemplar"), (to, "to")) if ex is not None]
+    for i, (ex, key) in enumerate(given):
+        c = _exemplar_code(model, ex, config, name(key), part(progress, i / len(given), 1 / len(given)), read,
+                           cancel)
         if c.history and report is not None:
             report(ex, c.history)
         codes.append(c)

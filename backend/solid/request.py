@@ -292,13 +292,14 @@ class SolidRequest:
         return PhotoConfig(periodic=bool(self.periodic), refine=int(self.refine), gaussian=bool(self.gaussian),
                            rest=self.rest)
 
-    def code(self, model, where: str = "", progress=None, report=None, on_code=None):
-        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.pipeline.texture_code`;
-        ``on_code(code)`` hears the code once it is made (a front end's note on what the encoding kept)."""
+    def code(self, model, where: str = "", progress=None, report=None, on_code=None, cancel=None):
+        """(TextureCode, the input images' sha256 or None): :func:`backend.solid.pipeline.texture_code` (with its
+        ``progress`` and ``cancel``); ``on_code(code)`` hears the code once it is made (a front end's note on what
+        the encoding kept)."""
         from .pipeline import texture_code
 
         code, sha = texture_code(model, self.exemplar, self.to, float(self.mix), self.photo_config(), where,
-                                 progress, report, self._read)
+                                 progress, report, self._read, cancel)
         if on_code is not None:
             on_code(code)
         return code, sha
@@ -511,7 +512,7 @@ class SolidRequest:
                     on_code=None, draw_progress=None, on_fit=None) -> np.ndarray:
         """The texture's 2D image: the plane y = 0 seen from the front (x right, z up), as the command line's
         ``--dim 2`` writes it: sRGB float32 (size, size, 3) in [0, 1], ``scale`` output pixels per exemplar pixel.
-        ``progress`` hears the synthesis, the spectral solid, the procedural fit, auto's stages or the refinement,
+        ``progress`` hears the synthesis, the spectral solid, the procedural fit, auto's stages or the encoding,
         ``draw_progress`` the drawing of a neural texture or a procedural solid; ``report`` hears the refinement as
         in :meth:`code`; ``on_code(code)`` gets the texture code before it is drawn (the neural texture only);
         ``on_fit`` the fitted procedural solid (method "procedural") or auto's

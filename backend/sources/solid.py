@@ -305,7 +305,7 @@ class EncodedSource(_Prepared):
         super().__init__(request, scale, density)
 
     def _make(self, progress, cancel):
-        code, _ = self.request.code(self.model, "source.", progress)
+        code, _ = self.request.code(self.model, "source.", progress, cancel=cancel)
         return SolidSource(self.model, self.request, self.scale, self.density, code=code)
 
     def _draw(self, encoded, shape, first, step, time, progress, cancel, start) -> np.ndarray:

@@ -575,6 +575,26 @@ def test_worker_bake_cancels_and_leaves_nothing(scene):
     assert bpy.context.active_object.active_material is None
 
 
+def test_a_photo_preview_shows_its_encoding_and_stops_when_cancelled(scene, monkeypatch):
+    """The neural texture of a photo is encoded on the worker with progress (its stages and the Gaussian rest's
+    check, about 2.5 s) in the first part of the preview's bar, and Esc stops the encoding: no preview, nothing
+    remembered, and the next preview encodes it whole."""
+    path = os.path.join(ROOT, "data", "photos", "val", "rock__rock_grey.jpg")
+    p = scene.omninoise_solid
+    p.source, p.image, p.method = "IMAGE", bpy.data.images.load(path), "NEURAL"
+    op = solid_ui.OMNINOISE_OT_solid_preview
+    task = op._start(type("Op", (), {})(), bpy.context, False)
+    assert task.progressed.wait(120)        # the encoding's first stage is done: its check has not begun
+    task.cancel()
+    tasks.wait(task)
+    assert task.status == "cancelled" and task.progress < 0.8 and f"{p.name} Preview" not in bpy.data.images
+    seen, report = [], tasks.Task._report
+    monkeypatch.setattr(tasks.Task, "_report", lambda self, f: seen.append(f) or report(self, f))
+    assert bpy.ops.omninoise.solid_preview() == {"FINISHED"}
+    assert len([f for f in seen if 0 < f < 0.8]) >= 10, seen
+    assert seen == sorted(seen) and seen[-1] == 1.0 and f"{p.name} Preview" in bpy.data.images
+
+
 def test_panel_draws(scene):
     log = []
     solid_ui.draw_solid_all(Recorder(log), bpy.context)

@@ -313,6 +313,24 @@ def test_a_photo_the_encoder_cannot_read_is_named_before_its_note(models, tmp_pa
     assert f"bake 'solid': source.{flag[2:]}: " in capsys.readouterr().out
 
 
+def test_encoding_a_photo_shows_its_bar(models, tmp_path, capsys):
+    """Without --quiet, a photo's encoding (its stages and the Gaussian rest's check: seconds) moves a bar of its
+    own, a line per tenth in a log, before the drawing's; a shipped exemplar's stored code needs none."""
+    from PIL import Image
+
+    photo = str(tmp_path / "p.png")
+    Image.fromarray((np.random.default_rng(3).random((64, 64, 3)) * 255).astype(np.uint8)).save(photo)
+    assert main(["solid", "--model", models["space3"], "--exemplar", photo, "--size", "8",
+                 "-o", str(tmp_path / "o.png")]) == 0
+    lines = capsys.readouterr().err.splitlines()
+    bar = [ln for ln in lines if ln.startswith("encoding [")]
+    assert len(bar) >= 5 and "100.0%" in bar[-1], lines
+    assert lines.index(bar[-1]) < max(i for i, ln in enumerate(lines) if ln.startswith("drawing ["))
+    assert main(["solid", "--model", models["space3"], "--exemplar", "gravel", "--size", "8",
+                 "-o", str(tmp_path / "o.png")]) == 0
+    assert "encoding" not in capsys.readouterr().err
+
+
 def test_the_neural_method_decodes_a_photo_once(models, tmp_path, capsys, monkeypatch):
     """The command line's check of the photos (``--exemplar``, ``--to``) and the encoding share one decoding of each
     file (a 12 MP photo takes 0.7 s to decode)."""

@@ -11,8 +11,8 @@ import pytest
 from omninoise.backend.solid.band_distance import band_distance
 from omninoise.backend.solid.pipeline import PhotoConfig, photo_code
 from omninoise.backend.solid.model import SolidTextureModel, slice_points
-from omninoise.backend.solid.gaussian_rest import (COUNT, MARGIN, MIXES, RENDER, GaussianRest, deproject, choose_mix, mix_rests,
-                                    rest_field, rest_waves)
+from omninoise.backend.solid.gaussian_rest import (CHECK_PLANES, COUNT, MARGIN, MIXES, RENDER, GaussianRest,
+                                                   deproject, choose_mix, mix_rests, rest_field, rest_waves)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SPACE = os.path.join(ROOT, "models", "solid", "space")
@@ -231,3 +231,45 @@ def test_stored_rests_round_trip_to_six_digits_and_bad_ones_are_named():
                      (dict(freq=[[1, 2, 3]], amp=[[1, 0, 0, 0, 0, 0]], mix=1.5), "mix in \\(0, 1\\]")):
         with pytest.raises(ValueError, match=why):
             rest_from_json(bad)
+
+
+def test_an_encoding_reports_its_stages_and_its_check_and_stops_when_cancelled(space):
+    """photo_code's progress runs sorted to 1 in the stages' shares (stage_shares), with a step for each of the rest
+    check's planes, rests and distances (about 2 s of an encoding's 2.5 s on 2 cores); a cancel asked during the
+    check stops it there (Cancelled), before its other planes are drawn."""
+    from omninoise.backend.grid import Cancelled
+    from omninoise.backend.solid.pipeline import stage_shares
+
+    img = band_photo(128)
+    seen = []
+    photo_code(space, img, progress=seen.append)
+    enc, _, rest = stage_shares(PhotoConfig())
+    assert seen == sorted(seen) and seen[-1] == 1.0 and 0.0 < enc < 0.2 and rest == 1.0 - enc
+    assert sum(enc < f < 1.0 for f in seen) >= len(CHECK_PLANES) + 1 + len(MIXES), seen
+    drawn = []
+    real = space.layers
+
+    def counted(*args, **kwargs):
+        drawn.append(1)
+        return real(*args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(space, "layers", counted)
+        with pytest.raises(Cancelled):
+            photo_code(space, img, cancel=lambda: len(drawn) >= 2)
+    assert len(drawn) == 2 < len(CHECK_PLANES)
+
+
+@pytest.mark.long
+def test_a_refinement_and_a_second_photo_take_their_shares_of_the_progress(space):
+    """A refinement's steps are heard in its share (stage_shares); with ``to``, each photo's stages over its half."""
+    from omninoise.backend.solid.pipeline import stage_shares, texture_code
+
+    img, seen = band_photo(128), []
+    photo_code(space, img, PhotoConfig(refine=3), progress=seen.append)
+    enc, ref, _ = stage_shares(PhotoConfig(refine=3))
+    assert seen == sorted(seen) and seen[-1] == 1.0 and sum(enc < f <= enc + ref + 1e-9 for f in seen) >= 3
+    seen.clear()
+    texture_code(space, img, to=band_photo(128, 1), mix=0.5, progress=seen.append)
+    assert seen == sorted(seen) and seen[-1] == 1.0
+    assert sum(0.0 < f < 0.5 for f in seen) >= len(CHECK_PLANES) <= sum(0.5 < f < 1.0 for f in seen)
