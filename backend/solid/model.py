@@ -148,13 +148,19 @@ def _colour(c: np.ndarray) -> tuple:
     return c[:3].copy(), c[3:12].reshape(3, 3).copy()
 
 
+STATS_CHUNK = 1 << 18   #: pixels per float64 chunk of :func:`colour_stats` (no float64 copy of a 12 MP photo)
+
+
 def colour_stats(img: np.ndarray, eps: float = 1e-4) -> np.ndarray:
     """Mean colour and Cholesky factor of the colour covariance of an image (H, W, 3): float32 (12,) = [mu, L.ravel()]
     (the numpy twin of ``training.solid.model.colour_stats``)."""
-    x = np.asarray(img, np.float64).reshape(-1, 3)
-    mu = x.mean(0)
-    xc = x - mu
-    cov = xc.T @ xc / x.shape[0] + eps * np.eye(3)
+    x = np.reshape(img, (-1, 3))
+
+    def chunks():
+        return (np.asarray(x[i:i + STATS_CHUNK], np.float64) for i in range(0, len(x), STATS_CHUNK))
+
+    mu = sum(c.sum(0) for c in chunks()) / len(x)
+    cov = sum((c - mu).T @ (c - mu) for c in chunks()) / len(x) + eps * np.eye(3)
     return np.concatenate([mu, np.linalg.cholesky(cov).ravel()]).astype(_F)
 
 
