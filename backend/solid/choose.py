@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..progress import part, step
-from .band_distance import band_distance
+from .band_distance import BandReference, band_distance
 from .gaussian_rest import MARGIN
 from .procedural.fit import oblique_points, plane_group
 from .procedural.structure import TOLERANCE as STRUCTURE_TOLERANCE, photo_structure as _photo_structure, structure_error
@@ -44,8 +44,9 @@ PLANES = (((1.0, 0.0, 0.0), (4.1, -3.7, 2.9)), ((1.0, 0.0, 0.0), (-3.6, 2.2, -4.
           ((-0.19, 0.92, -0.35), (-1.0, 0.36, 1.65)), ((-0.62, 0.52, -0.59), (3.16, 3.95, -4.38)))
 
 
-def check_figures(images: list, photo: np.ndarray) -> dict:
-    """The check's figures of ``images`` (one per plane of :data:`PLANES`) against the photo, as the held-out
+def check_figures(images: list, photo) -> dict:
+    """The check's figures of ``images`` (one per plane of :data:`PLANES`) against the photo (or its
+    :class:`~backend.solid.band_distance.BandReference`, measuring several textures against it), as the held-out
     evaluation gives them: ``axes``, the mean of the band distances of the cuts across x, across y and across z
     (each group pooled: ``plane_group``), and ``oblique``, the band distance of the oblique cuts; rounded to 0.01."""
     groups = {}
@@ -120,7 +121,8 @@ def choose(request, where: str = "", progress=None, report=None, on_code=None, f
         drawn["neural"].append(model.evaluate(p, code, int(request.seed), cancel=cancel).reshape(SIDE, SIDE, 3))
         step(checked, 0.4 * (i + 1) / len(planes), cancel)            # drawing the planes: 0.8 s of 2.2 s
     structure = photo_structure(img)
-    d = {k: dict(check_figures(v, img), structure=wall_structure(v, structure)) for k, v in drawn.items()}
+    ref = BandReference(img)
+    d = {k: dict(check_figures(v, ref), structure=wall_structure(v, structure)) for k, v in drawn.items()}
     step(checked, 1.0, None)
     closer = (all(d["procedural"][f] <= MARGIN * d["neural"][f] for f in ("axes", "oblique"))
               and d["procedural"]["structure"] <= d["neural"]["structure"] + STRUCTURE_TOLERANCE)

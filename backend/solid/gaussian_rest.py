@@ -47,7 +47,7 @@ import numpy as np
 
 from ..periodic import periodic_component
 from ..progress import step
-from .band_distance import band_distance
+from .band_distance import BandReference
 from .harmonic import mix_waves, read_waves, wave_sum
 
 __all__ = ["GaussianRest", "rest_waves", "rest_field", "choose_mix", "mix_rests", "rest_to_json", "rest_from_json",
@@ -241,13 +241,14 @@ def choose_mix(layers, photo: np.ndarray, offered: dict, planes=CHECK_PLANES, ma
         return [np.clip(f + np.float32(np.sqrt(1.0 - t)) * d + np.float32(np.sqrt(t)) * gi, 0.0, 1.0)
                 .reshape(RENDER, RENDER, 3) for (f, d, _, _), gi in zip(planes, g)]
 
-    base = tick(band_distance(renders([0.0] * len(planes), 0.0), photo))
+    ref = BandReference(photo)          # the photo's side of the distances once
+    base = tick(ref.distance(renders([0.0] * len(planes), 0.0)))
     best = None
     for kind, (freq, amp) in offered.items():
         full = GaussianRest(freq, amp, 1.0, kind)
         g = [tick(rest_field(pts, full, seed)) for _, _, pts, seed in planes]
         for t in mixes:
-            dist = tick(band_distance(renders(g, t), photo))
+            dist = tick(ref.distance(renders(g, t)))
             if best is None or dist < best[0]:
                 best = (dist, kind, t)
     dist, kind, t = best

@@ -110,6 +110,23 @@ def test_band_distance_sees_structure_and_is_near_zero_for_the_same_texture():
         band_distance([], img)
 
 
+def test_a_prepared_photo_measures_as_band_distance_does_for_any_layout_of_renders():
+    """BandReference (the photo's pyramid, draws and sorted projections kept per layout of renders, as the checks
+    measure five to nine render sets against one photo) gives band_distance's figure to the bit, whichever layouts
+    (counts and shapes of renders) it has met before, and with its own seed."""
+    from omninoise.backend.solid.band_distance import BandReference
+
+    img, rng = band_photo(160), np.random.default_rng(4)
+    layouts = ([(64, 64, 3)] * 3, [(64, 64, 3)] * 2, [(48, 80, 3), (64, 64, 3)], [(64, 64, 3)] * 3)
+    for seed in (0, 3):
+        ref = BandReference(img, seed)
+        for shapes in layouts + layouts[::-1]:
+            renders = [rng.random(s) for s in shapes]
+            assert ref.distance(renders) == band_distance(renders, img, seed) == band_distance(renders, ref)
+    with pytest.raises(ValueError, match="at least one image"):
+        BandReference(img).distance([])
+
+
 def _layers_from(dec_fn, img):
     """A check's layers: fixed = the photo's mean, decoder = dec_fn(points)."""
     mean = img.mean((0, 1)).astype(np.float32)
