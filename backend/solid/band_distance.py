@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["band_distance", "BandReference", "laplacian_bands", "central_crop", "PATCH", "LEVELS", "SAMPLES", "DIRECTIONS", "REFERENCE_SIDE"]
+__all__ = ["band_distance", "BandReference", "laplacian_bands", "central_crop", "PATCH", "LEVELS", "SAMPLES",
+           "DIRECTIONS", "REFERENCE_SIDE"]
 
 PATCH = 5             #: neighbourhood side, px
 LEVELS = 4            #: Laplacian levels (three bands and the low-pass residue)
