@@ -473,9 +473,10 @@ class OMNINOISE_OT_solid_preview(SolidTask, bpy.types.Operator):
         seed, name = p.seed, f"{p.name} Preview"
 
         def work(progress, cancel):
-            code = code_fn(lambda f: progress(0.8 * f), cancel)          # a fit or an encoding: seconds
-            progress(0.8)
-            img = m.image(128, code, seed, progress=lambda f: progress(0.8 + 0.2 * f), cancel=cancel)
+            making, drawing = _mod("bake").split_progress(progress, 0.8)     # a fit or an encoding: seconds
+            code = code_fn(making, cancel)
+            making(1.0)
+            img = m.image(128, code, seed, progress=drawing, cancel=cancel)
             return img, periodic_info(code), gaussian_info(code), grid_info(req)
 
         def done(result):
@@ -609,17 +610,17 @@ class OMNINOISE_OT_solid_bake(SolidTask, bpy.types.Operator):
             uv, pos = _mesh_arrays(context, obj, world, uv=True)
 
             unwrap = f"the UV map of {obj.name!r} covers no pixel of the image: unwrap it (UV > Smart UV Project)"
-            share = _mod("bake").PREPARE_SHARE      # of the bar: the texels, then the texture's making, to here
+            share, part = _mod("bake").PREPARE_SHARE, _mod("progress").part   # texels, making, drawing
 
             def work(progress, cancel):
-                mask, pts = surface.texel_positions(uv, pos, size, size, lambda f: progress(0.2 * f), cancel)
+                mask, pts = surface.texel_positions(uv, pos, size, size, part(progress, 0.0, 0.2), cancel)
                 if not mask.any():          # UVs at a point, or faces too small to hold a pixel's centre: refused
                     raise backend.SettingError("uv", unwrap)        # before the texture is made (a fit: seconds)
-                code = code_fn(lambda f: progress(0.2 + (share - 0.2) * f), cancel)
+                code = code_fn(part(progress, 0.2, share - 0.2), cancel)
                 mask, pts = surface.dilate(mask, pts, margin)
                 rgb = np.zeros((size, size, 3), np.float32)
-                rgb[mask] = m.evaluate(pts[mask] * scale, code, seed,
-                                       progress=lambda f: progress(share + (1 - share) * f), cancel=cancel)
+                rgb[mask] = m.evaluate(pts[mask] * scale, code, seed, progress=part(progress, share, 1.0 - share),
+                                       cancel=cancel)
                 return rgb
 
             def done(rgb):

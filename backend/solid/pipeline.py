@@ -139,7 +139,7 @@ def photo_code(model: SolidTextureModel, image: np.ndarray, config: PhotoConfig 
     enc, ref, _ = stage_shares(config)
     h = model.harmonics(img, config.harmonic) if config.periodic else None                        # 2. measure
     z, history = model.encode(img, h), []                                                           # 3. encode
-    step(part(progress, 0.0, enc), 1.0, cancel)
+    step(progress, enc, cancel)
     if config.refine > 0:                                                                           # 4. refine
         z, history = refine_code(model, z, img, steps=config.refine, progress=part(progress, enc, ref),
                                  cancel=cancel, harmonics=h)
